@@ -1,0 +1,1 @@
+#include "bake/bake.h"
