@@ -1,0 +1,90 @@
+// Material evaluation shared by the forward and decoupled paths. Both pass explicit UV
+// derivatives: the forward path from screen-space dFdx/dFdy, the decoupled path from the
+// barycentrics of neighbouring shadels, so texture LOD selection is the same code.
+#ifndef SHADEL_MATERIAL_GLSL
+#define SHADEL_MATERIAL_GLSL
+#include "common/bindless.glsl"
+
+struct SurfaceInput {
+    vec3 position;  // world
+    vec3 normal;    // world, normalised geometric/interpolated normal
+    vec4 tangent;   // world xyz + handedness
+    vec2 uv;
+    vec2 uvDx;      // derivatives of uv along the two screen (or shadel) axes
+    vec2 uvDy;
+    bool frontFacing;
+};
+
+struct MaterialSample {
+    vec3 baseColor;
+    float alpha;
+    vec3 normal; // world, with normal map applied
+    float metallic;
+    float roughness;
+    float occlusion;
+    vec3 emissive;
+};
+
+// One-texel checker: the seed's `IntTexCoord.x % 2` shader. It is a point function of the
+// texel coordinate and has no filtered form, so any path that point-samples it aliases.
+float texelChecker(vec2 uv, float scale) {
+    ivec2 cell = ivec2(floor(uv * scale));
+    return float((cell.x + cell.y) & 1);
+}
+
+vec3 bricks(vec2 uv, float scale) {
+    vec2 p = uv * scale * vec2(1.0, 2.0);
+    if ((int(floor(p.y)) & 1) == 1) p.x += 0.5;
+    vec2 f = fract(p);
+    float mortar = smoothstep(0.0, 0.06, f.x) * smoothstep(1.0, 0.94, f.x) *
+                   smoothstep(0.0, 0.1, f.y) * smoothstep(1.0, 0.9, f.y);
+    float tone = fract(sin(dot(floor(p), vec2(12.9898, 78.233))) * 43758.5453);
+    vec3 brick = mix(vec3(0.55, 0.22, 0.15), vec3(0.7, 0.35, 0.25), tone);
+    return mix(vec3(0.75, 0.72, 0.68), brick, mortar);
+}
+
+MaterialSample evaluateMaterial(GpuMaterial m, SurfaceInput s) {
+    MaterialSample o;
+    vec4 base = m.baseColorFactor;
+    if (m.baseColorTexture != NO_TEXTURE)
+        base *= sampleTexture(m.baseColorTexture, SAMPLER_LINEAR_REPEAT, s.uv, s.uvDx, s.uvDy);
+    if (m.procedural == PROCEDURAL_TEXEL_CHECKER)
+        base.rgb *= mix(0.08, 1.0, texelChecker(s.uv, m.proceduralScale));
+    else if (m.procedural == PROCEDURAL_BRICKS)
+        base.rgb *= bricks(s.uv, m.proceduralScale);
+    o.baseColor = base.rgb;
+    o.alpha = base.a;
+
+    o.metallic = m.metallicFactor;
+    o.roughness = m.roughnessFactor;
+    if (m.metallicRoughnessTexture != NO_TEXTURE) {
+        vec4 mr = sampleTexture(m.metallicRoughnessTexture, SAMPLER_LINEAR_REPEAT, s.uv, s.uvDx, s.uvDy);
+        o.roughness *= mr.g;
+        o.metallic *= mr.b;
+    }
+    o.roughness = clamp(o.roughness, 0.04, 1.0);
+    o.metallic = clamp(o.metallic, 0.0, 1.0);
+
+    o.occlusion = 1.0;
+    if (m.occlusionTexture != NO_TEXTURE) {
+        float ao = sampleTexture(m.occlusionTexture, SAMPLER_LINEAR_REPEAT, s.uv, s.uvDx, s.uvDy).r;
+        o.occlusion = mix(1.0, ao, m.occlusionStrength);
+    }
+
+    o.emissive = m.emissiveFactor;
+    if (m.emissiveTexture != NO_TEXTURE)
+        o.emissive *= sampleTexture(m.emissiveTexture, SAMPLER_LINEAR_REPEAT, s.uv, s.uvDx, s.uvDy).rgb;
+
+    vec3 n = normalize(s.normal);
+    if ((m.flags & MATERIAL_DOUBLE_SIDED) != 0u && !s.frontFacing) n = -n;
+    if (m.normalTexture != NO_TEXTURE && dot(s.tangent.xyz, s.tangent.xyz) > 1e-8) {
+        vec3 t = normalize(s.tangent.xyz - n * dot(n, s.tangent.xyz));
+        vec3 b = cross(n, t) * (s.tangent.w < 0.0 ? -1.0 : 1.0);
+        vec3 tn = sampleTexture(m.normalTexture, SAMPLER_LINEAR_REPEAT, s.uv, s.uvDx, s.uvDy).xyz * 2.0 - 1.0;
+        tn.xy *= m.normalScale;
+        n = normalize(t * tn.x + b * tn.y + n * max(tn.z, 1e-3));
+    }
+    o.normal = n;
+    return o;
+}
+#endif

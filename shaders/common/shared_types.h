@@ -1,0 +1,162 @@
+// GPU data layouts shared by C++ and GLSL (scalar block layout on both sides).
+// C++ includes this inside namespace shadel::gpu with glm types; GLSL includes it directly.
+#ifndef SHADEL_SHARED_TYPES_H
+#define SHADEL_SHARED_TYPES_H
+
+#ifdef __cplusplus
+#include <cstdint>
+#include <glm/glm.hpp>
+namespace shadel::gpu {
+using glm::ivec2;
+using glm::mat4;
+using glm::uvec2;
+using glm::uvec4;
+using glm::vec2;
+using glm::vec3;
+using glm::vec4;
+using uint = uint32_t;
+#endif
+
+// Material flags.
+#define MATERIAL_ALPHA_MASK 1u
+#define MATERIAL_ALPHA_BLEND 2u
+#define MATERIAL_DOUBLE_SIDED 4u
+#define MATERIAL_UNLIT 8u
+
+#define PROCEDURAL_NONE 0u
+#define PROCEDURAL_TEXEL_CHECKER 1u
+#define PROCEDURAL_BRICKS 2u
+
+#define LIGHT_DIRECTIONAL 0u
+#define LIGHT_POINT 1u
+#define LIGHT_SPOT 2u
+
+#define NO_TEXTURE 0xFFFFFFFFu
+
+// Draw lists written by the instance culling pass.
+#define DRAW_LIST_OPAQUE 0u
+#define DRAW_LIST_BLEND 1u
+#define DRAW_LIST_COUNT 2u
+
+// Debug views (--visualize).
+#define VISUALIZE_NONE 0u
+#define VISUALIZE_MARKING 1u
+#define VISUALIZE_MIPS 2u
+#define VISUALIZE_CHUNKS 3u
+#define VISUALIZE_SHEET 4u
+
+// One vertex of the unified geometry buffer (matches shadel::Vertex).
+struct GpuVertex {
+    vec3 position;
+    vec3 normal;
+    vec4 tangent;
+    vec2 uv0;
+};
+
+struct GpuMesh {
+    uint firstIndex;  // into the unified index buffer
+    uint indexCount;
+    int vertexOffset; // into the unified vertex buffer
+    uint shadelMesh;  // index into GpuShadelMesh, 0xFFFFFFFF when the mesh is forward-only
+    vec3 boundsMin;   // object space
+    float pad0;
+    vec3 boundsMax;
+    float pad1;
+};
+
+struct GpuInstance {
+    mat4 model;
+    mat4 normalMatrix; // inverse transpose of model (upper 3x3 used)
+    vec3 worldMin;
+    uint mesh;
+    vec3 worldMax;
+    uint material;
+};
+
+struct GpuMaterial {
+    vec4 baseColorFactor;
+    vec3 emissiveFactor;
+    float metallicFactor;
+    float roughnessFactor;
+    float normalScale;
+    float occlusionStrength;
+    float alphaCutoff;
+    uint baseColorTexture; // bindless slots, NO_TEXTURE when absent
+    uint metallicRoughnessTexture;
+    uint normalTexture;
+    uint emissiveTexture;
+    uint occlusionTexture;
+    uint flags;
+    uint procedural;
+    float proceduralScale;
+};
+
+struct GpuLight {
+    vec3 position;
+    uint type;
+    vec3 direction; // the way light travels
+    float range;    // 0 = infinite
+    vec3 color;     // colour * intensity
+    float spotScale; // 1 / max(cos(inner) - cos(outer), 1e-4)
+    float spotOffset; // -cos(outer) * spotScale
+    float pad0;
+    float pad1;
+    float pad2;
+};
+
+struct DrawIndexedCommand { // VkDrawIndexedIndirectCommand
+    uint indexCount;
+    uint instanceCount;
+    uint firstIndex;
+    int vertexOffset;
+    uint firstInstance;
+};
+
+struct FrameConstants {
+    mat4 view;
+    mat4 proj;
+    mat4 viewProj;
+    mat4 invViewProj;
+    mat4 sunViewProj;
+    vec4 frustumPlanes[6]; // camera, world space, inside when dot(p, (x,1)) >= 0
+    vec4 shadowPlanes[6];  // sun shadow volume
+    vec3 cameraPosition;
+    float exposure;
+    vec3 sunDirection; // the way sunlight travels
+    uint sunShadowSlot; // bindless slot of the sun shadow map, NO_TEXTURE when off
+    vec3 sunColor;
+    float shadowTexelSize;
+    vec3 skyColor;
+    uint lightCount;
+    vec3 ambientColor;
+    uint instanceCount;
+    vec2 viewportSize;
+    vec2 invViewportSize;
+    uint frameIndex;
+    uint visualize;
+    float shadingBias; // fractional MIP bias of the decoupled path
+    uint pad0;
+    uint64_t vertices;  // GpuVertex[]
+    uint64_t indices;   // uint[]
+    uint64_t meshes;    // GpuMesh[]
+    uint64_t instances; // GpuInstance[]
+    uint64_t materials; // GpuMaterial[]
+    uint64_t lights;    // GpuLight[]
+    uint64_t messages;  // ShaderMessages (shader asserts)
+    uint64_t shadel;    // ShadelFrame (decoupled path), 0 when forward
+};
+
+// Shader -> CPU message channel (shader asserts). Written with atomics, read after the frame.
+#define SHADER_MESSAGE_CAPACITY 256u
+struct ShaderMessage {
+    uint assertId;
+    uint shaderId;
+    uint line;
+    uint pad;
+    uvec4 values;
+};
+
+#ifdef __cplusplus
+} // namespace shadel::gpu
+#endif
+#endif

@@ -1,0 +1,23 @@
+#version 460
+// Depth prepass / shadow pass: only alpha-masked materials need a fragment shader's work.
+#include "common/material.glsl"
+
+layout(push_constant, scalar) uniform Push {
+    uint64_t frame;
+    uint shadowView;
+} pc;
+
+layout(location = 3) in vec2 inUv;
+layout(location = 4) flat in uint inInstance;
+
+void main() {
+    FrameConstants f = FrameConstantsRef(pc.frame).f;
+    GpuInstance inst = InstanceBuffer(f.instances).i[inInstance];
+    GpuMaterial m = MaterialBuffer(f.materials).m[inst.material];
+    if ((m.flags & MATERIAL_ALPHA_MASK) != 0u) {
+        float alpha = m.baseColorFactor.a;
+        if (m.baseColorTexture != NO_TEXTURE)
+            alpha *= sampleTexture(m.baseColorTexture, SAMPLER_LINEAR_REPEAT, inUv, dFdx(inUv), dFdy(inUv)).a;
+        if (alpha < m.alphaCutoff) discard;
+    }
+}

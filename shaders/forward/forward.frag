@@ -1,0 +1,35 @@
+#version 460
+// Forward shading: the shared material + lighting code evaluated per pixel.
+#include "common/lighting.glsl"
+
+layout(push_constant, scalar) uniform Push {
+    uint64_t frame;
+    uint shadowView;
+} pc;
+
+layout(location = 0) in vec3 inPosition;
+layout(location = 1) in vec3 inNormal;
+layout(location = 2) in vec4 inTangent;
+layout(location = 3) in vec2 inUv;
+layout(location = 4) flat in uint inInstance;
+
+layout(location = 0) out vec4 outColor;
+
+void main() {
+    FrameConstants f = FrameConstantsRef(pc.frame).f;
+    GpuInstance inst = InstanceBuffer(f.instances).i[inInstance];
+    GpuMaterial mat = MaterialBuffer(f.materials).m[inst.material];
+    SurfaceInput s;
+    s.position = inPosition;
+    s.normal = normalize(inNormal);
+    s.tangent = inTangent;
+    s.uv = inUv;
+    s.uvDx = dFdx(inUv);
+    s.uvDy = dFdy(inUv);
+    s.frontFacing = gl_FrontFacing;
+    MaterialSample m = evaluateMaterial(mat, s);
+    if ((mat.flags & MATERIAL_ALPHA_MASK) != 0u && m.alpha < mat.alphaCutoff) discard;
+    vec3 color = shadeSurface(f, m, inPosition, s.normal);
+    float alpha = (mat.flags & MATERIAL_ALPHA_BLEND) != 0u ? m.alpha : 1.0;
+    outColor = vec4(color, alpha);
+}

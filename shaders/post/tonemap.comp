@@ -1,0 +1,45 @@
+#version 460
+// HDR scene colour -> display: exposure, ACES fit, N x N supersample resolve (averaged after
+// the tone curve, before sRGB encoding), sRGB encode, RGBA8 into a readback buffer. Alpha
+// records coverage: 255 where any sample saw geometry (reversed-Z depth > 0).
+#include "common/bindless.glsl"
+
+layout(local_size_x = 8, local_size_y = 8) in;
+
+layout(push_constant, scalar) uniform Push {
+    uint64_t frame;
+    uint64_t pixels; // uint RGBA8 per pixel, row-major
+    uint hdrSlot;
+    uint depthSlot;
+    uint width;
+    uint height;
+    uint ssaa;
+} pc;
+
+vec3 acesFit(vec3 x) {
+    return clamp((x * (2.51 * x + 0.03)) / (x * (2.43 * x + 0.59) + 0.14), 0.0, 1.0);
+}
+
+vec3 linearToSrgb(vec3 c) {
+    return mix(c * 12.92, 1.055 * pow(c, vec3(1.0 / 2.4)) - 0.055, step(vec3(0.0031308), c));
+}
+
+void main() {
+    uvec2 p = gl_GlobalInvocationID.xy;
+    if (p.x >= pc.width || p.y >= pc.height) return;
+    FrameConstants f = FrameConstantsRef(pc.frame).f;
+    vec3 sum = vec3(0.0);
+    bool covered = false;
+    for (uint y = 0u; y < pc.ssaa; ++y) {
+        for (uint x = 0u; x < pc.ssaa; ++x) {
+            ivec2 q = ivec2(p * pc.ssaa + uvec2(x, y));
+            vec3 hdr = fetchTexture(pc.hdrSlot, q, 0).rgb;
+            sum += acesFit(max(hdr, vec3(0.0)) * f.exposure);
+            covered = covered || fetchTexture(pc.depthSlot, q, 0).r > 0.0;
+        }
+    }
+    vec3 c = linearToSrgb(sum / float(pc.ssaa * pc.ssaa));
+    uvec3 b = uvec3(clamp(c, 0.0, 1.0) * 255.0 + 0.5);
+    uint a = covered ? 255u : 0u;
+    UintBuffer(pc.pixels).v[p.y * pc.width + p.x] = b.r | (b.g << 8) | (b.b << 16) | (a << 24);
+}

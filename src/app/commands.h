@@ -1,0 +1,62 @@
+#pragma once
+// The `shadel` commands as functions, so tests can run them in-process on a shared device.
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "render/renderer.h"
+
+namespace shadel {
+
+struct RenderOptions {
+    std::string scene = "builtin:default";
+    RenderMode mode = RenderMode::Forward;
+    uint32_t width = 1280, height = 720;
+    uint32_t frames = 1;
+    std::string camera;
+    bool jitter = false;
+    uint32_t ssaa = 1;
+    Visualize visualize = Visualize::None;
+    std::string out;   // FILE.png or DIR/ ; empty = no image
+    std::string stats; // FILE.json ; empty = none
+    std::optional<TimingMode> timing;
+    float exposure = 1.0f;
+    float shadelsPerMetre = 32.0f;
+    std::string cacheDir; // empty = default cache directory
+    bool printPasses = false;
+    bool progress = true;
+};
+
+struct RenderRun {
+    std::vector<FrameResult> frames;
+    nlohmann::json stats;
+};
+
+// Parses "WxH"; throws InputError naming the flag.
+void parseSize(const std::string& text, uint32_t& width, uint32_t& height);
+RenderMode parseMode(const std::string& text);
+Visualize parseVisualize(const std::string& text);
+std::string defaultCacheDir();
+
+// Renders with an existing Gpu (tests share one). Writes images/stats as the options say.
+RenderRun runRender(Gpu& gpu, const RenderOptions& options);
+// Writes RGBA8 pixels as an RGB PNG; throws InputError naming the path when it cannot.
+void writePng(const std::string& path, const std::vector<uint8_t>& rgba, uint32_t width, uint32_t height);
+// Per-pass table on stdout.
+void printPassTable(const nlohmann::json& stats);
+
+struct BenchOptions {
+    std::string scene = "builtin:default";
+    uint32_t width = 1280, height = 720;
+    uint32_t frames = 8;
+    std::string camera;
+    std::string json;
+    std::optional<TimingMode> timing;
+    float shadelsPerMetre = 32.0f;
+    std::string cacheDir;
+};
+nlohmann::json runBench(Gpu& gpu, const BenchOptions& options);
+
+} // namespace shadel

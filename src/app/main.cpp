@@ -1,0 +1,171 @@
+// `shadel`: render, bench, bake, info. Errors: one line on stderr naming the input and the
+// reason; exit 2 for bad input, 3 for a device problem, 1 for anything else.
+#include <chrono>
+#include <cstdio>
+#include <unistd.h>
+
+#include <CLI/CLI.hpp>
+
+#include "app/commands.h"
+#include "bake/bake.h"
+#include "core/error.h"
+#include "core/log.h"
+#include "scene/load.h"
+
+using namespace shadel;
+
+namespace {
+
+std::optional<TimingMode> parseTiming(const std::string& t) {
+    if (t == "auto") return std::nullopt;
+    if (t == "timestamps") return TimingMode::Timestamps;
+    if (t == "submit") return TimingMode::SubmitPerPass;
+    throw InputError(format("--timing %s: expected auto, timestamps or submit", t.c_str()));
+}
+
+DeviceDesc deviceDesc(const std::string& device, bool validation) {
+    DeviceDesc d;
+    d.selection = device;
+    const char* env = std::getenv("SHADEL_VALIDATION");
+    d.validation = validation || (env && std::string(env) == "1");
+    return d;
+}
+
+struct GpuGuard {
+    Gpu gpu;
+    ~GpuGuard() { destroyGpu(gpu); }
+};
+
+} // namespace
+
+int main(int argc, char** argv) {
+    CLI::App app{"shadel: a Vulkan renderer built around generalized decoupled shading"};
+    app.require_subcommand(1);
+    std::string device = "auto";
+    bool validation = false, verbose = false;
+    app.add_option("--device", device, "auto | cpu | gpu | INDEX")->capture_default_str();
+    app.add_flag("--validation", validation, "enable the Khronos validation layer (or SHADEL_VALIDATION=1)");
+    app.add_flag("-v,--verbose", verbose, "debug logging");
+
+    // render
+    RenderOptions ro;
+    std::string size = "1280x720", mode = "forward", visualize = "none", jitter = "none", timing = "auto";
+    auto* render = app.add_subcommand("render", "render frames headless to PNG + stats JSON");
+    render->add_option("--scene", ro.scene, "builtin:NAME | FILE.gltf | FILE.glb")->capture_default_str();
+    render->add_option("--mode", mode, "forward | decoupled")->capture_default_str();
+    render->add_option("--size", size, "WIDTHxHEIGHT")->capture_default_str();
+    render->add_option("--frames", ro.frames, "frames to render")->capture_default_str();
+    render->add_option("--camera", ro.camera, "camera name (default: the scene's first)");
+    render->add_option("--jitter", jitter, "none | subpixel: sub-pixel camera offsets between frames")->capture_default_str();
+    render->add_option("--ssaa", ro.ssaa, "N: NxN supersampled reference")->capture_default_str();
+    render->add_option("--visualize", visualize, "none | marking | mips | chunks | sheet")->capture_default_str();
+    render->add_option("--out", ro.out, "FILE.png (last frame) or DIR/ (every frame)");
+    render->add_option("--stats", ro.stats, "FILE.json");
+    render->add_option("--timing", timing, "auto | timestamps | submit (per-pass submit+wait)")->capture_default_str();
+    render->add_option("--exposure", ro.exposure, "exposure multiplier")->capture_default_str();
+    render->add_option("--density", ro.shadelsPerMetre, "shadels per metre (decoupled)")->capture_default_str();
+    render->add_option("--cache-dir", ro.cacheDir, "bake cache directory");
+    render->add_flag("--passes", ro.printPasses, "print the per-pass timing table");
+
+    // bench
+    BenchOptions bo;
+    std::string benchSize = "1280x720", benchTiming = "auto";
+    auto* bench = app.add_subcommand("bench", "render the same scene forward and decoupled; print ratios");
+    bench->add_option("--scene", bo.scene, "builtin:NAME | FILE.gltf | FILE.glb")->capture_default_str();
+    bench->add_option("--size", benchSize, "WIDTHxHEIGHT")->capture_default_str();
+    bench->add_option("--frames", bo.frames, "frames per mode")->capture_default_str();
+    bench->add_option("--camera", bo.camera, "camera name");
+    bench->add_option("--json", bo.json, "write the results as JSON");
+    bench->add_option("--timing", benchTiming, "auto | timestamps | submit")->capture_default_str();
+    bench->add_option("--density", bo.shadelsPerMetre, "shadels per metre")->capture_default_str();
+    bench->add_option("--cache-dir", bo.cacheDir, "bake cache directory");
+
+    // bake
+    std::string bakeSceneSpec = "builtin:default", bakeCache;
+    float bakeDensity = 32.0f;
+    bool bakeNoCache = false;
+    auto* bake = app.add_subcommand("bake", "bake shadel charts and triangle-ID maps (cached)");
+    bake->add_option("scene", bakeSceneSpec, "builtin:NAME | FILE.gltf | FILE.glb")->capture_default_str();
+    bake->add_option("--density", bakeDensity, "shadels per metre")->capture_default_str();
+    bake->add_option("--cache-dir", bakeCache, "bake cache directory");
+    bake->add_flag("--no-cache", bakeNoCache, "bake from scratch (still writes the cache)");
+
+    auto* info = app.add_subcommand("info", "print the device, driver, features and limits");
+
+    try {
+        app.parse(argc, argv);
+    } catch (const CLI::ParseError& e) {
+        return app.exit(e);
+    }
+    if (verbose) setLogLevel(LogLevel::Debug);
+
+    try {
+        if (*info) {
+            std::printf("Vulkan devices:\n%s", listPhysicalDevices().c_str());
+            GpuGuard g;
+            createGpu(g.gpu, deviceDesc(device, validation));
+            std::printf("selected (--device %s):\n%s", device.c_str(), describeDevice(g.gpu.device).c_str());
+            return 0;
+        }
+        if (*bake) {
+            Scene scene = loadScene(bakeSceneSpec);
+            BakeSettings bs;
+            bs.shadelsPerMetre = bakeDensity;
+            std::string dir = bakeCache.empty() ? defaultCacheDir() : bakeCache;
+            if (bakeNoCache) dir = "";
+            bool tty = isatty(STDERR_FILENO);
+            auto start = std::chrono::steady_clock::now();
+            auto baked = bakeScene(scene, bs, dir.empty() ? std::string() : dir, [&](size_t done, size_t total) {
+                if (tty) {
+                    int width = 40, filled = total ? int(width * done / total) : width;
+                    std::fprintf(stderr, "\rbake: [%s%s] %zu/%zu meshes", std::string(filled, '#').c_str(),
+                                 std::string(width - filled, '.').c_str(), done, total);
+                } else if (done == total || done % 16 == 0) {
+                    std::fprintf(stderr, "bake: %zu/%zu meshes\n", done, total);
+                }
+            });
+            if (tty) std::fprintf(stderr, "\n");
+            double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+            std::printf("%s", bakeReport(baked, seconds).c_str());
+            return 0;
+        }
+        GpuGuard g;
+        createGpu(g.gpu, deviceDesc(device, validation));
+        if (*render) {
+            parseSize(size, ro.width, ro.height);
+            ro.mode = parseMode(mode);
+            ro.visualize = parseVisualize(visualize);
+            if (jitter != "none" && jitter != "subpixel")
+                throw InputError(format("--jitter %s: expected none or subpixel", jitter.c_str()));
+            ro.jitter = jitter == "subpixel";
+            ro.timing = parseTiming(timing);
+            RenderRun run = runRender(g.gpu, ro);
+            const auto& s = run.stats;
+            std::printf("%s %s %ux%u: %u frame(s), median %.2f ms, %llu px covered, %llu shader asserts, "
+                        "%llu validation errors%s%s\n",
+                        ro.scene.c_str(), s["mode"].get<std::string>().c_str(), ro.width, ro.height, ro.frames,
+                        s["frame_ms"]["median"].get<double>(),
+                        (unsigned long long)s["pixels_covered"].get<uint64_t>(),
+                        (unsigned long long)s["shader_asserts"].get<uint64_t>(),
+                        (unsigned long long)s["validation_errors"].get<uint64_t>(),
+                        ro.out.empty() ? "" : " -> ", ro.out.c_str());
+            return s["shader_asserts"].get<uint64_t>() || s["validation_errors"].get<uint64_t>() ? 4 : 0;
+        }
+        if (*bench) {
+            parseSize(benchSize, bo.width, bo.height);
+            bo.timing = parseTiming(benchTiming);
+            runBench(g.gpu, bo);
+            return 0;
+        }
+    } catch (const InputError& e) {
+        std::fprintf(stderr, "shadel: %s\n", e.what());
+        return 2;
+    } catch (const DeviceError& e) {
+        std::fprintf(stderr, "shadel: device: %s\n", e.what());
+        return 3;
+    } catch (const std::exception& e) {
+        std::fprintf(stderr, "shadel: %s\n", e.what());
+        return 1;
+    }
+    return 0;
+}

@@ -1,0 +1,184 @@
+#include <algorithm>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <unistd.h>
+
+#include <stb/stb_image_write.h>
+
+#include "app/commands.h"
+#include "bake/bake.h"
+#include "core/error.h"
+#include "core/log.h"
+#include "render/shadel/decoupled.h"
+#include "scene/load.h"
+
+namespace shadel {
+
+void parseSize(const std::string& text, uint32_t& width, uint32_t& height) {
+    unsigned w = 0, h = 0;
+    char x = 0, extra = 0;
+    int n = std::sscanf(text.c_str(), "%u%c%u%c", &w, &x, &h, &extra);
+    if (n != 3 || (x != 'x' && x != 'X'))
+        throw InputError(format("--size %s: expected WIDTHxHEIGHT, e.g. 1280x720", text.c_str()));
+    if (w < 1 || h < 1 || w > 16384 || h > 16384)
+        throw InputError(format("--size %s: each side must be between 1 and 16384", text.c_str()));
+    width = w, height = h;
+}
+
+RenderMode parseMode(const std::string& text) {
+    if (text == "forward") return RenderMode::Forward;
+    if (text == "decoupled") return RenderMode::Decoupled;
+    throw InputError(format("--mode %s: expected forward or decoupled", text.c_str()));
+}
+
+Visualize parseVisualize(const std::string& text) {
+    if (text == "none") return Visualize::None;
+    if (text == "marking") return Visualize::Marking;
+    if (text == "mips") return Visualize::Mips;
+    if (text == "chunks") return Visualize::Chunks;
+    if (text == "sheet") return Visualize::Sheet;
+    throw InputError(format("--visualize %s: expected none, marking, mips, chunks or sheet", text.c_str()));
+}
+
+std::string defaultCacheDir() {
+    if (const char* env = std::getenv("SHADEL_CACHE_DIR")) return env;
+    if (const char* xdg = std::getenv("XDG_CACHE_HOME")) return std::string(xdg) + "/shadel";
+    if (const char* home = std::getenv("HOME")) return std::string(home) + "/.cache/shadel";
+    return "/tmp/shadel-cache";
+}
+
+void writePng(const std::string& path, const std::vector<uint8_t>& rgba, uint32_t width, uint32_t height) {
+    std::vector<uint8_t> rgb(size_t(width) * height * 3);
+    for (size_t i = 0, n = size_t(width) * height; i < n; ++i)
+        for (int c = 0; c < 3; ++c) rgb[i * 3 + c] = rgba[i * 4 + c];
+    if (!stbi_write_png(path.c_str(), int(width), int(height), 3, rgb.data(), int(width * 3)))
+        throw InputError(format("%s: cannot write PNG", path.c_str()));
+}
+
+static double median(std::vector<double> v) {
+    if (v.empty()) return 0.0;
+    std::sort(v.begin(), v.end());
+    size_t n = v.size();
+    return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
+static const char* modeName(RenderMode m) { return m == RenderMode::Forward ? "forward" : "decoupled"; }
+
+void printPassTable(const nlohmann::json& stats) {
+    std::printf("%-24s %10s\n", "pass", "gpu ms");
+    for (const auto& p : stats["passes"])
+        std::printf("%-24s %10.3f\n", p["name"].get<std::string>().c_str(), p["gpu_ms"].get<double>());
+    std::printf("%-24s %10.3f  (median frame, wall clock)\n", "frame",
+                stats["frame_ms"]["median"].get<double>());
+}
+
+RenderRun runRender(Gpu& gpu, const RenderOptions& o) {
+    if (o.frames < 1 || o.frames > 100000) throw InputError(format("--frames %u: expected 1..100000", o.frames));
+    if (o.ssaa < 1 || o.ssaa > 16) throw InputError(format("--ssaa %u: expected 1..16", o.ssaa));
+    bool outDir = !o.out.empty() && o.out.back() == '/';
+    if (outDir) {
+        std::error_code ec;
+        std::filesystem::create_directories(o.out, ec);
+        if (ec) throw InputError(format("%s: cannot create output directory (%s)", o.out.c_str(), ec.message().c_str()));
+    }
+    Scene scene = loadScene(o.scene);
+    Camera camera = findCamera(scene, o.camera);
+
+    std::vector<BakedMesh> baked;
+    GpuScene gpuScene;
+    if (o.mode == RenderMode::Decoupled) {
+        BakeSettings bs;
+        bs.shadelsPerMetre = o.shadelsPerMetre;
+        baked = bakeScene(scene, bs, o.cacheDir.empty() ? defaultCacheDir() : o.cacheDir, nullptr);
+        uploadScene(gpu, scene, gpuScene, &baked);
+    } else {
+        uploadScene(gpu, scene, gpuScene);
+    }
+
+    RenderSettings settings;
+    settings.width = o.width;
+    settings.height = o.height;
+    settings.ssaa = o.ssaa;
+    settings.mode = o.mode;
+    settings.visualize = o.visualize;
+    settings.exposure = o.exposure;
+    settings.timing = o.timing ? *o.timing : defaultTimingMode(gpu);
+    Renderer renderer;
+    RenderRun run;
+    try {
+        initRenderer(renderer, gpu, settings, gpuScene);
+        bool tty = isatty(STDERR_FILENO);
+        for (uint32_t i = 0; i < o.frames; ++i) {
+            glm::vec2 jitter = o.jitter ? subpixelJitter(i) : glm::vec2(0.0f);
+            CameraView view = makeCameraView(camera, o.width * o.ssaa, o.height * o.ssaa, jitter * float(o.ssaa));
+            run.frames.push_back(renderFrame(renderer, gpuScene, view));
+            if (o.progress && o.frames > 1 && tty)
+                std::fprintf(stderr, "\rrender: frame %u/%u (%.1f ms)", i + 1, o.frames, run.frames.back().frameMs);
+            if (outDir) writePng(format("%sframe_%04u.png", o.out.c_str(), i), run.frames.back().rgba, o.width, o.height);
+        }
+        if (o.progress && o.frames > 1 && tty) std::fprintf(stderr, "\n");
+    } catch (...) {
+        destroyRenderer(renderer);
+        destroyScene(gpu, gpuScene);
+        throw;
+    }
+    if (!o.out.empty() && !outDir) writePng(o.out, run.frames.back().rgba, o.width, o.height);
+
+    // Stats (DESIGN §5): medians over frames.
+    nlohmann::json s;
+    s["device"] = gpu.device.name;
+    s["driver"] = gpu.device.driver;
+    s["scene"] = o.scene;
+    s["camera"] = camera.name;
+    s["mode"] = modeName(o.mode);
+    s["width"] = o.width;
+    s["height"] = o.height;
+    s["ssaa"] = o.ssaa;
+    s["frames"] = o.frames;
+    s["timing"] = settings.timing == TimingMode::Timestamps ? "timestamps" : "submit-per-pass";
+    std::vector<double> frameMs;
+    for (auto& f : run.frames) frameMs.push_back(f.frameMs);
+    s["frame_ms"] = {{"median", median(frameMs)},
+                     {"min", *std::min_element(frameMs.begin(), frameMs.end())},
+                     {"max", *std::max_element(frameMs.begin(), frameMs.end())}};
+    nlohmann::json passes = nlohmann::json::array();
+    for (size_t p = 0; p < run.frames.front().passes.size(); ++p) {
+        std::vector<double> ms;
+        for (auto& f : run.frames)
+            if (p < f.passes.size()) ms.push_back(f.passes[p].gpuMs);
+        passes.push_back({{"name", run.frames.front().passes[p].name}, {"gpu_ms", median(ms)}});
+    }
+    s["passes"] = passes;
+    uint64_t asserts = 0;
+    for (auto& f : run.frames) asserts += f.shaderAsserts;
+    s["pixels_covered"] = run.frames.back().pixelsCovered;
+    s["shadels_shaded"] = 0;
+    s["shadels_per_pixel"] = 0.0;
+    s["chunks_allocated"] = 0;
+    s["chunks_capacity"] = 0;
+    s["shading_bias"] = 0.0;
+    s["reconstruction_misses"] = 0;
+    s["shader_asserts"] = asserts;
+    s["validation_errors"] = gpu.device.validationErrors.load();
+    s["instances"] = gpuScene.instanceCount;
+    s["triangles"] = scene.triangleCount();
+    s["lights"] = scene.lights.size();
+    MemoryHeapStats mem = memoryStats(gpu.memory);
+    s["gpu_memory"] = {{"pool_bytes", mem.poolBytes}, {"used_bytes", mem.usedBytes}, {"pools", mem.pools}};
+    if (renderer.decoupled) decoupledStats(renderer, s);
+    run.stats = s;
+
+    destroyRenderer(renderer);
+    destroyScene(gpu, gpuScene);
+
+    if (!o.stats.empty()) {
+        std::ofstream out(o.stats);
+        if (!out) throw InputError(format("%s: cannot write stats", o.stats.c_str()));
+        out << s.dump(2) << "\n";
+    }
+    if (o.printPasses) printPassTable(s);
+    return run;
+}
+
+} // namespace shadel

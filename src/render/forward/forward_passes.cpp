@@ -1,0 +1,204 @@
+#include "render/forward/forward_passes.h"
+
+#include "render/renderer.h"
+
+namespace shadel {
+
+namespace {
+struct RasterPush {
+    uint64_t frame;
+    uint32_t shadowView;
+};
+struct CullPush {
+    uint64_t frame;
+    uint64_t draws;
+    uint64_t counts;
+    uint32_t maxDraws;
+    uint32_t shadowView;
+};
+
+void setViewport(VkCommandBuffer cmd, uint32_t w, uint32_t h) {
+    VkViewport vp{0, 0, float(w), float(h), 0, 1};
+    VkRect2D scissor{{0, 0}, {w, h}};
+    vkCmdSetViewport(cmd, 0, 1, &vp);
+    vkCmdSetScissor(cmd, 0, 1, &scissor);
+}
+
+void drawList(Renderer& r, VkCommandBuffer cmd, BufferHandle draws, VkDeviceSize countOffset,
+              uint32_t list) {
+    Gpu& gpu = *r.gpu;
+    vkCmdDrawIndexedIndirectCount(cmd, vkBuffer(gpu, draws),
+                                  VkDeviceSize(list) * r.maxDraws * sizeof(gpu::DrawIndexedCommand),
+                                  vkBuffer(gpu, r.drawCounts), countOffset + list * 4, r.maxDraws,
+                                  sizeof(gpu::DrawIndexedCommand));
+}
+} // namespace
+
+void createForwardPipelines(Renderer& r) {
+    Gpu& gpu = *r.gpu;
+    r.instanceCull = createComputePipeline(gpu, "instanceCull", "forward_instance_cull.comp.spv");
+    GraphicsPipelineDesc depth;
+    depth.name = "depthPrepass";
+    depth.vertexShader = "forward_forward.vert.spv";
+    depth.fragmentShader = "forward_depth.frag.spv";
+    depth.depthFormat = VK_FORMAT_D32_SFLOAT;
+    depth.cullMode = VK_CULL_MODE_NONE; // double-sided materials; backfaces cost little here
+    r.depthPrepass = createGraphicsPipeline(gpu, depth);
+
+    GraphicsPipelineDesc shadow = depth;
+    shadow.name = "shadowMap";
+    shadow.depthCompare = VK_COMPARE_OP_LESS_OR_EQUAL;
+    shadow.depthClamp = true;
+    shadow.depthBias = true;
+    r.shadowPass = createGraphicsPipeline(gpu, shadow);
+
+    GraphicsPipelineDesc opaque;
+    opaque.name = "forwardOpaque";
+    opaque.vertexShader = "forward_forward.vert.spv";
+    opaque.fragmentShader = "forward_forward.frag.spv";
+    opaque.colorFormats = {VK_FORMAT_R16G16B16A16_SFLOAT};
+    opaque.depthFormat = VK_FORMAT_D32_SFLOAT;
+    opaque.depthWrite = false;
+    opaque.depthCompare = VK_COMPARE_OP_EQUAL; // the prepass resolved visibility
+    opaque.cullMode = VK_CULL_MODE_NONE;
+    r.forwardOpaque = createGraphicsPipeline(gpu, opaque);
+
+    GraphicsPipelineDesc blend = opaque;
+    blend.name = "forwardBlend";
+    blend.depthCompare = VK_COMPARE_OP_GREATER_OR_EQUAL;
+    blend.blend = GraphicsPipelineDesc::Blend::Alpha;
+    r.forwardBlend = createGraphicsPipeline(gpu, blend);
+}
+
+void destroyForwardPipelines(Renderer& r) {
+    for (Pipeline* p : {&r.instanceCull, &r.depthPrepass, &r.shadowPass, &r.forwardOpaque, &r.forwardBlend})
+        destroy(*r.gpu, *p);
+}
+
+void recordInstanceCull(Renderer& r, VkCommandBuffer cmd, uint64_t frame, const GpuScene& scene) {
+    Gpu& gpu = *r.gpu;
+    vkCmdFillBuffer(cmd, vkBuffer(gpu, r.drawCounts), 0, VK_WHOLE_SIZE, 0);
+    memoryBarrier(cmd, VK_PIPELINE_STAGE_2_CLEAR_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT,
+                  VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
+                  VK_ACCESS_2_SHADER_STORAGE_READ_BIT | VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT);
+    bind(gpu, cmd, r.instanceCull);
+    uint32_t groups = (scene.instanceCount + 63) / 64;
+    CullPush push{frame, address(gpu, r.draws), address(gpu, r.drawCounts), r.maxDraws, 0};
+    pushConstants(gpu, cmd, push);
+    if (groups) vkCmdDispatch(cmd, groups, 1, 1);
+    push = {frame, address(gpu, r.shadowDraws), address(gpu, r.drawCounts) + DRAW_LIST_COUNT * 4,
+            r.maxDraws, 1};
+    pushConstants(gpu, cmd, push);
+    if (groups) vkCmdDispatch(cmd, groups, 1, 1);
+    memoryBarrier(cmd, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT,
+                  VK_PIPELINE_STAGE_2_DRAW_INDIRECT_BIT, VK_ACCESS_2_INDIRECT_COMMAND_READ_BIT);
+}
+
+void recordShadowMap(Renderer& r, VkCommandBuffer cmd, uint64_t frame) {
+    Gpu& gpu = *r.gpu;
+    VkImage image = vkImage(gpu, r.shadowMap);
+    imageBarrier(cmd, image, VK_IMAGE_ASPECT_DEPTH_BIT, VK_IMAGE_LAYOUT_UNDEFINED,
+                 VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL, VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT, 0,
+                 VK_PIPELINE_STAGE_2_EARLY_FRAGMENT_TESTS_BIT | VK_PIPELINE_STAGE_2_LATE_FRAGMENT_TESTS_BIT,
+                 VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT);
+    VkRenderingAttachmentInfo depth{VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO};
+    depth.imageView = vkView(gpu, r.shadowTarget);
+    depth.imageLayout = VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL;
+    depth.loadOp = VK_ATTACHMENT_LOAD_OP_CLEAR;
+    depth.storeOp = VK_ATTACHMENT_STORE_OP_STORE;
+    depth.clearValue.depthStencil = {1.0f, 0};
+    VkRenderingInfo ri{VK_STRUCTURE_TYPE_RENDERING_INFO};
+    ri.renderArea = {{0, 0}, {r.settings.shadowMapSize, r.settings.shadowMapSize}};
+    ri.layerCount = 1;
+    ri.pDepthAttachment = &depth;
+    vkCmdBeginRendering(cmd, &ri);
+    bind(gpu, cmd, r.shadowPass);
+    setViewport(cmd, r.settings.shadowMapSize, r.settings.shadowMapSize);
+    vkCmdSetDepthBias(cmd, 1.25f, 0.0f, 1.75f);
+    vkCmdBindIndexBuffer(cmd, vkBuffer(gpu, r.sceneIndices), 0, VK_INDEX_TYPE_UINT32);
+    pushConstants(gpu, cmd, RasterPush{frame, 1});
+    drawList(r, cmd, r.shadowDraws, DRAW_LIST_COUNT * 4, DRAW_LIST_OPAQUE);
+    vkCmdEndRendering(cmd);
+    imageBarrier(cmd, image, VK_IMAGE_ASPECT_DEPTH_BIT, VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL,
+                 VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, VK_PIPELINE_STAGE_2_LATE_FRAGMENT_TESTS_BIT,
+                 VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT,
+                 VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT | VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
+                 VK_ACCESS_2_SHADER_SAMPLED_READ_BIT);
+}
+
+void drawCameraList(Renderer& r, VkCommandBuffer cmd, uint32_t list) {
+    Gpu& gpu = *r.gpu;
+    setViewport(cmd, r.internalWidth, r.internalHeight);
+    vkCmdBindIndexBuffer(cmd, vkBuffer(gpu, r.sceneIndices), 0, VK_INDEX_TYPE_UINT32);
+    drawList(r, cmd, r.draws, 0, list);
+}
+
+void recordDepthPrepass(Renderer& r, VkCommandBuffer cmd, uint64_t frame) {
+    Gpu& gpu = *r.gpu;
+    VkImage image = vkImage(gpu, r.depth);
+    imageBarrier(cmd, image, VK_IMAGE_ASPECT_DEPTH_BIT, VK_IMAGE_LAYOUT_UNDEFINED,
+                 VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL,
+                 VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT | VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, 0,
+                 VK_PIPELINE_STAGE_2_EARLY_FRAGMENT_TESTS_BIT | VK_PIPELINE_STAGE_2_LATE_FRAGMENT_TESTS_BIT,
+                 VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT | VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_READ_BIT);
+    VkRenderingAttachmentInfo depth{VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO};
+    depth.imageView = vkView(gpu, r.depthTarget);
+    depth.imageLayout = VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL;
+    depth.loadOp = VK_ATTACHMENT_LOAD_OP_CLEAR;
+    depth.storeOp = VK_ATTACHMENT_STORE_OP_STORE;
+    depth.clearValue.depthStencil = {0.0f, 0}; // reversed Z
+    VkRenderingInfo ri{VK_STRUCTURE_TYPE_RENDERING_INFO};
+    ri.renderArea = {{0, 0}, {r.internalWidth, r.internalHeight}};
+    ri.layerCount = 1;
+    ri.pDepthAttachment = &depth;
+    vkCmdBeginRendering(cmd, &ri);
+    bind(gpu, cmd, r.depthPrepass);
+    pushConstants(gpu, cmd, RasterPush{frame, 0});
+    drawCameraList(r, cmd, DRAW_LIST_OPAQUE);
+    vkCmdEndRendering(cmd);
+    memoryBarrier(cmd, VK_PIPELINE_STAGE_2_LATE_FRAGMENT_TESTS_BIT,
+                  VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT,
+                  VK_PIPELINE_STAGE_2_EARLY_FRAGMENT_TESTS_BIT | VK_PIPELINE_STAGE_2_LATE_FRAGMENT_TESTS_BIT,
+                  VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_READ_BIT | VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT);
+}
+
+void beginSceneColorPass(Renderer& r, VkCommandBuffer cmd, bool clear) {
+    Gpu& gpu = *r.gpu;
+    if (clear)
+        imageBarrier(cmd, vkImage(gpu, r.hdr), VK_IMAGE_ASPECT_COLOR_BIT, VK_IMAGE_LAYOUT_UNDEFINED,
+                     VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, 0,
+                     VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT,
+                     VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT | VK_ACCESS_2_COLOR_ATTACHMENT_READ_BIT);
+    VkRenderingAttachmentInfo color{VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO};
+    color.imageView = vkView(gpu, r.hdrTarget);
+    color.imageLayout = VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL;
+    color.loadOp = clear ? VK_ATTACHMENT_LOAD_OP_CLEAR : VK_ATTACHMENT_LOAD_OP_LOAD;
+    color.storeOp = VK_ATTACHMENT_STORE_OP_STORE;
+    color.clearValue.color = {{r.skyColor.x, r.skyColor.y, r.skyColor.z, 0.0f}};
+    VkRenderingAttachmentInfo depth{VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO};
+    depth.imageView = vkView(gpu, r.depthTarget);
+    depth.imageLayout = VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL;
+    depth.loadOp = VK_ATTACHMENT_LOAD_OP_LOAD;
+    depth.storeOp = VK_ATTACHMENT_STORE_OP_STORE;
+    VkRenderingInfo ri{VK_STRUCTURE_TYPE_RENDERING_INFO};
+    ri.renderArea = {{0, 0}, {r.internalWidth, r.internalHeight}};
+    ri.layerCount = 1;
+    ri.colorAttachmentCount = 1;
+    ri.pColorAttachments = &color;
+    ri.pDepthAttachment = &depth;
+    vkCmdBeginRendering(cmd, &ri);
+}
+
+void recordForwardShading(Renderer& r, VkCommandBuffer cmd, uint64_t frame) {
+    Gpu& gpu = *r.gpu;
+    beginSceneColorPass(r, cmd, true);
+    bind(gpu, cmd, r.forwardOpaque);
+    pushConstants(gpu, cmd, RasterPush{frame, 0});
+    drawCameraList(r, cmd, DRAW_LIST_OPAQUE);
+    bind(gpu, cmd, r.forwardBlend);
+    pushConstants(gpu, cmd, RasterPush{frame, 0});
+    drawCameraList(r, cmd, DRAW_LIST_BLEND);
+    vkCmdEndRendering(cmd);
+}
+
+} // namespace shadel

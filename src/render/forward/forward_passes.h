@@ -1,0 +1,25 @@
+#pragma once
+// The forward path's passes: GPU instance culling into indirect draw lists, the sun's shadow
+// map, the depth prepass and forward shading. The decoupled path reuses the first three.
+#include "rhi/vk.h"
+
+namespace shadel {
+
+struct Renderer;
+struct GpuScene;
+
+void createForwardPipelines(Renderer& r);
+void destroyForwardPipelines(Renderer& r);
+
+// Culls every instance against the camera frustum and the sun's shadow volume on the GPU.
+void recordInstanceCull(Renderer& r, VkCommandBuffer cmd, uint64_t frame, const GpuScene& scene);
+void recordShadowMap(Renderer& r, VkCommandBuffer cmd, uint64_t frame);
+void recordDepthPrepass(Renderer& r, VkCommandBuffer cmd, uint64_t frame);
+void recordForwardShading(Renderer& r, VkCommandBuffer cmd, uint64_t frame);
+
+// Shared by every raster pass that draws the culled camera list (decoupled passes too).
+void drawCameraList(Renderer& r, VkCommandBuffer cmd, uint32_t list);
+// Begins dynamic rendering into the HDR target with the prepass depth (loaded, not cleared).
+void beginSceneColorPass(Renderer& r, VkCommandBuffer cmd, bool clearColor);
+
+} // namespace shadel

@@ -1,0 +1,180 @@
+#include "render/gpu_scene.h"
+
+#include <cmath>
+
+#include "bake/bake.h"
+#include "core/log.h"
+
+namespace shadel {
+
+static BufferHandle uploadArray(Gpu& gpu, const char* name, const void* data, size_t bytes,
+                                VkBufferUsageFlags usage = 0) {
+    size_t size = std::max<size_t>(bytes, 16);
+    BufferHandle b = createBuffer(gpu, {name, size, usage, MemoryKind::DeviceLocal});
+    if (!b) throw DeviceError(format("out of GPU memory uploading %s (%zu bytes)", name, bytes));
+    if (bytes) uploadBuffer(gpu, b, data, bytes);
+    return b;
+}
+
+static uint32_t mipCount(uint32_t w, uint32_t h) {
+    return 1 + uint32_t(std::floor(std::log2(double(std::max(w, h)))));
+}
+
+void uploadScene(Gpu& gpu, const Scene& scene, GpuScene& out, const std::vector<BakedMesh>* baked) {
+    // Textures: sRGB for colour data. Every texture gets a full mip chain and a bindless slot.
+    std::vector<bool> srgb(scene.textures.size(), false);
+    for (const Material& m : scene.materials) {
+        if (m.baseColorTexture >= 0 && size_t(m.baseColorTexture) < srgb.size()) srgb[m.baseColorTexture] = true;
+        if (m.emissiveTexture >= 0 && size_t(m.emissiveTexture) < srgb.size()) srgb[m.emissiveTexture] = true;
+    }
+    for (size_t i = 0; i < scene.textures.size(); ++i) {
+        const Texture& t = scene.textures[i];
+        TextureDesc d;
+        d.name = format("texture.%s", t.name.empty() ? std::to_string(i).c_str() : t.name.c_str());
+        d.format = (srgb[i] || t.srgb) ? VK_FORMAT_R8G8B8A8_SRGB : VK_FORMAT_R8G8B8A8_UNORM;
+        d.width = t.width;
+        d.height = t.height;
+        d.mipLevels = mipCount(t.width, t.height);
+        d.usage = VK_IMAGE_USAGE_SAMPLED_BIT;
+        TextureHandle tex = createTexture(gpu, d);
+        if (!tex) {
+            SHADEL_WARN("texture %s does not fit in GPU memory: drawn untextured", d.name.c_str());
+            out.textures.push_back({});
+            out.textureViews.push_back({});
+            continue;
+        }
+        uploadTexture(gpu, tex, t.rgba8.data(), t.rgba8.size());
+        out.textures.push_back(tex);
+        out.textureViews.push_back(createReadView(gpu, tex));
+    }
+    auto textureSlot = [&](int32_t index) -> uint32_t {
+        if (index < 0 || size_t(index) >= out.textureViews.size() || !out.textureViews[index])
+            return NO_TEXTURE;
+        return slot(gpu, out.textureViews[index]).value;
+    };
+
+    std::vector<gpu::GpuMaterial> materials;
+    for (const Material& m : scene.materials) {
+        gpu::GpuMaterial g{};
+        g.baseColorFactor = m.baseColorFactor;
+        g.emissiveFactor = m.emissiveFactor;
+        g.metallicFactor = m.metallicFactor;
+        g.roughnessFactor = m.roughnessFactor;
+        g.normalScale = m.normalScale;
+        g.occlusionStrength = m.occlusionStrength;
+        g.alphaCutoff = m.alphaCutoff;
+        g.baseColorTexture = textureSlot(m.baseColorTexture);
+        g.metallicRoughnessTexture = textureSlot(m.metallicRoughnessTexture);
+        g.normalTexture = textureSlot(m.normalTexture);
+        g.emissiveTexture = textureSlot(m.emissiveTexture);
+        g.occlusionTexture = textureSlot(m.occlusionTexture);
+        g.flags = (m.alphaMode == AlphaMode::Mask ? MATERIAL_ALPHA_MASK : 0u) |
+                  (m.alphaMode == AlphaMode::Blend ? MATERIAL_ALPHA_BLEND : 0u) |
+                  (m.doubleSided ? MATERIAL_DOUBLE_SIDED : 0u);
+        g.procedural = uint32_t(m.procedural);
+        g.proceduralScale = m.proceduralScale;
+        materials.push_back(g);
+    }
+    if (materials.empty()) {
+        gpu::GpuMaterial g{};
+        g.baseColorFactor = glm::vec4(0.8f, 0.8f, 0.8f, 1.0f);
+        g.roughnessFactor = 0.7f;
+        g.baseColorTexture = g.metallicRoughnessTexture = g.normalTexture = g.emissiveTexture =
+            g.occlusionTexture = NO_TEXTURE;
+        materials.push_back(g);
+    }
+
+    // Unified geometry.
+    std::vector<gpu::GpuVertex> vertices;
+    std::vector<glm::vec2> shadelUvs;
+    std::vector<uint32_t> indices;
+    out.meshInfo.clear();
+    for (size_t mi = 0; mi < scene.meshes.size(); ++mi) {
+        const Mesh& mesh = scene.meshes[mi];
+        gpu::GpuMesh g{};
+        g.firstIndex = uint32_t(indices.size());
+        g.vertexOffset = int32_t(vertices.size());
+        g.shadelMesh = 0xFFFFFFFFu;
+        g.boundsMin = mesh.bounds.min;
+        g.boundsMax = mesh.bounds.max;
+        const BakedMesh* b = baked ? &(*baked)[mi] : nullptr;
+        if (b && !b->indices.empty()) {
+            for (size_t v = 0; v < b->vertexRemap.size(); ++v) {
+                const Vertex& src = mesh.vertices[b->vertexRemap[v]];
+                vertices.push_back({src.position, src.normal, src.tangent, src.uv0});
+                shadelUvs.push_back(b->shadelUv[v]);
+            }
+            indices.insert(indices.end(), b->indices.begin(), b->indices.end());
+            g.shadelMesh = uint32_t(mi);
+        } else {
+            for (const Vertex& v : mesh.vertices) vertices.push_back({v.position, v.normal, v.tangent, v.uv0});
+            if (baked) shadelUvs.resize(vertices.size(), glm::vec2(0.0f));
+            indices.insert(indices.end(), mesh.indices.begin(), mesh.indices.end());
+        }
+        g.indexCount = uint32_t(indices.size()) - g.firstIndex;
+        out.meshInfo.push_back(g);
+    }
+
+    std::vector<gpu::GpuInstance> instances;
+    out.bounds = Aabb{};
+    for (const Instance& inst : scene.instances) {
+        gpu::GpuInstance g{};
+        g.model = inst.transform;
+        g.normalMatrix = glm::transpose(glm::inverse(inst.transform));
+        Aabb world = transformAabb(scene.meshes[inst.mesh].bounds, inst.transform);
+        g.worldMin = world.min;
+        g.worldMax = world.max;
+        g.mesh = inst.mesh;
+        uint32_t material = scene.meshes[inst.mesh].material;
+        g.material = material < materials.size() ? material : 0;
+        instances.push_back(g);
+        out.bounds.extend(world);
+    }
+    out.instanceInfo = instances;
+
+    std::vector<gpu::GpuLight> lights;
+    bool haveSun = false;
+    for (const Light& l : scene.lights) {
+        if (l.type == LightType::Directional && !haveSun) {
+            haveSun = true;
+            out.sunDirection = glm::normalize(l.direction);
+            out.sunColor = l.color * l.intensity;
+            out.sunCastsShadow = true;
+            continue;
+        }
+        gpu::GpuLight g{};
+        g.position = l.position;
+        g.type = uint32_t(l.type);
+        g.direction = glm::normalize(l.direction);
+        g.range = l.range;
+        g.color = l.color * l.intensity;
+        float cosOuter = std::cos(l.outerConeAngle), cosInner = std::cos(l.innerConeAngle);
+        g.spotScale = 1.0f / std::max(cosInner - cosOuter, 1e-4f);
+        g.spotOffset = -cosOuter * g.spotScale;
+        lights.push_back(g);
+    }
+    out.skyColor = scene.skyColor;
+    out.ambientColor = scene.ambientColor;
+
+    VkBufferUsageFlags indexUsage = VK_BUFFER_USAGE_INDEX_BUFFER_BIT;
+    out.vertices = uploadArray(gpu, "scene.vertices", vertices.data(), vertices.size() * sizeof(gpu::GpuVertex));
+    if (baked) out.shadelUvs = uploadArray(gpu, "scene.shadelUvs", shadelUvs.data(), shadelUvs.size() * sizeof(glm::vec2));
+    out.indices = uploadArray(gpu, "scene.indices", indices.data(), indices.size() * 4, indexUsage);
+    out.meshes = uploadArray(gpu, "scene.meshes", out.meshInfo.data(), out.meshInfo.size() * sizeof(gpu::GpuMesh));
+    out.instances = uploadArray(gpu, "scene.instances", instances.data(), instances.size() * sizeof(gpu::GpuInstance));
+    out.materials = uploadArray(gpu, "scene.materials", materials.data(), materials.size() * sizeof(gpu::GpuMaterial));
+    out.lights = uploadArray(gpu, "scene.lights", lights.data(), lights.size() * sizeof(gpu::GpuLight));
+    out.instanceCount = uint32_t(instances.size());
+    out.lightCount = uint32_t(lights.size());
+    out.geometryBytes = vertices.size() * sizeof(gpu::GpuVertex) + indices.size() * 4;
+}
+
+void destroyScene(Gpu& gpu, GpuScene& s) {
+    for (TextureReadView v : s.textureViews) destroy(gpu, v);
+    for (TextureHandle t : s.textures) destroy(gpu, t);
+    for (BufferHandle b : {s.vertices, s.shadelUvs, s.indices, s.meshes, s.instances, s.materials, s.lights})
+        destroy(gpu, b);
+    s = GpuScene{};
+}
+
+} // namespace shadel

@@ -1,0 +1,44 @@
+#pragma once
+// The scene on the GPU (seed 003's unified geometry): one vertex buffer and one index buffer
+// for every mesh, material and instance tables, textures in the bindless table.
+#include <vector>
+
+#include "common/shared_types.h"
+#include "rhi/gpu.h"
+#include "scene/scene.h"
+
+namespace shadel {
+
+struct BakedMesh;
+
+struct GpuScene {
+    BufferHandle vertices;  // gpu::GpuVertex[]
+    BufferHandle shadelUvs; // vec2 per vertex (decoupled path), invalid when not baked
+    BufferHandle indices;   // uint32
+    BufferHandle meshes;    // gpu::GpuMesh[]
+    BufferHandle instances; // gpu::GpuInstance[]
+    BufferHandle materials; // gpu::GpuMaterial[]
+    BufferHandle lights;    // gpu::GpuLight[] (point and spot; the first directional is the sun)
+    std::vector<TextureHandle> textures;
+    std::vector<TextureReadView> textureViews;
+    std::vector<gpu::GpuMesh> meshInfo;
+    std::vector<gpu::GpuInstance> instanceInfo;
+    uint32_t instanceCount = 0;
+    uint32_t lightCount = 0;
+    Aabb bounds;
+    // The sun: the first directional light of the scene (none: sunColor = 0).
+    glm::vec3 sunDirection{0.3f, -1.0f, 0.2f};
+    glm::vec3 sunColor{0.0f};
+    bool sunCastsShadow = false;
+    glm::vec3 skyColor{0.5f};
+    glm::vec3 ambientColor{0.05f};
+    uint64_t geometryBytes = 0;
+};
+
+// Uploads the scene. With `baked` (one per mesh), each mesh's vertices are the baked ones
+// (duplicated along chart seams) so forward and decoupled paths draw identical geometry.
+void uploadScene(Gpu& gpu, const Scene& scene, GpuScene& out,
+                 const std::vector<BakedMesh>* baked = nullptr);
+void destroyScene(Gpu& gpu, GpuScene& scene);
+
+} // namespace shadel

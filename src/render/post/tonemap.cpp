@@ -1,0 +1,48 @@
+#include "render/post/tonemap.h"
+
+#include "render/renderer.h"
+
+namespace shadel {
+
+namespace {
+struct TonemapPush {
+    uint64_t frame;
+    uint64_t pixels;
+    uint32_t hdrSlot;
+    uint32_t depthSlot;
+    uint32_t width;
+    uint32_t height;
+    uint32_t ssaa;
+};
+} // namespace
+
+void createTonemapPipeline(Renderer& r) {
+    r.tonemap = createComputePipeline(*r.gpu, "tonemap", "post_tonemap.comp.spv");
+}
+
+void recordTonemap(Renderer& r, VkCommandBuffer cmd, uint64_t frame) {
+    Gpu& gpu = *r.gpu;
+    imageBarrier(cmd, vkImage(gpu, r.hdr), VK_IMAGE_ASPECT_COLOR_BIT,
+                 VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL,
+                 VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT, VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT,
+                 VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_SHADER_SAMPLED_READ_BIT);
+    imageBarrier(cmd, vkImage(gpu, r.depth), VK_IMAGE_ASPECT_DEPTH_BIT,
+                 VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL,
+                 VK_PIPELINE_STAGE_2_LATE_FRAGMENT_TESTS_BIT | VK_PIPELINE_STAGE_2_EARLY_FRAGMENT_TESTS_BIT,
+                 VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT,
+                 VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_SHADER_SAMPLED_READ_BIT);
+    bind(gpu, cmd, r.tonemap);
+    TonemapPush push{frame,
+                     address(gpu, r.pixels),
+                     slot(gpu, r.hdrRead).value,
+                     slot(gpu, r.depthRead).value,
+                     r.settings.width,
+                     r.settings.height,
+                     r.settings.ssaa};
+    pushConstants(gpu, cmd, push);
+    vkCmdDispatch(cmd, (r.settings.width + 7) / 8, (r.settings.height + 7) / 8, 1);
+    memoryBarrier(cmd, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT,
+                  VK_PIPELINE_STAGE_2_HOST_BIT, VK_ACCESS_2_HOST_READ_BIT);
+}
+
+} // namespace shadel

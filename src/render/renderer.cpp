@@ -1,0 +1,186 @@
+#include "render/renderer.h"
+
+#include <cstring>
+
+#include <glm/gtc/matrix_transform.hpp>
+
+#include "core/log.h"
+#include "render/forward/forward_passes.h"
+#include "render/post/tonemap.h"
+#include "render/shadel/decoupled.h"
+
+namespace shadel {
+
+static void createTargets(Renderer& r) {
+    Gpu& gpu = *r.gpu;
+    r.internalWidth = r.settings.width * r.settings.ssaa;
+    r.internalHeight = r.settings.height * r.settings.ssaa;
+    uint32_t maxDim = gpu.device.properties.limits.maxImageDimension2D;
+    if (r.internalWidth > maxDim || r.internalHeight > maxDim)
+        throw InputError(format("--size %ux%u with --ssaa %u needs %ux%u targets; this device "
+                                "allows at most %u",
+                                r.settings.width, r.settings.height, r.settings.ssaa,
+                                r.internalWidth, r.internalHeight, maxDim));
+    auto need = [](auto handle, const char* what) {
+        if (!handle) throw DeviceError(format("out of GPU memory for %s", what));
+        return handle;
+    };
+    TextureDesc hdr;
+    hdr.name = "sceneColor";
+    hdr.format = VK_FORMAT_R16G16B16A16_SFLOAT;
+    hdr.width = r.internalWidth;
+    hdr.height = r.internalHeight;
+    hdr.usage = VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT | VK_IMAGE_USAGE_SAMPLED_BIT;
+    r.hdr = need(createTexture(gpu, hdr), "the scene colour target");
+    r.hdrTarget = createRenderTargetView(gpu, r.hdr);
+    r.hdrRead = createReadView(gpu, r.hdr);
+
+    TextureDesc depth;
+    depth.name = "sceneDepth";
+    depth.format = VK_FORMAT_D32_SFLOAT;
+    depth.width = r.internalWidth;
+    depth.height = r.internalHeight;
+    depth.usage = VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT | VK_IMAGE_USAGE_SAMPLED_BIT;
+    r.depth = need(createTexture(gpu, depth), "the depth target");
+    r.depthTarget = createDepthTargetView(gpu, r.depth);
+    r.depthRead = createReadView(gpu, r.depth);
+
+    TextureDesc shadow = depth;
+    shadow.name = "sunShadowMap";
+    shadow.width = shadow.height = r.settings.shadowMapSize;
+    r.shadowMap = need(createTexture(gpu, shadow), "the shadow map");
+    r.shadowTarget = createDepthTargetView(gpu, r.shadowMap);
+    r.shadowRead = createReadView(gpu, r.shadowMap);
+}
+
+void initRenderer(Renderer& r, Gpu& gpu, const RenderSettings& settings, const GpuScene& scene) {
+    r.gpu = &gpu;
+    r.settings = settings;
+    if (settings.width == 0 || settings.height == 0 || settings.ssaa == 0)
+        throw InputError("--size and --ssaa must be positive");
+    createTargets(r);
+    r.maxDraws = std::max<uint32_t>(scene.instanceCount, 1);
+    VkDeviceSize drawBytes = VkDeviceSize(DRAW_LIST_COUNT) * r.maxDraws * sizeof(gpu::DrawIndexedCommand);
+    r.draws = createBuffer(gpu, {"draws.camera", drawBytes, VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT});
+    r.shadowDraws = createBuffer(gpu, {"draws.sunShadow", drawBytes, VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT});
+    r.drawCounts = createBuffer(gpu, {"draws.counts", 2 * DRAW_LIST_COUNT * 4, VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT});
+    r.frameConstants = createBuffer(gpu, {"frameConstants", sizeof(gpu::FrameConstants), 0, MemoryKind::Upload});
+    r.pixels = createBuffer(gpu, {"pixels.readback", VkDeviceSize(settings.width) * settings.height * 4, 0,
+                                  MemoryKind::Readback});
+    if (!r.draws || !r.shadowDraws || !r.drawCounts || !r.frameConstants || !r.pixels)
+        throw DeviceError("out of GPU memory for the renderer's frame buffers");
+    createForwardPipelines(r);
+    createTonemapPipeline(r);
+    initShaderMessages(gpu, r.messages);
+    initFrameRecorder(gpu, r.recorder, settings.timing);
+    if (settings.mode == RenderMode::Decoupled) r.decoupled = createDecoupled(r, scene);
+}
+
+void destroyRenderer(Renderer& r) {
+    if (!r.gpu) return;
+    Gpu& gpu = *r.gpu;
+    vkDeviceWaitIdle(gpu.device.device);
+    if (r.decoupled) destroyDecoupled(r, r.decoupled);
+    destroyFrameRecorder(r.recorder);
+    destroyShaderMessages(gpu, r.messages);
+    destroyForwardPipelines(r);
+    destroy(gpu, r.tonemap);
+    for (BufferHandle b : {r.draws, r.shadowDraws, r.drawCounts, r.frameConstants, r.pixels}) destroy(gpu, b);
+    destroy(gpu, r.hdrTarget);
+    destroy(gpu, r.hdrRead);
+    destroy(gpu, r.depthTarget);
+    destroy(gpu, r.depthRead);
+    destroy(gpu, r.shadowTarget);
+    destroy(gpu, r.shadowRead);
+    for (TextureHandle t : {r.hdr, r.depth, r.shadowMap}) destroy(gpu, t);
+    r.gpu = nullptr;
+}
+
+// The sun's orthographic shadow volume, fitted to the scene bounds.
+static glm::mat4 sunViewProj(const GpuScene& scene, float& texelWorldSize, uint32_t mapSize) {
+    Aabb b = scene.bounds.valid() ? scene.bounds : Aabb{glm::vec3(-1), glm::vec3(1)};
+    glm::vec3 center = b.center();
+    float radius = std::max(glm::length(b.extent()) * 0.5f, 1e-3f);
+    glm::vec3 dir = glm::normalize(scene.sunDirection);
+    glm::vec3 up = std::abs(dir.y) > 0.99f ? glm::vec3(1, 0, 0) : glm::vec3(0, 1, 0);
+    glm::mat4 view = glm::lookAt(center - dir * radius * 2.0f, center, up);
+    glm::mat4 proj = glm::orthoRH_ZO(-radius, radius, -radius, radius, radius * 0.5f, radius * 3.5f);
+    texelWorldSize = 2.0f * radius / float(mapSize);
+    return proj * view;
+}
+
+static gpu::FrameConstants makeFrameConstants(Renderer& r, const GpuScene& scene, const CameraView& camera) {
+    Gpu& gpu = *r.gpu;
+    gpu::FrameConstants f{};
+    f.view = camera.view;
+    f.proj = camera.proj;
+    f.viewProj = camera.proj * camera.view;
+    f.invViewProj = glm::inverse(f.viewProj);
+    float texel = 0.0f;
+    f.sunViewProj = sunViewProj(scene, texel, r.settings.shadowMapSize);
+    auto planes = frustumPlanes(f.viewProj);
+    auto shadowPlanes = frustumPlanes(f.sunViewProj);
+    shadowPlanes[4] = glm::vec4(0, 0, 0, 1); // depth clamp keeps casters in front of the near plane
+    for (int i = 0; i < 6; ++i) f.frustumPlanes[i] = planes[i], f.shadowPlanes[i] = shadowPlanes[i];
+    f.cameraPosition = camera.position;
+    f.exposure = r.settings.exposure;
+    f.sunDirection = glm::normalize(scene.sunDirection);
+    f.sunColor = scene.sunColor;
+    f.sunShadowSlot = scene.sunCastsShadow ? slot(gpu, r.shadowRead).value : NO_TEXTURE;
+    f.shadowTexelSize = texel;
+    f.skyColor = scene.skyColor;
+    f.ambientColor = scene.ambientColor;
+    f.lightCount = scene.lightCount;
+    f.instanceCount = scene.instanceCount;
+    f.viewportSize = glm::vec2(r.internalWidth, r.internalHeight);
+    f.invViewportSize = 1.0f / f.viewportSize;
+    f.frameIndex = uint32_t(gpu.frameIndex);
+    f.visualize = uint32_t(r.settings.visualize);
+    f.vertices = address(gpu, scene.vertices);
+    f.indices = address(gpu, scene.indices);
+    f.meshes = address(gpu, scene.meshes);
+    f.instances = address(gpu, scene.instances);
+    f.materials = address(gpu, scene.materials);
+    f.lights = address(gpu, scene.lights);
+    f.messages = shaderMessagesAddress(gpu, r.messages);
+    return f;
+}
+
+// One frame, top to bottom. Forward: cull, shadow, depth prepass, shading, tonemap.
+// Decoupled replaces shading with marking, allocation, work queues, shadel shading and
+// reconstruction (render/shadel/decoupled.h).
+FrameResult renderFrame(Renderer& r, const GpuScene& scene, const CameraView& camera) {
+    Gpu& gpu = *r.gpu;
+    r.sceneIndices = scene.indices;
+    r.skyColor = scene.skyColor;
+    gpu::FrameConstants constants = makeFrameConstants(r, scene, camera);
+    if (r.decoupled) prepareDecoupledFrame(r, scene, camera, constants);
+    std::memcpy(mapped(gpu, r.frameConstants), &constants, sizeof(constants));
+    uint64_t frame = address(gpu, r.frameConstants);
+
+    FrameRecorder& rec = r.recorder;
+    beginFrame(rec);
+    pass(rec, "instanceCull", [&](VkCommandBuffer cmd) { recordInstanceCull(r, cmd, frame, scene); });
+    pass(rec, "shadowMap", [&](VkCommandBuffer cmd) { recordShadowMap(r, cmd, frame); });
+    pass(rec, "depthPrepass", [&](VkCommandBuffer cmd) { recordDepthPrepass(r, cmd, frame); });
+    if (r.settings.mode == RenderMode::Forward) {
+        pass(rec, "forwardShading", [&](VkCommandBuffer cmd) { recordForwardShading(r, cmd, frame); });
+    } else {
+        recordDecoupledPasses(r, rec, frame, scene);
+    }
+    pass(rec, "tonemap", [&](VkCommandBuffer cmd) { recordTonemap(r, cmd, frame); });
+    endFrame(rec);
+
+    FrameResult result;
+    result.passes = rec.passes;
+    result.frameMs = rec.frameMs;
+    result.shaderAsserts = collectShaderMessages(gpu, r.messages);
+    if (r.decoupled) finishDecoupledFrame(r);
+    size_t bytes = size_t(r.settings.width) * r.settings.height * 4;
+    result.rgba.resize(bytes);
+    std::memcpy(result.rgba.data(), mapped(gpu, r.pixels), bytes);
+    for (size_t i = 3; i < bytes; i += 4) result.pixelsCovered += result.rgba[i] != 0;
+    return result;
+}
+
+} // namespace shadel

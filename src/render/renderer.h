@@ -1,0 +1,72 @@
+#pragma once
+// The renderer: owns render targets, pipelines and per-frame buffers, and renders one frame
+// as a list of passes (renderFrame in renderer.cpp reads top to bottom).
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "render/camera.h"
+#include "render/gpu_scene.h"
+#include "rhi/frame.h"
+#include "rhi/pipeline.h"
+#include "rhi/shader_messages.h"
+
+namespace shadel {
+
+enum class RenderMode { Forward, Decoupled };
+enum class Visualize : uint32_t { None = 0, Marking = 1, Mips = 2, Chunks = 3, Sheet = 4 };
+
+struct RenderSettings {
+    uint32_t width = 1280, height = 720;
+    uint32_t ssaa = 1; // N x N supersampling (forward reference)
+    RenderMode mode = RenderMode::Forward;
+    Visualize visualize = Visualize::None;
+    float exposure = 1.0f;
+    uint32_t shadowMapSize = 2048;
+    TimingMode timing = TimingMode::SubmitPerPass;
+};
+
+struct FrameResult {
+    std::vector<uint8_t> rgba; // width x height RGBA8, alpha = 255 where geometry covers the pixel
+    uint64_t pixelsCovered = 0;
+    std::vector<PassTiming> passes;
+    double frameMs = 0.0;
+    uint32_t shaderAsserts = 0;
+};
+
+struct DecoupledState; // render/shadel/decoupled.h
+struct DecoupledStateDeleter {
+    void operator()(DecoupledState* state) const; // defined with the state
+};
+using DecoupledStatePtr = std::unique_ptr<DecoupledState, DecoupledStateDeleter>;
+
+struct Renderer {
+    Gpu* gpu = nullptr;
+    RenderSettings settings;
+    // Targets at the internal resolution (width*ssaa x height*ssaa).
+    uint32_t internalWidth = 0, internalHeight = 0;
+    TextureHandle hdr, depth, shadowMap;
+    RenderTargetView hdrTarget;
+    TextureReadView hdrRead;
+    DepthTargetView depthTarget, shadowTarget;
+    TextureReadView depthRead, shadowRead;
+    // Per-frame data.
+    BufferHandle frameConstants; // host-visible gpu::FrameConstants
+    BufferHandle draws;          // DrawIndexedCommand[DRAW_LIST_COUNT * maxDraws], camera view
+    BufferHandle shadowDraws;
+    BufferHandle drawCounts;     // uint[DRAW_LIST_COUNT] camera, then uint[...] shadow
+    BufferHandle pixels;         // readback RGBA8
+    uint32_t maxDraws = 0;
+    BufferHandle sceneIndices; // the unified index buffer of the scene being drawn
+    glm::vec3 skyColor{0.5f};
+    Pipeline instanceCull, depthPrepass, shadowPass, forwardOpaque, forwardBlend, tonemap;
+    ShaderMessageChannel messages;
+    FrameRecorder recorder;
+    DecoupledStatePtr decoupled;
+};
+
+void initRenderer(Renderer& renderer, Gpu& gpu, const RenderSettings& settings, const GpuScene& scene);
+void destroyRenderer(Renderer& renderer);
+FrameResult renderFrame(Renderer& renderer, const GpuScene& scene, const CameraView& camera);
+
+} // namespace shadel

@@ -1,0 +1,31 @@
+#pragma once
+// Generalized decoupled shading (seeds 000/002): the passes that replace forward shading.
+#include <memory>
+
+#include <nlohmann/json_fwd.hpp>
+
+#include "common/shared_types.h"
+#include "render/renderer.h"
+#include "rhi/frame.h"
+
+namespace shadel {
+
+struct Renderer;
+struct GpuScene;
+struct CameraView;
+struct DecoupledState;
+
+DecoupledStatePtr createDecoupled(Renderer& r, const GpuScene& scene);
+void destroyDecoupled(Renderer& r, DecoupledStatePtr& state);
+// CPU side of the frame: coarse allocation of potentially visible objects in the virtual
+// sheet, shading bias; fills the decoupled fields of the frame constants.
+void prepareDecoupledFrame(Renderer& r, const GpuScene& scene, const CameraView& camera,
+                           gpu::FrameConstants& constants);
+// Marking, allocation, work queues, shading, reconstruction.
+void recordDecoupledPasses(Renderer& r, FrameRecorder& rec, uint64_t frame, const GpuScene& scene);
+// Reads back the frame's counters (after the GPU finished).
+void finishDecoupledFrame(Renderer& r);
+// Adds the decoupled fields of DESIGN §5 (medians over the frames rendered so far).
+void decoupledStats(const Renderer& r, nlohmann::json& stats);
+
+} // namespace shadel

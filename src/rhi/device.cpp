@@ -1,0 +1,491 @@
+#include "rhi/device.h"
+
+#include <cstring>
+#include <optional>
+#include <vector>
+
+#include "core/log.h"
+
+namespace shadel {
+
+const char* vkResultName(VkResult r) {
+    switch (r) {
+#define CASE(x)                                                                                    \
+    case x: return #x;
+        CASE(VK_SUCCESS)
+        CASE(VK_NOT_READY)
+        CASE(VK_TIMEOUT)
+        CASE(VK_INCOMPLETE)
+        CASE(VK_ERROR_OUT_OF_HOST_MEMORY)
+        CASE(VK_ERROR_OUT_OF_DEVICE_MEMORY)
+        CASE(VK_ERROR_INITIALIZATION_FAILED)
+        CASE(VK_ERROR_DEVICE_LOST)
+        CASE(VK_ERROR_MEMORY_MAP_FAILED)
+        CASE(VK_ERROR_LAYER_NOT_PRESENT)
+        CASE(VK_ERROR_EXTENSION_NOT_PRESENT)
+        CASE(VK_ERROR_FEATURE_NOT_PRESENT)
+        CASE(VK_ERROR_INCOMPATIBLE_DRIVER)
+        CASE(VK_ERROR_TOO_MANY_OBJECTS)
+        CASE(VK_ERROR_FORMAT_NOT_SUPPORTED)
+        CASE(VK_ERROR_FRAGMENTED_POOL)
+        CASE(VK_ERROR_OUT_OF_POOL_MEMORY)
+#undef CASE
+    default: return "VK_ERROR_(unknown)";
+    }
+}
+
+void throwVkError(VkResult r, const char* call, const char* file, int line) {
+    throw DeviceError(format("Vulkan call failed: %s returned %s (%s:%d)", call, vkResultName(r),
+                             file, line));
+}
+
+static VKAPI_ATTR VkBool32 VKAPI_CALL debugCallback(VkDebugUtilsMessageSeverityFlagBitsEXT severity,
+                                                   VkDebugUtilsMessageTypeFlagsEXT,
+                                                   const VkDebugUtilsMessengerCallbackDataEXT* data,
+                                                   void* user) {
+    Device& device = *static_cast<Device*>(user);
+    if (severity & VK_DEBUG_UTILS_MESSAGE_SEVERITY_ERROR_BIT_EXT) {
+        device.validationErrors++;
+        if (device.printValidation) SHADEL_ERROR("vulkan validation: %s", data->pMessage);
+    } else if (severity & VK_DEBUG_UTILS_MESSAGE_SEVERITY_WARNING_BIT_EXT) {
+        device.validationWarnings++;
+        if (device.printValidation) SHADEL_WARN("vulkan validation: %s", data->pMessage);
+    }
+    return VK_FALSE;
+}
+
+static bool hasLayer(const char* name) {
+    uint32_t n = 0;
+    vkEnumerateInstanceLayerProperties(&n, nullptr);
+    std::vector<VkLayerProperties> layers(n);
+    vkEnumerateInstanceLayerProperties(&n, layers.data());
+    for (auto& l : layers)
+        if (!std::strcmp(l.layerName, name)) return true;
+    return false;
+}
+
+static bool hasInstanceExtension(const char* name) {
+    uint32_t n = 0;
+    vkEnumerateInstanceExtensionProperties(nullptr, &n, nullptr);
+    std::vector<VkExtensionProperties> exts(n);
+    vkEnumerateInstanceExtensionProperties(nullptr, &n, exts.data());
+    for (auto& e : exts)
+        if (!std::strcmp(e.extensionName, name)) return true;
+    return false;
+}
+
+static std::vector<VkExtensionProperties> deviceExtensions(VkPhysicalDevice pd) {
+    uint32_t n = 0;
+    vkEnumerateDeviceExtensionProperties(pd, nullptr, &n, nullptr);
+    std::vector<VkExtensionProperties> exts(n);
+    vkEnumerateDeviceExtensionProperties(pd, nullptr, &n, exts.data());
+    return exts;
+}
+
+static bool hasExtension(const std::vector<VkExtensionProperties>& exts, const char* name) {
+    for (auto& e : exts)
+        if (!std::strcmp(e.extensionName, name)) return true;
+    return false;
+}
+
+static const char* typeName(VkPhysicalDeviceType t) {
+    switch (t) {
+    case VK_PHYSICAL_DEVICE_TYPE_DISCRETE_GPU: return "discrete GPU";
+    case VK_PHYSICAL_DEVICE_TYPE_INTEGRATED_GPU: return "integrated GPU";
+    case VK_PHYSICAL_DEVICE_TYPE_VIRTUAL_GPU: return "virtual GPU";
+    case VK_PHYSICAL_DEVICE_TYPE_CPU: return "CPU";
+    default: return "other";
+    }
+}
+
+static VkInstance createInstanceForQuery() {
+    VkApplicationInfo app{VK_STRUCTURE_TYPE_APPLICATION_INFO};
+    app.apiVersion = VK_API_VERSION_1_3;
+    VkInstanceCreateInfo ci{VK_STRUCTURE_TYPE_INSTANCE_CREATE_INFO};
+    ci.pApplicationInfo = &app;
+    VkInstance instance = VK_NULL_HANDLE;
+    if (vkCreateInstance(&ci, nullptr, &instance) != VK_SUCCESS) return VK_NULL_HANDLE;
+    return instance;
+}
+
+static std::vector<VkPhysicalDevice> physicalDevices(VkInstance instance) {
+    uint32_t n = 0;
+    vkEnumeratePhysicalDevices(instance, &n, nullptr);
+    std::vector<VkPhysicalDevice> pds(n);
+    vkEnumeratePhysicalDevices(instance, &n, pds.data());
+    return pds;
+}
+
+std::string listPhysicalDevices() {
+    VkInstance instance = createInstanceForQuery();
+    if (!instance) return "  (no Vulkan instance)\n";
+    std::string out;
+    auto pds = physicalDevices(instance);
+    for (size_t i = 0; i < pds.size(); ++i) {
+        VkPhysicalDeviceProperties p;
+        vkGetPhysicalDeviceProperties(pds[i], &p);
+        out += format("  [%zu] %s (%s)\n", i, p.deviceName, typeName(p.deviceType));
+    }
+    vkDestroyInstance(instance, nullptr);
+    return out;
+}
+
+// Checks every feature DESIGN §2 requires; returns the name of the first one missing.
+struct FeatureChain {
+    VkPhysicalDeviceFeatures2 core{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2};
+    VkPhysicalDeviceVulkan11Features v11{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_1_FEATURES};
+    VkPhysicalDeviceVulkan12Features v12{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_2_FEATURES};
+    VkPhysicalDeviceVulkan13Features v13{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_3_FEATURES};
+    void link() {
+        core.pNext = &v11;
+        v11.pNext = &v12;
+        v12.pNext = &v13;
+        v13.pNext = nullptr;
+    }
+};
+
+static std::optional<std::string> missingRequiredFeature(VkPhysicalDevice pd) {
+    VkPhysicalDeviceProperties props;
+    vkGetPhysicalDeviceProperties(pd, &props);
+    if (props.apiVersion < VK_API_VERSION_1_3) return std::string("Vulkan 1.3");
+    FeatureChain f;
+    f.link();
+    vkGetPhysicalDeviceFeatures2(pd, &f.core);
+    struct Req {
+        VkBool32 have;
+        const char* name;
+    };
+    const Req reqs[] = {
+        {f.v13.dynamicRendering, "dynamicRendering"},
+        {f.v13.synchronization2, "synchronization2"},
+        {f.v12.timelineSemaphore, "timelineSemaphore"},
+        {f.v12.descriptorIndexing, "descriptorIndexing"},
+        {f.v12.runtimeDescriptorArray, "runtimeDescriptorArray"},
+        {f.v12.descriptorBindingPartiallyBound, "descriptorBindingPartiallyBound"},
+        {f.v12.shaderSampledImageArrayNonUniformIndexing, "shaderSampledImageArrayNonUniformIndexing"},
+        {f.v12.shaderStorageImageArrayNonUniformIndexing, "shaderStorageImageArrayNonUniformIndexing"},
+        {f.v12.descriptorBindingSampledImageUpdateAfterBind, "descriptorBindingSampledImageUpdateAfterBind"},
+        {f.v12.descriptorBindingStorageImageUpdateAfterBind, "descriptorBindingStorageImageUpdateAfterBind"},
+        {f.v12.bufferDeviceAddress, "bufferDeviceAddress"},
+        {f.v12.shaderBufferInt64Atomics, "shaderBufferInt64Atomics"},
+        {f.v12.drawIndirectCount, "drawIndirectCount"},
+        {f.v12.scalarBlockLayout, "scalarBlockLayout"},
+        {f.v12.hostQueryReset, "hostQueryReset"},
+        {f.v11.shaderDrawParameters, "shaderDrawParameters"},
+        {f.core.features.shaderInt64, "shaderInt64"},
+        {f.core.features.fragmentStoresAndAtomics, "fragmentStoresAndAtomics"},
+        {f.core.features.multiDrawIndirect, "multiDrawIndirect"},
+        {f.core.features.drawIndirectFirstInstance, "drawIndirectFirstInstance"},
+        {f.core.features.samplerAnisotropy, "samplerAnisotropy"},
+        {f.core.features.shaderStorageImageWriteWithoutFormat, "shaderStorageImageWriteWithoutFormat"},
+        {f.core.features.depthClamp, "depthClamp"},
+    };
+    for (const Req& r : reqs)
+        if (!r.have) return std::string(r.name);
+    if (!props.limits.timestampComputeAndGraphics) return std::string("timestampComputeAndGraphics");
+    return std::nullopt;
+}
+
+static VkPhysicalDevice choosePhysicalDevice(VkInstance instance, const std::string& selection) {
+    auto pds = physicalDevices(instance);
+    if (pds.empty()) throw DeviceError("no Vulkan device found (is mesa-vulkan-drivers installed?)");
+    auto isCpu = [](VkPhysicalDevice pd) {
+        VkPhysicalDeviceProperties p;
+        vkGetPhysicalDeviceProperties(pd, &p);
+        return p.deviceType == VK_PHYSICAL_DEVICE_TYPE_CPU;
+    };
+    auto rank = [](VkPhysicalDevice pd) {
+        VkPhysicalDeviceProperties p;
+        vkGetPhysicalDeviceProperties(pd, &p);
+        switch (p.deviceType) {
+        case VK_PHYSICAL_DEVICE_TYPE_DISCRETE_GPU: return 4;
+        case VK_PHYSICAL_DEVICE_TYPE_INTEGRATED_GPU: return 3;
+        case VK_PHYSICAL_DEVICE_TYPE_VIRTUAL_GPU: return 2;
+        case VK_PHYSICAL_DEVICE_TYPE_CPU: return 1;
+        default: return 0;
+        }
+    };
+    if (!selection.empty() && std::isdigit(uint8_t(selection[0]))) {
+        char* end = nullptr;
+        unsigned long index = std::strtoul(selection.c_str(), &end, 10);
+        if (*end || index >= pds.size())
+            throw InputError(format("--device %s: no such device index (devices:\n%s)",
+                                    selection.c_str(), listPhysicalDevices().c_str()));
+        if (auto missing = missingRequiredFeature(pds[index]))
+            throw DeviceError(format("--device %s lacks required Vulkan feature %s",
+                                     selection.c_str(), missing->c_str()));
+        return pds[index];
+    }
+    if (selection != "auto" && selection != "cpu" && selection != "gpu")
+        throw InputError(format("--device %s: expected auto, cpu, gpu or an index",
+                                selection.c_str()));
+    VkPhysicalDevice best = VK_NULL_HANDLE;
+    int bestRank = -1;
+    std::string lastMissing;
+    for (VkPhysicalDevice pd : pds) {
+        if (selection == "cpu" && !isCpu(pd)) continue;
+        if (selection == "gpu" && isCpu(pd)) continue;
+        if (auto missing = missingRequiredFeature(pd)) {
+            VkPhysicalDeviceProperties p;
+            vkGetPhysicalDeviceProperties(pd, &p);
+            lastMissing = format("%s lacks required Vulkan feature %s", p.deviceName, missing->c_str());
+            SHADEL_DEBUG("skipping device: %s", lastMissing.c_str());
+            continue;
+        }
+        if (rank(pd) > bestRank) best = pd, bestRank = rank(pd);
+    }
+    if (!best) {
+        if (!lastMissing.empty()) throw DeviceError(lastMissing);
+        throw DeviceError(format("--device %s: no matching Vulkan device", selection.c_str()));
+    }
+    return best;
+}
+
+void createDevice(Device& device, const DeviceDesc& desc) {
+    device.printValidation = desc.printValidation;
+    VkApplicationInfo app{VK_STRUCTURE_TYPE_APPLICATION_INFO};
+    app.pApplicationName = "shadel";
+    app.pEngineName = "shadel";
+    app.apiVersion = VK_API_VERSION_1_3;
+
+    std::vector<const char*> layers;
+    std::vector<const char*> extensions;
+    bool debugUtils = hasInstanceExtension(VK_EXT_DEBUG_UTILS_EXTENSION_NAME);
+    if (debugUtils) extensions.push_back(VK_EXT_DEBUG_UTILS_EXTENSION_NAME);
+    if (desc.validation) {
+        if (!hasLayer("VK_LAYER_KHRONOS_validation"))
+            throw DeviceError("validation requested but VK_LAYER_KHRONOS_validation is not "
+                              "installed (apt-get install vulkan-validationlayers)");
+        layers.push_back("VK_LAYER_KHRONOS_validation");
+        device.validation = true;
+    }
+    VkDebugUtilsMessengerCreateInfoEXT messengerInfo{
+        VK_STRUCTURE_TYPE_DEBUG_UTILS_MESSENGER_CREATE_INFO_EXT};
+    messengerInfo.messageSeverity = VK_DEBUG_UTILS_MESSAGE_SEVERITY_ERROR_BIT_EXT |
+                                    VK_DEBUG_UTILS_MESSAGE_SEVERITY_WARNING_BIT_EXT;
+    messengerInfo.messageType = VK_DEBUG_UTILS_MESSAGE_TYPE_VALIDATION_BIT_EXT |
+                                VK_DEBUG_UTILS_MESSAGE_TYPE_GENERAL_BIT_EXT;
+    messengerInfo.pfnUserCallback = debugCallback;
+    messengerInfo.pUserData = &device;
+
+    VkInstanceCreateInfo ci{VK_STRUCTURE_TYPE_INSTANCE_CREATE_INFO};
+    ci.pApplicationInfo = &app;
+    ci.enabledLayerCount = uint32_t(layers.size());
+    ci.ppEnabledLayerNames = layers.data();
+    ci.enabledExtensionCount = uint32_t(extensions.size());
+    ci.ppEnabledExtensionNames = extensions.data();
+    if (desc.validation && debugUtils) ci.pNext = &messengerInfo;
+    VkResult r = vkCreateInstance(&ci, nullptr, &device.instance);
+    if (r != VK_SUCCESS)
+        throw DeviceError(format("cannot create a Vulkan 1.3 instance (%s)", vkResultName(r)));
+
+    if (debugUtils) {
+        device.setObjectName = (PFN_vkSetDebugUtilsObjectNameEXT)vkGetInstanceProcAddr(
+            device.instance, "vkSetDebugUtilsObjectNameEXT");
+        device.cmdBeginLabel = (PFN_vkCmdBeginDebugUtilsLabelEXT)vkGetInstanceProcAddr(
+            device.instance, "vkCmdBeginDebugUtilsLabelEXT");
+        device.cmdEndLabel = (PFN_vkCmdEndDebugUtilsLabelEXT)vkGetInstanceProcAddr(
+            device.instance, "vkCmdEndDebugUtilsLabelEXT");
+        if (desc.validation) {
+            auto create = (PFN_vkCreateDebugUtilsMessengerEXT)vkGetInstanceProcAddr(
+                device.instance, "vkCreateDebugUtilsMessengerEXT");
+            if (create) VK_CHECK(create(device.instance, &messengerInfo, nullptr, &device.messenger));
+        }
+    }
+
+    device.physical = choosePhysicalDevice(device.instance, desc.selection);
+    vkGetPhysicalDeviceProperties(device.physical, &device.properties);
+    vkGetPhysicalDeviceMemoryProperties(device.physical, &device.memory);
+    device.name = device.properties.deviceName;
+    device.isCpu = device.properties.deviceType == VK_PHYSICAL_DEVICE_TYPE_CPU;
+    device.timestampPeriodNs = device.properties.limits.timestampPeriod;
+
+    VkPhysicalDeviceDriverProperties driverProps{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_DRIVER_PROPERTIES};
+    VkPhysicalDeviceProperties2 props2{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PROPERTIES_2};
+    props2.pNext = &driverProps;
+    vkGetPhysicalDeviceProperties2(device.physical, &props2);
+    device.driver = format("%s %s", driverProps.driverName, driverProps.driverInfo);
+
+    uint32_t familyCount = 0;
+    vkGetPhysicalDeviceQueueFamilyProperties(device.physical, &familyCount, nullptr);
+    std::vector<VkQueueFamilyProperties> families(familyCount);
+    vkGetPhysicalDeviceQueueFamilyProperties(device.physical, &familyCount, families.data());
+    device.queueFamily = ~0u;
+    for (uint32_t i = 0; i < familyCount; ++i) {
+        if ((families[i].queueFlags & VK_QUEUE_GRAPHICS_BIT) &&
+            (families[i].queueFlags & VK_QUEUE_COMPUTE_BIT) && families[i].timestampValidBits) {
+            device.queueFamily = i;
+            break;
+        }
+    }
+    if (device.queueFamily == ~0u)
+        throw DeviceError(format("%s has no graphics+compute queue with timestamps", device.name.c_str()));
+
+    // Enable exactly what we require, plus optional features when present.
+    FeatureChain f;
+    f.link();
+    vkGetPhysicalDeviceFeatures2(device.physical, &f.core);
+    FeatureChain enable;
+    enable.link();
+    enable.v13.dynamicRendering = VK_TRUE;
+    enable.v13.synchronization2 = VK_TRUE;
+    enable.v13.maintenance4 = f.v13.maintenance4;
+    enable.v12.timelineSemaphore = VK_TRUE;
+    enable.v12.descriptorIndexing = VK_TRUE;
+    enable.v12.runtimeDescriptorArray = VK_TRUE;
+    enable.v12.descriptorBindingPartiallyBound = VK_TRUE;
+    enable.v12.shaderSampledImageArrayNonUniformIndexing = VK_TRUE;
+    enable.v12.shaderStorageImageArrayNonUniformIndexing = VK_TRUE;
+    enable.v12.descriptorBindingSampledImageUpdateAfterBind = VK_TRUE;
+    enable.v12.descriptorBindingStorageImageUpdateAfterBind = VK_TRUE;
+    enable.v12.descriptorBindingUpdateUnusedWhilePending = f.v12.descriptorBindingUpdateUnusedWhilePending;
+    enable.v12.bufferDeviceAddress = VK_TRUE;
+    enable.v12.shaderBufferInt64Atomics = VK_TRUE;
+    enable.v12.drawIndirectCount = VK_TRUE;
+    enable.v12.scalarBlockLayout = VK_TRUE;
+    enable.v12.hostQueryReset = VK_TRUE;
+    enable.v12.shaderFloat16 = f.v12.shaderFloat16;
+    enable.v12.storageBuffer8BitAccess = f.v12.storageBuffer8BitAccess;
+    enable.v12.shaderInt8 = f.v12.shaderInt8;
+    enable.v11.shaderDrawParameters = VK_TRUE;
+    enable.v11.storageBuffer16BitAccess = f.v11.storageBuffer16BitAccess;
+    enable.core.features.shaderInt64 = VK_TRUE;
+    enable.core.features.shaderInt16 = f.core.features.shaderInt16;
+    enable.core.features.fragmentStoresAndAtomics = VK_TRUE;
+    enable.core.features.vertexPipelineStoresAndAtomics = f.core.features.vertexPipelineStoresAndAtomics;
+    enable.core.features.multiDrawIndirect = VK_TRUE;
+    enable.core.features.drawIndirectFirstInstance = VK_TRUE;
+    enable.core.features.samplerAnisotropy = VK_TRUE;
+    enable.core.features.shaderStorageImageWriteWithoutFormat = VK_TRUE;
+    enable.core.features.shaderStorageImageReadWithoutFormat =
+        f.core.features.shaderStorageImageReadWithoutFormat;
+    enable.core.features.depthClamp = VK_TRUE;
+    enable.core.features.independentBlend = f.core.features.independentBlend;
+
+    auto exts = deviceExtensions(device.physical);
+    std::vector<const char*> deviceExts;
+    void* tail = nullptr;
+    VkPhysicalDeviceMeshShaderFeaturesEXT mesh{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_MESH_SHADER_FEATURES_EXT};
+    VkPhysicalDeviceRayQueryFeaturesKHR rayQuery{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_RAY_QUERY_FEATURES_KHR};
+    VkPhysicalDeviceAccelerationStructureFeaturesKHR accel{
+        VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_ACCELERATION_STRUCTURE_FEATURES_KHR};
+    VkPhysicalDeviceComputeShaderDerivativesFeaturesNV derivs{
+        VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_COMPUTE_SHADER_DERIVATIVES_FEATURES_NV};
+    if (hasExtension(exts, VK_EXT_MESH_SHADER_EXTENSION_NAME)) {
+        VkPhysicalDeviceFeatures2 q{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2};
+        q.pNext = &mesh;
+        vkGetPhysicalDeviceFeatures2(device.physical, &q);
+        if (mesh.meshShader && mesh.taskShader) {
+            mesh.multiviewMeshShader = VK_FALSE;
+            mesh.primitiveFragmentShadingRateMeshShader = VK_FALSE;
+            mesh.meshShaderQueries = VK_FALSE;
+            deviceExts.push_back(VK_EXT_MESH_SHADER_EXTENSION_NAME);
+            mesh.pNext = tail;
+            tail = &mesh;
+            device.optional.meshShader = true;
+        }
+    }
+    if (hasExtension(exts, VK_KHR_RAY_QUERY_EXTENSION_NAME) &&
+        hasExtension(exts, VK_KHR_ACCELERATION_STRUCTURE_EXTENSION_NAME) &&
+        hasExtension(exts, VK_KHR_DEFERRED_HOST_OPERATIONS_EXTENSION_NAME)) {
+        VkPhysicalDeviceFeatures2 q{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2};
+        q.pNext = &rayQuery;
+        rayQuery.pNext = &accel;
+        vkGetPhysicalDeviceFeatures2(device.physical, &q);
+        if (rayQuery.rayQuery && accel.accelerationStructure) {
+            deviceExts.push_back(VK_KHR_RAY_QUERY_EXTENSION_NAME);
+            deviceExts.push_back(VK_KHR_ACCELERATION_STRUCTURE_EXTENSION_NAME);
+            deviceExts.push_back(VK_KHR_DEFERRED_HOST_OPERATIONS_EXTENSION_NAME);
+            VkPhysicalDeviceRayQueryFeaturesKHR rq{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_RAY_QUERY_FEATURES_KHR};
+            rayQuery = rq;
+            rayQuery.rayQuery = VK_TRUE;
+            VkPhysicalDeviceAccelerationStructureFeaturesKHR as{
+                VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_ACCELERATION_STRUCTURE_FEATURES_KHR};
+            accel = as;
+            accel.accelerationStructure = VK_TRUE;
+            rayQuery.pNext = &accel;
+            accel.pNext = tail;
+            tail = &rayQuery;
+            device.optional.rayQuery = true;
+        } else {
+            rayQuery.pNext = nullptr;
+        }
+    }
+    if (hasExtension(exts, VK_NV_COMPUTE_SHADER_DERIVATIVES_EXTENSION_NAME)) {
+        VkPhysicalDeviceFeatures2 q{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2};
+        q.pNext = &derivs;
+        vkGetPhysicalDeviceFeatures2(device.physical, &q);
+        if (derivs.computeDerivativeGroupQuads) {
+            deviceExts.push_back(VK_NV_COMPUTE_SHADER_DERIVATIVES_EXTENSION_NAME);
+            derivs.computeDerivativeGroupLinear = VK_FALSE;
+            derivs.pNext = tail;
+            tail = &derivs;
+            device.optional.computeDerivatives = true;
+        }
+    }
+    enable.v13.pNext = tail;
+
+    float priority = 1.0f;
+    VkDeviceQueueCreateInfo qci{VK_STRUCTURE_TYPE_DEVICE_QUEUE_CREATE_INFO};
+    qci.queueFamilyIndex = device.queueFamily;
+    qci.queueCount = 1;
+    qci.pQueuePriorities = &priority;
+    VkDeviceCreateInfo dci{VK_STRUCTURE_TYPE_DEVICE_CREATE_INFO};
+    dci.pNext = &enable.core;
+    dci.queueCreateInfoCount = 1;
+    dci.pQueueCreateInfos = &qci;
+    dci.enabledExtensionCount = uint32_t(deviceExts.size());
+    dci.ppEnabledExtensionNames = deviceExts.data();
+    r = vkCreateDevice(device.physical, &dci, nullptr, &device.device);
+    if (r != VK_SUCCESS)
+        throw DeviceError(format("cannot create the Vulkan device on %s (%s)", device.name.c_str(),
+                                 vkResultName(r)));
+    vkGetDeviceQueue(device.device, device.queueFamily, 0, &device.queue);
+    if (device.optional.meshShader)
+        device.cmdDrawMeshTasksIndirect = (PFN_vkCmdDrawMeshTasksIndirectEXT)vkGetDeviceProcAddr(
+            device.device, "vkCmdDrawMeshTasksIndirectEXT");
+    setName(device, device.queue, VK_OBJECT_TYPE_QUEUE, "mainQueue");
+    SHADEL_DEBUG("device: %s (%s)", device.name.c_str(), device.driver.c_str());
+}
+
+void destroyDevice(Device& device) {
+    if (device.device) vkDestroyDevice(device.device, nullptr);
+    if (device.messenger) {
+        auto destroy = (PFN_vkDestroyDebugUtilsMessengerEXT)vkGetInstanceProcAddr(
+            device.instance, "vkDestroyDebugUtilsMessengerEXT");
+        if (destroy) destroy(device.instance, device.messenger, nullptr);
+    }
+    if (device.instance) vkDestroyInstance(device.instance, nullptr);
+    device.device = VK_NULL_HANDLE;
+    device.instance = VK_NULL_HANDLE;
+    device.messenger = VK_NULL_HANDLE;
+}
+
+std::string describeDevice(const Device& device) {
+    const VkPhysicalDeviceLimits& l = device.properties.limits;
+    std::string out;
+    out += format("device:   %s (%s)\n", device.name.c_str(), typeName(device.properties.deviceType));
+    out += format("driver:   %s\n", device.driver.c_str());
+    out += format("api:      %u.%u.%u\n", VK_API_VERSION_MAJOR(device.properties.apiVersion),
+                  VK_API_VERSION_MINOR(device.properties.apiVersion),
+                  VK_API_VERSION_PATCH(device.properties.apiVersion));
+    out += "required: dynamicRendering synchronization2 timelineSemaphore descriptorIndexing "
+           "bufferDeviceAddress shaderInt64 shaderBufferInt64Atomics fragmentStoresAndAtomics "
+           "multiDrawIndirect drawIndirectCount timestamps: all present\n";
+    out += format("optional: meshShader=%s rayQuery=%s computeDerivatives=%s\n",
+                  device.optional.meshShader ? "yes" : "no", device.optional.rayQuery ? "yes" : "no",
+                  device.optional.computeDerivatives ? "yes" : "no");
+    out += format("limits:   maxImageDimension2D=%u maxComputeWorkGroupInvocations=%u "
+                  "maxPushConstantsSize=%u maxDescriptorSetUpdateAfterBindSampledImages=%u "
+                  "timestampPeriod=%.3fns\n",
+                  l.maxImageDimension2D, l.maxComputeWorkGroupInvocations, l.maxPushConstantsSize,
+                  l.maxPerStageDescriptorSampledImages, double(l.timestampPeriod));
+    uint64_t heapTotal = 0;
+    for (uint32_t i = 0; i < device.memory.memoryHeapCount; ++i)
+        if (device.memory.memoryHeaps[i].flags & VK_MEMORY_HEAP_DEVICE_LOCAL_BIT)
+            heapTotal += device.memory.memoryHeaps[i].size;
+    out += format("memory:   %.1f GiB device-local\n", double(heapTotal) / (1 << 30));
+    return out;
+}
+
+} // namespace shadel

@@ -1,0 +1,52 @@
+#pragma once
+// Pipelines: SPIR-V modules loaded from the build's shader directory, one global pipeline
+// layout (the bindless set + 128 bytes of push constants). Vertices are pulled from the
+// unified geometry buffer by device address, so no vertex input state is declared.
+#include <string>
+#include <vector>
+
+#include "rhi/vk.h"
+
+namespace shadel {
+
+struct Gpu;
+
+struct GraphicsPipelineDesc {
+    std::string name;
+    std::string vertexShader;   // file name of the .spv in the shader directory
+    std::string fragmentShader; // empty = depth only
+    std::vector<VkFormat> colorFormats;
+    VkFormat depthFormat = VK_FORMAT_UNDEFINED;
+    bool depthTest = true;
+    bool depthWrite = true;
+    VkCompareOp depthCompare = VK_COMPARE_OP_GREATER_OR_EQUAL; // reversed Z
+    VkCullModeFlags cullMode = VK_CULL_MODE_BACK_BIT;
+    bool depthClamp = false;
+    bool depthBias = false;
+    enum class Blend { None, Alpha, Additive } blend = Blend::None;
+    std::vector<std::pair<uint32_t, uint32_t>> specialization; // constant id, value
+};
+
+struct Pipeline {
+    VkPipeline pipeline = VK_NULL_HANDLE;
+    VkPipelineBindPoint bindPoint = VK_PIPELINE_BIND_POINT_GRAPHICS;
+    std::string name;
+};
+
+std::string shaderDirectory();
+std::vector<uint32_t> loadSpirv(const std::string& fileName);
+Pipeline createGraphicsPipeline(Gpu& gpu, const GraphicsPipelineDesc& desc);
+Pipeline createComputePipeline(Gpu& gpu, const std::string& name, const std::string& shader,
+                               const std::vector<std::pair<uint32_t, uint32_t>>& specialization = {});
+void destroy(Gpu& gpu, Pipeline& pipeline);
+
+// Binds the pipeline and the current bindless set.
+void bind(const Gpu& gpu, VkCommandBuffer cmd, const Pipeline& pipeline);
+void pushConstants(const Gpu& gpu, VkCommandBuffer cmd, const void* data, uint32_t size);
+template <typename T>
+void pushConstants(const Gpu& gpu, VkCommandBuffer cmd, const T& value) {
+    static_assert(sizeof(T) <= 128, "push constants are limited to 128 bytes");
+    pushConstants(gpu, cmd, &value, sizeof(T));
+}
+
+} // namespace shadel

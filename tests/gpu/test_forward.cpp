@@ -1,0 +1,77 @@
+#include "gpu_test_env.h"
+
+#include "rhi/shader_messages.h"
+
+using namespace shadel;
+using namespace shadel::test;
+
+TEST(Forward, RendersDefaultSceneWithCoverageAndTimings) {
+    RenderOptions o;
+    o.scene = "builtin:default";
+    o.width = 160;
+    o.height = 90;
+    RenderRun run = renderChecked(o);
+    ASSERT_EQ(run.frames.size(), 1u);
+    const auto& s = run.stats;
+    EXPECT_GT(s["pixels_covered"].get<uint64_t>(), 160u * 90u / 4) << "the default camera should see geometry";
+    EXPECT_LE(s["pixels_covered"].get<uint64_t>(), 160u * 90u);
+    std::vector<std::string> passes;
+    for (auto& p : s["passes"]) passes.push_back(p["name"]);
+    EXPECT_EQ(passes, (std::vector<std::string>{"instanceCull", "shadowMap", "depthPrepass", "forwardShading", "tonemap"}));
+    for (auto& p : s["passes"]) EXPECT_GE(p["gpu_ms"].get<double>(), 0.0);
+    // The image is not flat: sky and lit geometry differ.
+    const auto& px = run.frames[0].rgba;
+    int minL = 255, maxL = 0;
+    for (size_t i = 0; i < px.size(); i += 4) {
+        int l = (px[i] + px[i + 1] + px[i + 2]) / 3;
+        minL = std::min(minL, l), maxL = std::max(maxL, l);
+    }
+    EXPECT_GT(maxL - minL, 60);
+}
+
+TEST(Forward, SameInputGivesSameImage) {
+    RenderOptions o;
+    o.scene = "builtin:smooth";
+    o.width = 96;
+    o.height = 64;
+    o.frames = 2;
+    RenderRun run = renderChecked(o);
+    EXPECT_EQ(run.frames[0].rgba, run.frames[1].rgba) << "no jitter: frames must be identical";
+}
+
+TEST(Forward, JitterMovesTheImage) {
+    RenderOptions o;
+    o.scene = "builtin:checker";
+    o.width = 96;
+    o.height = 64;
+    o.frames = 2;
+    o.jitter = true;
+    RenderRun run = renderChecked(o);
+    EXPECT_NE(run.frames[0].rgba, run.frames[1].rgba);
+}
+
+TEST(Forward, SupersampledReferenceIsCloseToOneSampleOnSmoothContent) {
+    RenderOptions o;
+    o.scene = "builtin:smooth";
+    o.width = 96;
+    o.height = 64;
+    RenderRun one = renderChecked(o);
+    o.ssaa = 4;
+    RenderRun four = renderChecked(o);
+    double p = psnr(one.frames[0].rgba, four.frames[0].rgba);
+    EXPECT_GT(p, 25.0) << "smooth content: 1x and 4x4 SSAA differ only on edges";
+    EXPECT_LT(p, 99.0) << "SSAA must change edge pixels";
+}
+
+TEST(Forward, TimestampAndSubmitTimingGiveTheSamePasses) {
+    RenderOptions o;
+    o.scene = "builtin:smooth";
+    o.width = 64;
+    o.height = 64;
+    o.timing = TimingMode::Timestamps;
+    RenderRun a = renderChecked(o);
+    o.timing = TimingMode::SubmitPerPass;
+    RenderRun b = renderChecked(o);
+    EXPECT_EQ(a.stats["passes"].size(), b.stats["passes"].size());
+    EXPECT_EQ(a.frames[0].rgba, b.frames[0].rgba);
+}
