@@ -34,6 +34,10 @@ layout(buffer_reference, scalar) readonly buffer InstanceBuffer { GpuInstance i[
 layout(buffer_reference, scalar) readonly buffer MaterialBuffer { GpuMaterial m[]; };
 layout(buffer_reference, scalar) readonly buffer LightBuffer { GpuLight l[]; };
 layout(buffer_reference, scalar) buffer UintBuffer { uint v[]; };
+layout(buffer_reference, scalar) buffer Uint64Buffer { uint64_t v[]; };
+layout(buffer_reference, scalar) readonly buffer Vec2Buffer { vec2 v[]; };
+layout(buffer_reference, scalar) readonly buffer ShadelFrameRef { ShadelFrame s; };
+layout(buffer_reference, scalar) readonly buffer ShadelObjectBuffer { GpuShadelObject o[]; };
 layout(buffer_reference, scalar) buffer DrawBuffer { DrawIndexedCommand d[]; };
 layout(buffer_reference, scalar) buffer ShaderMessages {
     uint count;

@@ -34,9 +34,10 @@ using uint = uint32_t;
 #define NO_TEXTURE 0xFFFFFFFFu
 
 // Draw lists written by the instance culling pass.
-#define DRAW_LIST_OPAQUE 0u
-#define DRAW_LIST_BLEND 1u
-#define DRAW_LIST_COUNT 2u
+#define DRAW_LIST_OPAQUE 0u    // forward-shaded opaque and alpha-masked instances
+#define DRAW_LIST_BLEND 1u     // forward-shaded blended instances
+#define DRAW_LIST_DECOUPLED 2u // opaque instances shaded in shadel space this frame
+#define DRAW_LIST_COUNT 3u
 
 // Debug views (--visualize).
 #define VISUALIZE_NONE 0u
@@ -154,6 +155,81 @@ struct ShaderMessage {
     uint line;
     uint pad;
     uvec4 values;
+};
+
+// ---- Decoupled shading (render/shadel) ----------------------------------------------------
+#define SHADEL_MAX_MIPS 10u
+#define SHADEL_COUNTERS 16u     // hashed allocation counters (seed: N parallel allocations)
+#define SHADEL_BLOCK 64u        // shadels per block side (8 x 8 chunks)
+#define SHADEL_CHUNK 8u         // shadels per chunk side
+#define SHADEL_INVALID 0xFFFFFFFFu
+#define SHADEL_OBJECT_DECOUPLED 1u // allocated in the sheet this frame: drawn decoupled
+
+// Per instance: where its shadel space lives in the virtual sheet at each MIP.
+struct GpuShadelObject {
+    uvec2 mip0Size;   // MIP-0 shadel rect (BakedMesh::width/height)
+    uint mipCount;
+    uint flags;
+    uint idMapOffset[SHADEL_MAX_MIPS]; // in 16-bit units into ShadelFrame::idMaps
+    uvec4 rect[SHADEL_MAX_MIPS];       // x, y, w, h in blocks of the virtual sheet
+};
+
+// One rectangle of the sheet in use this frame (the clear and allocation passes walk these).
+struct GpuShadelRect {
+    uvec4 rect;      // x, y, w, h in blocks
+    uint object;
+    uint mip;
+    uint firstBlock; // prefix sum of w*h over the rect list
+    uint pad;
+};
+
+// One chunk of shading work: {chunk, storage slot, object, MIP} as in the seed.
+struct GpuShadelWork {
+    uint chunk; // sheet chunk coordinate, x | y << 16
+    uint slot;  // storage chunk slot
+    uint object;
+    uint mip;
+};
+
+struct GpuShadelCounters {
+    uint hashed[SHADEL_COUNTERS]; // chunks taken from each storage section
+    uint chunksRequested;         // marked chunks
+    uint chunksAllocated;         // chunks that got storage
+    uint chunksOverflowed;        // marked chunks that did not fit (counted, not shaded)
+    uint markedBlocks;
+    uint reconstructionMisses;    // samples that found no marked chunk (must be 0)
+    uint overflowSamples;         // samples whose chunk overflowed storage (shaded forward)
+    uint shadelsShaded;
+    uint pad0;
+    uvec4 fillDispatch;   // x, y, z, pad: indirect args of the queue fill pass
+    uvec4 shadeDispatch;  // indirect args of the shading pass
+};
+
+struct ShadelFrame {
+    uint64_t objects;      // GpuShadelObject[instanceCount]
+    uint64_t occupancy;    // uint64 per sheet block: one bit per chunk
+    uint64_t offsetMap;    // uint per block: base storage slot of its chunks
+    uint64_t allocId;      // uint per block: (object + 1) << 4 | mip, 0 = free
+    uint64_t counters;     // GpuShadelCounters
+    uint64_t rects;        // GpuShadelRect[rectCount]
+    uint64_t markedBlocks; // uvec2 {block, first object-local chunk} per marked block
+    uint64_t objectChunks; // uint per object: chunk count, then (after setup) queue base
+    uint64_t objectDispatch; // uvec4 per object: indirect dispatch args + queue base
+    uint64_t queue;        // GpuShadelWork[capacityChunks]
+    uint64_t idMaps;       // uint16 triangle ids, packed in uints
+    uint64_t shadelUvs;    // vec2 per vertex of the unified geometry buffer
+    uint sheetBlocks;      // blocks per side of the virtual sheet
+    uint rectCount;
+    uint rectBlockCount;
+    uint storageWriteSlot; // bindless storage image of the shade storage
+    uint storageReadSlot;  // bindless sampled view of it
+    uint storageChunksPerRow;
+    uint capacityChunks;
+    uint chunksPerCounter;
+    uint objectCount;
+    float shadingBias;
+    uint pad0;
+    uint pad1;
 };
 
 #ifdef __cplusplus

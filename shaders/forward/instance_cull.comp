@@ -32,6 +32,10 @@ void main() {
     GpuMaterial mat = MaterialBuffer(f.materials).m[inst.material];
     uint list = (mat.flags & MATERIAL_ALPHA_BLEND) != 0u ? DRAW_LIST_BLEND : DRAW_LIST_OPAQUE;
     if (pc.shadowView != 0u && list == DRAW_LIST_BLEND) return;
+    // Instances allocated in the shadel sheet this frame are drawn by the decoupled passes.
+    if (pc.shadowView == 0u && list == DRAW_LIST_OPAQUE && f.shadel != 0ul &&
+        (ShadelObjectBuffer(ShadelFrameRef(f.shadel).s.objects).o[id].flags & SHADEL_OBJECT_DECOUPLED) != 0u)
+        list = DRAW_LIST_DECOUPLED;
     GpuMesh mesh = MeshBuffer(f.meshes).m[inst.mesh];
     uint slot = atomicAdd(UintBuffer(pc.counts).v[list], 1u);
     SHADEL_ASSERT(f, slot < pc.maxDraws, ASSERT_DRAW_OVERFLOW, slot, pc.maxDraws);

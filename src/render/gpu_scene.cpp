@@ -132,6 +132,29 @@ void uploadScene(Gpu& gpu, const Scene& scene, GpuScene& out, const std::vector<
     }
     out.instanceInfo = instances;
 
+    // Triangle-ID maps of every baked mesh and MIP, packed as 16-bit values.
+    std::vector<uint16_t> idMaps;
+    if (baked) {
+        out.shadelMeshes.resize(scene.meshes.size());
+        for (size_t mi = 0; mi < scene.meshes.size(); ++mi) {
+            const BakedMesh& b = (*baked)[mi];
+            ShadelMeshInfo& info = out.shadelMeshes[mi];
+            if (b.indices.empty() || b.idMaps.empty()) continue;
+            info.mip0Size = {b.width, b.height};
+            info.mipCount = std::min<uint32_t>(b.mipCount(), SHADEL_MAX_MIPS);
+            for (uint32_t k = 0; k < info.mipCount; ++k) {
+                info.idMapOffset[k] = uint32_t(idMaps.size());
+                idMaps.insert(idMaps.end(), b.idMaps[k].begin(), b.idMaps[k].end());
+                info.idMapTexels += b.idMaps[k].size();
+            }
+            if (idMaps.size() % 2) idMaps.push_back(0xFFFF);
+            if (idMaps.size() > 0xFFFFFFFFull)
+                throw DeviceError("triangle-ID maps exceed 4 G texels: lower --density");
+        }
+        out.idMaps = uploadArray(gpu, "scene.idMaps", idMaps.data(), idMaps.size() * 2);
+        out.idMapBytes = idMaps.size() * 2;
+    }
+
     std::vector<gpu::GpuLight> lights;
     bool haveSun = false;
     for (const Light& l : scene.lights) {
@@ -172,7 +195,7 @@ void uploadScene(Gpu& gpu, const Scene& scene, GpuScene& out, const std::vector<
 void destroyScene(Gpu& gpu, GpuScene& s) {
     for (TextureReadView v : s.textureViews) destroy(gpu, v);
     for (TextureHandle t : s.textures) destroy(gpu, t);
-    for (BufferHandle b : {s.vertices, s.shadelUvs, s.indices, s.meshes, s.instances, s.materials, s.lights})
+    for (BufferHandle b : {s.vertices, s.shadelUvs, s.indices, s.meshes, s.instances, s.materials, s.lights, s.idMaps})
         destroy(gpu, b);
     s = GpuScene{};
 }

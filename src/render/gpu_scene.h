@@ -1,6 +1,7 @@
 #pragma once
 // The scene on the GPU (seed 003's unified geometry): one vertex buffer and one index buffer
 // for every mesh, material and instance tables, textures in the bindless table.
+#include <array>
 #include <vector>
 
 #include "common/shared_types.h"
@@ -10,6 +11,14 @@
 namespace shadel {
 
 struct BakedMesh;
+
+// A mesh's shadel space as the decoupled path sees it.
+struct ShadelMeshInfo {
+    glm::uvec2 mip0Size{0};
+    uint32_t mipCount = 0; // 0: no shadel space (drawn forward)
+    std::array<uint32_t, SHADEL_MAX_MIPS> idMapOffset{}; // 16-bit units into GpuScene::idMaps
+    uint64_t idMapTexels = 0;
+};
 
 struct GpuScene {
     BufferHandle vertices;  // gpu::GpuVertex[]
@@ -22,6 +31,8 @@ struct GpuScene {
     std::vector<TextureHandle> textures;
     std::vector<TextureReadView> textureViews;
     std::vector<gpu::GpuMesh> meshInfo;
+    std::vector<ShadelMeshInfo> shadelMeshes; // per mesh, when baked
+    BufferHandle idMaps;                       // every mesh's triangle-ID maps, all MIPs
     std::vector<gpu::GpuInstance> instanceInfo;
     uint32_t instanceCount = 0;
     uint32_t lightCount = 0;
@@ -33,6 +44,7 @@ struct GpuScene {
     glm::vec3 skyColor{0.5f};
     glm::vec3 ambientColor{0.05f};
     uint64_t geometryBytes = 0;
+    uint64_t idMapBytes = 0;
 };
 
 // Uploads the scene. With `baked` (one per mesh), each mesh's vertices are the baked ones

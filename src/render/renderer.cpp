@@ -169,6 +169,7 @@ FrameResult renderFrame(Renderer& r, const GpuScene& scene, const CameraView& ca
         recordDecoupledPasses(r, rec, frame, scene);
     }
     pass(rec, "tonemap", [&](VkCommandBuffer cmd) { recordTonemap(r, cmd, frame); });
+    if (r.decoupled) recordDecoupledPostPasses(r, rec, frame);
     endFrame(rec);
 
     FrameResult result;

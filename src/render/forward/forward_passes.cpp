@@ -5,10 +5,6 @@
 namespace shadel {
 
 namespace {
-struct RasterPush {
-    uint64_t frame;
-    uint32_t shadowView;
-};
 struct CullPush {
     uint64_t frame;
     uint64_t draws;
@@ -155,6 +151,7 @@ void recordDepthPrepass(Renderer& r, VkCommandBuffer cmd, uint64_t frame) {
     bind(gpu, cmd, r.depthPrepass);
     pushConstants(gpu, cmd, RasterPush{frame, 0});
     drawCameraList(r, cmd, DRAW_LIST_OPAQUE);
+    drawCameraList(r, cmd, DRAW_LIST_DECOUPLED);
     vkCmdEndRendering(cmd);
     memoryBarrier(cmd, VK_PIPELINE_STAGE_2_LATE_FRAGMENT_TESTS_BIT,
                   VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT,

@@ -1,9 +1,16 @@
 #pragma once
 // The forward path's passes: GPU instance culling into indirect draw lists, the sun's shadow
 // map, the depth prepass and forward shading. The decoupled path reuses the first three.
+#include <cstdint>
+
 #include "rhi/vk.h"
 
 namespace shadel {
+
+struct RasterPush { // push constants of every raster pass (shaders/forward/forward.vert)
+    uint64_t frame;
+    uint32_t shadowView;
+};
 
 struct Renderer;
 struct GpuScene;

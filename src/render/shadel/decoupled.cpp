@@ -1,24 +1,465 @@
 #include "render/shadel/decoupled.h"
 
+#include <algorithm>
+#include <cstring>
+
 #include <nlohmann/json.hpp>
 
+#include "core/block_allocator.h"
 #include "core/error.h"
+#include "core/log.h"
+#include "render/forward/forward_passes.h"
 #include "render/renderer.h"
 
 namespace shadel {
 
-struct DecoupledState {};
+namespace {
+
+// The virtual sheet is split into one column of blocks per MIP level; finer levels need more
+// room (an object's MIP k rect is a quarter of its MIP k-1 rect, but never below one block).
+constexpr uint32_t kRegionWidths1024[SHADEL_MAX_MIPS] = {448, 224, 112, 64, 48, 32, 32, 32, 16, 16};
+
+struct SheetRegion {
+    uint32_t x0 = 0, width = 0;
+    std::unique_ptr<BlockAllocator2D> allocator;
+};
+
+struct ObjectSlot {
+    bool allocated = false;
+    bool noSpace = false; // wanted decoupled but the sheet was full: drawn forward
+    uint32_t mipCount = 0;
+    std::array<BlockId, SHADEL_MAX_MIPS> ids{};
+    std::array<glm::uvec4, SHADEL_MAX_MIPS> rects{};
+};
+
+struct FrameCounters {
+    gpu::GpuShadelCounters counters;
+    uint32_t objectsDecoupled = 0;
+    uint32_t objectsForward = 0;
+    uint64_t rectBlocks = 0;
+};
+
+} // namespace
+
+struct DecoupledState {
+    uint32_t sheetBlocks = 1024; // 64k x 64k shadels
+    uint32_t storageSize = 4096; // shadels per side of the physical storage
+    float frustumMargin = 0.1f;  // fraction of an object's radius
+    float shadingBias = 0.0f;
+    std::vector<SheetRegion> regions;
+    std::vector<ObjectSlot> objects;
+    std::vector<gpu::GpuShadelObject> gpuObjects;
+    std::vector<gpu::GpuShadelRect> rects;
+    uint32_t rectBlockCount = 0;
+    uint32_t capacityChunks = 0;
+    uint32_t objectsDecoupled = 0, objectsForward = 0;
+
+    BufferHandle frameInfo;     // gpu::ShadelFrame (upload)
+    BufferHandle objectBuffer;  // GpuShadelObject[] (upload)
+    BufferHandle rectBuffer;    // GpuShadelRect[] (upload)
+    BufferHandle occupancy;     // uint64 per block
+    BufferHandle offsetMap;     // uint per block
+    BufferHandle allocId;       // uint per block (upload: written by the CPU allocator)
+    BufferHandle counters;      // GpuShadelCounters (readback, also indirect args)
+    BufferHandle markedBlocks;  // uvec4 per marked block
+    uint32_t markedCapacity = 0;
+    BufferHandle objectChunks;  // uint per object
+    BufferHandle objectDispatch; // uvec4 per object
+    BufferHandle queue;         // GpuShadelWork[capacity]
+    TextureHandle storage;
+    TextureWriteView storageWrite;
+    TextureReadView storageRead;
+    Pipeline clear, allocate, queueSetup, fillQueue, shade, sheetView, mark, reconstruct;
+    std::vector<FrameCounters> history;
+};
 
 void DecoupledStateDeleter::operator()(DecoupledState* state) const { delete state; }
 
-DecoupledStatePtr createDecoupled(Renderer&, const GpuScene&) {
-    throw InputError("--mode decoupled: not available yet (the decoupled path is being built; "
-                     "use --mode forward)");
+static BufferHandle need(BufferHandle b, const char* what) {
+    if (!b) throw DeviceError(format("out of GPU memory for the decoupled path's %s", what));
+    return b;
 }
-void destroyDecoupled(Renderer&, DecoupledStatePtr& state) { state.reset(); }
-void prepareDecoupledFrame(Renderer&, const GpuScene&, const CameraView&, gpu::FrameConstants&) {}
-void recordDecoupledPasses(Renderer&, FrameRecorder&, uint64_t, const GpuScene&) {}
-void finishDecoupledFrame(Renderer&) {}
-void decoupledStats(const Renderer&, nlohmann::json&) {}
+
+DecoupledStatePtr createDecoupled(Renderer& r, const GpuScene& scene) {
+    Gpu& gpu = *r.gpu;
+    if (scene.shadelMeshes.empty())
+        throw InputError("--mode decoupled needs a baked scene (internal: uploadScene without bake)");
+    DecoupledStatePtr state(new DecoupledState());
+    DecoupledState& d = *state;
+    uint32_t x = 0;
+    for (uint32_t k = 0; k < SHADEL_MAX_MIPS; ++k) {
+        SheetRegion region;
+        region.x0 = x;
+        region.width = std::max(1u, kRegionWidths1024[k] * d.sheetBlocks / 1024);
+        region.allocator = std::make_unique<BlockAllocator2D>(Extent<2>{region.width, d.sheetBlocks});
+        x += region.width;
+        d.regions.push_back(std::move(region));
+    }
+    d.objects.resize(scene.instanceCount);
+    d.gpuObjects.resize(std::max(scene.instanceCount, 1u));
+    uint64_t blocks = uint64_t(d.sheetBlocks) * d.sheetBlocks;
+    uint32_t chunksPerSide = d.storageSize / SHADEL_CHUNK;
+    d.capacityChunks = chunksPerSide * chunksPerSide;
+
+    auto upload = [&](const char* name, VkDeviceSize bytes) {
+        return need(createBuffer(gpu, {name, bytes, 0, MemoryKind::Upload}), name);
+    };
+    auto device = [&](const char* name, VkDeviceSize bytes, VkBufferUsageFlags usage = 0) {
+        return need(createBuffer(gpu, {name, bytes, usage, MemoryKind::DeviceLocal}), name);
+    };
+    d.frameInfo = upload("shadel.frame", sizeof(gpu::ShadelFrame));
+    d.objectBuffer = upload("shadel.objects", d.gpuObjects.size() * sizeof(gpu::GpuShadelObject));
+    d.rectBuffer = upload("shadel.rects", std::max<size_t>(scene.instanceCount, 1) * SHADEL_MAX_MIPS *
+                                              sizeof(gpu::GpuShadelRect));
+    d.occupancy = device("shadel.chunkOccupancy", blocks * 8);
+    d.offsetMap = device("shadel.offsetMap", blocks * 4);
+    d.allocId = upload("shadel.allocId", blocks * 4);
+    std::memset(mapped(gpu, d.allocId), 0, blocks * 4);
+    d.counters = need(createBuffer(gpu, {"shadel.counters", sizeof(gpu::GpuShadelCounters),
+                                         VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT, MemoryKind::Readback}),
+                      "counters");
+    d.objectChunks = device("shadel.objectChunks", d.gpuObjects.size() * 4);
+    d.objectDispatch = device("shadel.objectDispatch", d.gpuObjects.size() * 16,
+                              VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT);
+    d.queue = device("shadel.workQueue", VkDeviceSize(d.capacityChunks) * sizeof(gpu::GpuShadelWork));
+
+    TextureDesc storage;
+    storage.name = "shadel.shadeStorage";
+    storage.format = VK_FORMAT_R16G16B16A16_SFLOAT;
+    storage.width = storage.height = d.storageSize;
+    storage.usage = VK_IMAGE_USAGE_STORAGE_BIT | VK_IMAGE_USAGE_SAMPLED_BIT;
+    d.storage = createTexture(gpu, storage);
+    if (!d.storage) throw DeviceError("out of GPU memory for the shade storage");
+    d.storageWrite = createWriteView(gpu, d.storage);
+    d.storageRead = createReadView(gpu, d.storage);
+    VkImage image = vkImage(gpu, d.storage);
+    immediateSubmit(gpu, [&](VkCommandBuffer cmd) {
+        imageBarrier(cmd, image, VK_IMAGE_ASPECT_COLOR_BIT, VK_IMAGE_LAYOUT_UNDEFINED,
+                     VK_IMAGE_LAYOUT_GENERAL, VK_PIPELINE_STAGE_2_NONE, 0,
+                     VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, VK_ACCESS_2_SHADER_READ_BIT);
+    });
+
+    d.clear = createComputePipeline(gpu, "shadelClear", "shadel_clear.comp.spv");
+    d.allocate = createComputePipeline(gpu, "shadelAllocate", "shadel_allocate.comp.spv");
+    d.queueSetup = createComputePipeline(gpu, "shadelQueueSetup", "shadel_queue_setup.comp.spv");
+    d.fillQueue = createComputePipeline(gpu, "shadelFillQueue", "shadel_fill_queue.comp.spv");
+    d.shade = createComputePipeline(gpu, "shadelShade", "shadel_shade.comp.spv");
+    d.sheetView = createComputePipeline(gpu, "shadelSheetView", "shadel_sheet_view.comp.spv");
+    GraphicsPipelineDesc mark;
+    mark.name = "shadelMark";
+    mark.vertexShader = "forward_forward.vert.spv";
+    mark.fragmentShader = "shadel_mark.frag.spv";
+    mark.depthFormat = VK_FORMAT_D32_SFLOAT;
+    mark.depthWrite = false;
+    mark.depthCompare = VK_COMPARE_OP_EQUAL;
+    mark.cullMode = VK_CULL_MODE_NONE;
+    d.mark = createGraphicsPipeline(gpu, mark);
+    GraphicsPipelineDesc recon = mark;
+    recon.name = "shadelReconstruct";
+    recon.fragmentShader = "shadel_reconstruct.frag.spv";
+    recon.colorFormats = {VK_FORMAT_R16G16B16A16_SFLOAT};
+    d.reconstruct = createGraphicsPipeline(gpu, recon);
+    return state;
+}
+
+void destroyDecoupled(Renderer& r, DecoupledStatePtr& state) {
+    if (!state) return;
+    Gpu& gpu = *r.gpu;
+    DecoupledState& d = *state;
+    for (Pipeline* p : {&d.clear, &d.allocate, &d.queueSetup, &d.fillQueue, &d.shade, &d.sheetView, &d.mark,
+                        &d.reconstruct})
+        destroy(gpu, *p);
+    destroy(gpu, d.storageWrite);
+    destroy(gpu, d.storageRead);
+    destroy(gpu, d.storage);
+    for (BufferHandle b : {d.frameInfo, d.objectBuffer, d.rectBuffer, d.occupancy, d.offsetMap, d.allocId,
+                           d.counters, d.markedBlocks, d.objectChunks, d.objectDispatch, d.queue})
+        destroy(gpu, b);
+    state.reset();
+}
+
+static void writeAllocId(Gpu& gpu, DecoupledState& d, const glm::uvec4& rect, uint32_t value) {
+    auto* ids = static_cast<uint32_t*>(mapped(gpu, d.allocId));
+    for (uint32_t y = rect.y; y < rect.y + rect.w; ++y)
+        for (uint32_t x = rect.x; x < rect.x + rect.z; ++x) ids[size_t(y) * d.sheetBlocks + x] = value;
+}
+
+static void freeObject(Gpu& gpu, DecoupledState& d, ObjectSlot& o) {
+    for (uint32_t k = 0; k < o.mipCount; ++k) {
+        if (!o.ids[k].valid()) continue;
+        d.regions[k].allocator->remove(o.ids[k]);
+        writeAllocId(gpu, d, o.rects[k], 0);
+        o.ids[k] = BlockId{};
+    }
+    o.allocated = false;
+}
+
+// Coarse CPU allocation (seed: "CPU side max space estimator"): every potentially visible
+// object gets a rect at each of its MIPs; objects that leave the view give theirs back.
+static bool allocateObject(Gpu& gpu, DecoupledState& d, ObjectSlot& o, uint32_t object,
+                           const ShadelMeshInfo& mesh) {
+    o.mipCount = mesh.mipCount;
+    for (uint32_t k = 0; k < mesh.mipCount; ++k) {
+        uint32_t w = std::max(1u, mesh.mip0Size.x >> k), h = std::max(1u, mesh.mip0Size.y >> k);
+        Extent<2> blocks{(w + SHADEL_BLOCK - 1) / SHADEL_BLOCK, (h + SHADEL_BLOCK - 1) / SHADEL_BLOCK};
+        auto placed = d.regions[k].allocator->insert(blocks);
+        if (!placed) {
+            freeObject(gpu, d, o);
+            return false;
+        }
+        o.ids[k] = placed->id;
+        o.rects[k] = {d.regions[k].x0 + placed->origin[0], placed->origin[1], blocks[0], blocks[1]};
+        writeAllocId(gpu, d, o.rects[k], ((object + 1) << 4) | k);
+    }
+    o.allocated = true;
+    return true;
+}
+
+static bool boxVisible(const std::array<glm::vec4, 6>& planes, glm::vec3 bmin, glm::vec3 bmax) {
+    for (const glm::vec4& p : planes) {
+        glm::vec3 v{p.x >= 0 ? bmax.x : bmin.x, p.y >= 0 ? bmax.y : bmin.y, p.z >= 0 ? bmax.z : bmin.z};
+        if (glm::dot(glm::vec3(p), v) + p.w < 0) return false;
+    }
+    return true;
+}
+
+void prepareDecoupledFrame(Renderer& r, const GpuScene& scene, const CameraView&,
+                           gpu::FrameConstants& constants) {
+    Gpu& gpu = *r.gpu;
+    DecoupledState& d = *r.decoupled;
+    auto planes = frustumPlanes(constants.viewProj);
+    d.rects.clear();
+    d.rectBlockCount = 0;
+    d.objectsDecoupled = d.objectsForward = 0;
+    for (uint32_t i = 0; i < scene.instanceCount; ++i) {
+        const gpu::GpuInstance& inst = scene.instanceInfo[i];
+        const ShadelMeshInfo& mesh = scene.shadelMeshes[inst.mesh];
+        ObjectSlot& o = d.objects[i];
+        gpu::GpuShadelObject& g = d.gpuObjects[i];
+        g = gpu::GpuShadelObject{};
+        glm::vec3 margin = (inst.worldMax - inst.worldMin) * d.frustumMargin;
+        bool wanted = mesh.mipCount > 0 && boxVisible(planes, inst.worldMin - margin, inst.worldMax + margin);
+        if (!wanted) {
+            if (o.allocated) freeObject(gpu, d, o);
+            o.noSpace = false;
+            continue;
+        }
+        if (!o.allocated) o.noSpace = !allocateObject(gpu, d, o, i, mesh);
+        if (!o.allocated) {
+            d.objectsForward++;
+            continue;
+        }
+        d.objectsDecoupled++;
+        g.mip0Size = mesh.mip0Size;
+        g.mipCount = mesh.mipCount;
+        g.flags = SHADEL_OBJECT_DECOUPLED;
+        for (uint32_t k = 0; k < mesh.mipCount; ++k) {
+            g.idMapOffset[k] = mesh.idMapOffset[k];
+            g.rect[k] = o.rects[k];
+            d.rects.push_back({o.rects[k], i, k, d.rectBlockCount, 0});
+            d.rectBlockCount += o.rects[k].z * o.rects[k].w;
+        }
+    }
+    if (d.rectBlockCount > d.markedCapacity) {
+        destroy(gpu, d.markedBlocks);
+        d.markedCapacity = std::max(d.rectBlockCount, d.markedCapacity * 2);
+        d.markedBlocks = need(createBuffer(gpu, {"shadel.markedBlocks", VkDeviceSize(d.markedCapacity) * 16}),
+                              "marked block list");
+    }
+    std::memcpy(mapped(gpu, d.objectBuffer), d.gpuObjects.data(), d.gpuObjects.size() * sizeof(gpu::GpuShadelObject));
+    std::memcpy(mapped(gpu, d.rectBuffer), d.rects.data(), d.rects.size() * sizeof(gpu::GpuShadelRect));
+
+    gpu::ShadelFrame s{};
+    s.objects = address(gpu, d.objectBuffer);
+    s.occupancy = address(gpu, d.occupancy);
+    s.offsetMap = address(gpu, d.offsetMap);
+    s.allocId = address(gpu, d.allocId);
+    s.counters = address(gpu, d.counters);
+    s.rects = address(gpu, d.rectBuffer);
+    s.markedBlocks = d.markedBlocks ? address(gpu, d.markedBlocks) : 0;
+    s.objectChunks = address(gpu, d.objectChunks);
+    s.objectDispatch = address(gpu, d.objectDispatch);
+    s.queue = address(gpu, d.queue);
+    s.idMaps = address(gpu, scene.idMaps);
+    s.shadelUvs = address(gpu, scene.shadelUvs);
+    s.sheetBlocks = d.sheetBlocks;
+    s.rectCount = uint32_t(d.rects.size());
+    s.rectBlockCount = d.rectBlockCount;
+    s.storageWriteSlot = slot(gpu, d.storageWrite).value;
+    s.storageReadSlot = slot(gpu, d.storageRead).value;
+    s.storageChunksPerRow = d.storageSize / SHADEL_CHUNK;
+    s.capacityChunks = d.capacityChunks;
+    s.chunksPerCounter = d.capacityChunks / SHADEL_COUNTERS;
+    s.objectCount = scene.instanceCount;
+    s.shadingBias = d.shadingBias;
+    std::memcpy(mapped(gpu, d.frameInfo), &s, sizeof(s));
+    constants.shadel = address(gpu, d.frameInfo);
+    constants.shadingBias = d.shadingBias;
+}
+
+namespace {
+struct FramePush {
+    uint64_t frame;
+};
+void computeToCompute(VkCommandBuffer cmd) {
+    memoryBarrier(cmd, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_2_CLEAR_BIT,
+                  VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT | VK_ACCESS_2_TRANSFER_WRITE_BIT,
+                  VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_2_DRAW_INDIRECT_BIT,
+                  VK_ACCESS_2_SHADER_STORAGE_READ_BIT | VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT |
+                      VK_ACCESS_2_INDIRECT_COMMAND_READ_BIT);
+}
+} // namespace
+
+void recordDecoupledPasses(Renderer& r, FrameRecorder& rec, uint64_t frame, const GpuScene&) {
+    Gpu& gpu = *r.gpu;
+    DecoupledState& d = *r.decoupled;
+    uint32_t rectGroups = (d.rectBlockCount + 63) / 64;
+
+    pass(rec, "shadelClear", [&](VkCommandBuffer cmd) {
+        vkCmdFillBuffer(cmd, vkBuffer(gpu, d.counters), 0, VK_WHOLE_SIZE, 0);
+        vkCmdFillBuffer(cmd, vkBuffer(gpu, d.objectChunks), 0, VK_WHOLE_SIZE, 0);
+        if (rectGroups) {
+            bind(gpu, cmd, d.clear);
+            pushConstants(gpu, cmd, FramePush{frame});
+            vkCmdDispatch(cmd, rectGroups, 1, 1);
+        }
+        memoryBarrier(cmd, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_2_CLEAR_BIT,
+                      VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT | VK_ACCESS_2_TRANSFER_WRITE_BIT,
+                      VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT | VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
+                      VK_ACCESS_2_SHADER_STORAGE_READ_BIT | VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT);
+    });
+
+    pass(rec, "marking", [&](VkCommandBuffer cmd) {
+        VkRenderingAttachmentInfo depth{VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO};
+        depth.imageView = vkView(gpu, r.depthTarget);
+        depth.imageLayout = VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL;
+        depth.loadOp = VK_ATTACHMENT_LOAD_OP_LOAD;
+        depth.storeOp = VK_ATTACHMENT_STORE_OP_STORE;
+        VkRenderingInfo ri{VK_STRUCTURE_TYPE_RENDERING_INFO};
+        ri.renderArea = {{0, 0}, {r.internalWidth, r.internalHeight}};
+        ri.layerCount = 1;
+        ri.pDepthAttachment = &depth;
+        vkCmdBeginRendering(cmd, &ri);
+        bind(gpu, cmd, d.mark);
+        pushConstants(gpu, cmd, RasterPush{frame, 0});
+        drawCameraList(r, cmd, DRAW_LIST_DECOUPLED);
+        vkCmdEndRendering(cmd);
+        memoryBarrier(cmd, VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT, VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT,
+                      VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
+                      VK_ACCESS_2_SHADER_STORAGE_READ_BIT | VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT);
+    });
+
+    pass(rec, "shadelAllocate", [&](VkCommandBuffer cmd) {
+        if (rectGroups) {
+            bind(gpu, cmd, d.allocate);
+            pushConstants(gpu, cmd, FramePush{frame});
+            vkCmdDispatch(cmd, rectGroups, 1, 1);
+        }
+        computeToCompute(cmd);
+    });
+
+    pass(rec, "workQueues", [&](VkCommandBuffer cmd) {
+        bind(gpu, cmd, d.queueSetup);
+        pushConstants(gpu, cmd, FramePush{frame});
+        vkCmdDispatch(cmd, 1, 1, 1);
+        computeToCompute(cmd);
+        if (d.markedBlocks) {
+            bind(gpu, cmd, d.fillQueue);
+            pushConstants(gpu, cmd, FramePush{frame});
+            vkCmdDispatchIndirect(cmd, vkBuffer(gpu, d.counters), offsetof(gpu::GpuShadelCounters, fillDispatch));
+        }
+        computeToCompute(cmd);
+    });
+
+    pass(rec, "shadelShading", [&](VkCommandBuffer cmd) {
+        memoryBarrier(cmd, VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT, VK_ACCESS_2_SHADER_SAMPLED_READ_BIT,
+                      VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT);
+        bind(gpu, cmd, d.shade);
+        pushConstants(gpu, cmd, FramePush{frame});
+        vkCmdDispatchIndirect(cmd, vkBuffer(gpu, d.counters), offsetof(gpu::GpuShadelCounters, shadeDispatch));
+        memoryBarrier(cmd, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT,
+                      VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT, VK_ACCESS_2_SHADER_SAMPLED_READ_BIT);
+    });
+
+    // Decoupled objects read their shadels; forward objects (hybrid) shade as usual.
+    pass(rec, "reconstruction", [&](VkCommandBuffer cmd) {
+        beginSceneColorPass(r, cmd, true);
+        bind(gpu, cmd, d.reconstruct);
+        pushConstants(gpu, cmd, RasterPush{frame, 0});
+        drawCameraList(r, cmd, DRAW_LIST_DECOUPLED);
+        bind(gpu, cmd, r.forwardOpaque);
+        pushConstants(gpu, cmd, RasterPush{frame, 0});
+        drawCameraList(r, cmd, DRAW_LIST_OPAQUE);
+        bind(gpu, cmd, r.forwardBlend);
+        pushConstants(gpu, cmd, RasterPush{frame, 0});
+        drawCameraList(r, cmd, DRAW_LIST_BLEND);
+        vkCmdEndRendering(cmd);
+    });
+}
+
+void recordDecoupledPostPasses(Renderer& r, FrameRecorder& rec, uint64_t frame) {
+    if (r.settings.visualize != Visualize::Sheet) return;
+    Gpu& gpu = *r.gpu;
+    DecoupledState& d = *r.decoupled;
+    pass(rec, "sheetView", [&](VkCommandBuffer cmd) {
+        struct {
+            uint64_t frame;
+            uint64_t pixels;
+            uint32_t width, height;
+        } push{frame, address(gpu, r.pixels), r.settings.width, r.settings.height};
+        memoryBarrier(cmd, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT,
+                      VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT);
+        bind(gpu, cmd, d.sheetView);
+        pushConstants(gpu, cmd, push);
+        vkCmdDispatch(cmd, (r.settings.width + 7) / 8, (r.settings.height + 7) / 8, 1);
+        memoryBarrier(cmd, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT,
+                      VK_PIPELINE_STAGE_2_HOST_BIT, VK_ACCESS_2_HOST_READ_BIT);
+    });
+}
+
+void finishDecoupledFrame(Renderer& r) {
+    DecoupledState& d = *r.decoupled;
+    FrameCounters f;
+    std::memcpy(&f.counters, mapped(*r.gpu, d.counters), sizeof(f.counters));
+    f.objectsDecoupled = d.objectsDecoupled;
+    f.objectsForward = d.objectsForward;
+    f.rectBlocks = d.rectBlockCount;
+    d.history.push_back(f);
+    if (f.counters.chunksOverflowed)
+        SHADEL_WARN("shade storage full: %u of %u marked chunks did not fit (%u chunks capacity); "
+                    "those samples were shaded forward",
+                    f.counters.chunksOverflowed, f.counters.chunksRequested, d.capacityChunks);
+}
+
+void decoupledStats(const Renderer& r, nlohmann::json& s) {
+    const DecoupledState& d = *r.decoupled;
+    if (d.history.empty()) return;
+    const FrameCounters& last = d.history.back();
+    uint64_t misses = 0, overflowSamples = 0;
+    for (const FrameCounters& f : d.history) {
+        misses += f.counters.reconstructionMisses;
+        overflowSamples += f.counters.overflowSamples;
+    }
+    uint64_t shaded = last.counters.shadelsShaded;
+    uint64_t covered = s.value("pixels_covered", uint64_t(0));
+    s["shadels_shaded"] = shaded;
+    s["shadels_per_pixel"] = covered ? double(shaded) / double(covered) : 0.0;
+    s["chunks_allocated"] = last.counters.chunksAllocated;
+    s["chunks_requested"] = last.counters.chunksRequested;
+    s["chunks_overflowed"] = last.counters.chunksOverflowed;
+    s["chunks_capacity"] = d.capacityChunks;
+    s["shading_bias"] = d.shadingBias;
+    s["reconstruction_misses"] = misses;
+    s["overflow_samples"] = overflowSamples;
+    s["marked_blocks"] = last.counters.markedBlocks;
+    s["objects_decoupled"] = last.objectsDecoupled;
+    s["objects_forward"] = last.objectsForward;
+    s["sheet_blocks_allocated"] = last.rectBlocks;
+    s["sheet_shadels"] = uint64_t(d.sheetBlocks) * SHADEL_BLOCK;
+    // Bookkeeping per shaded shadel: the 64-bit occupancy mask + 32-bit offset of every block
+    // in use (the seed quotes ~1.5 bits per shadel).
+    s["occupancy_bits_per_shadel"] = shaded ? double(last.rectBlocks) * 96.0 / double(shaded) : 0.0;
+    s["storage_used"] = d.capacityChunks ? double(last.counters.chunksAllocated) / d.capacityChunks : 0.0;
+}
 
 } // namespace shadel

@@ -23,6 +23,8 @@ void prepareDecoupledFrame(Renderer& r, const GpuScene& scene, const CameraView&
                            gpu::FrameConstants& constants);
 // Marking, allocation, work queues, shading, reconstruction.
 void recordDecoupledPasses(Renderer& r, FrameRecorder& rec, uint64_t frame, const GpuScene& scene);
+// Passes after tonemapping (the sheet view).
+void recordDecoupledPostPasses(Renderer& r, FrameRecorder& rec, uint64_t frame);
 // Reads back the frame's counters (after the GPU finished).
 void finishDecoupledFrame(Renderer& r);
 // Adds the decoupled fields of DESIGN §5 (medians over the frames rendered so far).

@@ -1,0 +1,32 @@
+#!/usr/bin/env bash
+# The whole test suite: install, build, CPU unit tests + GPU tests (lavapipe, validation on),
+# the CPU unit tests again under AddressSanitizer + UBSan, and a bounded fuzz run.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+start=$(date +%s)
+bash scripts/setup.sh
+jobs=$(nproc 2>/dev/null || echo 2)
+
+echo "== build (Release)"
+bash scripts/build.sh
+
+echo "== tests: unit + GPU (Release, Khronos validation on)"
+export SHADEL_CACHE_DIR="$PWD/build/test-cache"
+ctest --test-dir build --output-on-failure -j1 --timeout 900
+
+echo "== tests: unit under AddressSanitizer + UBSan"
+cmake -S . -B build-asan -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DSHADEL_CPU_ONLY=ON \
+      -DSHADEL_BENCH=OFF -DSHADEL_SANITIZE=ON >/dev/null
+cmake --build build-asan -j"$jobs"
+ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=print_stacktrace=1 \
+    ctest --test-dir build-asan --output-on-failure -j"$jobs" --timeout 900
+
+if command -v clang++ >/dev/null 2>&1 && [ -f fuzz/fuzz_allocators.cpp ]; then
+  echo "== fuzz: allocators (libFuzzer, bounded)"
+  CC=clang CXX=clang++ cmake -S . -B build-fuzz -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo \
+      -DSHADEL_CPU_ONLY=ON -DSHADEL_BENCH=OFF -DSHADEL_FUZZ=ON >/dev/null
+  cmake --build build-fuzz -j"$jobs" --target shadel_fuzz_allocators
+  mkdir -p build-fuzz/corpus
+  ./build-fuzz/fuzz/shadel_fuzz_allocators -max_total_time=60 -seed=1 build-fuzz/corpus 2>&1 | tail -3
+fi
+echo "== all tests passed in $(( $(date +%s) - start )) s"

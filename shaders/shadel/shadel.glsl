@@ -1,0 +1,58 @@
+// Decoupled shading: addressing in the virtual shadel sheet, shared by marking, shading and
+// reconstruction so all three agree on which chunk a sample reads.
+#ifndef SHADEL_SHADEL_GLSL
+#define SHADEL_SHADEL_GLSL
+#include "common/bindless.glsl"
+
+layout(buffer_reference, scalar) buffer ShadelCountersRef { GpuShadelCounters c; };
+layout(buffer_reference, scalar) readonly buffer ShadelRectBuffer { GpuShadelRect r[]; };
+layout(buffer_reference, scalar) buffer ShadelWorkBuffer { GpuShadelWork w[]; };
+layout(buffer_reference, scalar) buffer Uvec4Buffer { uvec4 v[]; };
+layout(buffer_reference, scalar) buffer Uvec2Buffer { uvec2 v[]; };
+
+// MIP selection: the same in marking and reconstruction (the seed's custom MIP calculation).
+// `texel` is the position in MIP-0 shadels; derivatives are per pixel.
+float shadelLod(vec2 texelDx, vec2 texelDy, float bias) {
+    float footprint = max(length(texelDx), length(texelDy));
+    return log2(max(footprint, 1e-8)) + bias;
+}
+
+uvec2 levelSize(GpuShadelObject o, uint mip) { return max(o.mip0Size >> mip, uvec2(1u)); }
+
+// The 2x2 bilinear footprint at `mip` of the sample at shadel-UV `uv`: first texel + weights.
+void bilinearFootprint(GpuShadelObject o, uint mip, vec2 uv, out ivec2 texel0, out vec2 weight) {
+    vec2 size = vec2(levelSize(o, mip));
+    vec2 t = uv * size - 0.5;
+    texel0 = ivec2(floor(t));
+    weight = t - vec2(texel0);
+}
+
+// Sheet shadel coordinate of an object's level texel (clamped to the object's level rect so
+// border taps never leave the object).
+uvec2 sheetShadel(GpuShadelObject o, uint mip, ivec2 texel) {
+    uvec2 size = levelSize(o, mip);
+    uvec2 t = uvec2(clamp(texel, ivec2(0), ivec2(size) - 1));
+    return o.rect[mip].xy * SHADEL_BLOCK + t;
+}
+
+uint blockIndex(ShadelFrame s, uvec2 sheetShadel) {
+    uvec2 b = sheetShadel / SHADEL_BLOCK;
+    return b.y * s.sheetBlocks + b.x;
+}
+
+uint chunkBit(uvec2 sheetShadel) {
+    uvec2 c = (sheetShadel / SHADEL_CHUNK) % (SHADEL_BLOCK / SHADEL_CHUNK);
+    return c.y * 8u + c.x;
+}
+
+// Storage slot of a marked chunk: the block's base + the marked chunks before it (popcount).
+uint chunkSlot(uint64_t mask, uint base, uint bit) {
+    uint64_t below = bit == 0u ? 0ul : (mask & ((1ul << bit) - 1ul));
+    return base + bitCount(uint(below)) + bitCount(uint(below >> 32));
+}
+
+ivec2 storageTexel(ShadelFrame s, uint slot, uvec2 inChunk) {
+    uvec2 c = uvec2(slot % s.storageChunksPerRow, slot / s.storageChunksPerRow);
+    return ivec2(c * SHADEL_CHUNK + inChunk);
+}
+#endif
