@@ -67,10 +67,10 @@ SHADEL_INLINE vec3 shadelBarycentrics(vec2 p, vec2 a, vec2 b, vec2 c) {
     float den = ab.x * ac.y - ac.x * ab.y;
     if (abs(den) < kShadelDegenerateArea) return vec3(1.0f / 3.0f);
     float invDen = 1.0f / den;
-    float wb = clamp((ap.x * ac.y - ac.x * ap.y) * invDen, -kShadelBaryEpsilon,
-                     1.0f + kShadelBaryEpsilon);
-    float wc = clamp((ab.x * ap.y - ap.x * ab.y) * invDen, -kShadelBaryEpsilon,
-                     1.0f + kShadelBaryEpsilon);
+    float wb =
+        clamp((ap.x * ac.y - ac.x * ap.y) * invDen, -kShadelBaryEpsilon, 1.0f + kShadelBaryEpsilon);
+    float wc =
+        clamp((ab.x * ap.y - ap.x * ab.y) * invDen, -kShadelBaryEpsilon, 1.0f + kShadelBaryEpsilon);
     return vec3(1.0f - wb - wc, wb, wc);
 }
 

@@ -25,6 +25,9 @@ struct RenderOptions {
     float exposure = 1.0f;
     float shadelsPerMetre = 32.0f;
     std::string cacheDir; // empty = default cache directory
+    uint32_t shadeStorageSize = 4096;
+    uint32_t sheetShadels = 65536;
+    float shadingBias = 0.0f;
     bool printPasses = false;
     bool progress = true;
 };

@@ -65,6 +65,9 @@ int main(int argc, char** argv) {
     render->add_option("--exposure", ro.exposure, "exposure multiplier")->capture_default_str();
     render->add_option("--density", ro.shadelsPerMetre, "shadels per metre (decoupled)")->capture_default_str();
     render->add_option("--cache-dir", ro.cacheDir, "bake cache directory");
+    render->add_option("--storage", ro.shadeStorageSize, "decoupled: shade storage side in shadels")->capture_default_str();
+    render->add_option("--shading-bias", ro.shadingBias, "decoupled: fractional MIP bias (+ = fewer shadels)")->capture_default_str();
+    render->add_option("--sheet", ro.sheetShadels, "decoupled: virtual sheet side in shadels (64k..256k)")->capture_default_str();
     render->add_flag("--passes", ro.printPasses, "print the per-pass timing table");
 
     // bench

@@ -103,6 +103,9 @@ RenderRun runRender(Gpu& gpu, const RenderOptions& o) {
     settings.mode = o.mode;
     settings.visualize = o.visualize;
     settings.exposure = o.exposure;
+    settings.shadeStorageSize = o.shadeStorageSize;
+    settings.sheetShadels = o.sheetShadels;
+    settings.shadingBias = o.shadingBias;
     settings.timing = o.timing ? *o.timing : defaultTimingMode(gpu);
     Renderer renderer;
     RenderRun run;

@@ -1,1 +1,307 @@
 #include "bake/bake.h"
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <condition_variable>
+#include <exception>
+#include <map>
+#include <mutex>
+#include <thread>
+
+#include "bake/bake_cache.h"
+#include "bake/charting.h"
+#include "bake/id_map.h"
+#include "bake/packing.h"
+#include "core/error.h"
+#include "core/log.h"
+
+namespace shadel {
+namespace {
+
+constexpr uint32_t kChunk = 8;
+
+uint32_t roundUp(uint32_t v, uint32_t granularity) {
+    return (v + granularity - 1) / granularity * granularity;
+}
+
+double secondsSince(std::chrono::steady_clock::time_point start) {
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+// Shadel size of each chart's content (without gutters) at a density.
+glm::uvec2 contentSize(const Chart& chart, double density) {
+    if (chart.kind == ChartKind::DegenerateCells) return glm::uvec2(chart.extent);
+    glm::dvec2 e = glm::ceil(chart.extent * density - 1e-9);
+    return glm::uvec2(glm::max(e, glm::dvec2(1.0)));
+}
+
+double chartScale(const Chart& chart, double density) {
+    return chart.kind == ChartKind::DegenerateCells ? 1.0 : density;
+}
+
+struct Layout {
+    PackResult pack;
+    std::vector<glm::uvec2> content;
+};
+
+Layout layoutCharts(const ChartedMesh& charted, double density, uint32_t gutter) {
+    Layout layout;
+    std::vector<PackRect> rects;
+    rects.reserve(charted.charts.size());
+    for (const Chart& chart : charted.charts) {
+        glm::uvec2 c = contentSize(chart, density);
+        layout.content.push_back(c);
+        rects.push_back({c.x + 2 * gutter, c.y + 2 * gutter});
+    }
+    layout.pack = packNearSquare(rects, kChunk);
+    return layout;
+}
+
+// Chart-local coordinates -> shadel UVs of the packed rect (width x height shadels).
+std::vector<glm::vec2> placeCharts(const ChartedMesh& charted, const Layout& layout, double density,
+                                   uint32_t gutter, uint32_t width, uint32_t height) {
+    std::vector<glm::vec2> uv(charted.local.size());
+    for (size_t c = 0; c < charted.charts.size(); ++c) {
+        const Chart& chart = charted.charts[c];
+        const PackPlacement& place = layout.pack.placements[c];
+        double scale = chartScale(chart, density);
+        glm::dvec2 content(layout.content[c]);
+        glm::dvec2 centring = (content - chart.extent * scale) * 0.5; // spare space split evenly
+        glm::dvec2 origin(place.x + gutter, place.y + gutter);
+        for (uint32_t v = chart.firstVertex; v < chart.firstVertex + chart.vertexCount; ++v) {
+            glm::dvec2 q = charted.local[v] * scale + centring;
+            if (place.turned) q = glm::dvec2(q.y, content.x - q.x); // quarter turn, no mirror
+            glm::dvec2 texel = origin + q;
+            uv[v] = glm::vec2(float(texel.x / width), float(texel.y / height));
+            uv[v] = glm::clamp(uv[v], glm::vec2(0.0f), glm::vec2(1.0f));
+        }
+    }
+    return uv;
+}
+
+} // namespace
+
+uint32_t bakedMipCount(uint32_t width, uint32_t height) {
+    uint32_t side = std::min(width, height), count = 1;
+    while ((side >> count) >= kChunk) ++count;
+    return side >= kChunk ? count : 1;
+}
+
+BakedMesh bakeMesh(const Mesh& mesh, const BakeSettings& settings) {
+    auto start = std::chrono::steady_clock::now();
+    if (mesh.triangleCount() > kMaxTrianglesPerMesh)
+        throw InputError(format("mesh '%s': %u triangles, the baker takes at most %u per mesh",
+                                mesh.name.c_str(), mesh.triangleCount(), kMaxTrianglesPerMesh));
+    if (!(settings.shadelsPerMetre > 0) || !std::isfinite(settings.shadelsPerMetre))
+        throw InputError(format("bake: shadels per metre must be positive (got %g)",
+                                double(settings.shadelsPerMetre)));
+    uint32_t minResolution = roundUp(std::max(settings.minResolution, kChunk), kChunk);
+    uint32_t maxResolution = std::max(minResolution, settings.maxResolution / kChunk * kChunk);
+    uint32_t gutter = settings.gutterShadels;
+
+    ChartedMesh charted = buildCharts(mesh, {settings.chartConeDegrees});
+    BakedMesh out;
+    out.triangleCount = mesh.triangleCount();
+    out.degenerateTriangles = charted.degenerateTriangles;
+    out.surfaceArea = charted.surfaceArea;
+    out.chartCount = uint32_t(charted.charts.size());
+    out.vertexRemap = std::move(charted.vertexRemap);
+    out.indices = charted.indices;
+
+    IdMapOptions options;
+    options.floodPasses = std::max(2u, gutter + 1);
+    if (out.triangleCount == 0) {
+        out.width = out.height = minResolution;
+        out.shadelsPerMetre = settings.shadelsPerMetre;
+        for (uint32_t k = 0; k < bakedMipCount(out.width, out.height); ++k)
+            out.idMaps.emplace_back(size_t(out.width >> k) * (out.height >> k), kEmptyShadel);
+        out.bakeSeconds = secondsSince(start);
+        return out;
+    }
+
+    // Find a density whose packed rect fits [min, max] resolution and lets every triangle own a
+    // MIP-0 shadel. Charting is scale-free, so only packing and rasterization repeat.
+    double density = settings.shadelsPerMetre;
+    int growthsToMinimum = 0;
+    IdMapStats stats0;
+    for (int attempt = 0;; ++attempt) {
+        Layout layout = layoutCharts(charted, density, gutter);
+        uint32_t packedSide = std::max(layout.pack.width, layout.pack.height);
+        if (packedSide > maxResolution) {
+            if (attempt > 40 || density < 1e-9)
+                throw InputError(format("mesh '%s': %u charts do not fit %ux%u shadels",
+                                        mesh.name.c_str(), out.chartCount, maxResolution,
+                                        maxResolution));
+            density *= 0.97 * double(maxResolution) / packedSide;
+            continue;
+        }
+        if (growthsToMinimum < 8 && packedSide * 1.2 < minResolution && charted.surfaceArea > 0) {
+            // Tiny object: spend the minimum rect on detail instead of empty space. Gutters do
+            // not scale with density, so this takes a few steps.
+            ++growthsToMinimum;
+            density *= std::max(1.1, 0.9 * double(minResolution) / packedSide);
+            continue;
+        }
+        uint32_t width = std::max(layout.pack.width, minResolution);
+        uint32_t height = std::max(layout.pack.height, minResolution);
+        std::vector<glm::vec2> uv = placeCharts(charted, layout, density, gutter, width, height);
+        options.forceOwnership = true;
+        std::vector<uint16_t> level0 = buildIdMap(uv, out.indices, width, height, options, &stats0);
+        bool canGrow = std::max(width, height) < maxResolution && attempt < 40;
+        if (stats0.unownedTriangles > 0 && canGrow) {
+            // Triangles smaller than a shadel crowd each other out: raise the density.
+            density *= 1.4;
+            continue;
+        }
+        out.width = width, out.height = height;
+        out.shadelUv = std::move(uv);
+        out.idMaps.push_back(std::move(level0));
+        break;
+    }
+    out.shadelsPerMetre = float(density);
+    out.forcedTriangles = stats0.forcedTriangles;
+    out.unownedTriangles = stats0.unownedTriangles;
+    out.utilisation = float(double(stats0.coveredShadels) / (double(out.width) * out.height));
+    if (out.unownedTriangles > 0)
+        SHADEL_WARN("mesh '%s': %u triangles own no shadel even at %ux%u", mesh.name.c_str(),
+                    out.unownedTriangles, out.width, out.height);
+
+    options.forceOwnership = false; // coarse levels cannot hold every triangle, nor need to
+    uint32_t mips = bakedMipCount(out.width, out.height);
+    for (uint32_t k = 1; k < mips; ++k)
+        out.idMaps.push_back(buildIdMap(out.shadelUv, out.indices, out.width >> k, out.height >> k,
+                                        options, nullptr));
+    out.bakeSeconds = secondsSince(start);
+    return out;
+}
+
+std::vector<BakedMesh> bakeScene(const Scene& scene, const BakeSettings& settings,
+                                 const std::string& cacheDir, const BakeProgress& progress) {
+    size_t meshCount = scene.meshes.size();
+    // Density is meant per metre of *world* surface. Meshes are often authored in other units
+    // and scaled by their instances (a glTF in millimetres under a 0.001 node), so each mesh is
+    // baked at shadelsPerMetre times the largest linear scale of any instance using it.
+    std::vector<float> worldScale(meshCount, 0.0f);
+    for (const Instance& instance : scene.instances) {
+        if (instance.mesh >= meshCount) continue;
+        glm::mat3 m(instance.transform);
+        float scale = std::max({glm::length(m[0]), glm::length(m[1]), glm::length(m[2])});
+        if (std::isfinite(scale) && scale > 0)
+            worldScale[instance.mesh] = std::max(worldScale[instance.mesh], scale);
+    }
+    std::vector<BakeSettings> meshSettings(meshCount, settings);
+    for (size_t i = 0; i < meshCount; ++i)
+        if (worldScale[i] > 0)
+            meshSettings[i].shadelsPerMetre = settings.shadelsPerMetre * worldScale[i];
+    std::vector<BakeKey> keys(meshCount);
+    std::vector<size_t> firstWithKey(meshCount);
+    std::vector<size_t> jobs; // indices of the first mesh of each distinct content
+    {
+        std::map<std::pair<uint64_t, uint64_t>, size_t> seen;
+        for (size_t i = 0; i < meshCount; ++i) {
+            keys[i] = bakeKey(scene.meshes[i], meshSettings[i]);
+            auto [it, inserted] = seen.emplace(std::make_pair(keys[i].lo, keys[i].hi), i);
+            firstWithKey[i] = it->second;
+            if (inserted) jobs.push_back(i);
+        }
+    }
+
+    std::vector<BakedMesh> results(meshCount);
+    std::vector<std::exception_ptr> errors(jobs.size());
+    std::atomic<size_t> next{0};
+    std::mutex mutex;
+    std::condition_variable finished;
+    size_t done = 0;
+
+    auto work = [&] {
+        for (size_t j; (j = next.fetch_add(1)) < jobs.size();) {
+            size_t i = jobs[j];
+            const Mesh& mesh = scene.meshes[i];
+            try {
+                auto start = std::chrono::steady_clock::now();
+                std::string path =
+                    cacheDir.empty() ? std::string() : bakeCachePath(cacheDir, keys[i]);
+                std::string why;
+                BakedMesh baked;
+                if (!path.empty() && readBakeCache(path, keys[i], mesh, baked, &why)) {
+                    baked.fromCache = true;
+                    baked.bakeSeconds = secondsSince(start);
+                } else {
+                    if (!path.empty() && why != "missing")
+                        SHADEL_WARN("bake cache %s: %s; rebaking", path.c_str(), why.c_str());
+                    baked = bakeMesh(mesh, meshSettings[i]);
+                    if (!path.empty() && !writeBakeCache(path, keys[i], baked, &why))
+                        SHADEL_WARN("bake cache: %s", why.c_str());
+                }
+                results[i] = std::move(baked);
+            } catch (...) {
+                errors[j] = std::current_exception();
+            }
+            std::lock_guard lock(mutex);
+            ++done;
+            finished.notify_one();
+        }
+    };
+
+    if (progress) progress(0, jobs.size());
+    size_t workerCount = std::clamp<size_t>(settings.threads, 1, std::max<size_t>(jobs.size(), 1));
+    std::vector<std::thread> workers;
+    for (size_t w = 0; w < workerCount; ++w) workers.emplace_back(work);
+    {
+        std::unique_lock lock(mutex);
+        size_t reported = 0;
+        while (reported < jobs.size()) {
+            finished.wait(lock, [&] { return done > reported; });
+            size_t now = done;
+            lock.unlock();
+            for (size_t d = reported + 1; d <= now; ++d)
+                if (progress) progress(d, jobs.size());
+            reported = now;
+            lock.lock();
+        }
+    }
+    for (std::thread& t : workers) t.join();
+    for (const std::exception_ptr& e : errors)
+        if (e) std::rethrow_exception(e);
+    for (size_t i = 0; i < meshCount; ++i)
+        if (firstWithKey[i] != i) results[i] = results[firstWithKey[i]];
+    return results;
+}
+
+std::string bakeReport(const std::vector<BakedMesh>& meshes, double wallSeconds) {
+    uint64_t triangles = 0, charts = 0, shadels = 0, covered = 0, degenerate = 0, forced = 0,
+             unowned = 0;
+    size_t fromCache = 0;
+    double bakeSeconds = 0, area = 0;
+    uint32_t maxSide = 0, mips = 0;
+    for (const BakedMesh& m : meshes) {
+        triangles += m.triangleCount, charts += m.chartCount;
+        uint64_t s = uint64_t(m.width) * m.height;
+        shadels += s;
+        covered += uint64_t(std::llround(double(m.utilisation) * double(s)));
+        degenerate += m.degenerateTriangles, forced += m.forcedTriangles,
+            unowned += m.unownedTriangles;
+        fromCache += m.fromCache;
+        bakeSeconds += m.bakeSeconds;
+        area += m.surfaceArea;
+        maxSide = std::max({maxSide, m.width, m.height});
+        mips = std::max(mips, m.mipCount());
+    }
+    std::string r;
+    r += format("meshes: %zu (%zu from cache)\n", meshes.size(), fromCache);
+    r += format("triangles: %llu (degenerate %llu, forced %llu, unowned %llu)\n",
+                (unsigned long long)triangles, (unsigned long long)degenerate,
+                (unsigned long long)forced, (unsigned long long)unowned);
+    r += format("charts: %llu\n", (unsigned long long)charts);
+    r += format("shadels (MIP 0): %llu, largest rect side %u, up to %u MIPs\n",
+                (unsigned long long)shadels, maxSide, mips);
+    r += format("utilisation: %.1f%% (covered / allocated MIP-0 shadels)\n",
+                shadels ? 100.0 * double(covered) / double(shadels) : 0.0);
+    r += format("surface: %.3f m^2\n", area);
+    r += format("bake time: %.2f s wall, %.2f s summed over meshes\n", wallSeconds, bakeSeconds);
+    return r;
+}
+
+} // namespace shadel

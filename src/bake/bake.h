@@ -1,2 +1,101 @@
 #pragma once
-// Shadel baking: chart atlas ("shadel UVs") and triangle-ID maps per mesh.
+// Shadel baking: a unique chart atlas ("shadel UVs") and per-MIP triangle-ID maps per mesh.
+//
+// Resolution and blocks. A mesh's charts are laid out at `shadelsPerMetre` shadels per metre of
+// object-space surface, packed with gutters into a near-square rect whose sides are rounded up to
+// multiples of 8 (one chunk) and clamped to [minResolution, maxResolution]. The renderer places
+// the object in the virtual sheet in 64x64-shadel blocks: at MIP k the object needs
+// ceil((width >> k) / 64) x ceil((height >> k) / 64) blocks, and once a side drops below 64 it is
+// snapped up to one block (the seed's snapping of small MIPs). The density is raised above the
+// setting only when needed: for tiny objects (to fill minResolution) and for meshes whose
+// triangles are too small for each to own a shadel at MIP 0; lowered only to fit maxResolution.
+// BakedMesh::shadelsPerMetre is the density actually used.
+//
+// MIP levels. ID maps exist for levels k = 0 .. mipCount-1 with mipCount = 1 + floor(log2(
+// min(width, height) / 8)): the coarsest level is the first where a side is one chunk (8).
+// Coarser levels would still occupy one chunk and one block, so they save no storage; the
+// renderer clamps its MIP to mipCount-1 (the object is then a few pixels tall on screen and
+// over-shades by a bounded amount). The packer keeps rects near-square so both sides hit 8
+// together.
+//
+// Gutters. Each chart's rect is padded by gutterShadels on every side, so charts are >= 2*g MIP-0
+// shadels apart and >= g from the rect border. A bilinear tap at MIP k reads shadels whose
+// centres lie within 2^k MIP-0 shadels of the sample, so two charts never compete for a shadel
+// the filter reads while 2 * 2^k <= 2 * g, i.e. for all k <= log2(g) (g = 2: MIPs 0 and 1, and the
+// trilinear blend between them). Every level's ID map is flooded: each empty shadel near a
+// chart takes the ID of the *nearest* triangle (true 2-D distance, not flood steps), so within
+// the clean levels every shadel a filter reads belongs to the sampled chart and extrapolates the
+// right surface. Coarser levels can mix neighbouring charts in shared shadels (the usual mipmap
+// chart bleeding) but every shadel the filter reads still has a valid ID, so shading never reads
+// an unshaded shadel. The renderer must clamp shadel coordinates to [0, (W>>k) - 1] so taps on
+// the rect border never leave the object's rect at coarse levels.
+#include <cstdint>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "scene/mesh_utils.h" // kMaxTrianglesPerMesh (16-bit IDs, 0xFFFF reserved)
+#include "scene/scene.h"
+
+namespace shadel {
+
+constexpr uint16_t kEmptyShadel = 0xFFFF;
+
+struct BakeSettings {
+    float shadelsPerMetre = 32.0f;
+    uint32_t maxResolution = 4096;
+    uint32_t minResolution = 8;
+    uint32_t gutterShadels = 2;  // padding on each side of every chart, MIP-0 shadels
+    float chartConeDegrees = 40; // charts grow over triangles within this angle of the chart
+    uint32_t threads = 2;        // bakeScene workers
+};
+
+struct BakedMesh {
+    // Vertices are re-indexed so each has one shadel UV (duplicated along chart seams).
+    std::vector<uint32_t> vertexRemap; // baked vertex -> source Mesh vertex
+    std::vector<glm::vec2> shadelUv;   // per baked vertex, in [0,1]^2 of the object's shadel rect
+    std::vector<uint32_t> indices;     // same triangle order as the source (triangle ID = i/3)
+    uint32_t width = 0, height = 0;    // MIP-0 shadel resolution, multiples of 8 (chunk)
+    // Per MIP level k: (width >> k) x (height >> k) triangle IDs, row-major; kEmptyShadel = empty.
+    std::vector<std::vector<uint16_t>> idMaps;
+    uint32_t chartCount = 0;
+    float utilisation = 0;     // shadels covered by a triangle (centre rule) / width*height
+    float shadelsPerMetre = 0; // density actually used, per object-space unit (see above)
+    uint32_t triangleCount = 0;
+    uint32_t degenerateTriangles = 0; // zero-area triangles, given one private shadel each
+    uint32_t forcedTriangles = 0;     // triangles that got their MIP-0 shadel by force-assignment
+    uint32_t unownedTriangles = 0;    // triangles with no MIP-0 shadel (0 unless maxResolution hit)
+    double surfaceArea = 0;           // object-space m^2 of non-degenerate triangles
+    double bakeSeconds = 0;           // wall time of the bake (or of the cache load)
+    bool fromCache = false;
+
+    uint32_t mipCount() const { return uint32_t(idMaps.size()); }
+    uint32_t levelWidth(uint32_t level) const { return width >> level; }
+    uint32_t levelHeight(uint32_t level) const { return height >> level; }
+};
+
+// Number of ID-map levels for a MIP-0 rect of width x height (see header comment).
+uint32_t bakedMipCount(uint32_t width, uint32_t height);
+
+// Bakes one mesh. Throws InputError for meshes the baker cannot represent (more than
+// kMaxTrianglesPerMesh triangles, indices out of range).
+BakedMesh bakeMesh(const Mesh& mesh, const BakeSettings& settings);
+
+using BakeProgress = std::function<void(size_t done, size_t total)>;
+
+// Bakes every mesh of the scene (result[i] belongs to scene.meshes[i]) at settings.shadelsPerMetre
+// per metre of world surface: a mesh is baked at that density times the largest scale of the
+// instances using it (BakedMesh::shadelsPerMetre is then per object-space unit). Meshes with
+// identical content are baked once; results are read from / written to cacheDir (empty: no cache).
+// Uses settings.threads workers; output does not depend on the thread count. `progress` is called
+// on the calling thread, once with done = 0 and then after each distinct mesh.
+std::vector<BakedMesh> bakeScene(const Scene& scene, const BakeSettings& settings,
+                                 const std::string& cacheDir, const BakeProgress& progress = {});
+
+// Human-readable summary for `shadel bake`: meshes, triangles, charts, utilisation, density,
+// forced/unowned triangles, cache hits and bake time.
+std::string bakeReport(const std::vector<BakedMesh>& meshes, double wallSeconds);
+
+} // namespace shadel

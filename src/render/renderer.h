@@ -24,6 +24,9 @@ struct RenderSettings {
     float exposure = 1.0f;
     uint32_t shadowMapSize = 2048;
     TimingMode timing = TimingMode::SubmitPerPass;
+    uint32_t shadeStorageSize = 4096; // decoupled: physical shade storage, shadels per side
+    uint32_t sheetShadels = 65536;    // decoupled: virtual sheet, shadels per side
+    float shadingBias = 0.0f;         // decoupled: base MIP bias (the capacity controller adds to it)
 };
 
 struct FrameResult {

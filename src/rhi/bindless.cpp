@@ -202,16 +202,25 @@ BindlessSlot allocateBindless(Gpu& gpu, BindlessKind kind, VkImageView view, VkI
     return {slot};
 }
 
+// A newer write to a slot supersedes queued ones; dropping them also keeps a view that is
+// destroyed right after being queued from ever reaching vkUpdateDescriptorSets.
+static void dropPending(BindlessTable& t, BindlessKind kind, uint32_t slot) {
+    for (auto& queue : t.pending)
+        std::erase_if(queue, [&](const BindlessWrite& w) { return w.kind == kind && w.slot == slot; });
+}
+
 void updateBindless(Gpu& gpu, BindlessKind kind, BindlessSlot slot, VkImageView view,
                     VkImageLayout layout) {
     // Content changes (streaming) keep the slot: the front set is untouched until its frame.
     BindlessTable& t = gpu.bindless;
+    dropPending(t, kind, slot.value);
     t.pending[0].push_back({kind, slot.value, view, layout});
     t.pending[1].push_back({kind, slot.value, view, layout});
 }
 
 void freeBindless(Gpu& gpu, BindlessKind kind, BindlessSlot slot) {
     BindlessTable& t = gpu.bindless;
+    dropPending(t, kind, slot.value);
     t.pending[0].push_back({kind, slot.value, VK_NULL_HANDLE, VK_IMAGE_LAYOUT_GENERAL});
     t.pending[1].push_back({kind, slot.value, VK_NULL_HANDLE, VK_IMAGE_LAYOUT_GENERAL});
     t.retired.push_back({kind, slot.value, 3u});

@@ -26,7 +26,12 @@ BufferHandle createBuffer(Gpu& gpu, const BufferDesc& desc) {
     BufferRecord rec;
     rec.size = desc.size;
     rec.name = desc.name;
-    VK_CHECK(vkCreateBuffer(gpu.device.device, &ci, nullptr, &rec.buffer));
+    if (VkResult res = vkCreateBuffer(gpu.device.device, &ci, nullptr, &rec.buffer); res != VK_SUCCESS) {
+        gpu.failedAllocations++;
+        SHADEL_WARN("cannot create buffer %s (%llu bytes): %s", desc.name.c_str(),
+                    (unsigned long long)desc.size, vkResultName(res));
+        return {};
+    }
     VkMemoryRequirements req;
     vkGetBufferMemoryRequirements(gpu.device.device, rec.buffer, &req);
     auto block = allocateMemory(gpu.memory, desc.memory, req);
@@ -62,7 +67,12 @@ TextureHandle createTexture(Gpu& gpu, const TextureDesc& desc) {
     rec.desc = desc;
     rec.aspect = isDepthFormat(desc.format) ? VK_IMAGE_ASPECT_DEPTH_BIT : VK_IMAGE_ASPECT_COLOR_BIT;
     if (hasStencil(desc.format)) rec.aspect |= VK_IMAGE_ASPECT_STENCIL_BIT;
-    VK_CHECK(vkCreateImage(gpu.device.device, &ci, nullptr, &rec.image));
+    if (VkResult res = vkCreateImage(gpu.device.device, &ci, nullptr, &rec.image); res != VK_SUCCESS) {
+        gpu.failedAllocations++;
+        SHADEL_WARN("cannot create texture %s (%ux%u): %s", desc.name.c_str(), desc.width, desc.height,
+                    vkResultName(res));
+        return {};
+    }
     VkMemoryRequirements req;
     vkGetImageMemoryRequirements(gpu.device.device, rec.image, &req);
     auto block = allocateMemory(gpu.memory, MemoryKind::DeviceLocal, req);

@@ -10,7 +10,6 @@
 namespace shadel {
 
 // Stand-ins for the engine's consumers, with the signatures the real code uses.
-void beginRendering(std::span<const RenderTargetView> colors, DepthTargetView depth);
 void bindColor(RenderTargetView view);
 void bindDepth(DepthTargetView view);
 void sampleIn(TextureReadView view);

@@ -86,6 +86,14 @@ DecoupledStatePtr createDecoupled(Renderer& r, const GpuScene& scene) {
         throw InputError("--mode decoupled needs a baked scene (internal: uploadScene without bake)");
     DecoupledStatePtr state(new DecoupledState());
     DecoupledState& d = *state;
+    const RenderSettings& rs = r.settings;
+    if (rs.shadeStorageSize < 64 || rs.shadeStorageSize % 64 || rs.shadeStorageSize > 16384)
+        throw InputError(format("--storage %u: expected a multiple of 64 in [64, 16384]", rs.shadeStorageSize));
+    if (rs.sheetShadels < 65536 || rs.sheetShadels > 262144 || rs.sheetShadels % 65536)
+        throw InputError(format("--sheet %u: expected 65536, 131072, 196608 or 262144", rs.sheetShadels));
+    d.storageSize = rs.shadeStorageSize;
+    d.shadingBias = rs.shadingBias;
+    d.sheetBlocks = rs.sheetShadels / SHADEL_BLOCK;
     uint32_t x = 0;
     for (uint32_t k = 0; k < SHADEL_MAX_MIPS; ++k) {
         SheetRegion region;

@@ -1,0 +1,156 @@
+#pragma once
+// Guillotine binary-tree block allocator for 2-D and 3-D atlases (the structure of UE4's
+// FTextureLayout3d, with the improvements of seed 004 and a few more).
+//
+// Every node is an axis-aligned box; an inner node is cut into two children along one axis.
+// Inserting an element takes the first free leaf (depth-first, child A before child B) that can
+// hold it and cuts the leaf along the axis with the most slack until a leaf fits the element
+// exactly. Removing an element frees its leaf and collapses the highest ancestor whose subtree is
+// now empty back into one free leaf, which restores the largest free box.
+//
+// What makes it fast (the naive baseline in block_allocator_naive.h has none of it):
+// - each node stores its parent, so walking up is O(1) per step;
+// - each node stores whether its subtree holds a used leaf, so "is this subtree empty" is O(1),
+//   and removal climbs only as far as it collapses, not to the root;
+// - each node stores the per-axis maximum of the free leaves below it, so insertion skips
+//   subtrees that cannot hold the element instead of walking the whole tree;
+// - removal by position descends the tree (children partition their parent, so one path);
+//   removal by id is a table lookup; there is no separate contains-then-remove;
+// - nodes are deleted by moving the last node of the array into the hole and fixing its parent,
+//   children and id slot, instead of an order-preserving erase and a whole-array index fix-up;
+// - insertBatch places many elements in one depth-first traversal.
+// Placement decisions are exactly the naive allocator's, which the differential tests check.
+#include <array>
+#include <cstddef>
+#include <cstdint>
+#include <optional>
+#include <span>
+#include <vector>
+
+namespace shadel {
+
+template <size_t N>
+using Extent = std::array<uint32_t, N>;
+template <size_t N>
+using Position = std::array<uint32_t, N>;
+
+// Names one placed element. Ids are recycled; the generation makes a stale id harmless.
+struct BlockId {
+    uint32_t slot = ~0u;
+    uint32_t generation = 0;
+    bool valid() const { return slot != ~0u; }
+    friend bool operator==(const BlockId&, const BlockId&) = default;
+};
+
+template <size_t N>
+struct Placement {
+    Position<N> origin{};
+    Extent<N> extent{}; // what was reserved: the request rounded up to the alignment
+    BlockId id;
+};
+
+// One node of the tree in depth-first order (child A's subtree, then child B's). The same layout
+// gives the same list, whatever order the nodes have in memory; used to compare allocators.
+template <size_t N>
+struct BlockTreeNode {
+    Position<N> min{};
+    Extent<N> size{};
+    bool leaf = true;
+    bool used = false;
+    BlockId id;
+    friend bool operator==(const BlockTreeNode&, const BlockTreeNode&) = default;
+};
+
+template <size_t N>
+class BlockAllocator {
+    static_assert(N == 2 || N == 3, "2-D and 3-D atlases only");
+
+public:
+    // Every element's origin and extent become multiples of `alignment` (>= 1); the part of
+    // `size` beyond the last multiple of the alignment is not used.
+    explicit BlockAllocator(Extent<N> size, uint32_t alignment = 1);
+
+    // nullopt if no free box can hold the element or an axis of `extent` is 0.
+    std::optional<Placement<N>> insert(const Extent<N>& extent);
+    // Same placements as calling insert() for each element in order, in one traversal.
+    std::vector<std::optional<Placement<N>>> insertBatch(std::span<const Extent<N>> extents);
+    // False if no element starts at `origin` (or `id` is stale).
+    bool remove(const Position<N>& origin);
+    bool remove(BlockId id);
+    std::optional<Placement<N>> find(BlockId id) const;
+    void clear();
+
+    size_t size() const { return m_liveCount; } // live elements
+    uint64_t usedVolume() const { return m_usedVolume; }
+    Extent<N> bounds() const { return m_bounds; }
+    uint32_t alignment() const { return m_alignment; }
+    size_t nodeCount() const { return m_nodes.size(); }
+
+    std::vector<BlockTreeNode<N>> preorder() const;
+    // Checks links, the partition of every node by its children, the cached subtree data and the
+    // id table (tests and fuzzing).
+    bool validate() const;
+
+private:
+    static constexpr uint32_t kNone = ~0u;
+    static constexpr uint32_t kReservedSlot = ~0u - 1; // used leaf awaiting its id (batches)
+    struct Node {
+        Position<N> min{};
+        Extent<N> size{};
+        Extent<N> maxFree{}; // per-axis maximum over the free leaves of this subtree
+        uint32_t parent = kNone;
+        uint32_t childA = kNone;
+        uint32_t childB = kNone;
+        uint32_t slot = kNone; // id slot of the element, for used leaves
+        bool occupied = false; // some leaf of this subtree is used
+        bool leaf() const { return childA == kNone; }
+    };
+    struct BatchState;
+
+    std::optional<Extent<N>> roundUp(const Extent<N>& extent) const;
+    void splitLeaf(uint32_t index, const Extent<N>& extent);
+    Placement<N> occupyLeaf(uint32_t index);
+    bool refresh(uint32_t index);
+    void refreshUpwards(uint32_t index);
+    void visitBatch(uint32_t index, BatchState& state);
+    void removeLeaf(uint32_t index);
+    void collapse(uint32_t& top);
+
+    Extent<N> m_bounds;
+    uint32_t m_alignment;
+    std::vector<Node> m_nodes;
+    std::vector<uint32_t> m_slotNode; // id slot -> node index, kNone when the slot is free
+    std::vector<uint32_t> m_slotGeneration;
+    std::vector<uint32_t> m_freeSlots;
+    std::vector<uint32_t> m_scratch; // reused traversal stack
+    size_t m_liveCount = 0;
+    uint64_t m_usedVolume = 0;
+};
+
+using BlockAllocator2D = BlockAllocator<2>;
+using BlockAllocator3D = BlockAllocator<3>;
+
+namespace block_detail {
+// Shared by the fast and the naive allocator so that both make the same decisions.
+template <size_t N>
+std::optional<Extent<N>> roundUpExtent(const Extent<N>& extent, const Extent<N>& usable,
+                                       uint32_t alignment);
+// The axis to cut a free box of `box` size for an element of `element` size: the one with the
+// most slack (lowest axis on ties); N when the element fits exactly.
+template <size_t N>
+size_t splitAxis(const Extent<N>& box, const Extent<N>& element);
+template <size_t N>
+bool fitsIn(const Extent<N>& element, const Extent<N>& box) {
+    for (size_t axis = 0; axis < N; ++axis)
+        if (element[axis] > box[axis]) return false;
+    return true;
+}
+template <size_t N>
+uint64_t volume(const Extent<N>& extent) {
+    uint64_t v = 1;
+    for (uint32_t e : extent) v *= e;
+    return v;
+}
+} // namespace block_detail
+
+} // namespace shadel

@@ -1,0 +1,446 @@
+#include "scene/builtin_scenes.h"
+
+#include <cmath>
+#include <functional>
+#include <map>
+
+#include <glm/gtc/constants.hpp>
+#include <glm/gtc/matrix_transform.hpp>
+
+#include "core/error.h"
+#include "scene/mesh_utils.h"
+
+namespace shadel {
+
+namespace {
+
+// splitmix64: our own generator so the scenes are identical on every platform and standard
+// library (std:: distributions are implementation-defined).
+class Rng {
+public:
+    explicit Rng(uint64_t seed) : state_(seed) {}
+    uint64_t next() {
+        uint64_t z = (state_ += 0x9E3779B97F4A7C15ull);
+        z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
+        z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
+        return z ^ (z >> 31);
+    }
+    float uniform(float lo, float hi) {
+        return lo + (hi - lo) * float(next() >> 40) / float(1ull << 24);
+    }
+    int range(int lo, int hi) { return lo + int(next() % uint64_t(hi - lo + 1)); } // inclusive
+    bool chance(float p) { return uniform(0.0f, 1.0f) < p; }
+
+private:
+    uint64_t state_;
+};
+
+// Small helpers to keep the scene descriptions below readable.
+class SceneBuilder {
+public:
+    explicit SceneBuilder(Scene& scene) : scene_(scene) {}
+
+    uint32_t material(const std::string& name, glm::vec3 color, float roughness,
+                      float metallic = 0.0f, Procedural procedural = Procedural::None,
+                      float proceduralScale = 1.0f, glm::vec3 emissive = glm::vec3(0.0f)) {
+        Material m;
+        m.name = name;
+        m.baseColorFactor = glm::vec4(color, 1.0f);
+        m.roughnessFactor = roughness;
+        m.metallicFactor = metallic;
+        m.procedural = procedural;
+        m.proceduralScale = proceduralScale;
+        m.emissiveFactor = emissive;
+        scene_.materials.push_back(m);
+        return uint32_t(scene_.materials.size() - 1);
+    }
+
+    uint32_t mesh(Mesh m) {
+        scene_.meshes.push_back(std::move(m));
+        return uint32_t(scene_.meshes.size() - 1);
+    }
+
+    // Rigid placement only (translation + rotation about Y): mesh UVs are in metres, and the
+    // shadel parametrisation relies on object-space area matching world-space area.
+    void place(const std::string& name, uint32_t mesh, glm::vec3 position, float yaw = 0.0f) {
+        Instance inst;
+        inst.name = name;
+        inst.mesh = mesh;
+        inst.transform =
+            glm::rotate(glm::translate(glm::mat4(1.0f), position), yaw, glm::vec3(0, 1, 0));
+        scene_.instances.push_back(std::move(inst));
+    }
+
+    // Box resting on y = base (mesh is centred, so lift by half the height).
+    void box(const std::string& name, glm::vec3 size, uint32_t material, glm::vec3 footprint,
+             float yaw = 0.0f) {
+        uint32_t m = mesh(makeBox(name, size, material));
+        place(name, m, footprint + glm::vec3(0, size.y * 0.5f, 0), yaw);
+    }
+
+    void camera(const std::string& name, glm::vec3 position, glm::vec3 target, float yfov = 0.8f,
+                float znear = 0.1f, float zfar = 400.0f) {
+        Camera c;
+        c.name = name;
+        c.position = position;
+        c.forward = glm::normalize(target - position);
+        glm::vec3 up = glm::vec3(0, 1, 0) - c.forward * glm::dot(glm::vec3(0, 1, 0), c.forward);
+        c.up = glm::normalize(up);
+        c.yfov = yfov;
+        c.znear = znear;
+        c.zfar = zfar;
+        scene_.cameras.push_back(c);
+    }
+
+    void sun(glm::vec3 direction, float intensity, glm::vec3 color = {1.0f, 0.96f, 0.9f}) {
+        Light l;
+        l.name = "sun";
+        l.type = LightType::Directional;
+        l.direction = glm::normalize(direction);
+        l.intensity = intensity;
+        l.color = color;
+        l.castsShadow = true;
+        scene_.lights.push_back(l);
+    }
+
+    void pointLight(const std::string& name, glm::vec3 position, glm::vec3 color, float intensity,
+                    float range) {
+        Light l;
+        l.name = name;
+        l.type = LightType::Point;
+        l.position = position;
+        l.color = color;
+        l.intensity = intensity;
+        l.range = range;
+        scene_.lights.push_back(l);
+    }
+
+    void spotLight(const std::string& name, glm::vec3 position, glm::vec3 target, glm::vec3 color,
+                   float intensity, float range, float inner, float outer) {
+        Light l;
+        l.name = name;
+        l.type = LightType::Spot;
+        l.position = position;
+        l.direction = glm::normalize(target - position);
+        l.color = color;
+        l.intensity = intensity;
+        l.range = range;
+        l.innerConeAngle = inner;
+        l.outerConeAngle = outer;
+        scene_.lights.push_back(l);
+    }
+
+private:
+    Scene& scene_;
+};
+
+// A small city block around a plaza: one large ground, tens of buildings, props, and a hundred
+// or so objects of a few centimetres, lit by a sun, street lamps and spots.
+Scene makeDefault() {
+    Scene scene;
+    scene.name = "default";
+    SceneBuilder b(scene);
+    Rng rng(0x5ADE1D0001ull);
+    const float pi = glm::pi<float>();
+
+    uint32_t asphalt = b.material("asphalt", {0.22f, 0.22f, 0.24f}, 0.92f);
+    uint32_t plazaChecker = b.material("plaza checker", {0.85f, 0.85f, 0.82f}, 0.6f, 0.0f,
+                                       Procedural::TexelChecker, 20.0f); // 5 cm cells
+    uint32_t wallChecker = b.material("wall checker", {0.9f, 0.9f, 0.9f}, 0.5f, 0.0f,
+                                      Procedural::TexelChecker, 32.0f); // ~3 cm cells
+    uint32_t bricks =
+        b.material("bricks", {0.62f, 0.28f, 0.2f}, 0.85f, 0.0f, Procedural::Bricks, 4.0f);
+    uint32_t darkBricks =
+        b.material("dark bricks", {0.4f, 0.22f, 0.18f}, 0.9f, 0.0f, Procedural::Bricks, 3.0f);
+    const uint32_t concrete[4] = {
+        b.material("concrete", {0.7f, 0.68f, 0.62f}, 0.8f),
+        b.material("blue render", {0.5f, 0.57f, 0.65f}, 0.7f),
+        b.material("sandstone", {0.8f, 0.72f, 0.55f}, 0.85f),
+        b.material("slate", {0.4f, 0.41f, 0.45f}, 0.6f),
+    };
+    uint32_t roofGrey = b.material("roof units", {0.55f, 0.55f, 0.55f}, 0.5f, 0.6f);
+    uint32_t steel = b.material("steel", {0.85f, 0.86f, 0.88f}, 0.3f, 1.0f);
+    uint32_t lampGlass = b.material("lamp globe", {1.0f, 0.95f, 0.85f}, 0.2f, 0.0f,
+                                    Procedural::None, 1.0f, {4.0f, 3.2f, 2.2f});
+    uint32_t wood = b.material("wood", {0.55f, 0.38f, 0.22f}, 0.7f);
+    uint32_t barrelRed = b.material("barrel paint", {0.6f, 0.08f, 0.06f}, 0.45f, 0.3f);
+    uint32_t stone = b.material("stone", {0.62f, 0.6f, 0.58f}, 0.75f);
+    const uint32_t plastic[4] = {
+        b.material("red plastic", {0.8f, 0.1f, 0.08f}, 0.35f),
+        b.material("yellow plastic", {0.9f, 0.75f, 0.1f}, 0.4f),
+        b.material("blue plastic", {0.1f, 0.25f, 0.8f}, 0.3f),
+        b.material("green plastic", {0.15f, 0.6f, 0.2f}, 0.45f),
+    };
+    uint32_t chrome = b.material("chrome", {0.95f, 0.93f, 0.9f}, 0.1f, 1.0f);
+
+    // Ground and the high-frequency surfaces.
+    b.place("ground", b.mesh(makePlane("ground", 120.0f, 120.0f, asphalt, 12)), {0, 0, 0});
+    b.box("checker plaza", {16.0f, 0.05f, 16.0f}, plazaChecker, {0, 0, 0});
+    b.box("checker wall", {12.0f, 5.0f, 0.3f}, wallChecker, {0, 0, -14.0f});
+
+    // Buildings on a 15 m lot grid around an open centre of 45 m x 45 m, with an avenue along X.
+    int buildingCount = 0;
+    for (int gz = -3; gz <= 3; ++gz) {
+        for (int gx = -3; gx <= 3; ++gx) {
+            if (std::abs(gx) <= 1 && std::abs(gz) <= 1) continue;
+            if (gz == 0) continue; // an avenue along X through the plaza (the "street" camera)
+            if (!rng.chance(0.85f)) continue;
+            glm::vec3 size{rng.uniform(6.0f, 12.0f), 0.0f, rng.uniform(6.0f, 12.0f)};
+            // Mostly low, a few towers: heights spread over 4 m .. 40 m.
+            float t = rng.uniform(0.0f, 1.0f);
+            size.y = 4.0f + 36.0f * t * t * t;
+            glm::vec3 lot{gx * 15.0f + rng.uniform(-1.0f, 1.0f), 0.0f,
+                          gz * 15.0f + rng.uniform(-1.0f, 1.0f)};
+            float r = rng.uniform(0.0f, 1.0f);
+            uint32_t mat = r < 0.25f ? bricks : r < 0.35f ? darkBricks : concrete[rng.range(0, 3)];
+            std::string name = "building " + std::to_string(buildingCount++);
+            b.box(name, size, mat, lot);
+            int roofUnits = rng.range(0, 3);
+            for (int u = 0; u < roofUnits; ++u) {
+                glm::vec3 unit{rng.uniform(0.8f, 2.5f), rng.uniform(0.6f, 2.0f),
+                               rng.uniform(0.8f, 2.5f)};
+                glm::vec3 at = lot + glm::vec3(rng.uniform(-0.3f, 0.3f) * (size.x - unit.x), size.y,
+                                               rng.uniform(-0.3f, 0.3f) * (size.z - unit.z));
+                b.box(name + " roof unit " + std::to_string(u), unit, roofGrey, at,
+                      rng.uniform(0.0f, 0.3f));
+            }
+        }
+    }
+
+    // Pillars around the plaza, lamp posts with glowing globes.
+    uint32_t pillar = b.mesh(makeCylinder("pillar", 0.45f, 6.0f, stone));
+    for (int i = 0; i < 8; ++i) {
+        float a = 2.0f * pi * (float(i) + 0.5f) / 8.0f;
+        b.place("pillar " + std::to_string(i), pillar,
+                {std::cos(a) * 11.5f, 0.0f, std::sin(a) * 11.5f});
+    }
+    uint32_t post = b.mesh(makeCylinder("lamp post", 0.08f, 5.0f, steel, 12));
+    uint32_t globe = b.mesh(makeSphere("lamp globe", 0.22f, lampGlass, 16, 8));
+    const glm::vec3 lampSpots[6] = {{-9, 0, 9}, {9, 0, 9},  {-9, 0, -9},
+                                    {9, 0, -9}, {0, 0, 18}, {-18, 0, 0}};
+    for (int i = 0; i < 6; ++i) {
+        b.place("lamp post " + std::to_string(i), post, lampSpots[i]);
+        b.place("lamp globe " + std::to_string(i), globe, lampSpots[i] + glm::vec3(0, 5.2f, 0));
+    }
+
+    // Benches, crates, barrels and decorative spheres.
+    for (int i = 0; i < 6; ++i) {
+        float a = 2.0f * pi * float(i) / 6.0f;
+        b.box("bench " + std::to_string(i), {2.0f, 0.45f, 0.5f}, wood,
+              {std::cos(a) * 9.5f, 0.0f, std::sin(a) * 9.5f}, -a + pi * 0.5f);
+    }
+    for (int i = 0; i < 20; ++i) {
+        float s = rng.uniform(0.45f, 1.0f);
+        glm::vec3 at{rng.uniform(-20.0f, -12.0f), 0.0f, rng.uniform(-20.0f, 20.0f)};
+        b.box("crate " + std::to_string(i), glm::vec3(s), wood, at, rng.uniform(0.0f, pi));
+        if (rng.chance(0.3f)) {
+            float s2 = s * rng.uniform(0.5f, 0.9f);
+            b.box("crate " + std::to_string(i) + " top", glm::vec3(s2), wood,
+                  at + glm::vec3(0, s, 0), rng.uniform(0.0f, pi));
+        }
+    }
+    uint32_t barrel = b.mesh(makeCylinder("barrel", 0.3f, 0.9f, barrelRed, 20));
+    for (int i = 0; i < 12; ++i)
+        b.place("barrel " + std::to_string(i), barrel,
+                {rng.uniform(12.0f, 20.0f), 0.0f, rng.uniform(-20.0f, 20.0f)},
+                rng.uniform(0.0f, pi));
+    for (int i = 0; i < 10; ++i) {
+        float r = rng.uniform(0.3f, 1.5f);
+        uint32_t mat = i % 3 == 0 ? chrome : plastic[rng.range(0, 3)];
+        uint32_t m = b.mesh(makeSphere("ball " + std::to_string(i), r, mat, 32, 16));
+        b.place("ball " + std::to_string(i), m,
+                {rng.uniform(-7.0f, 7.0f), r + 0.05f, rng.uniform(-7.0f, 7.0f)});
+    }
+
+    // A table near the main camera covered with objects of a few centimetres.
+    const glm::vec3 table{3.0f, 0.0f, 8.0f};
+    b.box("table top", {1.6f, 0.05f, 0.9f}, wood, table + glm::vec3(0, 0.72f, 0));
+    uint32_t leg = b.mesh(makeCylinder("table leg", 0.03f, 0.72f, steel, 10));
+    for (int i = 0; i < 4; ++i)
+        b.place("table leg " + std::to_string(i), leg,
+                table + glm::vec3((i & 1) ? 0.72f : -0.72f, 0, (i & 2) ? 0.38f : -0.38f));
+    std::vector<uint32_t> tinyBoxes, tinySpheres;
+    for (int i = 0; i < 4; ++i) {
+        float s = 0.02f + 0.015f * float(i);
+        tinyBoxes.push_back(
+            b.mesh(makeBox("tiny box " + std::to_string(i), glm::vec3(s), plastic[i])));
+        tinySpheres.push_back(
+            b.mesh(makeSphere("tiny sphere " + std::to_string(i), 0.01f + 0.01f * float(i),
+                              i % 2 ? chrome : plastic[(i + 2) % 4], 12, 6)));
+    }
+    for (int i = 0; i < 30; ++i) {
+        int k = rng.range(0, 3);
+        glm::vec3 at =
+            table + glm::vec3(rng.uniform(-0.7f, 0.7f), 0.745f, rng.uniform(-0.38f, 0.38f));
+        if (i % 2 == 0) {
+            float s = 0.02f + 0.015f * float(k);
+            b.place("table box " + std::to_string(i), tinyBoxes[size_t(k)],
+                    at + glm::vec3(0, s * 0.5f, 0), rng.uniform(0.0f, pi));
+        } else {
+            b.place("table sphere " + std::to_string(i), tinySpheres[size_t(k)],
+                    at + glm::vec3(0, 0.01f + 0.01f * float(k), 0));
+        }
+    }
+    // Pebbles and tiny debris on the ground around the plaza.
+    std::vector<uint32_t> pebbles;
+    for (int i = 0; i < 4; ++i)
+        pebbles.push_back(b.mesh(
+            makeSphere("pebble " + std::to_string(i), 0.02f + 0.012f * float(i), stone, 10, 5)));
+    for (int i = 0; i < 100; ++i) {
+        int k = rng.range(0, 3);
+        glm::vec3 at{rng.uniform(-10.0f, 10.0f), 0.0f, rng.uniform(6.0f, 16.0f)};
+        if (i % 3 == 0) {
+            float s = 0.02f + 0.015f * float(k);
+            b.place("debris " + std::to_string(i), tinyBoxes[size_t(k)],
+                    at + glm::vec3(0, s * 0.5f, 0), rng.uniform(0.0f, pi));
+        } else {
+            b.place("pebble " + std::to_string(i), pebbles[size_t(k)],
+                    at + glm::vec3(0, 0.02f + 0.012f * float(k), 0));
+        }
+    }
+
+    // Lights: sun, warm street lamps, a cool accent, spots on the checker wall, a facade, the
+    // table.
+    b.sun({-0.45f, -1.0f, -0.3f}, 3.0f);
+    for (int i = 0; i < 4; ++i)
+        b.pointLight("lamp " + std::to_string(i), lampSpots[i] + glm::vec3(0, 4.9f, 0),
+                     {1.0f, 0.8f, 0.55f}, 40.0f, 14.0f);
+    b.pointLight("blue accent", {-16.0f, 1.5f, -16.0f}, {0.4f, 0.6f, 1.0f}, 25.0f, 10.0f);
+    b.spotLight("wall spot", {0.0f, 6.0f, -5.0f}, {0.0f, 2.5f, -14.0f}, {1.0f, 0.97f, 0.9f}, 300.0f,
+                25.0f, 0.35f, 0.55f);
+    b.spotLight("facade spot", {-20.0f, 0.5f, 22.0f}, {-30.0f, 10.0f, 30.0f}, {1.0f, 0.85f, 0.7f},
+                400.0f, 40.0f, 0.25f, 0.45f);
+    b.spotLight("table spot", table + glm::vec3(0.5f, 3.5f, 0.5f), table + glm::vec3(0, 0.75f, 0),
+                {1.0f, 1.0f, 1.0f}, 80.0f, 8.0f, 0.3f, 0.5f);
+
+    // Main: between two pillars towards the checker wall, over the checker plaza, with the table
+    // of tiny objects in the near right.
+    b.camera("main", {1.5f, 1.7f, 17.0f}, {-0.5f, 1.2f, -10.0f});
+    b.camera("overview", {60.0f, 50.0f, 60.0f}, {0.0f, 0.0f, 0.0f}, 0.8f, 0.5f, 400.0f);
+    b.camera("street", {-52.0f, 1.6f, 2.0f}, {0.0f, 3.0f, -1.0f});
+    return scene;
+}
+
+// A huge one-texel checker seen at a grazing angle: the aliasing test.
+Scene makeChecker() {
+    Scene scene;
+    scene.name = "checker";
+    SceneBuilder b(scene);
+    uint32_t checker =
+        b.material("checker", {0.85f, 0.85f, 0.85f}, 0.7f, 0.0f, Procedural::TexelChecker,
+                   20.0f); // 5 cm cells
+    b.place("checker plane", b.mesh(makePlane("checker plane", 200.0f, 200.0f, checker, 20)),
+            {0, 0, 0});
+    b.sun({-0.3f, -1.0f, -0.5f}, 3.0f);
+    // 1.5 m above the plane, looking 7 degrees down: the ground fills the lower half of the view
+    // out to the horizon.
+    const float pitch = glm::radians(7.0f);
+    glm::vec3 eye{0.0f, 1.5f, 95.0f};
+    b.camera("main", eye, eye + glm::vec3(0.0f, -std::sin(pitch), -std::cos(pitch)), 0.8f, 0.1f,
+             400.0f);
+    const float lowPitch = glm::radians(4.0f);
+    b.camera("low", eye, eye + glm::vec3(0.3f, -std::sin(lowPitch), -std::cos(lowPitch)), 0.8f,
+             0.1f, 400.0f);
+    return scene;
+}
+
+// Only low-frequency materials: for comparing shading paths where aliasing must not dominate.
+Scene makeSmooth() {
+    Scene scene;
+    scene.name = "smooth";
+    SceneBuilder b(scene);
+    uint32_t ground = b.material("ground", {0.6f, 0.6f, 0.58f}, 0.9f);
+    uint32_t red = b.material("matte red", {0.75f, 0.15f, 0.12f}, 0.6f);
+    uint32_t gold = b.material("gold", {1.0f, 0.78f, 0.34f}, 0.35f, 1.0f);
+    uint32_t white = b.material("white", {0.85f, 0.85f, 0.85f}, 0.8f);
+    uint32_t blue = b.material("blue", {0.2f, 0.35f, 0.75f}, 0.5f);
+    uint32_t green = b.material("green", {0.25f, 0.6f, 0.3f}, 0.7f);
+    uint32_t orange = b.material("orange", {0.9f, 0.45f, 0.1f}, 0.4f);
+    uint32_t silver = b.material("silver", {0.9f, 0.9f, 0.92f}, 0.5f, 1.0f);
+
+    b.place("ground", b.mesh(makePlane("ground", 40.0f, 40.0f, ground, 4)), {0, 0, 0});
+    b.place("red sphere", b.mesh(makeSphere("red sphere", 1.0f, red, 48, 24)), {-2.5f, 1.0f, 0.0f});
+    b.place("gold sphere", b.mesh(makeSphere("gold sphere", 0.6f, gold, 48, 24)),
+            {0.2f, 0.6f, 1.5f});
+    b.place("white sphere", b.mesh(makeSphere("white sphere", 1.5f, white, 48, 24)),
+            {3.0f, 1.5f, -2.5f});
+    b.box("blue box", {2.0f, 2.0f, 2.0f}, blue, {0.5f, 0.0f, -2.0f}, 0.5f);
+    b.box("green tower", {1.0f, 3.0f, 1.0f}, green, {-4.5f, 0.0f, -3.0f}, 0.2f);
+    b.place("orange cylinder", b.mesh(makeCylinder("orange cylinder", 0.5f, 2.0f, orange, 40)),
+            {2.8f, 0, 1.8f});
+    b.place("silver cylinder", b.mesh(makeCylinder("silver cylinder", 0.35f, 1.2f, silver, 40)),
+            {-1.0f, 0, 2.5f});
+
+    b.sun({-0.5f, -1.0f, -0.35f}, 3.0f);
+    b.pointLight("warm", {-3.0f, 3.0f, 3.0f}, {1.0f, 0.75f, 0.5f}, 30.0f, 15.0f);
+    b.pointLight("cool", {4.0f, 2.5f, 2.0f}, {0.5f, 0.7f, 1.0f}, 20.0f, 12.0f);
+    b.camera("main", {0.0f, 3.0f, 9.5f}, {0.0f, 0.8f, 0.0f}, 0.8f, 0.1f, 100.0f);
+    b.camera("side", {-9.0f, 2.0f, 3.0f}, {0.0f, 1.0f, 0.0f}, 0.8f, 0.1f, 100.0f);
+    return scene;
+}
+
+// 10 000 small instances sharing a dozen meshes: for scaling tests (culling, instancing).
+Scene makeMany() {
+    Scene scene;
+    scene.name = "many";
+    SceneBuilder b(scene);
+    Rng rng(0x5ADE1D0004ull);
+    uint32_t ground = b.material("ground", {0.45f, 0.45f, 0.45f}, 0.9f);
+    const glm::vec3 colours[4] = {
+        {0.8f, 0.2f, 0.15f}, {0.9f, 0.8f, 0.2f}, {0.2f, 0.4f, 0.85f}, {0.3f, 0.7f, 0.35f}};
+    std::vector<uint32_t> meshes;
+    for (int c = 0; c < 4; ++c) {
+        uint32_t mat = b.material("colour " + std::to_string(c), colours[c], 0.5f);
+        meshes.push_back(b.mesh(makeBox("box " + std::to_string(c), glm::vec3(0.4f), mat)));
+        meshes.push_back(b.mesh(makeSphere("sphere " + std::to_string(c), 0.22f, mat, 16, 8)));
+        meshes.push_back(
+            b.mesh(makeCylinder("cylinder " + std::to_string(c), 0.18f, 0.5f, mat, 12)));
+    }
+    b.place("ground", b.mesh(makePlane("ground", 120.0f, 120.0f, ground, 12)), {0, 0, 0});
+    for (int z = 0; z < 100; ++z) {
+        for (int x = 0; x < 100; ++x) {
+            size_t k = size_t(rng.range(0, int(meshes.size()) - 1));
+            int shape = int(k % 3);
+            float lift = shape == 0 ? 0.2f : shape == 1 ? 0.22f : 0.0f;
+            b.place("object " + std::to_string(z * 100 + x), meshes[k],
+                    {(float(x) - 49.5f) * 1.1f, lift, (float(z) - 49.5f) * 1.1f},
+                    rng.uniform(0.0f, 3.14f));
+        }
+    }
+    b.sun({-0.4f, -1.0f, -0.3f}, 3.0f);
+    for (int i = 0; i < 4; ++i)
+        b.pointLight("light " + std::to_string(i),
+                     {(i & 1) ? 25.0f : -25.0f, 3.0f, (i & 2) ? 25.0f : -25.0f},
+                     {1.0f, 0.85f, 0.7f}, 60.0f, 20.0f);
+    b.camera("main", {0.0f, 12.0f, 62.0f}, {0.0f, 0.0f, 10.0f}, 0.8f, 0.1f, 300.0f);
+    b.camera("overview", {0.0f, 90.0f, 0.01f}, {0.0f, 0.0f, 0.0f}, 0.9f, 1.0f, 300.0f);
+    return scene;
+}
+
+const std::vector<std::pair<std::string, std::function<Scene()>>>& registry() {
+    static const std::vector<std::pair<std::string, std::function<Scene()>>> scenes = {
+        {"default", makeDefault},
+        {"checker", makeChecker},
+        {"smooth", makeSmooth},
+        {"many", makeMany},
+    };
+    return scenes;
+}
+
+} // namespace
+
+std::vector<std::string> builtinSceneNames() {
+    std::vector<std::string> names;
+    for (const auto& [name, make] : registry()) names.push_back(name);
+    return names;
+}
+
+Scene makeBuiltinScene(const std::string& name) {
+    for (const auto& [known, make] : registry())
+        if (known == name) return make();
+    std::string list;
+    for (const auto& [known, make] : registry()) list += (list.empty() ? "" : ", ") + known;
+    throw InputError("builtin:" + name + ": unknown built-in scene (known: " + list + ")");
+}
+
+} // namespace shadel

@@ -1,0 +1,18 @@
+#pragma once
+// glTF 2.0 import (.gltf and .glb) into the plain scene model.
+#include <string>
+
+#include "scene/scene.h"
+
+namespace shadel {
+
+// Loads a glTF 2.0 file. Every malformed input throws InputError with one line
+// "<path>: <reason>"; recoverable problems (unsupported extensions, missing images, repaired
+// normals) are logged as warnings and the import continues.
+//
+// The node hierarchy is flattened to instances with world transforms; a primitive becomes one
+// Mesh (split into parts of at most kMaxTrianglesPerMesh triangles). A file without cameras
+// gets an "auto" camera framing the scene, one without lights an "auto-sun".
+Scene importGltf(const std::string& path);
+
+} // namespace shadel
