@@ -266,7 +266,10 @@ std::vector<BakedMesh> bakeScene(const Scene& scene, const BakeSettings& setting
     for (const std::exception_ptr& e : errors)
         if (e) std::rethrow_exception(e);
     for (size_t i = 0; i < meshCount; ++i)
-        if (firstWithKey[i] != i) results[i] = results[firstWithKey[i]];
+        if (firstWithKey[i] != i) {
+            results[i] = results[firstWithKey[i]];
+            results[i].bakeSeconds = 0; // the work was done once, for the first copy
+        }
     return results;
 }
 
