@@ -40,12 +40,14 @@ Extent<2> randomExtent(std::mt19937& rng) {
     return {uint32_t(1 + rng() % 8), uint32_t(1 + rng() % 8)};
 }
 
-// The starting layout for one live count, built once with the fast allocator and copied into
-// the naive one (building 50k elements at naive speed would take longer than the whole run).
+// The starting layout for one live count: the same insertion sequence given to each allocator,
+// so each starts from the layout it makes itself (the fast allocator halves free boxes, the naive
+// one keeps UE4's placement, so the trees differ; nodeCount is printed with the table). Building
+// the naive layout for 50k elements at naive speed takes a few seconds, once per run.
 struct Layout {
     std::unique_ptr<BlockAllocator2D> fast;
     std::unique_ptr<NaiveBlockAllocator2D> naive;
-    std::vector<Placement<2>> live;
+    std::vector<Placement<2>> fastLive, naiveLive; // same order: element i of the sequence
 };
 
 const Layout& layoutFor(uint32_t liveCount) {
@@ -55,14 +57,15 @@ const Layout& layoutFor(uint32_t liveCount) {
         std::mt19937 rng(liveCount);
         Layout& layout = it->second;
         layout.fast = std::make_unique<BlockAllocator2D>(kSheet);
-        while (layout.live.size() < liveCount) {
-            auto placement = layout.fast->insert(randomExtent(rng));
-            if (!placement) std::abort(); // the sheet is sized so that this cannot happen
-            layout.live.push_back(*placement);
+        layout.naive = std::make_unique<NaiveBlockAllocator2D>(kSheet);
+        while (layout.fastLive.size() < liveCount) {
+            Extent<2> extent = randomExtent(rng);
+            auto fast = layout.fast->insert(extent);
+            auto naive = layout.naive->insert(extent);
+            if (!fast || !naive) std::abort(); // the sheet is sized so that this cannot happen
+            layout.fastLive.push_back(*fast);
+            layout.naiveLive.push_back(*naive);
         }
-        auto tree = layout.fast->preorder();
-        layout.naive = std::make_unique<NaiveBlockAllocator2D>(
-            NaiveBlockAllocator2D::fromPreorder(kSheet, 1, tree));
     }
     return it->second;
 }
@@ -75,6 +78,14 @@ const Allocator& startOf(const Layout& layout) {
         return *layout.naive;
 }
 
+template <class Allocator>
+const std::vector<Placement<2>>& liveOf(const Layout& layout) {
+    if constexpr (std::is_same_v<Allocator, BlockAllocator2D>)
+        return layout.fastLive;
+    else
+        return layout.naiveLive;
+}
+
 // Each iteration starts from a copy of the same layout (not timed) and times kOpsPerIteration
 // operations on it; the reported time is per operation.
 template <class Allocator, class Body>
@@ -83,16 +94,21 @@ void timePerOp(benchmark::State& state, uint32_t liveCount, Body body) {
     std::mt19937 rng(12345);
     for (auto _ : state) {
         Allocator allocator = startOf<Allocator>(layout);
+        // A copied vector has no spare capacity, so the first node the timed operations add
+        // would reallocate (copy) the whole node array, which an allocator in use does not do.
+        // One untimed insert and remove of a large element gives it room and leaves the tree
+        // as it was.
+        if (auto p = allocator.insert(Extent<2>{256, 256})) allocator.remove(p->id);
         // Distinct random victims for this iteration.
         std::vector<uint32_t> victims(kOpsPerIteration);
-        for (uint32_t& v : victims) v = rng() % uint32_t(layout.live.size());
+        for (uint32_t& v : victims) v = rng() % uint32_t(layout.fastLive.size());
         std::sort(victims.begin(), victims.end());
         victims.erase(std::unique(victims.begin(), victims.end()), victims.end());
         std::vector<Extent<2>> extents(kOpsPerIteration);
         for (auto& e : extents) e = randomExtent(rng);
 
         auto start = Clock::now();
-        size_t done = body(allocator, layout, victims, extents);
+        size_t done = body(allocator, liveOf<Allocator>(layout), victims, extents);
         double seconds = std::chrono::duration<double>(Clock::now() - start).count();
         benchmark::DoNotOptimize(done);
         state.SetIterationTime(seconds / double(std::max<size_t>(done, 1)));
@@ -104,10 +120,10 @@ void timePerOp(benchmark::State& state, uint32_t liveCount, Body body) {
 template <class Allocator, bool byId>
 void removal(benchmark::State& state, uint32_t liveCount) {
     timePerOp<Allocator>(state, liveCount,
-                         [](Allocator& allocator, const Layout& layout,
+                         [](Allocator& allocator, const std::vector<Placement<2>>& live,
                             const std::vector<uint32_t>& victims, const std::vector<Extent<2>>&) {
                              for (uint32_t v : victims) {
-                                 const Placement<2>& p = layout.live[v];
+                                 const Placement<2>& p = live[v];
                                  bool removed =
                                      byId ? allocator.remove(p.id) : allocator.remove(p.origin);
                                  if (!removed) std::abort();
@@ -119,7 +135,7 @@ void removal(benchmark::State& state, uint32_t liveCount) {
 template <class Allocator>
 void insertion(benchmark::State& state, uint32_t liveCount) {
     timePerOp<Allocator>(state, liveCount,
-                         [](Allocator& allocator, const Layout&, const std::vector<uint32_t>&,
+                         [](Allocator& allocator, const std::vector<Placement<2>>&, const std::vector<uint32_t>&,
                             const std::vector<Extent<2>>& extents) {
                              for (const auto& e : extents)
                                  if (!allocator.insert(e)) std::abort();
@@ -129,7 +145,7 @@ void insertion(benchmark::State& state, uint32_t liveCount) {
 
 void insertionBatched(benchmark::State& state, uint32_t liveCount) {
     timePerOp<BlockAllocator2D>(state, liveCount,
-                                [](BlockAllocator2D& allocator, const Layout&,
+                                [](BlockAllocator2D& allocator, const std::vector<Placement<2>>&,
                                    const std::vector<uint32_t>&,
                                    const std::vector<Extent<2>>& extents) {
                                     auto placements = allocator.insertBatch(extents);
@@ -144,11 +160,11 @@ void insertionBatched(benchmark::State& state, uint32_t liveCount) {
 template <class Allocator>
 void churn(benchmark::State& state, uint32_t liveCount) {
     timePerOp<Allocator>(state, liveCount,
-                         [](Allocator& allocator, const Layout& layout,
+                         [](Allocator& allocator, const std::vector<Placement<2>>& live,
                             const std::vector<uint32_t>& victims,
                             const std::vector<Extent<2>>& extents) {
                              for (size_t i = 0; i < victims.size(); ++i) {
-                                 if (!allocator.remove(layout.live[victims[i]].id)) std::abort();
+                                 if (!allocator.remove(live[victims[i]].id)) std::abort();
                                  if (!allocator.insert(extents[i])) std::abort();
                              }
                              return victims.size();
@@ -159,10 +175,10 @@ void churn(benchmark::State& state, uint32_t liveCount) {
 void churnBatched(benchmark::State& state, uint32_t liveCount) {
     timePerOp<BlockAllocator2D>(
         state, liveCount,
-        [](BlockAllocator2D& allocator, const Layout& layout, const std::vector<uint32_t>& victims,
+        [](BlockAllocator2D& allocator, const std::vector<Placement<2>>& live, const std::vector<uint32_t>& victims,
            const std::vector<Extent<2>>& extents) {
             for (uint32_t v : victims)
-                if (!allocator.remove(layout.live[v].id)) std::abort();
+                if (!allocator.remove(live[v].id)) std::abort();
             auto placements = allocator.insertBatch(std::span(extents).first(victims.size()));
             for (const auto& p : placements)
                 if (!p) std::abort();
@@ -401,6 +417,12 @@ void printRatioTable(const std::map<std::string, double>& ns) {
                     "%7.1fx %6.2fx | %9.0f %9.0f %9.0f %7.1fx\n",
                     live, rf, rn, ratio(rn, rf), of, on, ratio(on, of), is, ib, in, ratio(in, is),
                     ratio(in, ib), ratio(is, ib), cs, cb, cn, ratio(cn, cs));
+    }
+    std::printf("\nStarting layouts (same insertion sequence): tree nodes fast / naive\n");
+    for (uint32_t live : kLiveCounts) {
+        const Layout& layout = layoutFor(live);
+        std::printf("%-6u %9zu %9zu\n", live, layout.fast->nodeCount(),
+                    layout.naive->nodeCount());
     }
     double t = get("tlsf/alloc+free"), f = get("first-fit/alloc+free"),
            m = get("malloc/alloc+free");

@@ -228,8 +228,8 @@ struct ShadelFrame {
     uint chunksPerCounter;
     uint objectCount;
     float shadingBias;
-    uint pad0;
-    uint pad1;
+    float trilinearBand; // width of the LOD interval blended between two MIPs (1 = trilinear)
+    uint materialSamples; // material evaluations per shadel above MIP 0 (1 or 4)
 };
 
 #ifdef __cplusplus

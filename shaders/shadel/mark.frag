@@ -41,8 +41,7 @@ void main() {
     ShadelFrame s = ShadelFrameRef(f.shadel).s;
     GpuShadelObject o = ShadelObjectBuffer(s.objects).o[inInstance];
     vec2 texel = inShadelUv * vec2(o.mip0Size);
-    float lod = clamp(shadelLod(dFdx(texel), dFdy(texel), s.shadingBias), 0.0, float(o.mipCount - 1u));
-    uint m0 = uint(floor(lod));
-    markLevel(s, o, m0, inShadelUv);
-    if (fract(lod) > 0.0 && m0 + 1u < o.mipCount) markLevel(s, o, m0 + 1u, inShadelUv);
+    ShadelLevels l = shadelLevels(o, dFdx(texel), dFdy(texel), s.shadingBias, s.trilinearBand);
+    markLevel(s, o, l.mip0, inShadelUv);
+    if (l.two) markLevel(s, o, l.mip1, inShadelUv);
 }

@@ -73,13 +73,13 @@ void main() {
     ShadelFrame s = ShadelFrameRef(f.shadel).s;
     GpuShadelObject o = ShadelObjectBuffer(s.objects).o[inInstance];
     vec2 texel = inShadelUv * vec2(o.mip0Size);
-    float lod = clamp(shadelLod(dFdx(texel), dFdy(texel), s.shadingBias), 0.0, float(o.mipCount - 1u));
-    uint m0 = uint(floor(lod));
+    ShadelLevels l = shadelLevels(o, dFdx(texel), dFdy(texel), s.shadingBias, s.trilinearBand);
+    uint m0 = l.mip0;
+    float lod = float(l.mip0) + l.blend;
     uint missing = 0u, overflowed = 0u;
     uint64_t mask0, mask1;
-    vec3 color = sampleLevel(s, o, m0, inShadelUv, missing, overflowed, mask0);
-    if (fract(lod) > 0.0 && m0 + 1u < o.mipCount)
-        color = mix(color, sampleLevel(s, o, m0 + 1u, inShadelUv, missing, overflowed, mask1), fract(lod));
+    vec3 color = sampleLevel(s, o, l.mip0, inShadelUv, missing, overflowed, mask0);
+    if (l.two) color = mix(color, sampleLevel(s, o, l.mip1, inShadelUv, missing, overflowed, mask1), l.blend);
 
     ShadelCountersRef counters = ShadelCountersRef(s.counters);
     if (missing != 0u) atomicAdd(counters.c.reconstructionMisses, 1u);

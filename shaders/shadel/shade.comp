@@ -53,22 +53,51 @@ void main() {
     vec3 n = shadelInterpolate(bary.center, v0.normal, v1.normal, v2.normal);
     vec4 tangent = vec4(shadelInterpolate(bary.center, v0.tangent.xyz, v1.tangent.xyz, v2.tangent.xyz), v0.tangent.w);
     vec2 uv = shadelInterpolate2(bary.center, v0.uv0, v1.uv0, v2.uv0);
-    vec2 uvRight = shadelInterpolate2(bary.right, v0.uv0, v1.uv0, v2.uv0);
-    vec2 uvDown = shadelInterpolate2(bary.down, v0.uv0, v1.uv0, v2.uv0);
+    vec2 uvDx = shadelInterpolate2(bary.right, v0.uv0, v1.uv0, v2.uv0) - uv;
+    vec2 uvDy = shadelInterpolate2(bary.down, v0.uv0, v1.uv0, v2.uv0) - uv;
 
     SurfaceInput si;
     si.position = (inst.model * vec4(p, 1.0)).xyz;
     si.normal = normalize(mat3(inst.normalMatrix) * n);
     si.tangent = vec4(mat3(inst.model) * tangent.xyz, tangent.w);
     si.uv = uv;
-    si.uvDx = uvRight - uv;
-    si.uvDy = uvDown - uv;
+    si.uvDx = uvDx;
+    si.uvDy = uvDy;
     // No rasterizer here: a surface faces the viewer when its normal points at the camera.
     vec3 geometricNormal = normalize(mat3(inst.normalMatrix) *
                                      cross(v1.position - v0.position, v2.position - v0.position));
     si.frontFacing = dot(geometricNormal, f.cameraPosition - si.position) >= 0.0;
     GpuMaterial mat = MaterialBuffer(f.materials).m[inst.material];
-    MaterialSample m = evaluateMaterial(mat, si);
+    MaterialSample m;
+    if (work.mip == 0u || s.materialSamples <= 1u) {
+        m = evaluateMaterial(mat, si);
+    } else {
+        // A shadel of MIP k stands for 2^k x 2^k shadels of MIP 0. Evaluating the material at a
+        // 4-point rotated grid inside its footprint (lighting once, at the centre) approximates
+        // shading MIP 0 and filtering down, so materials with no filtered form (the one-texel
+        // checker) stay anti-aliased in coarse MIPs too.
+        const vec2 grid[4] = vec2[](vec2(-0.125, -0.375), vec2(0.375, -0.125), vec2(0.125, 0.375), vec2(-0.375, 0.125));
+        vec2 step = vec2(1.0) / vec2(size);
+        vec2 centre = shadelCenterUv(shadel, size);
+        MaterialSample sum;
+        sum.baseColor = vec3(0.0); sum.alpha = 0.0; sum.normal = vec3(0.0); sum.metallic = 0.0;
+        sum.roughness = 0.0; sum.occlusion = 0.0; sum.emissive = vec3(0.0);
+        SurfaceInput sub = si;
+        sub.uvDx = uvDx * 0.5;
+        sub.uvDy = uvDy * 0.5;
+        for (int i = 0; i < 4; ++i) {
+            vec3 b = shadelBarycentrics(centre + grid[i] * step, uvs.v[i0], uvs.v[i1], uvs.v[i2]);
+            sub.uv = shadelInterpolate2(b, v0.uv0, v1.uv0, v2.uv0);
+            MaterialSample one = evaluateMaterial(mat, sub);
+            sum.baseColor += one.baseColor; sum.alpha += one.alpha; sum.normal += one.normal;
+            sum.metallic += one.metallic; sum.roughness += one.roughness;
+            sum.occlusion += one.occlusion; sum.emissive += one.emissive;
+        }
+        m.baseColor = sum.baseColor * 0.25; m.alpha = sum.alpha * 0.25;
+        m.normal = normalize(sum.normal); m.metallic = sum.metallic * 0.25;
+        m.roughness = sum.roughness * 0.25; m.occlusion = sum.occlusion * 0.25;
+        m.emissive = sum.emissive * 0.25;
+    }
     vec3 color = shadeSurface(f, m, si.position, si.normal);
     imageStore(gImagesRgba16f[s.storageWriteSlot], outTexel, vec4(color, 1.0));
 }

@@ -19,6 +19,31 @@ float shadelLod(vec2 texelDx, vec2 texelDy, float bias) {
 
 uvec2 levelSize(GpuShadelObject o, uint mip) { return max(o.mip0Size >> mip, uvec2(1u)); }
 
+// The MIPs a sample reads and the weight of the second. Two MIPs are blended only inside a band
+// around the middle of each LOD interval ("brilinear", the seed's aside): near integer LODs one
+// level is read, so marking, storage and reconstruction all touch fewer chunks. Marking and
+// reconstruction call this with the same inputs, so they always agree.
+struct ShadelLevels {
+    uint mip0;
+    uint mip1;
+    float blend; // weight of mip1
+    bool two;    // read both levels
+};
+
+// texelDx/Dy: screen derivatives of the sample's MIP-0 shadel coordinate.
+ShadelLevels shadelLevels(GpuShadelObject o, vec2 texelDx, vec2 texelDy, float bias, float band) {
+    float lod = clamp(shadelLod(texelDx, texelDy, bias), 0.0, float(o.mipCount - 1u));
+    ShadelLevels l;
+    l.mip0 = uint(floor(lod));
+    l.mip1 = min(l.mip0 + 1u, o.mipCount - 1u);
+    float f = lod - float(l.mip0);
+    float t = band >= 1.0 ? f : clamp((f - 0.5 * (1.0 - band)) / max(band, 1e-6), 0.0, 1.0);
+    if (t >= 1.0 && l.mip1 != l.mip0) { l.mip0 = l.mip1; t = 0.0; }
+    l.blend = t;
+    l.two = t > 0.0 && l.mip1 != l.mip0;
+    return l;
+}
+
 // The 2x2 bilinear footprint at `mip` of the sample at shadel-UV `uv`: first texel + weights.
 void bilinearFootprint(GpuShadelObject o, uint mip, vec2 uv, out ivec2 texel0, out vec2 weight) {
     vec2 size = vec2(levelSize(o, mip));

@@ -28,6 +28,9 @@ struct RenderOptions {
     uint32_t shadeStorageSize = 4096;
     uint32_t sheetShadels = 65536;
     float shadingBias = 0.0f;
+    float trilinearBand = 1.0f;
+    uint32_t materialSamples = 4;
+    double shadelBudget = 64e6; // MIP-0 shadels the bake may use for the whole scene
     bool printPasses = false;
     bool progress = true;
 };

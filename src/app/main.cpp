@@ -67,6 +67,9 @@ int main(int argc, char** argv) {
     render->add_option("--cache-dir", ro.cacheDir, "bake cache directory");
     render->add_option("--storage", ro.shadeStorageSize, "decoupled: shade storage side in shadels")->capture_default_str();
     render->add_option("--shading-bias", ro.shadingBias, "decoupled: fractional MIP bias (+ = fewer shadels)")->capture_default_str();
+    render->add_option("--trilinear-band", ro.trilinearBand, "decoupled: LOD band blended between MIPs (1 = full trilinear)")->capture_default_str();
+    render->add_option("--material-samples", ro.materialSamples, "decoupled: material evaluations per shadel above MIP 0 (1 or 4)")->capture_default_str();
+    render->add_option("--shadel-budget", ro.shadelBudget, "decoupled: max MIP-0 shadels for the scene (lowers --density)")->capture_default_str();
     render->add_option("--sheet", ro.sheetShadels, "decoupled: virtual sheet side in shadels (64k..256k)")->capture_default_str();
     render->add_flag("--passes", ro.printPasses, "print the per-pass timing table");
 

@@ -44,11 +44,45 @@ using block_detail::volume;
 
 namespace {
 
+using block_detail::FreeSummary;
+
 template <size_t N>
-Extent<N> componentMax(const Extent<N>& a, const Extent<N>& b) {
-    Extent<N> out;
-    for (size_t axis = 0; axis < N; ++axis) out[axis] = std::max(a[axis], b[axis]);
+FreeSummary<N> summaryOfLeaf(const Extent<N>& size) {
+    return FreeSummary<N>{size, size};
+}
+
+template <size_t N>
+uint32_t shortestSide(const Extent<N>& e) {
+    uint32_t m = e[0];
+    for (size_t d = 1; d < N; ++d) m = std::min(m, e[d]);
+    return m;
+}
+
+template <size_t N>
+FreeSummary<N> combine(const FreeSummary<N>& a, const FreeSummary<N>& b) {
+    FreeSummary<N> out;
+    for (size_t d = 0; d < N; ++d) out.max[d] = std::max(a.max[d], b.max[d]);
+    out.square = shortestSide<N>(a.square) >= shortestSide<N>(b.square) ? a.square : b.square;
     return out;
+}
+
+// How well a subtree's free leaves can take an element: 0 not at all, 1 maybe (the per-axis
+// maximum admits it), 2 surely (the summary's square leaf holds it).
+enum Fit { kNoFit = 0, kMayFit = 1, kSureFit = 2 };
+
+template <size_t N>
+Fit fitOf(const Extent<N>& element, const FreeSummary<N>& summary) {
+    if (!fitsIn<N>(element, summary.max)) return kNoFit;
+    return fitsIn<N>(element, summary.square) ? kSureFit : kMayFit;
+}
+
+// Which child an element tries first: the one more certain to hold it; between equals, the one
+// with less free room (best fit: small elements fill small holes and large free boxes stay
+// whole), child A on ties.
+template <size_t N>
+bool aFirst(Fit fitA, const FreeSummary<N>& a, Fit fitB, const FreeSummary<N>& b) {
+    if (fitA != fitB) return fitA > fitB;
+    return volume<N>(a.max) <= volume<N>(b.max);
 }
 
 template <size_t N>
@@ -72,7 +106,7 @@ void BlockAllocator<N>::clear() {
     Node root;
     for (size_t axis = 0; axis < N; ++axis)
         root.size[axis] = m_bounds[axis] / m_alignment * m_alignment;
-    root.maxFree = root.size;
+    root.free = summaryOfLeaf<N>(root.size);
     m_nodes.push_back(root);
     // Bump live slots' generations so that ids handed out before clear() stay invalid.
     m_freeSlots.clear();
@@ -97,10 +131,11 @@ bool BlockAllocator<N>::refresh(uint32_t index) {
     const Node& a = m_nodes[node.childA];
     const Node& b = m_nodes[node.childB];
     bool occupied = a.occupied || b.occupied;
-    Extent<N> maxFree = componentMax<N>(a.maxFree, b.maxFree);
-    if (occupied == node.occupied && maxFree == node.maxFree) return false;
+    FreeSummary<N> free = combine<N>(a.free, b.free);
+    if (occupied == node.occupied && free.max == node.free.max && free.square == node.free.square)
+        return false;
     node.occupied = occupied;
-    node.maxFree = maxFree;
+    node.free = free;
     return true;
 }
 
@@ -112,27 +147,39 @@ void BlockAllocator<N>::refreshUpwards(uint32_t index) {
     }
 }
 
-// Cuts free leaf `index` once, along the axis with the most slack; child A is the part whose
-// extent on that axis matches the element.
+// Cuts free leaf `index` once on the way to an element of `extent` (which fits it and is not
+// equal to it); child A is the part the element continues into. A box at least twice the element
+// on some axis is halved along the longest such axis (child A, the lower half, is never the
+// larger one); otherwise it is cut to the element's extent along the axis with the most slack.
 template <size_t N>
 void BlockAllocator<N>::splitLeaf(uint32_t index, const Extent<N>& extent) {
-    size_t axis = block_detail::splitAxis<N>(m_nodes[index].size, extent);
-    SHADEL_ASSERT(axis < N);
+    const Extent<N> box = m_nodes[index].size;
+    size_t axis = N;
+    uint32_t cut = 0;
+    for (size_t d = 0; d < N; ++d) {
+        uint32_t half = box[d] / m_alignment / 2 * m_alignment;
+        if (half >= extent[d] && (axis == N || box[d] > box[axis])) axis = d, cut = half;
+    }
+    if (axis == N) {
+        axis = block_detail::splitAxis<N>(box, extent);
+        SHADEL_ASSERT(axis < N);
+        cut = extent[axis];
+    }
     Node a, b;
     a.min = b.min = m_nodes[index].min;
-    a.size = b.size = m_nodes[index].size;
-    a.size[axis] = extent[axis];
-    b.min[axis] += extent[axis];
-    b.size[axis] -= extent[axis];
-    a.maxFree = a.size;
-    b.maxFree = b.size;
+    a.size = b.size = box;
+    a.size[axis] = cut;
+    b.min[axis] += cut;
+    b.size[axis] -= cut;
+    a.free = summaryOfLeaf<N>(a.size);
+    b.free = summaryOfLeaf<N>(b.size);
     a.parent = b.parent = index;
     uint32_t first = uint32_t(m_nodes.size());
     m_nodes.push_back(a);
     m_nodes.push_back(b);
     m_nodes[index].childA = first;
     m_nodes[index].childB = first + 1;
-    m_nodes[index].maxFree = componentMax<N>(a.maxFree, b.maxFree);
+    m_nodes[index].free = combine<N>(a.free, b.free);
 }
 
 // Marks an exactly fitting free (or batch-reserved) leaf used and gives it an id. Ancestors are
@@ -152,7 +199,7 @@ Placement<N> BlockAllocator<N>::occupyLeaf(uint32_t index) {
     Node& node = m_nodes[index];
     node.slot = slot;
     node.occupied = true;
-    node.maxFree = Extent<N>{};
+    node.free = FreeSummary<N>{};
     ++m_liveCount;
     m_usedVolume += volume<N>(node.size);
     return Placement<N>{node.min, node.size, BlockId{slot, m_slotGeneration[slot]}};
@@ -161,29 +208,32 @@ Placement<N> BlockAllocator<N>::occupyLeaf(uint32_t index) {
 template <size_t N>
 std::optional<Placement<N>> BlockAllocator<N>::insert(const Extent<N>& requested) {
     auto extent = roundUp(requested);
-    if (!extent || !fitsIn<N>(*extent, m_nodes[0].maxFree)) return std::nullopt;
-    // Depth-first, A before B, entering only subtrees whose per-axis free maximum admits the
-    // element. The maximum is per axis, so a subtree can pass and still hold no fitting leaf;
-    // the stack keeps the B siblings to come back to.
+    if (!extent || fitOf<N>(*extent, m_nodes[0].free) == kNoFit) return std::nullopt;
+    // Depth-first, entering only subtrees whose summary admits the element. Below a node that
+    // surely holds it, some child surely holds it too, so the descent goes straight down. Only
+    // when the summary says "maybe" can a subtree turn out to hold no fitting leaf: the stack
+    // keeps the siblings not taken, to come back to.
     m_scratch.clear();
     uint32_t index = 0;
     while (!m_nodes[index].leaf()) {
         const Node& node = m_nodes[index];
-        bool intoA = fitsIn<N>(*extent, m_nodes[node.childA].maxFree);
-        bool intoB = fitsIn<N>(*extent, m_nodes[node.childB].maxFree);
-        if (intoA) {
-            if (intoB) m_scratch.push_back(node.childB);
-            index = node.childA;
-        } else if (intoB) {
-            index = node.childB;
-        } else {
+        const FreeSummary<N>& freeA = m_nodes[node.childA].free;
+        const FreeSummary<N>& freeB = m_nodes[node.childB].free;
+        Fit fitA = fitOf<N>(*extent, freeA), fitB = fitOf<N>(*extent, freeB);
+        if (fitA == kNoFit && fitB == kNoFit) {
             if (m_scratch.empty()) return std::nullopt;
             index = m_scratch.back();
             m_scratch.pop_back();
+            continue;
         }
+        bool intoA = aFirst<N>(fitA, freeA, fitB, freeB);
+        Fit other = intoA ? fitB : fitA;
+        if (other != kNoFit && std::max(fitA, fitB) != kSureFit)
+            m_scratch.push_back(intoA ? node.childB : node.childA);
+        index = intoA ? node.childA : node.childB;
     }
-    // A leaf is only entered when its maxFree admits the element: it is free and large enough.
-    while (block_detail::splitAxis<N>(m_nodes[index].size, *extent) < N) {
+    // A leaf is only entered when its summary admits the element: it is free and large enough.
+    while (m_nodes[index].size != *extent) {
         splitLeaf(index, *extent);
         index = m_nodes[index].childA;
     }
@@ -194,74 +244,151 @@ std::optional<Placement<N>> BlockAllocator<N>::insert(const Extent<N>& requested
 
 template <size_t N>
 struct BlockAllocator<N>::BatchState {
-    std::span<const Extent<N>> extents; // rounded
-    std::vector<uint32_t> pending;      // element numbers still unplaced, ascending
-    Extent<N> smallest;                 // per-axis minimum over the initial pending set
-    std::vector<uint32_t> leaves;       // element number -> leaf it got, or kNone
+    std::vector<Extent<N>> extents; // by rank: rank 0 is the largest element
+    std::vector<uint32_t> leaves;   // by rank: the leaf reserved for it, or kNone
+    std::vector<uint32_t> arena;    // lists of ranks, ascending, stacked by the recursion
+    std::vector<uint32_t> scratch;  // never held across a recursive call
 };
 
-// One depth-first traversal for the whole batch. At a free leaf the lowest-numbered pending
-// element that fits is placed, and the traversal continues into the pieces cut off, so the
-// result equals inserting the elements one by one (first fit in the same order), without
-// walking down from the root for each of them.
+// Places what it can of the elements listed in state.arena[list] (ranks, ascending) in the
+// subtree of `index`; the ones left over are moved to the front of the list, still ascending,
+// and the end of that part is returned. Arena entries above list.end are scratch for the
+// children's lists and are given back before returning.
+//
+// At a free leaf the largest element that fits is placed, cutting the leaf as insert() would and
+// continuing into the pieces. At an inner node each element goes first to the child insert()
+// would try first; what child A cannot take tries child B, and what B cannot take tries A if it
+// has not been there yet. So each element follows insert()'s search, but the elements share the
+// descent, and each node's summary is refreshed once per batch, on the way back up.
 template <size_t N>
-void BlockAllocator<N>::visitBatch(uint32_t index, BatchState& state) {
-    if (state.pending.empty() || !fitsIn<N>(state.smallest, m_nodes[index].maxFree)) return;
+size_t BlockAllocator<N>::visitBatch(uint32_t index, BatchState& state, BatchList list) {
+    std::vector<uint32_t>& arena = state.arena;
     if (m_nodes[index].leaf()) {
-        if (m_nodes[index].slot != kNone) return;
-        auto fitting = std::find_if(state.pending.begin(), state.pending.end(), [&](uint32_t e) {
-            return fitsIn<N>(state.extents[e], m_nodes[index].size);
-        });
-        if (fitting == state.pending.end()) return;
-        const Extent<N>& extent = state.extents[*fitting];
-        if (block_detail::splitAxis<N>(m_nodes[index].size, extent) == N) {
+        if (m_nodes[index].slot != kNone) return list.end;
+        size_t pick = list.begin;
+        while (pick < list.end && !fitsIn<N>(state.extents[arena[pick]], m_nodes[index].size))
+            ++pick;
+        if (pick == list.end) return list.end;
+        const uint32_t rank = arena[pick];
+        if (m_nodes[index].size == state.extents[rank]) {
             // Ids are handed out after the traversal, in element order, as insert() would.
             Node& node = m_nodes[index];
             node.slot = kReservedSlot;
             node.occupied = true;
-            node.maxFree = Extent<N>{};
-            state.leaves[*fitting] = index;
-            state.pending.erase(fitting);
-            return; // the caller refreshes this node's ancestors
+            node.free = FreeSummary<N>{};
+            state.leaves[rank] = index;
+            std::copy(arena.begin() + ptrdiff_t(pick) + 1, arena.begin() + ptrdiff_t(list.end),
+                      arena.begin() + ptrdiff_t(pick));
+            return list.end - 1; // the caller refreshes this node's ancestors
         }
-        // Lower-numbered pending elements did not fit this leaf, so they will not fit child A
-        // either: the element will be found again there.
-        splitLeaf(index, extent);
-    } else {
-        bool any = false;
-        for (uint32_t e : state.pending) {
-            if (fitsIn<N>(state.extents[e], m_nodes[index].maxFree)) {
-                any = true;
-                break;
-            }
-        }
-        if (!any) return;
+        // The elements before `pick` did not fit the whole leaf, so they fit neither piece.
+        splitLeaf(index, state.extents[rank]);
     }
-    visitBatch(m_nodes[index].childA, state);
-    visitBatch(m_nodes[index].childB, state);
+    const uint32_t childA = m_nodes[index].childA, childB = m_nodes[index].childB;
+    auto admits = [&](uint32_t child, uint32_t rank) {
+        return fitOf<N>(state.extents[rank], m_nodes[child].free) != kNoFit;
+    };
+    // Route: elements no child admits stay at the front [list.begin, kept); the others are
+    // appended as A's list [base, splitAt) and B's list [splitAt, endB).
+    const size_t base = arena.size();
+    std::vector<uint32_t>& bFirst = state.scratch;
+    bFirst.clear();
+    size_t kept = list.begin;
+    for (size_t i = list.begin; i < list.end; ++i) {
+        const uint32_t rank = arena[i];
+        const Extent<N>& e = state.extents[rank];
+        const FreeSummary<N>& freeA = m_nodes[childA].free;
+        const FreeSummary<N>& freeB = m_nodes[childB].free;
+        Fit fitA = fitOf<N>(e, freeA), fitB = fitOf<N>(e, freeB);
+        if (fitA == kNoFit && fitB == kNoFit) arena[kept++] = rank;
+        else if (aFirst<N>(fitA, freeA, fitB, freeB)) arena.push_back(rank);
+        else bFirst.push_back(rank);
+    }
+    const size_t splitAt = arena.size();
+    arena.insert(arena.end(), bFirst.begin(), bFirst.end());
+    const size_t endB = arena.size();
+
+    // A's list; its leftovers that B now admits are merged (by rank) into B's list, the others
+    // are final and compacted to [base, leftA).
+    size_t leftA = splitAt == base ? base : visitBatch(childA, state, {base, splitAt});
+    const size_t toB = arena.size();
+    {
+        size_t i = base, j = splitAt, keepA = base;
+        while (i < leftA || j < endB) {
+            bool fromA = j == endB || (i < leftA && arena[i] < arena[j]);
+            const uint32_t rank = arena[fromA ? i++ : j++];
+            if (fromA && !admits(childB, rank)) arena[keepA++] = rank;
+            else arena.push_back(rank);
+        }
+        leftA = keepA;
+    }
+    // B's list; its leftovers that started in B and that A now admits retry A, the others are
+    // final and compacted to [toB, leftB).
+    size_t leftB = toB == arena.size() ? toB : visitBatch(childB, state, {toB, arena.size()});
+    const size_t retry = arena.size();
+    {
+        size_t j = splitAt, keepB = toB;
+        for (size_t i = toB; i < leftB; ++i) {
+            const uint32_t rank = arena[i];
+            while (j < endB && arena[j] < rank) ++j;
+            bool startedInB = j < endB && arena[j] == rank;
+            if (startedInB && admits(childA, rank)) arena.push_back(rank);
+            else arena[keepB++] = rank;
+        }
+        leftB = keepB;
+    }
+    size_t leftRetry =
+        retry == arena.size() ? retry : visitBatch(childA, state, {retry, arena.size()});
+
+    // Every leftover, ascending, back to the front of the list.
+    std::vector<uint32_t>& left = state.scratch;
+    left.clear();
+    left.insert(left.end(), arena.begin() + ptrdiff_t(list.begin),
+                arena.begin() + ptrdiff_t(kept));
+    left.insert(left.end(), arena.begin() + ptrdiff_t(base), arena.begin() + ptrdiff_t(leftA));
+    left.insert(left.end(), arena.begin() + ptrdiff_t(toB), arena.begin() + ptrdiff_t(leftB));
+    left.insert(left.end(), arena.begin() + ptrdiff_t(retry),
+                arena.begin() + ptrdiff_t(leftRetry));
+    std::sort(left.begin(), left.end());
+    std::copy(left.begin(), left.end(), arena.begin() + ptrdiff_t(list.begin));
+    arena.resize(base);
     refresh(index);
+    return list.begin + left.size();
 }
 
 template <size_t N>
 std::vector<std::optional<Placement<N>>>
 BlockAllocator<N>::insertBatch(std::span<const Extent<N>> extents) {
     std::vector<std::optional<Placement<N>>> results(extents.size());
+    // Rank the elements that can fit at all, largest volume first (longest side, then element
+    // order on ties): placing large elements first packs better, and a leaf then takes the
+    // first element of its list that fits.
+    std::vector<uint32_t> byRank;
     std::vector<Extent<N>> rounded(extents.size());
-    BatchState state;
-    state.leaves.assign(extents.size(), kNone);
-    state.smallest.fill(~0u);
     for (uint32_t e = 0; e < extents.size(); ++e) {
         auto extent = roundUp(extents[e]);
         if (!extent) continue;
         rounded[e] = *extent;
-        state.pending.push_back(e);
-        for (size_t axis = 0; axis < N; ++axis)
-            state.smallest[axis] = std::min(state.smallest[axis], rounded[e][axis]);
+        byRank.push_back(e);
     }
-    state.extents = rounded;
-    visitBatch(0, state);
+    auto longest = [](const Extent<N>& x) { return *std::max_element(x.begin(), x.end()); };
+    std::stable_sort(byRank.begin(), byRank.end(), [&](uint32_t x, uint32_t y) {
+        uint64_t vx = volume<N>(rounded[x]), vy = volume<N>(rounded[y]);
+        if (vx != vy) return vx > vy;
+        return longest(rounded[x]) > longest(rounded[y]);
+    });
+    BatchState state;
+    state.leaves.assign(byRank.size(), kNone);
+    for (uint32_t e : byRank) state.extents.push_back(rounded[e]);
+    for (uint32_t rank = 0; rank < byRank.size(); ++rank)
+        if (fitOf<N>(state.extents[rank], m_nodes[0].free) != kNoFit) state.arena.push_back(rank);
+    if (!state.arena.empty()) {
+        visitBatch(0, state, {0, state.arena.size()});
+        }
+    std::vector<uint32_t> leafOf(extents.size(), kNone);
+    for (uint32_t rank = 0; rank < byRank.size(); ++rank) leafOf[byRank[rank]] = state.leaves[rank];
     for (uint32_t e = 0; e < extents.size(); ++e)
-        if (state.leaves[e] != kNone) results[e] = occupyLeaf(state.leaves[e]);
+        if (leafOf[e] != kNone) results[e] = occupyLeaf(leafOf[e]);
     return results;
 }
 
@@ -306,7 +433,7 @@ void BlockAllocator<N>::removeLeaf(uint32_t index) {
     m_freeSlots.push_back(slot);
     node.slot = kNone;
     node.occupied = false;
-    node.maxFree = node.size;
+    node.free = summaryOfLeaf<N>(node.size);
     --m_liveCount;
     m_usedVolume -= volume<N>(node.size);
 
@@ -347,7 +474,7 @@ void BlockAllocator<N>::collapse(uint32_t& top) {
     }
     Node& collapsed = m_nodes[top];
     collapsed.childA = collapsed.childB = kNone;
-    collapsed.maxFree = collapsed.size;
+    collapsed.free = summaryOfLeaf<N>(collapsed.size);
     std::sort(m_scratch.begin(), m_scratch.end(), std::greater<>());
     for (uint32_t hole : m_scratch) {
         uint32_t last = uint32_t(m_nodes.size() - 1);
@@ -406,7 +533,8 @@ bool BlockAllocator<N>::validate() const {
             if (node.childB != kNone) return false;
             bool used = node.slot != kNone;
             if (node.occupied != used) return false;
-            if (node.maxFree != (used ? Extent<N>{} : node.size)) return false;
+            if (node.free != (used ? FreeSummary<N>{} : summaryOfLeaf<N>(node.size)))
+                return false;
             if (used) {
                 if (node.slot >= m_slotNode.size() || m_slotNode[node.slot] != index) return false;
                 ++live;
@@ -434,7 +562,7 @@ bool BlockAllocator<N>::validate() const {
         if (cutAxes != 1) return false;
         if (node.occupied != (a.occupied || b.occupied)) return false;
         if (!node.occupied) return false; // an empty inner node should have collapsed
-        if (node.maxFree != componentMax<N>(a.maxFree, b.maxFree)) return false;
+        if (node.free != combine<N>(a.free, b.free)) return false;
         stack.push_back(node.childA);
         stack.push_back(node.childB);
     }

@@ -1,25 +1,40 @@
 #pragma once
 // Guillotine binary-tree block allocator for 2-D and 3-D atlases (the structure of UE4's
-// FTextureLayout3d, with the improvements of seed 004 and a few more).
+// FTextureLayout3d, with the improvements of seed 004 and a placement policy that keeps the tree
+// shallow).
 //
 // Every node is an axis-aligned box; an inner node is cut into two children along one axis.
-// Inserting an element takes the first free leaf (depth-first, child A before child B) that can
-// hold it and cuts the leaf along the axis with the most slack until a leaf fits the element
-// exactly. Removing an element frees its leaf and collapses the highest ancestor whose subtree is
-// now empty back into one free leaf, which restores the largest free box.
+// Removing an element frees its leaf and collapses the highest ancestor whose subtree is now
+// empty back into one free leaf, which restores the largest free box (the same rule as UE4's).
+//
+// Placement ("halving guillotine"): a free leaf that is at least twice the element on some axis
+// is cut in half along the longest such axis (like a 2-D/3-D buddy allocator), and the element
+// continues into the first half; once no axis can be halved, the box is cut exactly to the
+// element along the axis with the most slack (UE4's rule). So a leaf is at most
+// log2(sheet / element) halvings + N exact cuts below the root: 22 levels for a 1024 x 1024 sheet,
+// whatever the number of live elements. UE4's rule alone cuts off one element-sized strip per
+// element and chains them, which makes trees hundreds of levels deep, and every insertion and
+// removal pays for the depth. The free halves are square-ish boxes that later elements reuse,
+// and freeing merges them back like buddies.
+// Insertion descends into the child whose free summary is tighter (smaller), so small elements
+// fill holes and large free boxes stay intact for large elements.
 //
 // What makes it fast (the naive baseline in block_allocator_naive.h has none of it):
 // - each node stores its parent, so walking up is O(1) per step;
 // - each node stores whether its subtree holds a used leaf, so "is this subtree empty" is O(1),
 //   and removal climbs only as far as it collapses, not to the root;
 // - each node stores the per-axis maximum of the free leaves below it, so insertion skips
-//   subtrees that cannot hold the element instead of walking the whole tree;
+//   subtrees that cannot hold the element instead of walking the whole tree, and removal and
+//   insertion refresh these summaries only up to the first ancestor they leave unchanged;
 // - removal by position descends the tree (children partition their parent, so one path);
 //   removal by id is a table lookup; there is no separate contains-then-remove;
 // - nodes are deleted by moving the last node of the array into the hole and fixing its parent,
 //   children and id slot, instead of an order-preserving erase and a whole-array index fix-up;
-// - insertBatch places many elements in one depth-first traversal.
-// Placement decisions are exactly the naive allocator's, which the differential tests check.
+// - insertBatch places many elements in one traversal (largest first), sharing the descent and
+//   the summary refresh between them.
+// Layouts differ from the naive allocator's (which keeps UE4's placement); both produce valid
+// layouts for the same operations, and removal collapses the same way in both, which the
+// differential tests check.
 #include <array>
 #include <cstddef>
 #include <cstdint>
@@ -33,6 +48,20 @@ template <size_t N>
 using Extent = std::array<uint32_t, N>;
 template <size_t N>
 using Position = std::array<uint32_t, N>;
+
+namespace block_detail {
+// What the free leaves of a subtree offer: `max` is the per-axis maximum over them, `square` the
+// size of the free leaf whose shortest side is longest (the first one, child A before child B, on
+// ties). Both zero when no leaf is free. An element within `max` *may* fit some free leaf below;
+// one that fits `square` *surely* does, and the child `square` came from has the same box, so the
+// search can follow such children straight down to a fitting leaf.
+template <size_t N>
+struct FreeSummary {
+    Extent<N> max{};
+    Extent<N> square{};
+    friend bool operator==(const FreeSummary&, const FreeSummary&) = default;
+};
+} // namespace block_detail
 
 // Names one placed element. Ids are recycled; the generation makes a stale id harmless.
 struct BlockId {
@@ -72,7 +101,9 @@ public:
 
     // nullopt if no free box can hold the element or an axis of `extent` is 0.
     std::optional<Placement<N>> insert(const Extent<N>& extent);
-    // Same placements as calling insert() for each element in order, in one traversal.
+    // Places every element it can in one traversal of the tree: largest first (by volume), each
+    // by the same descent rule as insert(); results are in the order of `extents`, and ids are
+    // handed out in that order.
     std::vector<std::optional<Placement<N>>> insertBatch(std::span<const Extent<N>> extents);
     // False if no element starts at `origin` (or `id` is stale).
     bool remove(const Position<N>& origin);
@@ -97,7 +128,7 @@ private:
     struct Node {
         Position<N> min{};
         Extent<N> size{};
-        Extent<N> maxFree{}; // per-axis maximum over the free leaves of this subtree
+        block_detail::FreeSummary<N> free; // of this subtree's free leaves
         uint32_t parent = kNone;
         uint32_t childA = kNone;
         uint32_t childB = kNone;
@@ -106,13 +137,16 @@ private:
         bool leaf() const { return childA == kNone; }
     };
     struct BatchState;
+    struct BatchList {
+        size_t begin, end;
+    };
 
     std::optional<Extent<N>> roundUp(const Extent<N>& extent) const;
     void splitLeaf(uint32_t index, const Extent<N>& extent);
     Placement<N> occupyLeaf(uint32_t index);
     bool refresh(uint32_t index);
     void refreshUpwards(uint32_t index);
-    void visitBatch(uint32_t index, BatchState& state);
+    size_t visitBatch(uint32_t index, BatchState& state, BatchList list);
     void removeLeaf(uint32_t index);
     void collapse(uint32_t& top);
 
@@ -131,7 +165,7 @@ using BlockAllocator2D = BlockAllocator<2>;
 using BlockAllocator3D = BlockAllocator<3>;
 
 namespace block_detail {
-// Shared by the fast and the naive allocator so that both make the same decisions.
+// Shared by the fast and the naive allocator.
 template <size_t N>
 std::optional<Extent<N>> roundUpExtent(const Extent<N>& extent, const Extent<N>& usable,
                                        uint32_t alignment);

@@ -1,7 +1,7 @@
 // Golden images: the forward and decoupled renders of builtin:smooth compared with PNGs in
 // tests/data/reference. Tolerance: PSNR >= 40 dB (lavapipe reproduces them exactly; the margin
 // is for other drivers' rounding). After an intended change to shading, regenerate with
-//   build/src/app/shadel render --scene builtin:smooth --size 128x72 --mode MODE \
+//   build/src/app/shadel render --scene builtin:smooth --size 128x72 --mode MODE
 //       --out tests/data/reference/smooth_MODE_128x72.png
 #include "gpu_test_env.h"
 

@@ -46,6 +46,7 @@ struct DecoupledState {
     uint32_t storageSize = 4096; // shadels per side of the physical storage
     float frustumMargin = 0.1f;  // fraction of an object's radius
     float shadingBias = 0.0f;
+    float trilinearBand = 1.0f;
     std::vector<SheetRegion> regions;
     std::vector<ObjectSlot> objects;
     std::vector<gpu::GpuShadelObject> gpuObjects;
@@ -93,6 +94,7 @@ DecoupledStatePtr createDecoupled(Renderer& r, const GpuScene& scene) {
         throw InputError(format("--sheet %u: expected 65536, 131072, 196608 or 262144", rs.sheetShadels));
     d.storageSize = rs.shadeStorageSize;
     d.shadingBias = rs.shadingBias;
+    d.trilinearBand = std::clamp(rs.trilinearBand, 0.0f, 1.0f);
     d.sheetBlocks = rs.sheetShadels / SHADEL_BLOCK;
     uint32_t x = 0;
     for (uint32_t k = 0; k < SHADEL_MAX_MIPS; ++k) {
@@ -300,6 +302,8 @@ void prepareDecoupledFrame(Renderer& r, const GpuScene& scene, const CameraView&
     s.chunksPerCounter = d.capacityChunks / SHADEL_COUNTERS;
     s.objectCount = scene.instanceCount;
     s.shadingBias = d.shadingBias;
+    s.trilinearBand = d.trilinearBand;
+    s.materialSamples = r.settings.materialSamples;
     std::memcpy(mapped(gpu, d.frameInfo), &s, sizeof(s));
     constants.shadel = address(gpu, d.frameInfo);
     constants.shadingBias = d.shadingBias;
@@ -457,6 +461,8 @@ void decoupledStats(const Renderer& r, nlohmann::json& s) {
     s["chunks_overflowed"] = last.counters.chunksOverflowed;
     s["chunks_capacity"] = d.capacityChunks;
     s["shading_bias"] = d.shadingBias;
+    s["trilinear_band"] = d.trilinearBand;
+    s["material_samples"] = r.settings.materialSamples;
     s["reconstruction_misses"] = misses;
     s["overflow_samples"] = overflowSamples;
     s["marked_blocks"] = last.counters.markedBlocks;
