@@ -96,9 +96,9 @@ void timePerOp(benchmark::State& state, uint32_t liveCount, Body body) {
         Allocator allocator = startOf<Allocator>(layout);
         // A copied vector has no spare capacity, so the first node the timed operations add
         // would reallocate (copy) the whole node array, which an allocator in use does not do.
-        // One untimed insert and remove of a large element gives it room and leaves the tree
-        // as it was.
-        if (auto p = allocator.insert(Extent<2>{256, 256})) allocator.remove(p->id);
+        // One untimed insert and remove of a large odd-sized element (no free box has its exact
+        // size, so the tree grows) gives it room and leaves the tree as it was.
+        if (auto p = allocator.insert(Extent<2>{255, 253})) allocator.remove(p->id);
         // Distinct random victims for this iteration.
         std::vector<uint32_t> victims(kOpsPerIteration);
         for (uint32_t& v : victims) v = rng() % uint32_t(layout.fastLive.size());

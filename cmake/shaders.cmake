@@ -10,13 +10,18 @@ function(shadel_compile_shaders target source_dir binary_dir)
   set(outputs "")
   set(table "")
   set(id 1)
+  # Debug builds compile shaders with SHADEL_DEBUG_SHADERS: extra checks and loud colours.
+  set(debug_flags "")
+  if(CMAKE_BUILD_TYPE STREQUAL "Debug")
+    set(debug_flags -DSHADEL_DEBUG_SHADERS=1)
+  endif()
   foreach(stage ${stages})
     file(RELATIVE_PATH rel ${source_dir} ${stage})
     string(REPLACE "/" "_" flat ${rel})
     set(spv ${binary_dir}/${flat}.spv)
     add_custom_command(
       OUTPUT ${spv}
-      COMMAND ${GLSLC} --target-env=vulkan1.3 -O -g -I ${source_dir} -DSHADEL_SHADER_ID=${id}
+      COMMAND ${GLSLC} --target-env=vulkan1.3 -O -g -I ${source_dir} -DSHADEL_SHADER_ID=${id} ${debug_flags}
               -Werror -o ${spv} ${stage}
       DEPENDS ${stage} ${includes}
       COMMENT "glslc ${rel}"

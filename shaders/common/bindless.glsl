@@ -56,6 +56,11 @@ vec4 sampleTextureLod(uint slot, uint samplerId, vec2 uv, float lod) {
 vec4 fetchTexture(uint slot, ivec2 texel, int lod) {
     return texelFetch(gTextures[nonuniformEXT(slot)], texel, lod);
 }
+// For slots that are the same for every invocation of a draw or dispatch (push or frame
+// constants): no non-uniform indexing, so drivers take their fast descriptor path.
+vec4 fetchTextureUniform(uint slot, ivec2 texel, int lod) {
+    return texelFetch(gTextures[slot], texel, lod);
+}
 
 #ifndef SHADEL_SHADER_ID
 #define SHADEL_SHADER_ID 0

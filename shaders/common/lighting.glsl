@@ -48,11 +48,11 @@ float sunShadow(FrameConstants f, vec3 worldPos, vec3 n) {
     vec2 uv = ndc.xy * 0.5 + 0.5;
     if (any(lessThan(uv, vec2(0.0))) || any(greaterThan(uv, vec2(1.0))) || ndc.z > 1.0) return 1.0;
     float depth = ndc.z - 0.0015;
-    vec2 texel = 1.0 / vec2(textureSize(gTextures[nonuniformEXT(f.sunShadowSlot)], 0));
+    vec2 texel = 1.0 / vec2(textureSize(gTextures[f.sunShadowSlot], 0));
     float lit = 0.0;
     for (int y = -1; y <= 1; ++y)
         for (int x = -1; x <= 1; ++x)
-            lit += texture(sampler2DShadow(gTextures[nonuniformEXT(f.sunShadowSlot)], gShadowSamplers[SAMPLER_SHADOW]),
+            lit += texture(sampler2DShadow(gTextures[f.sunShadowSlot], gShadowSamplers[SAMPLER_SHADOW]),
                            vec3(uv + vec2(x, y) * texel, depth));
     return lit / 9.0;
 }

@@ -33,9 +33,9 @@ void main() {
     for (uint y = 0u; y < pc.ssaa; ++y) {
         for (uint x = 0u; x < pc.ssaa; ++x) {
             ivec2 q = ivec2(p * pc.ssaa + uvec2(x, y));
-            vec3 hdr = fetchTexture(pc.hdrSlot, q, 0).rgb;
+            vec3 hdr = fetchTextureUniform(pc.hdrSlot, q, 0).rgb;
             sum += acesFit(max(hdr, vec3(0.0)) * f.exposure);
-            covered = covered || fetchTexture(pc.depthSlot, q, 0).r > 0.0;
+            covered = covered || fetchTextureUniform(pc.depthSlot, q, 0).r > 0.0;
         }
     }
     vec3 c = linearToSrgb(sum / float(pc.ssaa * pc.ssaa));

@@ -41,7 +41,7 @@ vec3 sampleLevel(ShadelFrame s, GpuShadelObject o, uint mip, vec2 uv, inout uint
         uint base = UintBuffer(s.offsetMap).v[block];
         if (base == SHADEL_INVALID) { overflowed++; continue; }
         uint slot = chunkSlot(mask, base, bit);
-        vec3 c = fetchTexture(s.storageReadSlot, storageTexel(s, slot, sheet % SHADEL_CHUNK), 0).rgb;
+        vec3 c = fetchTextureUniform(s.storageReadSlot, storageTexel(s, slot, sheet % SHADEL_CHUNK), 0).rgb;
         float weight = (offset.x == 1 ? w.x : 1.0 - w.x) * (offset.y == 1 ? w.y : 1.0 - w.y);
         sum += c * weight;
     }
@@ -99,6 +99,11 @@ void main() {
         float line = float(any(greaterThan(edge, 0.5 - width)));
         color = mix(color, vec3(1.0, 0.9, 0.1), line);
     }
-    if (f.visualize != VISUALIZE_NONE && missing != 0u) color = vec3(1.0, 0.0, 1.0);
+#ifdef SHADEL_DEBUG_SHADERS
+    const bool showMisses = true; // debug builds: a miss is never hidden by the fallback
+#else
+    bool showMisses = f.visualize != VISUALIZE_NONE;
+#endif
+    if (showMisses && missing != 0u) color = vec3(1.0, 0.0, 1.0);
     outColor = vec4(color, 1.0);
 }

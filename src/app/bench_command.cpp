@@ -35,8 +35,8 @@ nlohmann::json runBench(Gpu& gpu, const BenchOptions& b) {
     double fwd = forward["frame_ms"]["median"], dec = decoupled["frame_ms"]["median"];
     out["frame_ratio"] = fwd > 0 ? dec / fwd : 0.0;
 
-    std::printf("shadel bench: %s at %ux%u on %s, %u frames, medians (timing: %s)\n", b.scene.c_str(),
-                b.width, b.height, gpu.device.name.c_str(), b.frames,
+    std::printf("shadel bench: %s at %ux%u on %s, %u frames, medians (timing: %s)\n",
+                b.scene.c_str(), b.width, b.height, gpu.device.name.c_str(), b.frames,
                 forward["timing"].get<std::string>().c_str());
     std::printf("%-26s %12s %12s %8s\n", "", "forward ms", "decoupled ms", "ratio");
     std::printf("%-26s %12.3f %12.3f %8.3f\n", "frame", fwd, dec, fwd > 0 ? dec / fwd : 0.0);
@@ -49,19 +49,23 @@ nlohmann::json runBench(Gpu& gpu, const BenchOptions& b) {
     std::vector<std::string> names;
     for (const auto& p : forward["passes"]) names.push_back(p["name"]);
     for (const auto& p : decoupled["passes"])
-        if (std::find(names.begin(), names.end(), p["name"]) == names.end()) names.push_back(p["name"]);
+        if (std::find(names.begin(), names.end(), p["name"]) == names.end())
+            names.push_back(p["name"]);
     for (const std::string& n : names) {
         double f = find(forward["passes"], n), d = find(decoupled["passes"], n);
         std::printf("  %-24s %12s %12s\n", n.c_str(), f >= 0 ? format("%.3f", f).c_str() : "-",
                     d >= 0 ? format("%.3f", d).c_str() : "-");
     }
-    std::printf("%-26s %12s %12.3f\n", "shadels per covered pixel", "-", decoupled["shadels_per_pixel"].get<double>());
+    std::printf("%-26s %12s %12.3f\n", "shadels per covered pixel", "-",
+                decoupled["shadels_per_pixel"].get<double>());
     if (decoupled.contains("occupancy_bits_per_shadel"))
         std::printf("%-26s %12s %12.3f\n", "occupancy bits per shadel", "-",
                     decoupled["occupancy_bits_per_shadel"].get<double>());
     std::printf("%-26s %12s %12s\n", "storage used (chunks)", "-",
-                format("%llu/%llu", (unsigned long long)decoupled["chunks_allocated"].get<uint64_t>(),
-                       (unsigned long long)decoupled["chunks_capacity"].get<uint64_t>()).c_str());
+                format("%llu/%llu",
+                       (unsigned long long)decoupled["chunks_allocated"].get<uint64_t>(),
+                       (unsigned long long)decoupled["chunks_capacity"].get<uint64_t>())
+                    .c_str());
     std::printf("%-26s %12llu %12llu\n", "reconstruction misses", 0ull,
                 (unsigned long long)decoupled["reconstruction_misses"].get<uint64_t>());
     if (!b.json.empty()) {

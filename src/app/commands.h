@@ -49,7 +49,8 @@ std::string defaultCacheDir();
 // Renders with an existing Gpu (tests share one). Writes images/stats as the options say.
 RenderRun runRender(Gpu& gpu, const RenderOptions& options);
 // Writes RGBA8 pixels as an RGB PNG; throws InputError naming the path when it cannot.
-void writePng(const std::string& path, const std::vector<uint8_t>& rgba, uint32_t width, uint32_t height);
+void writePng(const std::string& path, const std::vector<uint8_t>& rgba, uint32_t width,
+              uint32_t height);
 // Per-pass table on stdout.
 void printPassTable(const nlohmann::json& stats);
 

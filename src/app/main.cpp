@@ -44,40 +44,66 @@ int main(int argc, char** argv) {
     std::string device = "auto";
     bool validation = false, verbose = false;
     app.add_option("--device", device, "auto | cpu | gpu | INDEX")->capture_default_str();
-    app.add_flag("--validation", validation, "enable the Khronos validation layer (or SHADEL_VALIDATION=1)");
+    app.add_flag("--validation", validation,
+                 "enable the Khronos validation layer (or SHADEL_VALIDATION=1)");
     app.add_flag("-v,--verbose", verbose, "debug logging");
 
     // render
     RenderOptions ro;
-    std::string size = "1280x720", mode = "forward", visualize = "none", jitter = "none", timing = "auto";
+    std::string size = "1280x720", mode = "forward", visualize = "none", jitter = "none",
+                timing = "auto";
     auto* render = app.add_subcommand("render", "render frames headless to PNG + stats JSON");
-    render->add_option("--scene", ro.scene, "builtin:NAME | FILE.gltf | FILE.glb")->capture_default_str();
+    render->add_option("--scene", ro.scene, "builtin:NAME | FILE.gltf | FILE.glb")
+        ->capture_default_str();
     render->add_option("--mode", mode, "forward | decoupled")->capture_default_str();
     render->add_option("--size", size, "WIDTHxHEIGHT")->capture_default_str();
     render->add_option("--frames", ro.frames, "frames to render")->capture_default_str();
     render->add_option("--camera", ro.camera, "camera name (default: the scene's first)");
-    render->add_option("--jitter", jitter, "none | subpixel: sub-pixel camera offsets between frames")->capture_default_str();
+    render
+        ->add_option("--jitter", jitter, "none | subpixel: sub-pixel camera offsets between frames")
+        ->capture_default_str();
     render->add_option("--ssaa", ro.ssaa, "N: NxN supersampled reference")->capture_default_str();
-    render->add_option("--visualize", visualize, "none | marking | mips | chunks | sheet")->capture_default_str();
+    render->add_option("--visualize", visualize, "none | marking | mips | chunks | sheet")
+        ->capture_default_str();
     render->add_option("--out", ro.out, "FILE.png (last frame) or DIR/ (every frame)");
     render->add_option("--stats", ro.stats, "FILE.json");
-    render->add_option("--timing", timing, "auto | timestamps | submit (per-pass submit+wait)")->capture_default_str();
+    render->add_option("--timing", timing, "auto | timestamps | submit (per-pass submit+wait)")
+        ->capture_default_str();
     render->add_option("--exposure", ro.exposure, "exposure multiplier")->capture_default_str();
-    render->add_option("--density", ro.shadelsPerMetre, "shadels per metre (decoupled)")->capture_default_str();
+    render->add_option("--density", ro.shadelsPerMetre, "shadels per metre (decoupled)")
+        ->capture_default_str();
     render->add_option("--cache-dir", ro.cacheDir, "bake cache directory");
-    render->add_option("--storage", ro.shadeStorageSize, "decoupled: shade storage side in shadels")->capture_default_str();
-    render->add_option("--shading-bias", ro.shadingBias, "decoupled: fractional MIP bias (+ = fewer shadels)")->capture_default_str();
-    render->add_option("--trilinear-band", ro.trilinearBand, "decoupled: LOD band blended between MIPs (1 = full trilinear)")->capture_default_str();
-    render->add_option("--material-samples", ro.materialSamples, "decoupled: material evaluations per shadel above MIP 0 (1 or 4)")->capture_default_str();
-    render->add_option("--shadel-budget", ro.shadelBudget, "decoupled: max MIP-0 shadels for the scene (lowers --density)")->capture_default_str();
-    render->add_option("--sheet", ro.sheetShadels, "decoupled: virtual sheet side in shadels (64k..256k)")->capture_default_str();
+    render->add_option("--storage", ro.shadeStorageSize, "decoupled: shade storage side in shadels")
+        ->capture_default_str();
+    render
+        ->add_option("--shading-bias", ro.shadingBias,
+                     "decoupled: fractional MIP bias (+ = fewer shadels)")
+        ->capture_default_str();
+    render
+        ->add_option("--trilinear-band", ro.trilinearBand,
+                     "decoupled: LOD band blended between MIPs (1 = full trilinear)")
+        ->capture_default_str();
+    render
+        ->add_option("--material-samples", ro.materialSamples,
+                     "decoupled: material evaluations per shadel above MIP 0 (1 or 4)")
+        ->capture_default_str();
+    render
+        ->add_option("--shadel-budget", ro.shadelBudget,
+                     "decoupled: max MIP-0 shadels for the scene (lowers --density)")
+        ->capture_default_str();
+    render
+        ->add_option("--sheet", ro.sheetShadels,
+                     "decoupled: virtual sheet side in shadels (64k..256k)")
+        ->capture_default_str();
     render->add_flag("--passes", ro.printPasses, "print the per-pass timing table");
 
     // bench
     BenchOptions bo;
     std::string benchSize = "1280x720", benchTiming = "auto";
-    auto* bench = app.add_subcommand("bench", "render the same scene forward and decoupled; print ratios");
-    bench->add_option("--scene", bo.scene, "builtin:NAME | FILE.gltf | FILE.glb")->capture_default_str();
+    auto* bench =
+        app.add_subcommand("bench", "render the same scene forward and decoupled; print ratios");
+    bench->add_option("--scene", bo.scene, "builtin:NAME | FILE.gltf | FILE.glb")
+        ->capture_default_str();
     bench->add_option("--size", benchSize, "WIDTHxHEIGHT")->capture_default_str();
     bench->add_option("--frames", bo.frames, "frames per mode")->capture_default_str();
     bench->add_option("--camera", bo.camera, "camera name");
@@ -91,7 +117,8 @@ int main(int argc, char** argv) {
     float bakeDensity = 32.0f;
     bool bakeNoCache = false;
     auto* bake = app.add_subcommand("bake", "bake shadel charts and triangle-ID maps (cached)");
-    bake->add_option("scene", bakeSceneSpec, "builtin:NAME | FILE.gltf | FILE.glb")->capture_default_str();
+    bake->add_option("scene", bakeSceneSpec, "builtin:NAME | FILE.gltf | FILE.glb")
+        ->capture_default_str();
     bake->add_option("--density", bakeDensity, "shadels per metre")->capture_default_str();
     bake->add_option("--cache-dir", bakeCache, "bake cache directory");
     bake->add_flag("--no-cache", bakeNoCache, "bake from scratch (still writes the cache)");
@@ -110,7 +137,8 @@ int main(int argc, char** argv) {
             std::printf("Vulkan devices:\n%s", listPhysicalDevices().c_str());
             GpuGuard g;
             createGpu(g.gpu, deviceDesc(device, validation));
-            std::printf("selected (--device %s):\n%s", device.c_str(), describeDevice(g.gpu.device).c_str());
+            std::printf("selected (--device %s):\n%s", device.c_str(),
+                        describeDevice(g.gpu.device).c_str());
             return 0;
         }
         if (*bake) {
@@ -121,17 +149,20 @@ int main(int argc, char** argv) {
             if (bakeNoCache) dir = "";
             bool tty = isatty(STDERR_FILENO);
             auto start = std::chrono::steady_clock::now();
-            auto baked = bakeScene(scene, bs, dir.empty() ? std::string() : dir, [&](size_t done, size_t total) {
-                if (tty) {
-                    int width = 40, filled = total ? int(width * done / total) : width;
-                    std::fprintf(stderr, "\rbake: [%s%s] %zu/%zu meshes", std::string(filled, '#').c_str(),
-                                 std::string(width - filled, '.').c_str(), done, total);
-                } else if (done == total || done % 16 == 0) {
-                    std::fprintf(stderr, "bake: %zu/%zu meshes\n", done, total);
-                }
-            });
+            auto baked = bakeScene(
+                scene, bs, dir.empty() ? std::string() : dir, [&](size_t done, size_t total) {
+                    if (tty) {
+                        int width = 40, filled = total ? int(width * done / total) : width;
+                        std::fprintf(stderr, "\rbake: [%s%s] %zu/%zu meshes",
+                                     std::string(filled, '#').c_str(),
+                                     std::string(width - filled, '.').c_str(), done, total);
+                    } else if (done == total || done % 16 == 0) {
+                        std::fprintf(stderr, "bake: %zu/%zu meshes\n", done, total);
+                    }
+                });
             if (tty) std::fprintf(stderr, "\n");
-            double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+            double seconds =
+                std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
             std::printf("%s", bakeReport(baked, seconds).c_str());
             return 0;
         }
@@ -147,15 +178,18 @@ int main(int argc, char** argv) {
             ro.timing = parseTiming(timing);
             RenderRun run = runRender(g.gpu, ro);
             const auto& s = run.stats;
-            std::printf("%s %s %ux%u: %u frame(s), median %.2f ms, %llu px covered, %llu shader asserts, "
-                        "%llu validation errors%s%s\n",
-                        ro.scene.c_str(), s["mode"].get<std::string>().c_str(), ro.width, ro.height, ro.frames,
-                        s["frame_ms"]["median"].get<double>(),
-                        (unsigned long long)s["pixels_covered"].get<uint64_t>(),
-                        (unsigned long long)s["shader_asserts"].get<uint64_t>(),
-                        (unsigned long long)s["validation_errors"].get<uint64_t>(),
-                        ro.out.empty() ? "" : " -> ", ro.out.c_str());
-            return s["shader_asserts"].get<uint64_t>() || s["validation_errors"].get<uint64_t>() ? 4 : 0;
+            std::printf(
+                "%s %s %ux%u: %u frame(s), median %.2f ms, %llu px covered, %llu shader asserts, "
+                "%llu validation errors%s%s\n",
+                ro.scene.c_str(), s["mode"].get<std::string>().c_str(), ro.width, ro.height,
+                ro.frames, s["frame_ms"]["median"].get<double>(),
+                (unsigned long long)s["pixels_covered"].get<uint64_t>(),
+                (unsigned long long)s["shader_asserts"].get<uint64_t>(),
+                (unsigned long long)s["validation_errors"].get<uint64_t>(),
+                ro.out.empty() ? "" : " -> ", ro.out.c_str());
+            return s["shader_asserts"].get<uint64_t>() || s["validation_errors"].get<uint64_t>()
+                       ? 4
+                       : 0;
         }
         if (*bench) {
             parseSize(benchSize, bo.width, bo.height);

@@ -39,7 +39,8 @@ Visualize parseVisualize(const std::string& text) {
     if (text == "mips") return Visualize::Mips;
     if (text == "chunks") return Visualize::Chunks;
     if (text == "sheet") return Visualize::Sheet;
-    throw InputError(format("--visualize %s: expected none, marking, mips, chunks or sheet", text.c_str()));
+    throw InputError(
+        format("--visualize %s: expected none, marking, mips, chunks or sheet", text.c_str()));
 }
 
 std::string defaultCacheDir() {
@@ -49,7 +50,8 @@ std::string defaultCacheDir() {
     return "/tmp/shadel-cache";
 }
 
-void writePng(const std::string& path, const std::vector<uint8_t>& rgba, uint32_t width, uint32_t height) {
+void writePng(const std::string& path, const std::vector<uint8_t>& rgba, uint32_t width,
+              uint32_t height) {
     std::vector<uint8_t> rgb(size_t(width) * height * 3);
     for (size_t i = 0, n = size_t(width) * height; i < n; ++i)
         for (int c = 0; c < 3; ++c) rgb[i * 3 + c] = rgba[i * 4 + c];
@@ -63,7 +65,8 @@ void writePng(const std::string& path, const std::vector<uint8_t>& rgba, uint32_
 static float sceneDensity(const Scene& scene, float requested, double budget, double& area) {
     std::vector<float> maxScale(scene.meshes.size(), 0.0f);
     for (const Instance& inst : scene.instances) {
-        float s = std::max({glm::length(glm::vec3(inst.transform[0])), glm::length(glm::vec3(inst.transform[1])),
+        float s = std::max({glm::length(glm::vec3(inst.transform[0])),
+                            glm::length(glm::vec3(inst.transform[1])),
                             glm::length(glm::vec3(inst.transform[2]))});
         maxScale[inst.mesh] = std::max(maxScale[inst.mesh], s);
     }
@@ -91,24 +94,30 @@ static double median(std::vector<double> v) {
     return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
 }
 
-static const char* modeName(RenderMode m) { return m == RenderMode::Forward ? "forward" : "decoupled"; }
+static const char* modeName(RenderMode m) {
+    return m == RenderMode::Forward ? "forward" : "decoupled";
+}
 
 void printPassTable(const nlohmann::json& stats) {
     std::printf("%-24s %10s\n", "pass", "gpu ms");
     for (const auto& p : stats["passes"])
-        std::printf("%-24s %10.3f\n", p["name"].get<std::string>().c_str(), p["gpu_ms"].get<double>());
+        std::printf("%-24s %10.3f\n", p["name"].get<std::string>().c_str(),
+                    p["gpu_ms"].get<double>());
     std::printf("%-24s %10.3f  (median frame, wall clock)\n", "frame",
                 stats["frame_ms"]["median"].get<double>());
 }
 
 RenderRun runRender(Gpu& gpu, const RenderOptions& o) {
-    if (o.frames < 1 || o.frames > 100000) throw InputError(format("--frames %u: expected 1..100000", o.frames));
+    if (o.frames < 1 || o.frames > 100000)
+        throw InputError(format("--frames %u: expected 1..100000", o.frames));
     if (o.ssaa < 1 || o.ssaa > 16) throw InputError(format("--ssaa %u: expected 1..16", o.ssaa));
     bool outDir = !o.out.empty() && o.out.back() == '/';
     if (outDir) {
         std::error_code ec;
         std::filesystem::create_directories(o.out, ec);
-        if (ec) throw InputError(format("%s: cannot create output directory (%s)", o.out.c_str(), ec.message().c_str()));
+        if (ec)
+            throw InputError(format("%s: cannot create output directory (%s)", o.out.c_str(),
+                                    ec.message().c_str()));
     }
     Scene scene = loadScene(o.scene);
     Camera camera = findCamera(scene, o.camera);
@@ -121,11 +130,12 @@ RenderRun runRender(Gpu& gpu, const RenderOptions& o) {
         double area = 0.0;
         bs.shadelsPerMetre = sceneDensity(scene, o.shadelsPerMetre, o.shadelBudget, area);
         if (bs.shadelsPerMetre < o.shadelsPerMetre)
-            SHADEL_WARN("%s: %.0f units^2 of surface at %.1f shadels/unit would need %.0fM shadels; "
-                        "using %.3f shadels/unit to stay within %.0fM (--density, --shadel-budget)",
-                        o.scene.c_str(), area, double(o.shadelsPerMetre),
-                        area * o.shadelsPerMetre * o.shadelsPerMetre / 1e6, double(bs.shadelsPerMetre),
-                        o.shadelBudget / 1e6);
+            SHADEL_WARN(
+                "%s: %.0f units^2 of surface at %.1f shadels/unit would need %.0fM shadels; "
+                "using %.3f shadels/unit to stay within %.0fM (--density, --shadel-budget)",
+                o.scene.c_str(), area, double(o.shadelsPerMetre),
+                area * o.shadelsPerMetre * o.shadelsPerMetre / 1e6, double(bs.shadelsPerMetre),
+                o.shadelBudget / 1e6);
         density = bs.shadelsPerMetre;
         baked = bakeScene(scene, bs, o.cacheDir.empty() ? defaultCacheDir() : o.cacheDir, nullptr);
         uploadScene(gpu, scene, gpuScene, &baked);
@@ -155,11 +165,15 @@ RenderRun runRender(Gpu& gpu, const RenderOptions& o) {
         bool tty = isatty(STDERR_FILENO);
         for (uint32_t i = 0; i < o.frames; ++i) {
             glm::vec2 jitter = o.jitter ? subpixelJitter(i) : glm::vec2(0.0f);
-            CameraView view = makeCameraView(camera, o.width * o.ssaa, o.height * o.ssaa, jitter * float(o.ssaa));
+            CameraView view =
+                makeCameraView(camera, o.width * o.ssaa, o.height * o.ssaa, jitter * float(o.ssaa));
             run.frames.push_back(renderFrame(renderer, gpuScene, view));
             if (o.progress && o.frames > 1 && tty)
-                std::fprintf(stderr, "\rrender: frame %u/%u (%.1f ms)", i + 1, o.frames, run.frames.back().frameMs);
-            if (outDir) writePng(format("%sframe_%04u.png", o.out.c_str(), i), run.frames.back().rgba, o.width, o.height);
+                std::fprintf(stderr, "\rrender: frame %u/%u (%.1f ms)", i + 1, o.frames,
+                             run.frames.back().frameMs);
+            if (outDir)
+                writePng(format("%sframe_%04u.png", o.out.c_str(), i), run.frames.back().rgba,
+                         o.width, o.height);
         }
         if (o.progress && o.frames > 1 && tty) std::fprintf(stderr, "\n");
     } catch (...) {
@@ -209,7 +223,8 @@ RenderRun runRender(Gpu& gpu, const RenderOptions& o) {
     s["triangles"] = scene.triangleCount();
     s["lights"] = scene.lights.size();
     MemoryHeapStats mem = memoryStats(gpu.memory);
-    s["gpu_memory"] = {{"pool_bytes", mem.poolBytes}, {"used_bytes", mem.usedBytes}, {"pools", mem.pools}};
+    s["gpu_memory"] = {
+        {"pool_bytes", mem.poolBytes}, {"used_bytes", mem.usedBytes}, {"pools", mem.pools}};
     if (renderer.decoupled) {
         decoupledStats(renderer, s);
         s["shadels_per_metre"] = density;

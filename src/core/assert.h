@@ -7,7 +7,7 @@
 #define SHADEL_ASSERT(cond, ...)                                                                   \
     do {                                                                                           \
         if (!(cond)) [[unlikely]] {                                                                \
-            std::fprintf(stderr, "assertion failed: %s (%s:%d)\n", #cond, __FILE__, __LINE__);    \
+            std::fprintf(stderr, "assertion failed: %s (%s:%d)\n", #cond, __FILE__, __LINE__);     \
             std::abort();                                                                          \
         }                                                                                          \
     } while (0)

@@ -205,10 +205,11 @@ Placement<N> BlockAllocator<N>::occupyLeaf(uint32_t index) {
     return Placement<N>{node.min, node.size, BlockId{slot, m_slotGeneration[slot]}};
 }
 
+// Finds a free leaf for an element of (rounded) `extent` and cuts it down to the element's size;
+// kNone if there is none. The leaf is left free: the caller occupies or reserves it.
 template <size_t N>
-std::optional<Placement<N>> BlockAllocator<N>::insert(const Extent<N>& requested) {
-    auto extent = roundUp(requested);
-    if (!extent || fitOf<N>(*extent, m_nodes[0].free) == kNoFit) return std::nullopt;
+uint32_t BlockAllocator<N>::findLeaf(const Extent<N>& extent) {
+    if (fitOf<N>(extent, m_nodes[0].free) == kNoFit) return kNone;
     // Depth-first, entering only subtrees whose summary admits the element. Below a node that
     // surely holds it, some child surely holds it too, so the descent goes straight down. Only
     // when the summary says "maybe" can a subtree turn out to hold no fitting leaf: the stack
@@ -219,9 +220,9 @@ std::optional<Placement<N>> BlockAllocator<N>::insert(const Extent<N>& requested
         const Node& node = m_nodes[index];
         const FreeSummary<N>& freeA = m_nodes[node.childA].free;
         const FreeSummary<N>& freeB = m_nodes[node.childB].free;
-        Fit fitA = fitOf<N>(*extent, freeA), fitB = fitOf<N>(*extent, freeB);
+        Fit fitA = fitOf<N>(extent, freeA), fitB = fitOf<N>(extent, freeB);
         if (fitA == kNoFit && fitB == kNoFit) {
-            if (m_scratch.empty()) return std::nullopt;
+            if (m_scratch.empty()) return kNone;
             index = m_scratch.back();
             m_scratch.pop_back();
             continue;
@@ -233,10 +234,19 @@ std::optional<Placement<N>> BlockAllocator<N>::insert(const Extent<N>& requested
         index = intoA ? node.childA : node.childB;
     }
     // A leaf is only entered when its summary admits the element: it is free and large enough.
-    while (m_nodes[index].size != *extent) {
-        splitLeaf(index, *extent);
+    while (m_nodes[index].size != extent) {
+        splitLeaf(index, extent);
         index = m_nodes[index].childA;
     }
+    return index;
+}
+
+template <size_t N>
+std::optional<Placement<N>> BlockAllocator<N>::insert(const Extent<N>& requested) {
+    auto extent = roundUp(requested);
+    if (!extent) return std::nullopt;
+    uint32_t index = findLeaf(*extent);
+    if (index == kNone) return std::nullopt;
     Placement<N> placement = occupyLeaf(index);
     refreshUpwards(m_nodes[index].parent);
     return placement;
@@ -256,10 +266,23 @@ struct BlockAllocator<N>::BatchState {
 // children's lists and are given back before returning.
 //
 // At a free leaf the largest element that fits is placed, cutting the leaf as insert() would and
-// continuing into the pieces. At an inner node each element goes first to the child insert()
-// would try first; what child A cannot take tries child B, and what B cannot take tries A if it
-// has not been there yet. So each element follows insert()'s search, but the elements share the
-// descent, and each node's summary is refreshed once per batch, on the way back up.
+// continuing into the pieces. At an inner node an element only goes into a child that surely
+// holds it (per the summaries as they are when the node routes it), the one insert() would take
+// if both do; what child A could not take after all (earlier elements used the room) tries B if B
+// surely holds it, and what B could not take tries A the same way. Elements never enter a subtree
+// that only "may" hold them, so the traversal never searches a subtree in vain; insertBatch()
+// gives the few elements left over to insert()'s search. The elements share the descent, and
+// each node's summary is refreshed once per batch, on the way back up.
+// Marks a leaf used by a batch element; ids are handed out after the whole batch is placed, in
+// element order.
+template <size_t N>
+void BlockAllocator<N>::reserveLeaf(uint32_t index) {
+    Node& node = m_nodes[index];
+    node.slot = kReservedSlot;
+    node.occupied = true;
+    node.free = FreeSummary<N>{};
+}
+
 template <size_t N>
 size_t BlockAllocator<N>::visitBatch(uint32_t index, BatchState& state, BatchList list) {
     std::vector<uint32_t>& arena = state.arena;
@@ -271,11 +294,7 @@ size_t BlockAllocator<N>::visitBatch(uint32_t index, BatchState& state, BatchLis
         if (pick == list.end) return list.end;
         const uint32_t rank = arena[pick];
         if (m_nodes[index].size == state.extents[rank]) {
-            // Ids are handed out after the traversal, in element order, as insert() would.
-            Node& node = m_nodes[index];
-            node.slot = kReservedSlot;
-            node.occupied = true;
-            node.free = FreeSummary<N>{};
+            reserveLeaf(index);
             state.leaves[rank] = index;
             std::copy(arena.begin() + ptrdiff_t(pick) + 1, arena.begin() + ptrdiff_t(list.end),
                       arena.begin() + ptrdiff_t(pick));
@@ -286,9 +305,9 @@ size_t BlockAllocator<N>::visitBatch(uint32_t index, BatchState& state, BatchLis
     }
     const uint32_t childA = m_nodes[index].childA, childB = m_nodes[index].childB;
     auto admits = [&](uint32_t child, uint32_t rank) {
-        return fitOf<N>(state.extents[rank], m_nodes[child].free) != kNoFit;
+        return fitOf<N>(state.extents[rank], m_nodes[child].free) == kSureFit;
     };
-    // Route: elements no child admits stay at the front [list.begin, kept); the others are
+    // Route: elements no child surely holds stay at the front [list.begin, kept); the others are
     // appended as A's list [base, splitAt) and B's list [splitAt, endB).
     const size_t base = arena.size();
     std::vector<uint32_t>& bFirst = state.scratch;
@@ -300,7 +319,7 @@ size_t BlockAllocator<N>::visitBatch(uint32_t index, BatchState& state, BatchLis
         const FreeSummary<N>& freeA = m_nodes[childA].free;
         const FreeSummary<N>& freeB = m_nodes[childB].free;
         Fit fitA = fitOf<N>(e, freeA), fitB = fitOf<N>(e, freeB);
-        if (fitA == kNoFit && fitB == kNoFit) arena[kept++] = rank;
+        if (fitA != kSureFit && fitB != kSureFit) arena[kept++] = rank;
         else if (aFirst<N>(fitA, freeA, fitB, freeB)) arena.push_back(rank);
         else bFirst.push_back(rank);
     }
@@ -308,7 +327,7 @@ size_t BlockAllocator<N>::visitBatch(uint32_t index, BatchState& state, BatchLis
     arena.insert(arena.end(), bFirst.begin(), bFirst.end());
     const size_t endB = arena.size();
 
-    // A's list; its leftovers that B now admits are merged (by rank) into B's list, the others
+    // A's list; its leftovers that B surely holds are merged (by rank) into B's list, the others
     // are final and compacted to [base, leftA).
     size_t leftA = splitAt == base ? base : visitBatch(childA, state, {base, splitAt});
     const size_t toB = arena.size();
@@ -322,7 +341,7 @@ size_t BlockAllocator<N>::visitBatch(uint32_t index, BatchState& state, BatchLis
         }
         leftA = keepA;
     }
-    // B's list; its leftovers that started in B and that A now admits retry A, the others are
+    // B's list; its leftovers that started in B and that A surely holds retry A, the others are
     // final and compacted to [toB, leftB).
     size_t leftB = toB == arena.size() ? toB : visitBatch(childB, state, {toB, arena.size()});
     const size_t retry = arena.size();
@@ -381,10 +400,18 @@ BlockAllocator<N>::insertBatch(std::span<const Extent<N>> extents) {
     state.leaves.assign(byRank.size(), kNone);
     for (uint32_t e : byRank) state.extents.push_back(rounded[e]);
     for (uint32_t rank = 0; rank < byRank.size(); ++rank)
-        if (fitOf<N>(state.extents[rank], m_nodes[0].free) != kNoFit) state.arena.push_back(rank);
-    if (!state.arena.empty()) {
-        visitBatch(0, state, {0, state.arena.size()});
-        }
+        if (fitOf<N>(state.extents[rank], m_nodes[0].free) == kSureFit) state.arena.push_back(rank);
+    if (!state.arena.empty()) visitBatch(0, state, {0, state.arena.size()});
+    // What the traversal left (room taken by larger elements of the batch, or only "maybe" room)
+    // gets insert()'s full search, largest first.
+    for (uint32_t rank = 0; rank < byRank.size(); ++rank) {
+        if (state.leaves[rank] != kNone) continue;
+        uint32_t leaf = findLeaf(state.extents[rank]);
+        if (leaf == kNone) continue;
+        reserveLeaf(leaf);
+        refreshUpwards(m_nodes[leaf].parent);
+        state.leaves[rank] = leaf;
+    }
     std::vector<uint32_t> leafOf(extents.size(), kNone);
     for (uint32_t rank = 0; rank < byRank.size(); ++rank) leafOf[byRank[rank]] = state.leaves[rank];
     for (uint32_t e = 0; e < extents.size(); ++e)

@@ -143,6 +143,8 @@ private:
 
     std::optional<Extent<N>> roundUp(const Extent<N>& extent) const;
     void splitLeaf(uint32_t index, const Extent<N>& extent);
+    uint32_t findLeaf(const Extent<N>& extent);
+    void reserveLeaf(uint32_t index);
     Placement<N> occupyLeaf(uint32_t index);
     bool refresh(uint32_t index);
     void refreshUpwards(uint32_t index);

@@ -8,8 +8,12 @@ namespace shadel {
 static LogLevel g_level = LogLevel::Info;
 static std::mutex g_logMutex;
 
-void setLogLevel(LogLevel level) { g_level = level; }
-LogLevel logLevel() { return g_level; }
+void setLogLevel(LogLevel level) {
+    g_level = level;
+}
+LogLevel logLevel() {
+    return g_level;
+}
 
 void logLine(LogLevel level, const char* fmt, ...) {
     if (level < g_level) return;

@@ -14,8 +14,9 @@ Camera findCamera(const Scene& scene, const std::string& name) {
     if (!name.empty()) {
         std::string names;
         for (const Camera& c : scene.cameras) names += (names.empty() ? "" : ", ") + c.name;
-        throw InputError(format("--camera %s: no such camera in scene %s (cameras: %s)", name.c_str(),
-                                scene.name.c_str(), names.empty() ? "none" : names.c_str()));
+        throw InputError(format("--camera %s: no such camera in scene %s (cameras: %s)",
+                                name.c_str(), scene.name.c_str(),
+                                names.empty() ? "none" : names.c_str()));
     }
     // No camera in the file: frame the bounds from the front, slightly above.
     Aabb b = scene.worldBounds();
@@ -41,7 +42,8 @@ CameraView makeCameraView(const Camera& camera, uint32_t width, uint32_t height,
     v.znear = camera.znear;
     v.zfar = camera.zfar;
     glm::vec3 up = camera.up;
-    if (std::abs(glm::dot(glm::normalize(up), glm::normalize(camera.forward))) > 0.999f) up = {0, 0, 1};
+    if (std::abs(glm::dot(glm::normalize(up), glm::normalize(camera.forward))) > 0.999f)
+        up = {0, 0, 1};
     v.view = glm::lookAt(camera.position, camera.position + camera.forward, up);
     float aspect = float(width) / float(height);
     // Reversed Z: swap near and far in a [0,1] projection.

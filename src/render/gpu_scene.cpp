@@ -24,8 +24,10 @@ void uploadScene(Gpu& gpu, const Scene& scene, GpuScene& out, const std::vector<
     // Textures: sRGB for colour data. Every texture gets a full mip chain and a bindless slot.
     std::vector<bool> srgb(scene.textures.size(), false);
     for (const Material& m : scene.materials) {
-        if (m.baseColorTexture >= 0 && size_t(m.baseColorTexture) < srgb.size()) srgb[m.baseColorTexture] = true;
-        if (m.emissiveTexture >= 0 && size_t(m.emissiveTexture) < srgb.size()) srgb[m.emissiveTexture] = true;
+        if (m.baseColorTexture >= 0 && size_t(m.baseColorTexture) < srgb.size())
+            srgb[m.baseColorTexture] = true;
+        if (m.emissiveTexture >= 0 && size_t(m.emissiveTexture) < srgb.size())
+            srgb[m.emissiveTexture] = true;
     }
     for (size_t i = 0; i < scene.textures.size(); ++i) {
         const Texture& t = scene.textures[i];
@@ -107,7 +109,8 @@ void uploadScene(Gpu& gpu, const Scene& scene, GpuScene& out, const std::vector<
             indices.insert(indices.end(), b->indices.begin(), b->indices.end());
             g.shadelMesh = uint32_t(mi);
         } else {
-            for (const Vertex& v : mesh.vertices) vertices.push_back({v.position, v.normal, v.tangent, v.uv0});
+            for (const Vertex& v : mesh.vertices)
+                vertices.push_back({v.position, v.normal, v.tangent, v.uv0});
             if (baked) shadelUvs.resize(vertices.size(), glm::vec2(0.0f));
             indices.insert(indices.end(), mesh.indices.begin(), mesh.indices.end());
         }
@@ -180,13 +183,20 @@ void uploadScene(Gpu& gpu, const Scene& scene, GpuScene& out, const std::vector<
     out.ambientColor = scene.ambientColor;
 
     VkBufferUsageFlags indexUsage = VK_BUFFER_USAGE_INDEX_BUFFER_BIT;
-    out.vertices = uploadArray(gpu, "scene.vertices", vertices.data(), vertices.size() * sizeof(gpu::GpuVertex));
-    if (baked) out.shadelUvs = uploadArray(gpu, "scene.shadelUvs", shadelUvs.data(), shadelUvs.size() * sizeof(glm::vec2));
+    out.vertices = uploadArray(gpu, "scene.vertices", vertices.data(),
+                               vertices.size() * sizeof(gpu::GpuVertex));
+    if (baked)
+        out.shadelUvs = uploadArray(gpu, "scene.shadelUvs", shadelUvs.data(),
+                                    shadelUvs.size() * sizeof(glm::vec2));
     out.indices = uploadArray(gpu, "scene.indices", indices.data(), indices.size() * 4, indexUsage);
-    out.meshes = uploadArray(gpu, "scene.meshes", out.meshInfo.data(), out.meshInfo.size() * sizeof(gpu::GpuMesh));
-    out.instances = uploadArray(gpu, "scene.instances", instances.data(), instances.size() * sizeof(gpu::GpuInstance));
-    out.materials = uploadArray(gpu, "scene.materials", materials.data(), materials.size() * sizeof(gpu::GpuMaterial));
-    out.lights = uploadArray(gpu, "scene.lights", lights.data(), lights.size() * sizeof(gpu::GpuLight));
+    out.meshes = uploadArray(gpu, "scene.meshes", out.meshInfo.data(),
+                             out.meshInfo.size() * sizeof(gpu::GpuMesh));
+    out.instances = uploadArray(gpu, "scene.instances", instances.data(),
+                                instances.size() * sizeof(gpu::GpuInstance));
+    out.materials = uploadArray(gpu, "scene.materials", materials.data(),
+                                materials.size() * sizeof(gpu::GpuMaterial));
+    out.lights =
+        uploadArray(gpu, "scene.lights", lights.data(), lights.size() * sizeof(gpu::GpuLight));
     out.instanceCount = uint32_t(instances.size());
     out.lightCount = uint32_t(lights.size());
     out.geometryBytes = vertices.size() * sizeof(gpu::GpuVertex) + indices.size() * 4;
@@ -195,7 +205,8 @@ void uploadScene(Gpu& gpu, const Scene& scene, GpuScene& out, const std::vector<
 void destroyScene(Gpu& gpu, GpuScene& s) {
     for (TextureReadView v : s.textureViews) destroy(gpu, v);
     for (TextureHandle t : s.textures) destroy(gpu, t);
-    for (BufferHandle b : {s.vertices, s.shadelUvs, s.indices, s.meshes, s.instances, s.materials, s.lights, s.idMaps})
+    for (BufferHandle b : {s.vertices, s.shadelUvs, s.indices, s.meshes, s.instances, s.materials,
+                           s.lights, s.idMaps})
         destroy(gpu, b);
     s = GpuScene{};
 }

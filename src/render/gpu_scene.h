@@ -15,7 +15,7 @@ struct BakedMesh;
 // A mesh's shadel space as the decoupled path sees it.
 struct ShadelMeshInfo {
     glm::uvec2 mip0Size{0};
-    uint32_t mipCount = 0; // 0: no shadel space (drawn forward)
+    uint32_t mipCount = 0;                               // 0: no shadel space (drawn forward)
     std::array<uint32_t, SHADEL_MAX_MIPS> idMapOffset{}; // 16-bit units into GpuScene::idMaps
     uint64_t idMapTexels = 0;
 };
@@ -32,7 +32,7 @@ struct GpuScene {
     std::vector<TextureReadView> textureViews;
     std::vector<gpu::GpuMesh> meshInfo;
     std::vector<ShadelMeshInfo> shadelMeshes; // per mesh, when baked
-    BufferHandle idMaps;                       // every mesh's triangle-ID maps, all MIPs
+    BufferHandle idMaps;                      // every mesh's triangle-ID maps, all MIPs
     std::vector<gpu::GpuInstance> instanceInfo;
     uint32_t instanceCount = 0;
     uint32_t lightCount = 0;

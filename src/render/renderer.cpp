@@ -60,13 +60,18 @@ void initRenderer(Renderer& r, Gpu& gpu, const RenderSettings& settings, const G
         throw InputError("--size and --ssaa must be positive");
     createTargets(r);
     r.maxDraws = std::max<uint32_t>(scene.instanceCount, 1);
-    VkDeviceSize drawBytes = VkDeviceSize(DRAW_LIST_COUNT) * r.maxDraws * sizeof(gpu::DrawIndexedCommand);
+    VkDeviceSize drawBytes =
+        VkDeviceSize(DRAW_LIST_COUNT) * r.maxDraws * sizeof(gpu::DrawIndexedCommand);
     r.draws = createBuffer(gpu, {"draws.camera", drawBytes, VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT});
-    r.shadowDraws = createBuffer(gpu, {"draws.sunShadow", drawBytes, VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT});
-    r.drawCounts = createBuffer(gpu, {"draws.counts", 2 * DRAW_LIST_COUNT * 4, VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT});
-    r.frameConstants = createBuffer(gpu, {"frameConstants", sizeof(gpu::FrameConstants), 0, MemoryKind::Upload});
-    r.pixels = createBuffer(gpu, {"pixels.readback", VkDeviceSize(settings.width) * settings.height * 4, 0,
-                                  MemoryKind::Readback});
+    r.shadowDraws =
+        createBuffer(gpu, {"draws.sunShadow", drawBytes, VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT});
+    r.drawCounts = createBuffer(
+        gpu, {"draws.counts", 2 * DRAW_LIST_COUNT * 4, VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT});
+    r.frameConstants =
+        createBuffer(gpu, {"frameConstants", sizeof(gpu::FrameConstants), 0, MemoryKind::Upload});
+    r.pixels =
+        createBuffer(gpu, {"pixels.readback", VkDeviceSize(settings.width) * settings.height * 4, 0,
+                           MemoryKind::Readback});
     if (!r.draws || !r.shadowDraws || !r.drawCounts || !r.frameConstants || !r.pixels)
         throw DeviceError("out of GPU memory for the renderer's frame buffers");
     createForwardPipelines(r);
@@ -85,7 +90,8 @@ void destroyRenderer(Renderer& r) {
     destroyShaderMessages(gpu, r.messages);
     destroyForwardPipelines(r);
     destroy(gpu, r.tonemap);
-    for (BufferHandle b : {r.draws, r.shadowDraws, r.drawCounts, r.frameConstants, r.pixels}) destroy(gpu, b);
+    for (BufferHandle b : {r.draws, r.shadowDraws, r.drawCounts, r.frameConstants, r.pixels})
+        destroy(gpu, b);
     destroy(gpu, r.hdrTarget);
     destroy(gpu, r.hdrRead);
     destroy(gpu, r.depthTarget);
@@ -104,12 +110,14 @@ static glm::mat4 sunViewProj(const GpuScene& scene, float& texelWorldSize, uint3
     glm::vec3 dir = glm::normalize(scene.sunDirection);
     glm::vec3 up = std::abs(dir.y) > 0.99f ? glm::vec3(1, 0, 0) : glm::vec3(0, 1, 0);
     glm::mat4 view = glm::lookAt(center - dir * radius * 2.0f, center, up);
-    glm::mat4 proj = glm::orthoRH_ZO(-radius, radius, -radius, radius, radius * 0.5f, radius * 3.5f);
+    glm::mat4 proj =
+        glm::orthoRH_ZO(-radius, radius, -radius, radius, radius * 0.5f, radius * 3.5f);
     texelWorldSize = 2.0f * radius / float(mapSize);
     return proj * view;
 }
 
-static gpu::FrameConstants makeFrameConstants(Renderer& r, const GpuScene& scene, const CameraView& camera) {
+static gpu::FrameConstants makeFrameConstants(Renderer& r, const GpuScene& scene,
+                                              const CameraView& camera) {
     Gpu& gpu = *r.gpu;
     gpu::FrameConstants f{};
     f.view = camera.view;
@@ -160,11 +168,13 @@ FrameResult renderFrame(Renderer& r, const GpuScene& scene, const CameraView& ca
 
     FrameRecorder& rec = r.recorder;
     beginFrame(rec);
-    pass(rec, "instanceCull", [&](VkCommandBuffer cmd) { recordInstanceCull(r, cmd, frame, scene); });
+    pass(rec, "instanceCull",
+         [&](VkCommandBuffer cmd) { recordInstanceCull(r, cmd, frame, scene); });
     pass(rec, "shadowMap", [&](VkCommandBuffer cmd) { recordShadowMap(r, cmd, frame); });
     pass(rec, "depthPrepass", [&](VkCommandBuffer cmd) { recordDepthPrepass(r, cmd, frame); });
     if (r.settings.mode == RenderMode::Forward) {
-        pass(rec, "forwardShading", [&](VkCommandBuffer cmd) { recordForwardShading(r, cmd, frame); });
+        pass(rec, "forwardShading",
+             [&](VkCommandBuffer cmd) { recordForwardShading(r, cmd, frame); });
     } else {
         recordDecoupledPasses(r, rec, frame, scene);
     }

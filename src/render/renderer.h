@@ -26,9 +26,10 @@ struct RenderSettings {
     TimingMode timing = TimingMode::SubmitPerPass;
     uint32_t shadeStorageSize = 4096; // decoupled: physical shade storage, shadels per side
     uint32_t sheetShadels = 65536;    // decoupled: virtual sheet, shadels per side
-    float shadingBias = 0.0f;         // decoupled: base MIP bias (the capacity controller adds to it)
+    float shadingBias = 0.0f; // decoupled: base MIP bias (the capacity controller adds to it)
     float trilinearBand = 1.0f;
-    uint32_t materialSamples = 4;     // decoupled: material evaluations per shadel above MIP 0 (1 or 4)       // decoupled: LOD band blended between MIPs (1 = trilinear)
+    uint32_t materialSamples = 4; // decoupled: material evaluations per shadel above MIP 0 (1 or 4)
+                                  // // decoupled: LOD band blended between MIPs (1 = trilinear)
 };
 
 struct FrameResult {
@@ -59,8 +60,8 @@ struct Renderer {
     BufferHandle frameConstants; // host-visible gpu::FrameConstants
     BufferHandle draws;          // DrawIndexedCommand[DRAW_LIST_COUNT * maxDraws], camera view
     BufferHandle shadowDraws;
-    BufferHandle drawCounts;     // uint[DRAW_LIST_COUNT] camera, then uint[...] shadow
-    BufferHandle pixels;         // readback RGBA8
+    BufferHandle drawCounts; // uint[DRAW_LIST_COUNT] camera, then uint[...] shadow
+    BufferHandle pixels;     // readback RGBA8
     uint32_t maxDraws = 0;
     BufferHandle sceneIndices; // the unified index buffer of the scene being drawn
     glm::vec3 skyColor{0.5f};
@@ -70,7 +71,8 @@ struct Renderer {
     DecoupledStatePtr decoupled;
 };
 
-void initRenderer(Renderer& renderer, Gpu& gpu, const RenderSettings& settings, const GpuScene& scene);
+void initRenderer(Renderer& renderer, Gpu& gpu, const RenderSettings& settings,
+                  const GpuScene& scene);
 void destroyRenderer(Renderer& renderer);
 FrameResult renderFrame(Renderer& renderer, const GpuScene& scene, const CameraView& camera);
 

@@ -13,8 +13,8 @@ static VkSampler makeSampler(Gpu& gpu, VkFilter filter, VkSamplerAddressMode mod
     VkSamplerCreateInfo ci{VK_STRUCTURE_TYPE_SAMPLER_CREATE_INFO};
     ci.magFilter = filter;
     ci.minFilter = filter;
-    ci.mipmapMode = filter == VK_FILTER_LINEAR ? VK_SAMPLER_MIPMAP_MODE_LINEAR
-                                               : VK_SAMPLER_MIPMAP_MODE_NEAREST;
+    ci.mipmapMode =
+        filter == VK_FILTER_LINEAR ? VK_SAMPLER_MIPMAP_MODE_LINEAR : VK_SAMPLER_MIPMAP_MODE_NEAREST;
     ci.addressModeU = ci.addressModeV = ci.addressModeW = mode;
     ci.maxLod = VK_LOD_CLAMP_NONE;
     ci.anisotropyEnable = anisotropy > 1.0f;
@@ -63,10 +63,10 @@ void initBindless(Gpu& gpu) {
                                 true, 1.0f, "sampler.shadowCompare");
 
     VkDescriptorSetLayoutBinding bindings[3]{};
-    bindings[0] = {0, VK_DESCRIPTOR_TYPE_SAMPLED_IMAGE, kBindlessSampledCapacity, VK_SHADER_STAGE_ALL,
-                   nullptr};
-    bindings[1] = {1, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, kBindlessStorageCapacity, VK_SHADER_STAGE_ALL,
-                   nullptr};
+    bindings[0] = {0, VK_DESCRIPTOR_TYPE_SAMPLED_IMAGE, kBindlessSampledCapacity,
+                   VK_SHADER_STAGE_ALL, nullptr};
+    bindings[1] = {1, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, kBindlessStorageCapacity,
+                   VK_SHADER_STAGE_ALL, nullptr};
     bindings[2] = {2, VK_DESCRIPTOR_TYPE_SAMPLER, kBindlessSamplerCount, VK_SHADER_STAGE_ALL,
                    t.samplers.data()};
     VkDescriptorBindingFlags flags[3] = {
@@ -110,7 +110,8 @@ void initBindless(Gpu& gpu) {
     plci.pushConstantRangeCount = 1;
     plci.pPushConstantRanges = &push;
     VK_CHECK(vkCreatePipelineLayout(dev, &plci, nullptr, &t.pipelineLayout));
-    setName(gpu.device, t.pipelineLayout, VK_OBJECT_TYPE_PIPELINE_LAYOUT, "bindless.pipelineLayout");
+    setName(gpu.device, t.pipelineLayout, VK_OBJECT_TYPE_PIPELINE_LAYOUT,
+            "bindless.pipelineLayout");
 
     // The null resource: 1x1 black, sampled + storage, kept in GENERAL layout.
     TextureDesc nd;
@@ -140,10 +141,10 @@ void initBindless(Gpu& gpu) {
                      VK_ACCESS_2_SHADER_READ_BIT);
     });
     // Every slot of both sets starts at the null resource, so a stray index reads black.
-    std::vector<VkDescriptorImageInfo> sampledInfos(kBindlessSampledCapacity,
-                                                    {VK_NULL_HANDLE, t.nullSampledView, VK_IMAGE_LAYOUT_GENERAL});
-    std::vector<VkDescriptorImageInfo> storageInfos(kBindlessStorageCapacity,
-                                                    {VK_NULL_HANDLE, t.nullStorageView, VK_IMAGE_LAYOUT_GENERAL});
+    std::vector<VkDescriptorImageInfo> sampledInfos(
+        kBindlessSampledCapacity, {VK_NULL_HANDLE, t.nullSampledView, VK_IMAGE_LAYOUT_GENERAL});
+    std::vector<VkDescriptorImageInfo> storageInfos(
+        kBindlessStorageCapacity, {VK_NULL_HANDLE, t.nullStorageView, VK_IMAGE_LAYOUT_GENERAL});
     for (VkDescriptorSet set : t.sets) {
         VkWriteDescriptorSet writes[2]{};
         writes[0] = {VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET};
@@ -186,7 +187,8 @@ BindlessSlot allocateBindless(Gpu& gpu, BindlessKind kind, VkImageView view, VkI
     BindlessTable& t = gpu.bindless;
     auto& freeList = kind == BindlessKind::Sampled ? t.freeSampled : t.freeStorage;
     uint32_t& next = kind == BindlessKind::Sampled ? t.nextSampled : t.nextStorage;
-    uint32_t limit = kind == BindlessKind::Sampled ? kBindlessSampledStatic : kBindlessStorageStatic;
+    uint32_t limit =
+        kind == BindlessKind::Sampled ? kBindlessSampledStatic : kBindlessStorageStatic;
     uint32_t slot;
     if (!freeList.empty()) {
         slot = freeList.back();
@@ -206,7 +208,8 @@ BindlessSlot allocateBindless(Gpu& gpu, BindlessKind kind, VkImageView view, VkI
 // destroyed right after being queued from ever reaching vkUpdateDescriptorSets.
 static void dropPending(BindlessTable& t, BindlessKind kind, uint32_t slot) {
     for (auto& queue : t.pending)
-        std::erase_if(queue, [&](const BindlessWrite& w) { return w.kind == kind && w.slot == slot; });
+        std::erase_if(queue,
+                      [&](const BindlessWrite& w) { return w.kind == kind && w.slot == slot; });
 }
 
 void updateBindless(Gpu& gpu, BindlessKind kind, BindlessSlot slot, VkImageView view,
@@ -232,7 +235,8 @@ BindlessSlot allocateDynamicBindless(Gpu& gpu, BindlessKind kind, VkImageView vi
     BindlessTable& t = gpu.bindless;
     uint32_t& cursor = kind == BindlessKind::Sampled ? t.dynamicSampled : t.dynamicStorage;
     uint32_t base = kind == BindlessKind::Sampled ? kBindlessSampledStatic : kBindlessStorageStatic;
-    uint32_t cap = kind == BindlessKind::Sampled ? kBindlessSampledCapacity : kBindlessStorageCapacity;
+    uint32_t cap =
+        kind == BindlessKind::Sampled ? kBindlessSampledCapacity : kBindlessStorageCapacity;
     if (base + cursor >= cap) throw DeviceError("bindless dynamic section full for this frame");
     uint32_t slot = base + cursor++;
     writeNow(gpu, t.sets[t.current], {kind, slot, view, layout});
@@ -246,14 +250,17 @@ void prepareBindlessFrame(Gpu& gpu, uint64_t frameIndex) {
     t.pending[t.current].clear();
     // Slots whose null write has now reached both sets can be reused.
     for (auto& r : t.retired) r.setsLeft &= ~(1u << t.current);
-    auto done = std::stable_partition(t.retired.begin(), t.retired.end(),
-                                      [](const BindlessTable::Retired& r) { return r.setsLeft != 0; });
+    auto done =
+        std::stable_partition(t.retired.begin(), t.retired.end(),
+                              [](const BindlessTable::Retired& r) { return r.setsLeft != 0; });
     for (auto it = done; it != t.retired.end(); ++it)
         (it->kind == BindlessKind::Sampled ? t.freeSampled : t.freeStorage).push_back(it->slot);
     t.retired.erase(done, t.retired.end());
     t.dynamicSampled = t.dynamicStorage = 0;
 }
 
-VkDescriptorSet currentBindlessSet(const Gpu& gpu) { return gpu.bindless.sets[gpu.bindless.current]; }
+VkDescriptorSet currentBindlessSet(const Gpu& gpu) {
+    return gpu.bindless.sets[gpu.bindless.current];
+}
 
 } // namespace shadel

@@ -23,7 +23,12 @@ constexpr uint32_t kBindlessStorageCapacity = 4096;
 constexpr uint32_t kBindlessSamplerCount = 4;
 
 // Immutable samplers, indexed in GLSL through shaders/common/bindless.glsl.
-enum class SamplerId : uint32_t { LinearRepeat = 0, LinearClamp = 1, NearestClamp = 2, ShadowCompare = 3 };
+enum class SamplerId : uint32_t {
+    LinearRepeat = 0,
+    LinearClamp = 1,
+    NearestClamp = 2,
+    ShadowCompare = 3
+};
 
 enum class BindlessKind : uint32_t { Sampled = 0, Storage = 1 };
 
@@ -66,8 +71,7 @@ void destroyBindless(Gpu& gpu);
 // Static section.
 // Sampled views of textures with storage usage are read in GENERAL layout (those textures
 // never leave it); all other sampled views in SHADER_READ_ONLY_OPTIMAL.
-BindlessSlot allocateBindless(Gpu& gpu, BindlessKind kind, VkImageView view,
-                              VkImageLayout layout);
+BindlessSlot allocateBindless(Gpu& gpu, BindlessKind kind, VkImageView view, VkImageLayout layout);
 void updateBindless(Gpu& gpu, BindlessKind kind, BindlessSlot slot, VkImageView view,
                     VkImageLayout layout);
 void freeBindless(Gpu& gpu, BindlessKind kind, BindlessSlot slot);

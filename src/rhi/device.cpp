@@ -11,7 +11,8 @@ namespace shadel {
 const char* vkResultName(VkResult r) {
     switch (r) {
 #define CASE(x)                                                                                    \
-    case x: return #x;
+    case x:                                                                                        \
+        return #x;
         CASE(VK_SUCCESS)
         CASE(VK_NOT_READY)
         CASE(VK_TIMEOUT)
@@ -30,19 +31,19 @@ const char* vkResultName(VkResult r) {
         CASE(VK_ERROR_FRAGMENTED_POOL)
         CASE(VK_ERROR_OUT_OF_POOL_MEMORY)
 #undef CASE
-    default: return "VK_ERROR_(unknown)";
+    default:
+        return "VK_ERROR_(unknown)";
     }
 }
 
 void throwVkError(VkResult r, const char* call, const char* file, int line) {
-    throw DeviceError(format("Vulkan call failed: %s returned %s (%s:%d)", call, vkResultName(r),
-                             file, line));
+    throw DeviceError(
+        format("Vulkan call failed: %s returned %s (%s:%d)", call, vkResultName(r), file, line));
 }
 
-static VKAPI_ATTR VkBool32 VKAPI_CALL debugCallback(VkDebugUtilsMessageSeverityFlagBitsEXT severity,
-                                                   VkDebugUtilsMessageTypeFlagsEXT,
-                                                   const VkDebugUtilsMessengerCallbackDataEXT* data,
-                                                   void* user) {
+static VKAPI_ATTR VkBool32 VKAPI_CALL
+debugCallback(VkDebugUtilsMessageSeverityFlagBitsEXT severity, VkDebugUtilsMessageTypeFlagsEXT,
+              const VkDebugUtilsMessengerCallbackDataEXT* data, void* user) {
     Device& device = *static_cast<Device*>(user);
     if (severity & VK_DEBUG_UTILS_MESSAGE_SEVERITY_ERROR_BIT_EXT) {
         device.validationErrors++;
@@ -90,11 +91,16 @@ static bool hasExtension(const std::vector<VkExtensionProperties>& exts, const c
 
 static const char* typeName(VkPhysicalDeviceType t) {
     switch (t) {
-    case VK_PHYSICAL_DEVICE_TYPE_DISCRETE_GPU: return "discrete GPU";
-    case VK_PHYSICAL_DEVICE_TYPE_INTEGRATED_GPU: return "integrated GPU";
-    case VK_PHYSICAL_DEVICE_TYPE_VIRTUAL_GPU: return "virtual GPU";
-    case VK_PHYSICAL_DEVICE_TYPE_CPU: return "CPU";
-    default: return "other";
+    case VK_PHYSICAL_DEVICE_TYPE_DISCRETE_GPU:
+        return "discrete GPU";
+    case VK_PHYSICAL_DEVICE_TYPE_INTEGRATED_GPU:
+        return "integrated GPU";
+    case VK_PHYSICAL_DEVICE_TYPE_VIRTUAL_GPU:
+        return "virtual GPU";
+    case VK_PHYSICAL_DEVICE_TYPE_CPU:
+        return "CPU";
+    default:
+        return "other";
     }
 }
 
@@ -162,10 +168,14 @@ static std::optional<std::string> missingRequiredFeature(VkPhysicalDevice pd) {
         {f.v12.descriptorIndexing, "descriptorIndexing"},
         {f.v12.runtimeDescriptorArray, "runtimeDescriptorArray"},
         {f.v12.descriptorBindingPartiallyBound, "descriptorBindingPartiallyBound"},
-        {f.v12.shaderSampledImageArrayNonUniformIndexing, "shaderSampledImageArrayNonUniformIndexing"},
-        {f.v12.shaderStorageImageArrayNonUniformIndexing, "shaderStorageImageArrayNonUniformIndexing"},
-        {f.v12.descriptorBindingSampledImageUpdateAfterBind, "descriptorBindingSampledImageUpdateAfterBind"},
-        {f.v12.descriptorBindingStorageImageUpdateAfterBind, "descriptorBindingStorageImageUpdateAfterBind"},
+        {f.v12.shaderSampledImageArrayNonUniformIndexing,
+         "shaderSampledImageArrayNonUniformIndexing"},
+        {f.v12.shaderStorageImageArrayNonUniformIndexing,
+         "shaderStorageImageArrayNonUniformIndexing"},
+        {f.v12.descriptorBindingSampledImageUpdateAfterBind,
+         "descriptorBindingSampledImageUpdateAfterBind"},
+        {f.v12.descriptorBindingStorageImageUpdateAfterBind,
+         "descriptorBindingStorageImageUpdateAfterBind"},
         {f.v12.bufferDeviceAddress, "bufferDeviceAddress"},
         {f.v12.shaderBufferInt64Atomics, "shaderBufferInt64Atomics"},
         {f.v12.drawIndirectCount, "drawIndirectCount"},
@@ -177,18 +187,21 @@ static std::optional<std::string> missingRequiredFeature(VkPhysicalDevice pd) {
         {f.core.features.multiDrawIndirect, "multiDrawIndirect"},
         {f.core.features.drawIndirectFirstInstance, "drawIndirectFirstInstance"},
         {f.core.features.samplerAnisotropy, "samplerAnisotropy"},
-        {f.core.features.shaderStorageImageWriteWithoutFormat, "shaderStorageImageWriteWithoutFormat"},
+        {f.core.features.shaderStorageImageWriteWithoutFormat,
+         "shaderStorageImageWriteWithoutFormat"},
         {f.core.features.depthClamp, "depthClamp"},
     };
     for (const Req& r : reqs)
         if (!r.have) return std::string(r.name);
-    if (!props.limits.timestampComputeAndGraphics) return std::string("timestampComputeAndGraphics");
+    if (!props.limits.timestampComputeAndGraphics)
+        return std::string("timestampComputeAndGraphics");
     return std::nullopt;
 }
 
 static VkPhysicalDevice choosePhysicalDevice(VkInstance instance, const std::string& selection) {
     auto pds = physicalDevices(instance);
-    if (pds.empty()) throw DeviceError("no Vulkan device found (is mesa-vulkan-drivers installed?)");
+    if (pds.empty())
+        throw DeviceError("no Vulkan device found (is mesa-vulkan-drivers installed?)");
     auto isCpu = [](VkPhysicalDevice pd) {
         VkPhysicalDeviceProperties p;
         vkGetPhysicalDeviceProperties(pd, &p);
@@ -198,11 +211,16 @@ static VkPhysicalDevice choosePhysicalDevice(VkInstance instance, const std::str
         VkPhysicalDeviceProperties p;
         vkGetPhysicalDeviceProperties(pd, &p);
         switch (p.deviceType) {
-        case VK_PHYSICAL_DEVICE_TYPE_DISCRETE_GPU: return 4;
-        case VK_PHYSICAL_DEVICE_TYPE_INTEGRATED_GPU: return 3;
-        case VK_PHYSICAL_DEVICE_TYPE_VIRTUAL_GPU: return 2;
-        case VK_PHYSICAL_DEVICE_TYPE_CPU: return 1;
-        default: return 0;
+        case VK_PHYSICAL_DEVICE_TYPE_DISCRETE_GPU:
+            return 4;
+        case VK_PHYSICAL_DEVICE_TYPE_INTEGRATED_GPU:
+            return 3;
+        case VK_PHYSICAL_DEVICE_TYPE_VIRTUAL_GPU:
+            return 2;
+        case VK_PHYSICAL_DEVICE_TYPE_CPU:
+            return 1;
+        default:
+            return 0;
         }
     };
     if (!selection.empty() && std::isdigit(uint8_t(selection[0]))) {
@@ -217,8 +235,8 @@ static VkPhysicalDevice choosePhysicalDevice(VkInstance instance, const std::str
         return pds[index];
     }
     if (selection != "auto" && selection != "cpu" && selection != "gpu")
-        throw InputError(format("--device %s: expected auto, cpu, gpu or an index",
-                                selection.c_str()));
+        throw InputError(
+            format("--device %s: expected auto, cpu, gpu or an index", selection.c_str()));
     VkPhysicalDevice best = VK_NULL_HANDLE;
     int bestRank = -1;
     std::string lastMissing;
@@ -228,7 +246,8 @@ static VkPhysicalDevice choosePhysicalDevice(VkInstance instance, const std::str
         if (auto missing = missingRequiredFeature(pd)) {
             VkPhysicalDeviceProperties p;
             vkGetPhysicalDeviceProperties(pd, &p);
-            lastMissing = format("%s lacks required Vulkan feature %s", p.deviceName, missing->c_str());
+            lastMissing =
+                format("%s lacks required Vulkan feature %s", p.deviceName, missing->c_str());
             SHADEL_DEBUG("skipping device: %s", lastMissing.c_str());
             continue;
         }
@@ -289,7 +308,8 @@ void createDevice(Device& device, const DeviceDesc& desc) {
         if (desc.validation) {
             auto create = (PFN_vkCreateDebugUtilsMessengerEXT)vkGetInstanceProcAddr(
                 device.instance, "vkCreateDebugUtilsMessengerEXT");
-            if (create) VK_CHECK(create(device.instance, &messengerInfo, nullptr, &device.messenger));
+            if (create)
+                VK_CHECK(create(device.instance, &messengerInfo, nullptr, &device.messenger));
         }
     }
 
@@ -300,7 +320,8 @@ void createDevice(Device& device, const DeviceDesc& desc) {
     device.isCpu = device.properties.deviceType == VK_PHYSICAL_DEVICE_TYPE_CPU;
     device.timestampPeriodNs = device.properties.limits.timestampPeriod;
 
-    VkPhysicalDeviceDriverProperties driverProps{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_DRIVER_PROPERTIES};
+    VkPhysicalDeviceDriverProperties driverProps{
+        VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_DRIVER_PROPERTIES};
     VkPhysicalDeviceProperties2 props2{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PROPERTIES_2};
     props2.pNext = &driverProps;
     vkGetPhysicalDeviceProperties2(device.physical, &props2);
@@ -319,7 +340,8 @@ void createDevice(Device& device, const DeviceDesc& desc) {
         }
     }
     if (device.queueFamily == ~0u)
-        throw DeviceError(format("%s has no graphics+compute queue with timestamps", device.name.c_str()));
+        throw DeviceError(
+            format("%s has no graphics+compute queue with timestamps", device.name.c_str()));
 
     // Enable exactly what we require, plus optional features when present.
     FeatureChain f;
@@ -338,7 +360,8 @@ void createDevice(Device& device, const DeviceDesc& desc) {
     enable.v12.shaderStorageImageArrayNonUniformIndexing = VK_TRUE;
     enable.v12.descriptorBindingSampledImageUpdateAfterBind = VK_TRUE;
     enable.v12.descriptorBindingStorageImageUpdateAfterBind = VK_TRUE;
-    enable.v12.descriptorBindingUpdateUnusedWhilePending = f.v12.descriptorBindingUpdateUnusedWhilePending;
+    enable.v12.descriptorBindingUpdateUnusedWhilePending =
+        f.v12.descriptorBindingUpdateUnusedWhilePending;
     enable.v12.bufferDeviceAddress = VK_TRUE;
     enable.v12.shaderBufferInt64Atomics = VK_TRUE;
     enable.v12.drawIndirectCount = VK_TRUE;
@@ -352,7 +375,8 @@ void createDevice(Device& device, const DeviceDesc& desc) {
     enable.core.features.shaderInt64 = VK_TRUE;
     enable.core.features.shaderInt16 = f.core.features.shaderInt16;
     enable.core.features.fragmentStoresAndAtomics = VK_TRUE;
-    enable.core.features.vertexPipelineStoresAndAtomics = f.core.features.vertexPipelineStoresAndAtomics;
+    enable.core.features.vertexPipelineStoresAndAtomics =
+        f.core.features.vertexPipelineStoresAndAtomics;
     enable.core.features.multiDrawIndirect = VK_TRUE;
     enable.core.features.drawIndirectFirstInstance = VK_TRUE;
     enable.core.features.samplerAnisotropy = VK_TRUE;
@@ -365,8 +389,10 @@ void createDevice(Device& device, const DeviceDesc& desc) {
     auto exts = deviceExtensions(device.physical);
     std::vector<const char*> deviceExts;
     void* tail = nullptr;
-    VkPhysicalDeviceMeshShaderFeaturesEXT mesh{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_MESH_SHADER_FEATURES_EXT};
-    VkPhysicalDeviceRayQueryFeaturesKHR rayQuery{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_RAY_QUERY_FEATURES_KHR};
+    VkPhysicalDeviceMeshShaderFeaturesEXT mesh{
+        VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_MESH_SHADER_FEATURES_EXT};
+    VkPhysicalDeviceRayQueryFeaturesKHR rayQuery{
+        VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_RAY_QUERY_FEATURES_KHR};
     VkPhysicalDeviceAccelerationStructureFeaturesKHR accel{
         VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_ACCELERATION_STRUCTURE_FEATURES_KHR};
     VkPhysicalDeviceComputeShaderDerivativesFeaturesNV derivs{
@@ -396,7 +422,8 @@ void createDevice(Device& device, const DeviceDesc& desc) {
             deviceExts.push_back(VK_KHR_RAY_QUERY_EXTENSION_NAME);
             deviceExts.push_back(VK_KHR_ACCELERATION_STRUCTURE_EXTENSION_NAME);
             deviceExts.push_back(VK_KHR_DEFERRED_HOST_OPERATIONS_EXTENSION_NAME);
-            VkPhysicalDeviceRayQueryFeaturesKHR rq{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_RAY_QUERY_FEATURES_KHR};
+            VkPhysicalDeviceRayQueryFeaturesKHR rq{
+                VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_RAY_QUERY_FEATURES_KHR};
             rayQuery = rq;
             rayQuery.rayQuery = VK_TRUE;
             VkPhysicalDeviceAccelerationStructureFeaturesKHR as{
@@ -464,7 +491,8 @@ void destroyDevice(Device& device) {
 std::string describeDevice(const Device& device) {
     const VkPhysicalDeviceLimits& l = device.properties.limits;
     std::string out;
-    out += format("device:   %s (%s)\n", device.name.c_str(), typeName(device.properties.deviceType));
+    out +=
+        format("device:   %s (%s)\n", device.name.c_str(), typeName(device.properties.deviceType));
     out += format("driver:   %s\n", device.driver.c_str());
     out += format("api:      %u.%u.%u\n", VK_API_VERSION_MAJOR(device.properties.apiVersion),
                   VK_API_VERSION_MINOR(device.properties.apiVersion),
@@ -472,9 +500,10 @@ std::string describeDevice(const Device& device) {
     out += "required: dynamicRendering synchronization2 timelineSemaphore descriptorIndexing "
            "bufferDeviceAddress shaderInt64 shaderBufferInt64Atomics fragmentStoresAndAtomics "
            "multiDrawIndirect drawIndirectCount timestamps: all present\n";
-    out += format("optional: meshShader=%s rayQuery=%s computeDerivatives=%s\n",
-                  device.optional.meshShader ? "yes" : "no", device.optional.rayQuery ? "yes" : "no",
-                  device.optional.computeDerivatives ? "yes" : "no");
+    out +=
+        format("optional: meshShader=%s rayQuery=%s computeDerivatives=%s\n",
+               device.optional.meshShader ? "yes" : "no", device.optional.rayQuery ? "yes" : "no",
+               device.optional.computeDerivatives ? "yes" : "no");
     out += format("limits:   maxImageDimension2D=%u maxComputeWorkGroupInvocations=%u "
                   "maxPushConstantsSize=%u maxDescriptorSetUpdateAfterBindSampledImages=%u "
                   "timestampPeriod=%.3fns\n",

@@ -10,7 +10,7 @@ namespace shadel {
 
 struct DeviceDesc {
     std::string selection = "auto"; // auto | cpu | gpu | INDEX
-    bool validation = false;         // Khronos validation layer; errors are counted
+    bool validation = false;        // Khronos validation layer; errors are counted
     bool printValidation = true;
 };
 

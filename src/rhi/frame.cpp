@@ -59,8 +59,10 @@ static void submitAndWait(FrameRecorder& r) {
     si.pCommandBufferInfos = &cbi;
     VK_CHECK(vkResetFences(r.gpu->device.device, 1, &r.fence));
     VK_CHECK(vkQueueSubmit2(r.gpu->device.queue, 1, &si, r.fence));
-    VkResult res = vkWaitForFences(r.gpu->device.device, 1, &r.fence, VK_TRUE, 120ull * 1000000000ull);
-    if (res == VK_TIMEOUT) throw DeviceError("GPU frame did not finish within 120 s (device hang?)");
+    VkResult res =
+        vkWaitForFences(r.gpu->device.device, 1, &r.fence, VK_TRUE, 120ull * 1000000000ull);
+    if (res == VK_TIMEOUT)
+        throw DeviceError("GPU frame did not finish within 120 s (device hang?)");
     VK_CHECK(res);
 }
 
@@ -86,7 +88,8 @@ void pass(FrameRecorder& r, const char* name, const std::function<void(VkCommand
         endLabel(gpu, r.cmd);
         submitAndWait(r);
         r.passes.back().gpuMs =
-            std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+            std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
+                .count();
         return;
     }
     beginLabel(gpu, r.cmd, name);
@@ -103,17 +106,17 @@ void endFrame(FrameRecorder& r) {
         uint32_t n = uint32_t(r.passes.size());
         if (n) {
             std::vector<uint64_t> ticks(n * 2);
-            VK_CHECK(vkGetQueryPoolResults(gpu.device.device, r.queries, 0, n * 2,
-                                           ticks.size() * sizeof(uint64_t), ticks.data(),
-                                           sizeof(uint64_t),
-                                           VK_QUERY_RESULT_64_BIT | VK_QUERY_RESULT_WAIT_BIT));
+            VK_CHECK(vkGetQueryPoolResults(
+                gpu.device.device, r.queries, 0, n * 2, ticks.size() * sizeof(uint64_t),
+                ticks.data(), sizeof(uint64_t), VK_QUERY_RESULT_64_BIT | VK_QUERY_RESULT_WAIT_BIT));
             for (uint32_t i = 0; i < n; ++i)
                 r.passes[i].gpuMs = double(ticks[i * 2 + 1] - ticks[i * 2]) *
                                     double(gpu.device.timestampPeriodNs) * 1e-6;
         }
     }
-    r.frameMs = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - r.frameStart)
-                    .count();
+    r.frameMs =
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - r.frameStart)
+            .count();
     gpu.frameIndex++;
 }
 

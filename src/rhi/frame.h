@@ -42,7 +42,8 @@ TimingMode defaultTimingMode(const Gpu& gpu); // SubmitPerPass on CPU devices
 
 void beginFrame(FrameRecorder& recorder);
 // Records `record` as the named pass (debug label + timing).
-void pass(FrameRecorder& recorder, const char* name, const std::function<void(VkCommandBuffer)>& record);
+void pass(FrameRecorder& recorder, const char* name,
+          const std::function<void(VkCommandBuffer)>& record);
 // Submits what is left, waits for the GPU, resolves timings.
 void endFrame(FrameRecorder& recorder);
 

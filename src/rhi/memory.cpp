@@ -22,7 +22,9 @@ void destroyMemory(Memory& memory) {
 static uint32_t findMemoryType(const Device& device, uint32_t typeBits, MemoryKind kind) {
     VkMemoryPropertyFlags want = 0, avoid = 0;
     switch (kind) {
-    case MemoryKind::DeviceLocal: want = VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT; break;
+    case MemoryKind::DeviceLocal:
+        want = VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT;
+        break;
     case MemoryKind::Upload:
         want = VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT;
         break;
@@ -40,7 +42,8 @@ static uint32_t findMemoryType(const Device& device, uint32_t typeBits, MemoryKi
             if (pass == 0 && (f & want) == want && !(f & avoid)) return i;
             if (pass == 1 && (f & want) == want) return i;
             if (pass == 2 && kind != MemoryKind::DeviceLocal &&
-                (f & (VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT)) ==
+                (f &
+                 (VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT)) ==
                     (VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT))
                 return i;
             if (pass == 2 && kind == MemoryKind::DeviceLocal) return i;
@@ -80,8 +83,9 @@ static MemoryHeap& heapFor(Memory& memory, MemoryKind kind, uint32_t memoryType)
         raw->poolMemory[poolIndex] = mem;
         raw->poolMapped[poolIndex] = mapped;
         static const char* kindNames[] = {"deviceLocal", "upload", "readback"};
-        setName(*device, mem, VK_OBJECT_TYPE_DEVICE_MEMORY,
-                format("heap.%s.type%u.pool%u", kindNames[int(raw->kind)], raw->memoryType, poolIndex));
+        setName(
+            *device, mem, VK_OBJECT_TYPE_DEVICE_MEMORY,
+            format("heap.%s.type%u.pool%u", kindNames[int(raw->kind)], raw->memoryType, poolIndex));
         return true;
     };
     callbacks.destroy = [raw, device](uint32_t poolIndex) {

@@ -61,7 +61,8 @@ struct Specialization {
 Pipeline createGraphicsPipeline(Gpu& gpu, const GraphicsPipelineDesc& desc) {
     Specialization spec(desc.specialization);
     VkShaderModule vs = createModule(gpu, desc.vertexShader);
-    VkShaderModule fs = desc.fragmentShader.empty() ? VK_NULL_HANDLE : createModule(gpu, desc.fragmentShader);
+    VkShaderModule fs =
+        desc.fragmentShader.empty() ? VK_NULL_HANDLE : createModule(gpu, desc.fragmentShader);
     VkPipelineShaderStageCreateInfo stages[2]{};
     stages[0] = {VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO};
     stages[0].stage = VK_SHADER_STAGE_VERTEX_BIT;
@@ -74,22 +75,28 @@ Pipeline createGraphicsPipeline(Gpu& gpu, const GraphicsPipelineDesc& desc) {
     stages[1].pName = "main";
     stages[1].pSpecializationInfo = spec.get();
 
-    VkPipelineVertexInputStateCreateInfo vertexInput{VK_STRUCTURE_TYPE_PIPELINE_VERTEX_INPUT_STATE_CREATE_INFO};
-    VkPipelineInputAssemblyStateCreateInfo assembly{VK_STRUCTURE_TYPE_PIPELINE_INPUT_ASSEMBLY_STATE_CREATE_INFO};
+    VkPipelineVertexInputStateCreateInfo vertexInput{
+        VK_STRUCTURE_TYPE_PIPELINE_VERTEX_INPUT_STATE_CREATE_INFO};
+    VkPipelineInputAssemblyStateCreateInfo assembly{
+        VK_STRUCTURE_TYPE_PIPELINE_INPUT_ASSEMBLY_STATE_CREATE_INFO};
     assembly.topology = VK_PRIMITIVE_TOPOLOGY_TRIANGLE_LIST;
-    VkPipelineViewportStateCreateInfo viewport{VK_STRUCTURE_TYPE_PIPELINE_VIEWPORT_STATE_CREATE_INFO};
+    VkPipelineViewportStateCreateInfo viewport{
+        VK_STRUCTURE_TYPE_PIPELINE_VIEWPORT_STATE_CREATE_INFO};
     viewport.viewportCount = 1;
     viewport.scissorCount = 1;
-    VkPipelineRasterizationStateCreateInfo raster{VK_STRUCTURE_TYPE_PIPELINE_RASTERIZATION_STATE_CREATE_INFO};
+    VkPipelineRasterizationStateCreateInfo raster{
+        VK_STRUCTURE_TYPE_PIPELINE_RASTERIZATION_STATE_CREATE_INFO};
     raster.polygonMode = VK_POLYGON_MODE_FILL;
     raster.cullMode = desc.cullMode;
     raster.frontFace = VK_FRONT_FACE_COUNTER_CLOCKWISE;
     raster.depthClampEnable = desc.depthClamp;
     raster.depthBiasEnable = desc.depthBias;
     raster.lineWidth = 1.0f;
-    VkPipelineMultisampleStateCreateInfo ms{VK_STRUCTURE_TYPE_PIPELINE_MULTISAMPLE_STATE_CREATE_INFO};
+    VkPipelineMultisampleStateCreateInfo ms{
+        VK_STRUCTURE_TYPE_PIPELINE_MULTISAMPLE_STATE_CREATE_INFO};
     ms.rasterizationSamples = VK_SAMPLE_COUNT_1_BIT;
-    VkPipelineDepthStencilStateCreateInfo depth{VK_STRUCTURE_TYPE_PIPELINE_DEPTH_STENCIL_STATE_CREATE_INFO};
+    VkPipelineDepthStencilStateCreateInfo depth{
+        VK_STRUCTURE_TYPE_PIPELINE_DEPTH_STENCIL_STATE_CREATE_INFO};
     depth.depthTestEnable = desc.depthTest;
     depth.depthWriteEnable = desc.depthWrite;
     depth.depthCompareOp = desc.depthCompare;
@@ -110,7 +117,8 @@ Pipeline createGraphicsPipeline(Gpu& gpu, const GraphicsPipelineDesc& desc) {
             b.srcAlphaBlendFactor = b.dstAlphaBlendFactor = VK_BLEND_FACTOR_ONE;
         }
     }
-    VkPipelineColorBlendStateCreateInfo blend{VK_STRUCTURE_TYPE_PIPELINE_COLOR_BLEND_STATE_CREATE_INFO};
+    VkPipelineColorBlendStateCreateInfo blend{
+        VK_STRUCTURE_TYPE_PIPELINE_COLOR_BLEND_STATE_CREATE_INFO};
     blend.attachmentCount = uint32_t(blends.size());
     blend.pAttachments = blends.data();
     VkDynamicState dynamics[] = {VK_DYNAMIC_STATE_VIEWPORT, VK_DYNAMIC_STATE_SCISSOR,
@@ -139,7 +147,8 @@ Pipeline createGraphicsPipeline(Gpu& gpu, const GraphicsPipelineDesc& desc) {
     Pipeline out;
     out.name = desc.name;
     out.bindPoint = VK_PIPELINE_BIND_POINT_GRAPHICS;
-    VK_CHECK(vkCreateGraphicsPipelines(gpu.device.device, VK_NULL_HANDLE, 1, &ci, nullptr, &out.pipeline));
+    VK_CHECK(vkCreateGraphicsPipelines(gpu.device.device, VK_NULL_HANDLE, 1, &ci, nullptr,
+                                       &out.pipeline));
     setName(gpu.device, out.pipeline, VK_OBJECT_TYPE_PIPELINE, desc.name);
     vkDestroyShaderModule(gpu.device.device, vs, nullptr);
     if (fs) vkDestroyShaderModule(gpu.device.device, fs, nullptr);
@@ -160,7 +169,8 @@ Pipeline createComputePipeline(Gpu& gpu, const std::string& name, const std::str
     Pipeline out;
     out.name = name;
     out.bindPoint = VK_PIPELINE_BIND_POINT_COMPUTE;
-    VK_CHECK(vkCreateComputePipelines(gpu.device.device, VK_NULL_HANDLE, 1, &ci, nullptr, &out.pipeline));
+    VK_CHECK(vkCreateComputePipelines(gpu.device.device, VK_NULL_HANDLE, 1, &ci, nullptr,
+                                      &out.pipeline));
     setName(gpu.device, out.pipeline, VK_OBJECT_TYPE_PIPELINE, name);
     vkDestroyShaderModule(gpu.device.device, cs, nullptr);
     return out;

@@ -36,8 +36,9 @@ struct Pipeline {
 std::string shaderDirectory();
 std::vector<uint32_t> loadSpirv(const std::string& fileName);
 Pipeline createGraphicsPipeline(Gpu& gpu, const GraphicsPipelineDesc& desc);
-Pipeline createComputePipeline(Gpu& gpu, const std::string& name, const std::string& shader,
-                               const std::vector<std::pair<uint32_t, uint32_t>>& specialization = {});
+Pipeline
+createComputePipeline(Gpu& gpu, const std::string& name, const std::string& shader,
+                      const std::vector<std::pair<uint32_t, uint32_t>>& specialization = {});
 void destroy(Gpu& gpu, Pipeline& pipeline);
 
 // Binds the pipeline and the current bindless set.

@@ -26,7 +26,8 @@ BufferHandle createBuffer(Gpu& gpu, const BufferDesc& desc) {
     BufferRecord rec;
     rec.size = desc.size;
     rec.name = desc.name;
-    if (VkResult res = vkCreateBuffer(gpu.device.device, &ci, nullptr, &rec.buffer); res != VK_SUCCESS) {
+    if (VkResult res = vkCreateBuffer(gpu.device.device, &ci, nullptr, &rec.buffer);
+        res != VK_SUCCESS) {
         gpu.failedAllocations++;
         SHADEL_WARN("cannot create buffer %s (%llu bytes): %s", desc.name.c_str(),
                     (unsigned long long)desc.size, vkResultName(res));
@@ -43,7 +44,8 @@ BufferHandle createBuffer(Gpu& gpu, const BufferDesc& desc) {
         return {};
     }
     rec.memory = *block;
-    VK_CHECK(vkBindBufferMemory(gpu.device.device, rec.buffer, rec.memory.memory, rec.memory.offset));
+    VK_CHECK(
+        vkBindBufferMemory(gpu.device.device, rec.buffer, rec.memory.memory, rec.memory.offset));
     VkBufferDeviceAddressInfo ai{VK_STRUCTURE_TYPE_BUFFER_DEVICE_ADDRESS_INFO};
     ai.buffer = rec.buffer;
     rec.address = vkGetBufferDeviceAddress(gpu.device.device, &ai);
@@ -67,10 +69,11 @@ TextureHandle createTexture(Gpu& gpu, const TextureDesc& desc) {
     rec.desc = desc;
     rec.aspect = isDepthFormat(desc.format) ? VK_IMAGE_ASPECT_DEPTH_BIT : VK_IMAGE_ASPECT_COLOR_BIT;
     if (hasStencil(desc.format)) rec.aspect |= VK_IMAGE_ASPECT_STENCIL_BIT;
-    if (VkResult res = vkCreateImage(gpu.device.device, &ci, nullptr, &rec.image); res != VK_SUCCESS) {
+    if (VkResult res = vkCreateImage(gpu.device.device, &ci, nullptr, &rec.image);
+        res != VK_SUCCESS) {
         gpu.failedAllocations++;
-        SHADEL_WARN("cannot create texture %s (%ux%u): %s", desc.name.c_str(), desc.width, desc.height,
-                    vkResultName(res));
+        SHADEL_WARN("cannot create texture %s (%ux%u): %s", desc.name.c_str(), desc.width,
+                    desc.height, vkResultName(res));
         return {};
     }
     VkMemoryRequirements req;
@@ -105,7 +108,8 @@ void destroy(Gpu& gpu, TextureHandle texture) {
     gpu.textures.remove(texture.index);
 }
 
-static ViewRecord makeView(Gpu& gpu, TextureHandle texture, const ViewDesc& desc, const char* suffix) {
+static ViewRecord makeView(Gpu& gpu, TextureHandle texture, const ViewDesc& desc,
+                           const char* suffix) {
     SHADEL_ASSERT(gpu.textures.contains(texture.index));
     const TextureRecord& tex = gpu.textures[texture.index];
     ViewRecord rec;
@@ -119,8 +123,8 @@ static ViewRecord makeView(Gpu& gpu, TextureHandle texture, const ViewDesc& desc
     ci.viewType = VK_IMAGE_VIEW_TYPE_2D;
     ci.format = desc.format == VK_FORMAT_UNDEFINED ? tex.desc.format : desc.format;
     // Views see depth only; stencil is reached through the attachment.
-    VkImageAspectFlags aspect = isDepthFormat(tex.desc.format) ? VK_IMAGE_ASPECT_DEPTH_BIT
-                                                                : VK_IMAGE_ASPECT_COLOR_BIT;
+    VkImageAspectFlags aspect =
+        isDepthFormat(tex.desc.format) ? VK_IMAGE_ASPECT_DEPTH_BIT : VK_IMAGE_ASPECT_COLOR_BIT;
     ci.subresourceRange = {aspect, rec.baseMip, rec.mipCount, 0, 1};
     VK_CHECK(vkCreateImageView(gpu.device.device, &ci, nullptr, &rec.view));
     setName(gpu.device, rec.view, VK_OBJECT_TYPE_IMAGE_VIEW,
@@ -193,19 +197,47 @@ void destroy(Gpu& gpu, DepthTargetView view) {
     gpu.depthViews.remove(view.index);
 }
 
-VkBuffer vkBuffer(const Gpu& gpu, BufferHandle b) { return gpu.buffers[b.index].buffer; }
-VkDeviceAddress address(const Gpu& gpu, BufferHandle b) { return gpu.buffers[b.index].address; }
-VkDeviceSize size(const Gpu& gpu, BufferHandle b) { return gpu.buffers[b.index].size; }
-void* mapped(const Gpu& gpu, BufferHandle b) { return gpu.buffers[b.index].memory.mapped; }
-VkImage vkImage(const Gpu& gpu, TextureHandle t) { return gpu.textures[t.index].image; }
-const TextureDesc& desc(const Gpu& gpu, TextureHandle t) { return gpu.textures[t.index].desc; }
-VkImageView vkView(const Gpu& gpu, RenderTargetView v) { return gpu.targetViews[v.index].view; }
-VkImageView vkView(const Gpu& gpu, DepthTargetView v) { return gpu.depthViews[v.index].view; }
-TextureHandle textureOf(const Gpu& gpu, RenderTargetView v) { return gpu.targetViews[v.index].texture; }
-TextureHandle textureOf(const Gpu& gpu, DepthTargetView v) { return gpu.depthViews[v.index].texture; }
-TextureHandle textureOf(const Gpu& gpu, TextureReadView v) { return gpu.readViews[v.index].texture; }
-TextureHandle textureOf(const Gpu& gpu, TextureWriteView v) { return gpu.writeViews[v.index].texture; }
-BindlessSlot slot(const Gpu& gpu, TextureReadView v) { return gpu.readViews[v.index].slot; }
-BindlessSlot slot(const Gpu& gpu, TextureWriteView v) { return gpu.writeViews[v.index].slot; }
+VkBuffer vkBuffer(const Gpu& gpu, BufferHandle b) {
+    return gpu.buffers[b.index].buffer;
+}
+VkDeviceAddress address(const Gpu& gpu, BufferHandle b) {
+    return gpu.buffers[b.index].address;
+}
+VkDeviceSize size(const Gpu& gpu, BufferHandle b) {
+    return gpu.buffers[b.index].size;
+}
+void* mapped(const Gpu& gpu, BufferHandle b) {
+    return gpu.buffers[b.index].memory.mapped;
+}
+VkImage vkImage(const Gpu& gpu, TextureHandle t) {
+    return gpu.textures[t.index].image;
+}
+const TextureDesc& desc(const Gpu& gpu, TextureHandle t) {
+    return gpu.textures[t.index].desc;
+}
+VkImageView vkView(const Gpu& gpu, RenderTargetView v) {
+    return gpu.targetViews[v.index].view;
+}
+VkImageView vkView(const Gpu& gpu, DepthTargetView v) {
+    return gpu.depthViews[v.index].view;
+}
+TextureHandle textureOf(const Gpu& gpu, RenderTargetView v) {
+    return gpu.targetViews[v.index].texture;
+}
+TextureHandle textureOf(const Gpu& gpu, DepthTargetView v) {
+    return gpu.depthViews[v.index].texture;
+}
+TextureHandle textureOf(const Gpu& gpu, TextureReadView v) {
+    return gpu.readViews[v.index].texture;
+}
+TextureHandle textureOf(const Gpu& gpu, TextureWriteView v) {
+    return gpu.writeViews[v.index].texture;
+}
+BindlessSlot slot(const Gpu& gpu, TextureReadView v) {
+    return gpu.readViews[v.index].slot;
+}
+BindlessSlot slot(const Gpu& gpu, TextureWriteView v) {
+    return gpu.writeViews[v.index].slot;
+}
 
 } // namespace shadel

@@ -25,14 +25,22 @@ const ShaderTableEntry kShaders[] = {
 
 const char* assertMessage(uint32_t id) {
     switch (id) {
-    case ASSERT_INSTANCE_RANGE: return "instance index out of range";
-    case ASSERT_MATERIAL_RANGE: return "material index out of range";
-    case ASSERT_DRAW_OVERFLOW: return "more draws than the indirect buffer holds";
-    case ASSERT_NON_FINITE: return "non-finite shading result";
-    case ASSERT_SHADEL_SLOT: return "shadel storage slot out of range";
-    case ASSERT_TRIANGLE_ID: return "triangle id out of range";
-    case ASSERT_TEST: return "test assert";
-    default: return "unknown assert";
+    case ASSERT_INSTANCE_RANGE:
+        return "instance index out of range";
+    case ASSERT_MATERIAL_RANGE:
+        return "material index out of range";
+    case ASSERT_DRAW_OVERFLOW:
+        return "more draws than the indirect buffer holds";
+    case ASSERT_NON_FINITE:
+        return "non-finite shading result";
+    case ASSERT_SHADEL_SLOT:
+        return "shadel storage slot out of range";
+    case ASSERT_TRIANGLE_ID:
+        return "triangle id out of range";
+    case ASSERT_TEST:
+        return "test assert";
+    default:
+        return "unknown assert";
     }
 }
 constexpr size_t kBufferSize =

@@ -15,7 +15,8 @@ Aabb transformAabb(const Aabb& box, const glm::mat4& m) {
 
 Aabb Scene::worldBounds() const {
     Aabb out;
-    for (const Instance& inst : instances) out.extend(transformAabb(meshes[inst.mesh].bounds, inst.transform));
+    for (const Instance& inst : instances)
+        out.extend(transformAabb(meshes[inst.mesh].bounds, inst.transform));
     return out;
 }
 

@@ -88,10 +88,10 @@ struct Light {
     std::string name;
     LightType type = LightType::Point;
     glm::vec3 color{1.0f};
-    float intensity = 1.0f;     // lux for directional, candela for point/spot (glTF units)
-    glm::vec3 position{0.0f};   // world
+    float intensity = 1.0f;        // lux for directional, candela for point/spot (glTF units)
+    glm::vec3 position{0.0f};      // world
     glm::vec3 direction{0, -1, 0}; // world, the way the light travels
-    float range = 0.0f;         // 0 = infinite
+    float range = 0.0f;            // 0 = infinite
     float innerConeAngle = 0.0f;
     float outerConeAngle = 0.7853982f;
     bool castsShadow = false;

@@ -4,8 +4,8 @@
 #include <concepts>
 #include <type_traits>
 
-#include "rhi/resources.h"
 #include "rhi/gpu.h"
+#include "rhi/resources.h"
 
 namespace shadel {
 
@@ -16,19 +16,33 @@ void sampleIn(TextureReadView view);
 void writeIn(TextureWriteView view);
 
 template <typename V>
-concept BindableAsColor = requires(V v) { bindColor(v); };
+concept BindableAsColor = requires(V v) {
+    bindColor(v);
+};
 template <typename V>
-concept BindableAsDepth = requires(V v) { bindDepth(v); };
+concept BindableAsDepth = requires(V v) {
+    bindDepth(v);
+};
 template <typename V>
-concept Sampleable = requires(V v) { sampleIn(v); };
+concept Sampleable = requires(V v) {
+    sampleIn(v);
+};
 template <typename V>
-concept Writable = requires(V v) { writeIn(v); };
+concept Writable = requires(V v) {
+    writeIn(v);
+};
 template <typename H>
-concept BufferAccess = requires(const Gpu& g, H h) { vkBuffer(g, h); };
+concept BufferAccess = requires(const Gpu& g, H h) {
+    vkBuffer(g, h);
+};
 template <typename H>
-concept ImageAccess = requires(const Gpu& g, H h) { vkImage(g, h); };
+concept ImageAccess = requires(const Gpu& g, H h) {
+    vkImage(g, h);
+};
 template <typename H>
-concept ReadViewSlot = requires(const Gpu& g, H h) { slot(g, h); };
+concept ReadViewSlot = requires(const Gpu& g, H h) {
+    slot(g, h);
+};
 
 // A render target view binds as colour; nothing else does.
 static_assert(BindableAsColor<RenderTargetView>);
@@ -52,7 +66,8 @@ static_assert(!Writable<TextureReadView>);
 
 // Buffers and textures are not interchangeable.
 static_assert(BufferAccess<BufferHandle>);
-static_assert(!BufferAccess<TextureHandle>, "a texture must not be used where a buffer is expected");
+static_assert(!BufferAccess<TextureHandle>,
+              "a texture must not be used where a buffer is expected");
 static_assert(ImageAccess<TextureHandle>);
 static_assert(!ImageAccess<BufferHandle>);
 static_assert(!ImageAccess<TextureReadView>);

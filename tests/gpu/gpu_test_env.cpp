@@ -23,7 +23,9 @@ Gpu& sharedGpu() {
     return shared.gpu;
 }
 
-uint32_t validationErrors() { return sharedGpu().device.validationErrors.load(); }
+uint32_t validationErrors() {
+    return sharedGpu().device.validationErrors.load();
+}
 
 RenderRun renderChecked(const RenderOptions& options) {
     Gpu& gpu = sharedGpu();
@@ -34,7 +36,8 @@ RenderRun renderChecked(const RenderOptions& options) {
         o.cacheDir = (std::filesystem::temp_directory_path() / "shadel-test-cache").string();
     RenderRun run = runRender(gpu, o);
     EXPECT_EQ(validationErrors(), before) << "validation errors while rendering " << o.scene;
-    EXPECT_EQ(run.stats["shader_asserts"].get<uint64_t>(), 0u) << "shader asserts while rendering " << o.scene;
+    EXPECT_EQ(run.stats["shader_asserts"].get<uint64_t>(), 0u)
+        << "shader asserts while rendering " << o.scene;
     return run;
 }
 

@@ -17,8 +17,10 @@ struct Result {
 };
 
 Result run(const std::string& args) {
-    std::string errFile = (std::filesystem::temp_directory_path() / "shadel_cli_stderr.txt").string();
-    std::string cmd = std::string("timeout 120 ") + SHADEL_BINARY + " " + args + " >/dev/null 2>" + errFile;
+    std::string errFile =
+        (std::filesystem::temp_directory_path() / "shadel_cli_stderr.txt").string();
+    std::string cmd =
+        std::string("timeout 120 ") + SHADEL_BINARY + " " + args + " >/dev/null 2>" + errFile;
     int status = std::system(cmd.c_str());
     Result r;
     r.exitCode = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
@@ -57,11 +59,12 @@ TEST(Cli, EveryMalformedGltfIsOneErrorLineAndExitCode2) {
 }
 
 TEST(Cli, BadFlagsAndMissingFilesExitWith2) {
-    for (const std::string args : {"render --scene /nonexistent/scene.gltf", "render --scene builtin:nope",
-                                   "render --size 0x10", "render --size banana", "render --size 99999x10",
-                                   "render --mode sideways", "render --visualize everything",
-                                   "render --camera nope --size 16x16", "render --frames 0",
-                                   "render --ssaa 0", "--device 57 render", "render --jitter wobble"}) {
+    for (const std::string args :
+         {"render --scene /nonexistent/scene.gltf", "render --scene builtin:nope",
+          "render --size 0x10", "render --size banana", "render --size 99999x10",
+          "render --mode sideways", "render --visualize everything",
+          "render --camera nope --size 16x16", "render --frames 0", "render --ssaa 0",
+          "--device 57 render", "render --jitter wobble"}) {
         Result r = run(args);
         EXPECT_EQ(r.exitCode, 2) << args << ": " << r.stderrText;
         EXPECT_NE(r.stderrText.find("shadel: "), std::string::npos) << args;
@@ -72,15 +75,16 @@ TEST(Cli, RenderWritesPngAndStatsJson) {
     auto dir = std::filesystem::temp_directory_path() / "shadel_cli_out";
     std::filesystem::remove_all(dir);
     std::filesystem::create_directories(dir);
-    Result r = run("render --size 48x32 --frames 2 --out " + (dir / "frames/").string() + " --stats " +
-                   (dir / "s.json").string());
+    Result r = run("render --size 48x32 --frames 2 --out " + (dir / "frames/").string() +
+                   " --stats " + (dir / "s.json").string());
     EXPECT_EQ(r.exitCode, 0) << r.stderrText;
     EXPECT_TRUE(std::filesystem::exists(dir / "frames/frame_0000.png"));
     EXPECT_TRUE(std::filesystem::exists(dir / "frames/frame_0001.png"));
     std::ifstream in(dir / "s.json");
     std::stringstream ss;
     ss << in.rdbuf();
-    for (const char* key : {"\"device\"", "\"mode\"", "\"frame_ms\"", "\"passes\"", "\"pixels_covered\"",
-                            "\"shadels_per_pixel\"", "\"reconstruction_misses\"", "\"validation_errors\""})
+    for (const char* key :
+         {"\"device\"", "\"mode\"", "\"frame_ms\"", "\"passes\"", "\"pixels_covered\"",
+          "\"shadels_per_pixel\"", "\"reconstruction_misses\"", "\"validation_errors\""})
         EXPECT_NE(ss.str().find(key), std::string::npos) << key;
 }

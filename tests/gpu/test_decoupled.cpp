@@ -41,8 +41,9 @@ TEST(Decoupled, SmoothSceneMatchesForward) {
     RenderRun fwd = renderChecked(options("builtin:smooth", RenderMode::Forward, 256, 144));
     RenderRun dec = renderChecked(options("builtin:smooth", RenderMode::Decoupled, 256, 144));
     double p = psnr(dec.frames[0].rgba, fwd.frames[0].rgba);
-    std::printf("[ figures ] smooth 256x144: PSNR(decoupled, forward) = %.2f dB, %.2f shadels/pixel\n", p,
-                dec.stats["shadels_per_pixel"].get<double>());
+    std::printf(
+        "[ figures ] smooth 256x144: PSNR(decoupled, forward) = %.2f dB, %.2f shadels/pixel\n", p,
+        dec.stats["shadels_per_pixel"].get<double>());
     EXPECT_GE(p, 35.0);
     EXPECT_EQ(dec.stats["reconstruction_misses"].get<uint64_t>(), 0u);
     EXPECT_EQ(dec.stats["pixels_covered"], fwd.stats["pixels_covered"]);
@@ -56,8 +57,9 @@ TEST(Decoupled, CheckerIsCloserToSupersampledReferenceThanForward) {
     RenderRun dec = renderChecked(options("builtin:checker", RenderMode::Decoupled, 192, 108));
     double pf = psnr(fwd.frames[0].rgba, reference.frames[0].rgba);
     double pd = psnr(dec.frames[0].rgba, reference.frames[0].rgba);
-    std::printf("[ figures ] checker 192x108 vs 8x8 SSAA: forward %.2f dB, decoupled %.2f dB (+%.2f)\n", pf, pd,
-                pd - pf);
+    std::printf(
+        "[ figures ] checker 192x108 vs 8x8 SSAA: forward %.2f dB, decoupled %.2f dB (+%.2f)\n", pf,
+        pd, pd - pf);
     EXPECT_GE(pd, pf + 3.0);
     EXPECT_EQ(dec.stats["reconstruction_misses"].get<uint64_t>(), 0u);
 }
@@ -72,7 +74,8 @@ TEST(Decoupled, FlickersFarLessThanForwardUnderJitter) {
     o.mode = RenderMode::Decoupled;
     RenderRun dec = renderChecked(o);
     double ff = flicker(fwd), fd = flicker(dec);
-    std::printf("[ figures ] default 1280x720, 16 jittered frames: mean |frame delta| forward %.3f, decoupled "
+    std::printf("[ figures ] default 1280x720, 16 jittered frames: mean |frame delta| forward "
+                "%.3f, decoupled "
                 "%.3f (ratio %.3f)\n",
                 ff, fd, fd / ff);
     EXPECT_GT(ff, 0.0);
@@ -87,9 +90,12 @@ TEST(Decoupled, NoReconstructionMissesOnAnyBuiltinSceneAndCamera) {
             RenderOptions o = options(scene, RenderMode::Decoupled, 128, 72);
             o.camera = camera.name;
             RenderRun run = renderChecked(o);
-            EXPECT_EQ(run.stats["reconstruction_misses"].get<uint64_t>(), 0u) << scene << " camera " << camera.name;
-            EXPECT_EQ(run.stats["chunks_overflowed"].get<uint64_t>(), 0u) << scene << " camera " << camera.name;
-            EXPECT_GT(run.stats["shadels_shaded"].get<uint64_t>(), 0u) << scene << " camera " << camera.name;
+            EXPECT_EQ(run.stats["reconstruction_misses"].get<uint64_t>(), 0u)
+                << scene << " camera " << camera.name;
+            EXPECT_EQ(run.stats["chunks_overflowed"].get<uint64_t>(), 0u)
+                << scene << " camera " << camera.name;
+            EXPECT_GT(run.stats["shadels_shaded"].get<uint64_t>(), 0u)
+                << scene << " camera " << camera.name;
         }
     }
 }
@@ -104,7 +110,8 @@ TEST(Decoupled, StorageOverflowIsCountedAndNeverCorrupts) {
     RenderRun dec = renderChecked(o);
     EXPECT_EQ(full.stats["chunks_overflowed"].get<uint64_t>(), 0u);
     EXPECT_GT(dec.stats["chunks_overflowed"].get<uint64_t>(), 0u);
-    EXPECT_LE(dec.stats["chunks_allocated"].get<uint64_t>(), dec.stats["chunks_capacity"].get<uint64_t>());
+    EXPECT_LE(dec.stats["chunks_allocated"].get<uint64_t>(),
+              dec.stats["chunks_capacity"].get<uint64_t>());
     EXPECT_GT(dec.stats["overflow_samples"].get<uint64_t>(), 0u);
     EXPECT_EQ(dec.stats["reconstruction_misses"].get<uint64_t>(), 0u);
     // Samples that found no storage were shaded forward: the image stays close to forward.
@@ -115,7 +122,8 @@ TEST(Decoupled, StorageOverflowIsCountedAndNeverCorrupts) {
 TEST(Decoupled, DebugViewsRenderAndDiffer) {
     RenderOptions o = options("builtin:default", RenderMode::Decoupled, 128, 72);
     std::vector<std::vector<uint8_t>> images;
-    for (Visualize v : {Visualize::None, Visualize::Marking, Visualize::Mips, Visualize::Chunks, Visualize::Sheet}) {
+    for (Visualize v : {Visualize::None, Visualize::Marking, Visualize::Mips, Visualize::Chunks,
+                        Visualize::Sheet}) {
         o.visualize = v;
         images.push_back(renderChecked(o).frames[0].rgba);
     }
@@ -126,9 +134,9 @@ TEST(Decoupled, DebugViewsRenderAndDiffer) {
 // textured box.
 TEST(Decoupled, NoReconstructionMissesOnRealGltfModels) {
     const std::string dir = "/usr/share/assimp/models/glTF2/";
-    for (const std::string model : {"2CylinderEngine-glTF-Binary/2CylinderEngine.glb",
-                                     "BoxTextured-glTF-Binary/BoxTextured.glb",
-                                     "ClearCoat-glTF/ClearCoatTest.gltf"}) {
+    for (const std::string model :
+         {"2CylinderEngine-glTF-Binary/2CylinderEngine.glb",
+          "BoxTextured-glTF-Binary/BoxTextured.glb", "ClearCoat-glTF/ClearCoatTest.gltf"}) {
         RenderOptions o = options(dir + model, RenderMode::Decoupled, 160, 120);
         RenderRun run = renderChecked(o);
         EXPECT_EQ(run.stats["reconstruction_misses"].get<uint64_t>(), 0u) << model;
@@ -137,7 +145,8 @@ TEST(Decoupled, NoReconstructionMissesOnRealGltfModels) {
         RenderRun fwd = renderChecked(options(dir + model, RenderMode::Forward, 160, 120));
         EXPECT_EQ(run.stats["pixels_covered"], fwd.stats["pixels_covered"]) << model;
         double p = psnr(run.frames[0].rgba, fwd.frames[0].rgba);
-        std::printf("[ figures ] %s 160x120: PSNR(decoupled, forward) = %.2f dB\n", model.c_str(), p);
+        std::printf("[ figures ] %s 160x120: PSNR(decoupled, forward) = %.2f dB\n", model.c_str(),
+                    p);
         EXPECT_GE(p, 25.0) << model;
     }
 }

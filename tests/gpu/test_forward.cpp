@@ -13,11 +13,13 @@ TEST(Forward, RendersDefaultSceneWithCoverageAndTimings) {
     RenderRun run = renderChecked(o);
     ASSERT_EQ(run.frames.size(), 1u);
     const auto& s = run.stats;
-    EXPECT_GT(s["pixels_covered"].get<uint64_t>(), 160u * 90u / 4) << "the default camera should see geometry";
+    EXPECT_GT(s["pixels_covered"].get<uint64_t>(), 160u * 90u / 4)
+        << "the default camera should see geometry";
     EXPECT_LE(s["pixels_covered"].get<uint64_t>(), 160u * 90u);
     std::vector<std::string> passes;
     for (auto& p : s["passes"]) passes.push_back(p["name"]);
-    EXPECT_EQ(passes, (std::vector<std::string>{"instanceCull", "shadowMap", "depthPrepass", "forwardShading", "tonemap"}));
+    EXPECT_EQ(passes, (std::vector<std::string>{"instanceCull", "shadowMap", "depthPrepass",
+                                                "forwardShading", "tonemap"}));
     for (auto& p : s["passes"]) EXPECT_GE(p["gpu_ms"].get<double>(), 0.0);
     // The image is not flat: sky and lit geometry differ.
     const auto& px = run.frames[0].rgba;

@@ -24,7 +24,8 @@ class ReferenceImage : public ::testing::TestWithParam<RenderMode> {};
 
 TEST_P(ReferenceImage, SmoothSceneMatchesGolden) {
     RenderMode mode = GetParam();
-    std::string name = std::string("smooth_") + (mode == RenderMode::Forward ? "forward" : "decoupled") + "_128x72.png";
+    std::string name = std::string("smooth_") +
+                       (mode == RenderMode::Forward ? "forward" : "decoupled") + "_128x72.png";
     int w = 0, h = 0;
     std::vector<uint8_t> reference = loadReference(name, w, h);
     ASSERT_FALSE(reference.empty()) << "missing reference " << name;
@@ -39,5 +40,8 @@ TEST_P(ReferenceImage, SmoothSceneMatchesGolden) {
     EXPECT_GE(p, 40.0);
 }
 
-INSTANTIATE_TEST_SUITE_P(Modes, ReferenceImage, ::testing::Values(RenderMode::Forward, RenderMode::Decoupled),
-                         [](const auto& info) { return info.param == RenderMode::Forward ? "forward" : "decoupled"; });
+INSTANTIATE_TEST_SUITE_P(Modes, ReferenceImage,
+                         ::testing::Values(RenderMode::Forward, RenderMode::Decoupled),
+                         [](const auto& info) {
+                             return info.param == RenderMode::Forward ? "forward" : "decoupled";
+                         });

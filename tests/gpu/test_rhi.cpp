@@ -17,7 +17,8 @@ namespace {
 struct Probe {
     Gpu& gpu = sharedGpu();
     Pipeline pipeline = createComputePipeline(gpu, "test.probe", "tests_probe.comp.spv");
-    BufferHandle constants = createBuffer(gpu, {"test.frameConstants", sizeof(gpu::FrameConstants), 0, MemoryKind::Upload});
+    BufferHandle constants = createBuffer(
+        gpu, {"test.frameConstants", sizeof(gpu::FrameConstants), 0, MemoryKind::Upload});
     BufferHandle result = createBuffer(gpu, {"test.result", 16, 0, MemoryKind::Readback});
     ShaderMessageChannel messages;
     FrameRecorder recorder;
@@ -46,8 +47,9 @@ struct Probe {
             bind(gpu, cmd, pipeline);
             pushConstants(gpu, cmd, push);
             vkCmdDispatch(cmd, 1, 1, 1);
-            memoryBarrier(cmd, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT,
-                          VK_PIPELINE_STAGE_2_HOST_BIT, VK_ACCESS_2_HOST_READ_BIT);
+            memoryBarrier(cmd, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
+                          VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT, VK_PIPELINE_STAGE_2_HOST_BIT,
+                          VK_ACCESS_2_HOST_READ_BIT);
         });
         endFrame(recorder);
         glm::vec4 v;
@@ -133,6 +135,7 @@ TEST(Memory, HeapsSubAllocateFromPoolsAndFailureIsAValue) {
     for (BufferHandle b : buffers) destroy(gpu, b);
     EXPECT_EQ(memoryStats(gpu.memory).allocations, before.allocations);
     // Larger than the whole pool limit: an invalid handle, not an abort.
-    BufferHandle huge = createBuffer(gpu, {"test.huge", gpu.memory.poolSize * (gpu.memory.maxPoolsPerHeap + 1)});
+    BufferHandle huge =
+        createBuffer(gpu, {"test.huge", gpu.memory.poolSize * (gpu.memory.maxPoolsPerHeap + 1)});
     EXPECT_FALSE(huge.valid());
 }

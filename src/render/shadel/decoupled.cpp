@@ -55,18 +55,18 @@ struct DecoupledState {
     uint32_t capacityChunks = 0;
     uint32_t objectsDecoupled = 0, objectsForward = 0;
 
-    BufferHandle frameInfo;     // gpu::ShadelFrame (upload)
-    BufferHandle objectBuffer;  // GpuShadelObject[] (upload)
-    BufferHandle rectBuffer;    // GpuShadelRect[] (upload)
-    BufferHandle occupancy;     // uint64 per block
-    BufferHandle offsetMap;     // uint per block
-    BufferHandle allocId;       // uint per block (upload: written by the CPU allocator)
-    BufferHandle counters;      // GpuShadelCounters (readback, also indirect args)
-    BufferHandle markedBlocks;  // uvec4 per marked block
+    BufferHandle frameInfo;    // gpu::ShadelFrame (upload)
+    BufferHandle objectBuffer; // GpuShadelObject[] (upload)
+    BufferHandle rectBuffer;   // GpuShadelRect[] (upload)
+    BufferHandle occupancy;    // uint64 per block
+    BufferHandle offsetMap;    // uint per block
+    BufferHandle allocId;      // uint per block (upload: written by the CPU allocator)
+    BufferHandle counters;     // GpuShadelCounters (readback, also indirect args)
+    BufferHandle markedBlocks; // uvec4 per marked block
     uint32_t markedCapacity = 0;
-    BufferHandle objectChunks;  // uint per object
+    BufferHandle objectChunks;   // uint per object
     BufferHandle objectDispatch; // uvec4 per object
-    BufferHandle queue;         // GpuShadelWork[capacity]
+    BufferHandle queue;          // GpuShadelWork[capacity]
     TextureHandle storage;
     TextureWriteView storageWrite;
     TextureReadView storageRead;
@@ -74,7 +74,9 @@ struct DecoupledState {
     std::vector<FrameCounters> history;
 };
 
-void DecoupledStateDeleter::operator()(DecoupledState* state) const { delete state; }
+void DecoupledStateDeleter::operator()(DecoupledState* state) const {
+    delete state;
+}
 
 static BufferHandle need(BufferHandle b, const char* what) {
     if (!b) throw DeviceError(format("out of GPU memory for the decoupled path's %s", what));
@@ -84,14 +86,17 @@ static BufferHandle need(BufferHandle b, const char* what) {
 DecoupledStatePtr createDecoupled(Renderer& r, const GpuScene& scene) {
     Gpu& gpu = *r.gpu;
     if (scene.shadelMeshes.empty())
-        throw InputError("--mode decoupled needs a baked scene (internal: uploadScene without bake)");
+        throw InputError(
+            "--mode decoupled needs a baked scene (internal: uploadScene without bake)");
     DecoupledStatePtr state(new DecoupledState());
     DecoupledState& d = *state;
     const RenderSettings& rs = r.settings;
     if (rs.shadeStorageSize < 64 || rs.shadeStorageSize % 64 || rs.shadeStorageSize > 16384)
-        throw InputError(format("--storage %u: expected a multiple of 64 in [64, 16384]", rs.shadeStorageSize));
+        throw InputError(
+            format("--storage %u: expected a multiple of 64 in [64, 16384]", rs.shadeStorageSize));
     if (rs.sheetShadels < 65536 || rs.sheetShadels > 262144 || rs.sheetShadels % 65536)
-        throw InputError(format("--sheet %u: expected 65536, 131072, 196608 or 262144", rs.sheetShadels));
+        throw InputError(
+            format("--sheet %u: expected 65536, 131072, 196608 or 262144", rs.sheetShadels));
     d.storageSize = rs.shadeStorageSize;
     d.shadingBias = rs.shadingBias;
     d.trilinearBand = std::clamp(rs.trilinearBand, 0.0f, 1.0f);
@@ -101,7 +106,8 @@ DecoupledStatePtr createDecoupled(Renderer& r, const GpuScene& scene) {
         SheetRegion region;
         region.x0 = x;
         region.width = std::max(1u, kRegionWidths1024[k] * d.sheetBlocks / 1024);
-        region.allocator = std::make_unique<BlockAllocator2D>(Extent<2>{region.width, d.sheetBlocks});
+        region.allocator =
+            std::make_unique<BlockAllocator2D>(Extent<2>{region.width, d.sheetBlocks});
         x += region.width;
         d.regions.push_back(std::move(region));
     }
@@ -119,19 +125,21 @@ DecoupledStatePtr createDecoupled(Renderer& r, const GpuScene& scene) {
     };
     d.frameInfo = upload("shadel.frame", sizeof(gpu::ShadelFrame));
     d.objectBuffer = upload("shadel.objects", d.gpuObjects.size() * sizeof(gpu::GpuShadelObject));
-    d.rectBuffer = upload("shadel.rects", std::max<size_t>(scene.instanceCount, 1) * SHADEL_MAX_MIPS *
-                                              sizeof(gpu::GpuShadelRect));
+    d.rectBuffer = upload("shadel.rects", std::max<size_t>(scene.instanceCount, 1) *
+                                              SHADEL_MAX_MIPS * sizeof(gpu::GpuShadelRect));
     d.occupancy = device("shadel.chunkOccupancy", blocks * 8);
     d.offsetMap = device("shadel.offsetMap", blocks * 4);
     d.allocId = upload("shadel.allocId", blocks * 4);
     std::memset(mapped(gpu, d.allocId), 0, blocks * 4);
-    d.counters = need(createBuffer(gpu, {"shadel.counters", sizeof(gpu::GpuShadelCounters),
-                                         VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT, MemoryKind::Readback}),
-                      "counters");
+    d.counters =
+        need(createBuffer(gpu, {"shadel.counters", sizeof(gpu::GpuShadelCounters),
+                                VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT, MemoryKind::Readback}),
+             "counters");
     d.objectChunks = device("shadel.objectChunks", d.gpuObjects.size() * 4);
     d.objectDispatch = device("shadel.objectDispatch", d.gpuObjects.size() * 16,
                               VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT);
-    d.queue = device("shadel.workQueue", VkDeviceSize(d.capacityChunks) * sizeof(gpu::GpuShadelWork));
+    d.queue =
+        device("shadel.workQueue", VkDeviceSize(d.capacityChunks) * sizeof(gpu::GpuShadelWork));
 
     TextureDesc storage;
     storage.name = "shadel.shadeStorage";
@@ -176,14 +184,15 @@ void destroyDecoupled(Renderer& r, DecoupledStatePtr& state) {
     if (!state) return;
     Gpu& gpu = *r.gpu;
     DecoupledState& d = *state;
-    for (Pipeline* p : {&d.clear, &d.allocate, &d.queueSetup, &d.fillQueue, &d.shade, &d.sheetView, &d.mark,
-                        &d.reconstruct})
+    for (Pipeline* p : {&d.clear, &d.allocate, &d.queueSetup, &d.fillQueue, &d.shade, &d.sheetView,
+                        &d.mark, &d.reconstruct})
         destroy(gpu, *p);
     destroy(gpu, d.storageWrite);
     destroy(gpu, d.storageRead);
     destroy(gpu, d.storage);
-    for (BufferHandle b : {d.frameInfo, d.objectBuffer, d.rectBuffer, d.occupancy, d.offsetMap, d.allocId,
-                           d.counters, d.markedBlocks, d.objectChunks, d.objectDispatch, d.queue})
+    for (BufferHandle b :
+         {d.frameInfo, d.objectBuffer, d.rectBuffer, d.occupancy, d.offsetMap, d.allocId,
+          d.counters, d.markedBlocks, d.objectChunks, d.objectDispatch, d.queue})
         destroy(gpu, b);
     state.reset();
 }
@@ -191,7 +200,8 @@ void destroyDecoupled(Renderer& r, DecoupledStatePtr& state) {
 static void writeAllocId(Gpu& gpu, DecoupledState& d, const glm::uvec4& rect, uint32_t value) {
     auto* ids = static_cast<uint32_t*>(mapped(gpu, d.allocId));
     for (uint32_t y = rect.y; y < rect.y + rect.w; ++y)
-        for (uint32_t x = rect.x; x < rect.x + rect.z; ++x) ids[size_t(y) * d.sheetBlocks + x] = value;
+        for (uint32_t x = rect.x; x < rect.x + rect.z; ++x)
+            ids[size_t(y) * d.sheetBlocks + x] = value;
 }
 
 static void freeObject(Gpu& gpu, DecoupledState& d, ObjectSlot& o) {
@@ -211,7 +221,8 @@ static bool allocateObject(Gpu& gpu, DecoupledState& d, ObjectSlot& o, uint32_t 
     o.mipCount = mesh.mipCount;
     for (uint32_t k = 0; k < mesh.mipCount; ++k) {
         uint32_t w = std::max(1u, mesh.mip0Size.x >> k), h = std::max(1u, mesh.mip0Size.y >> k);
-        Extent<2> blocks{(w + SHADEL_BLOCK - 1) / SHADEL_BLOCK, (h + SHADEL_BLOCK - 1) / SHADEL_BLOCK};
+        Extent<2> blocks{(w + SHADEL_BLOCK - 1) / SHADEL_BLOCK,
+                         (h + SHADEL_BLOCK - 1) / SHADEL_BLOCK};
         auto placed = d.regions[k].allocator->insert(blocks);
         if (!placed) {
             freeObject(gpu, d, o);
@@ -227,7 +238,8 @@ static bool allocateObject(Gpu& gpu, DecoupledState& d, ObjectSlot& o, uint32_t 
 
 static bool boxVisible(const std::array<glm::vec4, 6>& planes, glm::vec3 bmin, glm::vec3 bmax) {
     for (const glm::vec4& p : planes) {
-        glm::vec3 v{p.x >= 0 ? bmax.x : bmin.x, p.y >= 0 ? bmax.y : bmin.y, p.z >= 0 ? bmax.z : bmin.z};
+        glm::vec3 v{p.x >= 0 ? bmax.x : bmin.x, p.y >= 0 ? bmax.y : bmin.y,
+                    p.z >= 0 ? bmax.z : bmin.z};
         if (glm::dot(glm::vec3(p), v) + p.w < 0) return false;
     }
     return true;
@@ -248,7 +260,8 @@ void prepareDecoupledFrame(Renderer& r, const GpuScene& scene, const CameraView&
         gpu::GpuShadelObject& g = d.gpuObjects[i];
         g = gpu::GpuShadelObject{};
         glm::vec3 margin = (inst.worldMax - inst.worldMin) * d.frustumMargin;
-        bool wanted = mesh.mipCount > 0 && boxVisible(planes, inst.worldMin - margin, inst.worldMax + margin);
+        bool wanted =
+            mesh.mipCount > 0 && boxVisible(planes, inst.worldMin - margin, inst.worldMax + margin);
         if (!wanted) {
             if (o.allocated) freeObject(gpu, d, o);
             o.noSpace = false;
@@ -273,11 +286,14 @@ void prepareDecoupledFrame(Renderer& r, const GpuScene& scene, const CameraView&
     if (d.rectBlockCount > d.markedCapacity) {
         destroy(gpu, d.markedBlocks);
         d.markedCapacity = std::max(d.rectBlockCount, d.markedCapacity * 2);
-        d.markedBlocks = need(createBuffer(gpu, {"shadel.markedBlocks", VkDeviceSize(d.markedCapacity) * 16}),
-                              "marked block list");
+        d.markedBlocks =
+            need(createBuffer(gpu, {"shadel.markedBlocks", VkDeviceSize(d.markedCapacity) * 16}),
+                 "marked block list");
     }
-    std::memcpy(mapped(gpu, d.objectBuffer), d.gpuObjects.data(), d.gpuObjects.size() * sizeof(gpu::GpuShadelObject));
-    std::memcpy(mapped(gpu, d.rectBuffer), d.rects.data(), d.rects.size() * sizeof(gpu::GpuShadelRect));
+    std::memcpy(mapped(gpu, d.objectBuffer), d.gpuObjects.data(),
+                d.gpuObjects.size() * sizeof(gpu::GpuShadelObject));
+    std::memcpy(mapped(gpu, d.rectBuffer), d.rects.data(),
+                d.rects.size() * sizeof(gpu::GpuShadelRect));
 
     gpu::ShadelFrame s{};
     s.objects = address(gpu, d.objectBuffer);
@@ -337,7 +353,8 @@ void recordDecoupledPasses(Renderer& r, FrameRecorder& rec, uint64_t frame, cons
         }
         memoryBarrier(cmd, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_2_CLEAR_BIT,
                       VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT | VK_ACCESS_2_TRANSFER_WRITE_BIT,
-                      VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT | VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
+                      VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT |
+                          VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
                       VK_ACCESS_2_SHADER_STORAGE_READ_BIT | VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT);
     });
 
@@ -356,8 +373,8 @@ void recordDecoupledPasses(Renderer& r, FrameRecorder& rec, uint64_t frame, cons
         pushConstants(gpu, cmd, RasterPush{frame, 0});
         drawCameraList(r, cmd, DRAW_LIST_DECOUPLED);
         vkCmdEndRendering(cmd);
-        memoryBarrier(cmd, VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT, VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT,
-                      VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
+        memoryBarrier(cmd, VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT,
+                      VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
                       VK_ACCESS_2_SHADER_STORAGE_READ_BIT | VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT);
     });
 
@@ -378,19 +395,23 @@ void recordDecoupledPasses(Renderer& r, FrameRecorder& rec, uint64_t frame, cons
         if (d.markedBlocks) {
             bind(gpu, cmd, d.fillQueue);
             pushConstants(gpu, cmd, FramePush{frame});
-            vkCmdDispatchIndirect(cmd, vkBuffer(gpu, d.counters), offsetof(gpu::GpuShadelCounters, fillDispatch));
+            vkCmdDispatchIndirect(cmd, vkBuffer(gpu, d.counters),
+                                  offsetof(gpu::GpuShadelCounters, fillDispatch));
         }
         computeToCompute(cmd);
     });
 
     pass(rec, "shadelShading", [&](VkCommandBuffer cmd) {
-        memoryBarrier(cmd, VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT, VK_ACCESS_2_SHADER_SAMPLED_READ_BIT,
-                      VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT);
+        memoryBarrier(cmd, VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT,
+                      VK_ACCESS_2_SHADER_SAMPLED_READ_BIT, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
+                      VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT);
         bind(gpu, cmd, d.shade);
         pushConstants(gpu, cmd, FramePush{frame});
-        vkCmdDispatchIndirect(cmd, vkBuffer(gpu, d.counters), offsetof(gpu::GpuShadelCounters, shadeDispatch));
-        memoryBarrier(cmd, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT,
-                      VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT, VK_ACCESS_2_SHADER_SAMPLED_READ_BIT);
+        vkCmdDispatchIndirect(cmd, vkBuffer(gpu, d.counters),
+                              offsetof(gpu::GpuShadelCounters, shadeDispatch));
+        memoryBarrier(cmd, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
+                      VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT, VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT,
+                      VK_ACCESS_2_SHADER_SAMPLED_READ_BIT);
     });
 
     // Decoupled objects read their shadels; forward objects (hybrid) shade as usual.
@@ -419,13 +440,15 @@ void recordDecoupledPostPasses(Renderer& r, FrameRecorder& rec, uint64_t frame) 
             uint64_t pixels;
             uint32_t width, height;
         } push{frame, address(gpu, r.pixels), r.settings.width, r.settings.height};
-        memoryBarrier(cmd, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT,
-                      VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT);
+        memoryBarrier(cmd, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
+                      VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
+                      VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT);
         bind(gpu, cmd, d.sheetView);
         pushConstants(gpu, cmd, push);
         vkCmdDispatch(cmd, (r.settings.width + 7) / 8, (r.settings.height + 7) / 8, 1);
-        memoryBarrier(cmd, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT,
-                      VK_PIPELINE_STAGE_2_HOST_BIT, VK_ACCESS_2_HOST_READ_BIT);
+        memoryBarrier(cmd, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
+                      VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT, VK_PIPELINE_STAGE_2_HOST_BIT,
+                      VK_ACCESS_2_HOST_READ_BIT);
     });
 }
 
@@ -473,7 +496,8 @@ void decoupledStats(const Renderer& r, nlohmann::json& s) {
     // Bookkeeping per shaded shadel: the 64-bit occupancy mask + 32-bit offset of every block
     // in use (the seed quotes ~1.5 bits per shadel).
     s["occupancy_bits_per_shadel"] = shaded ? double(last.rectBlocks) * 96.0 / double(shaded) : 0.0;
-    s["storage_used"] = d.capacityChunks ? double(last.counters.chunksAllocated) / d.capacityChunks : 0.0;
+    s["storage_used"] =
+        d.capacityChunks ? double(last.counters.chunksAllocated) / d.capacityChunks : 0.0;
 }
 
 } // namespace shadel
