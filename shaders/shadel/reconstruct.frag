@@ -30,15 +30,22 @@ vec3 sampleLevel(ShadelFrame s, GpuShadelObject o, uint mip, vec2 uv, inout uint
     bilinearFootprint(o, mip, uv, t0, w);
     vec3 sum = vec3(0.0);
     firstMask = 0ul;
+    // The four taps usually share one block: look its mask and base up once.
+    uint cachedBlock = SHADEL_INVALID;
+    uint64_t mask = 0ul;
+    uint base = SHADEL_INVALID;
     for (int i = 0; i < 4; ++i) {
         ivec2 offset = ivec2(i & 1, i >> 1);
         uvec2 sheet = sheetShadel(o, mip, t0 + offset);
         uint block = blockIndex(s, sheet);
-        uint bit = chunkBit(sheet);
-        uint64_t mask = Uint64Buffer(s.occupancy).v[block];
+        if (block != cachedBlock) {
+            cachedBlock = block;
+            mask = Uint64Buffer(s.occupancy).v[block];
+            base = UintBuffer(s.offsetMap).v[block];
+        }
         if (i == 0) firstMask = mask;
+        uint bit = chunkBit(sheet);
         if ((mask & (1ul << bit)) == 0ul) { missing++; continue; }
-        uint base = UintBuffer(s.offsetMap).v[block];
         if (base == SHADEL_INVALID) { overflowed++; continue; }
         uint slot = chunkSlot(mask, base, bit);
         vec3 c = fetchTextureUniform(s.storageReadSlot, storageTexel(s, slot, sheet % SHADEL_CHUNK), 0).rgb;

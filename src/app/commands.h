@@ -30,6 +30,7 @@ struct RenderOptions {
     float shadingBias = 0.0f;
     float trilinearBand = 1.0f;
     uint32_t materialSamples = 4;
+    float forwardBelowPixels = 8.0f;
     double shadelBudget = 64e6; // MIP-0 shadels the bake may use for the whole scene
     bool printPasses = false;
     bool progress = true;

@@ -157,6 +157,7 @@ RenderRun runRender(Gpu& gpu, const RenderOptions& o) {
     if (o.materialSamples != 1 && o.materialSamples != 4)
         throw InputError(format("--material-samples %u: expected 1 or 4", o.materialSamples));
     settings.materialSamples = o.materialSamples;
+    settings.forwardBelowPixels = o.forwardBelowPixels;
     settings.timing = o.timing ? *o.timing : defaultTimingMode(gpu);
     Renderer renderer;
     RenderRun run;

@@ -76,14 +76,19 @@ Fit fitOf(const Extent<N>& element, const FreeSummary<N>& summary) {
     return fitsIn<N>(element, summary.square) ? kSureFit : kMayFit;
 }
 
-// Which child an element tries first: the one more certain to hold it; between equals, the one
-// with less free room (best fit: small elements fill small holes and large free boxes stay
-// whole), child A on ties.
+// Which child an element tries first when both may hold it: the one with less free room (best
+// fit: small elements fill small holes, large free boxes stay whole for large elements), child A
+// on ties.
 template <size_t N>
-bool aFirst(Fit fitA, const FreeSummary<N>& a, Fit fitB, const FreeSummary<N>& b) {
-    if (fitA != fitB) return fitA > fitB;
+bool aFirst(const FreeSummary<N>& a, const FreeSummary<N>& b) {
     return volume<N>(a.max) <= volume<N>(b.max);
 }
+
+// Nodes a search may visit following "maybe" before it settles for a box it is sure of. Filling
+// the holes between placed elements first keeps the layout compact (and the tree small); the
+// budget keeps a search among holes that turn out too small for the element from walking a large
+// part of the tree.
+constexpr uint32_t kSearchBudget = 32;
 
 template <size_t N>
 bool contains(const Position<N>& min, const Extent<N>& size, const Position<N>& point) {
@@ -205,33 +210,51 @@ Placement<N> BlockAllocator<N>::occupyLeaf(uint32_t index) {
     return Placement<N>{node.min, node.size, BlockId{slot, m_slotGeneration[slot]}};
 }
 
-// Finds a free leaf for an element of (rounded) `extent` and cuts it down to the element's size;
-// kNone if there is none. The leaf is left free: the caller occupies or reserves it.
+// Finds a free leaf below `start` for an element of (rounded) `extent` and cuts it down to the
+// element's size; kNone if there is none. The leaf is left free: the caller occupies or reserves
+// it and refreshes the summaries above it.
 template <size_t N>
-uint32_t BlockAllocator<N>::findLeaf(const Extent<N>& extent) {
-    if (fitOf<N>(extent, m_nodes[0].free) == kNoFit) return kNone;
-    // Depth-first, entering only subtrees whose summary admits the element. Below a node that
-    // surely holds it, some child surely holds it too, so the descent goes straight down. Only
-    // when the summary says "maybe" can a subtree turn out to hold no fitting leaf: the stack
-    // keeps the siblings not taken, to come back to.
+uint32_t BlockAllocator<N>::findLeaf(const Extent<N>& extent, uint32_t start) {
+    const Fit rootFit = fitOf<N>(extent, m_nodes[start].free);
+    if (rootFit == kNoFit) return kNone;
+    // Depth-first, best fit first, entering every subtree whose per-axis maximum admits the
+    // element; the stack keeps the siblings not taken, to come back to when a subtree holds no
+    // fitting leaf after all. Once that search has used its budget, and the root surely holds the
+    // element, it follows children that surely hold it straight down instead.
     m_scratch.clear();
-    uint32_t index = 0;
+    uint32_t index = start;
+    uint32_t budget = kSearchBudget;
     while (!m_nodes[index].leaf()) {
+        if (budget == 0 && rootFit == kSureFit) {
+            index = start;
+            while (!m_nodes[index].leaf()) {
+                const Node& node = m_nodes[index];
+                const FreeSummary<N>& freeA = m_nodes[node.childA].free;
+                const FreeSummary<N>& freeB = m_nodes[node.childB].free;
+                bool sureA = fitOf<N>(extent, freeA) == kSureFit;
+                bool sureB = fitOf<N>(extent, freeB) == kSureFit;
+                SHADEL_ASSERT(sureA || sureB);
+                index = sureA && (!sureB || aFirst<N>(freeA, freeB)) ? node.childA : node.childB;
+            }
+            break;
+        }
+        budget -= budget > 0;
         const Node& node = m_nodes[index];
         const FreeSummary<N>& freeA = m_nodes[node.childA].free;
         const FreeSummary<N>& freeB = m_nodes[node.childB].free;
-        Fit fitA = fitOf<N>(extent, freeA), fitB = fitOf<N>(extent, freeB);
-        if (fitA == kNoFit && fitB == kNoFit) {
+        bool intoA = fitOf<N>(extent, freeA) != kNoFit;
+        bool intoB = fitOf<N>(extent, freeB) != kNoFit;
+        if (intoA && intoB) {
+            bool a = aFirst<N>(freeA, freeB);
+            m_scratch.push_back(a ? node.childB : node.childA);
+            index = a ? node.childA : node.childB;
+        } else if (intoA || intoB) {
+            index = intoA ? node.childA : node.childB;
+        } else {
             if (m_scratch.empty()) return kNone;
             index = m_scratch.back();
             m_scratch.pop_back();
-            continue;
         }
-        bool intoA = aFirst<N>(fitA, freeA, fitB, freeB);
-        Fit other = intoA ? fitB : fitA;
-        if (other != kNoFit && std::max(fitA, fitB) != kSureFit)
-            m_scratch.push_back(intoA ? node.childB : node.childA);
-        index = intoA ? node.childA : node.childB;
     }
     // A leaf is only entered when its summary admits the element: it is free and large enough.
     while (m_nodes[index].size != extent) {
@@ -258,6 +281,7 @@ struct BlockAllocator<N>::BatchState {
     std::vector<uint32_t> leaves;   // by rank: the leaf reserved for it, or kNone
     std::vector<uint32_t> arena;    // lists of ranks, ascending, stacked by the recursion
     std::vector<uint32_t> scratch;  // never held across a recursive call
+    size_t budget = 0;              // node visits left for following "maybe"
 };
 
 // Places what it can of the elements listed in state.arena[list] (ranks, ascending) in the
@@ -266,13 +290,13 @@ struct BlockAllocator<N>::BatchState {
 // children's lists and are given back before returning.
 //
 // At a free leaf the largest element that fits is placed, cutting the leaf as insert() would and
-// continuing into the pieces. At an inner node an element only goes into a child that surely
-// holds it (per the summaries as they are when the node routes it), the one insert() would take
-// if both do; what child A could not take after all (earlier elements used the room) tries B if B
-// surely holds it, and what B could not take tries A the same way. Elements never enter a subtree
-// that only "may" hold them, so the traversal never searches a subtree in vain; insertBatch()
-// gives the few elements left over to insert()'s search. The elements share the descent, and
-// each node's summary is refreshed once per batch, on the way back up.
+// continuing into the pieces. At an inner node each element goes to the child insert() would try
+// first (per the summaries as they are when the node routes it); what child A could not take
+// tries B, and what B could not take tries A if it started in B. As in insert(), subtrees that
+// only "may" hold an element are entered while the batch's search budget (insert()'s budget per
+// element) lasts, and after that only subtrees that surely hold it; insertBatch() gives the few
+// elements left over to insert()'s search. The elements share the descent, and each node's
+// summary is refreshed once per batch, on the way back up.
 // Marks a leaf used by a batch element; ids are handed out after the whole batch is placed, in
 // element order.
 template <size_t N>
@@ -302,10 +326,23 @@ size_t BlockAllocator<N>::visitBatch(uint32_t index, BatchState& state, BatchLis
         }
         // The elements before `pick` did not fit the whole leaf, so they fit neither piece.
         splitLeaf(index, state.extents[rank]);
+    } else if (list.end - list.begin == 1) {
+        // A single element left on this path: insert()'s search from here does the same, cheaper.
+        const uint32_t rank = arena[list.begin];
+        uint32_t leaf = findLeaf(state.extents[rank], index);
+        if (leaf == kNone) return list.end;
+        reserveLeaf(leaf);
+        state.leaves[rank] = leaf;
+        for (uint32_t p = m_nodes[leaf].parent; p != m_nodes[index].parent && refresh(p);
+             p = m_nodes[p].parent) {
+        }
+        return list.begin;
     }
     const uint32_t childA = m_nodes[index].childA, childB = m_nodes[index].childB;
+    state.budget -= state.budget > 0;
+    const Fit enough = state.budget > 0 ? kMayFit : kSureFit;
     auto admits = [&](uint32_t child, uint32_t rank) {
-        return fitOf<N>(state.extents[rank], m_nodes[child].free) == kSureFit;
+        return fitOf<N>(state.extents[rank], m_nodes[child].free) >= enough;
     };
     // Route: elements no child surely holds stay at the front [list.begin, kept); the others are
     // appended as A's list [base, splitAt) and B's list [splitAt, endB).
@@ -318,9 +355,9 @@ size_t BlockAllocator<N>::visitBatch(uint32_t index, BatchState& state, BatchLis
         const Extent<N>& e = state.extents[rank];
         const FreeSummary<N>& freeA = m_nodes[childA].free;
         const FreeSummary<N>& freeB = m_nodes[childB].free;
-        Fit fitA = fitOf<N>(e, freeA), fitB = fitOf<N>(e, freeB);
-        if (fitA != kSureFit && fitB != kSureFit) arena[kept++] = rank;
-        else if (aFirst<N>(fitA, freeA, fitB, freeB)) arena.push_back(rank);
+        bool intoA = fitOf<N>(e, freeA) >= enough, intoB = fitOf<N>(e, freeB) >= enough;
+        if (!intoA && !intoB) arena[kept++] = rank;
+        else if (intoA && (!intoB || aFirst<N>(freeA, freeB))) arena.push_back(rank);
         else bFirst.push_back(rank);
     }
     const size_t splitAt = arena.size();
@@ -400,7 +437,8 @@ BlockAllocator<N>::insertBatch(std::span<const Extent<N>> extents) {
     state.leaves.assign(byRank.size(), kNone);
     for (uint32_t e : byRank) state.extents.push_back(rounded[e]);
     for (uint32_t rank = 0; rank < byRank.size(); ++rank)
-        if (fitOf<N>(state.extents[rank], m_nodes[0].free) == kSureFit) state.arena.push_back(rank);
+        if (fitOf<N>(state.extents[rank], m_nodes[0].free) != kNoFit) state.arena.push_back(rank);
+    state.budget = kSearchBudget;
     if (!state.arena.empty()) visitBatch(0, state, {0, state.arena.size()});
     // What the traversal left (room taken by larger elements of the batch, or only "maybe" room)
     // gets insert()'s full search, largest first.

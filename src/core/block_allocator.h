@@ -143,7 +143,7 @@ private:
 
     std::optional<Extent<N>> roundUp(const Extent<N>& extent) const;
     void splitLeaf(uint32_t index, const Extent<N>& extent);
-    uint32_t findLeaf(const Extent<N>& extent);
+    uint32_t findLeaf(const Extent<N>& extent, uint32_t start = 0);
     void reserveLeaf(uint32_t index);
     Placement<N> occupyLeaf(uint32_t index);
     bool refresh(uint32_t index);

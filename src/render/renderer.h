@@ -28,8 +28,11 @@ struct RenderSettings {
     uint32_t sheetShadels = 65536;    // decoupled: virtual sheet, shadels per side
     float shadingBias = 0.0f; // decoupled: base MIP bias (the capacity controller adds to it)
     float trilinearBand = 1.0f;
-    uint32_t materialSamples = 4; // decoupled: material evaluations per shadel above MIP 0 (1 or 4)
-                                  // // decoupled: LOD band blended between MIPs (1 = trilinear)
+    uint32_t materialSamples = 4;
+    float forwardBelowPixels =
+        8.0f; // decoupled: objects smaller on screen are drawn forward (0 = never) // decoupled:
+              // material evaluations per shadel above MIP 0 (1 or 4)
+              // // decoupled: LOD band blended between MIPs (1 = trilinear)
 };
 
 struct FrameResult {

@@ -150,3 +150,27 @@ TEST(Decoupled, NoReconstructionMissesOnRealGltfModels) {
         EXPECT_GE(p, 25.0) << model;
     }
 }
+
+// Hybrid forward: objects below the size threshold are drawn forward in the same frame.
+TEST(Decoupled, SmallObjectsFallBackToForwardInTheSameFrame) {
+    RenderOptions o = options("builtin:default", RenderMode::Decoupled, 320, 180);
+    o.forwardBelowPixels = 0.0f;
+    RenderRun none = renderChecked(o);
+    EXPECT_EQ(none.stats["objects_forward_small"].get<uint64_t>(), 0u);
+    o.forwardBelowPixels = 8.0f;
+    RenderRun some = renderChecked(o);
+    EXPECT_GT(some.stats["objects_forward_small"].get<uint64_t>(), 0u);
+    EXPECT_GT(some.stats["objects_decoupled"].get<uint64_t>(), 0u);
+    EXPECT_LT(some.stats["shadels_shaded"].get<uint64_t>(),
+              none.stats["shadels_shaded"].get<uint64_t>());
+    EXPECT_EQ(some.stats["reconstruction_misses"].get<uint64_t>(), 0u);
+    // A huge threshold leaves only objects around the camera (the ground) decoupled; the mixed
+    // frame still matches forward wherever the shading is smooth.
+    o.forwardBelowPixels = 1e9f;
+    RenderRun most = renderChecked(o);
+    EXPECT_LE(most.stats["objects_decoupled"].get<uint64_t>(), 2u);
+    EXPECT_GT(most.stats["objects_forward_small"].get<uint64_t>(),
+              some.stats["objects_forward_small"].get<uint64_t>());
+    RenderRun fwd = renderChecked(options("builtin:default", RenderMode::Forward, 320, 180));
+    EXPECT_GT(psnr(most.frames[0].rgba, fwd.frames[0].rgba), 30.0);
+}

@@ -36,6 +36,7 @@ struct FrameCounters {
     gpu::GpuShadelCounters counters;
     uint32_t objectsDecoupled = 0;
     uint32_t objectsForward = 0;
+    uint32_t objectsSmallForward = 0;
     uint64_t rectBlocks = 0;
 };
 
@@ -53,7 +54,7 @@ struct DecoupledState {
     std::vector<gpu::GpuShadelRect> rects;
     uint32_t rectBlockCount = 0;
     uint32_t capacityChunks = 0;
-    uint32_t objectsDecoupled = 0, objectsForward = 0;
+    uint32_t objectsDecoupled = 0, objectsForward = 0, objectsSmallForward = 0;
 
     BufferHandle frameInfo;    // gpu::ShadelFrame (upload)
     BufferHandle objectBuffer; // GpuShadelObject[] (upload)
@@ -245,14 +246,23 @@ static bool boxVisible(const std::array<glm::vec4, 6>& planes, glm::vec3 bmin, g
     return true;
 }
 
-void prepareDecoupledFrame(Renderer& r, const GpuScene& scene, const CameraView&,
+// Projected diameter in pixels of a world-space sphere (for the hybrid forward policy).
+static float projectedDiameter(const CameraView& camera, float viewportHeight, glm::vec3 center,
+                               float radius) {
+    float distance = glm::length(center - camera.position);
+    if (distance <= radius) return 1e9f; // the camera is inside: treat as huge
+    float focal = 0.5f * viewportHeight * std::abs(camera.proj[1][1]);
+    return 2.0f * radius * focal / std::sqrt(distance * distance - radius * radius);
+}
+
+void prepareDecoupledFrame(Renderer& r, const GpuScene& scene, const CameraView& camera,
                            gpu::FrameConstants& constants) {
     Gpu& gpu = *r.gpu;
     DecoupledState& d = *r.decoupled;
     auto planes = frustumPlanes(constants.viewProj);
     d.rects.clear();
     d.rectBlockCount = 0;
-    d.objectsDecoupled = d.objectsForward = 0;
+    d.objectsDecoupled = d.objectsForward = d.objectsSmallForward = 0;
     for (uint32_t i = 0; i < scene.instanceCount; ++i) {
         const gpu::GpuInstance& inst = scene.instanceInfo[i];
         const ShadelMeshInfo& mesh = scene.shadelMeshes[inst.mesh];
@@ -262,9 +272,17 @@ void prepareDecoupledFrame(Renderer& r, const GpuScene& scene, const CameraView&
         glm::vec3 margin = (inst.worldMax - inst.worldMin) * d.frustumMargin;
         bool wanted =
             mesh.mipCount > 0 && boxVisible(planes, inst.worldMin - margin, inst.worldMax + margin);
-        if (!wanted) {
+        // Hybrid (seed: "small objects fall back to a direct only render"): an object a few
+        // pixels across would still shade whole chunks at its coarsest MIP; forward is cheaper.
+        bool small = wanted && r.settings.forwardBelowPixels > 0.0f &&
+                     projectedDiameter(camera, float(r.internalHeight),
+                                       0.5f * (inst.worldMin + inst.worldMax),
+                                       0.5f * glm::length(inst.worldMax - inst.worldMin)) <
+                         r.settings.forwardBelowPixels;
+        if (!wanted || small) {
             if (o.allocated) freeObject(gpu, d, o);
             o.noSpace = false;
+            if (small) d.objectsSmallForward++, d.objectsForward++;
             continue;
         }
         if (!o.allocated) o.noSpace = !allocateObject(gpu, d, o, i, mesh);
@@ -458,6 +476,7 @@ void finishDecoupledFrame(Renderer& r) {
     std::memcpy(&f.counters, mapped(*r.gpu, d.counters), sizeof(f.counters));
     f.objectsDecoupled = d.objectsDecoupled;
     f.objectsForward = d.objectsForward;
+    f.objectsSmallForward = d.objectsSmallForward;
     f.rectBlocks = d.rectBlockCount;
     d.history.push_back(f);
     if (f.counters.chunksOverflowed)
@@ -490,7 +509,8 @@ void decoupledStats(const Renderer& r, nlohmann::json& s) {
     s["overflow_samples"] = overflowSamples;
     s["marked_blocks"] = last.counters.markedBlocks;
     s["objects_decoupled"] = last.objectsDecoupled;
-    s["objects_forward"] = last.objectsForward;
+    s["objects_forward"] = last.objectsForward; // small (hybrid) + no sheet space
+    s["objects_forward_small"] = last.objectsSmallForward;
     s["sheet_blocks_allocated"] = last.rectBlocks;
     s["sheet_shadels"] = uint64_t(d.sheetBlocks) * SHADEL_BLOCK;
     // Bookkeeping per shaded shadel: the 64-bit occupancy mask + 32-bit offset of every block
