@@ -116,11 +116,15 @@ int main(int argc, char** argv) {
     std::string bakeSceneSpec = "builtin:default", bakeCache;
     float bakeDensity = 32.0f;
     bool bakeNoCache = false;
+    double bakeBudget = 64e6;
     auto* bake = app.add_subcommand("bake", "bake shadel charts and triangle-ID maps (cached)");
     bake->add_option("scene", bakeSceneSpec, "builtin:NAME | FILE.gltf | FILE.glb")
         ->capture_default_str();
     bake->add_option("--density", bakeDensity, "shadels per metre")->capture_default_str();
     bake->add_option("--cache-dir", bakeCache, "bake cache directory");
+    bake->add_option("--shadel-budget", bakeBudget,
+                     "max MIP-0 shadels for the scene (lowers --density)")
+        ->capture_default_str();
     bake->add_flag("--no-cache", bakeNoCache, "bake from scratch (still writes the cache)");
 
     auto* info = app.add_subcommand("info", "print the device, driver, features and limits");
@@ -144,7 +148,13 @@ int main(int argc, char** argv) {
         if (*bake) {
             Scene scene = loadScene(bakeSceneSpec);
             BakeSettings bs;
-            bs.shadelsPerMetre = bakeDensity;
+            double area = 0.0;
+            bs.shadelsPerMetre = sceneShadelDensity(scene, bakeDensity, bakeBudget, area);
+            if (bs.shadelsPerMetre < bakeDensity)
+                SHADEL_WARN("%s: %.0f units^2 of surface: using %.3f shadels/unit to stay within "
+                            "%.0fM shadels",
+                            bakeSceneSpec.c_str(), area, double(bs.shadelsPerMetre),
+                            bakeBudget / 1e6);
             std::string dir = bakeCache.empty() ? defaultCacheDir() : bakeCache;
             if (bakeNoCache) dir = "";
             bool tty = isatty(STDERR_FILENO);

@@ -59,34 +59,6 @@ void writePng(const std::string& path, const std::vector<uint8_t>& rgba, uint32_
         throw InputError(format("%s: cannot write PNG", path.c_str()));
 }
 
-// Shadel density for a scene: the requested shadels per metre, lowered when the scene's
-// surface at that density would need more than `budget` MIP-0 shadels (triangle-ID maps cost
-// 2 bytes each). Unit-less CAD files in millimetres are the usual case.
-static float sceneDensity(const Scene& scene, float requested, double budget, double& area) {
-    std::vector<float> maxScale(scene.meshes.size(), 0.0f);
-    for (const Instance& inst : scene.instances) {
-        float s = std::max({glm::length(glm::vec3(inst.transform[0])),
-                            glm::length(glm::vec3(inst.transform[1])),
-                            glm::length(glm::vec3(inst.transform[2]))});
-        maxScale[inst.mesh] = std::max(maxScale[inst.mesh], s);
-    }
-    area = 0.0;
-    for (size_t m = 0; m < scene.meshes.size(); ++m) {
-        const Mesh& mesh = scene.meshes[m];
-        double a = 0.0;
-        for (size_t i = 0; i + 2 < mesh.indices.size(); i += 3) {
-            glm::vec3 p0 = mesh.vertices[mesh.indices[i]].position;
-            glm::vec3 p1 = mesh.vertices[mesh.indices[i + 1]].position;
-            glm::vec3 p2 = mesh.vertices[mesh.indices[i + 2]].position;
-            a += 0.5 * glm::length(glm::cross(p1 - p0, p2 - p0));
-        }
-        area += a * double(maxScale[m]) * double(maxScale[m]);
-    }
-    double needed = area * double(requested) * double(requested);
-    if (needed <= budget || area <= 0.0) return requested;
-    return float(std::sqrt(budget / area));
-}
-
 static double median(std::vector<double> v) {
     if (v.empty()) return 0.0;
     std::sort(v.begin(), v.end());
@@ -128,7 +100,7 @@ RenderRun runRender(Gpu& gpu, const RenderOptions& o) {
     if (o.mode == RenderMode::Decoupled) {
         BakeSettings bs;
         double area = 0.0;
-        bs.shadelsPerMetre = sceneDensity(scene, o.shadelsPerMetre, o.shadelBudget, area);
+        bs.shadelsPerMetre = sceneShadelDensity(scene, o.shadelsPerMetre, o.shadelBudget, area);
         if (bs.shadelsPerMetre < o.shadelsPerMetre)
             SHADEL_WARN(
                 "%s: %.0f units^2 of surface at %.1f shadels/unit would need %.0fM shadels; "

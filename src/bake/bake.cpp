@@ -307,4 +307,32 @@ std::string bakeReport(const std::vector<BakedMesh>& meshes, double wallSeconds)
     return r;
 }
 
+// Shadel density for a scene: the requested shadels per metre, lowered when the scene's
+// surface at that density would need more than `budget` MIP-0 shadels (triangle-ID maps cost
+// 2 bytes each). Unit-less CAD files in millimetres are the usual case.
+float sceneShadelDensity(const Scene& scene, float requested, double budget, double& area) {
+    std::vector<float> maxScale(scene.meshes.size(), 0.0f);
+    for (const Instance& inst : scene.instances) {
+        float s = std::max({glm::length(glm::vec3(inst.transform[0])),
+                            glm::length(glm::vec3(inst.transform[1])),
+                            glm::length(glm::vec3(inst.transform[2]))});
+        maxScale[inst.mesh] = std::max(maxScale[inst.mesh], s);
+    }
+    area = 0.0;
+    for (size_t m = 0; m < scene.meshes.size(); ++m) {
+        const Mesh& mesh = scene.meshes[m];
+        double a = 0.0;
+        for (size_t i = 0; i + 2 < mesh.indices.size(); i += 3) {
+            glm::vec3 p0 = mesh.vertices[mesh.indices[i]].position;
+            glm::vec3 p1 = mesh.vertices[mesh.indices[i + 1]].position;
+            glm::vec3 p2 = mesh.vertices[mesh.indices[i + 2]].position;
+            a += 0.5 * glm::length(glm::cross(p1 - p0, p2 - p0));
+        }
+        area += a * double(maxScale[m]) * double(maxScale[m]);
+    }
+    double needed = area * double(requested) * double(requested);
+    if (needed <= budget || area <= 0.0) return requested;
+    return float(std::sqrt(budget / area));
+}
+
 } // namespace shadel

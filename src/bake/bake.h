@@ -98,4 +98,9 @@ std::vector<BakedMesh> bakeScene(const Scene& scene, const BakeSettings& setting
 // forced/unowned triangles, cache hits and bake time.
 std::string bakeReport(const std::vector<BakedMesh>& meshes, double wallSeconds);
 
+// Shadel density for a scene: `requested` shadels per metre, lowered when the scene's
+// surface (each mesh at its largest instance scale) would need more than `budget` MIP-0
+// shadels. `area` receives that surface. Unit-less CAD files in millimetres are the usual case.
+float sceneShadelDensity(const Scene& scene, float requested, double budget, double& area);
+
 } // namespace shadel
