@@ -135,8 +135,8 @@ void removal(benchmark::State& state, uint32_t liveCount) {
 template <class Allocator>
 void insertion(benchmark::State& state, uint32_t liveCount) {
     timePerOp<Allocator>(state, liveCount,
-                         [](Allocator& allocator, const std::vector<Placement<2>>&, const std::vector<uint32_t>&,
-                            const std::vector<Extent<2>>& extents) {
+                         [](Allocator& allocator, const std::vector<Placement<2>>&,
+                            const std::vector<uint32_t>&, const std::vector<Extent<2>>& extents) {
                              for (const auto& e : extents)
                                  if (!allocator.insert(e)) std::abort();
                              return extents.size();
@@ -175,8 +175,8 @@ void churn(benchmark::State& state, uint32_t liveCount) {
 void churnBatched(benchmark::State& state, uint32_t liveCount) {
     timePerOp<BlockAllocator2D>(
         state, liveCount,
-        [](BlockAllocator2D& allocator, const std::vector<Placement<2>>& live, const std::vector<uint32_t>& victims,
-           const std::vector<Extent<2>>& extents) {
+        [](BlockAllocator2D& allocator, const std::vector<Placement<2>>& live,
+           const std::vector<uint32_t>& victims, const std::vector<Extent<2>>& extents) {
             for (uint32_t v : victims)
                 if (!allocator.remove(live[v].id)) std::abort();
             auto placements = allocator.insertBatch(std::span(extents).first(victims.size()));
@@ -421,8 +421,7 @@ void printRatioTable(const std::map<std::string, double>& ns) {
     std::printf("\nStarting layouts (same insertion sequence): tree nodes fast / naive\n");
     for (uint32_t live : kLiveCounts) {
         const Layout& layout = layoutFor(live);
-        std::printf("%-6u %9zu %9zu\n", live, layout.fast->nodeCount(),
-                    layout.naive->nodeCount());
+        std::printf("%-6u %9zu %9zu\n", live, layout.fast->nodeCount(), layout.naive->nodeCount());
     }
     double t = get("tlsf/alloc+free"), f = get("first-fit/alloc+free"),
            m = get("malloc/alloc+free");

@@ -68,8 +68,50 @@ void fuzzTlsf(FuzzedDataProvider& in) {
     CHECK(tlsf.stats().used == 0 && tlsf.stats().largestFree == capacity);
 }
 
-// Fast and naive side by side: same placements, same ids, same tree, and no overlap (checked
-// with a dense grid, so sheets stay small).
+// Checks the layout of one allocator: no overlap (with a dense grid, so sheets stay small), all
+// inside the usable bounds, aligned, and the used volume adds up.
+template <size_t N, class Allocator>
+void checkLayout(const Allocator& allocator, const Extent<N>& usable, uint32_t alignment) {
+    CHECK(allocator.validate());
+    size_t cells = 1;
+    for (uint32_t u : usable) cells *= u;
+    std::vector<uint8_t> grid(cells, 0);
+    uint64_t volume = 0;
+    size_t count = 0;
+    for (const auto& node : allocator.preorder()) {
+        if (!node.used) continue;
+        ++count;
+        uint64_t v = 1;
+        for (size_t axis = 0; axis < N; ++axis) {
+            CHECK(node.min[axis] % alignment == 0 && node.size[axis] % alignment == 0);
+            CHECK(node.size[axis] > 0 && node.min[axis] + node.size[axis] <= usable[axis]);
+            v *= node.size[axis];
+        }
+        volume += v;
+        Position<N> c = node.min;
+        while (true) {
+            size_t linear = 0;
+            for (size_t axis = N; axis-- > 0;) linear = linear * usable[axis] + c[axis];
+            CHECK(grid[linear] == 0);
+            grid[linear] = 1;
+            size_t axis = 0;
+            for (; axis < N; ++axis) {
+                if (++c[axis] < node.min[axis] + node.size[axis]) break;
+                c[axis] = node.min[axis];
+            }
+            if (axis == N) break;
+        }
+    }
+    CHECK(volume == allocator.usedVolume() && count == allocator.size());
+}
+
+// Fast and naive side by side on the same operations. Their placement policies differ, so each
+// keeps its own copy of every element; checked: valid layouts on both (checkLayout), the same
+// reserved extent when both place an element, both succeed where capacity clearly suffices (at
+// most a quarter of the usable volume in use and every side at most a quarter of the sheet),
+// removal by a point that is no origin fails, stale ids fail, and at the end removal collapses
+// the same way in both (the naive allocator rebuilt from the fast tree, the same removals, the
+// same tree after each) down to the empty root.
 template <size_t N>
 void fuzzBlocks(FuzzedDataProvider& in) {
     Extent<N> bounds;
@@ -78,24 +120,50 @@ void fuzzBlocks(FuzzedDataProvider& in) {
     const uint32_t maxSide = in.ConsumeIntegralInRange<uint32_t>(1, N == 2 ? 40 : 12);
     BlockAllocator<N> fast(bounds, alignment);
     NaiveBlockAllocator<N> naive(bounds, alignment);
-    std::vector<Placement<N>> live;
+    Extent<N> usable;
+    uint64_t usableVolume = 1;
+    for (size_t axis = 0; axis < N; ++axis) {
+        usable[axis] = bounds[axis] / alignment * alignment;
+        usableVolume *= usable[axis];
+    }
+    struct Element {
+        std::optional<Placement<N>> fast, naive;
+    };
+    std::vector<Element> live; // held by at least one of the two
     auto extent = [&] {
         Extent<N> e;
         for (auto& x : e) x = in.ConsumeIntegralInRange<uint32_t>(0, maxSide);
         return e;
     };
-    auto same = [](const std::optional<Placement<N>>& a, const std::optional<Placement<N>>& b) {
-        if (a.has_value() != b.has_value()) return false;
-        return !a || (a->origin == b->origin && a->extent == b->extent && a->id == b->id);
+    auto clearlyFits = [&](const Extent<N>& e, uint64_t used) {
+        if (used * 4 > usableVolume) return false;
+        for (size_t axis = 0; axis < N; ++axis)
+            if (e[axis] == 0 ||
+                uint64_t(e[axis] + alignment - 1) / alignment * alignment * 4 > usable[axis])
+                return false;
+        return true;
+    };
+    auto keep = [&](const Extent<N>& e, const std::optional<Placement<N>>& a,
+                    const std::optional<Placement<N>>& b, uint64_t usedFast, uint64_t usedNaive) {
+        if (clearlyFits(e, usedFast)) CHECK(a.has_value());
+        if (clearlyFits(e, usedNaive)) CHECK(b.has_value());
+        if (a && b) CHECK(a->extent == b->extent);
+        if (a || b) live.push_back(Element{a, b});
+    };
+    auto removeFrom = [&](auto& allocator, std::optional<Placement<N>>& p, bool byId) {
+        if (!p) return;
+        CHECK(byId ? allocator.remove(p->id) : allocator.remove(p->origin));
+        CHECK(!allocator.remove(p->id));
+        p.reset();
     };
     for (int op = 0; op < kMaxOps && in.remaining_bytes() > 0; ++op) {
         switch (in.ConsumeIntegralInRange(0, 4)) {
         case 0:
         case 1: {
             Extent<N> e = extent();
+            uint64_t usedFast = fast.usedVolume(), usedNaive = naive.usedVolume();
             auto a = fast.insert(e);
-            CHECK(same(a, naive.insert(e)));
-            if (a) live.push_back(*a);
+            keep(e, a, naive.insert(e), usedFast, usedNaive);
             break;
         }
         case 2: {
@@ -103,85 +171,66 @@ void fuzzBlocks(FuzzedDataProvider& in) {
             for (auto& e : batch) e = extent();
             auto a = fast.insertBatch(batch);
             auto b = naive.insertBatch(batch);
-            CHECK(a.size() == batch.size());
+            CHECK(a.size() == batch.size() && b.size() == batch.size());
+            // The batch is placed in its own order (largest first), so each element is judged
+            // with the whole batch's volume in use.
+            uint64_t usedFast = fast.usedVolume(), usedNaive = naive.usedVolume();
             for (size_t i = 0; i < batch.size(); ++i) {
-                CHECK(same(a[i], b[i]));
-                if (a[i]) live.push_back(*a[i]);
+                if (a[i]) CHECK(fast.find(a[i]->id)->origin == a[i]->origin);
+                keep(batch[i], a[i], b[i], usedFast, usedNaive);
             }
             break;
         }
-        case 3: { // remove by origin; sometimes a point that is not an origin
-            if (live.empty() || in.ConsumeIntegralInRange(0, 7) == 0) {
-                Position<N> p;
-                for (auto& x : p) x = in.ConsumeIntegralInRange<uint32_t>(0, 100);
-                bool removed = fast.remove(p);
-                CHECK(removed == naive.remove(p));
-                if (removed) {
-                    auto it = std::find_if(live.begin(), live.end(),
-                                           [&](const auto& l) { return l.origin == p; });
-                    CHECK(it != live.end());
-                    live.erase(it);
-                }
-                break;
-            }
-            size_t pick = in.ConsumeIntegralInRange<size_t>(0, live.size() - 1);
-            CHECK(fast.remove(live[pick].origin) && naive.remove(live[pick].origin));
-            live.erase(live.begin() + pick);
+        case 3: { // a point: removes exactly when it is the origin of an element
+            Position<N> p;
+            for (auto& x : p) x = in.ConsumeIntegralInRange<uint32_t>(0, 100);
+            auto at = [&](auto member) {
+                return std::find_if(live.begin(), live.end(), [&](const Element& l) {
+                    return (l.*member) && (l.*member)->origin == p;
+                });
+            };
+            auto f = at(&Element::fast);
+            CHECK(fast.remove(p) == (f != live.end()));
+            if (f != live.end()) f->fast.reset();
+            auto n = at(&Element::naive);
+            CHECK(naive.remove(p) == (n != live.end()));
+            if (n != live.end()) n->naive.reset();
+            std::erase_if(live, [](const Element& l) { return !l.fast && !l.naive; });
             break;
         }
-        case 4: { // remove by id, then the stale id must fail
+        case 4: { // remove an element from both, by id or by origin; the stale id must fail
             if (live.empty()) break;
             size_t pick = in.ConsumeIntegralInRange<size_t>(0, live.size() - 1);
-            BlockId id = live[pick].id;
-            CHECK(fast.remove(id) && naive.remove(id));
-            CHECK(!fast.remove(id) && !naive.remove(id));
-            live.erase(live.begin() + pick);
+            bool byId = in.ConsumeBool();
+            removeFrom(fast, live[pick].fast, byId);
+            removeFrom(naive, live[pick].naive, byId);
+            live.erase(live.begin() + ptrdiff_t(pick));
             break;
         }
         }
-        CHECK(fast.size() == live.size() && naive.size() == live.size());
-        CHECK(fast.usedVolume() == naive.usedVolume() && fast.nodeCount() == naive.nodeCount());
+        size_t inFast = 0, inNaive = 0;
+        for (const auto& l : live) inFast += l.fast.has_value(), inNaive += l.naive.has_value();
+        CHECK(fast.size() == inFast && naive.size() == inNaive);
         if (op % 32 == 0) {
-            CHECK(fast.validate() && naive.validate());
-            CHECK(fast.preorder() == naive.preorder());
+            checkLayout<N>(fast, usable, alignment);
+            checkLayout<N>(naive, usable, alignment);
         }
     }
-    CHECK(fast.validate() && naive.validate());
-    CHECK(fast.preorder() == naive.preorder());
-    // No overlap, all inside the usable bounds, aligned.
-    Extent<N> usable;
-    size_t cells = 1;
-    for (size_t axis = 0; axis < N; ++axis) {
-        usable[axis] = bounds[axis] / alignment * alignment;
-        cells *= usable[axis];
+    checkLayout<N>(fast, usable, alignment);
+    checkLayout<N>(naive, usable, alignment);
+    // Removal collapses the same way in both, whatever the layout.
+    auto tree = fast.preorder();
+    auto mirror = NaiveBlockAllocator<N>::fromPreorder(bounds, alignment, tree);
+    CHECK(mirror.validate() && mirror.preorder() == tree);
+    for (const auto& l : live) {
+        if (!l.fast) continue;
+        CHECK(fast.remove(l.fast->id) && mirror.remove(l.fast->origin));
+        CHECK(fast.nodeCount() == mirror.nodeCount() && fast.preorder() == mirror.preorder());
     }
-    std::vector<uint8_t> grid(cells, 0);
-    uint64_t volume = 0;
-    for (const auto& p : live) {
-        uint64_t v = 1;
-        for (size_t axis = 0; axis < N; ++axis) {
-            CHECK(p.origin[axis] % alignment == 0 && p.extent[axis] % alignment == 0);
-            CHECK(p.origin[axis] + p.extent[axis] <= usable[axis]);
-            v *= p.extent[axis];
-        }
-        volume += v;
-        Position<N> c = p.origin;
-        while (true) {
-            size_t linear = 0;
-            for (size_t axis = N; axis-- > 0;) linear = linear * usable[axis] + c[axis];
-            CHECK(grid[linear] == 0);
-            grid[linear] = 1;
-            size_t axis = 0;
-            for (; axis < N; ++axis) {
-                if (++c[axis] < p.origin[axis] + p.extent[axis]) break;
-                c[axis] = p.origin[axis];
-            }
-            if (axis == N) break;
-        }
-    }
-    CHECK(volume == fast.usedVolume());
-    for (const auto& p : live) CHECK(fast.remove(p.id));
     CHECK(fast.nodeCount() == 1 && fast.usedVolume() == 0 && fast.validate());
+    for (const auto& l : live)
+        if (l.naive) CHECK(naive.remove(l.naive->id));
+    CHECK(naive.nodeCount() == 1 && naive.usedVolume() == 0 && naive.validate());
 }
 
 } // namespace

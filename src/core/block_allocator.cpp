@@ -47,15 +47,15 @@ namespace {
 using block_detail::FreeSummary;
 
 template <size_t N>
-FreeSummary<N> summaryOfLeaf(const Extent<N>& size) {
-    return FreeSummary<N>{size, size};
-}
-
-template <size_t N>
 uint32_t shortestSide(const Extent<N>& e) {
     uint32_t m = e[0];
     for (size_t d = 1; d < N; ++d) m = std::min(m, e[d]);
     return m;
+}
+
+template <size_t N>
+FreeSummary<N> summaryOfLeaf(const Extent<N>& size) {
+    return FreeSummary<N>{size, size};
 }
 
 template <size_t N>
@@ -137,8 +137,7 @@ bool BlockAllocator<N>::refresh(uint32_t index) {
     const Node& b = m_nodes[node.childB];
     bool occupied = a.occupied || b.occupied;
     FreeSummary<N> free = combine<N>(a.free, b.free);
-    if (occupied == node.occupied && free.max == node.free.max && free.square == node.free.square)
-        return false;
+    if (occupied == node.occupied && free == node.free) return false;
     node.occupied = occupied;
     node.free = free;
     return true;
@@ -324,8 +323,22 @@ size_t BlockAllocator<N>::visitBatch(uint32_t index, BatchState& state, BatchLis
                       arena.begin() + ptrdiff_t(pick));
             return list.end - 1; // the caller refreshes this node's ancestors
         }
-        // The elements before `pick` did not fit the whole leaf, so they fit neither piece.
-        splitLeaf(index, state.extents[rank]);
+        // Cut the leaf down to this element and place it; the elements before `pick` did not fit
+        // the whole leaf, and the others continue into the pieces cut off.
+        uint32_t leaf = index;
+        while (m_nodes[leaf].size != state.extents[rank]) {
+            splitLeaf(leaf, state.extents[rank]);
+            leaf = m_nodes[leaf].childA;
+        }
+        reserveLeaf(leaf);
+        state.leaves[rank] = leaf;
+        for (uint32_t p = m_nodes[leaf].parent; p != index; p = m_nodes[p].parent) refresh(p);
+        std::copy(arena.begin() + ptrdiff_t(pick) + 1, arena.begin() + ptrdiff_t(list.end),
+                  arena.begin() + ptrdiff_t(pick));
+        if (--list.end == list.begin) {
+            refresh(index);
+            return list.end;
+        }
     } else if (list.end - list.begin == 1) {
         // A single element left on this path: insert()'s search from here does the same, cheaper.
         const uint32_t rank = arena[list.begin];
@@ -356,9 +369,12 @@ size_t BlockAllocator<N>::visitBatch(uint32_t index, BatchState& state, BatchLis
         const FreeSummary<N>& freeA = m_nodes[childA].free;
         const FreeSummary<N>& freeB = m_nodes[childB].free;
         bool intoA = fitOf<N>(e, freeA) >= enough, intoB = fitOf<N>(e, freeB) >= enough;
-        if (!intoA && !intoB) arena[kept++] = rank;
-        else if (intoA && (!intoB || aFirst<N>(freeA, freeB))) arena.push_back(rank);
-        else bFirst.push_back(rank);
+        if (!intoA && !intoB)
+            arena[kept++] = rank;
+        else if (intoA && (!intoB || aFirst<N>(freeA, freeB)))
+            arena.push_back(rank);
+        else
+            bFirst.push_back(rank);
     }
     const size_t splitAt = arena.size();
     arena.insert(arena.end(), bFirst.begin(), bFirst.end());
@@ -373,8 +389,10 @@ size_t BlockAllocator<N>::visitBatch(uint32_t index, BatchState& state, BatchLis
         while (i < leftA || j < endB) {
             bool fromA = j == endB || (i < leftA && arena[i] < arena[j]);
             const uint32_t rank = arena[fromA ? i++ : j++];
-            if (fromA && !admits(childB, rank)) arena[keepA++] = rank;
-            else arena.push_back(rank);
+            if (fromA && !admits(childB, rank))
+                arena[keepA++] = rank;
+            else
+                arena.push_back(rank);
         }
         leftA = keepA;
     }
@@ -388,8 +406,10 @@ size_t BlockAllocator<N>::visitBatch(uint32_t index, BatchState& state, BatchLis
             const uint32_t rank = arena[i];
             while (j < endB && arena[j] < rank) ++j;
             bool startedInB = j < endB && arena[j] == rank;
-            if (startedInB && admits(childA, rank)) arena.push_back(rank);
-            else arena[keepB++] = rank;
+            if (startedInB && admits(childA, rank))
+                arena.push_back(rank);
+            else
+                arena[keepB++] = rank;
         }
         leftB = keepB;
     }
@@ -399,12 +419,10 @@ size_t BlockAllocator<N>::visitBatch(uint32_t index, BatchState& state, BatchLis
     // Every leftover, ascending, back to the front of the list.
     std::vector<uint32_t>& left = state.scratch;
     left.clear();
-    left.insert(left.end(), arena.begin() + ptrdiff_t(list.begin),
-                arena.begin() + ptrdiff_t(kept));
+    left.insert(left.end(), arena.begin() + ptrdiff_t(list.begin), arena.begin() + ptrdiff_t(kept));
     left.insert(left.end(), arena.begin() + ptrdiff_t(base), arena.begin() + ptrdiff_t(leftA));
     left.insert(left.end(), arena.begin() + ptrdiff_t(toB), arena.begin() + ptrdiff_t(leftB));
-    left.insert(left.end(), arena.begin() + ptrdiff_t(retry),
-                arena.begin() + ptrdiff_t(leftRetry));
+    left.insert(left.end(), arena.begin() + ptrdiff_t(retry), arena.begin() + ptrdiff_t(leftRetry));
     std::sort(left.begin(), left.end());
     std::copy(left.begin(), left.end(), arena.begin() + ptrdiff_t(list.begin));
     arena.resize(base);
@@ -598,8 +616,7 @@ bool BlockAllocator<N>::validate() const {
             if (node.childB != kNone) return false;
             bool used = node.slot != kNone;
             if (node.occupied != used) return false;
-            if (node.free != (used ? FreeSummary<N>{} : summaryOfLeaf<N>(node.size)))
-                return false;
+            if (node.free != (used ? FreeSummary<N>{} : summaryOfLeaf<N>(node.size))) return false;
             if (used) {
                 if (node.slot >= m_slotNode.size() || m_slotNode[node.slot] != index) return false;
                 ++live;

@@ -16,16 +16,19 @@
 // element and chains them, which makes trees hundreds of levels deep, and every insertion and
 // removal pays for the depth. The free halves are square-ish boxes that later elements reuse,
 // and freeing merges them back like buddies.
-// Insertion descends into the child whose free summary is tighter (smaller), so small elements
-// fill holes and large free boxes stay intact for large elements.
+// Insertion searches depth-first, best fit first (into the child with less free room), so small
+// elements fill the holes between placed ones and large free boxes stay whole; that search is
+// bounded (a node budget), after which it follows children whose summary guarantees a fitting
+// leaf straight down (see FreeSummary).
 //
 // What makes it fast (the naive baseline in block_allocator_naive.h has none of it):
 // - each node stores its parent, so walking up is O(1) per step;
 // - each node stores whether its subtree holds a used leaf, so "is this subtree empty" is O(1),
 //   and removal climbs only as far as it collapses, not to the root;
-// - each node stores the per-axis maximum of the free leaves below it, so insertion skips
-//   subtrees that cannot hold the element instead of walking the whole tree, and removal and
-//   insertion refresh these summaries only up to the first ancestor they leave unchanged;
+// - each node stores a summary of the free leaves below it (per-axis maximum, and the free box
+//   with the longest shortest side), so insertion skips subtrees that cannot hold the element
+//   instead of walking the whole tree, and removal and insertion refresh these summaries only up
+//   to the first ancestor they leave unchanged;
 // - removal by position descends the tree (children partition their parent, so one path);
 //   removal by id is a table lookup; there is no separate contains-then-remove;
 // - nodes are deleted by moving the last node of the array into the hole and fixing its parent,

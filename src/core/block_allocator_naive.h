@@ -3,9 +3,13 @@
 // nodes know only their children; removal finds the element by scanning every node, finds each
 // parent by scanning every node, asks "is this subtree used" by walking the subtree, and deletes
 // nodes with an order-preserving erase followed by a pass over all nodes to fix their indices;
-// every insertion walks the tree from the root without pruning. Kept only as the benchmark
-// baseline and as the oracle for differential tests: it makes the same placements as
-// BlockAllocator (block_allocator.h), through the same interface.
+// every insertion walks the tree from the root without pruning, and places elements by UE4's
+// rule (first free leaf that fits, cut to the element along the axis with the most slack). Kept
+// only as the benchmark baseline and as the oracle for differential tests, through the same
+// interface as BlockAllocator (block_allocator.h). BlockAllocator places elements differently
+// (it halves large free boxes), so layouts differ; both must be valid for the same operations,
+// and removal collapses the same way in both (the tests rebuild this allocator from a fast tree
+// with fromPreorder() and compare the trees after each removal).
 #include "core/block_allocator.h"
 
 namespace shadel {
