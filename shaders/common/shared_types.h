@@ -230,6 +230,7 @@ struct ShadelFrame {
     float shadingBias;
     float trilinearBand; // width of the LOD interval blended between two MIPs (1 = trilinear)
     uint materialSamples; // material evaluations per shadel above MIP 0 (1 or 4)
+    uint regionStart[SHADEL_MAX_MIPS]; // first block column of each MIP's region
 };
 
 #ifdef __cplusplus

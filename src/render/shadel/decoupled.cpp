@@ -338,6 +338,7 @@ void prepareDecoupledFrame(Renderer& r, const GpuScene& scene, const CameraView&
     s.shadingBias = d.shadingBias;
     s.trilinearBand = d.trilinearBand;
     s.materialSamples = r.settings.materialSamples;
+    for (uint32_t k = 0; k < SHADEL_MAX_MIPS; ++k) s.regionStart[k] = d.regions[k].x0;
     std::memcpy(mapped(gpu, d.frameInfo), &s, sizeof(s));
     constants.shadel = address(gpu, d.frameInfo);
     constants.shadingBias = d.shadingBias;
@@ -453,11 +454,14 @@ void recordDecoupledPostPasses(Renderer& r, FrameRecorder& rec, uint64_t frame) 
     Gpu& gpu = *r.gpu;
     DecoupledState& d = *r.decoupled;
     pass(rec, "sheetView", [&](VkCommandBuffer cmd) {
+        uint32_t rowsInUse = 16;
+        for (const gpu::GpuShadelRect& rect : d.rects)
+            rowsInUse = std::max(rowsInUse, rect.rect.y + rect.rect.w);
         struct {
             uint64_t frame;
             uint64_t pixels;
-            uint32_t width, height;
-        } push{frame, address(gpu, r.pixels), r.settings.width, r.settings.height};
+            uint32_t width, height, rowsInUse;
+        } push{frame, address(gpu, r.pixels), r.settings.width, r.settings.height, rowsInUse};
         memoryBarrier(cmd, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
                       VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
                       VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT);
