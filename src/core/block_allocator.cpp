@@ -108,25 +108,28 @@ BlockAllocator<N>::BlockAllocator(Extent<N> size, uint32_t alignment)
 template <size_t N>
 void BlockAllocator<N>::clear() {
     m_nodes.clear();
-    Node root;
+    m_boxes.clear();
+    Box root;
     for (size_t axis = 0; axis < N; ++axis)
         root.size[axis] = m_bounds[axis] / m_alignment * m_alignment;
-    root.free = summaryOfLeaf<N>(root.size);
-    m_nodes.push_back(root);
+    m_nodes.push_back(Node{summaryOfLeaf<N>(root.size)});
+    m_boxes.push_back(root);
+    m_nodes.push_back(Node{}); // padding: sibling pairs start at even indices
+    m_boxes.push_back(Box{});
     // Bump live slots' generations so that ids handed out before clear() stay invalid.
     m_freeSlots.clear();
-    for (uint32_t slot = 0; slot < m_slotNode.size(); ++slot) {
-        if (m_slotNode[slot] != kNone) ++m_slotGeneration[slot];
-        m_slotNode[slot] = kNone;
+    for (uint32_t slot = 0; slot < m_slots.size(); ++slot) {
+        if (m_slots[slot].node != kNone) ++m_slots[slot].generation;
+        m_slots[slot].node = kNone;
     }
-    for (uint32_t slot = uint32_t(m_slotNode.size()); slot-- > 0;) m_freeSlots.push_back(slot);
+    for (uint32_t slot = uint32_t(m_slots.size()); slot-- > 0;) m_freeSlots.push_back(slot);
     m_liveCount = 0;
     m_usedVolume = 0;
 }
 
 template <size_t N>
 std::optional<Extent<N>> BlockAllocator<N>::roundUp(const Extent<N>& extent) const {
-    return block_detail::roundUpExtent<N>(extent, m_nodes[0].size, m_alignment);
+    return block_detail::roundUpExtent<N>(extent, m_boxes[0].size, m_alignment);
 }
 
 // Recomputes the cached subtree data of an inner node from its children; false if unchanged.
@@ -135,18 +138,24 @@ bool BlockAllocator<N>::refresh(uint32_t index) {
     Node& node = m_nodes[index];
     const Node& a = m_nodes[node.childA];
     const Node& b = m_nodes[node.childB];
-    bool occupied = a.occupied || b.occupied;
     FreeSummary<N> free = combine<N>(a.free, b.free);
-    if (occupied == node.occupied && free == node.free) return false;
-    node.occupied = occupied;
+    if (free == node.free) return false;
     node.free = free;
     return true;
 }
 
-// Once a node's cached data comes out unchanged, nothing above it changes either: trees that
-// grew long chains only pay for the part of the path that actually changed.
+// Once a node's summary comes out unchanged, nothing above it changes either: trees that grew
+// long chains only pay for the part of the path that actually changed. That holds only where
+// the summaries were consistent before the change; the nodes just cut by splitLeaf() (up to and
+// including `through`, an ancestor of `index`) are not, and are refreshed regardless.
 template <size_t N>
-void BlockAllocator<N>::refreshUpwards(uint32_t index) {
+void BlockAllocator<N>::refreshUpwards(uint32_t index, uint32_t through) {
+    if (through != kNone) {
+        for (bool last = false; !last; index = m_nodes[index].parent) {
+            last = index == through;
+            refresh(index);
+        }
+    }
     for (; index != kNone && refresh(index); index = m_nodes[index].parent) {
     }
 }
@@ -157,7 +166,7 @@ void BlockAllocator<N>::refreshUpwards(uint32_t index) {
 // larger one); otherwise it is cut to the element's extent along the axis with the most slack.
 template <size_t N>
 void BlockAllocator<N>::splitLeaf(uint32_t index, const Extent<N>& extent) {
-    const Extent<N> box = m_nodes[index].size;
+    const Extent<N> box = m_boxes[index].size;
     size_t axis = N;
     uint32_t cut = 0;
     for (size_t d = 0; d < N; ++d) {
@@ -169,18 +178,21 @@ void BlockAllocator<N>::splitLeaf(uint32_t index, const Extent<N>& extent) {
         SHADEL_ASSERT(axis < N);
         cut = extent[axis];
     }
+    Box boxA, boxB;
+    boxA.min = boxB.min = m_boxes[index].min;
+    boxA.size = boxB.size = box;
+    boxA.size[axis] = cut;
+    boxB.min[axis] += cut;
+    boxB.size[axis] -= cut;
     Node a, b;
-    a.min = b.min = m_nodes[index].min;
-    a.size = b.size = box;
-    a.size[axis] = cut;
-    b.min[axis] += cut;
-    b.size[axis] -= cut;
-    a.free = summaryOfLeaf<N>(a.size);
-    b.free = summaryOfLeaf<N>(b.size);
+    a.free = summaryOfLeaf<N>(boxA.size);
+    b.free = summaryOfLeaf<N>(boxB.size);
     a.parent = b.parent = index;
     uint32_t first = uint32_t(m_nodes.size());
     m_nodes.push_back(a);
     m_nodes.push_back(b);
+    m_boxes.push_back(boxA);
+    m_boxes.push_back(boxB);
     m_nodes[index].childA = first;
     m_nodes[index].childB = first + 1;
     m_nodes[index].free = combine<N>(a.free, b.free);
@@ -195,18 +207,17 @@ Placement<N> BlockAllocator<N>::occupyLeaf(uint32_t index) {
         slot = m_freeSlots.back();
         m_freeSlots.pop_back();
     } else {
-        slot = uint32_t(m_slotNode.size());
-        m_slotNode.push_back(kNone);
-        m_slotGeneration.push_back(0);
+        slot = uint32_t(m_slots.size());
+        m_slots.push_back(Slot{});
     }
-    m_slotNode[slot] = index;
+    m_slots[slot].node = index;
     Node& node = m_nodes[index];
     node.slot = slot;
-    node.occupied = true;
     node.free = FreeSummary<N>{};
+    const Box& box = m_boxes[index];
     ++m_liveCount;
-    m_usedVolume += volume<N>(node.size);
-    return Placement<N>{node.min, node.size, BlockId{slot, m_slotGeneration[slot]}};
+    m_usedVolume += volume<N>(box.size);
+    return Placement<N>{box.min, box.size, BlockId{slot, m_slots[slot].generation}};
 }
 
 // Finds a free leaf below `start` for an element of (rounded) `extent` and cuts it down to the
@@ -221,6 +232,7 @@ uint32_t BlockAllocator<N>::findLeaf(const Extent<N>& extent, uint32_t start) {
     // fitting leaf after all. Once that search has used its budget, and the root surely holds the
     // element, it follows children that surely hold it straight down instead.
     m_scratch.clear();
+    m_splitTop = kNone;
     uint32_t index = start;
     uint32_t budget = kSearchBudget;
     while (!m_nodes[index].leaf()) {
@@ -256,7 +268,8 @@ uint32_t BlockAllocator<N>::findLeaf(const Extent<N>& extent, uint32_t start) {
         }
     }
     // A leaf is only entered when its summary admits the element: it is free and large enough.
-    while (m_nodes[index].size != extent) {
+    if (m_boxes[index].size != extent) m_splitTop = index;
+    while (m_boxes[index].size != extent) {
         splitLeaf(index, extent);
         index = m_nodes[index].childA;
     }
@@ -270,7 +283,7 @@ std::optional<Placement<N>> BlockAllocator<N>::insert(const Extent<N>& requested
     uint32_t index = findLeaf(*extent);
     if (index == kNone) return std::nullopt;
     Placement<N> placement = occupyLeaf(index);
-    refreshUpwards(m_nodes[index].parent);
+    refreshUpwards(m_nodes[index].parent, m_splitTop);
     return placement;
 }
 
@@ -302,7 +315,6 @@ template <size_t N>
 void BlockAllocator<N>::reserveLeaf(uint32_t index) {
     Node& node = m_nodes[index];
     node.slot = kReservedSlot;
-    node.occupied = true;
     node.free = FreeSummary<N>{};
 }
 
@@ -312,11 +324,11 @@ size_t BlockAllocator<N>::visitBatch(uint32_t index, BatchState& state, BatchLis
     if (m_nodes[index].leaf()) {
         if (m_nodes[index].slot != kNone) return list.end;
         size_t pick = list.begin;
-        while (pick < list.end && !fitsIn<N>(state.extents[arena[pick]], m_nodes[index].size))
+        while (pick < list.end && !fitsIn<N>(state.extents[arena[pick]], m_boxes[index].size))
             ++pick;
         if (pick == list.end) return list.end;
         const uint32_t rank = arena[pick];
-        if (m_nodes[index].size == state.extents[rank]) {
+        if (m_boxes[index].size == state.extents[rank]) {
             reserveLeaf(index);
             state.leaves[rank] = index;
             std::copy(arena.begin() + ptrdiff_t(pick) + 1, arena.begin() + ptrdiff_t(list.end),
@@ -326,7 +338,7 @@ size_t BlockAllocator<N>::visitBatch(uint32_t index, BatchState& state, BatchLis
         // Cut the leaf down to this element and place it; the elements before `pick` did not fit
         // the whole leaf, and the others continue into the pieces cut off.
         uint32_t leaf = index;
-        while (m_nodes[leaf].size != state.extents[rank]) {
+        while (m_boxes[leaf].size != state.extents[rank]) {
             splitLeaf(leaf, state.extents[rank]);
             leaf = m_nodes[leaf].childA;
         }
@@ -346,8 +358,12 @@ size_t BlockAllocator<N>::visitBatch(uint32_t index, BatchState& state, BatchLis
         if (leaf == kNone) return list.end;
         reserveLeaf(leaf);
         state.leaves[rank] = leaf;
-        for (uint32_t p = m_nodes[leaf].parent; p != m_nodes[index].parent && refresh(p);
-             p = m_nodes[p].parent) {
+        uint32_t p = m_nodes[leaf].parent;
+        for (bool last = m_splitTop == kNone; !last; p = m_nodes[p].parent) {
+            last = p == m_splitTop;
+            refresh(p);
+        }
+        for (; p != m_nodes[index].parent && refresh(p); p = m_nodes[p].parent) {
         }
         return list.begin;
     }
@@ -465,7 +481,7 @@ BlockAllocator<N>::insertBatch(std::span<const Extent<N>> extents) {
         uint32_t leaf = findLeaf(state.extents[rank]);
         if (leaf == kNone) continue;
         reserveLeaf(leaf);
-        refreshUpwards(m_nodes[leaf].parent);
+        refreshUpwards(m_nodes[leaf].parent, m_splitTop);
         state.leaves[rank] = leaf;
     }
     std::vector<uint32_t> leafOf(extents.size(), kNone);
@@ -477,48 +493,49 @@ BlockAllocator<N>::insertBatch(std::span<const Extent<N>> extents) {
 
 template <size_t N>
 bool BlockAllocator<N>::remove(const Position<N>& origin) {
-    if (!contains<N>(m_nodes[0].min, m_nodes[0].size, origin)) return false;
+    if (!contains<N>(m_boxes[0].min, m_boxes[0].size, origin)) return false;
     // Children partition their parent, so exactly one child contains the point.
     uint32_t index = 0;
     while (!m_nodes[index].leaf()) {
-        const Node& a = m_nodes[m_nodes[index].childA];
-        index = contains<N>(a.min, a.size, origin) ? m_nodes[index].childA : m_nodes[index].childB;
+        const Node& node = m_nodes[index];
+        const Box& a = m_boxes[node.childA];
+        index = contains<N>(a.min, a.size, origin) ? node.childA : node.childB;
     }
-    if (m_nodes[index].slot == kNone || m_nodes[index].min != origin) return false;
+    if (m_nodes[index].slot == kNone || m_boxes[index].min != origin) return false;
     removeLeaf(index);
     return true;
 }
 
 template <size_t N>
 bool BlockAllocator<N>::remove(BlockId id) {
-    if (id.slot >= m_slotNode.size() || m_slotNode[id.slot] == kNone ||
-        m_slotGeneration[id.slot] != id.generation)
+    if (id.slot >= m_slots.size() || m_slots[id.slot].node == kNone ||
+        m_slots[id.slot].generation != id.generation)
         return false;
-    removeLeaf(m_slotNode[id.slot]);
+    removeLeaf(m_slots[id.slot].node);
     return true;
 }
 
 template <size_t N>
 std::optional<Placement<N>> BlockAllocator<N>::find(BlockId id) const {
-    if (id.slot >= m_slotNode.size() || m_slotNode[id.slot] == kNone ||
-        m_slotGeneration[id.slot] != id.generation)
+    if (id.slot >= m_slots.size() || m_slots[id.slot].node == kNone ||
+        m_slots[id.slot].generation != id.generation)
         return std::nullopt;
-    const Node& node = m_nodes[m_slotNode[id.slot]];
-    return Placement<N>{node.min, node.size, id};
+    const Box& box = m_boxes[m_slots[id.slot].node];
+    return Placement<N>{box.min, box.size, id};
 }
 
 template <size_t N>
 void BlockAllocator<N>::removeLeaf(uint32_t index) {
     Node& node = m_nodes[index];
     uint32_t slot = node.slot;
-    m_slotNode[slot] = kNone;
-    ++m_slotGeneration[slot];
+    m_slots[slot].node = kNone;
+    ++m_slots[slot].generation;
     m_freeSlots.push_back(slot);
     node.slot = kNone;
-    node.occupied = false;
-    node.free = summaryOfLeaf<N>(node.size);
+    const Extent<N> size = m_boxes[index].size;
+    node.free = summaryOfLeaf<N>(size);
     --m_liveCount;
-    m_usedVolume -= volume<N>(node.size);
+    m_usedVolume -= volume<N>(size);
 
     // Climb while the sibling subtree is empty too: those ancestors just became empty, and the
     // highest of them is collapsed back into one free leaf, restoring the box as it was before
@@ -527,8 +544,7 @@ void BlockAllocator<N>::removeLeaf(uint32_t index) {
     for (uint32_t child = index, p = node.parent; p != kNone; child = p, p = m_nodes[p].parent) {
         const Node& parent = m_nodes[p];
         uint32_t sibling = parent.childA == child ? parent.childB : parent.childA;
-        if (m_nodes[sibling].occupied) break;
-        m_nodes[p].occupied = false;
+        if (m_nodes[sibling].occupied()) break;
         top = p;
     }
     uint32_t changed = index;
@@ -539,41 +555,45 @@ void BlockAllocator<N>::removeLeaf(uint32_t index) {
     refreshUpwards(m_nodes[changed].parent);
 }
 
-// Deletes every node below `top` and makes `top` a free leaf. Each deleted slot is filled with
-// the array's last node (swap-remove), whose parent, children and id slot are then re-pointed.
-// Deleting in descending index order means the last node is never one still to be deleted, so
-// no traversal state needs fixing except `top` itself, which may be the node that moves.
+// Deletes every node below `top` and makes `top` a free leaf. Siblings are deleted as a pair:
+// each deleted pair is filled with the array's last pair (swap-remove), whose parent, children
+// and id slots are then re-pointed. Deleting in descending index order means the last pair is
+// never one still to be deleted, so no traversal state needs fixing except `top` itself, which
+// may be a node that moves.
 template <size_t N>
 void BlockAllocator<N>::collapse(uint32_t& top) {
+    // The child A of every deleted pair.
     m_scratch.clear();
     m_scratch.push_back(m_nodes[top].childA);
-    m_scratch.push_back(m_nodes[top].childB);
     for (size_t i = 0; i < m_scratch.size(); ++i) {
-        const Node& node = m_nodes[m_scratch[i]];
-        if (!node.leaf()) {
-            m_scratch.push_back(node.childA);
-            m_scratch.push_back(node.childB);
-        }
+        for (uint32_t child = m_scratch[i]; child < m_scratch[i] + 2; ++child)
+            if (!m_nodes[child].leaf()) m_scratch.push_back(m_nodes[child].childA);
     }
     Node& collapsed = m_nodes[top];
     collapsed.childA = collapsed.childB = kNone;
-    collapsed.free = summaryOfLeaf<N>(collapsed.size);
+    collapsed.free = summaryOfLeaf<N>(m_boxes[top].size);
     std::sort(m_scratch.begin(), m_scratch.end(), std::greater<>());
     for (uint32_t hole : m_scratch) {
-        uint32_t last = uint32_t(m_nodes.size() - 1);
+        uint32_t last = uint32_t(m_nodes.size() - 2);
         if (hole != last) {
-            Node& moved = m_nodes[hole];
-            moved = m_nodes[last];
-            Node& parent = m_nodes[moved.parent];
-            (parent.childA == last ? parent.childA : parent.childB) = hole;
-            if (!moved.leaf()) {
-                m_nodes[moved.childA].parent = hole;
-                m_nodes[moved.childB].parent = hole;
+            for (uint32_t k = 0; k < 2; ++k) {
+                Node& moved = m_nodes[hole + k];
+                moved = m_nodes[last + k];
+                m_boxes[hole + k] = m_boxes[last + k];
+                if (!moved.leaf()) {
+                    m_nodes[moved.childA].parent = hole + k;
+                    m_nodes[moved.childB].parent = hole + k;
+                }
+                if (moved.slot != kNone && moved.slot != kReservedSlot)
+                    m_slots[moved.slot].node = hole + k;
+                if (top == last + k) top = hole + k;
             }
-            if (moved.slot != kNone) m_slotNode[moved.slot] = hole;
-            if (top == last) top = hole;
+            Node& parent = m_nodes[m_nodes[hole].parent];
+            parent.childA = hole;
+            parent.childB = hole + 1;
         }
-        m_nodes.pop_back();
+        m_nodes.resize(m_nodes.size() - 2);
+        m_boxes.resize(m_boxes.size() - 2);
     }
 }
 
@@ -584,9 +604,10 @@ std::vector<BlockTreeNode<N>> BlockAllocator<N>::preorder() const {
     std::vector<uint32_t> stack{0};
     while (!stack.empty()) {
         const Node& node = m_nodes[stack.back()];
+        const Box& box = m_boxes[stack.back()];
         stack.pop_back();
-        BlockTreeNode<N> entry{node.min, node.size, node.leaf(), node.slot != kNone, BlockId{}};
-        if (entry.used) entry.id = BlockId{node.slot, m_slotGeneration[node.slot]};
+        BlockTreeNode<N> entry{box.min, box.size, node.leaf(), node.slot != kNone, BlockId{}};
+        if (entry.used) entry.id = BlockId{node.slot, m_slots[node.slot].generation};
         out.push_back(entry);
         if (!node.leaf()) {
             stack.push_back(node.childB);
@@ -598,61 +619,67 @@ std::vector<BlockTreeNode<N>> BlockAllocator<N>::preorder() const {
 
 template <size_t N>
 bool BlockAllocator<N>::validate() const {
-    if (m_nodes.empty() || m_nodes[0].parent != kNone || m_nodes[0].min != Position<N>{})
+    if (m_nodes.empty() || m_boxes.size() != m_nodes.size() || m_nodes[0].parent != kNone ||
+        m_boxes[0].min != Position<N>{})
         return false;
     for (size_t axis = 0; axis < N; ++axis)
-        if (m_nodes[0].size[axis] != m_bounds[axis] / m_alignment * m_alignment) return false;
+        if (m_boxes[0].size[axis] != m_bounds[axis] / m_alignment * m_alignment) return false;
     size_t reached = 0, live = 0;
     uint64_t usedVolume = 0;
     std::vector<uint32_t> stack{0};
     while (!stack.empty()) {
         uint32_t index = stack.back();
         stack.pop_back();
-        if (index >= m_nodes.size() || ++reached > m_nodes.size()) return false;
+        if (index >= m_nodes.size() || ++reached >= m_nodes.size()) return false;
         const Node& node = m_nodes[index];
+        const Box& box = m_boxes[index];
         for (size_t axis = 0; axis < N; ++axis)
-            if (node.min[axis] % m_alignment || node.size[axis] % m_alignment) return false;
+            if (box.min[axis] % m_alignment || box.size[axis] % m_alignment) return false;
         if (node.leaf()) {
             if (node.childB != kNone) return false;
             bool used = node.slot != kNone;
-            if (node.occupied != used) return false;
-            if (node.free != (used ? FreeSummary<N>{} : summaryOfLeaf<N>(node.size))) return false;
+            if (node.free != (used ? FreeSummary<N>{} : summaryOfLeaf<N>(box.size))) return false;
             if (used) {
-                if (node.slot >= m_slotNode.size() || m_slotNode[node.slot] != index) return false;
+                if (node.slot >= m_slots.size() || m_slots[node.slot].node != index) return false;
                 ++live;
-                usedVolume += volume<N>(node.size);
+                usedVolume += volume<N>(box.size);
             }
             continue;
         }
         if (node.slot != kNone || node.childB == kNone) return false;
-        if (node.childA >= m_nodes.size() || node.childB >= m_nodes.size()) return false;
-        const Node& a = m_nodes[node.childA];
-        const Node& b = m_nodes[node.childB];
-        if (a.parent != index || b.parent != index) return false;
+        if (node.childA >= m_nodes.size() || node.childB != node.childA + 1 || node.childA % 2)
+            return false;
+        if (m_nodes[node.childA].parent != index || m_nodes[node.childB].parent != index)
+            return false;
+        const Box& a = m_boxes[node.childA];
+        const Box& b = m_boxes[node.childB];
         // The children must tile the parent: equal on all axes but one, adjacent along it.
         size_t cutAxes = 0;
         for (size_t axis = 0; axis < N; ++axis) {
-            if (a.min[axis] != node.min[axis]) return false;
-            if (a.size[axis] == node.size[axis] && b.size[axis] == node.size[axis] &&
-                b.min[axis] == node.min[axis])
+            if (a.min[axis] != box.min[axis]) return false;
+            if (a.size[axis] == box.size[axis] && b.size[axis] == box.size[axis] &&
+                b.min[axis] == box.min[axis])
                 continue;
             ++cutAxes;
             if (a.size[axis] == 0 || b.size[axis] == 0) return false;
-            if (a.size[axis] + b.size[axis] != node.size[axis]) return false;
-            if (b.min[axis] != node.min[axis] + a.size[axis]) return false;
+            if (a.size[axis] + b.size[axis] != box.size[axis]) return false;
+            if (b.min[axis] != box.min[axis] + a.size[axis]) return false;
         }
         if (cutAxes != 1) return false;
-        if (node.occupied != (a.occupied || b.occupied)) return false;
-        if (!node.occupied) return false; // an empty inner node should have collapsed
-        if (node.free != combine<N>(a.free, b.free)) return false;
+        // An empty inner node should have collapsed: some child must hold a used leaf (inner
+        // children are checked the same way further down).
+        const Node& nodeA = m_nodes[node.childA];
+        const Node& nodeB = m_nodes[node.childB];
+        if (!nodeA.occupied() && !nodeB.occupied()) return false;
+        if (node.free != combine<N>(nodeA.free, nodeB.free)) return false;
         stack.push_back(node.childA);
         stack.push_back(node.childB);
     }
-    if (reached != m_nodes.size() || live != m_liveCount || usedVolume != m_usedVolume)
+    if (reached + 1 != m_nodes.size() || live != m_liveCount || usedVolume != m_usedVolume)
         return false;
     size_t liveSlots = 0;
-    for (uint32_t node : m_slotNode) liveSlots += node != kNone;
-    return liveSlots == m_liveCount && liveSlots + m_freeSlots.size() == m_slotNode.size();
+    for (const Slot& entry : m_slots) liveSlots += entry.node != kNone;
+    return liveSlots == m_liveCount && liveSlots + m_freeSlots.size() == m_slots.size();
 }
 
 template class BlockAllocator<2>;

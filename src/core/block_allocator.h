@@ -23,8 +23,11 @@
 //
 // What makes it fast (the naive baseline in block_allocator_naive.h has none of it):
 // - each node stores its parent, so walking up is O(1) per step;
-// - each node stores whether its subtree holds a used leaf, so "is this subtree empty" is O(1),
-//   and removal climbs only as far as it collapses, not to the root;
+// - "is this subtree empty" is O(1) (an inner node never is, a leaf is when it has no id), so
+//   removal climbs only as far as it collapses, not to the root;
+// - the node array holds only links and summaries (boxes are in a parallel array), siblings are
+//   adjacent and share a cache line (2-D), and an id lookup is one cache line, so each step up
+//   a removal costs about one cache line;
 // - each node stores a summary of the free leaves below it (per-axis maximum, and the free box
 //   with the longest shortest side), so insertion skips subtrees that cannot hold the element
 //   instead of walking the whole tree, and removal and insertion refresh these summaries only up
@@ -41,6 +44,7 @@
 #include <array>
 #include <cstddef>
 #include <cstdint>
+#include <new>
 #include <optional>
 #include <span>
 #include <vector>
@@ -118,7 +122,7 @@ public:
     uint64_t usedVolume() const { return m_usedVolume; }
     Extent<N> bounds() const { return m_bounds; }
     uint32_t alignment() const { return m_alignment; }
-    size_t nodeCount() const { return m_nodes.size(); }
+    size_t nodeCount() const { return m_nodes.size() - 1; } // without the padding node
 
     std::vector<BlockTreeNode<N>> preorder() const;
     // Checks links, the partition of every node by its children, the cached subtree data and the
@@ -128,16 +132,40 @@ public:
 private:
     static constexpr uint32_t kNone = ~0u;
     static constexpr uint32_t kReservedSlot = ~0u - 1; // used leaf awaiting its id (batches)
-    struct Node {
-        Position<N> min{};
-        Extent<N> size{};
+    // The tree is split into a hot array (links and summaries, what the searches and the refresh
+    // on the way up read) and a cold one (each node's box), so that the part walked on every
+    // removal is small and dense. Whether a subtree holds a used leaf is not stored: an inner
+    // node always does (empty ones are collapsed), a leaf does when it has an id slot.
+    struct alignas(N == 2 ? 32 : 8) Node {
         block_detail::FreeSummary<N> free; // of this subtree's free leaves
         uint32_t parent = kNone;
         uint32_t childA = kNone;
         uint32_t childB = kNone;
         uint32_t slot = kNone; // id slot of the element, for used leaves
-        bool occupied = false; // some leaf of this subtree is used
         bool leaf() const { return childA == kNone; }
+        bool occupied() const { return childA != kNone || slot != kNone; }
+    };
+    struct Box {
+        Position<N> min{};
+        Extent<N> size{};
+    };
+    // The two children of a node are always adjacent, child A at an even index (the root is
+    // node 0, node 1 is padding), and the node array starts on a cache line: in 2-D, where a
+    // node is 32 bytes, a pair of siblings is one cache line, which is what refreshing a parent
+    // reads.
+    template <class T>
+    struct CacheLineAllocator {
+        using value_type = T;
+        CacheLineAllocator() = default;
+        template <class U>
+        CacheLineAllocator(const CacheLineAllocator<U>&) {}
+        T* allocate(size_t n) {
+            return static_cast<T*>(::operator new (n * sizeof(T), std::align_val_t{64}));
+        }
+        void deallocate(T* p, size_t) { ::operator delete (p, std::align_val_t{64}); }
+        friend bool operator==(const CacheLineAllocator&, const CacheLineAllocator&) {
+            return true;
+        }
     };
     struct BatchState;
     struct BatchList {
@@ -150,18 +178,23 @@ private:
     void reserveLeaf(uint32_t index);
     Placement<N> occupyLeaf(uint32_t index);
     bool refresh(uint32_t index);
-    void refreshUpwards(uint32_t index);
+    void refreshUpwards(uint32_t index, uint32_t through = kNone);
     size_t visitBatch(uint32_t index, BatchState& state, BatchList list);
     void removeLeaf(uint32_t index);
     void collapse(uint32_t& top);
 
     Extent<N> m_bounds;
     uint32_t m_alignment;
-    std::vector<Node> m_nodes;
-    std::vector<uint32_t> m_slotNode; // id slot -> node index, kNone when the slot is free
-    std::vector<uint32_t> m_slotGeneration;
+    std::vector<Node, CacheLineAllocator<Node>> m_nodes;
+    std::vector<Box> m_boxes; // parallel to m_nodes
+    struct Slot {
+        uint32_t node = kNone; // node index, kNone when the slot is free
+        uint32_t generation = 0;
+    };
+    std::vector<Slot> m_slots; // by id slot (one cache line per lookup)
     std::vector<uint32_t> m_freeSlots;
     std::vector<uint32_t> m_scratch; // reused traversal stack
+    uint32_t m_splitTop = kNone;     // the leaf the last findLeaf() cut, kNone if it cut none
     size_t m_liveCount = 0;
     uint64_t m_usedVolume = 0;
 };
