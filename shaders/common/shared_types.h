@@ -55,7 +55,7 @@ struct GpuVertex {
 };
 
 struct GpuMesh {
-    uint firstIndex;  // into the unified index buffer
+    uint firstIndex; // into the unified index buffer
     uint indexCount;
     int vertexOffset; // into the unified vertex buffer
     uint shadelMesh;  // index into GpuShadelMesh, 0xFFFFFFFF when the mesh is forward-only
@@ -95,10 +95,10 @@ struct GpuMaterial {
 struct GpuLight {
     vec3 position;
     uint type;
-    vec3 direction; // the way light travels
-    float range;    // 0 = infinite
-    vec3 color;     // colour * intensity
-    float spotScale; // 1 / max(cos(inner) - cos(outer), 1e-4)
+    vec3 direction;   // the way light travels
+    float range;      // 0 = infinite
+    vec3 color;       // colour * intensity
+    float spotScale;  // 1 / max(cos(inner) - cos(outer), 1e-4)
     float spotOffset; // -cos(outer) * spotScale
     float pad0;
     float pad1;
@@ -123,7 +123,7 @@ struct FrameConstants {
     vec4 shadowPlanes[6];  // sun shadow volume
     vec3 cameraPosition;
     float exposure;
-    vec3 sunDirection; // the way sunlight travels
+    vec3 sunDirection;  // the way sunlight travels
     uint sunShadowSlot; // bindless slot of the sun shadow map, NO_TEXTURE when off
     vec3 sunColor;
     float shadowTexelSize;
@@ -159,15 +159,15 @@ struct ShaderMessage {
 
 // ---- Decoupled shading (render/shadel) ----------------------------------------------------
 #define SHADEL_MAX_MIPS 10u
-#define SHADEL_COUNTERS 16u     // hashed allocation counters (seed: N parallel allocations)
-#define SHADEL_BLOCK 64u        // shadels per block side (8 x 8 chunks)
-#define SHADEL_CHUNK 8u         // shadels per chunk side
+#define SHADEL_COUNTERS 16u // hashed allocation counters (seed: N parallel allocations)
+#define SHADEL_BLOCK 64u    // shadels per block side (8 x 8 chunks)
+#define SHADEL_CHUNK 8u     // shadels per chunk side
 #define SHADEL_INVALID 0xFFFFFFFFu
 #define SHADEL_OBJECT_DECOUPLED 1u // allocated in the sheet this frame: drawn decoupled
 
 // Per instance: where its shadel space lives in the virtual sheet at each MIP.
 struct GpuShadelObject {
-    uvec2 mip0Size;   // MIP-0 shadel rect (BakedMesh::width/height)
+    uvec2 mip0Size; // MIP-0 shadel rect (BakedMesh::width/height)
     uint mipCount;
     uint flags;
     uint idMapOffset[SHADEL_MAX_MIPS]; // in 16-bit units into ShadelFrame::idMaps
@@ -176,7 +176,7 @@ struct GpuShadelObject {
 
 // One rectangle of the sheet in use this frame (the clear and allocation passes walk these).
 struct GpuShadelRect {
-    uvec4 rect;      // x, y, w, h in blocks
+    uvec4 rect; // x, y, w, h in blocks
     uint object;
     uint mip;
     uint firstBlock; // prefix sum of w*h over the rect list
@@ -197,28 +197,28 @@ struct GpuShadelCounters {
     uint chunksAllocated;         // chunks that got storage
     uint chunksOverflowed;        // marked chunks that did not fit (counted, not shaded)
     uint markedBlocks;
-    uint reconstructionMisses;    // samples that found no marked chunk (must be 0)
-    uint overflowSamples;         // samples whose chunk overflowed storage (shaded forward)
+    uint reconstructionMisses; // samples that found no marked chunk (must be 0)
+    uint overflowSamples;      // samples whose chunk overflowed storage (shaded forward)
     uint shadelsShaded;
     uint pad0;
-    uvec4 fillDispatch;   // x, y, z, pad: indirect args of the queue fill pass
-    uvec4 shadeDispatch;  // indirect args of the shading pass
+    uvec4 fillDispatch;  // x, y, z, pad: indirect args of the queue fill pass
+    uvec4 shadeDispatch; // indirect args of the shading pass
 };
 
 struct ShadelFrame {
-    uint64_t objects;      // GpuShadelObject[instanceCount]
-    uint64_t occupancy;    // uint64 per sheet block: one bit per chunk
-    uint64_t offsetMap;    // uint per block: base storage slot of its chunks
-    uint64_t allocId;      // uint per block: (object + 1) << 4 | mip, 0 = free
-    uint64_t counters;     // GpuShadelCounters
-    uint64_t rects;        // GpuShadelRect[rectCount]
-    uint64_t markedBlocks; // uvec2 {block, first object-local chunk} per marked block
-    uint64_t objectChunks; // uint per object: chunk count, then (after setup) queue base
+    uint64_t objects;        // GpuShadelObject[instanceCount]
+    uint64_t occupancy;      // uint64 per sheet block: one bit per chunk
+    uint64_t offsetMap;      // uint per block: base storage slot of its chunks
+    uint64_t allocId;        // uint per block: (object + 1) << 4 | mip, 0 = free
+    uint64_t counters;       // GpuShadelCounters
+    uint64_t rects;          // GpuShadelRect[rectCount]
+    uint64_t markedBlocks;   // uvec2 {block, first object-local chunk} per marked block
+    uint64_t objectChunks;   // uint per object: chunk count, then (after setup) queue base
     uint64_t objectDispatch; // uvec4 per object: indirect dispatch args + queue base
-    uint64_t queue;        // GpuShadelWork[capacityChunks]
-    uint64_t idMaps;       // uint16 triangle ids, packed in uints
-    uint64_t shadelUvs;    // vec2 per vertex of the unified geometry buffer
-    uint sheetBlocks;      // blocks per side of the virtual sheet
+    uint64_t queue;          // GpuShadelWork[capacityChunks]
+    uint64_t idMaps;         // uint16 triangle ids, packed in uints
+    uint64_t shadelUvs;      // vec2 per vertex of the unified geometry buffer
+    uint sheetBlocks;        // blocks per side of the virtual sheet
     uint rectCount;
     uint rectBlockCount;
     uint storageWriteSlot; // bindless storage image of the shade storage
@@ -228,7 +228,7 @@ struct ShadelFrame {
     uint chunksPerCounter;
     uint objectCount;
     float shadingBias;
-    float trilinearBand; // width of the LOD interval blended between two MIPs (1 = trilinear)
+    float trilinearBand;  // width of the LOD interval blended between two MIPs (1 = trilinear)
     uint materialSamples; // material evaluations per shadel above MIP 0 (1 or 4)
     uint regionStart[SHADEL_MAX_MIPS]; // first block column of each MIP's region
 };

@@ -26,6 +26,8 @@ void recordForwardShading(Renderer& r, VkCommandBuffer cmd, uint64_t frame);
 
 // Shared by every raster pass that draws the culled camera list (decoupled passes too).
 void drawCameraList(Renderer& r, VkCommandBuffer cmd, uint32_t list);
+// Begins depth-only rendering into the scene depth (cleared for the prepass, loaded after).
+void beginSceneDepthPass(Renderer& r, VkCommandBuffer cmd, bool clear);
 // Begins dynamic rendering into the HDR target with the prepass depth (loaded, not cleared).
 void beginSceneColorPass(Renderer& r, VkCommandBuffer cmd, bool clearColor);
 

@@ -378,16 +378,7 @@ void recordDecoupledPasses(Renderer& r, FrameRecorder& rec, uint64_t frame, cons
     });
 
     pass(rec, "marking", [&](VkCommandBuffer cmd) {
-        VkRenderingAttachmentInfo depth{VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO};
-        depth.imageView = vkView(gpu, r.depthTarget);
-        depth.imageLayout = VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL;
-        depth.loadOp = VK_ATTACHMENT_LOAD_OP_LOAD;
-        depth.storeOp = VK_ATTACHMENT_STORE_OP_STORE;
-        VkRenderingInfo ri{VK_STRUCTURE_TYPE_RENDERING_INFO};
-        ri.renderArea = {{0, 0}, {r.internalWidth, r.internalHeight}};
-        ri.layerCount = 1;
-        ri.pDepthAttachment = &depth;
-        vkCmdBeginRendering(cmd, &ri);
+        beginSceneDepthPass(r, cmd, false); // against the prepass depth
         bind(gpu, cmd, d.mark);
         pushConstants(gpu, cmd, RasterPush{frame, 0});
         drawCameraList(r, cmd, DRAW_LIST_DECOUPLED);
