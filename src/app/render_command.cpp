@@ -196,8 +196,10 @@ RenderRun runRender(Gpu& gpu, const RenderOptions& o) {
     s["triangles"] = scene.triangleCount();
     s["lights"] = scene.lights.size();
     MemoryHeapStats mem = memoryStats(gpu.memory);
-    s["gpu_memory"] = {
-        {"pool_bytes", mem.poolBytes}, {"used_bytes", mem.usedBytes}, {"pools", mem.pools}};
+    s["gpu_memory"] = {{"pool_bytes", mem.poolBytes},
+                       {"used_bytes", mem.usedBytes},
+                       {"pools", mem.pools},
+                       {"failed_allocations", gpu.failedAllocations}};
     if (renderer.decoupled) {
         decoupledStats(renderer, s);
         s["shadels_per_metre"] = density;

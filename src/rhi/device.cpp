@@ -468,9 +468,6 @@ void createDevice(Device& device, const DeviceDesc& desc) {
         throw DeviceError(format("cannot create the Vulkan device on %s (%s)", device.name.c_str(),
                                  vkResultName(r)));
     vkGetDeviceQueue(device.device, device.queueFamily, 0, &device.queue);
-    if (device.optional.meshShader)
-        device.cmdDrawMeshTasksIndirect = (PFN_vkCmdDrawMeshTasksIndirectEXT)vkGetDeviceProcAddr(
-            device.device, "vkCmdDrawMeshTasksIndirectEXT");
     setName(device, device.queue, VK_OBJECT_TYPE_QUEUE, "mainQueue");
     SHADEL_DEBUG("device: %s (%s)", device.name.c_str(), device.driver.c_str());
 }

@@ -43,7 +43,6 @@ struct Device {
     PFN_vkSetDebugUtilsObjectNameEXT setObjectName = nullptr;
     PFN_vkCmdBeginDebugUtilsLabelEXT cmdBeginLabel = nullptr;
     PFN_vkCmdEndDebugUtilsLabelEXT cmdEndLabel = nullptr;
-    PFN_vkCmdDrawMeshTasksIndirectEXT cmdDrawMeshTasksIndirect = nullptr;
 };
 
 // Creates the instance and device. Throws DeviceError with one line naming what is missing.

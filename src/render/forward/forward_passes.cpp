@@ -198,15 +198,19 @@ void beginSceneColorPass(Renderer& r, VkCommandBuffer cmd, bool clear) {
     vkCmdBeginRendering(cmd, &ri);
 }
 
-void recordForwardShading(Renderer& r, VkCommandBuffer cmd, uint64_t frame) {
+void drawForwardLists(Renderer& r, VkCommandBuffer cmd, uint64_t frame) {
     Gpu& gpu = *r.gpu;
-    beginSceneColorPass(r, cmd, true);
     bind(gpu, cmd, r.forwardOpaque);
     pushConstants(gpu, cmd, RasterPush{frame, 0});
     drawCameraList(r, cmd, DRAW_LIST_OPAQUE);
     bind(gpu, cmd, r.forwardBlend);
     pushConstants(gpu, cmd, RasterPush{frame, 0});
     drawCameraList(r, cmd, DRAW_LIST_BLEND);
+}
+
+void recordForwardShading(Renderer& r, VkCommandBuffer cmd, uint64_t frame) {
+    beginSceneColorPass(r, cmd, true);
+    drawForwardLists(r, cmd, frame);
     vkCmdEndRendering(cmd);
 }
 

@@ -26,7 +26,6 @@ struct SheetRegion {
 
 struct ObjectSlot {
     bool allocated = false;
-    bool noSpace = false; // wanted decoupled but the sheet was full: drawn forward
     uint32_t mipCount = 0;
     std::array<BlockId, SHADEL_MAX_MIPS> ids{};
     std::array<glm::uvec4, SHADEL_MAX_MIPS> rects{};
@@ -281,11 +280,11 @@ void prepareDecoupledFrame(Renderer& r, const GpuScene& scene, const CameraView&
                          r.settings.forwardBelowPixels;
         if (!wanted || small) {
             if (o.allocated) freeObject(gpu, d, o);
-            o.noSpace = false;
             if (small) d.objectsSmallForward++, d.objectsForward++;
             continue;
         }
-        if (!o.allocated) o.noSpace = !allocateObject(gpu, d, o, i, mesh);
+        // No room in the sheet: drawn forward this frame, retried next frame.
+        if (!o.allocated) allocateObject(gpu, d, o, i, mesh);
         if (!o.allocated) {
             d.objectsForward++;
             continue;
@@ -430,12 +429,7 @@ void recordDecoupledPasses(Renderer& r, FrameRecorder& rec, uint64_t frame, cons
         bind(gpu, cmd, d.reconstruct);
         pushConstants(gpu, cmd, RasterPush{frame, 0});
         drawCameraList(r, cmd, DRAW_LIST_DECOUPLED);
-        bind(gpu, cmd, r.forwardOpaque);
-        pushConstants(gpu, cmd, RasterPush{frame, 0});
-        drawCameraList(r, cmd, DRAW_LIST_OPAQUE);
-        bind(gpu, cmd, r.forwardBlend);
-        pushConstants(gpu, cmd, RasterPush{frame, 0});
-        drawCameraList(r, cmd, DRAW_LIST_BLEND);
+        drawForwardLists(r, cmd, frame);
         vkCmdEndRendering(cmd);
     });
 }
