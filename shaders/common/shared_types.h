@@ -170,6 +170,8 @@ struct GpuShadelObject {
     uvec2 mip0Size; // MIP-0 shadel rect (BakedMesh::width/height)
     uint mipCount;
     uint flags;
+    uint firstMip; // finest MIP with a rect this frame (the CPU's estimate of what it can need)
+    uint pad0;
     uint idMapOffset[SHADEL_MAX_MIPS]; // in 16-bit units into ShadelFrame::idMaps
     uvec4 rect[SHADEL_MAX_MIPS];       // x, y, w, h in blocks of the virtual sheet
 };
@@ -192,17 +194,21 @@ struct GpuShadelWork {
 };
 
 struct GpuShadelCounters {
-    uint hashed[SHADEL_COUNTERS]; // chunks taken from each storage section
-    uint chunksRequested;         // marked chunks
-    uint chunksAllocated;         // chunks that got storage
-    uint chunksOverflowed;        // marked chunks that did not fit (counted, not shaded)
-    uint markedBlocks;
-    uint reconstructionMisses; // samples that found no marked chunk (must be 0)
-    uint overflowSamples;      // samples whose chunk overflowed storage (shaded forward)
-    uint shadelsShaded;
+    // Chunks requested through each hashed counter. The counters only spread the atomics: once
+    // every block has its place within its counter, the sections are laid end to end
+    // (sectionBase), so storage is shared and overflows only when it is full as a whole.
+    uint hashed[SHADEL_COUNTERS];
+    uint sectionBase[SHADEL_COUNTERS]; // prefix sum of hashed[] (queue setup)
+    uint chunksRequested;              // marked chunks
+    uint chunksAllocated;              // chunks that got storage
+    uint chunksOverflowed;             // marked chunks that did not fit (counted, not shaded)
+    uint markedBlocks;                 // blocks with any marked chunk (may exceed the list)
+    uint reconstructionMisses;         // samples that found no marked chunk (must be 0)
+    uint overflowSamples;              // samples whose chunk overflowed storage (shaded forward)
     uint pad0;
-    uvec4 fillDispatch;  // x, y, z, pad: indirect args of the queue fill pass
-    uvec4 shadeDispatch; // indirect args of the shading pass
+    uint pad1;
+    uvec4 fillDispatch;  // x, y, z, marked blocks in the list: indirect args of the queue fill
+    uvec4 shadeDispatch; // x, y, z, queue length: indirect args of the shading pass
 };
 
 struct ShadelFrame {
@@ -212,10 +218,8 @@ struct ShadelFrame {
     uint64_t allocId;        // uint per block: (object + 1) << 4 | mip, 0 = free
     uint64_t counters;       // GpuShadelCounters
     uint64_t rects;          // GpuShadelRect[rectCount]
-    uint64_t markedBlocks;   // uvec2 {block, first object-local chunk} per marked block
-    uint64_t objectChunks;   // uint per object: chunk count, then (after setup) queue base
-    uint64_t objectDispatch; // uvec4 per object: indirect dispatch args + queue base
-    uint64_t queue;          // GpuShadelWork[capacityChunks]
+    uint64_t markedBlocks;   // uvec4 {block, place in its counter, object, mip | counter << 8}
+    uint64_t queue;          // GpuShadelWork[capacityChunks], indexed by storage slot
     uint64_t idMaps;         // uint16 triangle ids, packed in uints
     uint64_t shadelUvs;      // vec2 per vertex of the unified geometry buffer
     uint sheetBlocks;        // blocks per side of the virtual sheet
@@ -225,8 +229,8 @@ struct ShadelFrame {
     uint storageReadSlot;  // bindless sampled view of it
     uint storageChunksPerRow;
     uint capacityChunks;
-    uint chunksPerCounter;
-    uint objectCount;
+    uint markedCapacity;    // entries of markedBlocks (= capacityChunks: a block needs >= 1 chunk)
+    uint allocationCounters; // hashed counters in use (SHADEL_COUNTERS; fewer only for tests)
     float shadingBias;
     float trilinearBand;  // width of the LOD interval blended between two MIPs (1 = trilinear)
     uint materialSamples; // material evaluations per shadel above MIP 0 (1 or 4)

@@ -1,8 +1,11 @@
 #version 460
-// Allocation (seed: "Allocation Pass/Collection"): every marked block takes storage for its
-// marked chunks from one of 16 counters picked by hashing the block, so the atomics of
-// different blocks rarely meet. Blocks that do not fit are counted and left unallocated;
-// reconstruction then shades those samples forward, so nothing is corrupted.
+// Allocation (seed: "Allocation Pass/Collection"): every marked block reserves room for its
+// marked chunks through one of 16 counters picked by hashing the block, so the atomics of
+// different blocks rarely meet. This pass only records the block's place within its counter;
+// queue setup lays the counters' sections end to end and the fill pass turns place + section
+// base into the block's storage offset. Storage is thereby shared by all counters: a block
+// overflows only when storage as a whole is full. Overflowed blocks are counted and left
+// unallocated; reconstruction then shades those samples forward, so nothing is corrupted.
 #include "shadel/shadel.glsl"
 #include "shadel/rects.glsl"
 
@@ -20,17 +23,14 @@ void main() {
     uint n = bitCount(uint(mask)) + bitCount(uint(mask >> 32));
     ShadelCountersRef counters = ShadelCountersRef(s.counters);
     atomicAdd(counters.c.chunksRequested, n);
-    uint counter = (block * 2654435761u >> 7) % SHADEL_COUNTERS;
-    uint base = atomicAdd(counters.c.hashed[counter], n);
     uint listIndex = atomicAdd(counters.c.markedBlocks, 1u);
-    Uvec4Buffer list = Uvec4Buffer(s.markedBlocks);
-    if (base + n > s.chunksPerCounter) {
+    // Every listed block needs >= 1 chunk, so a list as long as storage has chunks can only
+    // run out when storage has too.
+    if (listIndex >= s.markedCapacity) {
         atomicAdd(counters.c.chunksOverflowed, n);
-        list.v[listIndex] = uvec4(SHADEL_INVALID);
         return;
     }
-    atomicAdd(counters.c.chunksAllocated, n);
-    UintBuffer(s.offsetMap).v[block] = counter * s.chunksPerCounter + base;
-    uint objectLocal = atomicAdd(UintBuffer(s.objectChunks).v[rect.object], n);
-    list.v[listIndex] = uvec4(block, objectLocal, rect.object, rect.mip);
+    uint counter = ((block * 2654435761u) >> 7) % s.allocationCounters;
+    uint place = atomicAdd(counters.c.hashed[counter], n);
+    Uvec4Buffer(s.markedBlocks).v[listIndex] = uvec4(block, place, rect.object, rect.mip | (counter << 8));
 }

@@ -21,6 +21,7 @@ void main() {
     uint workIndex = gl_WorkGroupID.y * 32768u + gl_WorkGroupID.x;
     if (workIndex >= ShadelCountersRef(s.counters).c.shadeDispatch.w) return;
     GpuShadelWork work = ShadelWorkBuffer(s.queue).w[workIndex];
+    if (work.slot == SHADEL_INVALID) return; // part of a block that overflowed storage
     GpuShadelObject o = ShadelObjectBuffer(s.objects).o[work.object];
     uvec2 local = gl_LocalInvocationID.xy;
     ivec2 outTexel = storageTexel(s, work.slot, local);

@@ -32,7 +32,8 @@ struct ShadelLevels {
 
 // texelDx/Dy: screen derivatives of the sample's MIP-0 shadel coordinate.
 ShadelLevels shadelLevels(GpuShadelObject o, vec2 texelDx, vec2 texelDy, float bias, float band) {
-    float lod = clamp(shadelLod(texelDx, texelDy, bias), 0.0, float(o.mipCount - 1u));
+    // The object has rects only from firstMip on (the CPU's lower bound of what it can need).
+    float lod = clamp(shadelLod(texelDx, texelDy, bias), float(o.firstMip), float(o.mipCount - 1u));
     ShadelLevels l;
     l.mip0 = uint(floor(lod));
     l.mip1 = min(l.mip0 + 1u, o.mipCount - 1u);

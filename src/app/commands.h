@@ -31,6 +31,8 @@ struct RenderOptions {
     float trilinearBand = 1.0f;
     uint32_t materialSamples = 4;
     float forwardBelowPixels = 8.0f;
+    uint32_t allocationCounters = SHADEL_COUNTERS;
+    bool sheetAllMips = false;
     double shadelBudget = 64e6; // MIP-0 shadels the bake may use for the whole scene
     bool printPasses = false;
     bool progress = true;

@@ -95,6 +95,14 @@ int main(int argc, char** argv) {
         ->add_option("--sheet", ro.sheetShadels,
                      "decoupled: virtual sheet side in shadels (64k..256k)")
         ->capture_default_str();
+    render
+        ->add_option("--allocation-counters", ro.allocationCounters,
+                     "decoupled: hashed storage counters to use, 1..16 (fewer only to test "
+                     "that storage is shared)")
+        ->capture_default_str();
+    render->add_flag("--sheet-all-mips", ro.sheetAllMips,
+                     "decoupled: give every visible object rects at all MIPs, not only from the "
+                     "finest it can need (for comparison)");
     render->add_flag("--passes", ro.printPasses, "print the per-pass timing table");
 
     // bench

@@ -130,6 +130,11 @@ RenderRun runRender(Gpu& gpu, const RenderOptions& o) {
         throw InputError(format("--material-samples %u: expected 1 or 4", o.materialSamples));
     settings.materialSamples = o.materialSamples;
     settings.forwardBelowPixels = o.forwardBelowPixels;
+    if (o.allocationCounters < 1 || o.allocationCounters > SHADEL_COUNTERS)
+        throw InputError(format("--allocation-counters %u: expected 1..%u", o.allocationCounters,
+                                SHADEL_COUNTERS));
+    settings.allocationCounters = o.allocationCounters;
+    settings.sheetAllMips = o.sheetAllMips;
     settings.timing = o.timing ? *o.timing : defaultTimingMode(gpu);
     Renderer renderer;
     RenderRun run;

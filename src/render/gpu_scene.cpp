@@ -144,6 +144,7 @@ void uploadScene(Gpu& gpu, const Scene& scene, GpuScene& out, const std::vector<
             ShadelMeshInfo& info = out.shadelMeshes[mi];
             if (b.indices.empty() || b.idMaps.empty()) continue;
             info.mip0Size = {b.width, b.height};
+            info.shadelsPerUnit = b.shadelsPerMetre;
             info.mipCount = std::min<uint32_t>(b.mipCount(), SHADEL_MAX_MIPS);
             for (uint32_t k = 0; k < info.mipCount; ++k) {
                 info.idMapOffset[k] = uint32_t(idMaps.size());

@@ -27,12 +27,11 @@ struct RenderSettings {
     uint32_t shadeStorageSize = 4096; // decoupled: physical shade storage, shadels per side
     uint32_t sheetShadels = 65536;    // decoupled: virtual sheet, shadels per side
     float shadingBias = 0.0f; // decoupled: base MIP bias (the capacity controller adds to it)
-    float trilinearBand = 1.0f;
-    uint32_t materialSamples = 4;
-    float forwardBelowPixels =
-        8.0f; // decoupled: objects smaller on screen are drawn forward (0 = never) // decoupled:
-              // material evaluations per shadel above MIP 0 (1 or 4)
-              // // decoupled: LOD band blended between MIPs (1 = trilinear)
+    float trilinearBand = 1.0f;    // decoupled: LOD band blended between MIPs (1 = trilinear)
+    uint32_t materialSamples = 4;  // decoupled: material evaluations per shadel above MIP 0
+    float forwardBelowPixels = 8;  // decoupled: objects smaller on screen drawn forward (0 = never)
+    uint32_t allocationCounters = SHADEL_COUNTERS; // decoupled: hashed counters used (tests)
+    bool sheetAllMips = false; // decoupled: rects at every MIP (the old policy, for comparison)
 };
 
 struct FrameResult {

@@ -24,8 +24,11 @@ struct SheetRegion {
     std::unique_ptr<BlockAllocator2D> allocator;
 };
 
+// An object's rects in the sheet: levels firstMip .. mipCount-1 (finer levels only while the
+// camera can need them).
 struct ObjectSlot {
     bool allocated = false;
+    uint32_t firstMip = 0;
     uint32_t mipCount = 0;
     std::array<BlockId, SHADEL_MAX_MIPS> ids{};
     std::array<glm::uvec4, SHADEL_MAX_MIPS> rects{};
@@ -36,7 +39,9 @@ struct FrameCounters {
     uint32_t objectsDecoupled = 0;
     uint32_t objectsForward = 0;
     uint32_t objectsSmallForward = 0;
+    uint32_t objectsSheetLimited = 0;
     uint64_t rectBlocks = 0;
+    std::array<uint32_t, SHADEL_MAX_MIPS> firstMipHistogram{};
 };
 
 } // namespace
@@ -54,6 +59,8 @@ struct DecoupledState {
     uint32_t rectBlockCount = 0;
     uint32_t capacityChunks = 0;
     uint32_t objectsDecoupled = 0, objectsForward = 0, objectsSmallForward = 0;
+    uint32_t objectsSheetLimited = 0; // finer levels wanted but no sheet room: clamped
+    std::array<uint32_t, SHADEL_MAX_MIPS> firstMipHistogram{};
 
     BufferHandle frameInfo;    // gpu::ShadelFrame (upload)
     BufferHandle objectBuffer; // GpuShadelObject[] (upload)
@@ -62,11 +69,8 @@ struct DecoupledState {
     BufferHandle offsetMap;    // uint per block
     BufferHandle allocId;      // uint per block (upload: written by the CPU allocator)
     BufferHandle counters;     // GpuShadelCounters (readback, also indirect args)
-    BufferHandle markedBlocks; // uvec4 per marked block
-    uint32_t markedCapacity = 0;
-    BufferHandle objectChunks;   // uint per object
-    BufferHandle objectDispatch; // uvec4 per object
-    BufferHandle queue;          // GpuShadelWork[capacity]
+    BufferHandle markedBlocks; // uvec4 per marked block, capacityChunks of them
+    BufferHandle queue;        // GpuShadelWork[capacity], indexed by storage slot
     TextureHandle storage;
     TextureWriteView storageWrite;
     TextureReadView storageRead;
@@ -135,9 +139,8 @@ DecoupledStatePtr createDecoupled(Renderer& r, const GpuScene& scene) {
         need(createBuffer(gpu, {"shadel.counters", sizeof(gpu::GpuShadelCounters),
                                 VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT, MemoryKind::Readback}),
              "counters");
-    d.objectChunks = device("shadel.objectChunks", d.gpuObjects.size() * 4);
-    d.objectDispatch = device("shadel.objectDispatch", d.gpuObjects.size() * 16,
-                              VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT);
+    // Sized once from storage (a listed block holds >= 1 chunk), so no frame allocates.
+    d.markedBlocks = device("shadel.markedBlocks", VkDeviceSize(d.capacityChunks) * 16);
     d.queue =
         device("shadel.workQueue", VkDeviceSize(d.capacityChunks) * sizeof(gpu::GpuShadelWork));
 
@@ -192,7 +195,7 @@ void destroyDecoupled(Renderer& r, DecoupledStatePtr& state) {
     destroy(gpu, d.storage);
     for (BufferHandle b :
          {d.frameInfo, d.objectBuffer, d.rectBuffer, d.occupancy, d.offsetMap, d.allocId,
-          d.counters, d.markedBlocks, d.objectChunks, d.objectDispatch, d.queue})
+          d.counters, d.markedBlocks, d.queue})
         destroy(gpu, b);
     state.reset();
 }
@@ -204,36 +207,82 @@ static void writeAllocId(Gpu& gpu, DecoupledState& d, const glm::uvec4& rect, ui
             ids[size_t(y) * d.sheetBlocks + x] = value;
 }
 
+static void freeLevel(Gpu& gpu, DecoupledState& d, ObjectSlot& o, uint32_t k) {
+    if (!o.ids[k].valid()) return;
+    d.regions[k].allocator->remove(o.ids[k]);
+    writeAllocId(gpu, d, o.rects[k], 0);
+    o.ids[k] = BlockId{};
+}
+
 static void freeObject(Gpu& gpu, DecoupledState& d, ObjectSlot& o) {
-    for (uint32_t k = 0; k < o.mipCount; ++k) {
-        if (!o.ids[k].valid()) continue;
-        d.regions[k].allocator->remove(o.ids[k]);
-        writeAllocId(gpu, d, o.rects[k], 0);
-        o.ids[k] = BlockId{};
-    }
+    for (uint32_t k = 0; k < o.mipCount; ++k) freeLevel(gpu, d, o, k);
     o.allocated = false;
 }
 
-// Coarse CPU allocation (seed: "CPU side max space estimator"): every potentially visible
-// object gets a rect at each of its MIPs; objects that leave the view give theirs back.
-static bool allocateObject(Gpu& gpu, DecoupledState& d, ObjectSlot& o, uint32_t object,
-                           const ShadelMeshInfo& mesh) {
-    o.mipCount = mesh.mipCount;
-    for (uint32_t k = 0; k < mesh.mipCount; ++k) {
-        uint32_t w = std::max(1u, mesh.mip0Size.x >> k), h = std::max(1u, mesh.mip0Size.y >> k);
-        Extent<2> blocks{(w + SHADEL_BLOCK - 1) / SHADEL_BLOCK,
-                         (h + SHADEL_BLOCK - 1) / SHADEL_BLOCK};
-        auto placed = d.regions[k].allocator->insert(blocks);
-        if (!placed) {
-            freeObject(gpu, d, o);
-            return false;
-        }
-        o.ids[k] = placed->id;
-        o.rects[k] = {d.regions[k].x0 + placed->origin[0], placed->origin[1], blocks[0], blocks[1]};
-        writeAllocId(gpu, d, o.rects[k], ((object + 1) << 4) | k);
-    }
-    o.allocated = true;
+static bool allocateLevel(Gpu& gpu, DecoupledState& d, ObjectSlot& o, uint32_t object,
+                          const ShadelMeshInfo& mesh, uint32_t k) {
+    uint32_t w = std::max(1u, mesh.mip0Size.x >> k), h = std::max(1u, mesh.mip0Size.y >> k);
+    Extent<2> blocks{(w + SHADEL_BLOCK - 1) / SHADEL_BLOCK, (h + SHADEL_BLOCK - 1) / SHADEL_BLOCK};
+    auto placed = d.regions[k].allocator->insert(blocks);
+    if (!placed) return false;
+    o.ids[k] = placed->id;
+    o.rects[k] = {d.regions[k].x0 + placed->origin[0], placed->origin[1], blocks[0], blocks[1]};
+    writeAllocId(gpu, d, o.rects[k], ((object + 1) << 4) | k);
     return true;
+}
+
+// Coarse CPU allocation (seed: "CPU side max space estimator"): a potentially visible object
+// gets rects from the finest MIP it can need this frame down to its coarsest; objects that
+// leave the view give theirs back. Levels are added as the camera comes closer and dropped
+// (with one level of slack, so a camera hovering at a boundary does not churn the sheet) as it
+// moves away. Returns false when the object has no rects at all (drawn forward this frame).
+static bool updateObjectRects(Gpu& gpu, DecoupledState& d, ObjectSlot& o, uint32_t object,
+                              const ShadelMeshInfo& mesh, uint32_t wantFirst, bool& limited) {
+    limited = false;
+    if (!o.allocated) {
+        o.mipCount = mesh.mipCount;
+        o.firstMip = mesh.mipCount;
+        o.allocated = true;
+    }
+    while (o.firstMip > wantFirst && allocateLevel(gpu, d, o, object, mesh, o.firstMip - 1))
+        --o.firstMip;
+    if (o.firstMip > wantFirst) limited = true; // the sheet is full: clamped to coarser levels
+    while (o.firstMip + 1 < wantFirst) freeLevel(gpu, d, o, o.firstMip++);
+    if (o.firstMip == o.mipCount) { // not even the coarsest level fits
+        o.allocated = false;
+        return false;
+    }
+    return true;
+}
+
+// The finest MIP the reconstruction filter can read anywhere on the instance this frame: a
+// lower bound of its screen footprint in MIP-0 shadels. The nearest view depth of the (margin-
+// padded) bounds bounds every point's depth; a pixel there spans at least depth * cos(the
+// screen's half-diagonal angle) / focal world units in any screen direction; one world unit
+// holds at most shadelsPerUnit / (largest scale of the instance) MIP-0 shadels on average, and
+// charts vary around that average (stretch, density CV <= 0.2), hence one MIP of slack.
+static uint32_t finestMipNeeded(const CameraView& camera, float viewportHeight,
+                                const gpu::GpuInstance& inst, const ShadelMeshInfo& mesh,
+                                glm::vec3 boundsMin, glm::vec3 boundsMax, float bias) {
+    if (mesh.shadelsPerUnit <= 0.0f || mesh.mipCount <= 1) return 0;
+    float nearestDepth = 1e30f;
+    for (int c = 0; c < 8; ++c) {
+        glm::vec3 corner{c & 1 ? boundsMax.x : boundsMin.x, c & 2 ? boundsMax.y : boundsMin.y,
+                         c & 4 ? boundsMax.z : boundsMin.z};
+        nearestDepth = std::min(nearestDepth, -(camera.view * glm::vec4(corner, 1.0f)).z);
+    }
+    if (nearestDepth <= camera.znear) return 0;
+    float tanX = 1.0f / std::abs(camera.proj[0][0]), tanY = 1.0f / std::abs(camera.proj[1][1]);
+    float cosEdge = 1.0f / std::sqrt(1.0f + tanX * tanX + tanY * tanY);
+    float focal = 0.5f * viewportHeight * std::abs(camera.proj[1][1]);
+    float pixelWorld = nearestDepth * cosEdge / focal;
+    glm::mat3 m(inst.model);
+    float scale = std::max({glm::length(m[0]), glm::length(m[1]), glm::length(m[2]), 1e-12f});
+    constexpr float kDensitySlack = 0.5f;
+    float footprint = pixelWorld * mesh.shadelsPerUnit / scale * kDensitySlack;
+    float lod = std::log2(std::max(footprint, 1e-12f)) + bias;
+    if (!(lod > 0.0f)) return 0;
+    return std::min(uint32_t(lod), mesh.mipCount - 1);
 }
 
 static bool boxVisible(const std::array<glm::vec4, 6>& planes, glm::vec3 bmin, glm::vec3 bmax) {
@@ -261,7 +310,8 @@ void prepareDecoupledFrame(Renderer& r, const GpuScene& scene, const CameraView&
     auto planes = frustumPlanes(constants.viewProj);
     d.rects.clear();
     d.rectBlockCount = 0;
-    d.objectsDecoupled = d.objectsForward = d.objectsSmallForward = 0;
+    d.objectsDecoupled = d.objectsForward = d.objectsSmallForward = d.objectsSheetLimited = 0;
+    d.firstMipHistogram.fill(0);
     for (uint32_t i = 0; i < scene.instanceCount; ++i) {
         const gpu::GpuInstance& inst = scene.instanceInfo[i];
         const ShadelMeshInfo& mesh = scene.shadelMeshes[inst.mesh];
@@ -283,29 +333,30 @@ void prepareDecoupledFrame(Renderer& r, const GpuScene& scene, const CameraView&
             if (small) d.objectsSmallForward++, d.objectsForward++;
             continue;
         }
+        uint32_t wantFirst = r.settings.sheetAllMips
+                                 ? 0
+                                 : finestMipNeeded(camera, float(r.internalHeight), inst, mesh,
+                                                   inst.worldMin - margin, inst.worldMax + margin,
+                                                   d.shadingBias);
+        bool limited = false;
         // No room in the sheet: drawn forward this frame, retried next frame.
-        if (!o.allocated) allocateObject(gpu, d, o, i, mesh);
-        if (!o.allocated) {
+        if (!updateObjectRects(gpu, d, o, i, mesh, wantFirst, limited)) {
             d.objectsForward++;
             continue;
         }
+        d.objectsSheetLimited += limited;
         d.objectsDecoupled++;
+        d.firstMipHistogram[o.firstMip]++;
         g.mip0Size = mesh.mip0Size;
         g.mipCount = mesh.mipCount;
+        g.firstMip = o.firstMip;
         g.flags = SHADEL_OBJECT_DECOUPLED;
-        for (uint32_t k = 0; k < mesh.mipCount; ++k) {
+        for (uint32_t k = o.firstMip; k < mesh.mipCount; ++k) {
             g.idMapOffset[k] = mesh.idMapOffset[k];
             g.rect[k] = o.rects[k];
             d.rects.push_back({o.rects[k], i, k, d.rectBlockCount, 0});
             d.rectBlockCount += o.rects[k].z * o.rects[k].w;
         }
-    }
-    if (d.rectBlockCount > d.markedCapacity) {
-        destroy(gpu, d.markedBlocks);
-        d.markedCapacity = std::max(d.rectBlockCount, d.markedCapacity * 2);
-        d.markedBlocks =
-            need(createBuffer(gpu, {"shadel.markedBlocks", VkDeviceSize(d.markedCapacity) * 16}),
-                 "marked block list");
     }
     std::memcpy(mapped(gpu, d.objectBuffer), d.gpuObjects.data(),
                 d.gpuObjects.size() * sizeof(gpu::GpuShadelObject));
@@ -319,9 +370,7 @@ void prepareDecoupledFrame(Renderer& r, const GpuScene& scene, const CameraView&
     s.allocId = address(gpu, d.allocId);
     s.counters = address(gpu, d.counters);
     s.rects = address(gpu, d.rectBuffer);
-    s.markedBlocks = d.markedBlocks ? address(gpu, d.markedBlocks) : 0;
-    s.objectChunks = address(gpu, d.objectChunks);
-    s.objectDispatch = address(gpu, d.objectDispatch);
+    s.markedBlocks = address(gpu, d.markedBlocks);
     s.queue = address(gpu, d.queue);
     s.idMaps = address(gpu, scene.idMaps);
     s.shadelUvs = address(gpu, scene.shadelUvs);
@@ -332,8 +381,8 @@ void prepareDecoupledFrame(Renderer& r, const GpuScene& scene, const CameraView&
     s.storageReadSlot = slot(gpu, d.storageRead).value;
     s.storageChunksPerRow = d.storageSize / SHADEL_CHUNK;
     s.capacityChunks = d.capacityChunks;
-    s.chunksPerCounter = d.capacityChunks / SHADEL_COUNTERS;
-    s.objectCount = scene.instanceCount;
+    s.markedCapacity = d.capacityChunks;
+    s.allocationCounters = std::clamp(r.settings.allocationCounters, 1u, SHADEL_COUNTERS);
     s.shadingBias = d.shadingBias;
     s.trilinearBand = d.trilinearBand;
     s.materialSamples = r.settings.materialSamples;
@@ -363,7 +412,6 @@ void recordDecoupledPasses(Renderer& r, FrameRecorder& rec, uint64_t frame, cons
 
     pass(rec, "shadelClear", [&](VkCommandBuffer cmd) {
         vkCmdFillBuffer(cmd, vkBuffer(gpu, d.counters), 0, VK_WHOLE_SIZE, 0);
-        vkCmdFillBuffer(cmd, vkBuffer(gpu, d.objectChunks), 0, VK_WHOLE_SIZE, 0);
         if (rectGroups) {
             bind(gpu, cmd, d.clear);
             pushConstants(gpu, cmd, FramePush{frame});
@@ -401,12 +449,10 @@ void recordDecoupledPasses(Renderer& r, FrameRecorder& rec, uint64_t frame, cons
         pushConstants(gpu, cmd, FramePush{frame});
         vkCmdDispatch(cmd, 1, 1, 1);
         computeToCompute(cmd);
-        if (d.markedBlocks) {
-            bind(gpu, cmd, d.fillQueue);
-            pushConstants(gpu, cmd, FramePush{frame});
-            vkCmdDispatchIndirect(cmd, vkBuffer(gpu, d.counters),
-                                  offsetof(gpu::GpuShadelCounters, fillDispatch));
-        }
+        bind(gpu, cmd, d.fillQueue);
+        pushConstants(gpu, cmd, FramePush{frame});
+        vkCmdDispatchIndirect(cmd, vkBuffer(gpu, d.counters),
+                              offsetof(gpu::GpuShadelCounters, fillDispatch));
         computeToCompute(cmd);
     });
 
@@ -466,6 +512,8 @@ void finishDecoupledFrame(Renderer& r) {
     f.objectsDecoupled = d.objectsDecoupled;
     f.objectsForward = d.objectsForward;
     f.objectsSmallForward = d.objectsSmallForward;
+    f.objectsSheetLimited = d.objectsSheetLimited;
+    f.firstMipHistogram = d.firstMipHistogram;
     f.rectBlocks = d.rectBlockCount;
     d.history.push_back(f);
     if (f.counters.chunksOverflowed)
@@ -483,7 +531,8 @@ void decoupledStats(const Renderer& r, nlohmann::json& s) {
         misses += f.counters.reconstructionMisses;
         overflowSamples += f.counters.overflowSamples;
     }
-    uint64_t shaded = last.counters.shadelsShaded;
+    uint64_t chunksShaded = last.counters.chunksAllocated;
+    uint64_t shaded = chunksShaded * SHADEL_CHUNK * SHADEL_CHUNK;
     uint64_t covered = s.value("pixels_covered", uint64_t(0));
     s["shadels_shaded"] = shaded;
     s["shadels_per_pixel"] = covered ? double(shaded) / double(covered) : 0.0;
@@ -497,14 +546,24 @@ void decoupledStats(const Renderer& r, nlohmann::json& s) {
     s["reconstruction_misses"] = misses;
     s["overflow_samples"] = overflowSamples;
     s["marked_blocks"] = last.counters.markedBlocks;
+    s["chunks_shaded"] = chunksShaded;
     s["objects_decoupled"] = last.objectsDecoupled;
     s["objects_forward"] = last.objectsForward; // small (hybrid) + no sheet space
     s["objects_forward_small"] = last.objectsSmallForward;
-    s["sheet_blocks_allocated"] = last.rectBlocks;
+    s["objects_sheet_limited"] = last.objectsSheetLimited;
+    nlohmann::json firstMips = nlohmann::json::array();
+    for (uint32_t k = 0; k < SHADEL_MAX_MIPS; ++k) firstMips.push_back(last.firstMipHistogram[k]);
+    s["objects_by_first_mip"] = firstMips;
+    s["sheet_blocks_allocated"] = last.rectBlocks; // rect blocks of every level in use
+    s["sheet_blocks_touched"] = last.counters.markedBlocks;
     s["sheet_shadels"] = uint64_t(d.sheetBlocks) * SHADEL_BLOCK;
-    // Bookkeeping per shaded shadel: the 64-bit occupancy mask + 32-bit offset of every block
-    // in use (the seed quotes ~1.5 bits per shadel).
-    s["occupancy_bits_per_shadel"] = shaded ? double(last.rectBlocks) * 96.0 / double(shaded) : 0.0;
+    // The seed's measure (~1.5 bits per shadel): the 64-bit occupancy mask + 32-bit offset of
+    // every block in use, over the shadels its marked chunks hold.
+    uint64_t shadelsMarked = uint64_t(last.counters.chunksRequested) * 64;
+    s["occupancy_bits_per_shadel"] =
+        shadelsMarked ? double(last.counters.markedBlocks) * 96.0 / double(shadelsMarked) : 0.0;
+    // The whole sheet's bookkeeping for this frame (every allocated rect block) per shadel.
+    s["sheet_bits_per_shadel"] = shaded ? double(last.rectBlocks) * 96.0 / double(shaded) : 0.0;
     s["storage_used"] =
         d.capacityChunks ? double(last.counters.chunksAllocated) / d.capacityChunks : 0.0;
 }

@@ -1,0 +1,119 @@
+// The decoupled core done as the seed does it (issue 19): the sheet holds only the MIPs a frame
+// can need, storage is shared by the hashed counters, the shading bias lowers the work, the
+// 256k sheet works, and the seed's occupancy measure is reported.
+#include "gpu_test_env.h"
+
+#include <cmath>
+
+using namespace shadel;
+using namespace shadel::test;
+
+namespace {
+
+RenderOptions decoupled(const std::string& scene, uint32_t w, uint32_t h) {
+    RenderOptions o;
+    o.scene = scene;
+    o.mode = RenderMode::Decoupled;
+    o.width = w;
+    o.height = h;
+    return o;
+}
+
+uint64_t stat(const RenderRun& run, const char* name) {
+    return run.stats[name].get<uint64_t>();
+}
+
+} // namespace
+
+// Far objects get no rects at the fine levels they cannot need; the image does not change.
+TEST(DecoupledCore, SheetHoldsOnlyTheMipsTheFrameCanNeed) {
+    RenderOptions o = decoupled("builtin:default", 320, 180);
+    o.camera = "overview";
+    RenderRun needed = renderChecked(o);
+    o.sheetAllMips = true;
+    RenderRun all = renderChecked(o);
+    uint64_t neededBlocks = stat(needed, "sheet_blocks_allocated");
+    uint64_t allBlocks = stat(all, "sheet_blocks_allocated");
+    double p = psnr(needed.frames[0].rgba, all.frames[0].rgba);
+    std::printf("[ figures ] default/overview 320x180: sheet blocks %llu (every MIP: %llu, %.2fx), "
+                "PSNR %.2f dB\n",
+                (unsigned long long)neededBlocks, (unsigned long long)allBlocks,
+                double(neededBlocks) / double(allBlocks), p);
+    EXPECT_LT(double(neededBlocks), 0.85 * double(allBlocks));
+    EXPECT_GT(needed.stats["objects_by_first_mip"][1].get<uint64_t>(), 0u);
+    EXPECT_EQ(stat(needed, "reconstruction_misses"), 0u);
+    EXPECT_GE(p, 50.0);
+}
+
+// The 16 counters only spread the atomics: with every block hashed onto one or two counters,
+// nothing overflows while the frame needs less than 90% of storage.
+TEST(DecoupledCore, StorageIsSharedByTheHashedCounters) {
+    RenderOptions o = decoupled("builtin:smooth", 256, 144);
+    RenderRun roomy = renderChecked(o);
+    uint64_t requested = stat(roomy, "chunks_requested");
+    ASSERT_GT(requested, 0u);
+    // The smallest storage (a multiple of 64 shadels per side) with requested < 90% of it.
+    uint32_t side = 64;
+    while (double((side / 8) * (side / 8)) * 0.9 <= double(requested)) side += 64;
+    o.shadeStorageSize = side;
+    for (uint32_t counters : {1u, 2u, 16u}) {
+        o.allocationCounters = counters;
+        RenderRun tight = renderChecked(o);
+        double use = double(stat(tight, "chunks_requested")) / double(stat(tight, "chunks_capacity"));
+        std::printf("[ figures ] smooth 256x144, storage %u^2, %u counter(s): %.1f%% of storage "
+                    "requested, %llu chunks overflowed\n",
+                    side, counters, 100.0 * use,
+                    (unsigned long long)stat(tight, "chunks_overflowed"));
+        EXPECT_LT(use, 0.9);
+        EXPECT_EQ(stat(tight, "chunks_overflowed"), 0u) << counters << " counters";
+        EXPECT_EQ(stat(tight, "chunks_allocated"), stat(tight, "chunks_requested"));
+        EXPECT_EQ(stat(tight, "reconstruction_misses"), 0u);
+        EXPECT_GE(psnr(tight.frames[0].rgba, roomy.frames[0].rgba), 50.0);
+    }
+}
+
+TEST(DecoupledCore, ShadingBiasLowersShadedShadels) {
+    RenderOptions o = decoupled("builtin:smooth", 256, 144);
+    RenderRun none = renderChecked(o);
+    o.shadingBias = 1.0f;
+    RenderRun one = renderChecked(o);
+    o.shadingBias = 2.0f;
+    RenderRun two = renderChecked(o);
+    uint64_t s0 = stat(none, "shadels_shaded"), s1 = stat(one, "shadels_shaded"),
+             s2 = stat(two, "shadels_shaded");
+    std::printf("[ figures ] smooth 256x144 shadels shaded: bias 0 %llu, bias 1 %llu, bias 2 %llu\n",
+                (unsigned long long)s0, (unsigned long long)s1, (unsigned long long)s2);
+    EXPECT_LT(double(s1), 0.7 * double(s0));
+    EXPECT_LT(s2, s1);
+    EXPECT_EQ(stat(two, "reconstruction_misses"), 0u);
+}
+
+TEST(DecoupledCore, SeedSizedSheetWorksEndToEnd) {
+    RenderOptions o = decoupled("builtin:smooth", 256, 144);
+    RenderRun small = renderChecked(o);
+    o.sheetShadels = 262144;
+    RenderRun big = renderChecked(o);
+    EXPECT_EQ(big.stats["sheet_shadels"].get<uint64_t>(), 262144u);
+    EXPECT_EQ(stat(big, "reconstruction_misses"), 0u);
+    EXPECT_EQ(stat(big, "shadels_shaded"), stat(small, "shadels_shaded"));
+    EXPECT_GE(psnr(big.frames[0].rgba, small.frames[0].rgba), 50.0);
+}
+
+// The seed's bookkeeping figure: a 64-bit mask + 32-bit offset per block in use, over the
+// shadels of its marked chunks (~1.5 bits per shadel or less); and shadels per covered pixel
+// in the range a MIP chain with chunk rounding gives.
+TEST(DecoupledCore, OccupancyAndShadelsPerPixelAreInRange) {
+    RenderRun run = renderChecked(decoupled("builtin:default", 320, 180));
+    double bits = run.stats["occupancy_bits_per_shadel"].get<double>();
+    double perPixel = run.stats["shadels_per_pixel"].get<double>();
+    std::printf("[ figures ] default 320x180: %.3f occupancy bits per shadel, %.2f shadels per "
+                "pixel, %llu of %llu sheet blocks touched\n",
+                bits, perPixel, (unsigned long long)stat(run, "sheet_blocks_touched"),
+                (unsigned long long)stat(run, "sheet_blocks_allocated"));
+    EXPECT_GT(bits, 0.0);
+    EXPECT_LE(bits, 1.5);
+    EXPECT_GE(perPixel, 0.5);
+    EXPECT_LE(perPixel, 6.0);
+    EXPECT_LE(stat(run, "sheet_blocks_touched"), stat(run, "sheet_blocks_allocated"));
+    EXPECT_EQ(stat(run, "chunks_shaded") * 64, stat(run, "shadels_shaded"));
+}
