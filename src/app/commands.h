@@ -33,6 +33,8 @@ struct RenderOptions {
     float forwardBelowPixels = 8.0f;
     uint32_t allocationCounters = SHADEL_COUNTERS;
     bool sheetAllMips = false;
+    bool capacityControl = true;
+    CameraPath cameraPath = CameraPath::Static;
     double shadelBudget = 64e6; // MIP-0 shadels the bake may use for the whole scene
     bool printPasses = false;
     bool progress = true;
@@ -66,6 +68,7 @@ struct BenchOptions {
     std::optional<TimingMode> timing;
     float shadelsPerMetre = 32.0f;
     std::string cacheDir;
+    CameraPath cameraPath = CameraPath::Static;
 };
 nlohmann::json runBench(Gpu& gpu, const BenchOptions& options);
 

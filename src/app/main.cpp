@@ -103,6 +103,13 @@ int main(int argc, char** argv) {
     render->add_flag("--sheet-all-mips", ro.sheetAllMips,
                      "decoupled: give every visible object rects at all MIPs, not only from the "
                      "finest it can need (for comparison)");
+    std::string cameraPath = "static", capacityControl = "on";
+    render->add_option("--camera-path", cameraPath, "static | orbit | walk: camera motion over --frames")
+        ->capture_default_str();
+    render
+        ->add_option("--capacity-control", capacityControl,
+                     "decoupled: on | off: raise the shading bias when storage runs short")
+        ->capture_default_str();
     render->add_flag("--passes", ro.printPasses, "print the per-pass timing table");
 
     // bench
@@ -119,6 +126,9 @@ int main(int argc, char** argv) {
     bench->add_option("--timing", benchTiming, "auto | timestamps | submit")->capture_default_str();
     bench->add_option("--density", bo.shadelsPerMetre, "shadels per metre")->capture_default_str();
     bench->add_option("--cache-dir", bo.cacheDir, "bake cache directory");
+    std::string benchCameraPath = "static";
+    bench->add_option("--camera-path", benchCameraPath, "static | orbit | walk")
+        ->capture_default_str();
 
     // bake
     std::string bakeSceneSpec = "builtin:default", bakeCache;
@@ -194,6 +204,11 @@ int main(int argc, char** argv) {
                 throw InputError(format("--jitter %s: expected none or subpixel", jitter.c_str()));
             ro.jitter = jitter == "subpixel";
             ro.timing = parseTiming(timing);
+            ro.cameraPath = parseCameraPath(cameraPath);
+            if (capacityControl != "on" && capacityControl != "off")
+                throw InputError(format("--capacity-control %s: expected on or off",
+                                        capacityControl.c_str()));
+            ro.capacityControl = capacityControl == "on";
             RenderRun run = runRender(g.gpu, ro);
             const auto& s = run.stats;
             std::printf(
@@ -212,6 +227,7 @@ int main(int argc, char** argv) {
         if (*bench) {
             parseSize(benchSize, bo.width, bo.height);
             bo.timing = parseTiming(benchTiming);
+            bo.cameraPath = parseCameraPath(benchCameraPath);
             runBench(g.gpu, bo);
             return 0;
         }

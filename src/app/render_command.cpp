@@ -135,16 +135,19 @@ RenderRun runRender(Gpu& gpu, const RenderOptions& o) {
                                 SHADEL_COUNTERS));
     settings.allocationCounters = o.allocationCounters;
     settings.sheetAllMips = o.sheetAllMips;
+    settings.capacityControl = o.capacityControl;
     settings.timing = o.timing ? *o.timing : defaultTimingMode(gpu);
     Renderer renderer;
     RenderRun run;
     try {
         initRenderer(renderer, gpu, settings, gpuScene);
         bool tty = isatty(STDERR_FILENO);
+        Aabb bounds = scene.worldBounds();
         for (uint32_t i = 0; i < o.frames; ++i) {
             glm::vec2 jitter = o.jitter ? subpixelJitter(i) : glm::vec2(0.0f);
-            CameraView view =
-                makeCameraView(camera, o.width * o.ssaa, o.height * o.ssaa, jitter * float(o.ssaa));
+            Camera onPath = cameraOnPath(camera, o.cameraPath, i, o.frames, bounds);
+            CameraView view = makeCameraView(onPath, o.width * o.ssaa, o.height * o.ssaa,
+                                             jitter * float(o.ssaa));
             run.frames.push_back(renderFrame(renderer, gpuScene, view));
             if (o.progress && o.frames > 1 && tty)
                 std::fprintf(stderr, "\rrender: frame %u/%u (%.1f ms)", i + 1, o.frames,

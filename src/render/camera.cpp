@@ -55,6 +55,42 @@ CameraView makeCameraView(const Camera& camera, uint32_t width, uint32_t height,
     return v;
 }
 
+CameraPath parseCameraPath(const std::string& text) {
+    if (text == "static") return CameraPath::Static;
+    if (text == "orbit") return CameraPath::Orbit;
+    if (text == "walk") return CameraPath::Walk;
+    throw InputError(format("--camera-path %s: expected static, orbit or walk", text.c_str()));
+}
+
+Camera cameraOnPath(const Camera& start, CameraPath path, uint32_t frame, uint32_t frames,
+                    const Aabb& sceneBounds) {
+    if (path == CameraPath::Static || frames < 2) return start;
+    float t = float(frame) / float(frames - 1);
+    glm::vec3 center = sceneBounds.valid() ? sceneBounds.center() : glm::vec3(0.0f);
+    float radius = sceneBounds.valid() ? std::max(glm::length(sceneBounds.extent()) * 0.5f, 1e-3f)
+                                       : 1.0f;
+    glm::vec3 forward = glm::normalize(start.forward);
+    Camera c = start;
+    if (path == CameraPath::Orbit) {
+        // Pivot: the point on the view ray nearest the scene's centre (at least 10% of the
+        // scene's radius ahead), so the orbit keeps the scene in view.
+        float ahead = std::max(glm::dot(center - start.position, forward), 0.1f * radius);
+        glm::vec3 pivot = start.position + forward * ahead;
+        glm::mat3 turn = glm::mat3(
+            glm::rotate(glm::mat4(1.0f), glm::radians(40.0f) * t, glm::vec3(0.0f, 1.0f, 0.0f)));
+        c.position = pivot + turn * (start.position - pivot);
+        c.forward = turn * forward;
+    } else {
+        glm::vec3 flat = glm::vec3(forward.x, 0.0f, forward.z);
+        flat = glm::length(flat) > 1e-4f ? glm::normalize(flat) : glm::vec3(0.0f, 0.0f, -1.0f);
+        c.position = start.position + flat * (0.05f * radius * t);
+        float sway = glm::radians(5.0f) * std::sin(t * 6.2831853f);
+        c.forward = glm::mat3(glm::rotate(glm::mat4(1.0f), sway, glm::vec3(0.0f, 1.0f, 0.0f))) *
+                    forward;
+    }
+    return c;
+}
+
 static float halton(uint32_t index, uint32_t base) {
     float f = 1.0f, r = 0.0f;
     while (index > 0) {

@@ -21,6 +21,14 @@ struct CameraView {
 Camera findCamera(const Scene& scene, const std::string& name);
 CameraView makeCameraView(const Camera& camera, uint32_t width, uint32_t height,
                           glm::vec2 jitterPixels = glm::vec2(0.0f));
+// Deterministic camera motion over a run (`--camera-path`), so reuse and stability are measured
+// on moving frames: static keeps the camera; orbit turns it 40 degrees about a vertical axis
+// through the point it looks at; walk moves it forward by 5% of the scene's radius with a
+// gentle side-to-side look.
+enum class CameraPath { Static, Orbit, Walk };
+CameraPath parseCameraPath(const std::string& text); // throws InputError naming the flag
+Camera cameraOnPath(const Camera& start, CameraPath path, uint32_t frame, uint32_t frames,
+                    const Aabb& sceneBounds);
 // Sub-pixel jitter for frame i (Halton 2,3), in pixels in [-0.5, 0.5).
 glm::vec2 subpixelJitter(uint32_t frame);
 // World-space planes (inside: dot(n, p) + d >= 0) of a view-projection matrix, [0,1] depth.

@@ -31,7 +31,8 @@ struct RenderSettings {
     uint32_t materialSamples = 4;  // decoupled: material evaluations per shadel above MIP 0
     float forwardBelowPixels = 8;  // decoupled: objects smaller on screen drawn forward (0 = never)
     uint32_t allocationCounters = SHADEL_COUNTERS; // decoupled: hashed counters used (tests)
-    bool sheetAllMips = false; // decoupled: rects at every MIP (the old policy, for comparison)
+    bool sheetAllMips = false;
+    bool capacityControl = true; // decoupled: steer the shading bias from storage use // decoupled: rects at every MIP (the old policy, for comparison)
 };
 
 struct FrameResult {

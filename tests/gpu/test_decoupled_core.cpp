@@ -5,6 +5,8 @@
 
 #include <cmath>
 
+#include "core/log.h"
+
 using namespace shadel;
 using namespace shadel::test;
 
@@ -116,4 +118,58 @@ TEST(DecoupledCore, OccupancyAndShadelsPerPixelAreInRange) {
     EXPECT_LE(perPixel, 6.0);
     EXPECT_LE(stat(run, "sheet_blocks_touched"), stat(run, "sheet_blocks_allocated"));
     EXPECT_EQ(stat(run, "chunks_shaded") * 64, stat(run, "shadels_shaded"));
+}
+
+// Capacity control: with storage far too small for the view, the controller raises the shading
+// bias from the read-back counts until the frame fits; overflow stops within a few frames, the
+// image stays close to the unconstrained one, and without the controller overflow persists.
+TEST(DecoupledCore, CapacityControlEndsOverflowWithinFiveFrames) {
+    RenderOptions o = decoupled("builtin:default", 1280, 720);
+    RenderRun roomy = renderChecked(o);
+    uint64_t requested = stat(roomy, "chunks_requested");
+    // Storage for about 40% of what the view asks for.
+    uint32_t side = 64;
+    while (double((side + 64) / 8) * double((side + 64) / 8) < 0.4 * double(requested)) side += 64;
+    o.shadeStorageSize = side;
+    o.frames = 12;
+    RenderRun run = renderChecked(o);
+    const auto& bias = run.stats["shading_bias_per_frame"];
+    const auto& overflow = run.stats["chunks_overflowed_per_frame"];
+    ASSERT_EQ(overflow.size(), 12u);
+    std::string trace;
+    for (size_t i = 0; i < overflow.size(); ++i)
+        trace += format(" %.2f/%llu", bias[i].get<double>(),
+                        (unsigned long long)overflow[i].get<uint64_t>());
+    double p = psnr(run.frames.back().rgba, roomy.frames[0].rgba);
+    std::printf("[ figures ] default 1280x720, storage %u^2 (%llu chunks needed): bias/overflow per "
+                "frame%s; last frame %.2f dB against unconstrained\n",
+                side, (unsigned long long)requested, trace.c_str(), p);
+    EXPECT_GT(overflow[0].get<uint64_t>(), 0u); // the test really starts over capacity
+    for (size_t i = 5; i < overflow.size(); ++i) EXPECT_EQ(overflow[i].get<uint64_t>(), 0u) << i;
+    EXPECT_GT(run.stats["shading_bias"].get<double>(), 0.0);
+    EXPECT_EQ(stat(run, "reconstruction_misses"), 0u);
+    EXPECT_GE(p, 30.0);
+
+    o.capacityControl = false;
+    o.frames = 3;
+    RenderRun uncontrolled = renderChecked(o);
+    EXPECT_GT(uncontrolled.stats["chunks_overflowed_per_frame"][2].get<uint64_t>(), 0u);
+    EXPECT_EQ(uncontrolled.stats["shading_bias"].get<double>(), 0.0);
+}
+
+TEST(DecoupledCore, CameraPathsMoveTheCameraDeterministically) {
+    RenderOptions o = decoupled("builtin:smooth", 128, 72);
+    o.frames = 3;
+    RenderRun still = renderChecked(o);
+    o.cameraPath = CameraPath::Orbit;
+    RenderRun orbit = renderChecked(o);
+    RenderRun again = renderChecked(o);
+    o.cameraPath = CameraPath::Walk;
+    RenderRun walk = renderChecked(o);
+    EXPECT_EQ(orbit.frames[0].rgba, still.frames[0].rgba); // paths start at the camera
+    EXPECT_EQ(still.frames[2].rgba, still.frames[0].rgba);
+    EXPECT_LT(psnr(orbit.frames[2].rgba, orbit.frames[0].rgba), 30.0);
+    EXPECT_LT(psnr(walk.frames[2].rgba, walk.frames[0].rgba), 40.0);
+    EXPECT_NE(walk.frames[2].rgba, orbit.frames[2].rgba);
+    EXPECT_EQ(again.frames[2].rgba, orbit.frames[2].rgba);
 }

@@ -10,6 +10,7 @@
 #include "core/log.h"
 #include "render/forward/forward_passes.h"
 #include "render/renderer.h"
+#include "render/shadel/capacity_control.h"
 
 namespace shadel {
 
@@ -41,6 +42,7 @@ struct FrameCounters {
     uint32_t objectsSmallForward = 0;
     uint32_t objectsSheetLimited = 0;
     uint64_t rectBlocks = 0;
+    float shadingBias = 0.0f; // the bias this frame was shaded with
     std::array<uint32_t, SHADEL_MAX_MIPS> firstMipHistogram{};
 };
 
@@ -50,7 +52,10 @@ struct DecoupledState {
     uint32_t sheetBlocks = 1024; // 64k x 64k shadels
     uint32_t storageSize = 4096; // shadels per side of the physical storage
     float frustumMargin = 0.1f;  // fraction of an object's radius
-    float shadingBias = 0.0f;
+    float baseShadingBias = 0.0f; // --shading-bias
+    float shadingBias = 0.0f;     // this frame's: base + the capacity controller's
+    bool capacityControl = true;
+    CapacityController controller;
     float trilinearBand = 1.0f;
     std::vector<SheetRegion> regions;
     std::vector<ObjectSlot> objects;
@@ -102,7 +107,9 @@ DecoupledStatePtr createDecoupled(Renderer& r, const GpuScene& scene) {
         throw InputError(
             format("--sheet %u: expected 65536, 131072, 196608 or 262144", rs.sheetShadels));
     d.storageSize = rs.shadeStorageSize;
+    d.baseShadingBias = rs.shadingBias;
     d.shadingBias = rs.shadingBias;
+    d.capacityControl = rs.capacityControl;
     d.trilinearBand = std::clamp(rs.trilinearBand, 0.0f, 1.0f);
     d.sheetBlocks = rs.sheetShadels / SHADEL_BLOCK;
     uint32_t x = 0;
@@ -308,6 +315,7 @@ void prepareDecoupledFrame(Renderer& r, const GpuScene& scene, const CameraView&
     Gpu& gpu = *r.gpu;
     DecoupledState& d = *r.decoupled;
     auto planes = frustumPlanes(constants.viewProj);
+    d.shadingBias = d.baseShadingBias + (d.capacityControl ? d.controller.bias : 0.0f);
     d.rects.clear();
     d.rectBlockCount = 0;
     d.objectsDecoupled = d.objectsForward = d.objectsSmallForward = d.objectsSheetLimited = 0;
@@ -515,7 +523,12 @@ void finishDecoupledFrame(Renderer& r) {
     f.objectsSheetLimited = d.objectsSheetLimited;
     f.firstMipHistogram = d.firstMipHistogram;
     f.rectBlocks = d.rectBlockCount;
+    f.shadingBias = d.shadingBias;
     d.history.push_back(f);
+    // Next frame's bias from this frame's counts (one frame of latency, as with a ring of
+    // readback buffers on a pipelined GPU).
+    if (d.capacityControl)
+        updateCapacityControl(d.controller, f.counters.chunksRequested, d.capacityChunks);
     if (f.counters.chunksOverflowed)
         SHADEL_WARN("shade storage full: %u of %u marked chunks did not fit (%u chunks capacity); "
                     "those samples were shaded forward",
@@ -540,7 +553,16 @@ void decoupledStats(const Renderer& r, nlohmann::json& s) {
     s["chunks_requested"] = last.counters.chunksRequested;
     s["chunks_overflowed"] = last.counters.chunksOverflowed;
     s["chunks_capacity"] = d.capacityChunks;
-    s["shading_bias"] = d.shadingBias;
+    s["shading_bias"] = last.shadingBias;
+    s["capacity_control"] = d.capacityControl;
+    // Per frame, for the capacity controller's trace.
+    nlohmann::json biasTrace = nlohmann::json::array(), overflowTrace = nlohmann::json::array();
+    for (const FrameCounters& f : d.history) {
+        biasTrace.push_back(f.shadingBias);
+        overflowTrace.push_back(f.counters.chunksOverflowed);
+    }
+    s["shading_bias_per_frame"] = biasTrace;
+    s["chunks_overflowed_per_frame"] = overflowTrace;
     s["trilinear_band"] = d.trilinearBand;
     s["material_samples"] = r.settings.materialSamples;
     s["reconstruction_misses"] = misses;
