@@ -205,6 +205,9 @@ struct GpuShadelCounters {
     uint markedBlocks;                 // blocks with any marked chunk (may exceed the list)
     uint reconstructionMisses;         // samples that found no marked chunk (must be 0)
     uint overflowSamples;              // samples whose chunk overflowed storage (shaded forward)
+    uint magnifiedPixels;     // sampled reconstructed pixels whose MIP-0 shadel spans > 1 pixel
+    uint reconstructedPixels; // sampled (even x and y) pixels the reconstruction drew
+    uint chunksPerMip[SHADEL_MAX_MIPS]; // allocated chunks by MIP level
     uint pad0;
     uint pad1;
     uvec4 fillDispatch;  // x, y, z, marked blocks in the list: indirect args of the queue fill

@@ -25,6 +25,7 @@ void main() {
     if (fits) {
         UintBuffer(s.offsetMap).v[block] = base;
         atomicAdd(counters.c.chunksAllocated, n);
+        atomicAdd(counters.c.chunksPerMip[mip], n);
     } else {
         atomicAdd(counters.c.chunksOverflowed, n);
     }

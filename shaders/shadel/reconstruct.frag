@@ -89,6 +89,13 @@ void main() {
     if (l.two) color = mix(color, sampleLevel(s, o, l.mip1, inShadelUv, missing, overflowed, mask1), l.blend);
 
     ShadelCountersRef counters = ShadelCountersRef(s.counters);
+    // Magnification: the MIP-0 shadel is larger than the pixel along the longer screen axis.
+    // Counted on one pixel of every 2x2 (a fraction needs no more, and atomics cost).
+    if (all(equal(ivec2(gl_FragCoord.xy) & 1, ivec2(0)))) {
+        vec2 dx = dFdx(texel), dy = dFdy(texel);
+        if (max(dot(dx, dx), dot(dy, dy)) < 1.0) atomicAdd(counters.c.magnifiedPixels, 1u);
+        atomicAdd(counters.c.reconstructedPixels, 1u);
+    }
     if (missing != 0u) atomicAdd(counters.c.reconstructionMisses, 1u);
     if (overflowed != 0u) atomicAdd(counters.c.overflowSamples, 1u);
     if (missing + overflowed != 0u) color = forwardShade(f);

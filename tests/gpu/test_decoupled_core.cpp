@@ -173,3 +173,22 @@ TEST(DecoupledCore, CameraPathsMoveTheCameraDeterministically) {
     EXPECT_NE(walk.frames[2].rgba, orbit.frames[2].rgba);
     EXPECT_EQ(again.frames[2].rgba, orbit.frames[2].rgba);
 }
+
+// magnified_pixel_fraction follows the density: coarser shadels magnify more pixels.
+TEST(DecoupledCore, MagnificationFollowsDensity) {
+    RenderOptions o = decoupled("builtin:smooth", 256, 144);
+    o.shadelsPerMetre = 4.0f;
+    RenderRun coarse = renderChecked(o);
+    o.shadelsPerMetre = 64.0f;
+    RenderRun fine = renderChecked(o);
+    double c = coarse.stats["magnified_pixel_fraction"].get<double>();
+    double f = fine.stats["magnified_pixel_fraction"].get<double>();
+    std::printf("[ figures ] smooth 256x144 magnified pixel fraction: 4 shadels/m %.3f, 64 "
+                "shadels/m %.3f\n",
+                c, f);
+    EXPECT_GT(c, 0.5);
+    EXPECT_LT(f, 0.05);
+    uint64_t perMip = 0;
+    for (const auto& n : fine.stats["chunks_per_mip"]) perMip += n.get<uint64_t>();
+    EXPECT_EQ(perMip, stat(fine, "chunks_shaded"));
+}

@@ -569,6 +569,16 @@ void decoupledStats(const Renderer& r, nlohmann::json& s) {
     s["overflow_samples"] = overflowSamples;
     s["marked_blocks"] = last.counters.markedBlocks;
     s["chunks_shaded"] = chunksShaded;
+    nlohmann::json perMip = nlohmann::json::array();
+    for (uint32_t k = 0; k < SHADEL_MAX_MIPS; ++k) perMip.push_back(last.counters.chunksPerMip[k]);
+    s["chunks_per_mip"] = perMip;
+    // Pixels drawn from shadels whose MIP-0 shadel is larger than the pixel (the image can only
+    // be blurrier than forward there), over the pixels reconstructed from shadels.
+    s["reconstructed_pixels_sampled"] = last.counters.reconstructedPixels; // 1 of every 2x2
+    s["magnified_pixel_fraction"] =
+        last.counters.reconstructedPixels
+            ? double(last.counters.magnifiedPixels) / double(last.counters.reconstructedPixels)
+            : 0.0;
     s["objects_decoupled"] = last.objectsDecoupled;
     s["objects_forward"] = last.objectsForward; // small (hybrid) + no sheet space
     s["objects_forward_small"] = last.objectsSmallForward;
