@@ -45,6 +45,7 @@ using uint = uint32_t;
 #define VISUALIZE_MIPS 2u
 #define VISUALIZE_CHUNKS 3u
 #define VISUALIZE_SHEET 4u
+#define VISUALIZE_LAYER_MATERIAL 5u // --visualize layer:material
 
 // One vertex of the unified geometry buffer (matches shadel::Vertex).
 struct GpuVertex {
@@ -164,6 +165,14 @@ struct ShaderMessage {
 #define SHADEL_CHUNK 8u     // shadels per chunk side
 #define SHADEL_INVALID 0xFFFFFFFFu
 #define SHADEL_OBJECT_DECOUPLED 1u // allocated in the sheet this frame: drawn decoupled
+// Its bounds meet a light that changed this frame: carried-over chunks check their shadels.
+#define SHADEL_OBJECT_NEAR_CHANGED_LIGHT 2u
+#define SHADEL_MAX_CHANGED_LIGHTS 256u
+// Material layers of the shade storage (seed: "layers of different bit depths"): every layer
+// shares the slot allocation; each has its own format.
+#define SHADEL_LAYER_RADIANCE 0u // lit colour, RGBA16F
+#define SHADEL_LAYER_MATERIAL 1u // base colour + roughness, RGBA8 (for GI injection, debugging)
+#define SHADEL_LAYERS 2u
 
 // Per instance: where its shadel space lives in the virtual sheet at each MIP.
 struct GpuShadelObject {
@@ -171,7 +180,9 @@ struct GpuShadelObject {
     uint mipCount;
     uint flags;
     uint firstMip; // finest MIP with a rect this frame (the CPU's estimate of what it can need)
-    uint pad0;
+    // Bit k: MIP k's rect and every shading input of the object (transform, material, lights in
+    // range) are unchanged since last frame, so last frame's shadels there may be carried over.
+    uint reuseLevels;
     uint idMapOffset[SHADEL_MAX_MIPS]; // in 16-bit units into ShadelFrame::idMaps
     uvec4 rect[SHADEL_MAX_MIPS];       // x, y, w, h in blocks of the virtual sheet
 };
@@ -205,10 +216,10 @@ struct GpuShadelCounters {
     uint markedBlocks;                 // blocks with any marked chunk (may exceed the list)
     uint reconstructionMisses;         // samples that found no marked chunk (must be 0)
     uint overflowSamples;              // samples whose chunk overflowed storage (shaded forward)
+    uint chunksReused;        // chunks carried over from last frame's storage (preserved)
     uint magnifiedPixels;     // sampled reconstructed pixels whose MIP-0 shadel spans > 1 pixel
     uint reconstructedPixels; // sampled (even x and y) pixels the reconstruction drew
     uint chunksPerMip[SHADEL_MAX_MIPS]; // allocated chunks by MIP level
-    uint pad0;
     uint pad1;
     uvec4 fillDispatch;  // x, y, z, marked blocks in the list: indirect args of the queue fill
     uvec4 shadeDispatch; // x, y, z, queue length: indirect args of the shading pass
@@ -228,8 +239,18 @@ struct ShadelFrame {
     uint sheetBlocks;        // blocks per side of the virtual sheet
     uint rectCount;
     uint rectBlockCount;
-    uint storageWriteSlot; // bindless storage image of the shade storage
+    uint storageWriteSlot; // bindless storage image of this frame's radiance layer
     uint storageReadSlot;  // bindless sampled view of it
+    uint layerWriteSlot[SHADEL_LAYERS];    // this frame's layers (storage images)
+    uint layerReadSlot[SHADEL_LAYERS];     // this frame's layers (sampled)
+    uint prevLayerReadSlot[SHADEL_LAYERS]; // last frame's layers (sampled): preserved layers
+    uint64_t prevOccupancy;                // last frame's occupancy masks
+    uint64_t prevOffsetMap;                // last frame's offset map
+    uint64_t changedLights; // vec4 (centre, radius) of what lights that changed reach
+    uint changedLightCount;
+    uint frameNumber;   // frames rendered by this renderer (refresh phase)
+    uint refreshPeriod; // a carried-over chunk is reshaded at least every this many frames
+    uint reuse;         // 0: reshade everything (--reuse off)
     uint storageChunksPerRow;
     uint capacityChunks;
     uint markedCapacity;    // entries of markedBlocks (= capacityChunks: a block needs >= 1 chunk)

@@ -23,8 +23,8 @@ layout(location = 5) in vec2 inShadelUv;
 
 layout(location = 0) out vec4 outColor;
 
-vec3 sampleLevel(ShadelFrame s, GpuShadelObject o, uint mip, vec2 uv, inout uint missing,
-                 inout uint overflowed, out uint64_t firstMask) {
+vec3 sampleLevel(ShadelFrame s, GpuShadelObject o, uint mip, vec2 uv, uint layerSlot,
+                 inout uint missing, inout uint overflowed, out uint64_t firstMask) {
     ivec2 t0;
     vec2 w;
     bilinearFootprint(o, mip, uv, t0, w);
@@ -48,7 +48,7 @@ vec3 sampleLevel(ShadelFrame s, GpuShadelObject o, uint mip, vec2 uv, inout uint
         if ((mask & (1ul << bit)) == 0ul) { missing++; continue; }
         if (base == SHADEL_INVALID) { overflowed++; continue; }
         uint slot = chunkSlot(mask, base, bit);
-        vec3 c = fetchTextureUniform(s.storageReadSlot, storageTexel(s, slot, sheet % SHADEL_CHUNK), 0).rgb;
+        vec3 c = fetchTextureUniform(layerSlot, storageTexel(s, slot, sheet % SHADEL_CHUNK), 0).rgb;
         float weight = (offset.x == 1 ? w.x : 1.0 - w.x) * (offset.y == 1 ? w.y : 1.0 - w.y);
         sum += c * weight;
     }
@@ -85,8 +85,11 @@ void main() {
     float lod = float(l.mip0) + l.blend;
     uint missing = 0u, overflowed = 0u;
     uint64_t mask0, mask1;
-    vec3 color = sampleLevel(s, o, l.mip0, inShadelUv, missing, overflowed, mask0);
-    if (l.two) color = mix(color, sampleLevel(s, o, l.mip1, inShadelUv, missing, overflowed, mask1), l.blend);
+    // --visualize layer:material reads the material layer where the radiance layer is read.
+    uint layer = f.visualize == VISUALIZE_LAYER_MATERIAL ? s.layerReadSlot[SHADEL_LAYER_MATERIAL]
+                                                         : s.storageReadSlot;
+    vec3 color = sampleLevel(s, o, l.mip0, inShadelUv, layer, missing, overflowed, mask0);
+    if (l.two) color = mix(color, sampleLevel(s, o, l.mip1, inShadelUv, layer, missing, overflowed, mask1), l.blend);
 
     ShadelCountersRef counters = ShadelCountersRef(s.counters);
     // Magnification: the MIP-0 shadel is larger than the pixel along the longer screen axis.

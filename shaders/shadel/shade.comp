@@ -10,9 +10,75 @@
 layout(local_size_x = 8, local_size_y = 8) in;
 layout(push_constant, scalar) uniform Push { uint64_t frame; } pc;
 
+void storeLayers(ShadelFrame s, ivec2 texel, vec4 radiance, vec4 material) {
+    imageStore(gImagesRgba16f[s.layerWriteSlot[SHADEL_LAYER_RADIANCE]], texel, radiance);
+    imageStore(gImagesRgba8[s.layerWriteSlot[SHADEL_LAYER_MATERIAL]], texel, material);
+}
+
 uint triangleId(ShadelFrame s, uint offset) {
     uint word = UintBuffer(s.idMaps).v[offset >> 1];
     return (word >> ((offset & 1u) * 16u)) & 0xFFFFu;
+}
+
+// Preserved layers (seed: "GetIndexPrevSampleVirtualCoords ... if it was computed last frame
+// it's there"). Where last frame stored this chunk, returns its storage slot then; -1 when the
+// chunk must be shaded: reuse off, the object's level changed (reuseLevels, decided on the
+// CPU), or this chunk's turn to be refreshed (each chunk is reshaded once per refresh period,
+// at its own phase, so view-dependent terms never lag for long). Uniform over the workgroup.
+int carrySource(ShadelFrame s, GpuShadelObject o, GpuShadelWork work) {
+    if (s.reuse == 0u || ((o.reuseLevels >> work.mip) & 1u) == 0u) return -1;
+    if ((((work.chunk * 2654435761u) >> 20) + s.frameNumber) % s.refreshPeriod == 0u) return -1;
+    uvec2 sheet = uvec2(work.chunk & 0xFFFFu, work.chunk >> 16) * SHADEL_CHUNK;
+    uint block = blockIndex(s, sheet);
+    uint bit = chunkBit(sheet);
+    uint64_t prevMask = Uint64Buffer(s.prevOccupancy).v[block];
+    uint prevBase = UintBuffer(s.prevOffsetMap).v[block];
+    if ((prevMask & (1ul << bit)) == 0ul || prevBase == SHADEL_INVALID) return -1;
+    return int(chunkSlot(prevMask, prevBase, bit));
+}
+
+void carryOver(ShadelFrame s, uint fromSlot, ivec2 outTexel) {
+    ivec2 from = storageTexel(s, fromSlot, gl_LocalInvocationID.xy);
+    imageStore(gImagesRgba16f[s.layerWriteSlot[SHADEL_LAYER_RADIANCE]], outTexel,
+               fetchTexture(s.prevLayerReadSlot[SHADEL_LAYER_RADIANCE], from, 0));
+    imageStore(gImagesRgba8[s.layerWriteSlot[SHADEL_LAYER_MATERIAL]], outTexel,
+               fetchTexture(s.prevLayerReadSlot[SHADEL_LAYER_MATERIAL], from, 0));
+    if (gl_LocalInvocationIndex == 0u) atomicAdd(ShadelCountersRef(s.counters).c.chunksReused, 1u);
+}
+
+shared bool chunkNearChangedLight;
+
+// Whether any shadel of the chunk lies within reach of a light that changed this frame (the
+// object's bounds do, or this is not called). Only positions are rebuilt. Call in uniform flow.
+bool chunkTouchesChangedLight(FrameConstants f, ShadelFrame s, GpuShadelObject o, GpuShadelWork work) {
+    if (gl_LocalInvocationIndex == 0u) chunkNearChangedLight = false;
+    barrier();
+    uvec2 size = levelSize(o, work.mip);
+    uvec2 shadel = uvec2(work.chunk & 0xFFFFu, work.chunk >> 16) * SHADEL_CHUNK +
+                   gl_LocalInvocationID.xy - o.rect[work.mip].xy * SHADEL_BLOCK;
+    uint tri = all(lessThan(shadel, size))
+                   ? triangleId(s, o.idMapOffset[work.mip] + shadel.y * size.x + shadel.x)
+                   : 0xFFFFu;
+    if (tri != 0xFFFFu) {
+        GpuInstance inst = InstanceBuffer(f.instances).i[work.object];
+        GpuMesh mesh = MeshBuffer(f.meshes).m[inst.mesh];
+        IndexBuffer indices = IndexBuffer(f.indices);
+        uint i0 = indices.i[mesh.firstIndex + tri * 3u] + uint(mesh.vertexOffset);
+        uint i1 = indices.i[mesh.firstIndex + tri * 3u + 1u] + uint(mesh.vertexOffset);
+        uint i2 = indices.i[mesh.firstIndex + tri * 3u + 2u] + uint(mesh.vertexOffset);
+        Vec2Buffer uvs = Vec2Buffer(s.shadelUvs);
+        vec3 b = shadelBarycentrics(shadelCenterUv(shadel, size), uvs.v[i0], uvs.v[i1], uvs.v[i2]);
+        VertexBuffer vb = VertexBuffer(f.vertices);
+        vec3 p = shadelInterpolate(b, vb.v[i0].position, vb.v[i1].position, vb.v[i2].position);
+        vec3 world = (inst.model * vec4(p, 1.0)).xyz;
+        Vec4Buffer lights = Vec4Buffer(s.changedLights);
+        for (uint i = 0u; i < s.changedLightCount; ++i) {
+            vec4 l = lights.v[i];
+            if (isinf(l.w) || distance(world, l.xyz) <= l.w) chunkNearChangedLight = true;
+        }
+    }
+    barrier();
+    return chunkNearChangedLight;
 }
 
 void main() {
@@ -25,17 +91,25 @@ void main() {
     GpuShadelObject o = ShadelObjectBuffer(s.objects).o[work.object];
     uvec2 local = gl_LocalInvocationID.xy;
     ivec2 outTexel = storageTexel(s, work.slot, local);
+    int carrySlot = carrySource(s, o, work);
+    if (carrySlot >= 0 && (o.flags & SHADEL_OBJECT_NEAR_CHANGED_LIGHT) != 0u &&
+        chunkTouchesChangedLight(f, s, o, work))
+        carrySlot = -1;
+    if (carrySlot >= 0) {
+        carryOver(s, uint(carrySlot), outTexel);
+        return;
+    }
 
     uvec2 sheetShadel = uvec2(work.chunk & 0xFFFFu, work.chunk >> 16) * SHADEL_CHUNK + local;
     uvec2 size = levelSize(o, work.mip);
     uvec2 shadel = sheetShadel - o.rect[work.mip].xy * SHADEL_BLOCK;
     if (any(greaterThanEqual(shadel, size))) {
-        imageStore(gImagesRgba16f[s.storageWriteSlot], outTexel, vec4(0.0));
+        storeLayers(s, outTexel, vec4(0.0), vec4(0.0));
         return;
     }
     uint tri = triangleId(s, o.idMapOffset[work.mip] + shadel.y * size.x + shadel.x);
     if (tri == 0xFFFFu) { // gutter no filter reads: nothing to shade
-        imageStore(gImagesRgba16f[s.storageWriteSlot], outTexel, vec4(0.0));
+        storeLayers(s, outTexel, vec4(0.0), vec4(0.0));
         return;
     }
     GpuInstance inst = InstanceBuffer(f.instances).i[work.object];
@@ -100,5 +174,5 @@ void main() {
         m.emissive = sum.emissive * 0.25;
     }
     vec3 color = shadeSurface(f, m, si.position, si.normal);
-    imageStore(gImagesRgba16f[s.storageWriteSlot], outTexel, vec4(color, 1.0));
+    storeLayers(s, outTexel, vec4(color, 1.0), vec4(clamp(m.baseColor, 0.0, 1.0), m.roughness));
 }

@@ -9,6 +9,7 @@ layout(buffer_reference, scalar) readonly buffer ShadelRectBuffer { GpuShadelRec
 layout(buffer_reference, scalar) buffer ShadelWorkBuffer { GpuShadelWork w[]; };
 layout(buffer_reference, scalar) buffer Uvec4Buffer { uvec4 v[]; };
 layout(buffer_reference, scalar) buffer Uvec2Buffer { uvec2 v[]; };
+layout(buffer_reference, scalar) readonly buffer Vec4Buffer { vec4 v[]; };
 
 // MIP selection: the same in marking and reconstruction (the seed's custom MIP calculation).
 // `texel` is the position in MIP-0 shadels; derivatives are per pixel.

@@ -7,7 +7,9 @@
 
 namespace shadel {
 
-// Renders the same scene in both modes in one process and prints decoupled / forward ratios.
+// Renders the same scene over the same camera path forward, decoupled with reuse off and
+// decoupled with reuse on, in one process, and prints per-pass medians and frame-time ratios
+// against forward (DESIGN §5, §7).
 nlohmann::json runBench(Gpu& gpu, const BenchOptions& b) {
     RenderOptions o;
     o.scene = b.scene;
@@ -19,65 +21,83 @@ nlohmann::json runBench(Gpu& gpu, const BenchOptions& b) {
     o.shadelsPerMetre = b.shadelsPerMetre;
     o.cacheDir = b.cacheDir;
     o.cameraPath = b.cameraPath;
+    o.animateLights = b.animateLights;
+    o.reuseRefreshPeriod = b.reuseRefreshPeriod;
     o.progress = false;
 
-    std::fprintf(stderr, "bench: forward, %u frames at %ux%u\n", b.frames, b.width, b.height);
-    o.mode = RenderMode::Forward;
-    nlohmann::json forward = runRender(gpu, o).stats;
-    std::fprintf(stderr, "bench: decoupled, %u frames at %ux%u\n", b.frames, b.width, b.height);
-    o.mode = RenderMode::Decoupled;
-    nlohmann::json decoupled = runRender(gpu, o).stats;
-
+    struct Mode {
+        const char* name;
+        RenderMode mode;
+        bool reuse;
+    };
+    const Mode modes[] = {{"forward", RenderMode::Forward, false},
+                          {"decoupled", RenderMode::Decoupled, false},
+                          {"reuse", RenderMode::Decoupled, true}};
+    static const char* pathNames[] = {"static", "orbit", "walk"};
     nlohmann::json out;
     out["scene"] = b.scene;
     out["device"] = gpu.device.name;
     out["frames"] = b.frames;
-    static const char* pathNames[] = {"static", "orbit", "walk"};
     out["camera_path"] = pathNames[int(b.cameraPath)];
-    // DESIGN §5: modes.forward|decoupled|reuse and ratios (median frame over forward's). The
-    // reuse mode (preserved layers, issue 9) is not built yet, so it is absent, not faked.
-    out["modes"]["forward"] = forward;
-    out["modes"]["decoupled"] = decoupled;
-    double fwd = forward["frame_ms"]["median"], dec = decoupled["frame_ms"]["median"];
-    out["ratios"]["decoupled"] = fwd > 0 ? dec / fwd : 0.0;
-
-    std::printf("shadel bench: %s at %ux%u on %s, %u frames, medians (timing: %s)\n",
-                b.scene.c_str(), b.width, b.height, gpu.device.name.c_str(), b.frames,
-                forward["timing"].get<std::string>().c_str());
-    std::printf("%-26s %12s %12s %8s\n", "", "forward ms", "decoupled ms", "ratio");
-    std::printf("%-26s %12.3f %12.3f %8.3f\n", "frame", fwd, dec, fwd > 0 ? dec / fwd : 0.0);
-    // Passes: union by name, in frame order of the decoupled path.
-    auto find = [](const nlohmann::json& passes, const std::string& name) -> double {
-        for (const auto& p : passes)
-            if (p["name"] == name) return p["gpu_ms"];
-        return -1.0;
-    };
-    std::vector<std::string> names;
-    for (const auto& p : forward["passes"]) names.push_back(p["name"]);
-    for (const auto& p : decoupled["passes"])
-        if (std::find(names.begin(), names.end(), p["name"]) == names.end())
-            names.push_back(p["name"]);
-    for (const std::string& n : names) {
-        double f = find(forward["passes"], n), d = find(decoupled["passes"], n);
-        std::printf("  %-24s %12s %12s\n", n.c_str(), f >= 0 ? format("%.3f", f).c_str() : "-",
-                    d >= 0 ? format("%.3f", d).c_str() : "-");
+    out["animate_lights"] = b.animateLights;
+    for (const Mode& m : modes) {
+        std::fprintf(stderr, "bench: %s, %u frames at %ux%u (%s camera)\n", m.name, b.frames,
+                     b.width, b.height, pathNames[int(b.cameraPath)]);
+        o.mode = m.mode;
+        o.reuse = m.reuse;
+        out["modes"][m.name] = runRender(gpu, o).stats;
     }
-    std::printf("%-26s %12s %12.3f\n", "shadels per covered pixel", "-",
-                decoupled["shadels_per_pixel"].get<double>());
-    if (decoupled.contains("occupancy_bits_per_shadel"))
-        std::printf("%-26s %12s %12.3f\n", "occupancy bits per shadel", "-",
-                    decoupled["occupancy_bits_per_shadel"].get<double>());
-    std::printf("%-26s %12s %12s\n", "storage used (chunks)", "-",
-                format("%llu/%llu",
-                       (unsigned long long)decoupled["chunks_allocated"].get<uint64_t>(),
-                       (unsigned long long)decoupled["chunks_capacity"].get<uint64_t>())
-                    .c_str());
-    std::printf("%-26s %12llu %12llu\n", "reconstruction misses", 0ull,
-                (unsigned long long)decoupled["reconstruction_misses"].get<uint64_t>());
+    const nlohmann::json& forward = out["modes"]["forward"];
+    double fwd = forward["frame_ms"]["median"];
+    for (const char* name : {"decoupled", "reuse"}) {
+        double ms = out["modes"][name]["frame_ms"]["median"];
+        out["ratios"][name] = fwd > 0 ? ms / fwd : 0.0;
+    }
+
+    std::printf("shadel bench: %s at %ux%u on %s, %u frames, %s camera, medians (timing: %s)\n",
+                b.scene.c_str(), b.width, b.height, gpu.device.name.c_str(), b.frames,
+                pathNames[int(b.cameraPath)], forward["timing"].get<std::string>().c_str());
+    std::printf("%-28s %12s %12s %12s\n", "", "forward", "decoupled", "reuse");
+    auto row = [&](const char* label, auto value) {
+        std::printf("%-28s", label);
+        for (const Mode& m : modes) std::printf(" %12s", value(out["modes"][m.name]).c_str());
+        std::printf("\n");
+    };
+    row("frame ms", [](const nlohmann::json& s) {
+        return format("%.3f", s["frame_ms"]["median"].get<double>());
+    });
+    row("ratio to forward", [&](const nlohmann::json& s) {
+        return format("%.3f", fwd > 0 ? s["frame_ms"]["median"].get<double>() / fwd : 0.0);
+    });
+    // Passes: union by name, in frame order.
+    std::vector<std::string> names;
+    for (const Mode& m : modes)
+        for (const auto& p : out["modes"][m.name]["passes"])
+            if (std::find(names.begin(), names.end(), p["name"]) == names.end())
+                names.push_back(p["name"]);
+    for (const std::string& n : names)
+        row(("  " + n).c_str(), [&](const nlohmann::json& s) {
+            for (const auto& p : s["passes"])
+                if (p["name"] == n) return format("%.3f", p["gpu_ms"].get<double>());
+            return std::string("-");
+        });
+    auto decoupledOnly = [](const char* key, const char* fmt) {
+        return [key, fmt](const nlohmann::json& s) {
+            if (!s.contains(key)) return std::string("-");
+            return s[key].is_number_float() ? format(fmt, s[key].get<double>())
+                                            : format("%llu", (unsigned long long)s[key].get<uint64_t>());
+        };
+    };
+    row("shadels per covered pixel", decoupledOnly("shadels_per_pixel", "%.3f"));
+    row("shadels shaded (last)", decoupledOnly("shadels_shaded", ""));
+    row("reuse fraction", decoupledOnly("reuse_fraction", "%.3f"));
+    row("occupancy bits per shadel", decoupledOnly("occupancy_bits_per_shadel", "%.3f"));
+    row("reconstruction misses", decoupledOnly("reconstruction_misses", ""));
     if (!b.json.empty()) {
         std::ofstream f(b.json);
         if (!f) throw InputError(format("%s: cannot write bench JSON", b.json.c_str()));
         f << out.dump(2) << "\n";
+        if (!f) throw InputError(format("%s: cannot write bench JSON", b.json.c_str()));
     }
     return out;
 }

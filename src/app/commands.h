@@ -34,6 +34,9 @@ struct RenderOptions {
     uint32_t allocationCounters = SHADEL_COUNTERS;
     bool sheetAllMips = false;
     bool capacityControl = true;
+    bool reuse = true;
+    uint32_t reuseRefreshPeriod = 8;
+    bool animateLights = false;
     CameraPath cameraPath = CameraPath::Static;
     double shadelBudget = 64e6; // MIP-0 shadels the bake may use for the whole scene
     bool printPasses = false;
@@ -69,6 +72,8 @@ struct BenchOptions {
     float shadelsPerMetre = 32.0f;
     std::string cacheDir;
     CameraPath cameraPath = CameraPath::Static;
+    bool animateLights = false;
+    uint32_t reuseRefreshPeriod = 8;
 };
 nlohmann::json runBench(Gpu& gpu, const BenchOptions& options);
 

@@ -63,7 +63,9 @@ int main(int argc, char** argv) {
         ->add_option("--jitter", jitter, "none | subpixel: sub-pixel camera offsets between frames")
         ->capture_default_str();
     render->add_option("--ssaa", ro.ssaa, "N: NxN supersampled reference")->capture_default_str();
-    render->add_option("--visualize", visualize, "none | marking | mips | chunks | sheet")
+    render
+        ->add_option("--visualize", visualize,
+                     "none | marking | mips | chunks | sheet | layer:radiance | layer:material")
         ->capture_default_str();
     render->add_option("--out", ro.out, "FILE.png (last frame) or DIR/ (every frame)");
     render->add_option("--stats", ro.stats, "FILE.json");
@@ -110,6 +112,18 @@ int main(int argc, char** argv) {
         ->add_option("--capacity-control", capacityControl,
                      "decoupled: on | off: raise the shading bias when storage runs short")
         ->capture_default_str();
+    std::string reuse = "on";
+    render
+        ->add_option("--reuse", reuse,
+                     "decoupled: on | off: carry shadels whose inputs did not change over from "
+                     "last frame (preserved layers)")
+        ->capture_default_str();
+    render
+        ->add_option("--reuse-refresh", ro.reuseRefreshPeriod,
+                     "decoupled: reshade every carried-over chunk at least once per N frames")
+        ->capture_default_str();
+    render->add_flag("--animate-lights", ro.animateLights,
+                     "move point and spot lights on small circles over the frames");
     render->add_flag("--passes", ro.printPasses, "print the per-pass timing table");
 
     // bench
@@ -128,6 +142,10 @@ int main(int argc, char** argv) {
     bench->add_option("--cache-dir", bo.cacheDir, "bake cache directory");
     std::string benchCameraPath = "static";
     bench->add_option("--camera-path", benchCameraPath, "static | orbit | walk")
+        ->capture_default_str();
+    bench->add_flag("--animate-lights", bo.animateLights, "move point and spot lights");
+    bench->add_option("--reuse-refresh", bo.reuseRefreshPeriod,
+                      "reuse mode: reshade every carried-over chunk once per N frames")
         ->capture_default_str();
 
     // bake
@@ -209,6 +227,9 @@ int main(int argc, char** argv) {
                 throw InputError(format("--capacity-control %s: expected on or off",
                                         capacityControl.c_str()));
             ro.capacityControl = capacityControl == "on";
+            if (reuse != "on" && reuse != "off")
+                throw InputError(format("--reuse %s: expected on or off", reuse.c_str()));
+            ro.reuse = reuse == "on";
             RenderRun run = runRender(g.gpu, ro);
             const auto& s = run.stats;
             std::printf(

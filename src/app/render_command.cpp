@@ -39,8 +39,11 @@ Visualize parseVisualize(const std::string& text) {
     if (text == "mips") return Visualize::Mips;
     if (text == "chunks") return Visualize::Chunks;
     if (text == "sheet") return Visualize::Sheet;
-    throw InputError(
-        format("--visualize %s: expected none, marking, mips, chunks or sheet", text.c_str()));
+    if (text == "layer:radiance") return Visualize::None; // the image is the radiance layer
+    if (text == "layer:material") return Visualize::LayerMaterial;
+    throw InputError(format("--visualize %s: expected none, marking, mips, chunks, sheet, "
+                            "layer:radiance or layer:material",
+                            text.c_str()));
 }
 
 std::string defaultCacheDir() {
@@ -136,6 +139,11 @@ RenderRun runRender(Gpu& gpu, const RenderOptions& o) {
     settings.allocationCounters = o.allocationCounters;
     settings.sheetAllMips = o.sheetAllMips;
     settings.capacityControl = o.capacityControl;
+    settings.reuse = o.reuse;
+    if (o.reuseRefreshPeriod < 1 || o.reuseRefreshPeriod > 1024)
+        throw InputError(format("--reuse-refresh %u: expected 1..1024", o.reuseRefreshPeriod));
+    settings.reuseRefreshPeriod = o.reuseRefreshPeriod;
+    settings.animateLights = o.animateLights;
     settings.timing = o.timing ? *o.timing : defaultTimingMode(gpu);
     Renderer renderer;
     RenderRun run;

@@ -200,6 +200,7 @@ void uploadScene(Gpu& gpu, const Scene& scene, GpuScene& out, const std::vector<
         uploadArray(gpu, "scene.lights", lights.data(), lights.size() * sizeof(gpu::GpuLight));
     out.instanceCount = uint32_t(instances.size());
     out.lightCount = uint32_t(lights.size());
+    out.lightInfo = lights;
     out.geometryBytes = vertices.size() * sizeof(gpu::GpuVertex) + indices.size() * 4;
 }
 

@@ -35,6 +35,7 @@ struct GpuScene {
     std::vector<ShadelMeshInfo> shadelMeshes; // per mesh, when baked
     BufferHandle idMaps;                      // every mesh's triangle-ID maps, all MIPs
     std::vector<gpu::GpuInstance> instanceInfo;
+    std::vector<gpu::GpuLight> lightInfo; // what `lights` holds
     uint32_t instanceCount = 0;
     uint32_t lightCount = 0;
     Aabb bounds;

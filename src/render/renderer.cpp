@@ -6,6 +6,7 @@
 
 #include "core/log.h"
 #include "render/forward/forward_passes.h"
+#include "render/lighting/light_animation.h"
 #include "render/post/tonemap.h"
 #include "render/shadel/decoupled.h"
 
@@ -72,7 +73,13 @@ void initRenderer(Renderer& r, Gpu& gpu, const RenderSettings& settings, const G
     r.pixels =
         createBuffer(gpu, {"pixels.readback", VkDeviceSize(settings.width) * settings.height * 4, 0,
                            MemoryKind::Readback});
-    if (!r.draws || !r.shadowDraws || !r.drawCounts || !r.frameConstants || !r.pixels)
+    if (settings.animateLights)
+        r.animatedLights =
+            createBuffer(gpu, {"lights.animated",
+                               std::max<size_t>(scene.lightInfo.size(), 1) * sizeof(gpu::GpuLight),
+                               0, MemoryKind::Upload});
+    if (!r.draws || !r.shadowDraws || !r.drawCounts || !r.frameConstants || !r.pixels ||
+        (settings.animateLights && !r.animatedLights))
         throw DeviceError("out of GPU memory for the renderer's frame buffers");
     createForwardPipelines(r);
     createTonemapPipeline(r);
@@ -92,6 +99,7 @@ void destroyRenderer(Renderer& r) {
     destroy(gpu, r.tonemap);
     for (BufferHandle b : {r.draws, r.shadowDraws, r.drawCounts, r.frameConstants, r.pixels})
         destroy(gpu, b);
+    if (r.animatedLights) destroy(gpu, r.animatedLights);
     destroy(gpu, r.hdrTarget);
     destroy(gpu, r.hdrRead);
     destroy(gpu, r.depthTarget);
@@ -154,6 +162,19 @@ static gpu::FrameConstants makeFrameConstants(Renderer& r, const GpuScene& scene
     return f;
 }
 
+// --animate-lights: this frame's lights into the upload buffer, and what changed since the last
+// frame (the decoupled path reshades what changed lights reach).
+static void updateLights(Renderer& r, const GpuScene& scene, gpu::FrameConstants& constants) {
+    r.changedLightVolumes.clear();
+    if (!r.settings.animateLights || scene.lightInfo.empty()) return;
+    std::vector<gpu::GpuLight> lights = animatedLights(scene.lightInfo, r.framesRendered);
+    std::memcpy(mapped(*r.gpu, r.animatedLights), lights.data(),
+                lights.size() * sizeof(gpu::GpuLight));
+    constants.lights = address(*r.gpu, r.animatedLights);
+    if (r.framesRendered > 0) r.changedLightVolumes = changedLightVolumes(r.lightsLastFrame, lights);
+    r.lightsLastFrame = std::move(lights);
+}
+
 // One frame, top to bottom. Forward: cull, shadow, depth prepass, shading, tonemap.
 // Decoupled replaces shading with marking, allocation, work queues, shadel shading and
 // reconstruction (render/shadel/decoupled.h).
@@ -162,6 +183,7 @@ FrameResult renderFrame(Renderer& r, const GpuScene& scene, const CameraView& ca
     r.sceneIndices = scene.indices;
     r.skyColor = scene.skyColor;
     gpu::FrameConstants constants = makeFrameConstants(r, scene, camera);
+    updateLights(r, scene, constants);
     if (r.decoupled) prepareDecoupledFrame(r, scene, camera, constants);
     std::memcpy(mapped(gpu, r.frameConstants), &constants, sizeof(constants));
     uint64_t frame = address(gpu, r.frameConstants);
@@ -187,6 +209,7 @@ FrameResult renderFrame(Renderer& r, const GpuScene& scene, const CameraView& ca
     result.frameMs = rec.frameMs;
     result.shaderAsserts = collectShaderMessages(gpu, r.messages);
     if (r.decoupled) finishDecoupledFrame(r);
+    r.framesRendered++;
     size_t bytes = size_t(r.settings.width) * r.settings.height * 4;
     result.rgba.resize(bytes);
     std::memcpy(result.rgba.data(), mapped(gpu, r.pixels), bytes);

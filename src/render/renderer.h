@@ -14,7 +14,14 @@
 namespace shadel {
 
 enum class RenderMode { Forward, Decoupled };
-enum class Visualize : uint32_t { None = 0, Marking = 1, Mips = 2, Chunks = 3, Sheet = 4 };
+enum class Visualize : uint32_t {
+    None = 0,
+    Marking = 1,
+    Mips = 2,
+    Chunks = 3,
+    Sheet = 4,
+    LayerMaterial = 5, // --visualize layer:material (the shade storage's material layer)
+};
 
 struct RenderSettings {
     uint32_t width = 1280, height = 720;
@@ -32,7 +39,10 @@ struct RenderSettings {
     float forwardBelowPixels = 8;  // decoupled: objects smaller on screen drawn forward (0 = never)
     uint32_t allocationCounters = SHADEL_COUNTERS; // decoupled: hashed counters used (tests)
     bool sheetAllMips = false;
-    bool capacityControl = true; // decoupled: steer the shading bias from storage use // decoupled: rects at every MIP (the old policy, for comparison)
+    bool capacityControl = true; // decoupled: steer the shading bias from storage use
+    bool reuse = true;           // decoupled: carry unchanged shadels over from last frame
+    uint32_t reuseRefreshPeriod = 8; // decoupled: reshade every carried chunk this often
+    bool animateLights = false;  // point and spot lights move on small circles // decoupled: rects at every MIP (the old policy, for comparison)
 };
 
 struct FrameResult {
@@ -72,6 +82,12 @@ struct Renderer {
     ShaderMessageChannel messages;
     FrameRecorder recorder;
     DecoupledStatePtr decoupled;
+    // Light animation: this frame's lights, last frame's, and the volumes (xyz, radius) of the
+    // lights that changed between them (what the decoupled path must reshade).
+    BufferHandle animatedLights; // host-visible gpu::GpuLight[], when animating
+    std::vector<gpu::GpuLight> lightsLastFrame;
+    std::vector<glm::vec4> changedLightVolumes;
+    uint64_t framesRendered = 0;
 };
 
 void initRenderer(Renderer& renderer, Gpu& gpu, const RenderSettings& settings,

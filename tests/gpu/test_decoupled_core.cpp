@@ -192,3 +192,48 @@ TEST(DecoupledCore, MagnificationFollowsDensity) {
     for (const auto& n : fine.stats["chunks_per_mip"]) perMip += n.get<uint64_t>();
     EXPECT_EQ(perMip, stat(fine, "chunks_shaded"));
 }
+
+// Preserved layers: on a moving camera most chunks are carried over from last frame, and every
+// frame still matches the frame shaded from scratch; lights that move are never carried over
+// where they reach.
+TEST(DecoupledCore, ReuseChangesNothingVisibleOnAnOrbit) {
+    for (bool animateLights : {false, true}) {
+        RenderOptions o = decoupled("builtin:default", 320, 180);
+        o.frames = 24;
+        o.cameraPath = CameraPath::Orbit;
+        o.animateLights = animateLights;
+        o.reuse = false;
+        RenderRun off = renderChecked(o);
+        o.reuse = true;
+        RenderRun on = renderChecked(o);
+        double worst = 1e9;
+        for (size_t i = 0; i < on.frames.size(); ++i)
+            worst = std::min(worst, psnr(on.frames[i].rgba, off.frames[i].rgba));
+        double fraction = on.stats["reuse_fraction"].get<double>();
+        std::printf("[ figures ] default 320x180 orbit, 24 frames%s: reuse fraction %.3f, worst "
+                    "frame %.2f dB against reuse off\n",
+                    animateLights ? ", animated lights" : "", fraction, worst);
+        EXPECT_EQ(off.stats["reuse_fraction"].get<double>(), 0.0);
+        EXPECT_EQ(stat(on, "reconstruction_misses"), 0u);
+        if (animateLights) {
+            EXPECT_GE(worst, 35.0);
+            EXPECT_GT(fraction, 0.02);
+        } else {
+            EXPECT_GE(worst, 40.0);
+            EXPECT_GT(fraction, 0.5);
+            EXPECT_LT(stat(on, "shadels_shaded"), stat(off, "shadels_shaded"));
+        }
+    }
+}
+
+// --visualize layer:material shows the material layer (base colour + roughness) in place of
+// the lit radiance layer.
+TEST(DecoupledCore, MaterialLayerIsVisibleAndDiffersFromRadiance) {
+    RenderOptions o = decoupled("builtin:smooth", 128, 72);
+    RenderRun radiance = renderChecked(o);
+    o.visualize = Visualize::LayerMaterial;
+    RenderRun material = renderChecked(o);
+    EXPECT_NE(material.frames[0].rgba, radiance.frames[0].rgba);
+    EXPECT_EQ(stat(material, "reconstruction_misses"), 0u);
+    EXPECT_LT(psnr(material.frames[0].rgba, radiance.frames[0].rgba), 30.0);
+}

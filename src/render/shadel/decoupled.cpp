@@ -11,6 +11,7 @@
 #include "render/forward/forward_passes.h"
 #include "render/renderer.h"
 #include "render/shadel/capacity_control.h"
+#include "render/shadel/shade_storage.h"
 
 namespace shadel {
 
@@ -29,6 +30,8 @@ struct SheetRegion {
 // camera can need them).
 struct ObjectSlot {
     bool allocated = false;
+    bool decoupledLastFrame = false; // its rects were in last frame's list (maps hold its marks)
+    std::array<uint64_t, SHADEL_MAX_MIPS> levelSince{}; // frame number each level was placed
     uint32_t firstMip = 0;
     uint32_t mipCount = 0;
     std::array<BlockId, SHADEL_MAX_MIPS> ids{};
@@ -42,7 +45,8 @@ struct FrameCounters {
     uint32_t objectsSmallForward = 0;
     uint32_t objectsSheetLimited = 0;
     uint64_t rectBlocks = 0;
-    float shadingBias = 0.0f; // the bias this frame was shaded with
+    float shadingBias = 0.0f;     // the bias this frame was shaded with
+    uint32_t objectsReusable = 0; // objects with any level whose shadels may be carried over
     std::array<uint32_t, SHADEL_MAX_MIPS> firstMipHistogram{};
 };
 
@@ -70,15 +74,22 @@ struct DecoupledState {
     BufferHandle frameInfo;    // gpu::ShadelFrame (upload)
     BufferHandle objectBuffer; // GpuShadelObject[] (upload)
     BufferHandle rectBuffer;   // GpuShadelRect[] (upload)
-    BufferHandle occupancy;    // uint64 per block
-    BufferHandle offsetMap;    // uint per block
+    // Two frames of occupancy and offset map (this frame's at parity, last frame's at the other),
+    // so a chunk finds where its shadels were last frame.
+    std::array<BufferHandle, 2> occupancy; // uint64 per block
+    std::array<BufferHandle, 2> offsetMap; // uint per block
+    uint64_t frameNumber = 0;              // frames prepared so far
+    uint32_t parity() const { return uint32_t(frameNumber & 1); }
+    bool reuse = true;
+    uint32_t refreshPeriod = 8;
+    uint32_t objectsReusable = 0;
     BufferHandle allocId;      // uint per block (upload: written by the CPU allocator)
     BufferHandle counters;     // GpuShadelCounters (readback, also indirect args)
     BufferHandle markedBlocks; // uvec4 per marked block, capacityChunks of them
     BufferHandle queue;        // GpuShadelWork[capacity], indexed by storage slot
-    TextureHandle storage;
-    TextureWriteView storageWrite;
-    TextureReadView storageRead;
+    BufferHandle changedLights; // vec4[SHADEL_MAX_CHANGED_LIGHTS] (upload)
+    bool changedLightsOverflow = false;
+    ShadeStorage storage;
     Pipeline clear, allocate, queueSetup, fillQueue, shade, sheetView, mark, reconstruct;
     std::vector<FrameCounters> history;
 };
@@ -135,37 +146,36 @@ DecoupledStatePtr createDecoupled(Renderer& r, const GpuScene& scene) {
         return need(createBuffer(gpu, {name, bytes, usage, MemoryKind::DeviceLocal}), name);
     };
     d.frameInfo = upload("shadel.frame", sizeof(gpu::ShadelFrame));
+    d.changedLights = upload("shadel.changedLights", SHADEL_MAX_CHANGED_LIGHTS * 16);
     d.objectBuffer = upload("shadel.objects", d.gpuObjects.size() * sizeof(gpu::GpuShadelObject));
     d.rectBuffer = upload("shadel.rects", std::max<size_t>(scene.instanceCount, 1) *
                                               SHADEL_MAX_MIPS * sizeof(gpu::GpuShadelRect));
-    d.occupancy = device("shadel.chunkOccupancy", blocks * 8);
-    d.offsetMap = device("shadel.offsetMap", blocks * 4);
+    d.occupancy = {device("shadel.chunkOccupancy.frame0", blocks * 8),
+                   device("shadel.chunkOccupancy.frame1", blocks * 8)};
+    d.offsetMap = {device("shadel.offsetMap.frame0", blocks * 4),
+                   device("shadel.offsetMap.frame1", blocks * 4)};
     d.allocId = upload("shadel.allocId", blocks * 4);
     std::memset(mapped(gpu, d.allocId), 0, blocks * 4);
     d.counters =
         need(createBuffer(gpu, {"shadel.counters", sizeof(gpu::GpuShadelCounters),
                                 VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT, MemoryKind::Readback}),
              "counters");
+
+    // Out of GPU memory for the storage: degrade to a smaller one (reported), not fail.
+    while (!createShadeStorage(gpu, d.storageSize, d.storage)) {
+        if (d.storageSize <= 512)
+            throw DeviceError(format("out of GPU memory for a %u^2 shade storage", d.storageSize));
+        SHADEL_WARN("out of GPU memory for a %u^2 shade storage; trying %u^2", d.storageSize,
+                    d.storageSize / 2);
+        d.storageSize /= 2;
+    }
+    d.capacityChunks = (d.storageSize / SHADEL_CHUNK) * (d.storageSize / SHADEL_CHUNK);
+    d.reuse = rs.reuse;
+    d.refreshPeriod = std::max(rs.reuseRefreshPeriod, 1u);
     // Sized once from storage (a listed block holds >= 1 chunk), so no frame allocates.
     d.markedBlocks = device("shadel.markedBlocks", VkDeviceSize(d.capacityChunks) * 16);
     d.queue =
         device("shadel.workQueue", VkDeviceSize(d.capacityChunks) * sizeof(gpu::GpuShadelWork));
-
-    TextureDesc storage;
-    storage.name = "shadel.shadeStorage";
-    storage.format = VK_FORMAT_R16G16B16A16_SFLOAT;
-    storage.width = storage.height = d.storageSize;
-    storage.usage = VK_IMAGE_USAGE_STORAGE_BIT | VK_IMAGE_USAGE_SAMPLED_BIT;
-    d.storage = createTexture(gpu, storage);
-    if (!d.storage) throw DeviceError("out of GPU memory for the shade storage");
-    d.storageWrite = createWriteView(gpu, d.storage);
-    d.storageRead = createReadView(gpu, d.storage);
-    VkImage image = vkImage(gpu, d.storage);
-    immediateSubmit(gpu, [&](VkCommandBuffer cmd) {
-        imageBarrier(cmd, image, VK_IMAGE_ASPECT_COLOR_BIT, VK_IMAGE_LAYOUT_UNDEFINED,
-                     VK_IMAGE_LAYOUT_GENERAL, VK_PIPELINE_STAGE_2_NONE, 0,
-                     VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, VK_ACCESS_2_SHADER_READ_BIT);
-    });
 
     d.clear = createComputePipeline(gpu, "shadelClear", "shadel_clear.comp.spv");
     d.allocate = createComputePipeline(gpu, "shadelAllocate", "shadel_allocate.comp.spv");
@@ -197,12 +207,10 @@ void destroyDecoupled(Renderer& r, DecoupledStatePtr& state) {
     for (Pipeline* p : {&d.clear, &d.allocate, &d.queueSetup, &d.fillQueue, &d.shade, &d.sheetView,
                         &d.mark, &d.reconstruct})
         destroy(gpu, *p);
-    destroy(gpu, d.storageWrite);
-    destroy(gpu, d.storageRead);
-    destroy(gpu, d.storage);
-    for (BufferHandle b :
-         {d.frameInfo, d.objectBuffer, d.rectBuffer, d.occupancy, d.offsetMap, d.allocId,
-          d.counters, d.markedBlocks, d.queue})
+    destroyShadeStorage(gpu, d.storage);
+    for (BufferHandle b : {d.frameInfo, d.changedLights, d.objectBuffer, d.rectBuffer, d.occupancy[0],
+                           d.occupancy[1], d.offsetMap[0], d.offsetMap[1], d.allocId, d.counters,
+                           d.markedBlocks, d.queue})
         destroy(gpu, b);
     state.reset();
 }
@@ -233,6 +241,7 @@ static bool allocateLevel(Gpu& gpu, DecoupledState& d, ObjectSlot& o, uint32_t o
     auto placed = d.regions[k].allocator->insert(blocks);
     if (!placed) return false;
     o.ids[k] = placed->id;
+    o.levelSince[k] = d.frameNumber;
     o.rects[k] = {d.regions[k].x0 + placed->origin[0], placed->origin[1], blocks[0], blocks[1]};
     writeAllocId(gpu, d, o.rects[k], ((object + 1) << 4) | k);
     return true;
@@ -292,6 +301,18 @@ static uint32_t finestMipNeeded(const CameraView& camera, float viewportHeight,
     return std::min(uint32_t(lod), mesh.mipCount - 1);
 }
 
+// Which of the spheres (xyz centre, w radius; infinite radius = everything) a box meets.
+enum class LightReach { None, Bounded, Everything };
+static LightReach reachOf(const std::vector<glm::vec4>& spheres, glm::vec3 bmin, glm::vec3 bmax) {
+    LightReach reach = LightReach::None;
+    for (const glm::vec4& s : spheres) {
+        if (!std::isfinite(s.w)) return LightReach::Everything;
+        glm::vec3 nearest = glm::clamp(glm::vec3(s), bmin, bmax);
+        if (glm::length(nearest - glm::vec3(s)) <= s.w) reach = LightReach::Bounded;
+    }
+    return reach;
+}
+
 static bool boxVisible(const std::array<glm::vec4, 6>& planes, glm::vec3 bmin, glm::vec3 bmax) {
     for (const glm::vec4& p : planes) {
         glm::vec3 v{p.x >= 0 ? bmax.x : bmin.x, p.y >= 0 ? bmax.y : bmin.y,
@@ -320,10 +341,17 @@ void prepareDecoupledFrame(Renderer& r, const GpuScene& scene, const CameraView&
     d.rectBlockCount = 0;
     d.objectsDecoupled = d.objectsForward = d.objectsSmallForward = d.objectsSheetLimited = 0;
     d.firstMipHistogram.fill(0);
+    d.objectsReusable = 0;
+    d.changedLightsOverflow = r.changedLightVolumes.size() > SHADEL_MAX_CHANGED_LIGHTS;
+    if (!d.changedLightsOverflow && !r.changedLightVolumes.empty())
+        std::memcpy(mapped(gpu, d.changedLights), r.changedLightVolumes.data(),
+                    r.changedLightVolumes.size() * sizeof(glm::vec4));
     for (uint32_t i = 0; i < scene.instanceCount; ++i) {
         const gpu::GpuInstance& inst = scene.instanceInfo[i];
         const ShadelMeshInfo& mesh = scene.shadelMeshes[inst.mesh];
         ObjectSlot& o = d.objects[i];
+        bool wasDecoupled = o.decoupledLastFrame;
+        o.decoupledLastFrame = false;
         gpu::GpuShadelObject& g = d.gpuObjects[i];
         g = gpu::GpuShadelObject{};
         glm::vec3 margin = (inst.worldMax - inst.worldMin) * d.frustumMargin;
@@ -354,11 +382,28 @@ void prepareDecoupledFrame(Renderer& r, const GpuScene& scene, const CameraView&
         }
         d.objectsSheetLimited += limited;
         d.objectsDecoupled++;
+        o.decoupledLastFrame = true;
+        // Preserved layers: a level's shadels may be carried over when last frame marked and
+        // stored them at the same place (the object was decoupled and the level's rect is
+        // older than this frame) and nothing the shading reads has changed. Instances and
+        // materials are static in this renderer; lights that moved invalidate what they reach.
+        // View-dependent terms (specular) drift with the camera: the shading pass reshades
+        // every chunk at least once per refresh period.
+        // A light that changed and reaches the object: its chunks check their own shadels
+        // against the light (shade.comp); an unbounded one (or too many) changes everything.
+        LightReach reach = d.changedLightsOverflow
+                               ? LightReach::Everything
+                               : reachOf(r.changedLightVolumes, inst.worldMin, inst.worldMax);
+        if (reach == LightReach::Bounded) g.flags |= SHADEL_OBJECT_NEAR_CHANGED_LIGHT;
+        bool inputsUnchanged = d.reuse && wasDecoupled && reach != LightReach::Everything;
+        for (uint32_t k = o.firstMip; k < mesh.mipCount && inputsUnchanged; ++k)
+            if (o.levelSince[k] < d.frameNumber) g.reuseLevels |= 1u << k;
+        d.objectsReusable += g.reuseLevels != 0;
         d.firstMipHistogram[o.firstMip]++;
         g.mip0Size = mesh.mip0Size;
         g.mipCount = mesh.mipCount;
         g.firstMip = o.firstMip;
-        g.flags = SHADEL_OBJECT_DECOUPLED;
+        g.flags |= SHADEL_OBJECT_DECOUPLED;
         for (uint32_t k = o.firstMip; k < mesh.mipCount; ++k) {
             g.idMapOffset[k] = mesh.idMapOffset[k];
             g.rect[k] = o.rects[k];
@@ -373,8 +418,11 @@ void prepareDecoupledFrame(Renderer& r, const GpuScene& scene, const CameraView&
 
     gpu::ShadelFrame s{};
     s.objects = address(gpu, d.objectBuffer);
-    s.occupancy = address(gpu, d.occupancy);
-    s.offsetMap = address(gpu, d.offsetMap);
+    uint32_t now = d.parity(), prev = now ^ 1u;
+    s.occupancy = address(gpu, d.occupancy[now]);
+    s.offsetMap = address(gpu, d.offsetMap[now]);
+    s.prevOccupancy = address(gpu, d.occupancy[prev]);
+    s.prevOffsetMap = address(gpu, d.offsetMap[prev]);
     s.allocId = address(gpu, d.allocId);
     s.counters = address(gpu, d.counters);
     s.rects = address(gpu, d.rectBuffer);
@@ -385,8 +433,18 @@ void prepareDecoupledFrame(Renderer& r, const GpuScene& scene, const CameraView&
     s.sheetBlocks = d.sheetBlocks;
     s.rectCount = uint32_t(d.rects.size());
     s.rectBlockCount = d.rectBlockCount;
-    s.storageWriteSlot = slot(gpu, d.storageWrite).value;
-    s.storageReadSlot = slot(gpu, d.storageRead).value;
+    for (uint32_t l = 0; l < SHADEL_LAYERS; ++l) {
+        s.layerWriteSlot[l] = slot(gpu, d.storage.frames[now][l].write).value;
+        s.layerReadSlot[l] = slot(gpu, d.storage.frames[now][l].read).value;
+        s.prevLayerReadSlot[l] = slot(gpu, d.storage.frames[prev][l].read).value;
+    }
+    s.storageWriteSlot = s.layerWriteSlot[SHADEL_LAYER_RADIANCE];
+    s.storageReadSlot = s.layerReadSlot[SHADEL_LAYER_RADIANCE];
+    s.changedLights = address(gpu, d.changedLights);
+    s.changedLightCount = d.changedLightsOverflow ? 0u : uint32_t(r.changedLightVolumes.size());
+    s.frameNumber = uint32_t(d.frameNumber);
+    s.refreshPeriod = d.refreshPeriod;
+    s.reuse = d.reuse ? 1u : 0u;
     s.storageChunksPerRow = d.storageSize / SHADEL_CHUNK;
     s.capacityChunks = d.capacityChunks;
     s.markedCapacity = d.capacityChunks;
@@ -524,7 +582,9 @@ void finishDecoupledFrame(Renderer& r) {
     f.firstMipHistogram = d.firstMipHistogram;
     f.rectBlocks = d.rectBlockCount;
     f.shadingBias = d.shadingBias;
+    f.objectsReusable = d.objectsReusable;
     d.history.push_back(f);
+    d.frameNumber++;
     // Next frame's bias from this frame's counts (one frame of latency, as with a ring of
     // readback buffers on a pipelined GPU).
     if (d.capacityControl)
@@ -544,11 +604,27 @@ void decoupledStats(const Renderer& r, nlohmann::json& s) {
         misses += f.counters.reconstructionMisses;
         overflowSamples += f.counters.overflowSamples;
     }
-    uint64_t chunksShaded = last.counters.chunksAllocated;
+    // Stored: every allocated chunk (the MIP chain's density); shaded: those not carried over.
+    uint64_t chunksStored = last.counters.chunksAllocated;
+    uint64_t chunksShaded = chunksStored - std::min<uint64_t>(last.counters.chunksReused, chunksStored);
+    uint64_t stored = chunksStored * SHADEL_CHUNK * SHADEL_CHUNK;
     uint64_t shaded = chunksShaded * SHADEL_CHUNK * SHADEL_CHUNK;
     uint64_t covered = s.value("pixels_covered", uint64_t(0));
     s["shadels_shaded"] = shaded;
-    s["shadels_per_pixel"] = covered ? double(shaded) / double(covered) : 0.0;
+    s["shadels_stored"] = stored;
+    s["shadels_reused"] = stored - shaded;
+    s["reuse"] = d.reuse;
+    s["reuse_refresh_period"] = d.refreshPeriod;
+    s["objects_reusable"] = last.objectsReusable;
+    // Over the frames after the first (the first has nothing to reuse), when there are any.
+    uint64_t storedSum = 0, reusedSum = 0;
+    for (size_t i = d.history.size() > 1 ? 1 : 0; i < d.history.size(); ++i) {
+        storedSum += d.history[i].counters.chunksAllocated;
+        reusedSum += d.history[i].counters.chunksReused;
+    }
+    s["reuse_fraction"] = storedSum ? double(reusedSum) / double(storedSum) : 0.0;
+    // Shadels per covered pixel: the storage's density (shaded or carried over).
+    s["shadels_per_pixel"] = covered ? double(stored) / double(covered) : 0.0;
     s["chunks_allocated"] = last.counters.chunksAllocated;
     s["chunks_requested"] = last.counters.chunksRequested;
     s["chunks_overflowed"] = last.counters.chunksOverflowed;
@@ -595,7 +671,7 @@ void decoupledStats(const Renderer& r, nlohmann::json& s) {
     s["occupancy_bits_per_shadel"] =
         shadelsMarked ? double(last.counters.markedBlocks) * 96.0 / double(shadelsMarked) : 0.0;
     // The whole sheet's bookkeeping for this frame (every allocated rect block) per shadel.
-    s["sheet_bits_per_shadel"] = shaded ? double(last.rectBlocks) * 96.0 / double(shaded) : 0.0;
+    s["sheet_bits_per_shadel"] = stored ? double(last.rectBlocks) * 96.0 / double(stored) : 0.0;
     s["storage_used"] =
         d.capacityChunks ? double(last.counters.chunksAllocated) / d.capacityChunks : 0.0;
 }
