@@ -217,12 +217,15 @@ struct GpuShadelCounters {
     uint reconstructionMisses;         // samples that found no marked chunk (must be 0)
     uint overflowSamples;              // samples whose chunk overflowed storage (shaded forward)
     uint chunksReused;        // chunks carried over from last frame's storage (preserved)
+    uint shadeCount;          // entries in the shading queue
+    uint copyCount;           // entries in the carry-over queue
     uint magnifiedPixels;     // sampled reconstructed pixels whose MIP-0 shadel spans > 1 pixel
     uint reconstructedPixels; // sampled (even x and y) pixels the reconstruction drew
     uint chunksPerMip[SHADEL_MAX_MIPS]; // allocated chunks by MIP level
     uint pad1;
     uvec4 fillDispatch;  // x, y, z, marked blocks in the list: indirect args of the queue fill
     uvec4 shadeDispatch; // x, y, z, queue length: indirect args of the shading pass
+    uvec4 copyDispatch;  // x, y, z, queue length: indirect args of the carry-over pass
 };
 
 struct ShadelFrame {
@@ -233,7 +236,8 @@ struct ShadelFrame {
     uint64_t counters;       // GpuShadelCounters
     uint64_t rects;          // GpuShadelRect[rectCount]
     uint64_t markedBlocks;   // uvec4 {block, place in its counter, object, mip | counter << 8}
-    uint64_t queue;          // GpuShadelWork[capacityChunks], indexed by storage slot
+    uint64_t queue;          // GpuShadelWork[capacityChunks]: chunks to shade
+    uint64_t copyQueue;      // GpuShadelWork[capacityChunks]: chunks carried over (chunk = old slot)
     uint64_t idMaps;         // uint16 triangle ids, packed in uints
     uint64_t shadelUvs;      // vec2 per vertex of the unified geometry buffer
     uint sheetBlocks;        // blocks per side of the virtual sheet

@@ -1,7 +1,10 @@
 #version 460
 // Work queue fill: each marked block gets its storage offset (its counter's section base + its
-// place in the counter), publishes it in the offset map, and writes one entry {chunk, storage
-// slot, object, MIP} per marked chunk at the queue index equal to that slot.
+// place in the counter) and publishes it in the offset map. Each of its marked chunks then goes
+// to one of two queues: carried over from last frame's storage (preserved layers: the object's
+// level is unchanged, last frame stored the chunk, and it is not the chunk's turn to be
+// refreshed) or shaded. Chunks of objects a changed light reaches are queued for shading, which
+// checks their shadels against the lights and may still carry them over (shade.comp).
 #include "shadel/shadel.glsl"
 
 layout(local_size_x = 64) in;
@@ -20,28 +23,36 @@ void main() {
     uint64_t mask = Uint64Buffer(s.occupancy).v[block];
     uint n = bitCount(uint(mask)) + bitCount(uint(mask >> 32));
     uint base = counters.c.sectionBase[counter] + entry.y;
-    ShadelWorkBuffer queue = ShadelWorkBuffer(s.queue);
-    bool fits = base + n <= s.capacityChunks;
-    if (fits) {
-        UintBuffer(s.offsetMap).v[block] = base;
-        atomicAdd(counters.c.chunksAllocated, n);
-        atomicAdd(counters.c.chunksPerMip[mip], n);
-    } else {
+    if (base + n > s.capacityChunks) { // storage is full: counted, never written
         atomicAdd(counters.c.chunksOverflowed, n);
+        return;
     }
+    UintBuffer(s.offsetMap).v[block] = base;
+    atomicAdd(counters.c.chunksAllocated, n);
+    atomicAdd(counters.c.chunksPerMip[mip], n);
+
+    GpuShadelObject o = ShadelObjectBuffer(s.objects).o[entry.z];
+    bool copyable = s.reuse != 0u && ((o.reuseLevels >> mip) & 1u) != 0u &&
+                    (o.flags & SHADEL_OBJECT_NEAR_CHANGED_LIGHT) == 0u;
+    uint64_t prevMask = copyable ? Uint64Buffer(s.prevOccupancy).v[block] : 0ul;
+    uint prevBase = copyable ? UintBuffer(s.prevOffsetMap).v[block] : SHADEL_INVALID;
     uvec2 blockXy = uvec2(block % s.sheetBlocks, block / s.sheetBlocks);
     uint k = 0u;
     for (uint bit = 0u; bit < 64u; ++bit) {
         if ((mask & (1ul << bit)) == 0ul) continue;
-        uint slot = base + k;
-        ++k;
-        if (slot >= s.capacityChunks) break;
         uvec2 chunk = blockXy * 8u + uvec2(bit % 8u, bit / 8u);
         GpuShadelWork w;
         w.chunk = chunk.x | (chunk.y << 16);
-        w.slot = fits ? slot : SHADEL_INVALID; // a straddling block: skip entries
+        w.slot = base + k;
         w.object = entry.z;
         w.mip = mip;
-        queue.w[slot] = w;
+        ++k;
+        if ((prevMask & (1ul << bit)) != 0ul && prevBase != SHADEL_INVALID &&
+            !shadelRefreshDue(s, w.chunk)) {
+            w.chunk = chunkSlot(prevMask, prevBase, bit); // where last frame stored it
+            ShadelWorkBuffer(s.copyQueue).w[atomicAdd(counters.c.copyCount, 1u)] = w;
+        } else {
+            ShadelWorkBuffer(s.queue).w[atomicAdd(counters.c.shadeCount, 1u)] = w;
+        }
     }
 }

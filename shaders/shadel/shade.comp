@@ -27,7 +27,7 @@ uint triangleId(ShadelFrame s, uint offset) {
 // at its own phase, so view-dependent terms never lag for long). Uniform over the workgroup.
 int carrySource(ShadelFrame s, GpuShadelObject o, GpuShadelWork work) {
     if (s.reuse == 0u || ((o.reuseLevels >> work.mip) & 1u) == 0u) return -1;
-    if ((((work.chunk * 2654435761u) >> 20) + s.frameNumber) % s.refreshPeriod == 0u) return -1;
+    if (shadelRefreshDue(s, work.chunk)) return -1;
     uvec2 sheet = uvec2(work.chunk & 0xFFFFu, work.chunk >> 16) * SHADEL_CHUNK;
     uint block = blockIndex(s, sheet);
     uint bit = chunkBit(sheet);
@@ -87,14 +87,13 @@ void main() {
     uint workIndex = gl_WorkGroupID.y * 32768u + gl_WorkGroupID.x;
     if (workIndex >= ShadelCountersRef(s.counters).c.shadeDispatch.w) return;
     GpuShadelWork work = ShadelWorkBuffer(s.queue).w[workIndex];
-    if (work.slot == SHADEL_INVALID) return; // part of a block that overflowed storage
     GpuShadelObject o = ShadelObjectBuffer(s.objects).o[work.object];
     uvec2 local = gl_LocalInvocationID.xy;
     ivec2 outTexel = storageTexel(s, work.slot, local);
-    int carrySlot = carrySource(s, o, work);
-    if (carrySlot >= 0 && (o.flags & SHADEL_OBJECT_NEAR_CHANGED_LIGHT) != 0u &&
-        chunkTouchesChangedLight(f, s, o, work))
-        carrySlot = -1;
+    // Chunks of objects a changed light reaches come here even when reusable (the fill pass
+    // cannot tell which of their shadels the light reaches): carry over those it does not.
+    int carrySlot = (o.flags & SHADEL_OBJECT_NEAR_CHANGED_LIGHT) != 0u ? carrySource(s, o, work) : -1;
+    if (carrySlot >= 0 && chunkTouchesChangedLight(f, s, o, work)) carrySlot = -1;
     if (carrySlot >= 0) {
         carryOver(s, uint(carrySlot), outTexel);
         return;

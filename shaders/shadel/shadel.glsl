@@ -78,6 +78,12 @@ uint chunkSlot(uint64_t mask, uint base, uint bit) {
     return base + bitCount(uint(below)) + bitCount(uint(below >> 32));
 }
 
+// Preserved layers: a carried-over chunk is still reshaded once per refresh period, each chunk
+// at its own phase, so view-dependent terms never lag for long.
+bool shadelRefreshDue(ShadelFrame s, uint chunk) {
+    return (((chunk * 2654435761u) >> 20) + s.frameNumber) % s.refreshPeriod == 0u;
+}
+
 ivec2 storageTexel(ShadelFrame s, uint slot, uvec2 inChunk) {
     uvec2 c = uvec2(slot % s.storageChunksPerRow, slot / s.storageChunksPerRow);
     return ivec2(c * SHADEL_CHUNK + inChunk);

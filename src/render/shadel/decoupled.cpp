@@ -86,11 +86,13 @@ struct DecoupledState {
     BufferHandle allocId;      // uint per block (upload: written by the CPU allocator)
     BufferHandle counters;     // GpuShadelCounters (readback, also indirect args)
     BufferHandle markedBlocks; // uvec4 per marked block, capacityChunks of them
-    BufferHandle queue;        // GpuShadelWork[capacity], indexed by storage slot
+    BufferHandle queue;        // GpuShadelWork[capacity]: chunks to shade
+    BufferHandle copyQueue;    // GpuShadelWork[capacity]: chunks carried over from last frame
     BufferHandle changedLights; // vec4[SHADEL_MAX_CHANGED_LIGHTS] (upload)
     bool changedLightsOverflow = false;
     ShadeStorage storage;
-    Pipeline clear, allocate, queueSetup, fillQueue, shade, sheetView, mark, reconstruct;
+    Pipeline clear, allocate, queueSetup, fillQueue, dispatchSetup, carryOver, shade, sheetView,
+        mark, reconstruct;
     std::vector<FrameCounters> history;
 };
 
@@ -176,11 +178,16 @@ DecoupledStatePtr createDecoupled(Renderer& r, const GpuScene& scene) {
     d.markedBlocks = device("shadel.markedBlocks", VkDeviceSize(d.capacityChunks) * 16);
     d.queue =
         device("shadel.workQueue", VkDeviceSize(d.capacityChunks) * sizeof(gpu::GpuShadelWork));
+    d.copyQueue = device("shadel.carryOverQueue",
+                         VkDeviceSize(d.capacityChunks) * sizeof(gpu::GpuShadelWork));
 
     d.clear = createComputePipeline(gpu, "shadelClear", "shadel_clear.comp.spv");
     d.allocate = createComputePipeline(gpu, "shadelAllocate", "shadel_allocate.comp.spv");
     d.queueSetup = createComputePipeline(gpu, "shadelQueueSetup", "shadel_queue_setup.comp.spv");
     d.fillQueue = createComputePipeline(gpu, "shadelFillQueue", "shadel_fill_queue.comp.spv");
+    d.dispatchSetup =
+        createComputePipeline(gpu, "shadelDispatchSetup", "shadel_dispatch_setup.comp.spv");
+    d.carryOver = createComputePipeline(gpu, "shadelCarryOver", "shadel_carry_over.comp.spv");
     d.shade = createComputePipeline(gpu, "shadelShade", "shadel_shade.comp.spv");
     d.sheetView = createComputePipeline(gpu, "shadelSheetView", "shadel_sheet_view.comp.spv");
     GraphicsPipelineDesc mark;
@@ -204,13 +211,13 @@ void destroyDecoupled(Renderer& r, DecoupledStatePtr& state) {
     if (!state) return;
     Gpu& gpu = *r.gpu;
     DecoupledState& d = *state;
-    for (Pipeline* p : {&d.clear, &d.allocate, &d.queueSetup, &d.fillQueue, &d.shade, &d.sheetView,
-                        &d.mark, &d.reconstruct})
+    for (Pipeline* p : {&d.clear, &d.allocate, &d.queueSetup, &d.fillQueue, &d.dispatchSetup,
+                        &d.carryOver, &d.shade, &d.sheetView, &d.mark, &d.reconstruct})
         destroy(gpu, *p);
     destroyShadeStorage(gpu, d.storage);
     for (BufferHandle b : {d.frameInfo, d.changedLights, d.objectBuffer, d.rectBuffer, d.occupancy[0],
                            d.occupancy[1], d.offsetMap[0], d.offsetMap[1], d.allocId, d.counters,
-                           d.markedBlocks, d.queue})
+                           d.markedBlocks, d.queue, d.copyQueue})
         destroy(gpu, b);
     state.reset();
 }
@@ -428,6 +435,7 @@ void prepareDecoupledFrame(Renderer& r, const GpuScene& scene, const CameraView&
     s.rects = address(gpu, d.rectBuffer);
     s.markedBlocks = address(gpu, d.markedBlocks);
     s.queue = address(gpu, d.queue);
+    s.copyQueue = address(gpu, d.copyQueue);
     s.idMaps = address(gpu, scene.idMaps);
     s.shadelUvs = address(gpu, scene.shadelUvs);
     s.sheetBlocks = d.sheetBlocks;
@@ -520,6 +528,22 @@ void recordDecoupledPasses(Renderer& r, FrameRecorder& rec, uint64_t frame, cons
         vkCmdDispatchIndirect(cmd, vkBuffer(gpu, d.counters),
                               offsetof(gpu::GpuShadelCounters, fillDispatch));
         computeToCompute(cmd);
+        bind(gpu, cmd, d.dispatchSetup);
+        pushConstants(gpu, cmd, FramePush{frame});
+        vkCmdDispatch(cmd, 1, 1, 1);
+        computeToCompute(cmd);
+    });
+
+    // Preserved layers: chunks whose inputs did not change copy last frame's shadels.
+    pass(rec, "carryOver", [&](VkCommandBuffer cmd) {
+        // Reconstruction two frames ago read this storage: order the writes after it.
+        memoryBarrier(cmd, VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT,
+                      VK_ACCESS_2_SHADER_SAMPLED_READ_BIT, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
+                      VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT);
+        bind(gpu, cmd, d.carryOver);
+        pushConstants(gpu, cmd, FramePush{frame});
+        vkCmdDispatchIndirect(cmd, vkBuffer(gpu, d.counters),
+                              offsetof(gpu::GpuShadelCounters, copyDispatch));
     });
 
     pass(rec, "shadelShading", [&](VkCommandBuffer cmd) {

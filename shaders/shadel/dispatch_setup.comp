@@ -1,0 +1,21 @@
+#version 460
+// Indirect arguments of the shading and carry-over passes, from the queue lengths the fill
+// pass counted. 2-D dispatches keep x under every device's maxComputeWorkGroupCount[0].
+#include "shadel/shadel.glsl"
+
+layout(local_size_x = 1) in;
+layout(push_constant, scalar) uniform Push { uint64_t frame; } pc;
+
+uvec4 chunkDispatch(uint n) {
+    return uvec4(min(n, 32768u), n == 0u ? 0u : (n + 32767u) / 32768u, 1u, n);
+}
+
+void main() {
+    ShadelFrame s = ShadelFrameRef(FrameConstantsRef(pc.frame).f.shadel).s;
+    ShadelCountersRef counters = ShadelCountersRef(s.counters);
+    counters.c.shadeDispatch = chunkDispatch(counters.c.shadeCount);
+    // Carry-over copies 8 chunks per workgroup (carry_over.comp).
+    uint copyGroups = (counters.c.copyCount + 7u) / 8u;
+    counters.c.copyDispatch = chunkDispatch(copyGroups);
+    counters.c.copyDispatch.w = counters.c.copyCount;
+}
