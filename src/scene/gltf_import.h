@@ -6,6 +6,11 @@
 
 namespace shadel {
 
+struct SceneFileOptions {
+    // Buffer and image URIs may resolve outside the model's folder (`../`, absolute paths).
+    bool allowExternalFiles = false;
+};
+
 // Loads a glTF 2.0 file. Every malformed input throws InputError with one line
 // "<path>: <reason>"; recoverable problems (unsupported extensions, missing images, repaired
 // normals) are logged as warnings and the import continues.
@@ -13,6 +18,6 @@ namespace shadel {
 // The node hierarchy is flattened to instances with world transforms; a primitive becomes one
 // Mesh (split into parts of at most kMaxTrianglesPerMesh triangles). A file without cameras
 // gets an "auto" camera framing the scene, one without lights an "auto-sun".
-Scene importGltf(const std::string& path);
+Scene importGltf(const std::string& path, const SceneFileOptions& options = {});
 
 } // namespace shadel
