@@ -60,8 +60,8 @@ std::string writeFileAtomically(const std::string& path, const void* data, size_
     static std::atomic<unsigned long long> counter{0};
     // Hidden, unique per process and call, in the target's folder (same file system).
     std::filesystem::path target(path);
-    std::string name = format(".%s.tmp.%d.%llu", target.filename().c_str(), int(::getpid()),
-                              counter.fetch_add(1));
+    std::string name =
+        format(".%s.tmp.%d.%llu", target.filename().c_str(), int(::getpid()), counter.fetch_add(1));
     std::string temp = (target.parent_path() / name).string();
     int fd = ::open(temp.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0644);
     if (fd < 0) return failure(path, errno);

@@ -97,7 +97,8 @@ TEST(AtomicFile, MissingFolderAndDirectoryTargetsAreOneLineErrors) {
     std::string missing = (dir.path / "no/such/folder/out.png").string();
     EXPECT_EQ(writeFileAtomically(missing, "x", 1), missing + ": No such file or directory");
     EXPECT_EQ(checkFileCreatable(missing), missing + ": No such file or directory");
-    EXPECT_EQ(writeFileAtomically(dir.path.string(), "x", 1), dir.path.string() + ": Is a directory");
+    EXPECT_EQ(writeFileAtomically(dir.path.string(), "x", 1),
+              dir.path.string() + ": Is a directory");
     EXPECT_EQ(checkFileCreatable(dir.path.string()), dir.path.string() + ": Is a directory");
     EXPECT_EQ(checkFileCreatable((dir.path / "new.png").string()), "");
     EXPECT_EQ(checkFileCreatable("/dev/full"), "");

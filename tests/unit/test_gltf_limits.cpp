@@ -167,7 +167,8 @@ TEST(GltfLimits, UriEscapesAreDetectedLexically) {
 TEST(GltfLimits, BufferOutsideTheModelFolderIsRefusedUnlessAllowed) {
     TempDir dir;
     writeFile(dir.file("outside.bin"), triangleBytes()); // next to the model's folder
-    for (const std::string uri : {"../outside.bin", "%2e%2e/outside.bin", "sub/../../outside.bin"}) {
+    for (const std::string uri :
+         {"../outside.bin", "%2e%2e/outside.bin", "sub/../../outside.bin"}) {
         std::string path = dir.file("model/escape.gltf");
         writeFile(path, gltfWithNodes("[0]", R"([{"mesh":0}])", uri));
         Outcome refused = timedLoad(path);
