@@ -2,6 +2,7 @@
 #include <fstream>
 
 #include "app/commands.h"
+#include "app/output_files.h"
 #include "core/error.h"
 #include "core/log.h"
 
@@ -9,8 +10,10 @@ namespace shadel {
 
 // Renders the same scene in both modes in one process and prints decoupled / forward ratios.
 nlohmann::json runBench(Gpu& gpu, const BenchOptions& b) {
+    if (!b.json.empty()) requireCreatableOutput("--json", b.json); // before minutes of rendering
     RenderOptions o;
     o.scene = b.scene;
+    o.allowExternalFiles = b.allowExternalFiles;
     o.width = b.width;
     o.height = b.height;
     o.frames = b.frames;
@@ -68,11 +71,7 @@ nlohmann::json runBench(Gpu& gpu, const BenchOptions& b) {
                     .c_str());
     std::printf("%-26s %12llu %12llu\n", "reconstruction misses", 0ull,
                 (unsigned long long)decoupled["reconstruction_misses"].get<uint64_t>());
-    if (!b.json.empty()) {
-        std::ofstream f(b.json);
-        if (!f) throw InputError(format("%s: cannot write bench JSON", b.json.c_str()));
-        f << out.dump(2) << "\n";
-    }
+    if (!b.json.empty()) writeOutputFile(b.json, out.dump(2) + "\n");
     return out;
 }
 

@@ -12,6 +12,7 @@ namespace shadel {
 
 struct RenderOptions {
     std::string scene = "builtin:default";
+    bool allowExternalFiles = false; // glTF URIs may leave the model's folder
     RenderMode mode = RenderMode::Forward;
     uint32_t width = 1280, height = 720;
     uint32_t frames = 1;
@@ -45,6 +46,7 @@ struct RenderRun {
 void parseSize(const std::string& text, uint32_t& width, uint32_t& height);
 RenderMode parseMode(const std::string& text);
 Visualize parseVisualize(const std::string& text);
+// The bake cache folder when --cache-dir is not given (see defaultBakeCacheDir()).
 std::string defaultCacheDir();
 
 // Renders with an existing Gpu (tests share one). Writes images/stats as the options say.
@@ -57,6 +59,7 @@ void printPassTable(const nlohmann::json& stats);
 
 struct BenchOptions {
     std::string scene = "builtin:default";
+    bool allowExternalFiles = false;
     uint32_t width = 1280, height = 720;
     uint32_t frames = 8;
     std::string camera;

@@ -6,6 +6,8 @@
 
 #include <CLI/CLI.hpp>
 
+#include "app/cli_help.h"
+#include "app/cli_validate.h"
 #include "app/commands.h"
 #include "bake/bake.h"
 #include "core/error.h"
@@ -47,6 +49,9 @@ int main(int argc, char** argv) {
     app.add_flag("--validation", validation,
                  "enable the Khronos validation layer (or SHADEL_VALIDATION=1)");
     app.add_flag("-v,--verbose", verbose, "debug logging");
+    bool allowExternalFiles = false;
+    app.add_flag("--allow-external-files", allowExternalFiles,
+                 "let glTF buffer/image URIs point outside the model's folder");
 
     // render
     RenderOptions ro;
@@ -69,20 +74,25 @@ int main(int argc, char** argv) {
     render->add_option("--stats", ro.stats, "FILE.json");
     render->add_option("--timing", timing, "auto | timestamps | submit (per-pass submit+wait)")
         ->capture_default_str();
-    render->add_option("--exposure", ro.exposure, "exposure multiplier")->capture_default_str();
+    render->add_option("--exposure", ro.exposure, "exposure multiplier")
+        ->capture_default_str()
+        ->check(finiteInRange(0, 1e6, true));
     render->add_option("--density", ro.shadelsPerMetre, "shadels per metre (decoupled)")
-        ->capture_default_str();
+        ->capture_default_str()
+        ->check(finiteInRange(0, 1e6, true));
     render->add_option("--cache-dir", ro.cacheDir, "bake cache directory");
     render->add_option("--storage", ro.shadeStorageSize, "decoupled: shade storage side in shadels")
         ->capture_default_str();
     render
         ->add_option("--shading-bias", ro.shadingBias,
                      "decoupled: fractional MIP bias (+ = fewer shadels)")
-        ->capture_default_str();
+        ->capture_default_str()
+        ->check(finiteInRange(-8, 8));
     render
         ->add_option("--trilinear-band", ro.trilinearBand,
                      "decoupled: LOD band blended between MIPs (1 = full trilinear)")
-        ->capture_default_str();
+        ->capture_default_str()
+        ->check(finiteInRange(0, 1));
     render
         ->add_option("--material-samples", ro.materialSamples,
                      "decoupled: material evaluations per shadel above MIP 0 (1 or 4)")
@@ -90,11 +100,17 @@ int main(int argc, char** argv) {
     render
         ->add_option("--shadel-budget", ro.shadelBudget,
                      "decoupled: max MIP-0 shadels for the scene (lowers --density)")
-        ->capture_default_str();
+        ->capture_default_str()
+        ->check(finiteInRange(0, 1e12, true));
     render
         ->add_option("--sheet", ro.sheetShadels,
                      "decoupled: virtual sheet side in shadels (64k..256k)")
         ->capture_default_str();
+    render
+        ->add_option("--forward-below", ro.forwardBelowPixels,
+                     "decoupled: objects smaller on screen (pixels) are drawn forward (0 = never)")
+        ->capture_default_str()
+        ->check(finiteInRange(0, 1e6));
     render->add_flag("--passes", ro.printPasses, "print the per-pass timing table");
 
     // bench
@@ -109,7 +125,9 @@ int main(int argc, char** argv) {
     bench->add_option("--camera", bo.camera, "camera name");
     bench->add_option("--json", bo.json, "write the results as JSON");
     bench->add_option("--timing", benchTiming, "auto | timestamps | submit")->capture_default_str();
-    bench->add_option("--density", bo.shadelsPerMetre, "shadels per metre")->capture_default_str();
+    bench->add_option("--density", bo.shadelsPerMetre, "shadels per metre")
+        ->capture_default_str()
+        ->check(finiteInRange(0, 1e6, true));
     bench->add_option("--cache-dir", bo.cacheDir, "bake cache directory");
 
     // bake
@@ -120,25 +138,31 @@ int main(int argc, char** argv) {
     auto* bake = app.add_subcommand("bake", "bake shadel charts and triangle-ID maps (cached)");
     bake->add_option("scene", bakeSceneSpec, "builtin:NAME | FILE.gltf | FILE.glb")
         ->capture_default_str();
-    bake->add_option("--density", bakeDensity, "shadels per metre")->capture_default_str();
+    bake->add_option("--density", bakeDensity, "shadels per metre")
+        ->capture_default_str()
+        ->check(finiteInRange(0, 1e6, true));
     bake->add_option("--cache-dir", bakeCache, "bake cache directory");
     bake->add_option("--shadel-budget", bakeBudget,
                      "max MIP-0 shadels for the scene (lowers --density)")
-        ->capture_default_str();
+        ->capture_default_str()
+        ->check(finiteInRange(0, 1e12, true));
     bake->add_flag("--no-cache", bakeNoCache, "bake from scratch (still writes the cache)");
 
     auto* info = app.add_subcommand("info", "print the device, driver, features and limits");
+    showGlobalFlagsInSubcommandHelp(app);
 
     try {
         app.parse(argc, argv);
     } catch (const CLI::ParseError& e) {
-        return app.exit(e);
+        return exitForParseError(app, e);
     }
+    ro.allowExternalFiles = bo.allowExternalFiles = allowExternalFiles;
     if (verbose) setLogLevel(LogLevel::Debug);
 
     try {
         if (*info) {
             std::printf("Vulkan devices:\n%s", listPhysicalDevices().c_str());
+            std::printf("bake cache: %s\n", defaultCacheDir().c_str());
             GpuGuard g;
             createGpu(g.gpu, deviceDesc(device, validation));
             std::printf("selected (--device %s):\n%s", device.c_str(),
@@ -146,7 +170,7 @@ int main(int argc, char** argv) {
             return 0;
         }
         if (*bake) {
-            Scene scene = loadScene(bakeSceneSpec);
+            Scene scene = loadScene(bakeSceneSpec, {allowExternalFiles});
             BakeSettings bs;
             double area = 0.0;
             bs.shadelsPerMetre = sceneShadelDensity(scene, bakeDensity, bakeBudget, area);
