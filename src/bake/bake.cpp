@@ -209,6 +209,9 @@ std::vector<BakedMesh> bakeScene(const Scene& scene, const BakeSettings& setting
     }
 
     std::vector<BakedMesh> results(meshCount);
+    // An unwritable cache (read-only, full, a file in the way) fails for every mesh alike: warn
+    // once, not once per mesh.
+    std::atomic<size_t> failedWrites{0};
     std::vector<std::exception_ptr> errors(jobs.size());
     std::atomic<size_t> next{0};
     std::mutex mutex;
@@ -232,8 +235,11 @@ std::vector<BakedMesh> bakeScene(const Scene& scene, const BakeSettings& setting
                     if (!path.empty() && why != "missing")
                         SHADEL_WARN("bake cache %s: %s; rebaking", path.c_str(), why.c_str());
                     baked = bakeMesh(mesh, meshSettings[i]);
-                    if (!path.empty() && !writeBakeCache(path, keys[i], baked, &why))
-                        SHADEL_WARN("bake cache: %s", why.c_str());
+                    if (!path.empty() && !writeBakeCache(path, keys[i], baked, &why) &&
+                        failedWrites.fetch_add(1) == 0)
+                        SHADEL_WARN("bake cache: cannot write %s; baking without the cache "
+                                    "(further write failures are not reported)",
+                                    why.c_str());
                 }
                 results[i] = std::move(baked);
             } catch (...) {
