@@ -1396,8 +1396,13 @@ private:
 } // namespace
 
 Scene importGltf(const std::string& path, const SceneFileOptions& options) {
+    return importGltfBytes(readWholeFile(path, path), path, options);
+}
+
+Scene importGltfBytes(std::vector<uint8_t> bytes, const std::string& path,
+                      const SceneFileOptions& options) {
     const std::string& input = path;
-    std::vector<uint8_t> bytes = readWholeFile(path, input);
+    if (bytes.size() > kMaxFileBytes) fail(input, "file is larger than the size limit");
     bool binary = bytes.size() >= 4 && readU32(bytes.data()) == kGlbMagic;
 
     json document = parseJson(jsonTextOf(bytes, binary, input), input);

@@ -1,6 +1,8 @@
 #pragma once
 // glTF 2.0 import (.gltf and .glb) into the plain scene model.
+#include <cstdint>
 #include <string>
+#include <vector>
 
 #include "scene/scene.h"
 
@@ -19,5 +21,10 @@ struct SceneFileOptions {
 // Mesh (split into parts of at most kMaxTrianglesPerMesh triangles). A file without cameras
 // gets an "auto" camera framing the scene, one without lights an "auto-sun".
 Scene importGltf(const std::string& path, const SceneFileOptions& options = {});
+
+// The same for the file's contents already in memory (the fuzz target): `path` names the input
+// in errors and its folder is where buffer and image URIs resolve.
+Scene importGltfBytes(std::vector<uint8_t> bytes, const std::string& path,
+                      const SceneFileOptions& options = {});
 
 } // namespace shadel
