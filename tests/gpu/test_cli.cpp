@@ -292,3 +292,28 @@ TEST(Cli, BufferUriOutsideTheModelFolderIsRefused) {
     EXPECT_EQ(allowed.stderrText.find("outside the model's folder"), std::string::npos)
         << allowed.stderrText;
 }
+
+// OVERVIEW documented --forward-below, which did not exist: every flag the docs name must be in
+// some command's --help.
+TEST(Cli, EveryDocumentedFlagExists) {
+    std::string help;
+    for (const char* sub : {"render", "bench", "bake", "info"})
+        help += runWithEnv("", std::string(sub) + " --help").stdoutText;
+    int flags = 0;
+    for (const char* doc : {"/README.md", "/OVERVIEW.md"}) {
+        std::string text = readText(std::string(SHADEL_SOURCE_DIR) + doc);
+        for (size_t at = text.find("--"); at != std::string::npos; at = text.find("--", at + 2)) {
+            size_t end = at + 2;
+            while (end < text.size() &&
+                   (std::islower(static_cast<unsigned char>(text[end])) ||
+                    std::isdigit(static_cast<unsigned char>(text[end])) || text[end] == '-'))
+                ++end;
+            if (end == at + 2 || !std::islower(static_cast<unsigned char>(text[at + 2]))) continue;
+            std::string flag = text.substr(at, end - at);
+            while (flag.back() == '-') flag.pop_back();
+            ++flags;
+            EXPECT_NE(help.find(flag), std::string::npos) << doc << " documents " << flag;
+        }
+    }
+    EXPECT_GT(flags, 10);
+}
