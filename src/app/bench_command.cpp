@@ -21,6 +21,7 @@ nlohmann::json runBench(Gpu& gpu, const BenchOptions& b) {
     o.timing = b.timing;
     o.shadelsPerMetre = b.shadelsPerMetre;
     o.cacheDir = b.cacheDir;
+    o.cacheLimitBytes = b.cacheLimitBytes;
     o.progress = false;
 
     std::fprintf(stderr, "bench: forward, %u frames at %ux%u\n", b.frames, b.width, b.height);

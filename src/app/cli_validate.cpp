@@ -4,6 +4,7 @@
 #include <cstdio>
 #include <cstdlib>
 
+#include "bake/cache_eviction.h"
 #include "core/log.h"
 
 namespace shadel {
@@ -35,6 +36,15 @@ CLI::Validator finiteInRange(double min, double max, bool minExclusive) {
         return problem.empty() ? problem : text + ": " + problem;
     };
     return CLI::Validator(check, format("FINITE %s%g..%g]", minExclusive ? "(" : "[", min, max));
+}
+
+CLI::Validator byteSize() {
+    auto check = [](std::string& text) -> std::string {
+        uint64_t bytes = 0;
+        return parseByteSize(text, bytes) ? std::string()
+                                          : text + ": expected a size such as 4G, 512M or 0";
+    };
+    return CLI::Validator(check, "SIZE");
 }
 
 std::string checkFiniteInRange(const char* flag, double value, double min, double max,

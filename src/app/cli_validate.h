@@ -15,6 +15,9 @@ constexpr int kExitBadInput = 2;
 // rejection as "<flag>: <reason>".
 CLI::Validator finiteInRange(double min, double max, bool minExclusive = false);
 
+// Accepts a byte size: digits with an optional k, M, G or T (binary) suffix, e.g. 4G.
+CLI::Validator byteSize();
+
 // The same check for values set in code; "" or "<flag> <value>: <reason>".
 std::string checkFiniteInRange(const char* flag, double value, double min, double max,
                                bool minExclusive = false);

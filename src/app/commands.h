@@ -26,6 +26,8 @@ struct RenderOptions {
     float exposure = 1.0f;
     float shadelsPerMetre = 32.0f;
     std::string cacheDir; // empty = default cache directory
+    // --cache-limit: least recently used bake-cache files beyond it are removed (0 = none).
+    uint64_t cacheLimitBytes = 4ull << 30;
     uint32_t shadeStorageSize = 4096;
     uint32_t sheetShadels = 65536;
     float shadingBias = 0.0f;
@@ -67,6 +69,7 @@ struct BenchOptions {
     std::optional<TimingMode> timing;
     float shadelsPerMetre = 32.0f;
     std::string cacheDir;
+    uint64_t cacheLimitBytes = 4ull << 30;
 };
 nlohmann::json runBench(Gpu& gpu, const BenchOptions& options);
 

@@ -6,10 +6,12 @@
 
 #include <CLI/CLI.hpp>
 
+#include "app/cache_command.h"
 #include "app/cli_help.h"
 #include "app/cli_validate.h"
 #include "app/commands.h"
 #include "bake/bake.h"
+#include "bake/cache_eviction.h"
 #include "core/error.h"
 #include "core/log.h"
 #include "scene/load.h"
@@ -52,6 +54,11 @@ int main(int argc, char** argv) {
     bool allowExternalFiles = false;
     app.add_flag("--allow-external-files", allowExternalFiles,
                  "let glTF buffer/image URIs point outside the model's folder");
+    std::string cacheLimit = "4G";
+    app.add_option("--cache-limit", cacheLimit,
+                   "bake cache size; least recently used files beyond it are removed (0 = none)")
+        ->capture_default_str()
+        ->check(byteSize());
 
     // render
     RenderOptions ro;
@@ -149,6 +156,11 @@ int main(int argc, char** argv) {
     bake->add_flag("--no-cache", bakeNoCache, "bake from scratch (still writes the cache)");
 
     auto* info = app.add_subcommand("info", "print the device, driver, features and limits");
+    std::string cacheDirForCache;
+    auto* cache = app.add_subcommand("cache", "show the bake cache's folder and size");
+    cache->add_option("--cache-dir", cacheDirForCache, "bake cache directory");
+    auto* cacheClean = cache->add_subcommand("clean", "remove every bake cache file");
+    cacheClean->fallthrough(); // `shadel cache clean --cache-dir DIR`
     showGlobalFlagsInSubcommandHelp(app);
 
     try {
@@ -157,6 +169,9 @@ int main(int argc, char** argv) {
         return exitForParseError(app, e);
     }
     ro.allowExternalFiles = bo.allowExternalFiles = allowExternalFiles;
+    uint64_t cacheLimitBytes = 0;
+    parseByteSize(cacheLimit, cacheLimitBytes); // validated by byteSize()
+    ro.cacheLimitBytes = bo.cacheLimitBytes = cacheLimitBytes;
     if (verbose) setLogLevel(LogLevel::Debug);
 
     try {
@@ -169,9 +184,14 @@ int main(int argc, char** argv) {
                         describeDevice(g.gpu.device).c_str());
             return 0;
         }
+        if (*cache) {
+            std::string dir = cacheDirForCache.empty() ? defaultCacheDir() : cacheDirForCache;
+            return runCacheCommand(dir, bool(*cacheClean), cacheLimitBytes);
+        }
         if (*bake) {
             Scene scene = loadScene(bakeSceneSpec, {allowExternalFiles});
             BakeSettings bs;
+            bs.cacheLimitBytes = cacheLimitBytes;
             double area = 0.0;
             bs.shadelsPerMetre = sceneShadelDensity(scene, bakeDensity, bakeBudget, area);
             if (bs.shadelsPerMetre < bakeDensity)

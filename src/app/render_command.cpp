@@ -96,6 +96,7 @@ RenderRun runRender(Gpu& gpu, const RenderOptions& o) {
     float density = 0.0f;
     if (o.mode == RenderMode::Decoupled) {
         BakeSettings bs;
+        bs.cacheLimitBytes = o.cacheLimitBytes;
         double area = 0.0;
         bs.shadelsPerMetre = sceneShadelDensity(scene, o.shadelsPerMetre, o.shadelBudget, area);
         if (bs.shadelsPerMetre < o.shadelsPerMetre)

@@ -317,3 +317,21 @@ TEST(Cli, EveryDocumentedFlagExists) {
     }
     EXPECT_GT(flags, 10);
 }
+
+TEST(Cli, CacheCommandShowsAndCleansTheCache) {
+    CliTempDir dir;
+    std::string cache = dir.file("cache");
+    Output baked = runWithEnv("", "bake builtin:smooth --cache-dir " + cache);
+    ASSERT_EQ(baked.exitCode, 0) << baked.stderrText;
+    Output shown = runWithEnv("SHADEL_CACHE_DIR=" + cache, "cache");
+    EXPECT_EQ(shown.exitCode, 0) << shown.stderrText;
+    EXPECT_NE(shown.stdoutText.find("bake cache: " + cache + "\n8 files"), std::string::npos)
+        << shown.stdoutText;
+    Output cleaned = runWithEnv("", "cache clean --cache-dir " + cache);
+    EXPECT_EQ(cleaned.exitCode, 0) << cleaned.stderrText;
+    EXPECT_NE(cleaned.stdoutText.find("removed 8 files"), std::string::npos) << cleaned.stdoutText;
+    EXPECT_TRUE(std::filesystem::is_empty(cache));
+    Result bad = run("--cache-limit lots cache");
+    EXPECT_EQ(bad.exitCode, 2);
+    EXPECT_NE(bad.stderrText.find("--cache-limit"), std::string::npos) << bad.stderrText;
+}
