@@ -1,5 +1,7 @@
 #include "app/cli_help.h"
 
+#include <vector>
+
 #include "app/commands.h"
 #include "core/log.h"
 
@@ -13,11 +15,15 @@ void showGlobalFlagsInSubcommandHelp(CLI::App& app) {
         std::string value = option->get_type_size() == 0 ? "" : " " + option->get_type_name();
         text += format("  %-28s %s\n", (name + value).c_str(), option->get_description().c_str());
     }
-    std::string footer = text;
     app.footer([] { return "Bake cache: " + defaultCacheDir(); });
-    for (CLI::App* sub : app.get_subcommands({})) {
+    // Nested subcommands too (`shadel cache clean --help`).
+    std::vector<CLI::App*> pending = app.get_subcommands({});
+    while (!pending.empty()) {
+        CLI::App* sub = pending.back();
+        pending.pop_back();
         sub->fallthrough();
-        sub->footer([footer] { return footer + "Bake cache: " + defaultCacheDir(); });
+        sub->footer([text] { return text + "Bake cache: " + defaultCacheDir(); });
+        for (CLI::App* nested : sub->get_subcommands({})) pending.push_back(nested);
     }
 }
 

@@ -3,19 +3,22 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <tuple>
 
+#include "app/commands.h"
 #include "bake/cache_eviction.h"
+#include "core/error.h"
 #include "core/log.h"
 
 namespace shadel {
 namespace {
 
 // "" or why `value` is not a finite number in range.
-std::string rangeProblem(double value, double min, double max, bool minExclusive) {
+std::string rangeProblem(double value, FloatRange r) {
     if (!std::isfinite(value)) return "must be a finite number";
-    bool aboveMin = minExclusive ? value > min : value >= min;
-    if (!aboveMin || value > max)
-        return format("must be in %s%g, %g]", minExclusive ? "(" : "[", min, max);
+    bool aboveMin = r.minExclusive ? value > r.min : value >= r.min;
+    if (!aboveMin || value > r.max)
+        return format("must be in %s%g, %g]", r.minExclusive ? "(" : "[", r.min, r.max);
     return {};
 }
 
@@ -27,15 +30,16 @@ std::string oneLine(std::string text) {
 
 } // namespace
 
-CLI::Validator finiteInRange(double min, double max, bool minExclusive) {
+CLI::Validator finiteInRange(FloatRange range) {
     auto check = [=](std::string& text) -> std::string {
         char* end = nullptr;
         double value = std::strtod(text.c_str(), &end);
         if (text.empty() || end != text.c_str() + text.size()) return text + ": not a number";
-        std::string problem = rangeProblem(value, min, max, minExclusive);
+        std::string problem = rangeProblem(value, range);
         return problem.empty() ? problem : text + ": " + problem;
     };
-    return CLI::Validator(check, format("FINITE %s%g..%g]", minExclusive ? "(" : "[", min, max));
+    return CLI::Validator(
+        check, format("FINITE %s%g..%g]", range.minExclusive ? "(" : "[", range.min, range.max));
 }
 
 CLI::Validator byteSize() {
@@ -47,10 +51,23 @@ CLI::Validator byteSize() {
     return CLI::Validator(check, "SIZE");
 }
 
-std::string checkFiniteInRange(const char* flag, double value, double min, double max,
-                               bool minExclusive) {
-    std::string problem = rangeProblem(value, min, max, minExclusive);
+std::string checkFiniteInRange(const char* flag, double value, FloatRange range) {
+    std::string problem = rangeProblem(value, range);
     return problem.empty() ? problem : format("%s %g: %s", flag, value, problem.c_str());
+}
+
+void validateRenderOptions(const RenderOptions& o) {
+    const std::tuple<const char*, double, FloatRange> floats[] = {
+        {"--exposure", o.exposure, kExposureRange},
+        {"--density", o.shadelsPerMetre, kDensityRange},
+        {"--shading-bias", o.shadingBias, kShadingBiasRange},
+        {"--trilinear-band", o.trilinearBand, kTrilinearBandRange},
+        {"--shadel-budget", o.shadelBudget, kShadelBudgetRange},
+        {"--forward-below", o.forwardBelowPixels, kForwardBelowRange},
+    };
+    for (const auto& [flag, value, range] : floats)
+        if (std::string problem = checkFiniteInRange(flag, value, range); !problem.empty())
+            throw InputError(problem);
 }
 
 int exitForParseError(const CLI::App& app, const CLI::ParseError& error) {

@@ -83,10 +83,10 @@ int main(int argc, char** argv) {
         ->capture_default_str();
     render->add_option("--exposure", ro.exposure, "exposure multiplier")
         ->capture_default_str()
-        ->check(finiteInRange(0, 1e6, true));
+        ->check(finiteInRange(kExposureRange));
     render->add_option("--density", ro.shadelsPerMetre, "shadels per metre (decoupled)")
         ->capture_default_str()
-        ->check(finiteInRange(0, 1e6, true));
+        ->check(finiteInRange(kDensityRange));
     render->add_option("--cache-dir", ro.cacheDir, "bake cache directory");
     render->add_option("--storage", ro.shadeStorageSize, "decoupled: shade storage side in shadels")
         ->capture_default_str();
@@ -94,12 +94,12 @@ int main(int argc, char** argv) {
         ->add_option("--shading-bias", ro.shadingBias,
                      "decoupled: fractional MIP bias (+ = fewer shadels)")
         ->capture_default_str()
-        ->check(finiteInRange(-8, 8));
+        ->check(finiteInRange(kShadingBiasRange));
     render
         ->add_option("--trilinear-band", ro.trilinearBand,
                      "decoupled: LOD band blended between MIPs (1 = full trilinear)")
         ->capture_default_str()
-        ->check(finiteInRange(0, 1));
+        ->check(finiteInRange(kTrilinearBandRange));
     render
         ->add_option("--material-samples", ro.materialSamples,
                      "decoupled: material evaluations per shadel above MIP 0 (1 or 4)")
@@ -108,7 +108,7 @@ int main(int argc, char** argv) {
         ->add_option("--shadel-budget", ro.shadelBudget,
                      "decoupled: max MIP-0 shadels for the scene (lowers --density)")
         ->capture_default_str()
-        ->check(finiteInRange(0, 1e12, true));
+        ->check(finiteInRange(kShadelBudgetRange));
     render
         ->add_option("--sheet", ro.sheetShadels,
                      "decoupled: virtual sheet side in shadels (64k..256k)")
@@ -117,7 +117,7 @@ int main(int argc, char** argv) {
         ->add_option("--forward-below", ro.forwardBelowPixels,
                      "decoupled: objects smaller on screen (pixels) are drawn forward (0 = never)")
         ->capture_default_str()
-        ->check(finiteInRange(0, 1e6));
+        ->check(finiteInRange(kForwardBelowRange));
     render->add_flag("--passes", ro.printPasses, "print the per-pass timing table");
 
     // bench
@@ -134,7 +134,7 @@ int main(int argc, char** argv) {
     bench->add_option("--timing", benchTiming, "auto | timestamps | submit")->capture_default_str();
     bench->add_option("--density", bo.shadelsPerMetre, "shadels per metre")
         ->capture_default_str()
-        ->check(finiteInRange(0, 1e6, true));
+        ->check(finiteInRange(kDensityRange));
     bench->add_option("--cache-dir", bo.cacheDir, "bake cache directory");
 
     // bake
@@ -147,12 +147,12 @@ int main(int argc, char** argv) {
         ->capture_default_str();
     bake->add_option("--density", bakeDensity, "shadels per metre")
         ->capture_default_str()
-        ->check(finiteInRange(0, 1e6, true));
+        ->check(finiteInRange(kDensityRange));
     bake->add_option("--cache-dir", bakeCache, "bake cache directory");
     bake->add_option("--shadel-budget", bakeBudget,
                      "max MIP-0 shadels for the scene (lowers --density)")
         ->capture_default_str()
-        ->check(finiteInRange(0, 1e12, true));
+        ->check(finiteInRange(kShadelBudgetRange));
     bake->add_flag("--no-cache", bakeNoCache, "bake from scratch (still writes the cache)");
 
     auto* info = app.add_subcommand("info", "print the device, driver, features and limits");

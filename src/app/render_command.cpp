@@ -5,6 +5,7 @@
 #include <fstream>
 #include <unistd.h>
 
+#include "app/cli_validate.h"
 #include "app/commands.h"
 #include "app/output_files.h"
 #include "bake/bake.h"
@@ -77,6 +78,7 @@ RenderRun runRender(Gpu& gpu, const RenderOptions& o) {
     if (o.frames < 1 || o.frames > 100000)
         throw InputError(format("--frames %u: expected 1..100000", o.frames));
     if (o.ssaa < 1 || o.ssaa > 16) throw InputError(format("--ssaa %u: expected 1..16", o.ssaa));
+    validateRenderOptions(o);
     bool outDir = !o.out.empty() && o.out.back() == '/';
     if (outDir) {
         std::error_code ec;

@@ -202,7 +202,7 @@ TEST(Cli, ForwardBelowIsAFlag) {
 }
 
 TEST(Cli, SubcommandHelpShowsGlobalFlagsAndTheBakeCache) {
-    for (const char* sub : {"render", "bench", "bake", "info"}) {
+    for (const char* sub : {"render", "bench", "bake", "info", "cache", "cache clean"}) {
         Output o = runWithEnv("SHADEL_CACHE_DIR=/tmp/some-cache", std::string(sub) + " --help");
         EXPECT_EQ(o.exitCode, 0) << sub << ": " << o.stderrText;
         for (const char* global : {"--device", "--validation", "--verbose",
