@@ -19,10 +19,11 @@ namespace fs = std::filesystem;
 
 namespace {
 
-// The bound, measured inside the test. Sanitizer builds run the same code several times
-// slower; they are there to find memory errors, so they get proportionally more time.
+// The bound, measured inside the test (Release: about 0.5 s each here). AddressSanitizer
+// builds run this allocation-heavy code about 15x slower; they are there to find memory errors,
+// and the Release run of the same test enforces the bound.
 #if defined(__SANITIZE_ADDRESS__)
-constexpr double kMaxSeconds = 20.0;
+constexpr double kMaxSeconds = 60.0;
 #else
 constexpr double kMaxSeconds = 5.0;
 #endif
