@@ -24,7 +24,7 @@ constexpr FloatRange kDensityRange{0, 1e6, true};       // shadels per metre
 constexpr FloatRange kShadingBiasRange{-8, 8};          // MIP levels
 constexpr FloatRange kTrilinearBandRange{0, 1};         // fraction of a MIP level
 constexpr FloatRange kShadelBudgetRange{0, 1e12, true}; // MIP-0 shadels
-constexpr FloatRange kForwardBelowRange{0, 1e6};        // pixels; 0 = never
+constexpr FloatRange kForwardBelowRange{0, 1e12};       // pixels; 0 = never
 
 // Accepts a finite number in the range. CLI11 reports a rejection as "<flag>: <reason>".
 CLI::Validator finiteInRange(FloatRange range);
