@@ -323,13 +323,17 @@ TEST(Cli, CacheCommandShowsAndCleansTheCache) {
     std::string cache = dir.file("cache");
     Output baked = runWithEnv("", "bake builtin:smooth --cache-dir " + cache);
     ASSERT_EQ(baked.exitCode, 0) << baked.stderrText;
+    std::string files = std::to_string(std::distance(std::filesystem::directory_iterator(cache),
+                                                     std::filesystem::directory_iterator())) +
+                        " files";
+    ASSERT_NE(files, "0 files");
     Output shown = runWithEnv("SHADEL_CACHE_DIR=" + cache, "cache");
     EXPECT_EQ(shown.exitCode, 0) << shown.stderrText;
-    EXPECT_NE(shown.stdoutText.find("bake cache: " + cache + "\n8 files"), std::string::npos)
+    EXPECT_NE(shown.stdoutText.find("bake cache: " + cache + "\n" + files), std::string::npos)
         << shown.stdoutText;
     Output cleaned = runWithEnv("", "cache clean --cache-dir " + cache);
     EXPECT_EQ(cleaned.exitCode, 0) << cleaned.stderrText;
-    EXPECT_NE(cleaned.stdoutText.find("removed 8 files"), std::string::npos) << cleaned.stdoutText;
+    EXPECT_NE(cleaned.stdoutText.find("removed " + files), std::string::npos) << cleaned.stdoutText;
     EXPECT_TRUE(std::filesystem::is_empty(cache));
     Result bad = run("--cache-limit lots cache");
     EXPECT_EQ(bad.exitCode, 2);
