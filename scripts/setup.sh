@@ -44,5 +44,10 @@ $SUDO apt-get install -y -qq \
   glslc libshaderc-dev spirv-tools vulkan-validationlayers \
   libglm-dev libtinygltf-dev libmeshoptimizer-dev libstb-dev libcli11-dev nlohmann-json3-dev \
   libgtest-dev libgmock-dev libbenchmark-dev assimp-testmodels python3
+# The test suite's fuzz runs need clang with libFuzzer: fail here rather than skip them later.
+if ! command -v clang++ >/dev/null 2>&1; then
+  echo "setup: clang++ is missing after installing clang" >&2
+  exit 1
+fi
 echo "$want_version" | $SUDO tee "$stamp" >/dev/null
 echo "setup: done"

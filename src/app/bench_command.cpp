@@ -2,6 +2,7 @@
 #include <fstream>
 
 #include "app/commands.h"
+#include "app/output_files.h"
 #include "core/error.h"
 #include "core/log.h"
 
@@ -11,8 +12,10 @@ namespace shadel {
 // decoupled with reuse on, in one process, and prints per-pass medians and frame-time ratios
 // against forward (DESIGN §5, §7).
 nlohmann::json runBench(Gpu& gpu, const BenchOptions& b) {
+    if (!b.json.empty()) requireCreatableOutput("--json", b.json); // before minutes of rendering
     RenderOptions o;
     o.scene = b.scene;
+    o.allowExternalFiles = b.allowExternalFiles;
     o.width = b.width;
     o.height = b.height;
     o.frames = b.frames;
@@ -23,6 +26,7 @@ nlohmann::json runBench(Gpu& gpu, const BenchOptions& b) {
     o.cameraPath = b.cameraPath;
     o.animateLights = b.animateLights;
     o.reuseRefreshPeriod = b.reuseRefreshPeriod;
+    o.cacheLimitBytes = b.cacheLimitBytes;
     o.progress = false;
 
     struct Mode {
@@ -94,10 +98,7 @@ nlohmann::json runBench(Gpu& gpu, const BenchOptions& b) {
     row("occupancy bits per shadel", decoupledOnly("occupancy_bits_per_shadel", "%.3f"));
     row("reconstruction misses", decoupledOnly("reconstruction_misses", ""));
     if (!b.json.empty()) {
-        std::ofstream f(b.json);
-        if (!f) throw InputError(format("%s: cannot write bench JSON", b.json.c_str()));
-        f << out.dump(2) << "\n";
-        if (!f) throw InputError(format("%s: cannot write bench JSON", b.json.c_str()));
+        writeOutputFile(b.json, out.dump(2) + "\n");
     }
     return out;
 }

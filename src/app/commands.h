@@ -12,6 +12,7 @@ namespace shadel {
 
 struct RenderOptions {
     std::string scene = "builtin:default";
+    bool allowExternalFiles = false; // glTF URIs may leave the model's folder
     RenderMode mode = RenderMode::Forward;
     uint32_t width = 1280, height = 720;
     uint32_t frames = 1;
@@ -25,6 +26,8 @@ struct RenderOptions {
     float exposure = 1.0f;
     float shadelsPerMetre = 32.0f;
     std::string cacheDir; // empty = default cache directory
+    // --cache-limit: least recently used bake-cache files beyond it are removed (0 = none).
+    uint64_t cacheLimitBytes = 4ull << 30;
     uint32_t shadeStorageSize = 4096;
     uint32_t sheetShadels = 65536;
     float shadingBias = 0.0f;
@@ -52,6 +55,7 @@ struct RenderRun {
 void parseSize(const std::string& text, uint32_t& width, uint32_t& height);
 RenderMode parseMode(const std::string& text);
 Visualize parseVisualize(const std::string& text);
+// The bake cache folder when --cache-dir is not given (see defaultBakeCacheDir()).
 std::string defaultCacheDir();
 
 // Renders with an existing Gpu (tests share one). Writes images/stats as the options say.
@@ -64,6 +68,7 @@ void printPassTable(const nlohmann::json& stats);
 
 struct BenchOptions {
     std::string scene = "builtin:default";
+    bool allowExternalFiles = false;
     uint32_t width = 1280, height = 720;
     uint32_t frames = 8;
     std::string camera;
@@ -74,6 +79,7 @@ struct BenchOptions {
     CameraPath cameraPath = CameraPath::Static;
     bool animateLights = false;
     uint32_t reuseRefreshPeriod = 8;
+    uint64_t cacheLimitBytes = 4ull << 30;
 };
 nlohmann::json runBench(Gpu& gpu, const BenchOptions& options);
 

@@ -6,8 +6,12 @@
 
 #include <CLI/CLI.hpp>
 
+#include "app/cache_command.h"
+#include "app/cli_help.h"
+#include "app/cli_validate.h"
 #include "app/commands.h"
 #include "bake/bake.h"
+#include "bake/cache_eviction.h"
 #include "core/error.h"
 #include "core/log.h"
 #include "scene/load.h"
@@ -47,6 +51,14 @@ int main(int argc, char** argv) {
     app.add_flag("--validation", validation,
                  "enable the Khronos validation layer (or SHADEL_VALIDATION=1)");
     app.add_flag("-v,--verbose", verbose, "debug logging");
+    bool allowExternalFiles = false;
+    app.add_flag("--allow-external-files", allowExternalFiles,
+                 "let glTF buffer/image URIs point outside the model's folder");
+    std::string cacheLimit = "4G";
+    app.add_option("--cache-limit", cacheLimit,
+                   "bake cache size; least recently used files beyond it are removed (0 = none)")
+        ->capture_default_str()
+        ->check(byteSize());
 
     // render
     RenderOptions ro;
@@ -71,20 +83,25 @@ int main(int argc, char** argv) {
     render->add_option("--stats", ro.stats, "FILE.json");
     render->add_option("--timing", timing, "auto | timestamps | submit (per-pass submit+wait)")
         ->capture_default_str();
-    render->add_option("--exposure", ro.exposure, "exposure multiplier")->capture_default_str();
+    render->add_option("--exposure", ro.exposure, "exposure multiplier")
+        ->capture_default_str()
+        ->check(finiteInRange(kExposureRange));
     render->add_option("--density", ro.shadelsPerMetre, "shadels per metre (decoupled)")
-        ->capture_default_str();
+        ->capture_default_str()
+        ->check(finiteInRange(kDensityRange));
     render->add_option("--cache-dir", ro.cacheDir, "bake cache directory");
     render->add_option("--storage", ro.shadeStorageSize, "decoupled: shade storage side in shadels")
         ->capture_default_str();
     render
         ->add_option("--shading-bias", ro.shadingBias,
                      "decoupled: fractional MIP bias (+ = fewer shadels)")
-        ->capture_default_str();
+        ->capture_default_str()
+        ->check(finiteInRange(kShadingBiasRange));
     render
         ->add_option("--trilinear-band", ro.trilinearBand,
                      "decoupled: LOD band blended between MIPs (1 = full trilinear)")
-        ->capture_default_str();
+        ->capture_default_str()
+        ->check(finiteInRange(kTrilinearBandRange));
     render
         ->add_option("--material-samples", ro.materialSamples,
                      "decoupled: material evaluations per shadel above MIP 0 (1 or 4)")
@@ -92,11 +109,17 @@ int main(int argc, char** argv) {
     render
         ->add_option("--shadel-budget", ro.shadelBudget,
                      "decoupled: max MIP-0 shadels for the scene (lowers --density)")
-        ->capture_default_str();
+        ->capture_default_str()
+        ->check(finiteInRange(kShadelBudgetRange));
     render
         ->add_option("--sheet", ro.sheetShadels,
                      "decoupled: virtual sheet side in shadels (64k..256k)")
         ->capture_default_str();
+    render
+        ->add_option("--forward-below", ro.forwardBelowPixels,
+                     "decoupled: objects smaller on screen (pixels) are drawn forward (0 = never)")
+        ->capture_default_str()
+        ->check(finiteInRange(kForwardBelowRange));
     render
         ->add_option("--allocation-counters", ro.allocationCounters,
                      "decoupled: hashed storage counters to use, 1..16 (fewer only to test "
@@ -138,7 +161,9 @@ int main(int argc, char** argv) {
     bench->add_option("--camera", bo.camera, "camera name");
     bench->add_option("--json", bo.json, "write the results as JSON");
     bench->add_option("--timing", benchTiming, "auto | timestamps | submit")->capture_default_str();
-    bench->add_option("--density", bo.shadelsPerMetre, "shadels per metre")->capture_default_str();
+    bench->add_option("--density", bo.shadelsPerMetre, "shadels per metre")
+        ->capture_default_str()
+        ->check(finiteInRange(kDensityRange));
     bench->add_option("--cache-dir", bo.cacheDir, "bake cache directory");
     std::string benchCameraPath = "static";
     bench->add_option("--camera-path", benchCameraPath, "static | orbit | walk")
@@ -156,34 +181,53 @@ int main(int argc, char** argv) {
     auto* bake = app.add_subcommand("bake", "bake shadel charts and triangle-ID maps (cached)");
     bake->add_option("scene", bakeSceneSpec, "builtin:NAME | FILE.gltf | FILE.glb")
         ->capture_default_str();
-    bake->add_option("--density", bakeDensity, "shadels per metre")->capture_default_str();
+    bake->add_option("--density", bakeDensity, "shadels per metre")
+        ->capture_default_str()
+        ->check(finiteInRange(kDensityRange));
     bake->add_option("--cache-dir", bakeCache, "bake cache directory");
     bake->add_option("--shadel-budget", bakeBudget,
                      "max MIP-0 shadels for the scene (lowers --density)")
-        ->capture_default_str();
+        ->capture_default_str()
+        ->check(finiteInRange(kShadelBudgetRange));
     bake->add_flag("--no-cache", bakeNoCache, "bake from scratch (still writes the cache)");
 
     auto* info = app.add_subcommand("info", "print the device, driver, features and limits");
+    std::string cacheDirForCache;
+    auto* cache = app.add_subcommand("cache", "show the bake cache's folder and size");
+    cache->add_option("--cache-dir", cacheDirForCache, "bake cache directory");
+    auto* cacheClean = cache->add_subcommand("clean", "remove every bake cache file");
+    cacheClean->fallthrough(); // `shadel cache clean --cache-dir DIR`
+    showGlobalFlagsInSubcommandHelp(app);
 
     try {
         app.parse(argc, argv);
     } catch (const CLI::ParseError& e) {
-        return app.exit(e);
+        return exitForParseError(app, e);
     }
+    ro.allowExternalFiles = bo.allowExternalFiles = allowExternalFiles;
+    uint64_t cacheLimitBytes = 0;
+    parseByteSize(cacheLimit, cacheLimitBytes); // validated by byteSize()
+    ro.cacheLimitBytes = bo.cacheLimitBytes = cacheLimitBytes;
     if (verbose) setLogLevel(LogLevel::Debug);
 
     try {
         if (*info) {
             std::printf("Vulkan devices:\n%s", listPhysicalDevices().c_str());
+            std::printf("bake cache: %s\n", defaultCacheDir().c_str());
             GpuGuard g;
             createGpu(g.gpu, deviceDesc(device, validation));
             std::printf("selected (--device %s):\n%s", device.c_str(),
                         describeDevice(g.gpu.device).c_str());
             return 0;
         }
+        if (*cache) {
+            std::string dir = cacheDirForCache.empty() ? defaultCacheDir() : cacheDirForCache;
+            return runCacheCommand(dir, bool(*cacheClean), cacheLimitBytes);
+        }
         if (*bake) {
-            Scene scene = loadScene(bakeSceneSpec);
+            Scene scene = loadScene(bakeSceneSpec, {allowExternalFiles});
             BakeSettings bs;
+            bs.cacheLimitBytes = cacheLimitBytes;
             double area = 0.0;
             bs.shadelsPerMetre = sceneShadelDensity(scene, bakeDensity, bakeBudget, area);
             if (bs.shadelsPerMetre < bakeDensity)

@@ -5,10 +5,11 @@
 #include <fstream>
 #include <unistd.h>
 
-#include <stb/stb_image_write.h>
-
+#include "app/cli_validate.h"
 #include "app/commands.h"
+#include "app/output_files.h"
 #include "bake/bake.h"
+#include "bake/bake_cache.h"
 #include "core/error.h"
 #include "core/log.h"
 #include "render/shadel/decoupled.h"
@@ -47,19 +48,13 @@ Visualize parseVisualize(const std::string& text) {
 }
 
 std::string defaultCacheDir() {
-    if (const char* env = std::getenv("SHADEL_CACHE_DIR")) return env;
-    if (const char* xdg = std::getenv("XDG_CACHE_HOME")) return std::string(xdg) + "/shadel";
-    if (const char* home = std::getenv("HOME")) return std::string(home) + "/.cache/shadel";
-    return "/tmp/shadel-cache";
+    return defaultBakeCacheDir();
 }
 
 void writePng(const std::string& path, const std::vector<uint8_t>& rgba, uint32_t width,
               uint32_t height) {
-    std::vector<uint8_t> rgb(size_t(width) * height * 3);
-    for (size_t i = 0, n = size_t(width) * height; i < n; ++i)
-        for (int c = 0; c < 3; ++c) rgb[i * 3 + c] = rgba[i * 4 + c];
-    if (!stbi_write_png(path.c_str(), int(width), int(height), 3, rgb.data(), int(width * 3)))
-        throw InputError(format("%s: cannot write PNG", path.c_str()));
+    std::vector<uint8_t> png = encodePngRgb(rgba, width, height);
+    writeOutputFile(path, png.data(), png.size());
 }
 
 static double median(std::vector<double> v) {
@@ -86,6 +81,7 @@ RenderRun runRender(Gpu& gpu, const RenderOptions& o) {
     if (o.frames < 1 || o.frames > 100000)
         throw InputError(format("--frames %u: expected 1..100000", o.frames));
     if (o.ssaa < 1 || o.ssaa > 16) throw InputError(format("--ssaa %u: expected 1..16", o.ssaa));
+    validateRenderOptions(o);
     bool outDir = !o.out.empty() && o.out.back() == '/';
     if (outDir) {
         std::error_code ec;
@@ -94,7 +90,10 @@ RenderRun runRender(Gpu& gpu, const RenderOptions& o) {
             throw InputError(format("%s: cannot create output directory (%s)", o.out.c_str(),
                                     ec.message().c_str()));
     }
-    Scene scene = loadScene(o.scene);
+    // Fail before loading and rendering, not after.
+    if (!o.out.empty()) requireCreatableOutput("--out", outDir ? o.out + "frame_0000.png" : o.out);
+    if (!o.stats.empty()) requireCreatableOutput("--stats", o.stats);
+    Scene scene = loadScene(o.scene, {o.allowExternalFiles});
     Camera camera = findCamera(scene, o.camera);
 
     std::vector<BakedMesh> baked;
@@ -102,6 +101,7 @@ RenderRun runRender(Gpu& gpu, const RenderOptions& o) {
     float density = 0.0f;
     if (o.mode == RenderMode::Decoupled) {
         BakeSettings bs;
+        bs.cacheLimitBytes = o.cacheLimitBytes;
         double area = 0.0;
         bs.shadelsPerMetre = sceneShadelDensity(scene, o.shadelsPerMetre, o.shadelBudget, area);
         if (bs.shadelsPerMetre < o.shadelsPerMetre)
@@ -226,11 +226,7 @@ RenderRun runRender(Gpu& gpu, const RenderOptions& o) {
     destroyRenderer(renderer);
     destroyScene(gpu, gpuScene);
 
-    if (!o.stats.empty()) {
-        std::ofstream out(o.stats);
-        if (!out) throw InputError(format("%s: cannot write stats", o.stats.c_str()));
-        out << s.dump(2) << "\n";
-    }
+    if (!o.stats.empty()) writeOutputFile(o.stats, s.dump(2) + "\n");
     if (o.printPasses) printPassTable(s);
     return run;
 }

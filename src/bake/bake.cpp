@@ -6,11 +6,14 @@
 #include <cmath>
 #include <condition_variable>
 #include <exception>
+#include <filesystem>
 #include <map>
 #include <mutex>
+#include <set>
 #include <thread>
 
 #include "bake/bake_cache.h"
+#include "bake/cache_eviction.h"
 #include "bake/charting.h"
 #include "bake/id_map.h"
 #include "bake/packing.h"
@@ -209,6 +212,9 @@ std::vector<BakedMesh> bakeScene(const Scene& scene, const BakeSettings& setting
     }
 
     std::vector<BakedMesh> results(meshCount);
+    // An unwritable cache (read-only, full, a file in the way) fails for every mesh alike: warn
+    // once, not once per mesh.
+    std::atomic<size_t> failedWrites{0};
     std::vector<std::exception_ptr> errors(jobs.size());
     std::atomic<size_t> next{0};
     std::mutex mutex;
@@ -226,14 +232,18 @@ std::vector<BakedMesh> bakeScene(const Scene& scene, const BakeSettings& setting
                 std::string why;
                 BakedMesh baked;
                 if (!path.empty() && readBakeCache(path, keys[i], mesh, baked, &why)) {
+                    markBakeCacheFileUsed(path); // for least-recently-used eviction
                     baked.fromCache = true;
                     baked.bakeSeconds = secondsSince(start);
                 } else {
                     if (!path.empty() && why != "missing")
                         SHADEL_WARN("bake cache %s: %s; rebaking", path.c_str(), why.c_str());
                     baked = bakeMesh(mesh, meshSettings[i]);
-                    if (!path.empty() && !writeBakeCache(path, keys[i], baked, &why))
-                        SHADEL_WARN("bake cache: %s", why.c_str());
+                    if (!path.empty() && !writeBakeCache(path, keys[i], baked, &why) &&
+                        failedWrites.fetch_add(1) == 0)
+                        SHADEL_WARN("bake cache: cannot write %s; baking without the cache "
+                                    "(further write failures are not reported)",
+                                    why.c_str());
                 }
                 results[i] = std::move(baked);
             } catch (...) {
@@ -263,6 +273,20 @@ std::vector<BakedMesh> bakeScene(const Scene& scene, const BakeSettings& setting
         }
     }
     for (std::thread& t : workers) t.join();
+    if (!cacheDir.empty()) {
+        // Trim the cache to its limit (a listing of one folder), keeping every file this scene
+        // uses.
+        std::set<std::string> keep;
+        for (size_t j : jobs)
+            keep.insert(std::filesystem::path(bakeCachePath(cacheDir, keys[j])).filename());
+        CacheUsage removed = evictBakeCache(cacheDir, settings.cacheLimitBytes, keep);
+        if (removed.files > 0)
+            SHADEL_INFO("bake cache %s: removed %llu least recently used files (%.1f MiB) to "
+                        "stay within %.1f MiB (--cache-limit)",
+                        cacheDir.c_str(), (unsigned long long)removed.files,
+                        double(removed.bytes) / (1 << 20),
+                        double(settings.cacheLimitBytes) / (1 << 20));
+    }
     for (const std::exception_ptr& e : errors)
         if (e) std::rethrow_exception(e);
     for (size_t i = 0; i < meshCount; ++i)

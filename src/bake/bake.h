@@ -50,6 +50,9 @@ struct BakeSettings {
     uint32_t gutterShadels = 2;  // padding on each side of every chart, MIP-0 shadels
     float chartConeDegrees = 40; // charts grow over triangles within this angle of the chart
     uint32_t threads = 2;        // bakeScene workers
+    // bakeScene: least-recently-used cache files beyond this are removed (0 = no limit). Not
+    // part of the bake key: it does not change what is baked.
+    uint64_t cacheLimitBytes = 4ull << 30;
 };
 
 struct BakedMesh {

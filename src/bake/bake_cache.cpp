@@ -10,6 +10,8 @@
 
 #include <unistd.h>
 
+#include "bake/bake_cache_check.h"
+#include "core/atomic_file.h"
 #include "core/log.h"
 
 namespace shadel {
@@ -158,7 +160,28 @@ bool parsePayload(const uint8_t* data, size_t size, const Mesh& mesh, BakedMesh&
                 return fail("triangle ID out of range");
     }
     if (!r.atEnd()) return fail("trailing bytes");
+    // The checksum only proves the file is what was written; this proves it fits the mesh.
+    if (std::string contradiction = bakeContradictsMesh(mesh, b); !contradiction.empty()) {
+        *why = "does not match the mesh: " + contradiction;
+        return false;
+    }
     return true;
+}
+
+// Reads a whole regular file. Returns "" or why not ("missing" if it does not exist): a
+// directory or device where a cache file should be is a reason to rebake, not to stop.
+std::string readCacheFile(const std::string& path, std::vector<uint8_t>& bytes) {
+    std::error_code ec;
+    auto status = std::filesystem::status(path, ec);
+    if (!std::filesystem::exists(status)) return "missing";
+    if (!std::filesystem::is_regular_file(status)) return "not a regular file";
+    std::ifstream file(path, std::ios::binary);
+    uint64_t size = std::filesystem::file_size(path, ec);
+    if (!file || ec) return "cannot open: " + std::string(std::strerror(errno));
+    bytes.resize(size);
+    if (size > 0 && !file.read(reinterpret_cast<char*>(bytes.data()), std::streamsize(size)))
+        return "read error";
+    return {};
 }
 
 } // namespace
@@ -201,11 +224,13 @@ BakeKey bakeKey(const Mesh& mesh, const BakeSettings& settings) {
 }
 
 std::string defaultBakeCacheDir() {
-    if (const char* xdg = std::getenv("XDG_CACHE_HOME"); xdg && *xdg)
+    if (const char* dir = std::getenv("SHADEL_CACHE_DIR"); dir && *dir) return dir;
+    auto absolute = [](const char* path) { return path && path[0] == '/'; };
+    if (const char* xdg = std::getenv("XDG_CACHE_HOME"); absolute(xdg))
         return std::string(xdg) + "/shadel";
-    if (const char* home = std::getenv("HOME"); home && *home)
+    if (const char* home = std::getenv("HOME"); absolute(home))
         return std::string(home) + "/.cache/shadel";
-    return {};
+    return format("/tmp/shadel-cache-%u", unsigned(getuid()));
 }
 
 std::string bakeCachePath(const std::string& cacheDir, const BakeKey& key) {
@@ -216,13 +241,11 @@ bool readBakeCache(const std::string& path, const BakeKey& key, const Mesh& mesh
                    std::string* why) {
     std::string scratch;
     std::string& reason = why ? *why : scratch;
-    std::ifstream file(path, std::ios::binary);
-    if (!file) {
-        reason = "missing";
+    std::vector<uint8_t> bytes;
+    if (std::string error = readCacheFile(path, bytes); !error.empty()) {
+        reason = error;
         return false;
     }
-    std::vector<uint8_t> bytes((std::istreambuf_iterator<char>(file)),
-                               std::istreambuf_iterator<char>());
     FileHeader header;
     if (bytes.size() < sizeof header) {
         reason = "truncated header";
@@ -273,27 +296,11 @@ bool writeBakeCache(const std::string& path, const BakeKey& key, const BakedMesh
     std::error_code ec;
     fs::path target(path);
     if (target.has_parent_path()) fs::create_directories(target.parent_path(), ec);
-    static std::atomic<uint64_t> counter{0};
-    std::string temp = format("%s.tmp.%d.%llu", path.c_str(), int(getpid()),
-                              (unsigned long long)counter.fetch_add(1));
-    {
-        std::ofstream file(temp, std::ios::binary | std::ios::trunc);
-        file.write(reinterpret_cast<const char*>(&header), sizeof header);
-        file.write(reinterpret_cast<const char*>(payload.data()), std::streamsize(payload.size()));
-        file.flush();
-        if (!file) {
-            reason = "cannot write " + temp;
-            fs::remove(temp, ec);
-            return false;
-        }
-    }
-    fs::rename(temp, target, ec);
-    if (ec) {
-        reason = "cannot rename into " + path + ": " + ec.message();
-        fs::remove(temp, ec);
-        return false;
-    }
-    return true;
+    std::vector<uint8_t> bytes(sizeof header + payload.size());
+    std::memcpy(bytes.data(), &header, sizeof header);
+    std::memcpy(bytes.data() + sizeof header, payload.data(), payload.size());
+    reason = writeFileAtomically(path, bytes.data(), bytes.size());
+    return reason.empty();
 }
 
 } // namespace shadel

@@ -40,6 +40,8 @@
 
 #include "core/error.h"
 #include "core/log.h"
+#include "scene/gltf_uri.h"
+#include "scene/json_limits.h"
 #include "scene/mesh_utils.h"
 
 namespace shadel {
@@ -54,7 +56,22 @@ constexpr uint64_t kMaxFileBytes = 1ull << 30;
 // More elements than this in one accessor is not a scene this engine can render.
 constexpr uint64_t kMaxAccessorCount = 1ull << 24;
 // Deeper JSON nesting than this is refused: tinygltf converts "extras" recursively.
-constexpr int kMaxJsonDepth = 64;
+constexpr size_t kMaxJsonDepth = 64;
+// Element counts beyond any scene this engine renders; refused before tinygltf builds (large)
+// structures for each, so a small hostile file cannot take minutes or gigabytes.
+struct CountLimit {
+    const char* array;
+    size_t max;
+};
+constexpr CountLimit kMaxCounts[] = {
+    {"nodes", 1u << 18},   {"meshes", 1u << 16},   {"accessors", 1u << 18},
+    {"bufferViews", 1u << 18}, {"buffers", 1u << 12}, {"materials", 1u << 16},
+    {"textures", 1u << 16}, {"images", 1u << 14},   {"samplers", 1u << 12},
+    {"cameras", 1u << 12},  {"scenes", 1u << 12},   {"skins", 1u << 12},
+    {"animations", 1u << 12},
+};
+// Primitives summed over all meshes (each becomes at least one Mesh).
+constexpr size_t kMaxPrimitives = 1u << 18;
 constexpr uint64_t kMaxImagePixels = 1ull << 26;
 
 constexpr uint32_t kGlbMagic = 0x46546C67; // "glTF"
@@ -124,19 +141,61 @@ std::string_view jsonTextOf(const std::vector<uint8_t>& bytes, bool binary,
 
 json parseJson(std::string_view text, const std::string& input) {
     if (text.empty()) fail(input, "empty file");
+    // Checked in one pass before parsing: a parser callback (called per value with the value
+    // built so far) made parsing quadratic in the number of objects.
+    if (jsonNestingDepth(text, kMaxJsonDepth) > kMaxJsonDepth)
+        fail(input, format("JSON nested deeper than %zu levels", kMaxJsonDepth));
     try {
-        auto limitDepth = [&](int depth, json::parse_event_t, json&) {
-            if (depth > kMaxJsonDepth)
-                fail(input, format("JSON nested deeper than %d levels", kMaxJsonDepth));
-            return true;
-        };
-        return json::parse(text.begin(), text.end(), limitDepth);
+        return json::parse(text.begin(), text.end());
     } catch (const json::exception& e) {
         // nlohmann prefixes "[json.exception.parse_error.101] "; keep the useful tail.
         std::string what = e.what();
         size_t bracket = what.find("] ");
         fail(input, "invalid JSON: " +
                         oneLine(bracket != std::string::npos ? what.substr(bracket + 2) : what));
+    }
+}
+
+// Refuses element counts no renderable scene has (see kMaxCounts), in time linear in the counts.
+void checkCounts(const json& root, const std::string& input) {
+    if (!root.is_object()) return; // the schema check reports it
+    for (const CountLimit& limit : kMaxCounts) {
+        auto it = root.find(limit.array);
+        if (it != root.end() && it->is_array() && it->size() > limit.max)
+            fail(input, format("%zu %s, more than the limit of %zu", it->size(), limit.array,
+                               limit.max));
+    }
+    auto meshes = root.find("meshes");
+    if (meshes == root.end() || !meshes->is_array()) return;
+    size_t primitives = 0;
+    for (const json& mesh : *meshes) {
+        if (!mesh.is_object()) continue;
+        auto list = mesh.find("primitives");
+        if (list != mesh.end() && list->is_array()) primitives += list->size();
+    }
+    if (primitives > kMaxPrimitives)
+        fail(input, format("%zu mesh primitives, more than the limit of %zu", primitives,
+                           kMaxPrimitives));
+}
+
+// Refuses buffer and image URIs that leave the model's folder (unless allowed): a model is a
+// folder of files, and reading `../../etc/passwd` or `/home/...` on its behalf is never intended.
+void checkUrisStayInFolder(const json& root, const std::string& input) {
+    if (!root.is_object()) return;
+    for (const char* array : {"buffers", "images"}) {
+        auto list = root.find(array);
+        if (list == root.end() || !list->is_array()) continue;
+        for (size_t i = 0; i < list->size(); ++i) {
+            const json& item = (*list)[i];
+            auto uri = item.is_object() ? item.find("uri") : item.end();
+            if (uri == item.end() || !uri->is_string()) continue;
+            const std::string& text = uri->get_ref<const std::string&>();
+            if (text.rfind("data:", 0) == 0) continue;
+            if (uriEscapesFolder(decodeUriPath(text)))
+                fail(input, format("/%s/%zu/uri '%s' points outside the model's folder "
+                                   "(--allow-external-files allows it)",
+                                   array, i, oneLine(text.substr(0, 200)).c_str()));
+        }
     }
 }
 
@@ -577,7 +636,19 @@ bool decodeImageToRgba8(tinygltf::Image* image, const int index, std::string*, s
     return true;
 }
 
-bool fsFileExists(const std::string& path, void*) {
+// Where external files may be read from (the fs callbacks' user data).
+struct FileAccess {
+    std::string modelFolder;
+    bool allowExternal = false;
+    bool permits(const std::string& path) const {
+        return allowExternal || pathInsideFolder(path, modelFolder);
+    }
+};
+
+// tinygltf also looks for a relative URI in the working directory; outside the model's folder
+// a file does not exist for it (the URI check above gives the clear error first).
+bool fsFileExists(const std::string& path, void* access) {
+    if (!static_cast<const FileAccess*>(access)->permits(path)) return false;
     std::error_code ec;
     return std::filesystem::is_regular_file(path, ec);
 }
@@ -585,7 +656,11 @@ std::string fsExpandPath(const std::string& path, void*) {
     return path;
 }
 bool fsReadWholeFile(std::vector<unsigned char>* out, std::string* err, const std::string& path,
-                     void*) {
+                     void* access) {
+    if (!static_cast<const FileAccess*>(access)->permits(path)) {
+        if (err) *err += path + " is outside the model's folder";
+        return false;
+    }
     std::error_code ec;
     uint64_t size = std::filesystem::file_size(path, ec);
     if (ec || size > kMaxFileBytes) {
@@ -1320,21 +1395,29 @@ private:
 
 } // namespace
 
-Scene importGltf(const std::string& path) {
+Scene importGltf(const std::string& path, const SceneFileOptions& options) {
+    return importGltfBytes(readWholeFile(path, path), path, options);
+}
+
+Scene importGltfBytes(std::vector<uint8_t> bytes, const std::string& path,
+                      const SceneFileOptions& options) {
     const std::string& input = path;
-    std::vector<uint8_t> bytes = readWholeFile(path, input);
+    if (bytes.size() > kMaxFileBytes) fail(input, "file is larger than the size limit");
     bool binary = bytes.size() >= 4 && readU32(bytes.data()) == kGlbMagic;
 
     json document = parseJson(jsonTextOf(bytes, binary, input), input);
+    checkCounts(document, input);
     JsonSchemaCheck(document, input).run();
+    if (!options.allowExternalFiles) checkUrisStayInFolder(document, input);
     document = json(); // tinygltf parses its own copy
 
     tinygltf::TinyGLTF loader;
     loader.SetImageLoader(decodeImageToRgba8, nullptr);
-    loader.SetFsCallbacks({fsFileExists, fsExpandPath, fsReadWholeFile, fsWriteWholeFile, nullptr});
+    std::string baseDir = std::filesystem::path(path).parent_path().string();
+    FileAccess access{baseDir, options.allowExternalFiles};
+    loader.SetFsCallbacks({fsFileExists, fsExpandPath, fsReadWholeFile, fsWriteWholeFile, &access});
     tinygltf::Model model;
     std::string err, warn;
-    std::string baseDir = std::filesystem::path(path).parent_path().string();
     bool ok = binary ? loader.LoadBinaryFromMemory(&model, &err, &warn, bytes.data(),
                                                    unsigned(bytes.size()), baseDir)
                      : loader.LoadASCIIFromString(&model, &err, &warn,

@@ -1,10 +1,17 @@
 #pragma once
 // glTF 2.0 import (.gltf and .glb) into the plain scene model.
+#include <cstdint>
 #include <string>
+#include <vector>
 
 #include "scene/scene.h"
 
 namespace shadel {
+
+struct SceneFileOptions {
+    // Buffer and image URIs may resolve outside the model's folder (`../`, absolute paths).
+    bool allowExternalFiles = false;
+};
 
 // Loads a glTF 2.0 file. Every malformed input throws InputError with one line
 // "<path>: <reason>"; recoverable problems (unsupported extensions, missing images, repaired
@@ -13,6 +20,11 @@ namespace shadel {
 // The node hierarchy is flattened to instances with world transforms; a primitive becomes one
 // Mesh (split into parts of at most kMaxTrianglesPerMesh triangles). A file without cameras
 // gets an "auto" camera framing the scene, one without lights an "auto-sun".
-Scene importGltf(const std::string& path);
+Scene importGltf(const std::string& path, const SceneFileOptions& options = {});
+
+// The same for the file's contents already in memory (the fuzz target): `path` names the input
+// in errors and its folder is where buffer and image URIs resolve.
+Scene importGltfBytes(std::vector<uint8_t> bytes, const std::string& path,
+                      const SceneFileOptions& options = {});
 
 } // namespace shadel

@@ -8,7 +8,7 @@
 
 namespace shadel {
 
-Scene loadScene(const std::string& spec) {
+Scene loadScene(const std::string& spec, const SceneFileOptions& options) {
     static const std::string builtinPrefix = "builtin:";
     if (spec.rfind(builtinPrefix, 0) == 0)
         return makeBuiltinScene(spec.substr(builtinPrefix.size()));
@@ -19,7 +19,7 @@ Scene loadScene(const std::string& spec) {
     if (ext != ".gltf" && ext != ".glb")
         throw InputError(spec +
                          ": unknown scene format (expected builtin:NAME, a .gltf or a .glb file)");
-    return importGltf(spec);
+    return importGltf(spec, options);
 }
 
 } // namespace shadel

@@ -4,12 +4,13 @@
 #include <vector>
 
 #include "scene/builtin_scenes.h"
+#include "scene/gltf_import.h"
 #include "scene/scene.h"
 
 namespace shadel {
 
 // `builtin:NAME` (see builtinSceneNames()) or a path to a .gltf / .glb file. Bad input throws
 // InputError with one line naming the input and the reason.
-Scene loadScene(const std::string& spec);
+Scene loadScene(const std::string& spec, const SceneFileOptions& options = {});
 
 } // namespace shadel

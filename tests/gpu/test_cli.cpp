@@ -2,6 +2,7 @@
 // input and the reason and exit code 2 — never a crash or a hang.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <array>
 #include <cstdio>
 #include <filesystem>
@@ -15,6 +16,33 @@ struct Result {
     int exitCode = -1;
     std::string stderrText;
 };
+
+struct Output {
+    int exitCode = -1;
+    std::string stdoutText, stderrText;
+};
+
+std::string readText(const std::string& path) {
+    std::ifstream in(path);
+    std::stringstream ss;
+    ss << in.rdbuf();
+    return ss.str();
+}
+
+// Runs `env` (e.g. "XDG_CACHE_HOME=") shadel `args`, keeping both streams.
+Output runWithEnv(const std::string& env, const std::string& args) {
+    auto tmp = std::filesystem::temp_directory_path();
+    std::string outFile = (tmp / "shadel_cli_stdout.txt").string();
+    std::string errFile = (tmp / "shadel_cli_stderr.txt").string();
+    std::string cmd = "env " + env + " timeout 120 " + SHADEL_BINARY + " " + args + " >" + outFile +
+                      " 2>" + errFile;
+    int status = std::system(cmd.c_str());
+    Output o;
+    o.exitCode = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+    o.stdoutText = readText(outFile);
+    o.stderrText = readText(errFile);
+    return o;
+}
 
 Result run(const std::string& args) {
     std::string errFile =
@@ -87,4 +115,227 @@ TEST(Cli, RenderWritesPngAndStatsJson) {
          {"\"device\"", "\"mode\"", "\"frame_ms\"", "\"passes\"", "\"pixels_covered\"",
           "\"shadels_per_pixel\"", "\"reconstruction_misses\"", "\"validation_errors\""})
         EXPECT_NE(ss.str().find(key), std::string::npos) << key;
+}
+
+// --- issue 17: every command-line error is one line and exit code 2 ------------------------
+
+namespace {
+
+size_t lineCount(const std::string& text) {
+    return size_t(std::count(text.begin(), text.end(), '\n'));
+}
+
+// A scratch folder per test, removed afterwards.
+struct CliTempDir {
+    CliTempDir() {
+        path = std::filesystem::temp_directory_path() /
+               ("shadel_cli_" +
+                std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()));
+        std::filesystem::remove_all(path);
+        std::filesystem::create_directories(path);
+    }
+    ~CliTempDir() { std::filesystem::remove_all(path); }
+    std::string file(const std::string& name) const { return (path / name).string(); }
+    size_t entries() const {
+        return size_t(std::distance(std::filesystem::directory_iterator(path),
+                                    std::filesystem::directory_iterator()));
+    }
+    std::filesystem::path path;
+};
+
+} // namespace
+
+// The parser's own errors used CLI11's exit codes (109, 106, 105) and a two-line message.
+TEST(Cli, ParserErrorsAreOneLineAndExitCode2) {
+    const std::pair<const char*, const char*> cases[] = {
+        {"render --no-such-flag", "--no-such-flag"},
+        {"render --frames -1", "--frames"},
+        {"render --frames abc", "--frames"},
+        {"", "subcommand"},
+        {"paint", "subcommand"},
+        {"bench --frames x", "--frames"},
+    };
+    for (auto [args, named] : cases) {
+        Result r = run(args);
+        EXPECT_EQ(r.exitCode, 2) << args << ": " << r.stderrText;
+        EXPECT_EQ(lineCount(r.stderrText), 1u) << args << ": " << r.stderrText;
+        EXPECT_EQ(r.stderrText.rfind("shadel: ", 0), 0u) << args << ": " << r.stderrText;
+        EXPECT_NE(r.stderrText.find(named), std::string::npos) << args << ": " << r.stderrText;
+    }
+}
+
+// NaN, infinity and out-of-range floats used to render black or garbage with exit code 0.
+TEST(Cli, FloatFlagsMustBeFiniteAndInRange) {
+    const std::pair<const char*, const char*> cases[] = {
+        {"render --exposure nan", "--exposure"},
+        {"render --exposure 0", "--exposure"},
+        {"render --exposure inf", "--exposure"},
+        {"render --shading-bias nan", "--shading-bias"},
+        {"render --shading-bias 1e30", "--shading-bias"},
+        {"render --trilinear-band -1", "--trilinear-band"},
+        {"render --trilinear-band 1.5", "--trilinear-band"},
+        {"render --density nan", "--density"},
+        {"render --density -3", "--density"},
+        {"render --shadel-budget nan", "--shadel-budget"},
+        {"render --forward-below nan", "--forward-below"},
+        {"render --forward-below -1", "--forward-below"},
+        {"bench --density nan", "--density"},
+        {"bake --density inf builtin:smooth", "--density"},
+        {"bake --shadel-budget 0 builtin:smooth", "--shadel-budget"},
+    };
+    for (auto [args, flag] : cases) {
+        Result r = run(args);
+        EXPECT_EQ(r.exitCode, 2) << args << ": " << r.stderrText;
+        EXPECT_EQ(lineCount(r.stderrText), 1u) << args << ": " << r.stderrText;
+        EXPECT_NE(r.stderrText.find(flag), std::string::npos)
+            << "the message must name the flag: " << r.stderrText;
+    }
+}
+
+// OVERVIEW documents --forward-below; it was rejected as unknown.
+TEST(Cli, ForwardBelowIsAFlag) {
+    CliTempDir dir;
+    Result r =
+        run("render --mode decoupled --size 32x32 --forward-below 0 --stats " + dir.file("s.json"));
+    EXPECT_EQ(r.exitCode, 0) << r.stderrText;
+    EXPECT_TRUE(std::filesystem::exists(dir.file("s.json")));
+}
+
+TEST(Cli, SubcommandHelpShowsGlobalFlagsAndTheBakeCache) {
+    for (const char* sub : {"render", "bench", "bake", "info", "cache", "cache clean"}) {
+        Output o = runWithEnv("SHADEL_CACHE_DIR=/tmp/some-cache", std::string(sub) + " --help");
+        EXPECT_EQ(o.exitCode, 0) << sub << ": " << o.stderrText;
+        for (const char* global : {"--device", "--validation", "--verbose",
+                                   "--allow-external-files", "Bake cache: /tmp/some-cache"})
+            EXPECT_NE(o.stdoutText.find(global), std::string::npos) << sub << " --help: " << global;
+    }
+    // ... and they are accepted after the subcommand too.
+    Result r = run("render --size 16x16 --device cpu");
+    EXPECT_EQ(r.exitCode, 0) << r.stderrText;
+}
+
+// --- issue 17: every write is checked ---------------------------------------------------------
+
+TEST(Cli, FullDeviceFailsTheRenderWithOneLine) {
+    for (const char* flag : {"--out", "--stats"}) {
+        Result r = run(std::string("render --size 16x16 ") + flag + " /dev/full");
+        EXPECT_NE(r.exitCode, 0) << flag;
+        EXPECT_EQ(lastLine(r.stderrText), "shadel: cannot write /dev/full: No space left on device")
+            << flag << ": " << r.stderrText;
+    }
+    Result bench = run("bench --size 16x16 --frames 1 --json /dev/full");
+    EXPECT_NE(bench.exitCode, 0);
+    EXPECT_EQ(lastLine(bench.stderrText), "shadel: cannot write /dev/full: No space left on device")
+        << bench.stderrText;
+}
+
+// Outputs are checked before the scene is even loaded (the scene here does not exist).
+TEST(Cli, UncreatableOutputsFailBeforeRendering) {
+    CliTempDir dir;
+    std::string missing = dir.file("no/such/folder/x");
+    const std::pair<std::string, std::string> cases[] = {
+        {"render --scene /nonexistent.gltf --out " + missing + ".png", "--out " + missing + ".png"},
+        {"render --scene /nonexistent.gltf --stats " + missing + ".json",
+         "--stats " + missing + ".json"},
+        {"render --scene /nonexistent.gltf --stats " + dir.path.string(),
+         "--stats " + dir.path.string() + ": Is a directory"},
+        {"bench --scene /nonexistent.gltf --json " + missing + ".json",
+         "--json " + missing + ".json"},
+    };
+    for (const auto& [args, message] : cases) {
+        Result r = run(args);
+        EXPECT_EQ(r.exitCode, 2) << args;
+        EXPECT_EQ(lineCount(r.stderrText), 1u) << r.stderrText;
+        EXPECT_NE(r.stderrText.find(message), std::string::npos) << r.stderrText;
+    }
+    EXPECT_EQ(dir.entries(), 0u) << "nothing may be left behind";
+}
+
+// --- issue 17: the bake cache location and glTF URIs -------------------------------------------
+
+// XDG_CACHE_HOME="" put the cache at /shadel; an empty or relative value must be ignored.
+TEST(Cli, EmptyOrRelativeXdgCacheHomeIsIgnored) {
+    for (const char* xdg : {"XDG_CACHE_HOME=", "XDG_CACHE_HOME=relative/cache"}) {
+        Output o = runWithEnv(std::string("-u SHADEL_CACHE_DIR ") + xdg + " HOME=/home/someone",
+                              "render --help");
+        EXPECT_EQ(o.exitCode, 0);
+        EXPECT_NE(o.stdoutText.find("Bake cache: /home/someone/.cache/shadel"), std::string::npos)
+            << xdg << ": " << o.stdoutText;
+    }
+    Output o = runWithEnv("-u SHADEL_CACHE_DIR XDG_CACHE_HOME=/xdg", "bake --help");
+    EXPECT_NE(o.stdoutText.find("Bake cache: /xdg/shadel"), std::string::npos) << o.stdoutText;
+}
+
+TEST(Cli, InfoShowsTheBakeCache) {
+    Output o = runWithEnv("SHADEL_CACHE_DIR=/tmp/info-cache", "info");
+    EXPECT_EQ(o.exitCode, 0) << o.stderrText;
+    EXPECT_NE(o.stdoutText.find("bake cache: /tmp/info-cache"), std::string::npos) << o.stdoutText;
+}
+
+// A buffer URI ../../../../etc/passwd was read (absolute paths were already refused).
+TEST(Cli, BufferUriOutsideTheModelFolderIsRefused) {
+    CliTempDir dir;
+    std::string model = dir.file("escape.gltf");
+    std::ofstream(model) << R"({"asset":{"version":"2.0"},"scenes":[{"nodes":[0]}],
+        "nodes":[{"mesh":0}],"meshes":[{"primitives":[{"attributes":{"POSITION":0}}]}],
+        "accessors":[{"bufferView":0,"componentType":5126,"count":3,"type":"VEC3"}],
+        "bufferViews":[{"buffer":0,"byteLength":36}],
+        "buffers":[{"uri":"../../../../etc/passwd","byteLength":36}]})";
+    Result r = run("render --size 16x16 --scene " + model);
+    EXPECT_EQ(r.exitCode, 2);
+    EXPECT_EQ(lastLine(r.stderrText),
+              "shadel: " + model +
+                  ": /buffers/0/uri '../../../../etc/passwd' points outside the model's folder "
+                  "(--allow-external-files allows it)");
+    // With the flag the URI is followed (and the text file is then not a valid buffer).
+    Result allowed = run("--allow-external-files render --size 16x16 --scene " + model);
+    EXPECT_EQ(allowed.stderrText.find("outside the model's folder"), std::string::npos)
+        << allowed.stderrText;
+}
+
+// OVERVIEW documented --forward-below, which did not exist: every flag the docs name must be in
+// some command's --help.
+TEST(Cli, EveryDocumentedFlagExists) {
+    std::string help;
+    for (const char* sub : {"render", "bench", "bake", "info"})
+        help += runWithEnv("", std::string(sub) + " --help").stdoutText;
+    int flags = 0;
+    for (const char* doc : {"/README.md", "/OVERVIEW.md"}) {
+        std::string text = readText(std::string(SHADEL_SOURCE_DIR) + doc);
+        for (size_t at = text.find("--"); at != std::string::npos; at = text.find("--", at + 2)) {
+            size_t end = at + 2;
+            while (end < text.size() &&
+                   (std::islower(static_cast<unsigned char>(text[end])) ||
+                    std::isdigit(static_cast<unsigned char>(text[end])) || text[end] == '-'))
+                ++end;
+            if (end == at + 2 || !std::islower(static_cast<unsigned char>(text[at + 2]))) continue;
+            std::string flag = text.substr(at, end - at);
+            while (flag.back() == '-') flag.pop_back();
+            ++flags;
+            EXPECT_NE(help.find(flag), std::string::npos) << doc << " documents " << flag;
+        }
+    }
+    EXPECT_GT(flags, 10);
+}
+
+TEST(Cli, CacheCommandShowsAndCleansTheCache) {
+    CliTempDir dir;
+    std::string cache = dir.file("cache");
+    Output baked = runWithEnv("", "bake builtin:smooth --cache-dir " + cache);
+    ASSERT_EQ(baked.exitCode, 0) << baked.stderrText;
+    std::string files = std::to_string(std::distance(std::filesystem::directory_iterator(cache),
+                                                     std::filesystem::directory_iterator())) +
+                        " files";
+    ASSERT_NE(files, "0 files");
+    Output shown = runWithEnv("SHADEL_CACHE_DIR=" + cache, "cache");
+    EXPECT_EQ(shown.exitCode, 0) << shown.stderrText;
+    EXPECT_NE(shown.stdoutText.find("bake cache: " + cache + "\n" + files), std::string::npos)
+        << shown.stdoutText;
+    Output cleaned = runWithEnv("", "cache clean --cache-dir " + cache);
+    EXPECT_EQ(cleaned.exitCode, 0) << cleaned.stderrText;
+    EXPECT_NE(cleaned.stdoutText.find("removed " + files), std::string::npos) << cleaned.stdoutText;
+    EXPECT_TRUE(std::filesystem::is_empty(cache));
+    Result bad = run("--cache-limit lots cache");
+    EXPECT_EQ(bad.exitCode, 2);
+    EXPECT_NE(bad.stderrText.find("--cache-limit"), std::string::npos) << bad.stderrText;
 }

@@ -1,0 +1,80 @@
+#include "app/cli_validate.h"
+
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <tuple>
+
+#include "app/commands.h"
+#include "bake/cache_eviction.h"
+#include "core/error.h"
+#include "core/log.h"
+
+namespace shadel {
+namespace {
+
+// "" or why `value` is not a finite number in range.
+std::string rangeProblem(double value, FloatRange r) {
+    if (!std::isfinite(value)) return "must be a finite number";
+    bool aboveMin = r.minExclusive ? value > r.min : value >= r.min;
+    if (!aboveMin || value > r.max)
+        return format("must be in %s%g, %g]", r.minExclusive ? "(" : "[", r.min, r.max);
+    return {};
+}
+
+std::string oneLine(std::string text) {
+    while (!text.empty() && (text.back() == '\n' || text.back() == ' ')) text.pop_back();
+    for (size_t at; (at = text.find('\n')) != std::string::npos;) text.replace(at, 1, "; ");
+    return text;
+}
+
+} // namespace
+
+CLI::Validator finiteInRange(FloatRange range) {
+    auto check = [=](std::string& text) -> std::string {
+        char* end = nullptr;
+        double value = std::strtod(text.c_str(), &end);
+        if (text.empty() || end != text.c_str() + text.size()) return text + ": not a number";
+        std::string problem = rangeProblem(value, range);
+        return problem.empty() ? problem : text + ": " + problem;
+    };
+    return CLI::Validator(
+        check, format("FINITE %s%g..%g]", range.minExclusive ? "(" : "[", range.min, range.max));
+}
+
+CLI::Validator byteSize() {
+    auto check = [](std::string& text) -> std::string {
+        uint64_t bytes = 0;
+        return parseByteSize(text, bytes) ? std::string()
+                                          : text + ": expected a size such as 4G, 512M or 0";
+    };
+    return CLI::Validator(check, "SIZE");
+}
+
+std::string checkFiniteInRange(const char* flag, double value, FloatRange range) {
+    std::string problem = rangeProblem(value, range);
+    return problem.empty() ? problem : format("%s %g: %s", flag, value, problem.c_str());
+}
+
+void validateRenderOptions(const RenderOptions& o) {
+    const std::tuple<const char*, double, FloatRange> floats[] = {
+        {"--exposure", o.exposure, kExposureRange},
+        {"--density", o.shadelsPerMetre, kDensityRange},
+        {"--shading-bias", o.shadingBias, kShadingBiasRange},
+        {"--trilinear-band", o.trilinearBand, kTrilinearBandRange},
+        {"--shadel-budget", o.shadelBudget, kShadelBudgetRange},
+        {"--forward-below", o.forwardBelowPixels, kForwardBelowRange},
+    };
+    for (const auto& [flag, value, range] : floats)
+        if (std::string problem = checkFiniteInRange(flag, value, range); !problem.empty())
+            throw InputError(problem);
+}
+
+int exitForParseError(const CLI::App& app, const CLI::ParseError& error) {
+    // --help, --help-all and --version are "errors" with exit code 0 that print their text.
+    if (error.get_exit_code() == static_cast<int>(CLI::ExitCodes::Success)) return app.exit(error);
+    std::fprintf(stderr, "shadel: %s (see --help)\n", oneLine(error.what()).c_str());
+    return kExitBadInput;
+}
+
+} // namespace shadel

@@ -1,0 +1,47 @@
+#pragma once
+// Command-line checks shared by every subcommand's flag definitions: floats must be finite and
+// in range (NaN and infinity parse as floats, then silently render black or garbage), and every
+// command-line error, the CLI11 parser's own included, is one line on stderr and exit code 2.
+#include <string>
+
+#include <CLI/CLI.hpp>
+
+namespace shadel {
+
+// Exit code for bad input (README): flags, files, scenes.
+constexpr int kExitBadInput = 2;
+
+// [min, max], or (min, max] when minExclusive.
+struct FloatRange {
+    double min, max;
+    bool minExclusive = false;
+};
+
+// The accepted values of the float flags, shared by the flag definitions and
+// validateRenderOptions (in-process callers bypass the parser).
+constexpr FloatRange kExposureRange{0, 1e6, true};      // 0 renders black
+constexpr FloatRange kDensityRange{0, 1e6, true};       // shadels per metre
+constexpr FloatRange kShadingBiasRange{-8, 8};          // MIP levels
+constexpr FloatRange kTrilinearBandRange{0, 1};         // fraction of a MIP level
+constexpr FloatRange kShadelBudgetRange{0, 1e12, true}; // MIP-0 shadels
+constexpr FloatRange kForwardBelowRange{0, 1e12};       // pixels; 0 = never
+
+// Accepts a finite number in the range. CLI11 reports a rejection as "<flag>: <reason>".
+CLI::Validator finiteInRange(FloatRange range);
+
+// Accepts a byte size: digits with an optional k, M, G or T (binary) suffix, e.g. 4G.
+CLI::Validator byteSize();
+
+// The same check for values set in code; "" or "<flag> <value>: <reason>".
+std::string checkFiniteInRange(const char* flag, double value, FloatRange range);
+
+struct RenderOptions;
+// Throws InputError naming the flag for the first float option out of range: runRender's
+// callers in code (tests, bench) do not go through the flag checks.
+void validateRenderOptions(const RenderOptions& options);
+
+// What main returns for a CLI11 exception: help and version print and return 0; any other
+// error prints "shadel: <message>" on one line and returns kExitBadInput.
+int exitForParseError(const CLI::App& app, const CLI::ParseError& error);
+
+} // namespace shadel

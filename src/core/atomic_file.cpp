@@ -1,0 +1,96 @@
+#include "core/atomic_file.h"
+
+#include <atomic>
+#include <cerrno>
+#include <cstring>
+#include <filesystem>
+
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include "core/log.h"
+
+namespace shadel {
+namespace {
+
+std::string failure(const std::string& path, int error) {
+    return path + ": " + std::strerror(error);
+}
+
+// write() until done; returns 0 or the errno of the first failure.
+int writeAll(int fd, const void* data, size_t size) {
+    const char* bytes = static_cast<const char*>(data);
+    while (size > 0) {
+        ssize_t n = ::write(fd, bytes, size);
+        if (n < 0) {
+            if (errno == EINTR) continue;
+            return errno;
+        }
+        bytes += n;
+        size -= size_t(n);
+    }
+    return 0;
+}
+
+std::string folderOf(const std::string& path) {
+    std::string folder = std::filesystem::path(path).parent_path().string();
+    return folder.empty() ? "." : folder;
+}
+
+// Writes in place (devices, pipes): there is nothing to rename, but errors still count.
+std::string writeInPlace(const std::string& path, const void* data, size_t size) {
+    int fd = ::open(path.c_str(), O_WRONLY | O_CLOEXEC);
+    if (fd < 0) return failure(path, errno);
+    int error = writeAll(fd, data, size);
+    // fsync on a device or pipe may legitimately be unsupported (EINVAL); only close's verdict
+    // and the writes' count.
+    if (::close(fd) != 0 && error == 0) error = errno;
+    return error ? failure(path, error) : std::string();
+}
+
+} // namespace
+
+std::string writeFileAtomically(const std::string& path, const void* data, size_t size) {
+    struct stat existing {};
+    if (::stat(path.c_str(), &existing) == 0) {
+        if (S_ISDIR(existing.st_mode)) return failure(path, EISDIR);
+        if (!S_ISREG(existing.st_mode)) return writeInPlace(path, data, size);
+    }
+    static std::atomic<unsigned long long> counter{0};
+    // Hidden, unique per process and call, in the target's folder (same file system).
+    std::filesystem::path target(path);
+    std::string name =
+        format(".%s.tmp.%d.%llu", target.filename().c_str(), int(::getpid()), counter.fetch_add(1));
+    std::string temp = (target.parent_path() / name).string();
+    int fd = ::open(temp.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0644);
+    if (fd < 0) return failure(path, errno);
+    int error = writeAll(fd, data, size);
+    // Delayed allocation: on some file systems a full disk only shows at fsync or close.
+    if (error == 0 && ::fsync(fd) != 0 && errno != EINVAL) error = errno;
+    if (::close(fd) != 0 && error == 0) error = errno;
+    if (error == 0 && ::rename(temp.c_str(), path.c_str()) != 0) error = errno;
+    if (error != 0) {
+        ::unlink(temp.c_str());
+        return failure(path, error);
+    }
+    return {};
+}
+
+std::string checkFileCreatable(const std::string& path) {
+    if (path.empty()) return "output path is empty";
+    struct stat existing {};
+    if (::stat(path.c_str(), &existing) == 0) {
+        if (S_ISDIR(existing.st_mode)) return failure(path, EISDIR);
+        if (!S_ISREG(existing.st_mode))
+            return ::access(path.c_str(), W_OK) == 0 ? std::string() : failure(path, errno);
+    }
+    std::string folder = folderOf(path);
+    struct stat dir {};
+    if (::stat(folder.c_str(), &dir) != 0) return failure(path, errno);
+    if (!S_ISDIR(dir.st_mode)) return failure(path, ENOTDIR);
+    if (::access(folder.c_str(), W_OK) != 0) return failure(path, errno);
+    return {};
+}
+
+} // namespace shadel

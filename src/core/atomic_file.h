@@ -1,0 +1,23 @@
+#pragma once
+// Whole-file writes that either complete or leave nothing behind.
+//
+// A regular file is written to a temporary file in the same folder (so the final rename stays on
+// one file system and is atomic), flushed, checked, and renamed over the target: readers never
+// see a partial file, and a failed write (full disk, quota, I/O error) removes the temporary
+// file and leaves any previous target untouched. An existing non-regular target (a character
+// device such as /dev/null, /dev/full or /dev/stdout, a pipe) is written in place, because
+// renaming over it would replace the device node; its write errors are still reported.
+#include <cstddef>
+#include <string>
+
+namespace shadel {
+
+// Returns "" on success, else one line "<path>: <strerror reason>" (naming the file that failed,
+// which may be the temporary file next to path).
+std::string writeFileAtomically(const std::string& path, const void* data, size_t size);
+
+// Returns "" if path looks writable without creating it: not a directory, its folder exists and
+// is writable (or it is an existing writable non-regular file). Else "<path>: <reason>".
+std::string checkFileCreatable(const std::string& path);
+
+} // namespace shadel

@@ -1,0 +1,106 @@
+// Whole-file writes (core/atomic_file.h): a failed write names the file and the reason and
+// leaves nothing behind, not even a temporary file, and never a truncated target.
+#include <gtest/gtest.h>
+
+#include <csignal>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include <sys/resource.h>
+#include <unistd.h>
+
+#include "core/atomic_file.h"
+
+using namespace shadel;
+namespace fs = std::filesystem;
+
+namespace {
+
+struct TempDir {
+    TempDir() {
+        path = fs::temp_directory_path() /
+               ("shadel_atomic_test_" + std::to_string(getpid()) + "_" +
+                ::testing::UnitTest::GetInstance()->current_test_info()->name());
+        fs::remove_all(path);
+        fs::create_directories(path);
+    }
+    ~TempDir() { fs::remove_all(path); }
+    size_t entries() const {
+        return size_t(std::distance(fs::directory_iterator(path), fs::directory_iterator()));
+    }
+    fs::path path;
+};
+
+std::string readText(const fs::path& p) {
+    std::ifstream in(p, std::ios::binary);
+    std::stringstream ss;
+    ss << in.rdbuf();
+    return ss.str();
+}
+
+// A full disk for this process: files may not grow beyond `bytes` (write fails with EFBIG
+// instead of raising SIGXFSZ). Restored on destruction.
+class FileSizeLimit {
+public:
+    explicit FileSizeLimit(rlim_t bytes) {
+        previousHandler_ = std::signal(SIGXFSZ, SIG_IGN);
+        getrlimit(RLIMIT_FSIZE, &previous_);
+        rlimit limit = previous_;
+        limit.rlim_cur = bytes;
+        setrlimit(RLIMIT_FSIZE, &limit);
+    }
+    ~FileSizeLimit() {
+        setrlimit(RLIMIT_FSIZE, &previous_);
+        std::signal(SIGXFSZ, previousHandler_);
+    }
+
+private:
+    rlimit previous_{};
+    void (*previousHandler_)(int) = nullptr;
+};
+
+} // namespace
+
+TEST(AtomicFile, WritesTheWholeFileAndNothingElse) {
+    TempDir dir;
+    std::string path = (dir.path / "out.json").string();
+    EXPECT_EQ(writeFileAtomically(path, "first", 5), "");
+    EXPECT_EQ(writeFileAtomically(path, "second", 6), "");
+    EXPECT_EQ(readText(path), "second");
+    EXPECT_EQ(dir.entries(), 1u) << "a temporary file was left behind";
+}
+
+TEST(AtomicFile, FullDiskLeavesThePreviousFileAndNoTemporary) {
+    TempDir dir;
+    std::string path = (dir.path / "image.png").string();
+    ASSERT_EQ(writeFileAtomically(path, "old", 3), "");
+    std::string big(256 * 1024, 'x');
+    std::string error;
+    {
+        FileSizeLimit limit(16 * 1024);
+        error = writeFileAtomically(path, big.data(), big.size());
+    }
+    EXPECT_EQ(error, path + ": File too large");
+    EXPECT_EQ(readText(path), "old") << "the target must not be truncated";
+    EXPECT_EQ(dir.entries(), 1u) << "the temporary file must be removed";
+}
+
+TEST(AtomicFile, DeviceTargetsAreWrittenInPlaceWithErrorsReported) {
+    EXPECT_EQ(writeFileAtomically("/dev/null", "data", 4), "");
+    EXPECT_EQ(writeFileAtomically("/dev/full", "data", 4), "/dev/full: No space left on device");
+    EXPECT_TRUE(fs::is_character_file("/dev/full")) << "the device node must survive";
+}
+
+TEST(AtomicFile, MissingFolderAndDirectoryTargetsAreOneLineErrors) {
+    TempDir dir;
+    std::string missing = (dir.path / "no/such/folder/out.png").string();
+    EXPECT_EQ(writeFileAtomically(missing, "x", 1), missing + ": No such file or directory");
+    EXPECT_EQ(checkFileCreatable(missing), missing + ": No such file or directory");
+    EXPECT_EQ(writeFileAtomically(dir.path.string(), "x", 1),
+              dir.path.string() + ": Is a directory");
+    EXPECT_EQ(checkFileCreatable(dir.path.string()), dir.path.string() + ": Is a directory");
+    EXPECT_EQ(checkFileCreatable((dir.path / "new.png").string()), "");
+    EXPECT_EQ(checkFileCreatable("/dev/full"), "");
+    EXPECT_EQ(dir.entries(), 0u);
+}
