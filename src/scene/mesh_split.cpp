@@ -31,6 +31,8 @@ struct VertexPool {
 
     // The point of edge (a, b) on the plane `axis` = value. Computed from the endpoints in a
     // canonical order, so both triangles sharing the edge get the same bits.
+    float cell = 1.0f;
+
     uint32_t onPlane(uint32_t a, uint32_t b, int axis, float value) {
         const Vertex* p = &vertices[a];
         const Vertex* q = &vertices[b];
@@ -42,9 +44,17 @@ struct VertexPool {
         Vertex v;
         v.position = glm::mix(p->position, q->position, t);
         v.position[axis] = value;
+        // An edge through a grid line (two planes meeting) must hit it exactly, or the next
+        // axis's clip would cut a sliver off one side only (a T-junction of 1e-7 units).
+        for (int other = 0; other < 3; ++other) {
+            if (other == axis) continue;
+            float snapped = float(std::round(double(v.position[other]) / cell) * cell);
+            if (std::abs(v.position[other] - snapped) <= 1e-5f * cell) v.position[other] = snapped;
+        }
         glm::vec3 n = glm::mix(p->normal, q->normal, t);
         v.normal = glm::length(n) > 1e-20f ? glm::normalize(n) : p->normal;
         glm::vec3 tangent = glm::mix(glm::vec3(p->tangent), glm::vec3(q->tangent), t);
+        tangent -= v.normal * glm::dot(v.normal, tangent); // unit and perpendicular, as imported
         v.tangent = glm::vec4(glm::length(tangent) > 1e-20f ? glm::normalize(tangent)
                                                             : glm::vec3(p->tangent),
                               p->tangent.w);
@@ -99,6 +109,7 @@ std::vector<Mesh> splitMeshOnGrid(const Mesh& mesh, float cell,
     // 1. Clip every triangle at the grid planes strictly inside its extent.
     VertexPool pool;
     pool.vertices = mesh.vertices;
+    pool.cell = cell;
     std::vector<Piece> pieces;
     pieces.reserve(mesh.triangleCount());
     std::vector<Polygon> current, next;
