@@ -71,9 +71,8 @@ void main() {
     si.frontFacing = dot(geometricNormal, f.cameraPosition - si.position) >= 0.0;
     GpuMaterial mat = MaterialBuffer(f.materials).m[inst.material];
     // The shadel's whole footprint, not its centre (prefilter.glsl; --material-samples caps it).
-    MaterialSample m = prefilteredMaterial(mat, si, shadelCenterUv(shadel, size), vec2(1.0) / vec2(size),
-                                           uvs.v[i0], uvs.v[i1], uvs.v[i2], v0.uv0, v1.uv0, v2.uv0,
-                                           s.materialSamples, uvec3(shadel, work.object * 16u + work.mip));
-    vec3 color = shadeSurface(f, m, si.position, si.normal);
+    vec3 color = prefilteredShade(f, mat, si, shadelCenterUv(shadel, size), vec2(1.0) / vec2(size),
+                                  uvs.v[i0], uvs.v[i1], uvs.v[i2], v0.uv0, v1.uv0, v2.uv0,
+                                  s.materialSamples, uvec3(shadel, work.object * 16u + work.mip));
     imageStore(gImagesRgba16f[s.storageWriteSlot], outTexel, vec4(color, 1.0));
 }
