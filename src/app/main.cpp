@@ -2,8 +2,8 @@
 // reason; exit 2 for bad input, 3 for a device problem, 1 for anything else.
 #include <chrono>
 #include <cmath>
-#include <cstdlib>
 #include <cstdio>
+#include <cstdlib>
 #include <unistd.h>
 
 #include <CLI/CLI.hpp>
@@ -24,8 +24,8 @@ float parseDensity(const std::string& t) {
     char* end = nullptr;
     double v = std::strtod(t.c_str(), &end);
     if (end == t.c_str() || *end != '\0' || !(v > 0) || !std::isfinite(v) || v > 1e9)
-        throw InputError(format("--density %s: expected auto or a positive number of shadels "
-                                "per metre", t.c_str()));
+        throw InputError(format(
+            "--density %s: expected auto or a positive number of shadels per metre", t.c_str()));
     return float(v);
 }
 

@@ -103,21 +103,25 @@ RenderRun runRender(Gpu& gpu, const RenderOptions& o) {
     float density = 0.0f;
     bool autoDensity = !(o.shadelsPerMetre > 0.0f);
     ViewDensity viewDensity;
-    double bakeSeconds = 0.0;
+    double bakeSeconds = 0.0, viewDensitySeconds = 0.0;
     if (autoDensity) {
+        auto start = std::chrono::steady_clock::now();
         // Density from what this run's cameras can need, large meshes split into chunks. Both
         // modes draw the same (split) scene, so pixel coverage is identical between them.
-        RunViews views = runViews(camera, o.cameraPath, o.frames, bounds, o.width * o.ssaa,
-                                  o.height * o.ssaa);
+        RunViews views =
+            runViews(camera, o.cameraPath, o.frames, bounds, o.width * o.ssaa, o.height * o.ssaa);
         ViewDensityOptions vo;
         vo.budget = o.shadelBudget;
         viewDensity = viewDrivenDensity(scene, views, vo);
         scene = std::move(viewDensity.scene);
         viewDensity.scene = Scene{};
+        viewDensitySeconds =
+            std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
         if (o.mode == RenderMode::Decoupled && viewDensity.budgetScale < 1.0)
             SHADEL_WARN("%s: the view-driven density needs %.0fM MIP-0 shadels; every density "
                         "scaled by %.3f to stay within %.0fM (--shadel-budget)",
-                        o.scene.c_str(), viewDensity.mip0Shadels / 1e6 /
+                        o.scene.c_str(),
+                        viewDensity.mip0Shadels / 1e6 /
                             (viewDensity.budgetScale * viewDensity.budgetScale),
                         viewDensity.budgetScale, o.shadelBudget / 1e6);
     }
@@ -129,8 +133,7 @@ RenderRun runRender(Gpu& gpu, const RenderOptions& o) {
                               nullptr, viewDensity.meshDensity);
         } else {
             double area = 0.0;
-            bs.shadelsPerMetre =
-                sceneShadelDensity(scene, o.shadelsPerMetre, o.shadelBudget, area);
+            bs.shadelsPerMetre = sceneShadelDensity(scene, o.shadelsPerMetre, o.shadelBudget, area);
             if (bs.shadelsPerMetre < o.shadelsPerMetre)
                 SHADEL_WARN("%s: %.0f units^2 of surface at %.1f shadels/unit would need %.0fM "
                             "shadels; using %.3f shadels/unit to stay within %.0fM (--density, "
@@ -139,11 +142,11 @@ RenderRun runRender(Gpu& gpu, const RenderOptions& o) {
                             area * o.shadelsPerMetre * o.shadelsPerMetre / 1e6,
                             double(bs.shadelsPerMetre), o.shadelBudget / 1e6);
             density = bs.shadelsPerMetre;
-            baked = bakeScene(scene, bs, o.cacheDir.empty() ? defaultCacheDir() : o.cacheDir,
-                              nullptr);
+            baked =
+                bakeScene(scene, bs, o.cacheDir.empty() ? defaultCacheDir() : o.cacheDir, nullptr);
         }
-        bakeSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - bakeStart)
-                          .count();
+        bakeSeconds =
+            std::chrono::duration<double>(std::chrono::steady_clock::now() - bakeStart).count();
         uploadScene(gpu, scene, gpuScene, &baked);
     } else {
         uploadScene(gpu, scene, gpuScene);
@@ -244,7 +247,8 @@ RenderRun runRender(Gpu& gpu, const RenderOptions& o) {
                              {"chunks", viewDensity.chunksMade},
                              {"meshes_unseen", viewDensity.meshesUnseen},
                              {"min_shadels_per_metre", viewDensity.minDensityWorld},
-                             {"max_shadels_per_metre", viewDensity.maxDensityWorld}};
+                             {"max_shadels_per_metre", viewDensity.maxDensityWorld},
+                             {"seconds", viewDensitySeconds}};
     MemoryHeapStats mem = memoryStats(gpu.memory);
     s["gpu_memory"] = {{"pool_bytes", mem.poolBytes},
                        {"used_bytes", mem.usedBytes},
