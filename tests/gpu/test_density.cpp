@@ -5,7 +5,7 @@
 
 #include <cmath>
 
-#include "render/view_distance.h"
+#include "render/view_density.h"
 #include "scene/load.h"
 
 using namespace shadel;
@@ -159,4 +159,28 @@ TEST(Density, NearestVisibleDistanceSeesOnlyWhatTheFrustumShows) {
     Aabb target =
         transformAabb(scene.meshes[scene.instances[1].mesh].bounds, scene.instances[1].transform);
     EXPECT_LE(nearestVisibleDistance(walk, target), nearestVisibleDistance(still, target));
+}
+
+// Quantised densities and grid-aligned chunks: a camera moved by a few centimetres bakes the
+// same meshes at the same densities (bake-cache hits); a camera twice as far bakes coarser.
+TEST(Density, NearbyCamerasChooseTheSameChunksAndDensities) {
+    Scene scene = loadScene("builtin:checker");
+    Camera a = findCamera(scene, "");
+    Camera b = a;
+    b.position += glm::vec3(0.03f, 0.0f, -0.02f);
+    Camera far = a;
+    far.position.y *= 2.0f;
+    auto density = [&](const Camera& c) {
+        RunViews v = runViews(c, CameraPath::Static, 1, scene.worldBounds(), 480, 270);
+        return viewDrivenDensity(scene, v, ViewDensityOptions{});
+    };
+    ViewDensity da = density(a), db = density(b), dfar = density(far);
+    ASSERT_EQ(da.scene.meshes.size(), db.scene.meshes.size());
+    EXPECT_GT(da.scene.meshes.size(), 1u);
+    EXPECT_EQ(da.meshDensity, db.meshDensity);
+    for (size_t i = 0; i < da.scene.meshes.size(); ++i)
+        EXPECT_EQ(da.scene.meshes[i].indices, db.scene.meshes[i].indices) << i;
+    EXPECT_LT(dfar.maxDensityWorld, da.maxDensityWorld);
+    for (float d : da.meshDensity) // powers of 2^(1/4)
+        EXPECT_NEAR(std::log2(d) * 4.0f, std::round(std::log2(d) * 4.0f), 1e-3f) << d;
 }
