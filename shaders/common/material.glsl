@@ -43,6 +43,15 @@ vec3 bricks(vec2 uv, float scale) {
     return mix(vec3(0.75, 0.72, 0.68), brick, mortar);
 }
 
+// Toksvig: a filtered normal (mip-mapped normal map, or the mean of several samples) shorter
+// than 1 means the normals under the footprint disagree; widening the lobe by that variance keeps
+// specular from aliasing. roughness is perceptual (alpha = roughness^2).
+float toksvigRoughness(float roughness, float meanNormalLength) {
+    float len = clamp(meanNormalLength, 1e-3, 1.0);
+    float alpha = roughness * roughness;
+    return clamp(sqrt(sqrt(alpha * alpha + (1.0 - len) / len)), 0.04, 1.0);
+}
+
 MaterialSample evaluateMaterial(GpuMaterial m, SurfaceInput s) {
     MaterialSample o;
     vec4 base = m.baseColorFactor;
@@ -81,6 +90,7 @@ MaterialSample evaluateMaterial(GpuMaterial m, SurfaceInput s) {
         vec3 t = normalize(s.tangent.xyz - n * dot(n, s.tangent.xyz));
         vec3 b = cross(n, t) * (s.tangent.w < 0.0 ? -1.0 : 1.0);
         vec3 tn = sampleTexture(m.normalTexture, SAMPLER_LINEAR_REPEAT, s.uv, s.uvDx, s.uvDy).xyz * 2.0 - 1.0;
+        o.roughness = toksvigRoughness(o.roughness, length(tn)); // filtered normals are shorter
         tn.xy *= m.normalScale;
         n = normalize(t * tn.x + b * tn.y + n * max(tn.z, 1e-3));
     }

@@ -183,6 +183,9 @@ struct GpuShadelObject {
     // Bit k: MIP k's rect and every shading input of the object (transform, material, lights in
     // range) are unchanged since last frame, so last frame's shadels there may be carried over.
     uint reuseLevels;
+    // Frames a carried-over chunk may go unshaded: fewer where the camera's motion, seen from
+    // the object, turns the view direction faster (view-dependent terms drift).
+    uint refreshPeriod;
     uint idMapOffset[SHADEL_MAX_MIPS]; // in 16-bit units into ShadelFrame::idMaps
     uvec4 rect[SHADEL_MAX_MIPS];       // x, y, w, h in blocks of the virtual sheet
 };

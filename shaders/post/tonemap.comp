@@ -3,6 +3,7 @@
 // the tone curve, before sRGB encoding), sRGB encode, RGBA8 into a readback buffer. Alpha
 // records coverage: 255 where any sample saw geometry (reversed-Z depth > 0).
 #include "common/bindless.glsl"
+#include "common/tone_curve.glsl"
 
 layout(local_size_x = 8, local_size_y = 8) in;
 
@@ -15,10 +16,6 @@ layout(push_constant, scalar) uniform Push {
     uint height;
     uint ssaa;
 } pc;
-
-vec3 acesFit(vec3 x) {
-    return clamp((x * (2.51 * x + 0.03)) / (x * (2.43 * x + 0.59) + 0.14), 0.0, 1.0);
-}
 
 vec3 linearToSrgb(vec3 c) {
     return mix(c * 12.92, 1.055 * pow(c, vec3(1.0 / 2.4)) - 0.055, step(vec3(0.0031308), c));

@@ -48,7 +48,7 @@ void main() {
         w.mip = mip;
         ++k;
         if ((prevMask & (1ul << bit)) != 0ul && prevBase != SHADEL_INVALID &&
-            !shadelRefreshDue(s, w.chunk)) {
+            !shadelRefreshDue(s, o, w.chunk)) {
             w.chunk = chunkSlot(prevMask, prevBase, bit); // where last frame stored it
             ShadelWorkBuffer(s.copyQueue).w[atomicAdd(counters.c.copyCount, 1u)] = w;
         } else {

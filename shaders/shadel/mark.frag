@@ -2,7 +2,7 @@
 // Marking (seed: "Shadel Marking pass"): a raster of the decoupled objects against the prepass
 // depth, with no colour output. Each visible pixel ORs into the occupancy masks the bits of
 // every chunk the reconstruction filter will read: the 2x2 bilinear taps of both MIPs of the
-// trilinear blend, across chunk and block edges.
+// trilinear blend, across chunk and block edges, at every anisotropic tap.
 #include "shadel/shadel.glsl"
 
 layout(early_fragment_tests) in;
@@ -41,7 +41,12 @@ void main() {
     ShadelFrame s = ShadelFrameRef(f.shadel).s;
     GpuShadelObject o = ShadelObjectBuffer(s.objects).o[inInstance];
     vec2 texel = inShadelUv * vec2(o.mip0Size);
-    ShadelLevels l = shadelLevels(o, dFdx(texel), dFdy(texel), s.shadingBias, s.trilinearBand);
-    markLevel(s, o, l.mip0, inShadelUv);
-    if (l.two) markLevel(s, o, l.mip1, inShadelUv);
+    vec2 dx = dFdx(texel), dy = dFdy(texel);
+    ShadelLevels l = shadelLevels(o, dx, dy, s.shadingBias, s.trilinearBand);
+    ShadelAniso a = shadelAniso(dx, dy);
+    for (uint i = 0u; i < a.taps; ++i) {
+        vec2 uv = shadelTapUv(o.mip0Size, inShadelUv, a, i);
+        markLevel(s, o, l.mip0, uv);
+        if (l.two) markLevel(s, o, l.mip1, uv);
+    }
 }

@@ -81,15 +81,23 @@ void main() {
     GpuShadelObject o = ShadelObjectBuffer(s.objects).o[inInstance];
     vec2 texel = inShadelUv * vec2(o.mip0Size);
     ShadelLevels l = shadelLevels(o, dFdx(texel), dFdy(texel), s.shadingBias, s.trilinearBand);
+    ShadelAniso a = shadelAniso(dFdx(texel), dFdy(texel));
     uint m0 = l.mip0;
     float lod = float(l.mip0) + l.blend;
     uint missing = 0u, overflowed = 0u;
-    uint64_t mask0, mask1;
+    uint64_t mask0 = 0ul, mask1, tapMask;
     // --visualize layer:material reads the material layer where the radiance layer is read.
     uint layer = f.visualize == VISUALIZE_LAYER_MATERIAL ? s.layerReadSlot[SHADEL_LAYER_MATERIAL]
                                                          : s.storageReadSlot;
-    vec3 color = sampleLevel(s, o, l.mip0, inShadelUv, layer, missing, overflowed, mask0);
-    if (l.two) color = mix(color, sampleLevel(s, o, l.mip1, inShadelUv, layer, missing, overflowed, mask1), l.blend);
+    vec3 color = vec3(0.0);
+    for (uint i = 0u; i < a.taps; ++i) { // the same taps marking marked
+        vec2 uv = shadelTapUv(o.mip0Size, inShadelUv, a, i);
+        vec3 c = sampleLevel(s, o, l.mip0, uv, layer, missing, overflowed, tapMask);
+        if (i == 0u) mask0 = tapMask;
+        if (l.two) c = mix(c, sampleLevel(s, o, l.mip1, uv, layer, missing, overflowed, mask1), l.blend);
+        color += c;
+    }
+    color /= float(a.taps);
 
     ShadelCountersRef counters = ShadelCountersRef(s.counters);
     // Magnification: the MIP-0 shadel is larger than the pixel along the longer screen axis.

@@ -6,6 +6,7 @@
 #include "shadel/shadel.glsl"
 #include "common/lighting.glsl"
 #include "common/shadel_bary.h"
+#include "shadel/prefilter.glsl"
 
 layout(local_size_x = 8, local_size_y = 8) in;
 layout(push_constant, scalar) uniform Push { uint64_t frame; } pc;
@@ -27,7 +28,7 @@ uint triangleId(ShadelFrame s, uint offset) {
 // at its own phase, so view-dependent terms never lag for long). Uniform over the workgroup.
 int carrySource(ShadelFrame s, GpuShadelObject o, GpuShadelWork work) {
     if (s.reuse == 0u || ((o.reuseLevels >> work.mip) & 1u) == 0u) return -1;
-    if (shadelRefreshDue(s, work.chunk)) return -1;
+    if (shadelRefreshDue(s, o, work.chunk)) return -1;
     uvec2 sheet = uvec2(work.chunk & 0xFFFFu, work.chunk >> 16) * SHADEL_CHUNK;
     uint block = blockIndex(s, sheet);
     uint bit = chunkBit(sheet);
@@ -142,36 +143,11 @@ void main() {
                                      cross(v1.position - v0.position, v2.position - v0.position));
     si.frontFacing = dot(geometricNormal, f.cameraPosition - si.position) >= 0.0;
     GpuMaterial mat = MaterialBuffer(f.materials).m[inst.material];
-    MaterialSample m;
-    if (work.mip == 0u || s.materialSamples <= 1u) {
-        m = evaluateMaterial(mat, si);
-    } else {
-        // A shadel of MIP k stands for 2^k x 2^k shadels of MIP 0. Evaluating the material at a
-        // 4-point rotated grid inside its footprint (lighting once, at the centre) approximates
-        // shading MIP 0 and filtering down, so materials with no filtered form (the one-texel
-        // checker) stay anti-aliased in coarse MIPs too.
-        const vec2 grid[4] = vec2[](vec2(-0.125, -0.375), vec2(0.375, -0.125), vec2(0.125, 0.375), vec2(-0.375, 0.125));
-        vec2 step = vec2(1.0) / vec2(size);
-        vec2 centre = shadelCenterUv(shadel, size);
-        MaterialSample sum;
-        sum.baseColor = vec3(0.0); sum.alpha = 0.0; sum.normal = vec3(0.0); sum.metallic = 0.0;
-        sum.roughness = 0.0; sum.occlusion = 0.0; sum.emissive = vec3(0.0);
-        SurfaceInput sub = si;
-        sub.uvDx = uvDx * 0.5;
-        sub.uvDy = uvDy * 0.5;
-        for (int i = 0; i < 4; ++i) {
-            vec3 b = shadelBarycentrics(centre + grid[i] * step, uvs.v[i0], uvs.v[i1], uvs.v[i2]);
-            sub.uv = shadelInterpolate2(b, v0.uv0, v1.uv0, v2.uv0);
-            MaterialSample one = evaluateMaterial(mat, sub);
-            sum.baseColor += one.baseColor; sum.alpha += one.alpha; sum.normal += one.normal;
-            sum.metallic += one.metallic; sum.roughness += one.roughness;
-            sum.occlusion += one.occlusion; sum.emissive += one.emissive;
-        }
-        m.baseColor = sum.baseColor * 0.25; m.alpha = sum.alpha * 0.25;
-        m.normal = normalize(sum.normal); m.metallic = sum.metallic * 0.25;
-        m.roughness = sum.roughness * 0.25; m.occlusion = sum.occlusion * 0.25;
-        m.emissive = sum.emissive * 0.25;
-    }
-    vec3 color = shadeSurface(f, m, si.position, si.normal);
-    storeLayers(s, outTexel, vec4(color, 1.0), vec4(clamp(m.baseColor, 0.0, 1.0), m.roughness));
+    // The shadel's whole footprint, not its centre (prefilter.glsl; --material-samples caps it).
+    vec4 material;
+    vec3 color = prefilteredShade(f, mat, si, shadelCenterUv(shadel, size), vec2(1.0) / vec2(size),
+                                  uvs.v[i0], uvs.v[i1], uvs.v[i2], v0.uv0, v1.uv0, v2.uv0,
+                                  s.materialSamples, uvec3(shadel, work.object * 16u + work.mip),
+                                  material);
+    storeLayers(s, outTexel, vec4(color, 1.0), material);
 }

@@ -11,11 +11,44 @@ layout(buffer_reference, scalar) buffer Uvec4Buffer { uvec4 v[]; };
 layout(buffer_reference, scalar) buffer Uvec2Buffer { uvec2 v[]; };
 layout(buffer_reference, scalar) readonly buffer Vec4Buffer { vec4 v[]; };
 
+// Anisotropic footprint (issue 8): a pixel's footprint in MIP-0 shadels is the parallelogram
+// spanned by texelDx and texelDy: its length is the longer axis, its width the area over that
+// length. A grazing footprint is read by `taps` bilinear samples spread along the long axis, from
+// the MIP whose shadel is length / aniso, aniso = min(length / width, SHADEL_MAX_ANISO): the MIP
+// follows both screen axes instead of blurring to the long one (at a bounded cost in shadels:
+// about aniso times the isotropic count). aniso <= length / width keeps the chosen footprint
+// >= the width, so the MIP is never finer than the footprint's narrow side and the CPU's
+// per-object lower bound of the finest MIP (finestMipNeeded in decoupled.cpp, from the shortest
+// span a pixel can have) stays a lower bound.
+const float SHADEL_MAX_ANISO = 1.5;
+
+struct ShadelAniso {
+    float footprint; // MIP-0 shadels a tap stands for (>= the width)
+    vec2 step;       // MIP-0 shadels between neighbouring taps
+    uint taps;
+};
+
+ShadelAniso shadelAniso(vec2 texelDx, vec2 texelDy) {
+    float lx = length(texelDx), ly = length(texelDy);
+    float len = max(lx, ly);
+    float width = abs(texelDx.x * texelDy.y - texelDx.y * texelDy.x) / max(len, 1e-20);
+    float aniso = clamp(len / max(width, 1e-20), 1.0, SHADEL_MAX_ANISO);
+    ShadelAniso a;
+    a.footprint = len / aniso;
+    a.taps = uint(ceil(aniso - 0.01));
+    a.step = (lx >= ly ? texelDx : texelDy) / float(a.taps);
+    return a;
+}
+
+// The shadel-UV of tap i of n, centred on uv.
+vec2 shadelTapUv(uvec2 mip0Size, vec2 uv, ShadelAniso a, uint i) {
+    return uv + a.step * (float(i) - 0.5 * float(a.taps - 1u)) / vec2(mip0Size);
+}
+
 // MIP selection: the same in marking and reconstruction (the seed's custom MIP calculation).
 // `texel` is the position in MIP-0 shadels; derivatives are per pixel.
 float shadelLod(vec2 texelDx, vec2 texelDy, float bias) {
-    float footprint = max(length(texelDx), length(texelDy));
-    return log2(max(footprint, 1e-8)) + bias;
+    return log2(max(shadelAniso(texelDx, texelDy).footprint, 1e-8)) + bias;
 }
 
 uvec2 levelSize(GpuShadelObject o, uint mip) { return max(o.mip0Size >> mip, uvec2(1u)); }
@@ -78,10 +111,10 @@ uint chunkSlot(uint64_t mask, uint base, uint bit) {
     return base + bitCount(uint(below)) + bitCount(uint(below >> 32));
 }
 
-// Preserved layers: a carried-over chunk is still reshaded once per refresh period, each chunk
-// at its own phase, so view-dependent terms never lag for long.
-bool shadelRefreshDue(ShadelFrame s, uint chunk) {
-    return (((chunk * 2654435761u) >> 20) + s.frameNumber) % s.refreshPeriod == 0u;
+// Preserved layers: a carried-over chunk is still reshaded once per its object's refresh
+// period, each chunk at its own phase, so view-dependent terms never lag for long.
+bool shadelRefreshDue(ShadelFrame s, GpuShadelObject o, uint chunk) {
+    return (((chunk * 2654435761u) >> 20) + s.frameNumber) % max(o.refreshPeriod, 1u) == 0u;
 }
 
 ivec2 storageTexel(ShadelFrame s, uint slot, uvec2 inChunk) {

@@ -20,7 +20,8 @@ struct FloatRange {
 // The accepted values of the float flags, shared by the flag definitions and
 // validateRenderOptions (in-process callers bypass the parser).
 constexpr FloatRange kExposureRange{0, 1e6, true};      // 0 renders black
-constexpr FloatRange kDensityRange{0, 1e6, true};       // shadels per metre
+constexpr FloatRange kDensityRange{0, 1e6};             // shadels per metre; 0 = auto (view-driven)
+constexpr FloatRange kFixedDensityRange{0, 1e6, true};  // shadels per metre (bake: no auto)
 constexpr FloatRange kShadingBiasRange{-8, 8};          // MIP levels
 constexpr FloatRange kTrilinearBandRange{0, 1};         // fraction of a MIP level
 constexpr FloatRange kShadelBudgetRange{0, 1e12, true}; // MIP-0 shadels

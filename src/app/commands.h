@@ -24,7 +24,7 @@ struct RenderOptions {
     std::string stats; // FILE.json ; empty = none
     std::optional<TimingMode> timing;
     float exposure = 1.0f;
-    float shadelsPerMetre = 32.0f;
+    float shadelsPerMetre = 0.0f; // 0 = auto: view-driven per mesh (render/view_density.h)
     std::string cacheDir; // empty = default cache directory
     // --cache-limit: least recently used bake-cache files beyond it are removed (0 = none).
     uint64_t cacheLimitBytes = 4ull << 30;
@@ -32,7 +32,7 @@ struct RenderOptions {
     uint32_t sheetShadels = 65536;
     float shadingBias = 0.0f;
     float trilinearBand = 1.0f;
-    uint32_t materialSamples = 4;
+    uint32_t materialSamples = 16; // cap of material samples per shadel (prefilter.glsl)
     float forwardBelowPixels = 8.0f;
     uint32_t allocationCounters = SHADEL_COUNTERS;
     bool sheetAllMips = false;
@@ -74,7 +74,7 @@ struct BenchOptions {
     std::string camera;
     std::string json;
     std::optional<TimingMode> timing;
-    float shadelsPerMetre = 32.0f;
+    float shadelsPerMetre = 0.0f; // 0 = auto
     std::string cacheDir;
     CameraPath cameraPath = CameraPath::Static;
     bool animateLights = false;

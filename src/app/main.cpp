@@ -1,7 +1,9 @@
 // `shadel`: render, bench, bake, info. Errors: one line on stderr naming the input and the
 // reason; exit 2 for bad input, 3 for a device problem, 1 for anything else.
 #include <chrono>
+#include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <unistd.h>
 
 #include <CLI/CLI.hpp>
@@ -19,6 +21,17 @@
 using namespace shadel;
 
 namespace {
+
+// "auto" -> 0 (view-driven), else a positive number of shadels per metre.
+float parseDensity(const std::string& t) {
+    if (t == "auto") return 0.0f;
+    char* end = nullptr;
+    double v = std::strtod(t.c_str(), &end);
+    if (end == t.c_str() || *end != '\0' || !(v > 0) || !std::isfinite(v) || v > 1e9)
+        throw InputError(format(
+            "--density %s: expected auto or a positive number of shadels per metre", t.c_str()));
+    return float(v);
+}
 
 std::optional<TimingMode> parseTiming(const std::string& t) {
     if (t == "auto") return std::nullopt;
@@ -86,9 +99,12 @@ int main(int argc, char** argv) {
     render->add_option("--exposure", ro.exposure, "exposure multiplier")
         ->capture_default_str()
         ->check(finiteInRange(kExposureRange));
-    render->add_option("--density", ro.shadelsPerMetre, "shadels per metre (decoupled)")
-        ->capture_default_str()
-        ->check(finiteInRange(kDensityRange));
+    std::string density = "auto", benchDensity = "auto";
+    render
+        ->add_option("--density", density,
+                     "auto (per mesh, from what the run's cameras can need; large meshes split "
+                     "into chunks) | shadels per metre (one density, no chunks)")
+        ->capture_default_str();
     render->add_option("--cache-dir", ro.cacheDir, "bake cache directory");
     render->add_option("--storage", ro.shadeStorageSize, "decoupled: shade storage side in shadels")
         ->capture_default_str();
@@ -104,7 +120,8 @@ int main(int argc, char** argv) {
         ->check(finiteInRange(kTrilinearBandRange));
     render
         ->add_option("--material-samples", ro.materialSamples,
-                     "decoupled: material evaluations per shadel above MIP 0 (1 or 4)")
+                     "decoupled: cap of material evaluations per shadel (1..64; procedurals are "
+                     "supersampled in proportion to their footprint)")
         ->capture_default_str();
     render
         ->add_option("--shadel-budget", ro.shadelBudget,
@@ -161,9 +178,7 @@ int main(int argc, char** argv) {
     bench->add_option("--camera", bo.camera, "camera name");
     bench->add_option("--json", bo.json, "write the results as JSON");
     bench->add_option("--timing", benchTiming, "auto | timestamps | submit")->capture_default_str();
-    bench->add_option("--density", bo.shadelsPerMetre, "shadels per metre")
-        ->capture_default_str()
-        ->check(finiteInRange(kDensityRange));
+    bench->add_option("--density", benchDensity, "auto | shadels per metre")->capture_default_str();
     bench->add_option("--cache-dir", bo.cacheDir, "bake cache directory");
     std::string benchCameraPath = "static";
     bench->add_option("--camera-path", benchCameraPath, "static | orbit | walk")
@@ -183,7 +198,7 @@ int main(int argc, char** argv) {
         ->capture_default_str();
     bake->add_option("--density", bakeDensity, "shadels per metre")
         ->capture_default_str()
-        ->check(finiteInRange(kDensityRange));
+        ->check(finiteInRange(kFixedDensityRange));
     bake->add_option("--cache-dir", bakeCache, "bake cache directory");
     bake->add_option("--shadel-budget", bakeBudget,
                      "max MIP-0 shadels for the scene (lowers --density)")
@@ -266,6 +281,7 @@ int main(int argc, char** argv) {
                 throw InputError(format("--jitter %s: expected none or subpixel", jitter.c_str()));
             ro.jitter = jitter == "subpixel";
             ro.timing = parseTiming(timing);
+            ro.shadelsPerMetre = parseDensity(density);
             ro.cameraPath = parseCameraPath(cameraPath);
             if (capacityControl != "on" && capacityControl != "off")
                 throw InputError(format("--capacity-control %s: expected on or off",
@@ -292,6 +308,7 @@ int main(int argc, char** argv) {
         if (*bench) {
             parseSize(benchSize, bo.width, bo.height);
             bo.timing = parseTiming(benchTiming);
+            bo.shadelsPerMetre = parseDensity(benchDensity);
             bo.cameraPath = parseCameraPath(benchCameraPath);
             runBench(g.gpu, bo);
             return 0;

@@ -1,4 +1,5 @@
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
@@ -13,6 +14,7 @@
 #include "core/error.h"
 #include "core/log.h"
 #include "render/shadel/decoupled.h"
+#include "render/view_density.h"
 #include "scene/load.h"
 
 namespace shadel {
@@ -95,24 +97,59 @@ RenderRun runRender(Gpu& gpu, const RenderOptions& o) {
     if (!o.stats.empty()) requireCreatableOutput("--stats", o.stats);
     Scene scene = loadScene(o.scene, {o.allowExternalFiles});
     Camera camera = findCamera(scene, o.camera);
+    // The camera path is fixed by the loaded scene's bounds (chunking does not move it).
+    Aabb bounds = scene.worldBounds();
 
     std::vector<BakedMesh> baked;
     GpuScene gpuScene;
     float density = 0.0f;
+    bool autoDensity = !(o.shadelsPerMetre > 0.0f);
+    ViewDensity viewDensity;
+    double bakeSeconds = 0.0, viewDensitySeconds = 0.0;
+    if (autoDensity) {
+        auto start = std::chrono::steady_clock::now();
+        // Density from what this run's cameras can need, large meshes split into chunks. Both
+        // modes draw the same (split) scene, so pixel coverage is identical between them.
+        RunViews views =
+            runViews(camera, o.cameraPath, o.frames, bounds, o.width * o.ssaa, o.height * o.ssaa);
+        ViewDensityOptions vo;
+        vo.budget = o.shadelBudget;
+        viewDensity = viewDrivenDensity(scene, views, vo);
+        scene = std::move(viewDensity.scene);
+        viewDensity.scene = Scene{};
+        viewDensitySeconds =
+            std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+        if (o.mode == RenderMode::Decoupled && viewDensity.budgetScale < 1.0)
+            SHADEL_WARN("%s: the view-driven density needs %.0fM MIP-0 shadels; every density "
+                        "scaled by %.3f to stay within %.0fM (--shadel-budget)",
+                        o.scene.c_str(),
+                        viewDensity.mip0Shadels / 1e6 /
+                            (viewDensity.budgetScale * viewDensity.budgetScale),
+                        viewDensity.budgetScale, o.shadelBudget / 1e6);
+    }
     if (o.mode == RenderMode::Decoupled) {
+        auto bakeStart = std::chrono::steady_clock::now();
         BakeSettings bs;
         bs.cacheLimitBytes = o.cacheLimitBytes;
-        double area = 0.0;
-        bs.shadelsPerMetre = sceneShadelDensity(scene, o.shadelsPerMetre, o.shadelBudget, area);
-        if (bs.shadelsPerMetre < o.shadelsPerMetre)
-            SHADEL_WARN(
-                "%s: %.0f units^2 of surface at %.1f shadels/unit would need %.0fM shadels; "
-                "using %.3f shadels/unit to stay within %.0fM (--density, --shadel-budget)",
-                o.scene.c_str(), area, double(o.shadelsPerMetre),
-                area * o.shadelsPerMetre * o.shadelsPerMetre / 1e6, double(bs.shadelsPerMetre),
-                o.shadelBudget / 1e6);
-        density = bs.shadelsPerMetre;
-        baked = bakeScene(scene, bs, o.cacheDir.empty() ? defaultCacheDir() : o.cacheDir, nullptr);
+        if (autoDensity) {
+            baked = bakeScene(scene, bs, o.cacheDir.empty() ? defaultCacheDir() : o.cacheDir,
+                              nullptr, viewDensity.meshDensity);
+        } else {
+            double area = 0.0;
+            bs.shadelsPerMetre = sceneShadelDensity(scene, o.shadelsPerMetre, o.shadelBudget, area);
+            if (bs.shadelsPerMetre < o.shadelsPerMetre)
+                SHADEL_WARN("%s: %.0f units^2 of surface at %.1f shadels/unit would need %.0fM "
+                            "shadels; using %.3f shadels/unit to stay within %.0fM (--density, "
+                            "--shadel-budget)",
+                            o.scene.c_str(), area, double(o.shadelsPerMetre),
+                            area * o.shadelsPerMetre * o.shadelsPerMetre / 1e6,
+                            double(bs.shadelsPerMetre), o.shadelBudget / 1e6);
+            density = bs.shadelsPerMetre;
+            baked =
+                bakeScene(scene, bs, o.cacheDir.empty() ? defaultCacheDir() : o.cacheDir, nullptr);
+        }
+        bakeSeconds =
+            std::chrono::duration<double>(std::chrono::steady_clock::now() - bakeStart).count();
         uploadScene(gpu, scene, gpuScene, &baked);
     } else {
         uploadScene(gpu, scene, gpuScene);
@@ -129,8 +166,8 @@ RenderRun runRender(Gpu& gpu, const RenderOptions& o) {
     settings.sheetShadels = o.sheetShadels;
     settings.shadingBias = o.shadingBias;
     settings.trilinearBand = o.trilinearBand;
-    if (o.materialSamples != 1 && o.materialSamples != 4)
-        throw InputError(format("--material-samples %u: expected 1 or 4", o.materialSamples));
+    if (o.materialSamples < 1 || o.materialSamples > 64)
+        throw InputError(format("--material-samples %u: expected 1..64", o.materialSamples));
     settings.materialSamples = o.materialSamples;
     settings.forwardBelowPixels = o.forwardBelowPixels;
     if (o.allocationCounters < 1 || o.allocationCounters > SHADEL_COUNTERS)
@@ -150,7 +187,6 @@ RenderRun runRender(Gpu& gpu, const RenderOptions& o) {
     try {
         initRenderer(renderer, gpu, settings, gpuScene);
         bool tty = isatty(STDERR_FILENO);
-        Aabb bounds = scene.worldBounds();
         for (uint32_t i = 0; i < o.frames; ++i) {
             glm::vec2 jitter = o.jitter ? subpixelJitter(i) : glm::vec2(0.0f);
             Camera onPath = cameraOnPath(camera, o.cameraPath, i, o.frames, bounds);
@@ -211,6 +247,16 @@ RenderRun runRender(Gpu& gpu, const RenderOptions& o) {
     s["instances"] = gpuScene.instanceCount;
     s["triangles"] = scene.triangleCount();
     s["lights"] = scene.lights.size();
+    s["density_mode"] = autoDensity ? "auto" : "explicit";
+    if (autoDensity)
+        s["view_density"] = {{"budget_scale", viewDensity.budgetScale},
+                             {"mip0_shadels_estimate", viewDensity.mip0Shadels},
+                             {"meshes_split", viewDensity.meshesSplit},
+                             {"chunks", viewDensity.chunksMade},
+                             {"meshes_unseen", viewDensity.meshesUnseen},
+                             {"min_shadels_per_metre", viewDensity.minDensityWorld},
+                             {"max_shadels_per_metre", viewDensity.maxDensityWorld},
+                             {"seconds", viewDensitySeconds}};
     MemoryHeapStats mem = memoryStats(gpu.memory);
     s["gpu_memory"] = {{"pool_bytes", mem.poolBytes},
                        {"used_bytes", mem.usedBytes},
@@ -218,7 +264,11 @@ RenderRun runRender(Gpu& gpu, const RenderOptions& o) {
                        {"failed_allocations", gpu.failedAllocations}};
     if (renderer.decoupled) {
         decoupledStats(renderer, s);
-        s["shadels_per_metre"] = density;
+        s["shadels_per_metre"] = density; // 0: view-driven (see the density fields)
+        s["bake_seconds"] = bakeSeconds;
+        uint64_t mip0 = 0;
+        for (const BakedMesh& b : baked) mip0 += uint64_t(b.width) * b.height;
+        s["mip0_shadels"] = mip0;
         s["id_map_bytes"] = gpuScene.idMapBytes;
     }
     run.stats = s;

@@ -181,7 +181,8 @@ BakedMesh bakeMesh(const Mesh& mesh, const BakeSettings& settings) {
 }
 
 std::vector<BakedMesh> bakeScene(const Scene& scene, const BakeSettings& settings,
-                                 const std::string& cacheDir, const BakeProgress& progress) {
+                                 const std::string& cacheDir, const BakeProgress& progress,
+                                 const std::vector<float>& meshDensity) {
     size_t meshCount = scene.meshes.size();
     // Density is meant per metre of *world* surface. Meshes are often authored in other units
     // and scaled by their instances (a glTF in millimetres under a 0.001 node), so each mesh is
@@ -198,6 +199,9 @@ std::vector<BakedMesh> bakeScene(const Scene& scene, const BakeSettings& setting
     for (size_t i = 0; i < meshCount; ++i)
         if (worldScale[i] > 0)
             meshSettings[i].shadelsPerMetre = settings.shadelsPerMetre * worldScale[i];
+    for (size_t i = 0; i < std::min(meshCount, meshDensity.size()); ++i)
+        if (meshDensity[i] > 0 && std::isfinite(meshDensity[i]))
+            meshSettings[i].shadelsPerMetre = meshDensity[i];
     std::vector<BakeKey> keys(meshCount);
     std::vector<size_t> firstWithKey(meshCount);
     std::vector<size_t> jobs; // indices of the first mesh of each distinct content

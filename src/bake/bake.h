@@ -94,8 +94,11 @@ using BakeProgress = std::function<void(size_t done, size_t total)>;
 // identical content are baked once; results are read from / written to cacheDir (empty: no cache).
 // Uses settings.threads workers; output does not depend on the thread count. `progress` is called
 // on the calling thread, once with done = 0 and then after each distinct mesh.
+// `meshDensity` (optional, one per mesh, shadels per object-space unit; <= 0 = use the rule
+// above) overrides the density per mesh, e.g. the view-driven one (render/view_density.h).
 std::vector<BakedMesh> bakeScene(const Scene& scene, const BakeSettings& settings,
-                                 const std::string& cacheDir, const BakeProgress& progress = {});
+                                 const std::string& cacheDir, const BakeProgress& progress = {},
+                                 const std::vector<float>& meshDensity = {});
 
 // Human-readable summary for `shadel bake`: meshes, triangles, charts, utilisation, density,
 // forced/unowned triangles, cache hits and bake time.

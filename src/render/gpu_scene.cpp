@@ -194,6 +194,7 @@ void uploadScene(Gpu& gpu, const Scene& scene, GpuScene& out, const std::vector<
                              out.meshInfo.size() * sizeof(gpu::GpuMesh));
     out.instances = uploadArray(gpu, "scene.instances", instances.data(),
                                 instances.size() * sizeof(gpu::GpuInstance));
+    out.materialInfo = materials;
     out.materials = uploadArray(gpu, "scene.materials", materials.data(),
                                 materials.size() * sizeof(gpu::GpuMaterial));
     out.lights =

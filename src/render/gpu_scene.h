@@ -35,7 +35,8 @@ struct GpuScene {
     std::vector<ShadelMeshInfo> shadelMeshes; // per mesh, when baked
     BufferHandle idMaps;                      // every mesh's triangle-ID maps, all MIPs
     std::vector<gpu::GpuInstance> instanceInfo;
-    std::vector<gpu::GpuLight> lightInfo; // what `lights` holds
+    std::vector<gpu::GpuLight> lightInfo;       // what `lights` holds
+    std::vector<gpu::GpuMaterial> materialInfo; // what `materials` holds
     uint32_t instanceCount = 0;
     uint32_t lightCount = 0;
     Aabb bounds;

@@ -31,6 +31,9 @@ uint64_t stat(const RenderRun& run, const char* name) {
 TEST(DecoupledCore, SheetHoldsOnlyTheMipsTheFrameCanNeed) {
     RenderOptions o = decoupled("builtin:default", 320, 180);
     o.camera = "overview";
+    // One density for the whole scene (the view-driven default already bakes MIP 0 no finer than
+    // this view needs, which leaves these rects little to skip).
+    o.shadelsPerMetre = 32.0f;
     RenderRun needed = renderChecked(o);
     o.sheetAllMips = true;
     RenderRun all = renderChecked(o);
@@ -160,6 +163,9 @@ TEST(DecoupledCore, CapacityControlEndsOverflowWithinFiveFrames) {
 TEST(DecoupledCore, CameraPathsMoveTheCameraDeterministically) {
     RenderOptions o = decoupled("builtin:smooth", 128, 72);
     o.frames = 3;
+    // One density: the view-driven one depends on every frame of the path, so frame 0 of a path
+    // would differ (slightly) from a static camera's.
+    o.shadelsPerMetre = 32.0f;
     RenderRun still = renderChecked(o);
     o.cameraPath = CameraPath::Orbit;
     RenderRun orbit = renderChecked(o);

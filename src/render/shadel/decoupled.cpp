@@ -82,6 +82,7 @@ struct DecoupledState {
     uint32_t parity() const { return uint32_t(frameNumber & 1); }
     bool reuse = true;
     uint32_t refreshPeriod = 8;
+    glm::vec3 lastCameraPosition{0.0f}; // the previous frame's (view drift of carried shadels)
     uint32_t objectsReusable = 0;
     BufferHandle allocId;      // uint per block (upload: written by the CPU allocator)
     BufferHandle counters;     // GpuShadelCounters (readback, also indirect args)
@@ -320,6 +321,24 @@ static LightReach reachOf(const std::vector<glm::vec4>& spheres, glm::vec3 bmin,
     return reach;
 }
 
+// How many frames a carried-over chunk of this object may go unshaded. Specular and Fresnel
+// follow the view direction; seen from the object, the camera's last step turned it by about
+// step / distance radians. A specular lobe is about roughness^2 radians wide, so the view may
+// drift by about that much before the carried shading visibly lags (at most --reuse-refresh
+// frames, also when the camera stands still). Roughness textures only lower the factor's
+// roughness, so glossier texels than the factor can lag somewhat more.
+static uint32_t refreshPeriodFor(const DecoupledState& d, const CameraView& camera,
+                                 glm::vec3 bmin, glm::vec3 bmax, float roughness) {
+    float maxViewDrift = std::clamp(1.0f * roughness * roughness, 0.01f, 0.4f);
+    float step = glm::length(camera.position - d.lastCameraPosition);
+    if (d.frameNumber == 0 || step <= 0.0f) return d.refreshPeriod;
+    glm::vec3 nearest = glm::clamp(camera.position, bmin, bmax);
+    float distance = glm::length(nearest - camera.position);
+    float turnPerFrame = step / std::max(distance, 1e-3f);
+    float frames = maxViewDrift / turnPerFrame;
+    return uint32_t(std::clamp(frames, 1.0f, float(d.refreshPeriod)));
+}
+
 static bool boxVisible(const std::array<glm::vec4, 6>& planes, glm::vec3 bmin, glm::vec3 bmax) {
     for (const glm::vec4& p : planes) {
         glm::vec3 v{p.x >= 0 ? bmax.x : bmin.x, p.y >= 0 ? bmax.y : bmin.y,
@@ -405,6 +424,10 @@ void prepareDecoupledFrame(Renderer& r, const GpuScene& scene, const CameraView&
         bool inputsUnchanged = d.reuse && wasDecoupled && reach != LightReach::Everything;
         for (uint32_t k = o.firstMip; k < mesh.mipCount && inputsUnchanged; ++k)
             if (o.levelSince[k] < d.frameNumber) g.reuseLevels |= 1u << k;
+        float roughness = inst.material < scene.materialInfo.size()
+                              ? scene.materialInfo[inst.material].roughnessFactor
+                              : 1.0f;
+        g.refreshPeriod = refreshPeriodFor(d, camera, inst.worldMin, inst.worldMax, roughness);
         d.objectsReusable += g.reuseLevels != 0;
         d.firstMipHistogram[o.firstMip]++;
         g.mip0Size = mesh.mip0Size;
@@ -418,6 +441,7 @@ void prepareDecoupledFrame(Renderer& r, const GpuScene& scene, const CameraView&
             d.rectBlockCount += o.rects[k].z * o.rects[k].w;
         }
     }
+    d.lastCameraPosition = camera.position;
     std::memcpy(mapped(gpu, d.objectBuffer), d.gpuObjects.data(),
                 d.gpuObjects.size() * sizeof(gpu::GpuShadelObject));
     std::memcpy(mapped(gpu, d.rectBuffer), d.rects.data(),
