@@ -13,6 +13,7 @@ namespace shadel {
 struct RenderOptions {
     std::string scene = "builtin:default";
     RenderMode mode = RenderMode::Forward;
+    MarkingMode marking = MarkingMode::Visibility; // decoupled: --marking raster|visibility
     uint32_t width = 1280, height = 720;
     uint32_t frames = 1;
     std::string camera;
@@ -49,6 +50,7 @@ struct RenderRun {
 void parseSize(const std::string& text, uint32_t& width, uint32_t& height);
 RenderMode parseMode(const std::string& text);
 Visualize parseVisualize(const std::string& text);
+MarkingMode parseMarking(const std::string& text);
 std::string defaultCacheDir();
 
 // Renders with an existing Gpu (tests share one). Writes images/stats as the options say.

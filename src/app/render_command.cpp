@@ -43,6 +43,12 @@ Visualize parseVisualize(const std::string& text) {
         format("--visualize %s: expected none, marking, mips, chunks or sheet", text.c_str()));
 }
 
+MarkingMode parseMarking(const std::string& text) {
+    if (text == "raster") return MarkingMode::Raster;
+    if (text == "visibility") return MarkingMode::Visibility;
+    throw InputError(format("--marking %s: expected raster or visibility", text.c_str()));
+}
+
 std::string defaultCacheDir() {
     if (const char* env = std::getenv("SHADEL_CACHE_DIR")) return env;
     if (const char* xdg = std::getenv("XDG_CACHE_HOME")) return std::string(xdg) + "/shadel";
@@ -120,6 +126,7 @@ RenderRun runRender(Gpu& gpu, const RenderOptions& o) {
     settings.height = o.height;
     settings.ssaa = o.ssaa;
     settings.mode = o.mode;
+    settings.marking = o.marking;
     settings.visualize = o.visualize;
     settings.exposure = o.exposure;
     settings.shadeStorageSize = o.shadeStorageSize;
@@ -171,6 +178,8 @@ RenderRun runRender(Gpu& gpu, const RenderOptions& o) {
     s["scene"] = o.scene;
     s["camera"] = camera.name;
     s["mode"] = modeName(o.mode);
+    if (o.mode == RenderMode::Decoupled)
+        s["marking"] = o.marking == MarkingMode::Raster ? "raster" : "visibility";
     s["width"] = o.width;
     s["height"] = o.height;
     s["ssaa"] = o.ssaa;

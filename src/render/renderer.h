@@ -10,16 +10,21 @@
 #include "rhi/frame.h"
 #include "rhi/pipeline.h"
 #include "rhi/shader_messages.h"
+#include "render/shadel/visibility.h"
 
 namespace shadel {
 
 enum class RenderMode { Forward, Decoupled };
+// Decoupled marking + reconstruction: raster passes over the objects, or compute passes over
+// the pixels of a visibility buffer (render/shadel/visibility.h).
+enum class MarkingMode { Raster, Visibility };
 enum class Visualize : uint32_t { None = 0, Marking = 1, Mips = 2, Chunks = 3, Sheet = 4 };
 
 struct RenderSettings {
     uint32_t width = 1280, height = 720;
     uint32_t ssaa = 1; // N x N supersampling (forward reference)
     RenderMode mode = RenderMode::Forward;
+    MarkingMode marking = MarkingMode::Visibility; // decoupled only
     Visualize visualize = Visualize::None;
     float exposure = 1.0f;
     uint32_t shadowMapSize = 2048;
@@ -72,6 +77,7 @@ struct Renderer {
     ShaderMessageChannel messages;
     FrameRecorder recorder;
     DecoupledStatePtr decoupled;
+    VisibilityStatePtr visibility; // decoupled with --marking visibility
 };
 
 void initRenderer(Renderer& renderer, Gpu& gpu, const RenderSettings& settings,

@@ -11,6 +11,7 @@
 #include "render/forward/forward_passes.h"
 #include "render/renderer.h"
 #include "render/shadel/capacity_control.h"
+#include "render/shadel/visibility.h"
 
 namespace shadel {
 
@@ -432,7 +433,10 @@ void recordDecoupledPasses(Renderer& r, FrameRecorder& rec, uint64_t frame, cons
                       VK_ACCESS_2_SHADER_STORAGE_READ_BIT | VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT);
     });
 
-    pass(rec, "marking", [&](VkCommandBuffer cmd) {
+    if (r.visibility) // --marking visibility: compute over the visibility buffer's pixels
+        pass(rec, "markingCompute",
+             [&](VkCommandBuffer cmd) { recordMarkingCompute(r, cmd, frame); });
+    else pass(rec, "marking", [&](VkCommandBuffer cmd) {
         beginSceneDepthPass(r, cmd, false); // against the prepass depth
         bind(gpu, cmd, d.mark);
         pushConstants(gpu, cmd, RasterPush{frame, 0});
@@ -477,6 +481,13 @@ void recordDecoupledPasses(Renderer& r, FrameRecorder& rec, uint64_t frame, cons
                       VK_ACCESS_2_SHADER_SAMPLED_READ_BIT);
     });
 
+    if (r.visibility) { // compute resolve, then forward (hybrid) objects rastered over it
+        pass(rec, "resolveCompute",
+             [&](VkCommandBuffer cmd) { recordResolveCompute(r, cmd, frame); });
+        pass(rec, "hybridForward",
+             [&](VkCommandBuffer cmd) { recordHybridForward(r, cmd, frame); });
+        return;
+    }
     // Decoupled objects read their shadels; forward objects (hybrid) shade as usual.
     pass(rec, "reconstruction", [&](VkCommandBuffer cmd) {
         beginSceneColorPass(r, cmd, true);
