@@ -64,7 +64,8 @@ TEST(Cli, BadFlagsAndMissingFilesExitWith2) {
           "render --size 0x10", "render --size banana", "render --size 99999x10",
           "render --mode sideways", "render --visualize everything",
           "render --camera nope --size 16x16", "render --frames 0", "render --ssaa 0",
-          "--device 57 render", "render --jitter wobble"}) {
+          "--device 57 render", "render --jitter wobble",
+          "render --mode decoupled --marking sideways"}) {
         Result r = run(args);
         EXPECT_EQ(r.exitCode, 2) << args << ": " << r.stderrText;
         EXPECT_NE(r.stderrText.find("shadel: "), std::string::npos) << args;
