@@ -6,9 +6,24 @@
 #define SHADEL_MARKING_GLSL
 #include "shadel/shadel.glsl"
 
+#ifdef SHADEL_MARK_CACHE
+// The last chunks this invocation marked (block << 6 | bit), for invocations that mark several
+// pixels: repeats skip even the load of the mask.
+uint gMarked0 = SHADEL_INVALID, gMarked1 = SHADEL_INVALID, gMarked2 = SHADEL_INVALID,
+     gMarked3 = SHADEL_INVALID;
+#endif
+
 void markChunk(ShadelFrame s, uvec2 sheet) {
     uint block = blockIndex(s, sheet);
     uint64_t bit = 1ul << chunkBit(sheet);
+#ifdef SHADEL_MARK_CACHE
+    uint key = (block << 6) | chunkBit(sheet);
+    if (gMarked0 == key || gMarked1 == key || gMarked2 == key || gMarked3 == key) return;
+    gMarked3 = gMarked2;
+    gMarked2 = gMarked1;
+    gMarked1 = gMarked0;
+    gMarked0 = key;
+#endif
     Uint64Buffer occupancy = Uint64Buffer(s.occupancy);
     // Most pixels find their chunk already marked: skip the atomic then.
     if ((occupancy.v[block] & bit) == 0ul) atomicOr(occupancy.v[block], bit);

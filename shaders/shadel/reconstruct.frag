@@ -42,6 +42,7 @@ void main() {
     vec2 texel = inShadelUv * vec2(o.mip0Size);
     vec2 texelDx = dFdx(texel), texelDy = dFdy(texel);
     Reconstruction r = reconstructSample(s, o, inShadelUv, texelDx, texelDy, ivec2(gl_FragCoord.xy));
+    countReconstruction(s, r);
     vec3 color = r.color;
     if (r.missing + r.overflowed != 0u) color = forwardShade(f);
     outColor = vec4(visualizeReconstruction(f, o, r, color, inShadelUv, texelDx, texelDy), 1.0);

@@ -47,10 +47,12 @@ struct Reconstruction {
     uint64_t mask0;  // occupancy of the first tap's block (marking view)
     float lod;
     uint mip0;
+    bool sampled;   // a pixel of the statistics sample (one of every 2x2)
+    bool magnified; // ... whose MIP-0 shadel is larger than the pixel
 };
 
 // texelDx/Dy: screen derivatives of the MIP-0 shadel coordinate; pixel: for the sampled
-// statistics (one pixel of every 2x2). Updates the frame's counters.
+// statistics (one pixel of every 2x2). The caller counts (countReconstruction or its own sums).
 Reconstruction reconstructSample(ShadelFrame s, GpuShadelObject o, vec2 shadelUv, vec2 texelDx,
                                  vec2 texelDy, ivec2 pixel) {
     ShadelLevels l = shadelLevels(o, texelDx, texelDy, s.shadingBias, s.trilinearBand);
@@ -63,16 +65,20 @@ Reconstruction reconstructSample(ShadelFrame s, GpuShadelObject o, vec2 shadelUv
     r.color = sampleLevel(s, o, l.mip0, shadelUv, r.missing, r.overflowed, r.mask0);
     if (l.two) r.color = mix(r.color, sampleLevel(s, o, l.mip1, shadelUv, r.missing, r.overflowed, mask1), l.blend);
 
-    ShadelCountersRef counters = ShadelCountersRef(s.counters);
     // Magnification: the MIP-0 shadel is larger than the pixel along the longer screen axis.
     // Counted on one pixel of every 2x2 (a fraction needs no more, and atomics cost).
-    if (all(equal(pixel & 1, ivec2(0)))) {
-        if (max(dot(texelDx, texelDx), dot(texelDy, texelDy)) < 1.0) atomicAdd(counters.c.magnifiedPixels, 1u);
-        atomicAdd(counters.c.reconstructedPixels, 1u);
-    }
+    r.sampled = all(equal(pixel & 1, ivec2(0)));
+    r.magnified = r.sampled && max(dot(texelDx, texelDx), dot(texelDy, texelDy)) < 1.0;
+    return r;
+}
+
+// The frame's counters, one pixel at a time (raster reconstruction).
+void countReconstruction(ShadelFrame s, Reconstruction r) {
+    ShadelCountersRef counters = ShadelCountersRef(s.counters);
+    if (r.magnified) atomicAdd(counters.c.magnifiedPixels, 1u);
+    if (r.sampled) atomicAdd(counters.c.reconstructedPixels, 1u);
     if (r.missing != 0u) atomicAdd(counters.c.reconstructionMisses, 1u);
     if (r.overflowed != 0u) atomicAdd(counters.c.overflowSamples, 1u);
-    return r;
 }
 
 vec3 heat(float t) {

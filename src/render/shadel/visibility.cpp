@@ -35,7 +35,8 @@ ComputePush computePush(Renderer& r, uint64_t frame) {
 }
 
 void dispatchPixels(Renderer& r, VkCommandBuffer cmd) {
-    vkCmdDispatch(cmd, (r.internalWidth + 7) / 8, (r.internalHeight + 7) / 8, 1);
+    // One invocation per 2x2 quad, 8x8 invocations per group: 16x16 pixels.
+    vkCmdDispatch(cmd, (r.internalWidth + 15) / 16, (r.internalHeight + 15) / 16, 1);
 }
 } // namespace
 
