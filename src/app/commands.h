@@ -13,7 +13,7 @@ namespace shadel {
 struct RenderOptions {
     std::string scene = "builtin:default";
     RenderMode mode = RenderMode::Forward;
-    MarkingMode marking = MarkingMode::Visibility; // decoupled: --marking raster|visibility
+    MarkingMode marking = MarkingMode::Raster; // decoupled: --marking raster|visibility
     uint32_t width = 1280, height = 720;
     uint32_t frames = 1;
     std::string camera;

@@ -65,7 +65,7 @@ int main(int argc, char** argv) {
     render->add_option("--ssaa", ro.ssaa, "N: NxN supersampled reference")->capture_default_str();
     render->add_option("--visualize", visualize, "none | marking | mips | chunks | sheet")
         ->capture_default_str();
-    std::string marking = "visibility";
+    std::string marking = "raster";
     render
         ->add_option("--marking", marking,
                      "decoupled: raster (marking + reconstruction as raster passes) | visibility "
