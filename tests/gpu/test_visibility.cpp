@@ -53,7 +53,9 @@ TEST(Visibility, MatchesRasterMarkingAndReconstruction) {
                         "requested %.0f vs %.0f\n",
                         scene.c_str(), w, h, p, requestedVis, requestedRaster);
             EXPECT_GE(p, 45.0) << scene << " " << w << "x" << h;
-            EXPECT_LE(std::abs(requestedVis - requestedRaster), 0.002 * requestedRaster + 2.0)
+            // Same derivatives up to rounding: same MIPs, so the same chunks (lavapipe: exactly;
+            // the margin is for LOD ties at the last bit on other drivers).
+            EXPECT_LE(std::abs(requestedVis - requestedRaster), 0.0005 * requestedRaster + 1.0)
                 << scene << " " << w << "x" << h;
             EXPECT_EQ(stat(vis, "reconstruction_misses"), 0u) << scene;
             EXPECT_EQ(stat(raster, "reconstruction_misses"), 0u) << scene;
