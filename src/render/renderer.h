@@ -7,10 +7,10 @@
 
 #include "render/camera.h"
 #include "render/gpu_scene.h"
+#include "render/shadel/visibility.h"
 #include "rhi/frame.h"
 #include "rhi/pipeline.h"
 #include "rhi/shader_messages.h"
-#include "render/shadel/visibility.h"
 
 namespace shadel {
 

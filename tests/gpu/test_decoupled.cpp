@@ -58,8 +58,7 @@ TEST_P(Decoupled, SmoothSceneMatchesForward) {
     double p = psnr(dec.frames[0].rgba, fwd.frames[0].rgba);
     std::printf(
         "[ figures ] smooth 256x144 %s: PSNR(decoupled, forward) = %.2f dB, %.2f shadels/pixel\n",
-        markingName(GetParam()), p,
-        dec.stats["shadels_per_pixel"].get<double>());
+        markingName(GetParam()), p, dec.stats["shadels_per_pixel"].get<double>());
     EXPECT_GE(p, 35.0);
     EXPECT_EQ(dec.stats["reconstruction_misses"].get<uint64_t>(), 0u);
     EXPECT_EQ(dec.stats["pixels_covered"], fwd.stats["pixels_covered"]);
@@ -73,9 +72,9 @@ TEST_P(Decoupled, CheckerIsCloserToSupersampledReferenceThanForward) {
     RenderRun dec = renderChecked(options("builtin:checker", RenderMode::Decoupled, 192, 108));
     double pf = psnr(fwd.frames[0].rgba, reference.frames[0].rgba);
     double pd = psnr(dec.frames[0].rgba, reference.frames[0].rgba);
-    std::printf(
-        "[ figures ] checker 192x108 vs 8x8 SSAA: forward %.2f dB, decoupled (%s) %.2f dB (+%.2f)\n",
-        pf, markingName(GetParam()), pd, pd - pf);
+    std::printf("[ figures ] checker 192x108 vs 8x8 SSAA: forward %.2f dB, decoupled (%s) %.2f dB "
+                "(+%.2f)\n",
+                pf, markingName(GetParam()), pd, pd - pf);
     EXPECT_GE(pd, pf + 3.0);
     EXPECT_EQ(dec.stats["reconstruction_misses"].get<uint64_t>(), 0u);
 }

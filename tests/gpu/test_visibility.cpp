@@ -81,9 +81,12 @@ TEST(Visibility, SupersampledTargetsAreCoveredByTheComputePasses) {
 // The frame shows which path ran: one raster pass over the scene (the visibility prepass) and
 // compute marking + resolve, or the three raster passes.
 TEST(Visibility, PassesAreNamedPerMode) {
-    auto vis = passNames(renderChecked(decoupled("builtin:smooth", MarkingMode::Visibility, 64, 36)));
-    auto raster = passNames(renderChecked(decoupled("builtin:smooth", MarkingMode::Raster, 64, 36)));
-    for (const char* name : {"visibilityPrepass", "markingCompute", "resolveCompute", "hybridForward"}) {
+    auto vis =
+        passNames(renderChecked(decoupled("builtin:smooth", MarkingMode::Visibility, 64, 36)));
+    auto raster =
+        passNames(renderChecked(decoupled("builtin:smooth", MarkingMode::Raster, 64, 36)));
+    for (const char* name :
+         {"visibilityPrepass", "markingCompute", "resolveCompute", "hybridForward"}) {
         EXPECT_TRUE(has(vis, name)) << name;
         EXPECT_FALSE(has(raster, name)) << name;
     }

@@ -433,10 +433,9 @@ void recordDecoupledPasses(Renderer& r, FrameRecorder& rec, uint64_t frame, cons
                       VK_ACCESS_2_SHADER_STORAGE_READ_BIT | VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT);
     });
 
-    if (r.visibility) // --marking visibility: compute over the visibility buffer's pixels
-        pass(rec, "markingCompute",
-             [&](VkCommandBuffer cmd) { recordMarkingCompute(r, cmd, frame); });
-    else pass(rec, "marking", [&](VkCommandBuffer cmd) {
+    pass(rec, r.visibility ? "markingCompute" : "marking", [&](VkCommandBuffer cmd) {
+        // --marking visibility: a compute pass over the visibility buffer's pixels.
+        if (r.visibility) return recordMarkingCompute(r, cmd, frame);
         beginSceneDepthPass(r, cmd, false); // against the prepass depth
         bind(gpu, cmd, d.mark);
         pushConstants(gpu, cmd, RasterPush{frame, 0});
