@@ -14,6 +14,7 @@ struct RenderOptions {
     std::string scene = "builtin:default";
     bool allowExternalFiles = false; // glTF URIs may leave the model's folder
     RenderMode mode = RenderMode::Forward;
+    MarkingMode marking = MarkingMode::Raster; // decoupled: --marking raster|visibility
     uint32_t width = 1280, height = 720;
     uint32_t frames = 1;
     std::string camera;
@@ -55,6 +56,7 @@ struct RenderRun {
 void parseSize(const std::string& text, uint32_t& width, uint32_t& height);
 RenderMode parseMode(const std::string& text);
 Visualize parseVisualize(const std::string& text);
+MarkingMode parseMarking(const std::string& text);
 // The bake cache folder when --cache-dir is not given (see defaultBakeCacheDir()).
 std::string defaultCacheDir();
 

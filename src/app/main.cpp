@@ -92,6 +92,12 @@ int main(int argc, char** argv) {
         ->add_option("--visualize", visualize,
                      "none | marking | mips | chunks | sheet | layer:radiance | layer:material")
         ->capture_default_str();
+    std::string marking = "raster";
+    render
+        ->add_option("--marking", marking,
+                     "decoupled: raster (marking + reconstruction as raster passes) | visibility "
+                     "(visibility buffer, compute marking + resolve)")
+        ->capture_default_str();
     render->add_option("--out", ro.out, "FILE.png (last frame) or DIR/ (every frame)");
     render->add_option("--stats", ro.stats, "FILE.json");
     render->add_option("--timing", timing, "auto | timestamps | submit (per-pass submit+wait)")
@@ -277,6 +283,7 @@ int main(int argc, char** argv) {
             parseSize(size, ro.width, ro.height);
             ro.mode = parseMode(mode);
             ro.visualize = parseVisualize(visualize);
+            ro.marking = parseMarking(marking);
             if (jitter != "none" && jitter != "subpixel")
                 throw InputError(format("--jitter %s: expected none or subpixel", jitter.c_str()));
             ro.jitter = jitter == "subpixel";

@@ -49,6 +49,12 @@ Visualize parseVisualize(const std::string& text) {
                             text.c_str()));
 }
 
+MarkingMode parseMarking(const std::string& text) {
+    if (text == "raster") return MarkingMode::Raster;
+    if (text == "visibility") return MarkingMode::Visibility;
+    throw InputError(format("--marking %s: expected raster or visibility", text.c_str()));
+}
+
 std::string defaultCacheDir() {
     return defaultBakeCacheDir();
 }
@@ -160,6 +166,7 @@ RenderRun runRender(Gpu& gpu, const RenderOptions& o) {
     settings.height = o.height;
     settings.ssaa = o.ssaa;
     settings.mode = o.mode;
+    settings.marking = o.marking;
     settings.visualize = o.visualize;
     settings.exposure = o.exposure;
     settings.shadeStorageSize = o.shadeStorageSize;
@@ -215,6 +222,8 @@ RenderRun runRender(Gpu& gpu, const RenderOptions& o) {
     s["scene"] = o.scene;
     s["camera"] = camera.name;
     s["mode"] = modeName(o.mode);
+    if (o.mode == RenderMode::Decoupled)
+        s["marking"] = o.marking == MarkingMode::Raster ? "raster" : "visibility";
     s["width"] = o.width;
     s["height"] = o.height;
     s["ssaa"] = o.ssaa;

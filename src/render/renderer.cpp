@@ -9,8 +9,13 @@
 #include "render/lighting/light_animation.h"
 #include "render/post/tonemap.h"
 #include "render/shadel/decoupled.h"
+#include "render/shadel/visibility.h"
 
 namespace shadel {
+
+static bool usesVisibilityBuffer(const RenderSettings& s) {
+    return s.mode == RenderMode::Decoupled && s.marking == MarkingMode::Visibility;
+}
 
 static void createTargets(Renderer& r) {
     Gpu& gpu = *r.gpu;
@@ -32,6 +37,7 @@ static void createTargets(Renderer& r) {
     hdr.width = r.internalWidth;
     hdr.height = r.internalHeight;
     hdr.usage = VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT | VK_IMAGE_USAGE_SAMPLED_BIT;
+    if (usesVisibilityBuffer(r.settings)) hdr.usage |= VK_IMAGE_USAGE_STORAGE_BIT; // resolve
     r.hdr = need(createTexture(gpu, hdr), "the scene colour target");
     r.hdrTarget = createRenderTargetView(gpu, r.hdr);
     r.hdrRead = createReadView(gpu, r.hdr);
@@ -86,12 +92,14 @@ void initRenderer(Renderer& r, Gpu& gpu, const RenderSettings& settings, const G
     initShaderMessages(gpu, r.messages);
     initFrameRecorder(gpu, r.recorder, settings.timing);
     if (settings.mode == RenderMode::Decoupled) r.decoupled = createDecoupled(r, scene);
+    if (usesVisibilityBuffer(settings)) r.visibility = createVisibility(r);
 }
 
 void destroyRenderer(Renderer& r) {
     if (!r.gpu) return;
     Gpu& gpu = *r.gpu;
     vkDeviceWaitIdle(gpu.device.device);
+    if (r.visibility) destroyVisibility(r, r.visibility);
     if (r.decoupled) destroyDecoupled(r, r.decoupled);
     destroyFrameRecorder(r.recorder);
     destroyShaderMessages(gpu, r.messages);
@@ -193,7 +201,11 @@ FrameResult renderFrame(Renderer& r, const GpuScene& scene, const CameraView& ca
     pass(rec, "instanceCull",
          [&](VkCommandBuffer cmd) { recordInstanceCull(r, cmd, frame, scene); });
     pass(rec, "shadowMap", [&](VkCommandBuffer cmd) { recordShadowMap(r, cmd, frame); });
-    pass(rec, "depthPrepass", [&](VkCommandBuffer cmd) { recordDepthPrepass(r, cmd, frame); });
+    if (r.visibility)
+        pass(rec, "visibilityPrepass",
+             [&](VkCommandBuffer cmd) { recordVisibilityPrepass(r, cmd, frame); });
+    else
+        pass(rec, "depthPrepass", [&](VkCommandBuffer cmd) { recordDepthPrepass(r, cmd, frame); });
     if (r.settings.mode == RenderMode::Forward) {
         pass(rec, "forwardShading",
              [&](VkCommandBuffer cmd) { recordForwardShading(r, cmd, frame); });

@@ -385,6 +385,10 @@ void createDevice(Device& device, const DeviceDesc& desc) {
         f.core.features.shaderStorageImageReadWithoutFormat;
     enable.core.features.depthClamp = VK_TRUE;
     enable.core.features.independentBlend = f.core.features.independentBlend;
+    // gl_PrimitiveID in fragment shaders (the visibility buffer's triangle IDs) needs the
+    // Geometry capability.
+    enable.core.features.geometryShader = f.core.features.geometryShader;
+    device.optional.primitiveId = f.core.features.geometryShader == VK_TRUE;
 
     auto exts = deviceExtensions(device.physical);
     std::vector<const char*> deviceExts;

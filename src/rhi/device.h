@@ -18,6 +18,7 @@ struct DeviceFeatures { // optional features, used when present
     bool meshShader = false;
     bool rayQuery = false;
     bool computeDerivatives = false;
+    bool primitiveId = false; // fragment gl_PrimitiveID (geometryShader feature)
 };
 
 struct Device {

@@ -35,21 +35,36 @@ double flicker(const RenderRun& run) {
     return sum / double(std::max<size_t>(n, 1));
 }
 
+const char* markingName(MarkingMode m) {
+    return m == MarkingMode::Raster ? "raster" : "visibility";
+}
+
 } // namespace
 
-TEST(Decoupled, SmoothSceneMatchesForward) {
+// Every test runs with both marking modes: raster marking + reconstruction, and the visibility
+// buffer's compute marking + resolve.
+class Decoupled : public ::testing::TestWithParam<MarkingMode> {
+protected:
+    RenderOptions options(const std::string& scene, RenderMode mode, uint32_t w, uint32_t h) {
+        RenderOptions o = ::options(scene, mode, w, h);
+        o.marking = GetParam();
+        return o;
+    }
+};
+
+TEST_P(Decoupled, SmoothSceneMatchesForward) {
     RenderRun fwd = renderChecked(options("builtin:smooth", RenderMode::Forward, 256, 144));
     RenderRun dec = renderChecked(options("builtin:smooth", RenderMode::Decoupled, 256, 144));
     double p = psnr(dec.frames[0].rgba, fwd.frames[0].rgba);
     std::printf(
-        "[ figures ] smooth 256x144: PSNR(decoupled, forward) = %.2f dB, %.2f shadels/pixel\n", p,
-        dec.stats["shadels_per_pixel"].get<double>());
+        "[ figures ] smooth 256x144 %s: PSNR(decoupled, forward) = %.2f dB, %.2f shadels/pixel\n",
+        markingName(GetParam()), p, dec.stats["shadels_per_pixel"].get<double>());
     EXPECT_GE(p, 35.0);
     EXPECT_EQ(dec.stats["reconstruction_misses"].get<uint64_t>(), 0u);
     EXPECT_EQ(dec.stats["pixels_covered"], fwd.stats["pixels_covered"]);
 }
 
-TEST(Decoupled, CheckerIsCloserToSupersampledReferenceThanForward) {
+TEST_P(Decoupled, CheckerIsCloserToSupersampledReferenceThanForward) {
     RenderOptions ref = options("builtin:checker", RenderMode::Forward, 192, 108);
     ref.ssaa = 8;
     RenderRun reference = renderChecked(ref);
@@ -57,16 +72,16 @@ TEST(Decoupled, CheckerIsCloserToSupersampledReferenceThanForward) {
     RenderRun dec = renderChecked(options("builtin:checker", RenderMode::Decoupled, 192, 108));
     double pf = psnr(fwd.frames[0].rgba, reference.frames[0].rgba);
     double pd = psnr(dec.frames[0].rgba, reference.frames[0].rgba);
-    std::printf(
-        "[ figures ] checker 192x108 vs 8x8 SSAA: forward %.2f dB, decoupled %.2f dB (+%.2f)\n", pf,
-        pd, pd - pf);
+    std::printf("[ figures ] checker 192x108 vs 8x8 SSAA: forward %.2f dB, decoupled (%s) %.2f dB "
+                "(+%.2f)\n",
+                pf, markingName(GetParam()), pd, pd - pf);
     EXPECT_GE(pd, pf + 3.0);
     EXPECT_EQ(dec.stats["reconstruction_misses"].get<uint64_t>(), 0u);
 }
 
 // At 1280x720 (the bench resolution): geometric edges alias the same in both modes, so at low
 // resolutions they dominate both figures and hide what decoupled shading changes.
-TEST(Decoupled, FlickersFarLessThanForwardUnderJitter) {
+TEST_P(Decoupled, FlickersFarLessThanForwardUnderJitter) {
     RenderOptions o = options("builtin:default", RenderMode::Forward, 1280, 720);
     o.frames = 16;
     o.jitter = true;
@@ -83,7 +98,7 @@ TEST(Decoupled, FlickersFarLessThanForwardUnderJitter) {
     EXPECT_EQ(dec.stats["reconstruction_misses"].get<uint64_t>(), 0u);
 }
 
-TEST(Decoupled, NoReconstructionMissesOnAnyBuiltinSceneAndCamera) {
+TEST_P(Decoupled, NoReconstructionMissesOnAnyBuiltinSceneAndCamera) {
     for (const std::string scene : {"builtin:default", "builtin:checker", "builtin:smooth"}) {
         Scene s = loadScene(scene);
         for (const Camera& camera : s.cameras) {
@@ -96,13 +111,17 @@ TEST(Decoupled, NoReconstructionMissesOnAnyBuiltinSceneAndCamera) {
                 << scene << " camera " << camera.name;
             EXPECT_GT(run.stats["shadels_shaded"].get<uint64_t>(), 0u)
                 << scene << " camera " << camera.name;
+            RenderOptions f = options(scene, RenderMode::Forward, 128, 72);
+            f.camera = camera.name;
+            EXPECT_EQ(run.stats["pixels_covered"], renderChecked(f).stats["pixels_covered"])
+                << scene << " camera " << camera.name;
         }
     }
 }
 
 // On smooth content forward and decoupled agree, so an overflowing frame (part decoupled, part
 // shaded forward as the fallback) must agree with both.
-TEST(Decoupled, StorageOverflowIsCountedAndNeverCorrupts) {
+TEST_P(Decoupled, StorageOverflowIsCountedAndNeverCorrupts) {
     RenderRun fwd = renderChecked(options("builtin:smooth", RenderMode::Forward, 256, 144));
     RenderRun full = renderChecked(options("builtin:smooth", RenderMode::Decoupled, 256, 144));
     RenderOptions o = options("builtin:smooth", RenderMode::Decoupled, 256, 144);
@@ -119,7 +138,7 @@ TEST(Decoupled, StorageOverflowIsCountedAndNeverCorrupts) {
     EXPECT_GE(psnr(dec.frames[0].rgba, full.frames[0].rgba), 35.0);
 }
 
-TEST(Decoupled, DebugViewsRenderAndDiffer) {
+TEST_P(Decoupled, DebugViewsRenderAndDiffer) {
     RenderOptions o = options("builtin:default", RenderMode::Decoupled, 128, 72);
     std::vector<std::vector<uint8_t>> images;
     for (Visualize v : {Visualize::None, Visualize::Marking, Visualize::Mips, Visualize::Chunks,
@@ -132,7 +151,7 @@ TEST(Decoupled, DebugViewsRenderAndDiffer) {
 
 // Real assets from Debian's assimp-testmodels: millimetre-scale CAD (many small parts) and a
 // textured box.
-TEST(Decoupled, NoReconstructionMissesOnRealGltfModels) {
+TEST_P(Decoupled, NoReconstructionMissesOnRealGltfModels) {
     const std::string dir = "/usr/share/assimp/models/glTF2/";
     for (const std::string model :
          {"2CylinderEngine-glTF-Binary/2CylinderEngine.glb",
@@ -152,7 +171,7 @@ TEST(Decoupled, NoReconstructionMissesOnRealGltfModels) {
 }
 
 // Hybrid forward: objects below the size threshold are drawn forward in the same frame.
-TEST(Decoupled, SmallObjectsFallBackToForwardInTheSameFrame) {
+TEST_P(Decoupled, SmallObjectsFallBackToForwardInTheSameFrame) {
     RenderOptions o = options("builtin:default", RenderMode::Decoupled, 320, 180);
     o.forwardBelowPixels = 0.0f;
     RenderRun none = renderChecked(o);
@@ -174,3 +193,7 @@ TEST(Decoupled, SmallObjectsFallBackToForwardInTheSameFrame) {
     RenderRun fwd = renderChecked(options("builtin:default", RenderMode::Forward, 320, 180));
     EXPECT_GT(psnr(most.frames[0].rgba, fwd.frames[0].rgba), 30.0);
 }
+
+INSTANTIATE_TEST_SUITE_P(Marking, Decoupled,
+                         ::testing::Values(MarkingMode::Raster, MarkingMode::Visibility),
+                         [](const auto& info) { return std::string(markingName(info.param)); });

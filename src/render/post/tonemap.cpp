@@ -22,8 +22,12 @@ void createTonemapPipeline(Renderer& r) {
 
 void recordTonemap(Renderer& r, VkCommandBuffer cmd, uint64_t frame) {
     Gpu& gpu = *r.gpu;
+    // A target that also allows storage (the visibility resolve) is read in GENERAL layout.
+    VkImageLayout hdrLayout = (desc(gpu, r.hdr).usage & VK_IMAGE_USAGE_STORAGE_BIT)
+                                  ? VK_IMAGE_LAYOUT_GENERAL
+                                  : VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL;
     imageBarrier(cmd, vkImage(gpu, r.hdr), VK_IMAGE_ASPECT_COLOR_BIT,
-                 VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL,
+                 VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL, hdrLayout,
                  VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT,
                  VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
                  VK_ACCESS_2_SHADER_SAMPLED_READ_BIT);

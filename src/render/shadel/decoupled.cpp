@@ -12,6 +12,7 @@
 #include "render/renderer.h"
 #include "render/shadel/capacity_control.h"
 #include "render/shadel/shade_storage.h"
+#include "render/shadel/visibility.h"
 
 namespace shadel {
 
@@ -522,7 +523,9 @@ void recordDecoupledPasses(Renderer& r, FrameRecorder& rec, uint64_t frame, cons
                       VK_ACCESS_2_SHADER_STORAGE_READ_BIT | VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT);
     });
 
-    pass(rec, "marking", [&](VkCommandBuffer cmd) {
+    pass(rec, r.visibility ? "markingCompute" : "marking", [&](VkCommandBuffer cmd) {
+        // --marking visibility: a compute pass over the visibility buffer's pixels.
+        if (r.visibility) return recordMarkingCompute(r, cmd, frame);
         beginSceneDepthPass(r, cmd, false); // against the prepass depth
         bind(gpu, cmd, d.mark);
         pushConstants(gpu, cmd, RasterPush{frame, 0});
@@ -583,6 +586,13 @@ void recordDecoupledPasses(Renderer& r, FrameRecorder& rec, uint64_t frame, cons
                       VK_ACCESS_2_SHADER_SAMPLED_READ_BIT);
     });
 
+    if (r.visibility) { // compute resolve, then forward (hybrid) objects rastered over it
+        pass(rec, "resolveCompute",
+             [&](VkCommandBuffer cmd) { recordResolveCompute(r, cmd, frame); });
+        pass(rec, "hybridForward",
+             [&](VkCommandBuffer cmd) { recordHybridForward(r, cmd, frame); });
+        return;
+    }
     // Decoupled objects read their shadels; forward objects (hybrid) shade as usual.
     pass(rec, "reconstruction", [&](VkCommandBuffer cmd) {
         beginSceneColorPass(r, cmd, true);

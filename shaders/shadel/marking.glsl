@@ -1,0 +1,56 @@
+// Marking (seed: "Shadel Marking pass"), shared by the raster marking (mark.frag) and the
+// compute marking over the visibility buffer (mark_visibility.comp): a visible sample ORs into
+// the occupancy masks the bits of every chunk the reconstruction filter will read: the 2x2
+// bilinear taps of both MIPs of the trilinear blend, across chunk and block edges, at every
+// anisotropic tap (shadelAniso).
+#ifndef SHADEL_MARKING_GLSL
+#define SHADEL_MARKING_GLSL
+#include "shadel/shadel.glsl"
+
+#ifdef SHADEL_MARK_CACHE
+// The last chunks this invocation marked (block << 6 | bit), for invocations that mark several
+// pixels: repeats skip even the load of the mask.
+uint gMarked0 = SHADEL_INVALID, gMarked1 = SHADEL_INVALID, gMarked2 = SHADEL_INVALID,
+     gMarked3 = SHADEL_INVALID;
+#endif
+
+void markChunk(ShadelFrame s, uvec2 sheet) {
+    uint block = blockIndex(s, sheet);
+    uint64_t bit = 1ul << chunkBit(sheet);
+#ifdef SHADEL_MARK_CACHE
+    uint key = (block << 6) | chunkBit(sheet);
+    if (gMarked0 == key || gMarked1 == key || gMarked2 == key || gMarked3 == key) return;
+    gMarked3 = gMarked2;
+    gMarked2 = gMarked1;
+    gMarked1 = gMarked0;
+    gMarked0 = key;
+#endif
+    Uint64Buffer occupancy = Uint64Buffer(s.occupancy);
+    // Most pixels find their chunk already marked: skip the atomic then.
+    if ((occupancy.v[block] & bit) == 0ul) atomicOr(occupancy.v[block], bit);
+}
+
+void markLevel(ShadelFrame s, GpuShadelObject o, uint mip, vec2 uv) {
+    ivec2 t0;
+    vec2 w;
+    bilinearFootprint(o, mip, uv, t0, w);
+    uvec2 a = sheetShadel(o, mip, t0);
+    uvec2 b = sheetShadel(o, mip, t0 + ivec2(1));
+    // The four taps span at most 2x2 chunks; mark each distinct one.
+    markChunk(s, a);
+    if (b.x / SHADEL_CHUNK != a.x / SHADEL_CHUNK) markChunk(s, uvec2(b.x, a.y));
+    if (b.y / SHADEL_CHUNK != a.y / SHADEL_CHUNK) markChunk(s, uvec2(a.x, b.y));
+    if (b.x / SHADEL_CHUNK != a.x / SHADEL_CHUNK && b.y / SHADEL_CHUNK != a.y / SHADEL_CHUNK) markChunk(s, b);
+}
+
+// texelDx/Dy: screen derivatives of the sample's MIP-0 shadel coordinate (shadelUv * mip0Size).
+void markSample(ShadelFrame s, GpuShadelObject o, vec2 shadelUv, vec2 texelDx, vec2 texelDy) {
+    ShadelLevels l = shadelLevels(o, texelDx, texelDy, s.shadingBias, s.trilinearBand);
+    ShadelAniso a = shadelAniso(texelDx, texelDy);
+    for (uint i = 0u; i < a.taps; ++i) { // the same taps reconstruction reads
+        vec2 uv = shadelTapUv(o.mip0Size, shadelUv, a, i);
+        markLevel(s, o, l.mip0, uv);
+        if (l.two) markLevel(s, o, l.mip1, uv);
+    }
+}
+#endif

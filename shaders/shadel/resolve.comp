@@ -1,0 +1,102 @@
+#version 460
+// Compute resolve (--marking visibility): one invocation per 2x2 quad of pixels. Decoupled
+// pixels read their shadels with the same samples as the compute marking
+// (shadel/vis_shadel.glsl) and the same filter as the raster reconstruction
+// (shadel/resolve.glsl); misses and overflow are shaded forward here from the rebuilt
+// attributes. Every other pixel gets the sky: forward (hybrid) instances are drawn over it by
+// the raster pass that follows.
+#include "shadel/resolve.glsl"
+#include "shadel/vis_shadel.glsl"
+#include "common/lighting.glsl"
+#include "common/vertex.glsl"
+
+layout(local_size_x = 8, local_size_y = 8) in;
+
+layout(push_constant, scalar) uniform Push {
+    uint64_t frame;
+    uint visibilitySlot;
+    uint width;
+    uint height;
+    uint hdrSlot;
+} pc;
+
+// The forward material + lighting at the pixel, from the triangle's interpolated attributes
+// (what the forward raster pass's varyings and dFdx/dFdy would give).
+vec3 forwardShade(FrameConstants f, GpuInstance inst, VisTriangle tri, VisBary bary) {
+    GpuMaterial mat = MaterialBuffer(f.materials).m[inst.material];
+    WorldVertex a = fetchWorldVertex(f, inst, tri.v0);
+    WorldVertex b = fetchWorldVertex(f, inst, tri.v1);
+    WorldVertex c = fetchWorldVertex(f, inst, tri.v2);
+    vec3 w = bary.center;
+    SurfaceInput si;
+    si.position = visInterpolate(w, a.position, b.position, c.position);
+    si.normal = normalize(visInterpolate(w, a.normal, b.normal, c.normal));
+    si.tangent = visInterpolate(w, a.tangent, b.tangent, c.tangent);
+    si.uv = visInterpolate(w, a.uv0, b.uv0, c.uv0);
+    si.uvDx = visInterpolate(bary.dx, a.uv0, b.uv0, c.uv0);
+    si.uvDy = visInterpolate(bary.dy, a.uv0, b.uv0, c.uv0);
+    si.frontFacing = tri.frontFacing;
+    MaterialSample m = evaluateMaterial(mat, si);
+    return shadeSurface(f, m, si.position, si.normal);
+}
+
+// The frame's counters summed per workgroup first: one global atomic per group and counter.
+shared uint sMagnified, sSampled, sMisses, sOverflow;
+
+void resolveQuad(FrameConstants f, ShadelFrame s, ivec2 origin, inout uvec4 counts) {
+    uvec2 current = uvec2(VISIBILITY_NONE);
+    VisQuad q;
+    GpuShadelObject o;
+    GpuInstance inst;
+    for (int i = 0; i < 4; ++i) {
+        ivec2 pixel = origin + ivec2(i & 1, i >> 1);
+        if (pixel.x >= int(pc.width) || pixel.y >= int(pc.height)) continue;
+        vec4 color = vec4(f.skyColor, 0.0); // what the raster colour pass clears to
+        uvec2 vis = loadVisibility(pc.visibilitySlot, pixel);
+        bool decoupled = false;
+        if (vis.x != VISIBILITY_NONE) {
+            if (vis != current) {
+                current = vis;
+                o = ShadelObjectBuffer(s.objects).o[vis.x];
+                if ((o.flags & SHADEL_OBJECT_DECOUPLED) != 0u) {
+                    inst = InstanceBuffer(f.instances).i[vis.x];
+                    visQuadSetup(f, s, inst, vis.y, origin, q);
+                }
+            }
+            decoupled = (o.flags & SHADEL_OBJECT_DECOUPLED) != 0u;
+        }
+        if (decoupled) {
+            VisShadel v = visShadelSample(q, o, i);
+            Reconstruction r = reconstructSample(s, o, v.shadelUv, v.texelDx, v.texelDy, pixel,
+                                                 reconstructionLayer(f, s));
+            counts += uvec4(r.magnified ? 1u : 0u, r.sampled ? 1u : 0u, r.missing != 0u ? 1u : 0u,
+                            r.overflowed != 0u ? 1u : 0u);
+            vec3 c = r.color;
+            if (r.missing + r.overflowed != 0u) c = forwardShade(f, inst, q.tri, v.bary);
+            color = vec4(visualizeReconstruction(f, o, r, c, v.shadelUv, v.texelDx, v.texelDy), 1.0);
+        }
+        imageStore(gImagesRgba16f[pc.hdrSlot], pixel, color);
+    }
+}
+
+void main() {
+    if (gl_LocalInvocationIndex == 0u) sMagnified = sSampled = sMisses = sOverflow = 0u;
+    barrier();
+    ivec2 origin = ivec2(gl_GlobalInvocationID.xy) * 2;
+    FrameConstants f = FrameConstantsRef(pc.frame).f;
+    ShadelFrame s = ShadelFrameRef(f.shadel).s;
+    uvec4 counts = uvec4(0u);
+    if (origin.x < int(pc.width) && origin.y < int(pc.height)) resolveQuad(f, s, origin, counts);
+    if (counts.x != 0u) atomicAdd(sMagnified, counts.x);
+    if (counts.y != 0u) atomicAdd(sSampled, counts.y);
+    if (counts.z != 0u) atomicAdd(sMisses, counts.z);
+    if (counts.w != 0u) atomicAdd(sOverflow, counts.w);
+    barrier();
+    if (gl_LocalInvocationIndex == 0u) {
+        ShadelCountersRef counters = ShadelCountersRef(s.counters);
+        if (sMagnified != 0u) atomicAdd(counters.c.magnifiedPixels, sMagnified);
+        if (sSampled != 0u) atomicAdd(counters.c.reconstructedPixels, sSampled);
+        if (sMisses != 0u) atomicAdd(counters.c.reconstructionMisses, sMisses);
+        if (sOverflow != 0u) atomicAdd(counters.c.overflowSamples, sOverflow);
+    }
+}

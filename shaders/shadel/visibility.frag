@@ -1,0 +1,28 @@
+#version 460
+// Visibility prepass (--marking visibility): depth plus, per pixel, the instance and the
+// triangle (gl_PrimitiveID within its draw) that won the depth test. Alpha-masked materials
+// discard as in the depth prepass.
+#include "common/material.glsl"
+
+layout(push_constant, scalar) uniform Push {
+    uint64_t frame;
+    uint shadowView;
+} pc;
+
+layout(location = 3) in vec2 inUv;
+layout(location = 4) flat in uint inInstance;
+
+layout(location = 0) out uvec2 outVisibility;
+
+void main() {
+    FrameConstants f = FrameConstantsRef(pc.frame).f;
+    GpuInstance inst = InstanceBuffer(f.instances).i[inInstance];
+    GpuMaterial m = MaterialBuffer(f.materials).m[inst.material];
+    if ((m.flags & MATERIAL_ALPHA_MASK) != 0u) {
+        float alpha = m.baseColorFactor.a;
+        if (m.baseColorTexture != NO_TEXTURE)
+            alpha *= sampleTexture(m.baseColorTexture, SAMPLER_LINEAR_REPEAT, inUv, dFdx(inUv), dFdy(inUv)).a;
+        if (alpha < m.alphaCutoff) discard;
+    }
+    outVisibility = uvec2(inInstance, uint(gl_PrimitiveID));
+}

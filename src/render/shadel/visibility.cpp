@@ -1,0 +1,175 @@
+#include "render/shadel/visibility.h"
+
+#include "core/error.h"
+#include "render/forward/forward_passes.h"
+#include "render/renderer.h"
+
+namespace shadel {
+
+struct VisibilityState {
+    TextureHandle ids; // "visibilityBuffer": R32G32_UINT {instance, triangle}
+    RenderTargetView idsTarget;
+    TextureReadView idsRead;
+    TextureWriteView hdrWrite; // the scene colour target as a storage image (resolve)
+    Pipeline prepass, mark, resolve;
+};
+
+void VisibilityStateDeleter::operator()(VisibilityState* state) const {
+    delete state;
+}
+
+namespace {
+struct ComputePush {
+    uint64_t frame;
+    uint32_t visibilitySlot;
+    uint32_t width;
+    uint32_t height;
+    uint32_t hdrSlot;
+};
+
+ComputePush computePush(Renderer& r, uint64_t frame) {
+    Gpu& gpu = *r.gpu;
+    VisibilityState& v = *r.visibility;
+    return {frame, slot(gpu, v.idsRead).value, r.internalWidth, r.internalHeight,
+            slot(gpu, v.hdrWrite).value};
+}
+
+void dispatchPixels(Renderer& r, VkCommandBuffer cmd) {
+    // One invocation per 2x2 quad, 8x8 invocations per group: 16x16 pixels.
+    vkCmdDispatch(cmd, (r.internalWidth + 15) / 16, (r.internalHeight + 15) / 16, 1);
+}
+} // namespace
+
+VisibilityStatePtr createVisibility(Renderer& r) {
+    Gpu& gpu = *r.gpu;
+    if (!gpu.device.optional.primitiveId)
+        throw DeviceError("--marking visibility needs gl_PrimitiveID in fragment shaders "
+                          "(geometryShader feature); use --marking raster on this device");
+    VisibilityStatePtr state(new VisibilityState());
+    VisibilityState& v = *state;
+    TextureDesc ids;
+    ids.name = "visibilityBuffer";
+    ids.format = VK_FORMAT_R32G32_UINT;
+    ids.width = r.internalWidth;
+    ids.height = r.internalHeight;
+    ids.usage = VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT | VK_IMAGE_USAGE_SAMPLED_BIT;
+    v.ids = createTexture(gpu, ids);
+    if (!v.ids) throw DeviceError("out of GPU memory for the visibility buffer");
+    v.idsTarget = createRenderTargetView(gpu, v.ids);
+    v.idsRead = createReadView(gpu, v.ids);
+    v.hdrWrite = createWriteView(gpu, r.hdr);
+
+    GraphicsPipelineDesc prepass;
+    prepass.name = "visibilityPrepass";
+    prepass.vertexShader = "forward_forward.vert.spv";
+    prepass.fragmentShader = "shadel_visibility.frag.spv";
+    prepass.colorFormats = {VK_FORMAT_R32G32_UINT};
+    prepass.depthFormat = VK_FORMAT_D32_SFLOAT;
+    prepass.cullMode = VK_CULL_MODE_NONE; // as the depth prepass
+    v.prepass = createGraphicsPipeline(gpu, prepass);
+    v.mark = createComputePipeline(gpu, "shadelMarkVisibility", "shadel_mark_visibility.comp.spv");
+    v.resolve = createComputePipeline(gpu, "shadelResolve", "shadel_resolve.comp.spv");
+    return state;
+}
+
+void destroyVisibility(Renderer& r, VisibilityStatePtr& state) {
+    if (!state) return;
+    Gpu& gpu = *r.gpu;
+    VisibilityState& v = *state;
+    for (Pipeline* p : {&v.prepass, &v.mark, &v.resolve}) destroy(gpu, *p);
+    destroy(gpu, v.hdrWrite);
+    destroy(gpu, v.idsRead);
+    destroy(gpu, v.idsTarget);
+    destroy(gpu, v.ids);
+    state.reset();
+}
+
+void recordVisibilityPrepass(Renderer& r, VkCommandBuffer cmd, uint64_t frame) {
+    Gpu& gpu = *r.gpu;
+    VisibilityState& v = *r.visibility;
+    imageBarrier(
+        cmd, vkImage(gpu, r.depth), VK_IMAGE_ASPECT_DEPTH_BIT, VK_IMAGE_LAYOUT_UNDEFINED,
+        VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL,
+        VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT | VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, 0,
+        VK_PIPELINE_STAGE_2_EARLY_FRAGMENT_TESTS_BIT | VK_PIPELINE_STAGE_2_LATE_FRAGMENT_TESTS_BIT,
+        VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT |
+            VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_READ_BIT);
+    imageBarrier(cmd, vkImage(gpu, v.ids), VK_IMAGE_ASPECT_COLOR_BIT, VK_IMAGE_LAYOUT_UNDEFINED,
+                 VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
+                 0, VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT,
+                 VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT);
+    VkRenderingAttachmentInfo color{VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO};
+    color.imageView = vkView(gpu, v.idsTarget);
+    color.imageLayout = VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL;
+    color.loadOp = VK_ATTACHMENT_LOAD_OP_CLEAR;
+    color.storeOp = VK_ATTACHMENT_STORE_OP_STORE;
+    color.clearValue.color.uint32[0] = 0xFFFFFFFFu; // VISIBILITY_NONE
+    color.clearValue.color.uint32[1] = 0xFFFFFFFFu;
+    VkRenderingAttachmentInfo depth{VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO};
+    depth.imageView = vkView(gpu, r.depthTarget);
+    depth.imageLayout = VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL;
+    depth.loadOp = VK_ATTACHMENT_LOAD_OP_CLEAR;
+    depth.storeOp = VK_ATTACHMENT_STORE_OP_STORE;
+    depth.clearValue.depthStencil = {0.0f, 0}; // reversed Z
+    VkRenderingInfo ri{VK_STRUCTURE_TYPE_RENDERING_INFO};
+    ri.renderArea = {{0, 0}, {r.internalWidth, r.internalHeight}};
+    ri.layerCount = 1;
+    ri.colorAttachmentCount = 1;
+    ri.pColorAttachments = &color;
+    ri.pDepthAttachment = &depth;
+    vkCmdBeginRendering(cmd, &ri);
+    bind(gpu, cmd, v.prepass);
+    pushConstants(gpu, cmd, RasterPush{frame, 0});
+    drawCameraList(r, cmd, DRAW_LIST_OPAQUE);
+    drawCameraList(r, cmd, DRAW_LIST_DECOUPLED);
+    vkCmdEndRendering(cmd);
+    memoryBarrier(cmd, VK_PIPELINE_STAGE_2_LATE_FRAGMENT_TESTS_BIT,
+                  VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT,
+                  VK_PIPELINE_STAGE_2_EARLY_FRAGMENT_TESTS_BIT |
+                      VK_PIPELINE_STAGE_2_LATE_FRAGMENT_TESTS_BIT,
+                  VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_READ_BIT |
+                      VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT);
+    imageBarrier(cmd, vkImage(gpu, v.ids), VK_IMAGE_ASPECT_COLOR_BIT,
+                 VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL,
+                 VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT,
+                 VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
+                 VK_ACCESS_2_SHADER_SAMPLED_READ_BIT);
+}
+
+void recordMarkingCompute(Renderer& r, VkCommandBuffer cmd, uint64_t frame) {
+    Gpu& gpu = *r.gpu;
+    bind(gpu, cmd, r.visibility->mark);
+    pushConstants(gpu, cmd, computePush(r, frame));
+    dispatchPixels(r, cmd);
+    memoryBarrier(cmd, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT,
+                  VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
+                  VK_ACCESS_2_SHADER_STORAGE_READ_BIT | VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT);
+}
+
+void recordResolveCompute(Renderer& r, VkCommandBuffer cmd, uint64_t frame) {
+    Gpu& gpu = *r.gpu;
+    // Shade storage written by shadelShading, read here as sampled texels.
+    memoryBarrier(cmd, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT,
+                  VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
+                  VK_ACCESS_2_SHADER_SAMPLED_READ_BIT | VK_ACCESS_2_SHADER_STORAGE_READ_BIT);
+    imageBarrier(cmd, vkImage(gpu, r.hdr), VK_IMAGE_ASPECT_COLOR_BIT, VK_IMAGE_LAYOUT_UNDEFINED,
+                 VK_IMAGE_LAYOUT_GENERAL, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, 0,
+                 VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT);
+    bind(gpu, cmd, r.visibility->resolve);
+    pushConstants(gpu, cmd, computePush(r, frame));
+    dispatchPixels(r, cmd);
+}
+
+void recordHybridForward(Renderer& r, VkCommandBuffer cmd, uint64_t frame) {
+    Gpu& gpu = *r.gpu;
+    imageBarrier(cmd, vkImage(gpu, r.hdr), VK_IMAGE_ASPECT_COLOR_BIT, VK_IMAGE_LAYOUT_GENERAL,
+                 VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
+                 VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT,
+                 VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT,
+                 VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT | VK_ACCESS_2_COLOR_ATTACHMENT_READ_BIT);
+    beginSceneColorPass(r, cmd, false);
+    drawForwardLists(r, cmd, frame);
+    vkCmdEndRendering(cmd);
+}
+
+} // namespace shadel

@@ -1,0 +1,35 @@
+#pragma once
+// Visibility buffer for the decoupled path (--marking visibility): the depth prepass also
+// writes each pixel's instance and triangle; marking and reconstruction become compute passes
+// over screen pixels that rebuild the shadel UV and its derivatives from the triangle and the
+// pixel ray (shaders/common/visibility.glsl). Raster passes per frame: shadow, the visibility
+// prepass and, only for hybrid forward instances, one colour pass after the resolve.
+#include <memory>
+
+#include "rhi/vk.h"
+
+namespace shadel {
+
+struct Renderer;
+struct VisibilityState;
+
+struct VisibilityStateDeleter {
+    void operator()(VisibilityState* state) const;
+};
+using VisibilityStatePtr = std::unique_ptr<VisibilityState, VisibilityStateDeleter>;
+
+// Needs the renderer's targets (the HDR target must allow storage). Throws DeviceError when
+// the device cannot give fragment shaders gl_PrimitiveID.
+VisibilityStatePtr createVisibility(Renderer& r);
+void destroyVisibility(Renderer& r, VisibilityStatePtr& state);
+
+// "visibilityPrepass": reversed-Z depth + instance/triangle IDs of opaque and decoupled lists.
+void recordVisibilityPrepass(Renderer& r, VkCommandBuffer cmd, uint64_t frame);
+// "markingCompute": occupancy bits from the visibility buffer (after shadelClear).
+void recordMarkingCompute(Renderer& r, VkCommandBuffer cmd, uint64_t frame);
+// "resolveCompute": decoupled pixels reconstructed (and forward fallback) into the HDR target.
+void recordResolveCompute(Renderer& r, VkCommandBuffer cmd, uint64_t frame);
+// "hybridForward": forward opaque + blended lists drawn over the resolved image.
+void recordHybridForward(Renderer& r, VkCommandBuffer cmd, uint64_t frame);
+
+} // namespace shadel

@@ -1,0 +1,113 @@
+// The visibility buffer (--marking visibility) against the raster marking + reconstruction it
+// replaces: same chunks marked, same image within rounding, its passes named in the frame, and
+// the debug views working in both modes. (Every test of test_decoupled.cpp also runs in both
+// modes.)
+#include "gpu_test_env.h"
+
+#include <algorithm>
+#include <cmath>
+
+using namespace shadel;
+using namespace shadel::test;
+
+namespace {
+
+RenderOptions decoupled(const std::string& scene, MarkingMode marking, uint32_t w, uint32_t h) {
+    RenderOptions o;
+    o.scene = scene;
+    o.mode = RenderMode::Decoupled;
+    o.marking = marking;
+    o.width = w;
+    o.height = h;
+    return o;
+}
+
+uint64_t stat(const RenderRun& run, const char* name) {
+    return run.stats[name].get<uint64_t>();
+}
+
+std::vector<std::string> passNames(const RenderRun& run) {
+    std::vector<std::string> names;
+    for (const auto& p : run.frames.front().passes) names.push_back(p.name);
+    return names;
+}
+
+bool has(const std::vector<std::string>& names, const char* name) {
+    return std::find(names.begin(), names.end(), name) != names.end();
+}
+
+} // namespace
+
+// The compute marking rebuilds the shadel UV and its derivatives analytically; the raster path
+// takes them from interpolation and dFdx. They must pick the same MIPs and mark the same chunks
+// (up to LOD ties at the last bit), and the images must agree to rounding.
+TEST(Visibility, MatchesRasterMarkingAndReconstruction) {
+    for (const std::string scene : {"builtin:default", "builtin:smooth"}) {
+        for (auto [w, h] : {std::pair{320u, 180u}, std::pair{960u, 540u}}) {
+            RenderRun raster = renderChecked(decoupled(scene, MarkingMode::Raster, w, h));
+            RenderRun vis = renderChecked(decoupled(scene, MarkingMode::Visibility, w, h));
+            double p = psnr(vis.frames[0].rgba, raster.frames[0].rgba);
+            double requestedRaster = double(stat(raster, "chunks_requested"));
+            double requestedVis = double(stat(vis, "chunks_requested"));
+            std::printf("[ figures ] %s %ux%u: PSNR(visibility, raster) = %.2f dB, chunks "
+                        "requested %.0f vs %.0f\n",
+                        scene.c_str(), w, h, p, requestedVis, requestedRaster);
+            EXPECT_GE(p, 45.0) << scene << " " << w << "x" << h;
+            // Same derivatives up to rounding: same MIPs, so the same chunks (lavapipe: exactly;
+            // the margin is for LOD ties at the last bit on other drivers).
+            EXPECT_LE(std::abs(requestedVis - requestedRaster), 0.0005 * requestedRaster + 1.0)
+                << scene << " " << w << "x" << h;
+            EXPECT_EQ(stat(vis, "reconstruction_misses"), 0u) << scene;
+            EXPECT_EQ(stat(raster, "reconstruction_misses"), 0u) << scene;
+            EXPECT_EQ(stat(vis, "pixels_covered"), stat(raster, "pixels_covered")) << scene;
+            EXPECT_EQ(stat(vis, "reconstructed_pixels_sampled"),
+                      stat(raster, "reconstructed_pixels_sampled"))
+                << scene;
+        }
+    }
+}
+
+// With --ssaa the targets are N x N larger; the compute passes cover the internal resolution.
+TEST(Visibility, SupersampledTargetsAreCoveredByTheComputePasses) {
+    RenderOptions o = decoupled("builtin:smooth", MarkingMode::Visibility, 96, 54);
+    o.ssaa = 2;
+    RenderRun vis = renderChecked(o);
+    o.marking = MarkingMode::Raster;
+    RenderRun raster = renderChecked(o);
+    EXPECT_EQ(stat(vis, "reconstruction_misses"), 0u);
+    EXPECT_GE(psnr(vis.frames[0].rgba, raster.frames[0].rgba), 45.0);
+}
+
+// The frame shows which path ran: one raster pass over the scene (the visibility prepass) and
+// compute marking + resolve, or the three raster passes.
+TEST(Visibility, PassesAreNamedPerMode) {
+    auto vis =
+        passNames(renderChecked(decoupled("builtin:smooth", MarkingMode::Visibility, 64, 36)));
+    auto raster =
+        passNames(renderChecked(decoupled("builtin:smooth", MarkingMode::Raster, 64, 36)));
+    for (const char* name :
+         {"visibilityPrepass", "markingCompute", "resolveCompute", "hybridForward"}) {
+        EXPECT_TRUE(has(vis, name)) << name;
+        EXPECT_FALSE(has(raster, name)) << name;
+    }
+    for (const char* name : {"depthPrepass", "marking", "reconstruction"}) {
+        EXPECT_TRUE(has(raster, name)) << name;
+        EXPECT_FALSE(has(vis, name)) << name;
+    }
+}
+
+// The debug views are drawn by the resolve in visibility mode: each view matches the raster
+// path's (the marking view and the MIP heat map closely; chunk lines from analytic fwidth).
+TEST(Visibility, DebugViewsMatchRasterMode) {
+    for (Visualize v : {Visualize::Marking, Visualize::Mips, Visualize::Chunks, Visualize::Sheet}) {
+        RenderOptions o = decoupled("builtin:default", MarkingMode::Visibility, 160, 90);
+        o.visualize = v;
+        RenderRun vis = renderChecked(o);
+        o.marking = MarkingMode::Raster;
+        RenderRun raster = renderChecked(o);
+        double p = psnr(vis.frames[0].rgba, raster.frames[0].rgba);
+        std::printf("[ figures ] --visualize %u: PSNR(visibility, raster) = %.2f dB\n", uint32_t(v),
+                    p);
+        EXPECT_GE(p, 30.0) << "view " << uint32_t(v);
+    }
+}
