@@ -23,6 +23,7 @@ struct RenderOptions {
     Visualize visualize = Visualize::None;
     std::string out;   // FILE.png or DIR/ ; empty = no image
     std::string stats; // FILE.json ; empty = none
+    std::string trace; // FILE.json: Chrome trace events of the run; empty = none
     std::optional<TimingMode> timing;
     float exposure = 1.0f;
     float shadelsPerMetre = 0.0f; // 0 = auto: view-driven per mesh (render/view_density.h)

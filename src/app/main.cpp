@@ -170,6 +170,9 @@ int main(int argc, char** argv) {
         ->capture_default_str();
     render->add_flag("--animate-lights", ro.animateLights,
                      "move point and spot lights on small circles over the frames");
+    render->add_option("--trace", ro.trace,
+                       "FILE.json: Chrome trace events (CPU frontend and GPU passes per frame; "
+                       "chrome://tracing, Perfetto)");
     render->add_flag("--passes", ro.printPasses, "print the per-pass timing table");
 
     // bench

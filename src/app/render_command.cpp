@@ -8,6 +8,7 @@
 
 #include "app/cli_validate.h"
 #include "app/commands.h"
+#include "app/trace_export.h"
 #include "app/output_files.h"
 #include "bake/bake.h"
 #include "bake/bake_cache.h"
@@ -101,6 +102,7 @@ RenderRun runRender(Gpu& gpu, const RenderOptions& o) {
     // Fail before loading and rendering, not after.
     if (!o.out.empty()) requireCreatableOutput("--out", outDir ? o.out + "frame_0000.png" : o.out);
     if (!o.stats.empty()) requireCreatableOutput("--stats", o.stats);
+    if (!o.trace.empty()) requireCreatableOutput("--trace", o.trace);
     Scene scene = loadScene(o.scene, {o.allowExternalFiles});
     Camera camera = findCamera(scene, o.camera);
     // The camera path is fixed by the loaded scene's bounds (chunking does not move it).
@@ -231,6 +233,9 @@ RenderRun runRender(Gpu& gpu, const RenderOptions& o) {
     s["timing"] = settings.timing == TimingMode::Timestamps ? "timestamps" : "submit-per-pass";
     std::vector<double> frameMs;
     for (auto& f : run.frames) frameMs.push_back(f.frameMs);
+    std::vector<double> cpuMs;
+    for (auto& f : run.frames) cpuMs.push_back(f.cpuFrameMs);
+    s["cpu_frame_ms"] = median(cpuMs); // CPU time producing a frame, GPU waits excluded
     s["frame_ms"] = {{"median", median(frameMs)},
                      {"min", *std::min_element(frameMs.begin(), frameMs.end())},
                      {"max", *std::max_element(frameMs.begin(), frameMs.end())}};
@@ -286,6 +291,8 @@ RenderRun runRender(Gpu& gpu, const RenderOptions& o) {
     destroyScene(gpu, gpuScene);
 
     if (!o.stats.empty()) writeOutputFile(o.stats, s.dump(2) + "\n");
+    if (!o.trace.empty())
+        writeOutputFile(o.trace, chromeTrace(run.frames, o.scene + " " + modeName(o.mode)).dump() + "\n");
     if (o.printPasses) printPassTable(s);
     return run;
 }

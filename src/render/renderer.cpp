@@ -188,6 +188,12 @@ static void updateLights(Renderer& r, const GpuScene& scene, gpu::FrameConstants
 // reconstruction (render/shadel/decoupled.h).
 FrameResult renderFrame(Renderer& r, const GpuScene& scene, const CameraView& camera) {
     Gpu& gpu = *r.gpu;
+    using Clock = std::chrono::steady_clock;
+    auto msSince = [](Clock::time_point t) {
+        return std::chrono::duration<double, std::milli>(Clock::now() - t).count();
+    };
+    Clock::time_point cpuStart = Clock::now();
+    double startMs = std::chrono::duration<double, std::milli>(cpuStart - r.createdAt).count();
     r.sceneIndices = scene.indices;
     r.skyColor = scene.skyColor;
     gpu::FrameConstants constants = makeFrameConstants(r, scene, camera);
@@ -195,6 +201,7 @@ FrameResult renderFrame(Renderer& r, const GpuScene& scene, const CameraView& ca
     if (r.decoupled) prepareDecoupledFrame(r, scene, camera, constants);
     std::memcpy(mapped(gpu, r.frameConstants), &constants, sizeof(constants));
     uint64_t frame = address(gpu, r.frameConstants);
+    double prepareMs = msSince(cpuStart);
 
     FrameRecorder& rec = r.recorder;
     beginFrame(rec);
@@ -219,6 +226,11 @@ FrameResult renderFrame(Renderer& r, const GpuScene& scene, const CameraView& ca
     FrameResult result;
     result.passes = rec.passes;
     result.frameMs = rec.frameMs;
+    result.startMs = startMs;
+    result.cpuPrepareMs = prepareMs;
+    // CPU cost: the whole call minus the time spent waiting for the GPU (submit-per-pass waits
+    // inside the passes, so this is an upper bound there).
+    result.cpuFrameMs = prepareMs + std::max(0.0, msSince(cpuStart) - prepareMs - rec.gpuWaitMs);
     result.shaderAsserts = collectShaderMessages(gpu, r.messages);
     if (r.decoupled) finishDecoupledFrame(r);
     r.framesRendered++;

@@ -58,6 +58,9 @@ struct FrameResult {
     uint64_t pixelsCovered = 0;
     std::vector<PassTiming> passes;
     double frameMs = 0.0;
+    double cpuFrameMs = 0.0;   // CPU time to produce the frame (prepare + record), no GPU wait
+    double cpuPrepareMs = 0.0; // of which the CPU frontend: constants, decoupled coarse allocation
+    double startMs = 0.0;      // since the renderer was created (trace export)
     uint32_t shaderAsserts = 0;
 };
 
@@ -97,6 +100,7 @@ struct Renderer {
     std::vector<glm::vec4> changedLightVolumes;
     uint64_t framesRendered = 0;
     VisibilityStatePtr visibility; // decoupled with --marking visibility
+    std::chrono::steady_clock::time_point createdAt = std::chrono::steady_clock::now();
 };
 
 void initRenderer(Renderer& renderer, Gpu& gpu, const RenderSettings& settings,

@@ -59,8 +59,12 @@ static void submitAndWait(FrameRecorder& r) {
     si.pCommandBufferInfos = &cbi;
     VK_CHECK(vkResetFences(r.gpu->device.device, 1, &r.fence));
     VK_CHECK(vkQueueSubmit2(r.gpu->device.queue, 1, &si, r.fence));
+    auto waitStart = std::chrono::steady_clock::now();
     VkResult res =
         vkWaitForFences(r.gpu->device.device, 1, &r.fence, VK_TRUE, 120ull * 1000000000ull);
+    r.gpuWaitMs +=
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - waitStart)
+            .count();
     if (res == VK_TIMEOUT)
         throw DeviceError("GPU frame did not finish within 120 s (device hang?)");
     VK_CHECK(res);
@@ -70,6 +74,7 @@ void beginFrame(FrameRecorder& r) {
     Gpu& gpu = *r.gpu;
     prepareBindlessFrame(gpu, gpu.frameIndex);
     r.passes.clear();
+    r.gpuWaitMs = 0.0;
     r.frameStart = std::chrono::steady_clock::now();
     vkResetQueryPool(gpu.device.device, r.queries, 0, r.maxPasses * 2);
     if (r.mode == TimingMode::Timestamps) beginCommands(r);
@@ -79,9 +84,11 @@ void pass(FrameRecorder& r, const char* name, const std::function<void(VkCommand
     Gpu& gpu = *r.gpu;
     uint32_t index = uint32_t(r.passes.size());
     SHADEL_ASSERT(index < r.maxPasses);
-    r.passes.push_back({name, 0.0});
+    r.passes.push_back({name, 0.0, 0.0});
     if (r.mode == TimingMode::SubmitPerPass) {
         auto start = std::chrono::steady_clock::now();
+        r.passes.back().startMs =
+            std::chrono::duration<double, std::milli>(start - r.frameStart).count();
         beginCommands(r);
         beginLabel(gpu, r.cmd, name);
         record(r.cmd);
@@ -109,9 +116,11 @@ void endFrame(FrameRecorder& r) {
             VK_CHECK(vkGetQueryPoolResults(
                 gpu.device.device, r.queries, 0, n * 2, ticks.size() * sizeof(uint64_t),
                 ticks.data(), sizeof(uint64_t), VK_QUERY_RESULT_64_BIT | VK_QUERY_RESULT_WAIT_BIT));
-            for (uint32_t i = 0; i < n; ++i)
-                r.passes[i].gpuMs = double(ticks[i * 2 + 1] - ticks[i * 2]) *
-                                    double(gpu.device.timestampPeriodNs) * 1e-6;
+            double msPerTick = double(gpu.device.timestampPeriodNs) * 1e-6;
+            for (uint32_t i = 0; i < n; ++i) {
+                r.passes[i].gpuMs = double(ticks[i * 2 + 1] - ticks[i * 2]) * msPerTick;
+                r.passes[i].startMs = double(ticks[i * 2] - ticks[0]) * msPerTick;
+            }
         }
     }
     r.frameMs =

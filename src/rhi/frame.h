@@ -21,6 +21,7 @@ enum class TimingMode { Timestamps, SubmitPerPass };
 struct PassTiming {
     std::string name;
     double gpuMs = 0.0;
+    double startMs = 0.0; // GPU start relative to the frame's first pass (trace export)
 };
 
 struct FrameRecorder {
@@ -33,6 +34,7 @@ struct FrameRecorder {
     uint32_t maxPasses = 64;
     std::vector<PassTiming> passes; // filled by endFrame()
     double frameMs = 0.0;           // wall clock from beginFrame to the GPU finishing
+    double gpuWaitMs = 0.0;         // of which the CPU waited on fences
     std::chrono::steady_clock::time_point frameStart;
 };
 
