@@ -6,6 +6,8 @@
 #include <numeric>
 #include <unordered_map>
 
+#include "bake/lscm.h"
+#include "bake/stretch.h"
 #include "core/error.h"
 #include "core/log.h"
 
@@ -20,6 +22,15 @@ constexpr size_t kMinTrianglesToSplitForFill = 8;
 constexpr double kMinSplitGain = 0.8;
 // Charts of at most this many triangles try to merge into a neighbour after growth.
 constexpr size_t kSmallChartTriangles = 16;
+// Charts grow over a wider normal cone than planar projection could take: a conformal map unrolls
+// curved patches that a projection would squash. The stretch check decides what is kept, so the
+// cone only has to keep charts far from closing on themselves.
+constexpr double kConformalExtraConeDegrees = 25;
+constexpr double kMaxGrowthConeDegrees = 75;
+// Conformal charts are accepted up to this stretch (stretch.h), below the planar bound
+// 1/cos(cone + 10) = 1.56: a conformal map's scale varies over the whole chart, not only on a
+// tilted rim, and the density's coefficient of variation over the mesh must stay <= 0.2.
+constexpr double kMaxConformalStretch = 1.35;
 
 struct TriangleInfo {
     glm::dvec3 normal{0.0};
@@ -271,10 +282,15 @@ glm::dvec2 alignToMinAreaRect(std::vector<glm::dvec2>& coords) {
 
 class Charter {
 public:
-    Charter(const Mesh& mesh, const ChartingSettings& settings)
-        : mesh_(mesh), cosCone_(std::cos(glm::radians(double(settings.coneDegrees)))),
-          cosKeep_(std::cos(glm::radians(std::min(double(settings.coneDegrees) + 10.0, 80.0)))),
-          mergeLimit_(glm::radians(std::min(double(settings.coneDegrees) + 5.0, 75.0))) {}
+    explicit Charter(const Mesh& mesh, const ChartingSettings& settings) : mesh_(mesh) {
+        double cone = double(settings.coneDegrees);
+        double growth = std::min(cone + kConformalExtraConeDegrees, kMaxGrowthConeDegrees);
+        cosCone_ = std::cos(glm::radians(growth));
+        cosKeep_ = std::cos(glm::radians(growth + 10.0));
+        mergeLimit_ = glm::radians(growth + 5.0);
+        cosPlanar_ = std::cos(glm::radians(std::min(cone + 10.0, 80.0)));
+        maxConformalStretch_ = std::min(kMaxConformalStretch, 1.0 / cosPlanar_);
+    }
 
     ChartedMesh run();
 
@@ -289,20 +305,31 @@ private:
                           std::vector<uint32_t>& chartOf);
     std::vector<std::vector<uint32_t>> connectedPieces(const std::vector<uint32_t>& tris);
     void flattenAndEmit(std::vector<uint32_t> tris);
+    bool flattenConformal(const std::vector<uint32_t>& tris, std::vector<glm::dvec2>& corners,
+                          ChartDistortion& distortion);
+    bool flattenPlanar(const std::vector<uint32_t>& tris, std::vector<glm::dvec2>& corners,
+                       ChartDistortion& distortion);
+    std::vector<glm::dvec3> surfaceCorners(const std::vector<uint32_t>& tris) const;
+    double subsetRectArea(const std::vector<uint32_t>& subset,
+                          const std::vector<glm::dvec2>& corners);
     void splitInHalves(const std::vector<uint32_t>& tris, std::vector<uint32_t>& lower,
                        std::vector<uint32_t>& upper) const;
-    double projectedRectArea(const std::vector<uint32_t>& tris) const;
-    void emitChart(const std::vector<uint32_t>& tris, const std::vector<glm::dvec2>& corners);
+    void emitChart(const std::vector<uint32_t>& tris, const std::vector<glm::dvec2>& corners,
+                   ChartKind kind, const ChartDistortion& distortion);
     void emitDegenerateCells();
 
     const Mesh& mesh_;
-    double cosCone_, cosKeep_, mergeLimit_; // mergeLimit_ in radians
+    double cosCone_, cosKeep_, mergeLimit_; // growth; mergeLimit_ in radians
+    double cosPlanar_;                      // planar charts: every normal within this of the axis
+    double maxConformalStretch_;
     std::vector<uint32_t> weld_;
     std::vector<glm::dvec3> weldPosition_;
     std::vector<TriangleInfo> tris_;
     std::vector<uint32_t> neighbour_;
     std::vector<uint32_t> stamp_; // per triangle, scratch membership marks
     uint32_t stampValue_ = 0;
+    std::vector<uint32_t> localOf_;     // per welded vertex, scratch: its index in a patch
+    std::vector<uint32_t> slotOf_;      // per triangle, scratch: its index in the piece flattened
     std::vector<uint32_t> vertexStamp_; // per source vertex: chart index + 1 that baked it
     std::vector<uint32_t> vertexBaked_; // per source vertex: its baked vertex in that chart
     ChartedMesh out_;
@@ -479,61 +506,127 @@ std::vector<std::vector<uint32_t>> Charter::connectedPieces(const std::vector<ui
     return pieces;
 }
 
-// Projects a connected piece on the plane of its mean normal. A planar projection of a piece
-// whose normals all lie in a cone cannot fold locally, but can still overlap globally (a ramp
-// that spirals); such pieces are cut in two across their longest extent until they do not.
+std::vector<glm::dvec3> Charter::surfaceCorners(const std::vector<uint32_t>& tris) const {
+    std::vector<glm::dvec3> surface(tris.size() * 3);
+    for (size_t i = 0; i < tris.size(); ++i)
+        for (uint32_t c = 0; c < 3; ++c) surface[3 * i + c] = position(tris[i], c);
+    return surface;
+}
+
+// LSCM of a connected piece, on welded vertices so seam duplicates get one coordinate. Accepted
+// when no triangle folds, the stretch is within bounds and the piece does not overlap itself;
+// the corners are then scaled by 1 / maxSigma so the map never magnifies.
+bool Charter::flattenConformal(const std::vector<uint32_t>& tris, std::vector<glm::dvec2>& corners,
+                               ChartDistortion& distortion) {
+    std::vector<glm::dvec3> positions;
+    std::vector<uint32_t> triangles(tris.size() * 3);
+    std::vector<uint32_t> welded;
+    for (size_t i = 0; i < tris.size(); ++i) {
+        for (uint32_t c = 0; c < 3; ++c) {
+            uint32_t w = weld_[mesh_.indices[3 * tris[i] + c]];
+            if (localOf_[w] == kNone) {
+                localOf_[w] = uint32_t(positions.size());
+                positions.push_back(weldPosition_[w]);
+                welded.push_back(w);
+            }
+            triangles[3 * i + c] = localOf_[w];
+        }
+    }
+    for (uint32_t w : welded) localOf_[w] = kNone;
+    std::vector<glm::dvec2> uv;
+    if (!lscmFlatten(positions, triangles, uv)) return false;
+    corners.resize(triangles.size());
+    for (size_t k = 0; k < triangles.size(); ++k) corners[k] = uv[triangles[k]];
+    std::vector<glm::dvec3> surface = surfaceCorners(tris);
+    distortion = measureDistortion(surface, corners);
+    if (distortion.flippedTriangles * 2 > tris.size()) {
+        // The solve is free to return the mirror image; mirror it back.
+        for (glm::dvec2& c : corners) c.x = -c.x;
+        distortion = measureDistortion(surface, corners);
+    }
+    if (distortion.flippedTriangles > 0 || !(distortion.maxSigma > 0) ||
+        distortion.maxStretch() > maxConformalStretch_)
+        return false;
+    double scale = 1.0 / distortion.maxSigma;
+    for (glm::dvec2& c : corners) c *= scale;
+    return !pieceSelfOverlaps(corners);
+}
+
+// Projection on the plane of the piece's mean normal: cannot fold for triangles facing the axis
+// (all within cosPlanar_), but can still overlap globally (a ramp that spirals).
+bool Charter::flattenPlanar(const std::vector<uint32_t>& tris, std::vector<glm::dvec2>& corners,
+                            ChartDistortion& distortion) {
+    glm::dvec3 sum(0.0);
+    for (uint32_t t : tris) sum += tris_[t].normal * tris_[t].area;
+    glm::dvec3 axis = glm::length(sum) > 0 ? glm::normalize(sum) : tris_[tris[0]].normal;
+    glm::dvec3 u, v;
+    planeBasis(axis, u, v);
+    corners.resize(tris.size() * 3);
+    bool facing = true;
+    for (size_t i = 0; i < tris.size(); ++i) {
+        facing = facing && glm::dot(tris_[tris[i]].normal, axis) >= cosPlanar_;
+        for (uint32_t c = 0; c < 3; ++c) {
+            glm::dvec3 p = position(tris[i], c);
+            corners[3 * i + c] = glm::dvec2(glm::dot(p, u), glm::dot(p, v));
+        }
+    }
+    distortion = measureDistortion(surfaceCorners(tris), corners);
+    return tris.size() == 1 || (facing && !pieceSelfOverlaps(corners));
+}
+
+// Minimum-area rectangle of a subset of the piece whose corners were just flattened.
+double Charter::subsetRectArea(const std::vector<uint32_t>& subset,
+                               const std::vector<glm::dvec2>& corners) {
+    std::vector<glm::dvec2> points;
+    points.reserve(subset.size() * 3);
+    for (uint32_t t : subset)
+        for (uint32_t c = 0; c < 3; ++c) points.push_back(corners[3 * slotOf_[t] + c]);
+    return minAreaRect(points).area;
+}
+
+// Flattens a connected piece conformally, else by projection, else cuts it in two across its
+// longest extent and retries the halves. A single triangle always flattens.
 void Charter::flattenAndEmit(std::vector<uint32_t> initial) {
     std::vector<std::vector<uint32_t>> work{std::move(initial)};
     std::vector<glm::dvec2> corners;
     while (!work.empty()) {
         std::vector<uint32_t> tris = std::move(work.back());
         work.pop_back();
-        glm::dvec3 sum(0.0);
-        for (uint32_t t : tris) sum += tris_[t].normal * tris_[t].area;
-        glm::dvec3 axis = glm::length(sum) > 0 ? glm::normalize(sum) : tris_[tris[0]].normal;
-        glm::dvec3 u, v;
-        planeBasis(axis, u, v);
-        corners.resize(tris.size() * 3);
-        bool facing = true;
-        for (size_t i = 0; i < tris.size(); ++i) {
-            // Also re-checks the stretch bound: a part cut from a chart has its own mean normal.
-            facing = facing && glm::dot(tris_[tris[i]].normal, axis) >= cosKeep_;
-            for (uint32_t c = 0; c < 3; ++c) {
-                glm::dvec3 p = position(tris[i], c);
-                corners[3 * i + c] = glm::dvec2(glm::dot(p, u), glm::dot(p, v));
-            }
-        }
-        bool overlaps = tris.size() > 1 && (!facing || pieceSelfOverlaps(corners));
+        ChartDistortion distortion;
+        ChartKind kind = ChartKind::Conformal;
+        bool flat = tris.size() > 1 && flattenConformal(tris, corners, distortion);
+        if (!flat) kind = ChartKind::Planar, flat = flattenPlanar(tris, corners, distortion);
         std::vector<uint32_t> lower, upper;
-        if (overlaps || tris.size() >= kMinTrianglesToSplitForFill)
-            splitInHalves(tris, lower, upper);
-        if (overlaps) {
+        if (!flat || tris.size() >= kMinTrianglesToSplitForFill) splitInHalves(tris, lower, upper);
+        if (!flat) {
             for (auto* part : {&lower, &upper})
                 for (auto& piece : connectedPieces(*part)) work.push_back(std::move(piece));
             continue;
         }
         if (!lower.empty() && !upper.empty()) {
-            // Charts are packed by their bounding rectangles: a ring or a long curved strip wastes
-            // most of its rectangle. Cut it in two when the halves' rectangles are clearly
-            // smaller.
+            // Packing follows each chart's outline one column at a time, so a ring or a long
+            // curved strip still wastes its inside. Cut it in two when the halves' rectangles are
+            // clearly smaller.
             double area = 0;
             for (size_t i = 0; i < tris.size(); ++i) {
                 glm::dvec2 e1 = corners[3 * i + 1] - corners[3 * i],
                            e2 = corners[3 * i + 2] - corners[3 * i];
                 area += 0.5 * std::abs(e1.x * e2.y - e1.y * e2.x);
+                slotOf_[tris[i]] = uint32_t(i);
             }
             double rect = minAreaRect(corners).area;
             // Both halves must stay connected: pieces of one chart may only meet along shared
             // edges, else the gap between them would be narrower than a gutter.
             if (area < kMinRectFill * rect &&
-                projectedRectArea(lower) + projectedRectArea(upper) < kMinSplitGain * rect &&
+                subsetRectArea(lower, corners) + subsetRectArea(upper, corners) <
+                    kMinSplitGain * rect &&
                 connectedPieces(lower).size() == 1 && connectedPieces(upper).size() == 1) {
                 work.push_back(std::move(lower));
                 work.push_back(std::move(upper));
                 continue;
             }
         }
-        emitChart(tris, corners);
+        emitChart(tris, corners, kind, distortion);
     }
 }
 
@@ -557,24 +650,13 @@ void Charter::splitInHalves(const std::vector<uint32_t>& tris, std::vector<uint3
         (i < keyed.size() / 2 ? lower : upper).push_back(keyed[i].second);
 }
 
-// Bounding-rectangle area of a set of triangles projected on the plane of their mean normal.
-double Charter::projectedRectArea(const std::vector<uint32_t>& tris) const {
-    glm::dvec3 sum(0.0);
-    for (uint32_t t : tris) sum += tris_[t].normal * tris_[t].area;
-    if (!(glm::length(sum) > 0)) return 0;
-    glm::dvec3 u, v;
-    planeBasis(glm::normalize(sum), u, v);
-    std::vector<glm::dvec2> points;
-    points.reserve(tris.size() * 3);
-    for (uint32_t t : tris)
-        for (uint32_t c = 0; c < 3; ++c)
-            points.emplace_back(glm::dot(position(t, c), u), glm::dot(position(t, c), v));
-    return minAreaRect(points).area;
-}
-
-void Charter::emitChart(const std::vector<uint32_t>& tris, const std::vector<glm::dvec2>& corners) {
+void Charter::emitChart(const std::vector<uint32_t>& tris, const std::vector<glm::dvec2>& corners,
+                        ChartKind kind, const ChartDistortion& distortion) {
     uint32_t chartIndex = uint32_t(out_.charts.size());
     Chart chart;
+    chart.kind = kind;
+    chart.meanStretch = distortion.meanStretch();
+    chart.maxStretch = distortion.maxStretch();
     chart.firstVertex = uint32_t(out_.vertexRemap.size());
     for (size_t i = 0; i < tris.size(); ++i) {
         uint32_t t = tris[i];
@@ -639,6 +721,8 @@ ChartedMesh Charter::run() {
     classifyTriangles();
     neighbour_ = buildNeighbours(mesh_.indices, weld_, tris_);
     stamp_.assign(tris_.size(), 0);
+    slotOf_.assign(tris_.size(), 0);
+    localOf_.assign(weldPosition_.size(), kNone);
     vertexStamp_.assign(mesh_.vertices.size(), 0);
     vertexBaked_.assign(mesh_.vertices.size(), 0);
     out_.indices.assign(mesh_.indices.size(), 0);
