@@ -1,6 +1,7 @@
 #include "bake/bake.h"
 
 #include <algorithm>
+#include <array>
 #include <atomic>
 #include <chrono>
 #include <cmath>
@@ -11,6 +12,7 @@
 #include <thread>
 
 #include "bake/bake_cache.h"
+#include "bake/chart_packing.h"
 #include "bake/charting.h"
 #include "bake/id_map.h"
 #include "bake/packing.h"
@@ -42,20 +44,64 @@ double chartScale(const Chart& chart, double density) {
 }
 
 struct Layout {
-    PackResult pack;
+    OutlinePack pack;
     std::vector<glm::uvec2> content;
 };
 
-Layout layoutCharts(const ChartedMesh& charted, double density, uint32_t gutter) {
+// Triangles of each chart (a chart's baked vertices are contiguous, so its first corner says).
+std::vector<std::vector<uint32_t>> chartTriangles(const ChartedMesh& charted) {
+    std::vector<uint32_t> chartOfVertex(charted.local.size(), 0);
+    for (uint32_t c = 0; c < charted.charts.size(); ++c)
+        for (uint32_t v = 0; v < charted.charts[c].vertexCount; ++v)
+            chartOfVertex[charted.charts[c].firstVertex + v] = c;
+    std::vector<std::vector<uint32_t>> triangles(charted.charts.size());
+    for (uint32_t t = 0; t < charted.indices.size() / 3; ++t)
+        triangles[chartOfVertex[charted.indices[3 * t]]].push_back(t);
+    return triangles;
+}
+
+// A chart vertex in shadels inside its content box, before turning: spare space split evenly.
+glm::dvec2 contentPosition(const ChartedMesh& charted, const Chart& chart, uint32_t vertex,
+                           glm::uvec2 content, double density) {
+    double scale = chartScale(chart, density);
+    glm::dvec2 centring = (glm::dvec2(content) - chart.extent * scale) * 0.5;
+    return charted.local[vertex] * scale + centring;
+}
+
+// Packs the charts by their outlines (chart_packing.h); padded bounding rectangles
+// (packing.h) are kept instead when they happen to pack smaller, so shapes never lose.
+Layout layoutCharts(const ChartedMesh& charted, const std::vector<std::vector<uint32_t>>& triangles,
+                    double density, uint32_t gutter) {
     Layout layout;
     std::vector<PackRect> rects;
-    rects.reserve(charted.charts.size());
-    for (const Chart& chart : charted.charts) {
-        glm::uvec2 c = contentSize(chart, density);
-        layout.content.push_back(c);
-        rects.push_back({c.x + 2 * gutter, c.y + 2 * gutter});
+    std::vector<std::array<ChartOutline, 4>> outlines(charted.charts.size());
+    std::vector<glm::dvec2> corners;
+    for (size_t c = 0; c < charted.charts.size(); ++c) {
+        const Chart& chart = charted.charts[c];
+        glm::uvec2 content = contentSize(chart, density);
+        layout.content.push_back(content);
+        rects.push_back({content.x + 2 * gutter, content.y + 2 * gutter});
+        for (uint32_t k = 0; k < 4; ++k) {
+            corners.clear();
+            for (uint32_t t : triangles[c])
+                for (uint32_t i = 0; i < 3; ++i)
+                    corners.push_back(
+                        turnQuarter(contentPosition(charted, chart, charted.indices[3 * t + i],
+                                                    content, density),
+                                    glm::dvec2(content), k));
+            glm::uvec2 turned = k % 2 ? glm::uvec2(content.y, content.x) : content;
+            outlines[c][k] = chartOutline(corners, turned, gutter);
+        }
     }
-    layout.pack = packNearSquare(rects, kChunk);
+    layout.pack = packOutlines(outlines, kChunk);
+    PackResult boxes = packNearSquare(rects, kChunk);
+    if (boxes.width != 0 &&
+        uint64_t(boxes.width) * boxes.height < uint64_t(layout.pack.width) * layout.pack.height) {
+        layout.pack.width = boxes.width, layout.pack.height = boxes.height;
+        for (size_t c = 0; c < rects.size(); ++c)
+            layout.pack.placements[c] = {boxes.placements[c].x, boxes.placements[c].y,
+                                         boxes.placements[c].turned ? 1u : 0u};
+    }
     return layout;
 }
 
@@ -65,14 +111,12 @@ std::vector<glm::vec2> placeCharts(const ChartedMesh& charted, const Layout& lay
     std::vector<glm::vec2> uv(charted.local.size());
     for (size_t c = 0; c < charted.charts.size(); ++c) {
         const Chart& chart = charted.charts[c];
-        const PackPlacement& place = layout.pack.placements[c];
-        double scale = chartScale(chart, density);
-        glm::dvec2 content(layout.content[c]);
-        glm::dvec2 centring = (content - chart.extent * scale) * 0.5; // spare space split evenly
+        const OutlinePlacement& place = layout.pack.placements[c];
         glm::dvec2 origin(place.x + gutter, place.y + gutter);
         for (uint32_t v = chart.firstVertex; v < chart.firstVertex + chart.vertexCount; ++v) {
-            glm::dvec2 q = charted.local[v] * scale + centring;
-            if (place.turned) q = glm::dvec2(q.y, content.x - q.x); // quarter turn, no mirror
+            glm::dvec2 q =
+                turnQuarter(contentPosition(charted, chart, v, layout.content[c], density),
+                            glm::dvec2(layout.content[c]), place.orientation);
             glm::dvec2 texel = origin + q;
             uv[v] = glm::vec2(float(texel.x / width), float(texel.y / height));
             uv[v] = glm::clamp(uv[v], glm::vec2(0.0f), glm::vec2(1.0f));
@@ -107,6 +151,13 @@ BakedMesh bakeMesh(const Mesh& mesh, const BakeSettings& settings) {
     out.degenerateTriangles = charted.degenerateTriangles;
     out.surfaceArea = charted.surfaceArea;
     out.chartCount = uint32_t(charted.charts.size());
+    double stretchArea = 0, stretchSum = 0;
+    for (const Chart& chart : charted.charts) {
+        if (chart.kind == ChartKind::DegenerateCells) continue;
+        stretchArea += chart.surfaceArea, stretchSum += chart.surfaceArea * chart.meanStretch;
+        out.maxStretch = std::max(out.maxStretch, float(chart.maxStretch));
+    }
+    if (stretchArea > 0) out.meanStretch = float(stretchSum / stretchArea);
     out.vertexRemap = std::move(charted.vertexRemap);
     out.indices = charted.indices;
 
@@ -126,8 +177,9 @@ BakedMesh bakeMesh(const Mesh& mesh, const BakeSettings& settings) {
     double density = settings.shadelsPerMetre;
     int growthsToMinimum = 0;
     IdMapStats stats0;
+    std::vector<std::vector<uint32_t>> triangles = chartTriangles(charted);
     for (int attempt = 0;; ++attempt) {
-        Layout layout = layoutCharts(charted, density, gutter);
+        Layout layout = layoutCharts(charted, triangles, density, gutter);
         uint32_t packedSide = std::max(layout.pack.width, layout.pack.height);
         if (packedSide > maxResolution) {
             if (attempt > 40 || density < 1e-9)

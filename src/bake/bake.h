@@ -68,7 +68,10 @@ struct BakedMesh {
     uint32_t forcedTriangles = 0;     // triangles that got their MIP-0 shadel by force-assignment
     uint32_t unownedTriangles = 0;    // triangles with no MIP-0 shadel (0 unless maxResolution hit)
     double surfaceArea = 0;           // object-space m^2 of non-degenerate triangles
-    double bakeSeconds = 0;           // wall time of the bake (or of the cache load)
+    // Shadel spacing on the surface relative to the density, over chart triangles (1 = no
+    // distortion; stretch.h): area-weighted mean and worst chart.
+    float meanStretch = 1, maxStretch = 1;
+    double bakeSeconds = 0; // wall time of the bake (or of the cache load)
     bool fromCache = false;
 
     uint32_t mipCount() const { return uint32_t(idMaps.size()); }

@@ -1,0 +1,54 @@
+#pragma once
+// Shape-aware chart packing. A chart is described by its outline: per column, the rows its
+// triangles touch (conservatively) grown by the gutter on every side. Outlines go into one bin
+// along a horizon (per column, the lowest free row): each chart drops to where its bottom profile
+// first touches the horizon, so a round or L-shaped chart nests into the dents its neighbours
+// leave instead of reserving its whole bounding rectangle. One interval per column is kept, so
+// holes under an overhang stay empty (conservative: outlines never overlap).
+//
+// Gutter guarantee (bake.h): outlines are the content dilated by `gutter` in both axes, and
+// outlines never overlap nor leave the bin, so covered shadels of two charts are more than
+// 2 * gutter apart (Chebyshev distance) and every chart is >= gutter from the bin border: the
+// same separation padded rectangles gave.
+#include <array>
+#include <cstdint>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+namespace shadel {
+
+struct ChartOutline {
+    uint32_t width = 0, height = 0; // gutters included
+    // Per column: occupied rows [bottom, top); bottom >= top marks an empty column.
+    std::vector<uint32_t> bottom, top;
+};
+
+// Outline of a chart whose triangles (3 corners each, in shadels) lie in [0, content]: covers
+// every shadel a triangle overlaps, plus `gutter` shadels around. Column/row i of the outline is
+// content column/row i - gutter.
+ChartOutline chartOutline(const std::vector<glm::dvec2>& corners, glm::uvec2 content,
+                          uint32_t gutter);
+
+// Quarter turns: orientation k maps a point p of a content box w x h to
+//   0: p   1: (p.y, w - p.x)   2: (w - p.x, h - p.y)   3: (h - p.y, p.x)
+// (rotations only: triangles keep their winding).
+glm::dvec2 turnQuarter(glm::dvec2 p, glm::dvec2 content, uint32_t orientation);
+
+struct OutlinePlacement {
+    uint32_t x = 0, y = 0;    // bin position of the outline's corner (0, 0)
+    uint32_t orientation = 0; // which of the chart's outlines was placed
+};
+
+struct OutlinePack {
+    std::vector<OutlinePlacement> placements; // one per chart, same order
+    uint32_t width = 0, height = 0;           // each rounded up to `granularity`
+};
+
+// outlines[c][k]: chart c in orientation k (empty outlines, width 0, are not tried). Tries a few
+// bin widths around the square root of the outlines' area and keeps the smallest near-square
+// (<= 2:1 when possible) result. Deterministic.
+OutlinePack packOutlines(const std::vector<std::array<ChartOutline, 4>>& outlines,
+                         uint32_t granularity);
+
+} // namespace shadel
