@@ -12,6 +12,8 @@ namespace {
 // anything within this many shadels of a column or row border counts as touching it.
 constexpr double kTouchEpsilon = 1e-3;
 constexpr uint32_t kEmpty = std::numeric_limits<uint32_t>::max();
+// Column offsets tried per chart and orientation before refining around the best one.
+constexpr uint32_t kMaxStridedPositions = 256;
 
 uint32_t roundUp(uint32_t v, uint32_t granularity) {
     return (v + granularity - 1) / granularity * granularity;
@@ -45,25 +47,33 @@ OutlinePack packAtWidth(const std::vector<std::array<ChartOutline, 4>>& outlines
             uint32_t maxTop = 0;
             for (uint32_t i = 0; i < o.width; ++i)
                 if (o.bottom[i] < o.top[i]) maxTop = std::max(maxTop, o.top[i]);
-            for (uint32_t x = 0; x + o.width <= binWidth; ++x) {
+            // Every column offset on narrow bins; on wide ones a stride, then every offset
+            // around the best strided one, which keeps packing linear in the chart count.
+            uint32_t positions = binWidth - o.width + 1;
+            uint32_t stride = std::max(1u, positions / kMaxStridedPositions);
+            auto tryAt = [&](uint32_t x) {
                 uint64_t y = 0;
-                bool pruned = false;
                 for (uint32_t i = 0; i < o.width; ++i) {
                     if (o.bottom[i] >= o.top[i]) continue;
                     if (horizon[x + i] > o.bottom[i])
                         y = std::max<uint64_t>(y, horizon[x + i] - o.bottom[i]);
-                    if (y + maxTop > best.top) {
-                        pruned = true;
-                        break;
-                    }
+                    if (y + maxTop > best.top) return;
                 }
-                if (pruned) continue;
                 uint64_t waste = 0;
                 for (uint32_t i = 0; i < o.width; ++i)
                     if (o.bottom[i] < o.top[i]) waste += y + o.bottom[i] - horizon[x + i];
                 uint64_t chartTop = y + maxTop;
                 if (chartTop < best.top || (chartTop == best.top && waste < best.waste))
                     best = {chartTop, waste, x, uint32_t(y), k, true};
+            };
+            Candidate before = best;
+            for (uint32_t x = 0; x < positions; x += stride) tryAt(x);
+            if (stride > 1 && (best.x != before.x || best.orientation != before.orientation ||
+                               best.found != before.found)) {
+                uint32_t centre = best.x;
+                uint32_t from = centre >= stride ? centre - stride + 1 : 0;
+                uint32_t to = std::min(positions - 1, centre + stride - 1);
+                for (uint32_t x = from; x <= to; ++x) tryAt(x);
             }
         }
         if (!best.found) return {};
@@ -167,13 +177,15 @@ OutlinePack packOutlines(const std::vector<std::array<ChartOutline, 4>>& outline
     }
     std::vector<uint32_t> order(outlines.size());
     std::iota(order.begin(), order.end(), 0u);
-    // Big charts first; ties by index keep the result deterministic.
-    std::stable_sort(order.begin(), order.end(), [&](uint32_t a, uint32_t b) {
-        const ChartOutline &oa = outlines[a][0], &ob = outlines[b][0];
-        uint32_t ma = std::max(oa.width, oa.height), mb = std::max(ob.width, ob.height);
-        if (ma != mb) return ma > mb;
-        return std::min(oa.width, oa.height) > std::min(ob.width, ob.height);
-    });
+    // Big charts first (occupied area); ties by index keep the result deterministic.
+    std::vector<double> chartArea(outlines.size(), 0.0);
+    for (size_t c = 0; c < outlines.size(); ++c) {
+        const ChartOutline& o = outlines[c][0];
+        for (uint32_t i = 0; i < o.width; ++i)
+            if (o.bottom[i] < o.top[i]) chartArea[c] += double(o.top[i] - o.bottom[i]);
+    }
+    std::stable_sort(order.begin(), order.end(),
+                     [&](uint32_t a, uint32_t b) { return chartArea[a] > chartArea[b]; });
     double side = std::sqrt(area);
     OutlinePack best;
     double bestScore = 1e300;

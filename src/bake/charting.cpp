@@ -287,7 +287,9 @@ public:
         double growth = std::min(cone + kConformalExtraConeDegrees, kMaxGrowthConeDegrees);
         cosCone_ = std::cos(glm::radians(growth));
         cosKeep_ = std::cos(glm::radians(growth + 10.0));
-        mergeLimit_ = glm::radians(growth + 5.0);
+        // Merging only absorbs slivers left between charts; across creases (box edges) it would
+        // make folded nets that pack worse than their faces, so it keeps the planar bound.
+        mergeLimit_ = glm::radians(std::min(cone + 5.0, 75.0));
         cosPlanar_ = std::cos(glm::radians(std::min(cone + 10.0, 80.0)));
         maxConformalStretch_ = std::min(kMaxConformalStretch, 1.0 / cosPlanar_);
     }
