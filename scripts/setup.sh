@@ -6,7 +6,7 @@ set -euo pipefail
 export DEBIAN_FRONTEND=noninteractive
 
 stamp=/var/lib/shadel-setup.stamp
-want_version=3
+want_version=4
 if [ -f "$stamp" ] && [ "$(cat "$stamp")" = "$want_version" ] && [ "${SHADEL_FORCE_SETUP:-0}" != 1 ]; then
   echo "setup: already done (remove $stamp to redo)"
   exit 0
@@ -43,6 +43,6 @@ $SUDO apt-get install -y -qq \
   build-essential cmake ninja-build pkg-config git clang libclang-rt-14-dev \
   glslc libshaderc-dev spirv-tools vulkan-validationlayers \
   libglm-dev libtinygltf-dev libmeshoptimizer-dev libstb-dev libcli11-dev nlohmann-json3-dev \
-  libgtest-dev libgmock-dev libbenchmark-dev assimp-testmodels python3
+  libgtest-dev libgmock-dev libbenchmark-dev libeigen3-dev assimp-testmodels python3
 echo "$want_version" | $SUDO tee "$stamp" >/dev/null
 echo "setup: done"

@@ -328,6 +328,7 @@ std::vector<BakedMesh> bakeScene(const Scene& scene, const BakeSettings& setting
 std::string bakeReport(const std::vector<BakedMesh>& meshes, double wallSeconds) {
     uint64_t triangles = 0, charts = 0, shadels = 0, covered = 0, degenerate = 0, forced = 0,
              unowned = 0;
+    double stretchArea = 0, stretchSum = 0, maxStretch = 1;
     size_t fromCache = 0;
     double bakeSeconds = 0, area = 0;
     uint32_t maxSide = 0, mips = 0;
@@ -341,6 +342,8 @@ std::string bakeReport(const std::vector<BakedMesh>& meshes, double wallSeconds)
         fromCache += m.fromCache;
         bakeSeconds += m.bakeSeconds;
         area += m.surfaceArea;
+        stretchArea += m.surfaceArea, stretchSum += m.surfaceArea * m.meanStretch;
+        maxStretch = std::max(maxStretch, double(m.maxStretch));
         maxSide = std::max({maxSide, m.width, m.height});
         mips = std::max(mips, m.mipCount());
     }
@@ -354,6 +357,8 @@ std::string bakeReport(const std::vector<BakedMesh>& meshes, double wallSeconds)
                 (unsigned long long)shadels, maxSide, mips);
     r += format("utilisation: %.1f%% (covered / allocated MIP-0 shadels)\n",
                 shadels ? 100.0 * double(covered) / double(shadels) : 0.0);
+    r += format("stretch: mean %.3f, max %.3f (shadel spacing on the surface / requested)\n",
+                stretchArea > 0 ? stretchSum / stretchArea : 1.0, maxStretch);
     r += format("surface: %.3f m^2\n", area);
     r += format("bake time: %.2f s wall, %.2f s summed over meshes\n", wallSeconds, bakeSeconds);
     return r;

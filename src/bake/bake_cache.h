@@ -14,7 +14,7 @@
 namespace shadel {
 
 // Bump whenever the bake output for the same input can change (algorithm or layout).
-constexpr uint32_t kBakeFormatVersion = 1;
+constexpr uint32_t kBakeFormatVersion = 2; // 2: conformal charts, outline packing, stretch
 
 struct BakeKey {
     uint64_t lo = 0, hi = 0;
