@@ -1,10 +1,9 @@
 #pragma once
-// Shape-aware chart packing. A chart is described by its outline: per column, the rows its
-// triangles touch (conservatively) grown by the gutter on every side. Outlines go into one bin
-// along a horizon (per column, the lowest free row): each chart drops to where its bottom profile
-// first touches the horizon, so a round or L-shaped chart nests into the dents its neighbours
-// leave instead of reserving its whole bounding rectangle. One interval per column is kept, so
-// holes under an overhang stay empty (conservative: outlines never overlap).
+// Shape-aware chart packing. A chart is described by its outline: per column, the runs of rows
+// its triangles touch (conservatively), grown by the gutter on every side. Each chart drops to
+// the lowest place where none of its runs meets a run already placed, so round or L-shaped
+// charts nest into their neighbours' dents and small charts fall into the holes of rings,
+// instead of every chart reserving its whole bounding rectangle.
 //
 // Gutter guarantee (bake.h): outlines are the content dilated by `gutter` in both axes, and
 // outlines never overlap nor leave the bin, so covered shadels of two charts are more than
@@ -20,8 +19,12 @@ namespace shadel {
 
 struct ChartOutline {
     uint32_t width = 0, height = 0; // gutters included
-    // Per column: occupied rows [bottom, top); bottom >= top marks an empty column.
-    std::vector<uint32_t> bottom, top;
+    // Column i occupies rows [runs[k].x, runs[k].y) for k in [first[i], first[i + 1]): sorted,
+    // disjoint, not touching. A column with no run is empty.
+    std::vector<uint32_t> first;
+    std::vector<glm::uvec2> runs;
+
+    uint32_t occupiedShadels() const;
 };
 
 // Outline of a chart whose triangles (3 corners each, in shadels) lie in [0, content]: covers
@@ -45,8 +48,8 @@ struct OutlinePack {
     uint32_t width = 0, height = 0;           // each rounded up to `granularity`
 };
 
-// outlines[c][k]: chart c in orientation k (empty outlines, width 0, are not tried). Tries a few
-// bin widths around the square root of the outlines' area and keeps the smallest near-square
+// outlines[c][k]: chart c in orientation k (outlines of width 0 are not tried). Tries a few bin
+// widths around the square root of the outlines' area and keeps the smallest near-square
 // (<= 2:1 when possible) result. Deterministic.
 OutlinePack packOutlines(const std::vector<std::array<ChartOutline, 4>>& outlines,
                          uint32_t granularity);

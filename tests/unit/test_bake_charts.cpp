@@ -141,11 +141,12 @@ TEST(BakeOutlinePacking, OutlinesNeverOverlapAndBeatRectsOnLShapes) {
         const OutlinePlacement& at = pack.placements[c];
         const ChartOutline& o = outlines[c][at.orientation];
         for (uint32_t i = 0; i < o.width; ++i)
-            for (uint32_t y = o.bottom[i]; y < o.top[i]; ++y) {
-                ASSERT_LT(at.x + i, pack.width);
-                ASSERT_LT(at.y + y, pack.height);
-                ASSERT_EQ(grid[size_t(at.y + y) * pack.width + at.x + i]++, 0) << "chart " << c;
-            }
+            for (uint32_t k = o.first[i]; k < o.first[i + 1]; ++k)
+                for (uint32_t y = o.runs[k].x; y < o.runs[k].y; ++y) {
+                    ASSERT_LT(at.x + i, pack.width);
+                    ASSERT_LT(at.y + y, pack.height);
+                    ASSERT_EQ(grid[size_t(at.y + y) * pack.width + at.x + i]++, 0) << "chart " << c;
+                }
     }
     PackResult boxes = packNearSquare(rects, 8);
     double outlineArea = double(pack.width) * pack.height,
@@ -171,9 +172,42 @@ TEST(BakeOutlinePacking, OutlineCoversEveryTouchedShadelPlusGutter) {
             if (side(tri[0], tri[1]) < 0 || side(tri[1], tri[2]) < 0 || side(tri[2], tri[0]) < 0)
                 continue;
             for (int dx = -2; dx <= 2; ++dx) {
+                // Outline column x + 2 + dx must hold rows y .. y + 4 (content row y + 2, +-2).
                 uint32_t column = uint32_t(x + 2 + dx);
-                EXPECT_LE(o.bottom[column], uint32_t(y)) << x << "," << y;
-                EXPECT_GE(o.top[column], uint32_t(y + 5)) << x << "," << y;
+                bool covered = false;
+                for (uint32_t k = o.first[column]; k < o.first[column + 1]; ++k)
+                    covered =
+                        covered || (o.runs[k].x <= uint32_t(y) && o.runs[k].y >= uint32_t(y + 5));
+                EXPECT_TRUE(covered) << x << "," << y << " column " << column;
             }
         }
+}
+
+TEST(BakeOutlinePacking, SmallChartFallsIntoARingsHole) {
+    // A ring 40 shadels wide with a 24-shadel hole, and a 6 x 6 square: packed together they
+    // need no more room than the ring alone.
+    std::vector<glm::dvec2> ring;
+    const int segments = 32;
+    for (int s = 0; s < segments; ++s) {
+        double a0 = 2 * 3.14159265358979 * s / segments,
+               a1 = 2 * 3.14159265358979 * (s + 1) / segments;
+        glm::dvec2 c(20, 20);
+        glm::dvec2 i0 = c + 12.0 * glm::dvec2(std::cos(a0), std::sin(a0)),
+                   i1 = c + 12.0 * glm::dvec2(std::cos(a1), std::sin(a1));
+        glm::dvec2 o0 = c + 19.9 * glm::dvec2(std::cos(a0), std::sin(a0)),
+                   o1 = c + 19.9 * glm::dvec2(std::cos(a1), std::sin(a1));
+        ring.insert(ring.end(), {i0, o0, o1, i0, o1, i1});
+    }
+    std::vector<glm::dvec2> square = {{0, 0}, {6, 0}, {6, 6}, {0, 0}, {6, 6}, {0, 6}};
+    std::vector<std::array<ChartOutline, 4>> outlines(2);
+    for (uint32_t k = 0; k < 4; ++k) {
+        outlines[0][k] = chartOutline(ring, {40, 40}, 2);
+        outlines[1][k] = chartOutline(square, {6, 6}, 2);
+    }
+    OutlinePack alone = packOutlines({outlines[0]}, 8);
+    OutlinePack both = packOutlines(outlines, 8);
+    EXPECT_EQ(uint64_t(both.width) * both.height, uint64_t(alone.width) * alone.height);
+    const OutlinePlacement& p = both.placements[1];
+    EXPECT_GT(p.x, both.placements[0].x + 8);
+    EXPECT_GT(p.y, both.placements[0].y + 8);
 }
