@@ -93,13 +93,14 @@ Layout layoutCharts(const ChartedMesh& charted, const std::vector<std::vector<ui
             outlines[c][k] = chartOutline(corners, turned, gutter);
         }
     }
-    layout.pack = packOutlines(outlines, kChunk);
+    layout.pack = packOutlines(outlines, gutter, kChunk);
     PackResult boxes = packNearSquare(rects, kChunk);
     if (boxes.width != 0 &&
         uint64_t(boxes.width) * boxes.height < uint64_t(layout.pack.width) * layout.pack.height) {
         layout.pack.width = boxes.width, layout.pack.height = boxes.height;
         for (size_t c = 0; c < rects.size(); ++c)
-            layout.pack.placements[c] = {boxes.placements[c].x, boxes.placements[c].y,
+            layout.pack.placements[c] = {boxes.placements[c].x + gutter,
+                                         boxes.placements[c].y + gutter,
                                          boxes.placements[c].turned ? 1u : 0u};
     }
     return layout;
@@ -107,12 +108,12 @@ Layout layoutCharts(const ChartedMesh& charted, const std::vector<std::vector<ui
 
 // Chart-local coordinates -> shadel UVs of the packed rect (width x height shadels).
 std::vector<glm::vec2> placeCharts(const ChartedMesh& charted, const Layout& layout, double density,
-                                   uint32_t gutter, uint32_t width, uint32_t height) {
+                                   uint32_t width, uint32_t height) {
     std::vector<glm::vec2> uv(charted.local.size());
     for (size_t c = 0; c < charted.charts.size(); ++c) {
         const Chart& chart = charted.charts[c];
         const OutlinePlacement& place = layout.pack.placements[c];
-        glm::dvec2 origin(place.x + gutter, place.y + gutter);
+        glm::dvec2 origin(place.x, place.y);
         for (uint32_t v = chart.firstVertex; v < chart.firstVertex + chart.vertexCount; ++v) {
             glm::dvec2 q =
                 turnQuarter(contentPosition(charted, chart, v, layout.content[c], density),
@@ -198,7 +199,7 @@ BakedMesh bakeMesh(const Mesh& mesh, const BakeSettings& settings) {
         }
         uint32_t width = std::max(layout.pack.width, minResolution);
         uint32_t height = std::max(layout.pack.height, minResolution);
-        std::vector<glm::vec2> uv = placeCharts(charted, layout, density, gutter, width, height);
+        std::vector<glm::vec2> uv = placeCharts(charted, layout, density, width, height);
         options.forceOwnership = true;
         std::vector<uint16_t> level0 = buildIdMap(uv, out.indices, width, height, options, &stats0);
         bool canGrow = std::max(width, height) < maxResolution && attempt < 40;

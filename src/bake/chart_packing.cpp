@@ -146,8 +146,10 @@ ChartOutline coarsen(const ChartOutline& o, uint32_t s) {
 // as its runs allow (possibly inside an earlier chart's hole); the lowest top wins. Wide bins are
 // searched on coarse columns (at most kCoarseColumns), then the chart is dropped exactly.
 OutlinePack packAtWidth(const std::vector<std::array<ChartOutline, 4>>& outlines,
-                        const std::vector<uint32_t>& order, uint32_t binWidth,
+                        const std::vector<uint32_t>& order, uint32_t rectWidth, uint32_t gutter,
                         uint32_t granularity) {
+    // Outlines may overhang the rect by the gutter: only content must stay inside.
+    uint32_t binWidth = rectWidth + 2 * gutter;
     uint32_t s = std::max(1u, binWidth / kCoarseColumns);
     Occupancy fine(binWidth), coarseOccupancy((binWidth + s - 1) / s);
     const Occupancy& search = s == 1 ? fine : coarseOccupancy;
@@ -206,8 +208,11 @@ OutlinePack packAtWidth(const std::vector<std::array<ChartOutline, 4>>& outlines
         pack.placements[c] = {x, y, best.orientation};
         top = std::max(top, y + maxTop);
     }
-    pack.width = roundUp(std::max(right, 1u), granularity);
-    pack.height = roundUp(std::max(top, 1u), granularity);
+    // Outline column/row i holds content column/row i - gutter, and the outline reaches 2 * gutter
+    // past its content's far side: in rect coordinates (bin - gutter) the content ends 2 * gutter
+    // before the outline does.
+    pack.width = roundUp(std::max(right, 2 * gutter + 1) - 2 * gutter, granularity);
+    pack.height = roundUp(std::max(top, 2 * gutter + 1) - 2 * gutter, granularity);
     return pack;
 }
 
@@ -290,7 +295,7 @@ ChartOutline chartOutline(const std::vector<glm::dvec2>& corners, glm::uvec2 con
     return o;
 }
 
-OutlinePack packOutlines(const std::vector<std::array<ChartOutline, 4>>& outlines,
+OutlinePack packOutlines(const std::vector<std::array<ChartOutline, 4>>& outlines, uint32_t gutter,
                          uint32_t granularity) {
     if (outlines.empty()) return {{}, granularity, granularity};
     double area = 0;
@@ -299,7 +304,7 @@ OutlinePack packOutlines(const std::vector<std::array<ChartOutline, 4>>& outline
     for (size_t c = 0; c < outlines.size(); ++c) {
         uint32_t narrowest = ~0u;
         for (const ChartOutline& o : outlines[c])
-            if (o.width > 0) narrowest = std::min(narrowest, o.width);
+            if (o.width > 0) narrowest = std::min(narrowest, o.width - 2 * gutter);
         minWidthNeeded = std::max(minWidthNeeded, narrowest);
         chartArea[c] = outlines[c][0].occupiedShadels();
         area += chartArea[c];
@@ -319,7 +324,7 @@ OutlinePack packOutlines(const std::vector<std::array<ChartOutline, 4>>& outline
             roundUp(std::max(minWidthNeeded, uint32_t(std::ceil(side * factor))), granularity);
         if (width == lastWidth) continue;
         lastWidth = width;
-        OutlinePack pack = packAtWidth(outlines, order, width, granularity);
+        OutlinePack pack = packAtWidth(outlines, order, width, gutter, granularity);
         if (pack.width == 0) continue;
         double aspect =
             double(std::max(pack.width, pack.height)) / std::min(pack.width, pack.height);

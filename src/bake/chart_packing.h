@@ -5,10 +5,11 @@
 // charts nest into their neighbours' dents and small charts fall into the holes of rings,
 // instead of every chart reserving its whole bounding rectangle.
 //
-// Gutter guarantee (bake.h): outlines are the content dilated by `gutter` in both axes, and
-// outlines never overlap nor leave the bin, so covered shadels of two charts are more than
-// 2 * gutter apart (Chebyshev distance) and every chart is >= gutter from the bin border: the
-// same separation padded rectangles gave.
+// Gutter guarantee (bake.h): outlines are the content dilated by `gutter` in both axes and never
+// overlap, so covered shadels of two charts are more than 2 * gutter apart (Chebyshev distance):
+// the same separation padded rectangles gave. Outlines may overhang the rect by the gutter (only
+// content must lie inside): the renderer clamps taps to the rect, so a chart on the border reads
+// its own border shadels, and no other chart can be there.
 #include <array>
 #include <cstdint>
 #include <vector>
@@ -39,7 +40,8 @@ ChartOutline chartOutline(const std::vector<glm::dvec2>& corners, glm::uvec2 con
 glm::dvec2 turnQuarter(glm::dvec2 p, glm::dvec2 content, uint32_t orientation);
 
 struct OutlinePlacement {
-    uint32_t x = 0, y = 0;    // bin position of the outline's corner (0, 0)
+    // Rect position of the chart's content corner (0, 0), i.e. of the outline's corner (g, g).
+    uint32_t x = 0, y = 0;
     uint32_t orientation = 0; // which of the chart's outlines was placed
 };
 
@@ -51,7 +53,7 @@ struct OutlinePack {
 // outlines[c][k]: chart c in orientation k (outlines of width 0 are not tried). Tries a few bin
 // widths around the square root of the outlines' area and keeps the smallest near-square
 // (<= 2:1 when possible) result. Deterministic.
-OutlinePack packOutlines(const std::vector<std::array<ChartOutline, 4>>& outlines,
+OutlinePack packOutlines(const std::vector<std::array<ChartOutline, 4>>& outlines, uint32_t gutter,
                          uint32_t granularity);
 
 } // namespace shadel

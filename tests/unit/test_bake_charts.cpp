@@ -132,21 +132,27 @@ TEST(BakeOutlinePacking, OutlinesNeverOverlapAndBeatRectsOnLShapes) {
         }
         rects.push_back({content.x + 2 * gutter, content.y + 2 * gutter});
     }
-    OutlinePack pack = packOutlines(outlines, 8);
+    OutlinePack pack = packOutlines(outlines, gutter, 8);
     ASSERT_EQ(pack.placements.size(), outlines.size());
     EXPECT_EQ(pack.width % 8, 0u);
     EXPECT_EQ(pack.height % 8, 0u);
-    std::vector<uint8_t> grid(size_t(pack.width) * pack.height, 0);
+    // Outlines may overhang the rect by the gutter: check them on the rect grown by it, and the
+    // content (outline shrunk by the gutter) inside the rect.
+    uint32_t gridWidth = pack.width + 2 * gutter, gridHeight = pack.height + 2 * gutter;
+    std::vector<uint8_t> grid(size_t(gridWidth) * gridHeight, 0);
     for (size_t c = 0; c < outlines.size(); ++c) {
         const OutlinePlacement& at = pack.placements[c];
         const ChartOutline& o = outlines[c][at.orientation];
         for (uint32_t i = 0; i < o.width; ++i)
             for (uint32_t k = o.first[i]; k < o.first[i + 1]; ++k)
                 for (uint32_t y = o.runs[k].x; y < o.runs[k].y; ++y) {
-                    ASSERT_LT(at.x + i, pack.width);
-                    ASSERT_LT(at.y + y, pack.height);
-                    ASSERT_EQ(grid[size_t(at.y + y) * pack.width + at.x + i]++, 0) << "chart " << c;
+                    ASSERT_LT(at.x + i, gridWidth);
+                    ASSERT_LT(at.y + y, gridHeight);
+                    ASSERT_EQ(grid[size_t(at.y + y) * gridWidth + at.x + i]++, 0) << "chart " << c;
                 }
+        // The content box (outline minus the gutter ring) lies inside the rect.
+        EXPECT_LE(at.x + o.width - 2 * gutter, pack.width);
+        EXPECT_LE(at.y + o.height - 2 * gutter, pack.height);
     }
     PackResult boxes = packNearSquare(rects, 8);
     double outlineArea = double(pack.width) * pack.height,
@@ -204,8 +210,8 @@ TEST(BakeOutlinePacking, SmallChartFallsIntoARingsHole) {
         outlines[0][k] = chartOutline(ring, {40, 40}, 2);
         outlines[1][k] = chartOutline(square, {6, 6}, 2);
     }
-    OutlinePack alone = packOutlines({outlines[0]}, 8);
-    OutlinePack both = packOutlines(outlines, 8);
+    OutlinePack alone = packOutlines({outlines[0]}, 2, 8);
+    OutlinePack both = packOutlines(outlines, 2, 8);
     EXPECT_EQ(uint64_t(both.width) * both.height, uint64_t(alone.width) * alone.height);
     const OutlinePlacement& p = both.placements[1];
     EXPECT_GT(p.x, both.placements[0].x + 8);
