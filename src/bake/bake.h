@@ -2,8 +2,8 @@
 // Shadel baking: a unique chart atlas ("shadel UVs") and per-MIP triangle-ID maps per mesh.
 //
 // Resolution and blocks. A mesh's charts are laid out at `shadelsPerMetre` shadels per metre of
-// object-space surface (at least: conformal charts are scaled never to magnify, so parts of them
-// get up to stretch^2 more shadels per m^2, see stretch.h), packed with gutters into a near-square
+// object-space surface (at most: conformal charts are scaled never to magnify, so parts of them
+// get up to stretch^2 fewer shadels per m^2, see stretch.h), packed with gutters into a near-square
 // rect whose sides are rounded up to multiples of 8 (one chunk) and clamped to [minResolution,
 // maxResolution]. The renderer places the object in the virtual sheet in 64x64-shadel blocks: at
 // MIP k the object needs ceil((width >> k) / 64) x ceil((height >> k) / 64) blocks, and once a side

@@ -13,6 +13,8 @@ namespace {
 constexpr double kTouchEpsilon = 1e-3;
 // Column offsets tried per chart and orientation before refining around the best one.
 constexpr uint32_t kMaxStridedPositions = 64;
+// Meshes with at most this many charts are packed with more orders and bin widths.
+constexpr size_t kThoroughPackingCharts = 64;
 // Lifts of one chart while looking for a hole before it is put on top of its columns instead.
 constexpr uint32_t kMaxLifts = 1000;
 // Bins wider than this many columns are searched on columns merged in groups (see coarsen).
@@ -309,27 +311,46 @@ OutlinePack packOutlines(const std::vector<std::array<ChartOutline, 4>>& outline
         chartArea[c] = outlines[c][0].occupiedShadels();
         area += chartArea[c];
     }
-    // Big charts first (occupied area), so small ones fill the gaps and holes they leave; ties
-    // by index keep the result deterministic.
-    std::vector<uint32_t> order(outlines.size());
-    std::iota(order.begin(), order.end(), 0u);
-    std::stable_sort(order.begin(), order.end(),
-                     [&](uint32_t a, uint32_t b) { return chartArea[a] > chartArea[b]; });
+    // Big charts first, so small ones fill the gaps and holes they leave; ties by index keep the
+    // result deterministic. "Big" by occupied area, and for few charts (cheap to pack) also by
+    // longest side and by height, each at more bin widths: the best result wins.
+    auto sortedBy = [&](auto key) {
+        std::vector<uint32_t> order(outlines.size());
+        std::iota(order.begin(), order.end(), 0u);
+        std::stable_sort(order.begin(), order.end(),
+                         [&](uint32_t a, uint32_t b) { return key(a) > key(b); });
+        return order;
+    };
+    std::vector<std::vector<uint32_t>> orders;
+    orders.push_back(sortedBy([&](uint32_t c) { return chartArea[c]; }));
+    std::vector<double> factors = {1.0, 1.15, 1.35, 1.6};
+    if (outlines.size() <= kThoroughPackingCharts) {
+        orders.push_back(sortedBy([&](uint32_t c) {
+            return double(std::max(outlines[c][0].width, outlines[c][0].height));
+        }));
+        orders.push_back(sortedBy([&](uint32_t c) {
+            return double(std::min(outlines[c][0].width, outlines[c][0].height));
+        }));
+        factors.clear();
+        for (double f = 0.9; f < 2.01; f += 0.05) factors.push_back(f);
+    }
     double side = std::sqrt(area);
     OutlinePack best;
     double bestScore = 1e300;
-    uint32_t lastWidth = 0;
-    for (double factor : {1.0, 1.15, 1.35, 1.6}) {
-        uint32_t width =
-            roundUp(std::max(minWidthNeeded, uint32_t(std::ceil(side * factor))), granularity);
-        if (width == lastWidth) continue;
-        lastWidth = width;
-        OutlinePack pack = packAtWidth(outlines, order, width, gutter, granularity);
-        if (pack.width == 0) continue;
-        double aspect =
-            double(std::max(pack.width, pack.height)) / std::min(pack.width, pack.height);
-        double score = double(pack.width) * pack.height * (aspect > 2.0 ? aspect / 2.0 : 1.0);
-        if (score < bestScore) bestScore = score, best = std::move(pack);
+    for (const std::vector<uint32_t>& order : orders) {
+        uint32_t lastWidth = 0;
+        for (double factor : factors) {
+            uint32_t width =
+                roundUp(std::max(minWidthNeeded, uint32_t(std::ceil(side * factor))), granularity);
+            if (width == lastWidth) continue;
+            lastWidth = width;
+            OutlinePack pack = packAtWidth(outlines, order, width, gutter, granularity);
+            if (pack.width == 0) continue;
+            double aspect =
+                double(std::max(pack.width, pack.height)) / std::min(pack.width, pack.height);
+            double score = double(pack.width) * pack.height * (aspect > 2.0 ? aspect / 2.0 : 1.0);
+            if (score < bestScore) bestScore = score, best = std::move(pack);
+        }
     }
     return best;
 }

@@ -27,10 +27,12 @@ constexpr size_t kSmallChartTriangles = 16;
 // cone only has to keep charts far from closing on themselves.
 constexpr double kConformalExtraConeDegrees = 25;
 constexpr double kMaxGrowthConeDegrees = 75;
-// Conformal charts are accepted up to this stretch (stretch.h), below the planar bound
-// 1/cos(cone + 10) = 1.56: a conformal map's scale varies over the whole chart, not only on a
-// tilted rim, and the density's coefficient of variation over the mesh must stay <= 0.2.
-constexpr double kMaxConformalStretch = 1.35;
+// Conformal charts are accepted up to the planar stretch bound (1/cos(cone + 10), what
+// bake_validate.h checks), with a margin, and while their density stays within
+// kMaxChartDensityDeviation of the requested one (ChartDistortion::densityDeviation): 0.16 bounds
+// the mesh's density coefficient of variation by 0.16 / 0.84 = 0.19 <= 0.2.
+constexpr double kStretchMargin = 0.99;
+constexpr double kMaxChartDensityDeviation = 0.16;
 
 struct TriangleInfo {
     glm::dvec3 normal{0.0};
@@ -291,7 +293,7 @@ public:
         // make folded nets that pack worse than their faces, so it keeps the planar bound.
         mergeLimit_ = glm::radians(std::min(cone + 5.0, 75.0));
         cosPlanar_ = std::cos(glm::radians(std::min(cone + 10.0, 80.0)));
-        maxConformalStretch_ = std::min(kMaxConformalStretch, 1.0 / cosPlanar_);
+        maxConformalStretch_ = kStretchMargin / cosPlanar_;
     }
 
     ChartedMesh run();
@@ -547,7 +549,8 @@ bool Charter::flattenConformal(const std::vector<uint32_t>& tris, std::vector<gl
         distortion = measureDistortion(surface, corners);
     }
     if (distortion.flippedTriangles > 0 || !(distortion.maxSigma > 0) ||
-        distortion.maxStretch() > maxConformalStretch_)
+        distortion.maxStretch() > maxConformalStretch_ ||
+        distortion.densityDeviation() > kMaxChartDensityDeviation)
         return false;
     double scale = 1.0 / distortion.maxSigma;
     for (glm::dvec2& c : corners) c *= scale;

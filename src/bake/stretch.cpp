@@ -33,6 +33,8 @@ ChartDistortion measureDistortion(const std::vector<glm::dvec3>& surface,
         d.maxSigma = std::max(d.maxSigma, sigmaMax);
         d.minSigma = std::min(d.minSigma, sigmaMin);
         d.areaOverMinSigma += sigmaMin > 0 ? area / sigmaMin : 1e300;
+        d.areaScale += area * sigmaMax * sigmaMin;
+        d.areaScaleSquared += area * (sigmaMax * sigmaMin) * (sigmaMax * sigmaMin);
         d.area += area;
     }
     if (d.area == 0) d.minSigma = d.maxSigma = 1;
