@@ -12,13 +12,13 @@ namespace {
 // counts as touching it.
 constexpr double kTouchEpsilon = 1e-3;
 // Column offsets tried per chart and orientation before refining around the best one.
-constexpr uint32_t kMaxStridedPositions = 64;
+constexpr uint32_t kMaxStridedPositions = 48;
 // Meshes with at most this many charts are packed with more orders and bin widths.
-constexpr size_t kThoroughPackingCharts = 64;
+constexpr size_t kThoroughPackingCharts = 24;
 // Lifts of one chart while looking for a hole before it is put on top of its columns instead.
-constexpr uint32_t kMaxLifts = 1000;
+constexpr uint32_t kMaxLifts = 300;
 // Bins wider than this many columns are searched on columns merged in groups (see coarsen).
-constexpr uint32_t kCoarseColumns = 1024;
+constexpr uint32_t kCoarseColumns = 512;
 
 uint32_t roundUp(uint32_t v, uint32_t granularity) {
     return (v + granularity - 1) / granularity * granularity;

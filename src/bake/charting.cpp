@@ -6,6 +6,7 @@
 #include <numeric>
 #include <unordered_map>
 
+#include "bake/arap.h"
 #include "bake/lscm.h"
 #include "bake/stretch.h"
 #include "core/error.h"
@@ -33,6 +34,8 @@ constexpr double kMaxGrowthConeDegrees = 75;
 // the mesh's density coefficient of variation by 0.16 / 0.84 = 0.19 <= 0.2.
 constexpr double kStretchMargin = 0.99;
 constexpr double kMaxChartDensityDeviation = 0.16;
+// Local/global iterations of the ARAP rescue (arap.h); it converges fast from an LSCM start.
+constexpr int kArapIterations = 8;
 
 struct TriangleInfo {
     glm::dvec3 normal{0.0};
@@ -539,19 +542,29 @@ bool Charter::flattenConformal(const std::vector<uint32_t>& tris, std::vector<gl
     for (uint32_t w : welded) localOf_[w] = kNone;
     std::vector<glm::dvec2> uv;
     if (!lscmFlatten(positions, triangles, uv)) return false;
-    corners.resize(triangles.size());
-    for (size_t k = 0; k < triangles.size(); ++k) corners[k] = uv[triangles[k]];
-    std::vector<glm::dvec3> surface = surfaceCorners(tris);
-    distortion = measureDistortion(surface, corners);
-    if (distortion.flippedTriangles * 2 > tris.size()) {
-        // The solve is free to return the mirror image; mirror it back.
-        for (glm::dvec2& c : corners) c.x = -c.x;
-        distortion = measureDistortion(surface, corners);
+    // The solve is free to return the mirror image (triangles clockwise); mirror it back.
+    double signedArea = 0;
+    for (size_t k = 0; k < triangles.size(); k += 3) {
+        glm::dvec2 e1 = uv[triangles[k + 1]] - uv[triangles[k]];
+        glm::dvec2 e2 = uv[triangles[k + 2]] - uv[triangles[k]];
+        signedArea += e1.x * e2.y - e1.y * e2.x;
     }
-    if (distortion.flippedTriangles > 0 || !(distortion.maxSigma > 0) ||
-        distortion.maxStretch() > maxConformalStretch_ ||
-        distortion.densityDeviation() > kMaxChartDensityDeviation)
-        return false;
+    if (signedArea < 0)
+        for (glm::dvec2& q : uv) q.x = -q.x;
+    std::vector<glm::dvec3> surface = surfaceCorners(tris);
+    auto measure = [&](const std::vector<glm::dvec2>& flat) {
+        corners.resize(triangles.size());
+        for (size_t k = 0; k < triangles.size(); ++k) corners[k] = flat[triangles[k]];
+        distortion = measureDistortion(surface, corners);
+        return distortion.flippedTriangles == 0 && distortion.maxSigma > 0 &&
+               distortion.maxStretch() <= maxConformalStretch_ &&
+               distortion.densityDeviation() <= kMaxChartDensityDeviation;
+    };
+    if (!measure(uv)) {
+        // Too much scale drift for a conformal map: as-rigid-as-possible trades it for mild
+        // anisotropy, which often brings a curved chart within bounds without cutting it.
+        if (!arapRefine(positions, triangles, uv, kArapIterations) || !measure(uv)) return false;
+    }
     double scale = 1.0 / distortion.maxSigma;
     for (glm::dvec2& c : corners) c *= scale;
     return !pieceSelfOverlaps(corners);
