@@ -43,10 +43,46 @@ double chartScale(const Chart& chart, double density) {
     return chart.kind == ChartKind::DegenerateCells ? 1.0 : density;
 }
 
+// Charts are placed in one of kOrientations orientations: quarter turns of their min-area-rect
+// alignment (k < 4), and for meshes of few charts also of that rotated by 45 degrees (k >= 4),
+// which lets round charts nest in more ways (with many charts the packer has choice enough).
+constexpr size_t kEighthTurnsUpToCharts = 24;
+
+// A chart rotated by 0 or 45 degrees: where its local coordinates start and how far they reach.
+struct ChartFrame {
+    glm::dvec2 low{0.0}, extent{0.0};
+    glm::uvec2 content{0};
+};
+
 struct Layout {
     OutlinePack pack;
-    std::vector<glm::uvec2> content;
+    std::vector<std::array<ChartFrame, 2>> frames;
 };
+
+glm::dvec2 eighthTurn(glm::dvec2 p, uint32_t eighths) {
+    if (eighths == 0) return p;
+    const double h = std::sqrt(0.5);
+    return glm::dvec2(h * (p.x - p.y), h * (p.x + p.y));
+}
+
+ChartFrame chartFrame(const ChartedMesh& charted, const Chart& chart, uint32_t eighths,
+                      double density) {
+    ChartFrame f;
+    if (eighths == 0) {
+        f.extent = chart.extent;
+    } else {
+        glm::dvec2 lo(1e300), hi(-1e300);
+        for (uint32_t v = chart.firstVertex; v < chart.firstVertex + chart.vertexCount; ++v) {
+            glm::dvec2 r = eighthTurn(charted.local[v], eighths);
+            lo = glm::min(lo, r), hi = glm::max(hi, r);
+        }
+        f.low = lo, f.extent = hi - lo;
+    }
+    Chart rotated = chart;
+    rotated.extent = f.extent;
+    f.content = contentSize(rotated, density);
+    return f;
+}
 
 // Triangles of each chart (a chart's baked vertices are contiguous, so its first corner says).
 std::vector<std::vector<uint32_t>> chartTriangles(const ChartedMesh& charted) {
@@ -60,12 +96,14 @@ std::vector<std::vector<uint32_t>> chartTriangles(const ChartedMesh& charted) {
     return triangles;
 }
 
-// A chart vertex in shadels inside its content box, before turning: spare space split evenly.
-glm::dvec2 contentPosition(const ChartedMesh& charted, const Chart& chart, uint32_t vertex,
-                           glm::uvec2 content, double density) {
+// A chart vertex in shadels inside the content box of orientation k: spare space split evenly.
+glm::dvec2 orientedPosition(const ChartedMesh& charted, const Chart& chart, uint32_t vertex,
+                            const std::array<ChartFrame, 2>& frames, uint32_t k, double density) {
+    const ChartFrame& f = frames[k / 4];
     double scale = chartScale(chart, density);
-    glm::dvec2 centring = (glm::dvec2(content) - chart.extent * scale) * 0.5;
-    return charted.local[vertex] * scale + centring;
+    glm::dvec2 centring = (glm::dvec2(f.content) - f.extent * scale) * 0.5;
+    glm::dvec2 q = (eighthTurn(charted.local[vertex], k / 4) - f.low) * scale + centring;
+    return turnQuarter(q, glm::dvec2(f.content), k % 4);
 }
 
 // Packs the charts by their outlines (chart_packing.h); padded bounding rectangles
@@ -74,23 +112,27 @@ Layout layoutCharts(const ChartedMesh& charted, const std::vector<std::vector<ui
                     double density, uint32_t gutter) {
     Layout layout;
     std::vector<PackRect> rects;
-    std::vector<std::array<ChartOutline, 4>> outlines(charted.charts.size());
+    std::vector<std::array<ChartOutline, kOrientations>> outlines(charted.charts.size());
     std::vector<glm::dvec2> corners;
+    bool eighthTurns = charted.charts.size() <= kEighthTurnsUpToCharts;
     for (size_t c = 0; c < charted.charts.size(); ++c) {
         const Chart& chart = charted.charts[c];
-        glm::uvec2 content = contentSize(chart, density);
-        layout.content.push_back(content);
+        std::array<ChartFrame, 2> frames;
+        frames[0] = chartFrame(charted, chart, 0, density);
+        bool turnable = eighthTurns && chart.kind != ChartKind::DegenerateCells;
+        if (turnable) frames[1] = chartFrame(charted, chart, 1, density);
+        layout.frames.push_back(frames);
+        glm::uvec2 content = frames[0].content;
         rects.push_back({content.x + 2 * gutter, content.y + 2 * gutter});
-        for (uint32_t k = 0; k < 4; ++k) {
+        for (uint32_t k = 0; k < (turnable ? kOrientations : 4); ++k) {
             corners.clear();
             for (uint32_t t : triangles[c])
                 for (uint32_t i = 0; i < 3; ++i)
-                    corners.push_back(
-                        turnQuarter(contentPosition(charted, chart, charted.indices[3 * t + i],
-                                                    content, density),
-                                    glm::dvec2(content), k));
-            glm::uvec2 turned = k % 2 ? glm::uvec2(content.y, content.x) : content;
-            outlines[c][k] = chartOutline(corners, turned, gutter);
+                    corners.push_back(orientedPosition(charted, chart, charted.indices[3 * t + i],
+                                                       frames, k, density));
+            glm::uvec2 box = frames[k / 4].content;
+            if (k % 2) box = glm::uvec2(box.y, box.x);
+            outlines[c][k] = chartOutline(corners, box, gutter);
         }
     }
     layout.pack = packOutlines(outlines, gutter, kChunk);
@@ -116,8 +158,7 @@ std::vector<glm::vec2> placeCharts(const ChartedMesh& charted, const Layout& lay
         glm::dvec2 origin(place.x, place.y);
         for (uint32_t v = chart.firstVertex; v < chart.firstVertex + chart.vertexCount; ++v) {
             glm::dvec2 q =
-                turnQuarter(contentPosition(charted, chart, v, layout.content[c], density),
-                            glm::dvec2(layout.content[c]), place.orientation);
+                orientedPosition(charted, chart, v, layout.frames[c], place.orientation, density);
             glm::dvec2 texel = origin + q;
             uv[v] = glm::vec2(float(texel.x / width), float(texel.y / height));
             uv[v] = glm::clamp(uv[v], glm::vec2(0.0f), glm::vec2(1.0f));

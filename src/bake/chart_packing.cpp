@@ -147,7 +147,7 @@ ChartOutline coarsen(const ChartOutline& o, uint32_t s) {
 // Bottom-left over the occupancy: for every column offset and orientation the chart sits as low
 // as its runs allow (possibly inside an earlier chart's hole); the lowest top wins. Wide bins are
 // searched on coarse columns (at most kCoarseColumns), then the chart is dropped exactly.
-OutlinePack packAtWidth(const std::vector<std::array<ChartOutline, 4>>& outlines,
+OutlinePack packAtWidth(const std::vector<std::array<ChartOutline, kOrientations>>& outlines,
                         const std::vector<uint32_t>& order, uint32_t rectWidth, uint32_t gutter,
                         uint32_t granularity) {
     // Outlines may overhang the rect by the gutter: only content must stay inside.
@@ -155,11 +155,11 @@ OutlinePack packAtWidth(const std::vector<std::array<ChartOutline, 4>>& outlines
     uint32_t s = std::max(1u, binWidth / kCoarseColumns);
     Occupancy fine(binWidth), coarseOccupancy((binWidth + s - 1) / s);
     const Occupancy& search = s == 1 ? fine : coarseOccupancy;
-    std::vector<std::array<ChartOutline, 4>> coarse;
+    std::vector<std::array<ChartOutline, kOrientations>> coarse;
     if (s > 1) {
         coarse.resize(outlines.size());
         for (size_t c = 0; c < outlines.size(); ++c)
-            for (uint32_t k = 0; k < 4; ++k)
+            for (uint32_t k = 0; k < kOrientations; ++k)
                 if (outlines[c][k].width > 0) coarse[c][k] = coarsen(outlines[c][k], s);
     }
     OutlinePack pack;
@@ -167,7 +167,7 @@ OutlinePack packAtWidth(const std::vector<std::array<ChartOutline, 4>>& outlines
     uint32_t right = 0, top = 0;
     for (uint32_t c : order) {
         Candidate best; // x in search columns
-        for (uint32_t k = 0; k < 4; ++k) {
+        for (uint32_t k = 0; k < kOrientations; ++k) {
             const ChartOutline& o = outlines[c][k];
             if (o.width == 0 || o.width > binWidth || o.runs.empty()) continue;
             const ChartOutline& so = s == 1 ? o : coarse[c][k];
@@ -297,8 +297,8 @@ ChartOutline chartOutline(const std::vector<glm::dvec2>& corners, glm::uvec2 con
     return o;
 }
 
-OutlinePack packOutlines(const std::vector<std::array<ChartOutline, 4>>& outlines, uint32_t gutter,
-                         uint32_t granularity) {
+OutlinePack packOutlines(const std::vector<std::array<ChartOutline, kOrientations>>& outlines,
+                         uint32_t gutter, uint32_t granularity) {
     if (outlines.empty()) return {{}, granularity, granularity};
     double area = 0;
     uint32_t minWidthNeeded = 1;

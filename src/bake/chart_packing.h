@@ -18,6 +18,9 @@
 
 namespace shadel {
 
+// Orientations a chart may be packed in (the caller defines them; see bake.cpp).
+constexpr uint32_t kOrientations = 8;
+
 struct ChartOutline {
     uint32_t width = 0, height = 0; // gutters included
     // Column i occupies rows [runs[k].x, runs[k].y) for k in [first[i], first[i + 1]): sorted,
@@ -50,10 +53,11 @@ struct OutlinePack {
     uint32_t width = 0, height = 0;           // each rounded up to `granularity`
 };
 
-// outlines[c][k]: chart c in orientation k (outlines of width 0 are not tried). Tries a few bin
+// outlines[c][k]: chart c in orientation k (outlines of width 0 are not tried; orientation 0
+// must be given). Tries a few bin
 // widths around the square root of the outlines' area and keeps the smallest near-square
 // (<= 2:1 when possible) result. Deterministic.
-OutlinePack packOutlines(const std::vector<std::array<ChartOutline, 4>>& outlines, uint32_t gutter,
-                         uint32_t granularity);
+OutlinePack packOutlines(const std::vector<std::array<ChartOutline, kOrientations>>& outlines,
+                         uint32_t gutter, uint32_t granularity);
 
 } // namespace shadel

@@ -127,7 +127,7 @@ TEST(BakeLscm, CurvedCapStretchesAndIsMeasured) {
 TEST(BakeOutlinePacking, OutlinesNeverOverlapAndBeatRectsOnLShapes) {
     // L-shaped charts (two triangles per arm), various sizes; gutter 2.
     const uint32_t gutter = 2;
-    std::vector<std::array<ChartOutline, 4>> outlines;
+    std::vector<std::array<ChartOutline, kOrientations>> outlines;
     std::vector<PackRect> rects;
     uint32_t seed = 777;
     for (int c = 0; c < 120; ++c) {
@@ -219,7 +219,7 @@ TEST(BakeOutlinePacking, SmallChartFallsIntoARingsHole) {
         ring.insert(ring.end(), {i0, o0, o1, i0, o1, i1});
     }
     std::vector<glm::dvec2> square = {{0, 0}, {6, 0}, {6, 6}, {0, 0}, {6, 6}, {0, 6}};
-    std::vector<std::array<ChartOutline, 4>> outlines(2);
+    std::vector<std::array<ChartOutline, kOrientations>> outlines(2);
     for (uint32_t k = 0; k < 4; ++k) {
         outlines[0][k] = chartOutline(ring, {40, 40}, 2);
         outlines[1][k] = chartOutline(square, {6, 6}, 2);
