@@ -15,6 +15,8 @@ constexpr double kTouchEpsilon = 1e-3;
 constexpr uint32_t kMaxStridedPositions = 48;
 // Meshes with at most this many charts are packed with more orders and bin widths.
 constexpr size_t kThoroughPackingCharts = 24;
+// ... unless the quick pass already covers this much of the rect with outlines.
+constexpr double kTightOutlineFill = 0.85;
 // Lifts of one chart while looking for a hole before it is put on top of its columns instead.
 constexpr uint32_t kMaxLifts = 300;
 // Bins wider than this many columns are searched on columns merged in groups (see coarsen).
@@ -321,23 +323,10 @@ OutlinePack packOutlines(const std::vector<std::array<ChartOutline, kOrientation
                          [&](uint32_t a, uint32_t b) { return key(a) > key(b); });
         return order;
     };
-    std::vector<std::vector<uint32_t>> orders;
-    orders.push_back(sortedBy([&](uint32_t c) { return chartArea[c]; }));
-    std::vector<double> factors = {1.0, 1.15, 1.35, 1.6};
-    if (outlines.size() <= kThoroughPackingCharts) {
-        orders.push_back(sortedBy([&](uint32_t c) {
-            return double(std::max(outlines[c][0].width, outlines[c][0].height));
-        }));
-        orders.push_back(sortedBy([&](uint32_t c) {
-            return double(std::min(outlines[c][0].width, outlines[c][0].height));
-        }));
-        factors.clear();
-        for (double f = 0.9; f < 2.01; f += 0.05) factors.push_back(f);
-    }
     double side = std::sqrt(area);
     OutlinePack best;
     double bestScore = 1e300;
-    for (const std::vector<uint32_t>& order : orders) {
+    auto tryWidths = [&](const std::vector<uint32_t>& order, const std::vector<double>& factors) {
         uint32_t lastWidth = 0;
         for (double factor : factors) {
             uint32_t width =
@@ -351,6 +340,22 @@ OutlinePack packOutlines(const std::vector<std::array<ChartOutline, kOrientation
             double score = double(pack.width) * pack.height * (aspect > 2.0 ? aspect / 2.0 : 1.0);
             if (score < bestScore) bestScore = score, best = std::move(pack);
         }
+    };
+    tryWidths(sortedBy([&](uint32_t c) { return chartArea[c]; }), {1.0, 1.15, 1.35, 1.6});
+    // Outlines already covering most of the rect leave little to win (boxes, planes).
+    bool tight = best.width != 0 && area >= kTightOutlineFill * double(best.width) * best.height;
+    if (outlines.size() <= kThoroughPackingCharts && !tight) {
+        std::vector<double> factors;
+        for (double f = 0.9; f < 2.01; f += 0.05) factors.push_back(f);
+        tryWidths(sortedBy([&](uint32_t c) { return chartArea[c]; }), factors);
+        tryWidths(sortedBy([&](uint32_t c) {
+                      return double(std::max(outlines[c][0].width, outlines[c][0].height));
+                  }),
+                  factors);
+        tryWidths(sortedBy([&](uint32_t c) {
+                      return double(std::min(outlines[c][0].width, outlines[c][0].height));
+                  }),
+                  factors);
     }
     return best;
 }
