@@ -14,7 +14,8 @@
 namespace shadel {
 
 // Bump whenever the bake output for the same input can change (algorithm or layout).
-constexpr uint32_t kBakeFormatVersion = 2; // 2: conformal charts, outline packing, stretch
+constexpr uint32_t kBakeFormatVersion = 3; // 2: conformal charts, outline packing, stretch;
+                                           // 3: charts bounded by the mesh density CV
 
 struct BakeKey {
     uint64_t lo = 0, hi = 0;

@@ -16,6 +16,7 @@ namespace shadel {
 namespace {
 
 constexpr uint32_t kNone = ~0u;
+constexpr uint32_t kOutside = ~0u - 1; // growCharts: triangle not in the subset being grown
 // A chart filling less than this fraction of its bounding rectangle is cut in two.
 constexpr double kMinRectFill = 0.5;
 constexpr size_t kMinTrianglesToSplitForFill = 8;
@@ -25,15 +26,25 @@ constexpr double kMinSplitGain = 0.8;
 constexpr size_t kSmallChartTriangles = 16;
 // Charts grow over a wider normal cone than planar projection could take: a conformal map unrolls
 // curved patches that a projection would squash. The stretch check decides what is kept, so the
-// cone only has to keep charts far from closing on themselves.
+// cone only has to keep charts far from closing on themselves. Growth first tries the wide cone
+// (fewer, bigger charts on smooth curved surfaces); a wide chart that does not flatten is grown
+// again with the narrow one within its own triangles before any cutting in halves (halves of a
+// wide chart are worse charts than narrow growth makes).
 constexpr double kConformalExtraConeDegrees = 25;
+constexpr double kWideConformalExtraConeDegrees = 35;
 constexpr double kMaxGrowthConeDegrees = 75;
 // Conformal charts are accepted up to the planar stretch bound (1/cos(cone + 10), what
-// bake_validate.h checks), with a margin, and while their density stays within
-// kMaxChartDensityDeviation of the requested one (ChartDistortion::densityDeviation): 0.16 bounds
-// the mesh's density coefficient of variation by 0.16 / 0.84 = 0.19 <= 0.2.
+// bake_validate.h checks), with a margin, and while their density stays within a deviation of the
+// requested one (ChartDistortion::densityDeviation). kSafeChartDensityDeviation = 0.16 bounds the
+// mesh's density coefficient of variation by 0.16 / 0.84 = 0.19 <= 0.2 whatever the charts; the
+// first attempt allows kLooseChartDensityDeviation per chart (bigger charts, less gutter) and is
+// kept only if the mesh's CV, measured over all charts, stays within kMaxMeshDensityCv; else the
+// mesh is charted again with the safe bound.
 constexpr double kStretchMargin = 0.99;
-constexpr double kMaxChartDensityDeviation = 0.16;
+constexpr double kSafeChartDensityDeviation = 0.16;
+constexpr double kLooseChartDensityDeviation = 0.2;
+// Below bake_validate.h's 0.2: UVs are rounded to float and chart placement to shadels.
+constexpr double kMaxMeshDensityCv = 0.18;
 // Local/global iterations of the ARAP rescue (arap.h); it converges fast from an LSCM start.
 constexpr int kArapIterations = 8;
 
@@ -287,11 +298,11 @@ glm::dvec2 alignToMinAreaRect(std::vector<glm::dvec2>& coords) {
 
 class Charter {
 public:
-    explicit Charter(const Mesh& mesh, const ChartingSettings& settings) : mesh_(mesh) {
+    Charter(const Mesh& mesh, const ChartingSettings& settings, double maxChartDensityDeviation)
+        : mesh_(mesh), maxChartDensityDeviation_(maxChartDensityDeviation) {
         double cone = double(settings.coneDegrees);
-        double growth = std::min(cone + kConformalExtraConeDegrees, kMaxGrowthConeDegrees);
-        cosCone_ = std::cos(glm::radians(growth));
-        cosKeep_ = std::cos(glm::radians(growth + 10.0));
+        narrowGrowth_ = std::min(cone + kConformalExtraConeDegrees, kMaxGrowthConeDegrees);
+        wideGrowth_ = std::min(cone + kWideConformalExtraConeDegrees, kMaxGrowthConeDegrees);
         // Merging only absorbs slivers left between charts; across creases (box edges) it would
         // make folded nets that pack worse than their faces, so it keeps the planar bound.
         mergeLimit_ = glm::radians(std::min(cone + 5.0, 75.0));
@@ -307,11 +318,21 @@ private:
         return weldPosition_[weld_[mesh_.indices[3 * t + corner]]];
     }
     void classifyTriangles();
-    std::vector<std::vector<uint32_t>> growCharts();
+    // Charts grown over `subset` (non-degenerate triangles) within a cone of growthDegrees.
+    std::vector<std::vector<uint32_t>> growCharts(std::vector<uint32_t> subset,
+                                                  double growthDegrees);
     void mergeSmallCharts(std::vector<std::vector<uint32_t>>& charts,
                           std::vector<uint32_t>& chartOf);
     std::vector<std::vector<uint32_t>> connectedPieces(const std::vector<uint32_t>& tris);
-    void flattenAndEmit(std::vector<uint32_t> tris);
+    // A flattened piece, accepted as a chart.
+    struct Flattened {
+        std::vector<uint32_t> tris;
+        std::vector<glm::dvec2> corners;
+        ChartKind kind = ChartKind::Conformal;
+        ChartDistortion distortion;
+    };
+    void flattenPieces(std::vector<std::vector<uint32_t>> work, std::vector<Flattened>& charts);
+    void chartPiece(std::vector<uint32_t> piece, bool wide);
     bool flattenConformal(const std::vector<uint32_t>& tris, std::vector<glm::dvec2>& corners,
                           ChartDistortion& distortion);
     bool flattenPlanar(const std::vector<uint32_t>& tris, std::vector<glm::dvec2>& corners,
@@ -326,7 +347,10 @@ private:
     void emitDegenerateCells();
 
     const Mesh& mesh_;
-    double cosCone_, cosKeep_, mergeLimit_; // growth; mergeLimit_ in radians
+    double maxChartDensityDeviation_;
+    double narrowGrowth_, wideGrowth_;      // growth cones, degrees
+    double mergeLimit_;                     // radians
+    std::vector<uint32_t> chartOf_;         // per triangle, scratch of growCharts
     double cosPlanar_;                      // planar charts: every normal within this of the axis
     double maxConformalStretch_;
     std::vector<uint32_t> weld_;
@@ -368,16 +392,16 @@ void Charter::classifyTriangles() {
     }
 }
 
-std::vector<std::vector<uint32_t>> Charter::growCharts() {
-    uint32_t n = uint32_t(tris_.size());
-    std::vector<uint32_t> pending;
-    for (uint32_t t = 0; t < n; ++t)
-        if (!tris_[t].degenerate) pending.push_back(t);
+std::vector<std::vector<uint32_t>> Charter::growCharts(std::vector<uint32_t> pending,
+                                                       double growthDegrees) {
+    double cosCone = std::cos(glm::radians(growthDegrees));
+    double cosKeep = std::cos(glm::radians(growthDegrees + 10.0));
     // Seed from the largest triangles so big flat regions become big charts.
     std::stable_sort(pending.begin(), pending.end(),
                      [&](uint32_t a, uint32_t b) { return tris_[a].area > tris_[b].area; });
-
-    std::vector<uint32_t> chartOf(n, kNone);
+    // Triangles outside the subset stay kOutside, so growth never enters them.
+    std::vector<uint32_t>& chartOf = chartOf_;
+    for (uint32_t t : pending) chartOf[t] = kNone;
     std::vector<std::vector<uint32_t>> charts;
     std::vector<uint32_t> members;
     std::vector<std::pair<double, uint32_t>> frontier; // max-heap on alignment with the mean
@@ -407,7 +431,7 @@ std::vector<std::vector<uint32_t>> Charter::growCharts() {
                 frontier.pop_back();
                 if (chartOf[u] != kNone) continue;
                 glm::dvec3 nu = tris_[u].normal;
-                if (glm::dot(nu, glm::normalize(sum)) < cosCone_) continue;
+                if (glm::dot(nu, glm::normalize(sum)) < cosCone) continue;
                 chartOf[u] = id;
                 members.push_back(u);
                 sum += nu * tris_[u].area;
@@ -419,7 +443,7 @@ std::vector<std::vector<uint32_t>> Charter::growCharts() {
             std::vector<uint32_t> kept;
             kept.reserve(members.size());
             for (uint32_t t : members) {
-                if (t == seed || glm::dot(tris_[t].normal, axis) >= cosKeep_) {
+                if (t == seed || glm::dot(tris_[t].normal, axis) >= cosKeep) {
                     kept.push_back(t);
                 } else {
                     chartOf[t] = kNone;
@@ -431,6 +455,8 @@ std::vector<std::vector<uint32_t>> Charter::growCharts() {
         pending = std::move(retry);
     }
     mergeSmallCharts(charts, chartOf);
+    for (const std::vector<uint32_t>& chart : charts)
+        for (uint32_t t : chart) chartOf[t] = kOutside;
     return charts;
 }
 
@@ -467,7 +493,9 @@ void Charter::mergeSmallCharts(std::vector<std::vector<uint32_t>>& charts,
         for (uint32_t t : charts[s]) {
             for (uint32_t e = 0; e < 3; ++e) {
                 uint32_t u = neighbour_[3 * t + e];
-                if (u == kNone || chartOf[u] == s || chartOf[u] == best) continue;
+                if (u == kNone || chartOf[u] == kOutside || chartOf[u] == s ||
+                    chartOf[u] == best)
+                    continue;
                 uint32_t c = chartOf[u];
                 glm::dvec3 merged = sums[c] + sums[s];
                 if (!(glm::length(merged) > 0)) continue;
@@ -558,7 +586,7 @@ bool Charter::flattenConformal(const std::vector<uint32_t>& tris, std::vector<gl
         distortion = measureDistortion(surface, corners);
         return distortion.flippedTriangles == 0 && distortion.maxSigma > 0 &&
                distortion.maxStretch() <= maxConformalStretch_ &&
-               distortion.densityDeviation() <= kMaxChartDensityDeviation;
+               distortion.densityDeviation() <= maxChartDensityDeviation_;
     };
     if (!measure(uv)) {
         // Too much scale drift for a conformal map: as-rigid-as-possible trades it for mild
@@ -602,10 +630,10 @@ double Charter::subsetRectArea(const std::vector<uint32_t>& subset,
     return minAreaRect(points).area;
 }
 
-// Flattens a connected piece conformally, else by projection, else cuts it in two across its
+// Flattens connected pieces conformally, else by projection, else cuts them in two across their
 // longest extent and retries the halves. A single triangle always flattens.
-void Charter::flattenAndEmit(std::vector<uint32_t> initial) {
-    std::vector<std::vector<uint32_t>> work{std::move(initial)};
+void Charter::flattenPieces(std::vector<std::vector<uint32_t>> work,
+                            std::vector<Flattened>& charts) {
     std::vector<glm::dvec2> corners;
     while (!work.empty()) {
         std::vector<uint32_t> tris = std::move(work.back());
@@ -644,8 +672,33 @@ void Charter::flattenAndEmit(std::vector<uint32_t> initial) {
                 continue;
             }
         }
-        emitChart(tris, corners, kind, distortion);
+        charts.push_back({std::move(tris), corners, kind, distortion});
     }
+}
+
+// Charts a connected piece grown with the wide cone (wide) or the narrow one. A wide piece that
+// does not flatten whole is cut in halves, and also grown again with the narrow cone within its
+// triangles; the way that makes fewer charts (less gutter), then less rectangle area, is kept.
+void Charter::chartPiece(std::vector<uint32_t> piece, bool wide) {
+    std::vector<Flattened> charts;
+    std::vector<uint32_t> copy = wide ? piece : std::vector<uint32_t>();
+    flattenPieces({std::move(piece)}, charts);
+    if (wide && charts.size() > 1) {
+        std::vector<std::vector<uint32_t>> regrown;
+        for (const std::vector<uint32_t>& grown : growCharts(std::move(copy), narrowGrowth_))
+            for (std::vector<uint32_t>& p : connectedPieces(grown)) regrown.push_back(std::move(p));
+        std::vector<Flattened> narrow;
+        flattenPieces(std::move(regrown), narrow);
+        auto rectArea = [](const std::vector<Flattened>& set) {
+            double sum = 0;
+            for (const Flattened& f : set) sum += minAreaRect(f.corners).area;
+            return sum;
+        };
+        if (narrow.size() < charts.size() ||
+            (narrow.size() == charts.size() && rectArea(narrow) < rectArea(charts)))
+            charts = std::move(narrow);
+    }
+    for (const Flattened& f : charts) emitChart(f.tris, f.corners, f.kind, f.distortion);
 }
 
 void Charter::splitInHalves(const std::vector<uint32_t>& tris, std::vector<uint32_t>& lower,
@@ -675,6 +728,11 @@ void Charter::emitChart(const std::vector<uint32_t>& tris, const std::vector<glm
     chart.kind = kind;
     chart.meanStretch = distortion.meanStretch();
     chart.maxStretch = distortion.maxStretch();
+    if (distortion.maxSigma > 0) {
+        double m2 = distortion.maxSigma * distortion.maxSigma;
+        chart.densitySum = distortion.areaScale / m2;
+        chart.densitySquareSum = distortion.areaScaleSquared / (m2 * m2);
+    }
     chart.firstVertex = uint32_t(out_.vertexRemap.size());
     for (size_t i = 0; i < tris.size(); ++i) {
         uint32_t t = tris[i];
@@ -745,17 +803,37 @@ ChartedMesh Charter::run() {
     vertexBaked_.assign(mesh_.vertices.size(), 0);
     out_.indices.assign(mesh_.indices.size(), 0);
 
-    for (const std::vector<uint32_t>& grown : growCharts())
+    chartOf_.assign(tris_.size(), kOutside);
+    std::vector<uint32_t> all;
+    for (uint32_t t = 0; t < tris_.size(); ++t)
+        if (!tris_[t].degenerate) all.push_back(t);
+    for (const std::vector<uint32_t>& grown : growCharts(std::move(all), wideGrowth_))
         for (std::vector<uint32_t>& piece : connectedPieces(grown))
-            flattenAndEmit(std::move(piece));
+            chartPiece(std::move(piece), wideGrowth_ > narrowGrowth_);
     emitDegenerateCells();
     return std::move(out_);
+}
+
+// Area-weighted coefficient of variation of the density over the non-degenerate charts, each
+// normalized by its maxSigma as packing will (the measure bake_validate.h bounds).
+double meshDensityCv(const ChartedMesh& charted) {
+    double area = 0, sum = 0, sumSquares = 0;
+    for (const Chart& chart : charted.charts) {
+        if (chart.kind == ChartKind::DegenerateCells) continue;
+        area += chart.surfaceArea;
+        sum += chart.densitySum, sumSquares += chart.densitySquareSum;
+    }
+    if (!(area > 0) || !(sum > 0)) return 0;
+    double mean = sum / area;
+    return std::sqrt(std::max(0.0, sumSquares / area - mean * mean)) / mean;
 }
 
 } // namespace
 
 ChartedMesh buildCharts(const Mesh& mesh, const ChartingSettings& settings) {
-    return Charter(mesh, settings).run();
+    ChartedMesh loose = Charter(mesh, settings, kLooseChartDensityDeviation).run();
+    if (meshDensityCv(loose) <= kMaxMeshDensityCv) return loose;
+    return Charter(mesh, settings, kSafeChartDensityDeviation).run();
 }
 
 } // namespace shadel

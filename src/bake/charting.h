@@ -31,6 +31,9 @@ struct Chart {
     // Shadel spacing on the surface relative to the density (stretch.h): >= 1, area-weighted
     // mean and worst triangle. 1 for DegenerateCells (never sampled).
     double meanStretch = 1, maxStretch = 1;
+    // Density relative to the requested one, d = sigmaMax * sigmaMin / maxSigma^2 per triangle
+    // (stretch.h): sums of area * d and area * d^2 over the chart, for the mesh's density CV.
+    double densitySum = 0, densitySquareSum = 0;
 };
 
 struct ChartedMesh {
