@@ -4,6 +4,7 @@
 #include <cmath>
 #include <limits>
 #include <numeric>
+#include <iterator>
 
 namespace shadel {
 namespace {
@@ -17,6 +18,10 @@ constexpr uint32_t kMaxStridedPositions = 48;
 constexpr size_t kThoroughPackingCharts = 24;
 // ... unless the quick pass already covers this much of the rect with outlines.
 constexpr double kTightOutlineFill = 0.85;
+// Meshes of at most this many charts are also packed waste-aware (packAtWidth): a position's score
+// is its top plus kWasteWeight times the mean empty height left under the chart's columns.
+constexpr size_t kWasteAwareCharts = 12;
+constexpr double kWasteWeight = 1.0;
 // Lifts of one chart while looking for a hole before it is put on top of its columns instead.
 constexpr uint32_t kMaxLifts = 300;
 // Bins wider than this many columns are searched on columns merged in groups (see coarsen).
@@ -60,6 +65,14 @@ public:
         return begin - run.x;
     }
 
+    // One past the highest occupied row of column x at or below `row` (0 if none).
+    uint32_t floorBelow(uint32_t x, uint64_t row) const {
+        const std::vector<glm::uvec2>& col = columns_[x];
+        auto it = std::upper_bound(col.begin(), col.end(), row,
+                                   [](uint64_t v, glm::uvec2 r) { return v < r.y; });
+        return it == col.begin() ? 0u : std::prev(it)->y;
+    }
+
     // One past the highest occupied row of column x.
     uint32_t top(uint32_t x) const { return columns_[x].empty() ? 0 : columns_[x].back().y; }
 
@@ -86,6 +99,7 @@ private:
 
 struct Candidate {
     uint64_t top = std::numeric_limits<uint64_t>::max();
+    double score = 1e300;
     uint32_t x = 0, y = 0, orientation = 0;
     bool found = false;
 };
@@ -151,7 +165,7 @@ ChartOutline coarsen(const ChartOutline& o, uint32_t s) {
 // searched on coarse columns (at most kCoarseColumns), then the chart is dropped exactly.
 OutlinePack packAtWidth(const std::vector<std::array<ChartOutline, kOrientations>>& outlines,
                         const std::vector<uint32_t>& order, uint32_t rectWidth, uint32_t gutter,
-                        uint32_t granularity) {
+                        uint32_t granularity, double wasteWeight) {
     // Outlines may overhang the rect by the gutter: only content must stay inside.
     uint32_t binWidth = rectWidth + 2 * gutter;
     uint32_t s = std::max(1u, binWidth / kCoarseColumns);
@@ -176,10 +190,28 @@ OutlinePack packAtWidth(const std::vector<std::array<ChartOutline, kOrientations
             uint32_t maxTop = 0;
             for (const glm::uvec2& run : o.runs) maxTop = std::max(maxTop, run.y);
             auto tryAt = [&](uint32_t x) {
+                if (wasteWeight > 0 && s == 1) {
+                    // The score is at least the top: positions that cannot beat it are cut.
+                    if (best.found && best.score <= double(maxTop)) return;
+                    uint64_t limit =
+                        best.found ? uint64_t(best.score) - maxTop : ~0ull >> 2;
+                    uint64_t y = lowestFit(search, so, x, limit);
+                    if (y > limit) return;
+                    double waste = 0;
+                    for (uint32_t i = 0; i < o.width; ++i)
+                        if (o.first[i] < o.first[i + 1]) {
+                            uint64_t bottom = y + o.runs[o.first[i]].x;
+                            waste += double(bottom - fine.floorBelow(x + i, bottom));
+                        }
+                    double score = double(y + maxTop) + wasteWeight * waste / o.width;
+                    if (score < best.score) best = {y + maxTop, score, x, uint32_t(y), k, true};
+                    return;
+                }
                 if (best.found && best.top <= maxTop) return;
                 uint64_t limit = best.found ? best.top - maxTop - 1 : ~0ull >> 2;
                 uint64_t y = lowestFit(search, so, x, limit);
-                if (y + maxTop < best.top) best = {y + maxTop, x, uint32_t(y), k, true};
+                if (y + maxTop < best.top)
+                    best = {y + maxTop, double(y + maxTop), x, uint32_t(y), k, true};
             };
             // Every offset on narrow bins; on wide ones a stride, then every offset around the
             // best strided one, which keeps packing linear in the chart count.
@@ -326,6 +358,7 @@ OutlinePack packOutlines(const std::vector<std::array<ChartOutline, kOrientation
     double side = std::sqrt(area);
     OutlinePack best;
     double bestScore = 1e300;
+    double wasteWeight = 0;
     auto tryWidths = [&](const std::vector<uint32_t>& order, const std::vector<double>& factors) {
         uint32_t lastWidth = 0;
         for (double factor : factors) {
@@ -333,7 +366,7 @@ OutlinePack packOutlines(const std::vector<std::array<ChartOutline, kOrientation
                 roundUp(std::max(minWidthNeeded, uint32_t(std::ceil(side * factor))), granularity);
             if (width == lastWidth) continue;
             lastWidth = width;
-            OutlinePack pack = packAtWidth(outlines, order, width, gutter, granularity);
+            OutlinePack pack = packAtWidth(outlines, order, width, gutter, granularity, wasteWeight);
             if (pack.width == 0) continue;
             double aspect =
                 double(std::max(pack.width, pack.height)) / std::min(pack.width, pack.height);
@@ -356,6 +389,17 @@ OutlinePack packOutlines(const std::vector<std::array<ChartOutline, kOrientation
                       return double(std::min(outlines[c][0].width, outlines[c][0].height));
                   }),
                   factors);
+        if (outlines.size() <= kWasteAwareCharts) {
+            // Bottom-left leaves empty pockets under round charts; placing each chart where it
+            // sits low *and* leaves little empty space beneath it packs blobs more tightly.
+            wasteWeight = kWasteWeight;
+            tryWidths(sortedBy([&](uint32_t c) { return chartArea[c]; }), factors);
+            tryWidths(sortedBy([&](uint32_t c) {
+                          return double(std::max(outlines[c][0].width, outlines[c][0].height));
+                      }),
+                      factors);
+            wasteWeight = 0;
+        }
     }
     return best;
 }
