@@ -43,12 +43,16 @@ double chartScale(const Chart& chart, double density) {
     return chart.kind == ChartKind::DegenerateCells ? 1.0 : density;
 }
 
-// Charts are placed in one of kOrientations orientations: quarter turns of their min-area-rect
-// alignment (k < 4), and for meshes of few charts also of that rotated by 45 degrees (k >= 4),
-// which lets round charts nest in more ways (with many charts the packer has choice enough).
+// Charts are placed in one of kOrientations orientations: quarter turns (k % 4) of their
+// min-area-rect alignment rotated by (k / 4) * 22.5 degrees. Meshes of few charts also try 45
+// degrees, of fewer still 22.5 and 67.5, which lets round and curved charts nest in more ways
+// (with many charts the packer has choice enough).
 constexpr size_t kEighthTurnsUpToCharts = 24;
+constexpr size_t kSixteenthTurnsUpToCharts = 16;
+constexpr uint32_t kFrames = kOrientations / 4;
 
-// A chart rotated by 0 or 45 degrees: where its local coordinates start and how far they reach.
+// A chart rotated by a multiple of 22.5 degrees: where its local coordinates start and how far
+// they reach.
 struct ChartFrame {
     glm::dvec2 low{0.0}, extent{0.0};
     glm::uvec2 content{0};
@@ -56,24 +60,26 @@ struct ChartFrame {
 
 struct Layout {
     OutlinePack pack;
-    std::vector<std::array<ChartFrame, 2>> frames;
+    std::vector<std::array<ChartFrame, kFrames>> frames;
 };
 
-glm::dvec2 eighthTurn(glm::dvec2 p, uint32_t eighths) {
-    if (eighths == 0) return p;
-    const double h = std::sqrt(0.5);
-    return glm::dvec2(h * (p.x - p.y), h * (p.x + p.y));
+// Rotation by `step` of kFrames steps of a quarter turn.
+glm::dvec2 frameTurn(glm::dvec2 p, uint32_t step) {
+    if (step == 0) return p;
+    double a = 0.5 * 3.14159265358979323846 * double(step) / double(kFrames);
+    double c = std::cos(a), s = std::sin(a);
+    return glm::dvec2(c * p.x - s * p.y, s * p.x + c * p.y);
 }
 
-ChartFrame chartFrame(const ChartedMesh& charted, const Chart& chart, uint32_t eighths,
+ChartFrame chartFrame(const ChartedMesh& charted, const Chart& chart, uint32_t step,
                       double density) {
     ChartFrame f;
-    if (eighths == 0) {
+    if (step == 0) {
         f.extent = chart.extent;
     } else {
         glm::dvec2 lo(1e300), hi(-1e300);
         for (uint32_t v = chart.firstVertex; v < chart.firstVertex + chart.vertexCount; ++v) {
-            glm::dvec2 r = eighthTurn(charted.local[v], eighths);
+            glm::dvec2 r = frameTurn(charted.local[v], step);
             lo = glm::min(lo, r), hi = glm::max(hi, r);
         }
         f.low = lo, f.extent = hi - lo;
@@ -98,11 +104,11 @@ std::vector<std::vector<uint32_t>> chartTriangles(const ChartedMesh& charted) {
 
 // A chart vertex in shadels inside the content box of orientation k: spare space split evenly.
 glm::dvec2 orientedPosition(const ChartedMesh& charted, const Chart& chart, uint32_t vertex,
-                            const std::array<ChartFrame, 2>& frames, uint32_t k, double density) {
+                            const std::array<ChartFrame, kFrames>& frames, uint32_t k, double density) {
     const ChartFrame& f = frames[k / 4];
     double scale = chartScale(chart, density);
     glm::dvec2 centring = (glm::dvec2(f.content) - f.extent * scale) * 0.5;
-    glm::dvec2 q = (eighthTurn(charted.local[vertex], k / 4) - f.low) * scale + centring;
+    glm::dvec2 q = (frameTurn(charted.local[vertex], k / 4) - f.low) * scale + centring;
     return turnQuarter(q, glm::dvec2(f.content), k % 4);
 }
 
@@ -115,16 +121,20 @@ Layout layoutCharts(const ChartedMesh& charted, const std::vector<std::vector<ui
     std::vector<std::array<ChartOutline, kOrientations>> outlines(charted.charts.size());
     std::vector<glm::dvec2> corners;
     bool eighthTurns = charted.charts.size() <= kEighthTurnsUpToCharts;
+    bool sixteenthTurns = charted.charts.size() <= kSixteenthTurnsUpToCharts;
     for (size_t c = 0; c < charted.charts.size(); ++c) {
         const Chart& chart = charted.charts[c];
-        std::array<ChartFrame, 2> frames;
+        std::array<ChartFrame, kFrames> frames;
         frames[0] = chartFrame(charted, chart, 0, density);
         bool turnable = eighthTurns && chart.kind != ChartKind::DegenerateCells;
-        if (turnable) frames[1] = chartFrame(charted, chart, 1, density);
+        // Frames left out keep a zero extent, and their outlines width 0 (never tried).
+        for (uint32_t r = 1; r < kFrames && turnable; ++r)
+            if (r == kFrames / 2 || sixteenthTurns) frames[r] = chartFrame(charted, chart, r, density);
         layout.frames.push_back(frames);
         glm::uvec2 content = frames[0].content;
         rects.push_back({content.x + 2 * gutter, content.y + 2 * gutter});
         for (uint32_t k = 0; k < (turnable ? kOrientations : 4); ++k) {
+            if (k >= 4 && frames[k / 4].content == glm::uvec2(0)) continue;
             corners.clear();
             for (uint32_t t : triangles[c])
                 for (uint32_t i = 0; i < 3; ++i)

@@ -19,7 +19,7 @@
 namespace shadel {
 
 // Orientations a chart may be packed in (the caller defines them; see bake.cpp).
-constexpr uint32_t kOrientations = 8;
+constexpr uint32_t kOrientations = 16;
 
 struct ChartOutline {
     uint32_t width = 0, height = 0; // gutters included
