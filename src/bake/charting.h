@@ -3,9 +3,13 @@
 // and gives every chart vertex a 2-D coordinate in metres. Scale-free: packing decides density.
 //
 // Charts grow over triangles within a normal cone (developable enough to flatten), are flattened
-// by a least-squares conformal map (lscm.h) and accepted when no triangle folds, the chart does
-// not overlap itself and its stretch (stretch.h) stays within the bound bake_validate.h checks;
-// otherwise they are cut in two and retried. Small pieces that still fail fall back to planar
+// by a least-squares conformal map (lscm.h, with an ARAP rescue, arap.h) and accepted when no
+// triangle folds, the chart does not overlap itself and its stretch (stretch.h) stays within the
+// bound bake_validate.h checks; otherwise they are cut in two and retried. Growth first uses a
+// wide cone; a wide chart that does not flatten whole is also regrown with the narrow cone, and
+// whichever gives fewer charts is kept. Per-chart density deviation is allowed a loose bound as
+// long as the whole mesh's density CV stays below bake_validate.h's, else the mesh is charted
+// again with a bound that guarantees it. Small pieces that still fail fall back to planar
 // projection, which never folds for triangles facing the projection axis.
 #include <cstdint>
 #include <vector>
