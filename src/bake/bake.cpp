@@ -1,6 +1,7 @@
 #include "bake/bake.h"
 
 #include <algorithm>
+#include <array>
 #include <atomic>
 #include <chrono>
 #include <cmath>
@@ -14,6 +15,7 @@
 
 #include "bake/bake_cache.h"
 #include "bake/cache_eviction.h"
+#include "bake/chart_packing.h"
 #include "bake/charting.h"
 #include "bake/id_map.h"
 #include "bake/packing.h"
@@ -44,38 +46,132 @@ double chartScale(const Chart& chart, double density) {
     return chart.kind == ChartKind::DegenerateCells ? 1.0 : density;
 }
 
-struct Layout {
-    PackResult pack;
-    std::vector<glm::uvec2> content;
+// Charts are placed in one of kOrientations orientations: quarter turns (k % 4) of their
+// min-area-rect alignment rotated by (k / 4) * 22.5 degrees. Meshes of few charts also try 45
+// degrees, of fewer still 22.5 and 67.5, which lets round and curved charts nest in more ways
+// (with many charts the packer has choice enough).
+constexpr size_t kEighthTurnsUpToCharts = 24;
+constexpr size_t kSixteenthTurnsUpToCharts = 16;
+constexpr uint32_t kFrames = kOrientations / 4;
+
+// A chart rotated by a multiple of 22.5 degrees: where its local coordinates start and how far
+// they reach.
+struct ChartFrame {
+    glm::dvec2 low{0.0}, extent{0.0};
+    glm::uvec2 content{0};
 };
 
-Layout layoutCharts(const ChartedMesh& charted, double density, uint32_t gutter) {
+struct Layout {
+    OutlinePack pack;
+    std::vector<std::array<ChartFrame, kFrames>> frames;
+};
+
+// Rotation by `step` of kFrames steps of a quarter turn.
+glm::dvec2 frameTurn(glm::dvec2 p, uint32_t step) {
+    if (step == 0) return p;
+    double a = 0.5 * 3.14159265358979323846 * double(step) / double(kFrames);
+    double c = std::cos(a), s = std::sin(a);
+    return glm::dvec2(c * p.x - s * p.y, s * p.x + c * p.y);
+}
+
+ChartFrame chartFrame(const ChartedMesh& charted, const Chart& chart, uint32_t step,
+                      double density) {
+    ChartFrame f;
+    if (step == 0) {
+        f.extent = chart.extent;
+    } else {
+        glm::dvec2 lo(1e300), hi(-1e300);
+        for (uint32_t v = chart.firstVertex; v < chart.firstVertex + chart.vertexCount; ++v) {
+            glm::dvec2 r = frameTurn(charted.local[v], step);
+            lo = glm::min(lo, r), hi = glm::max(hi, r);
+        }
+        f.low = lo, f.extent = hi - lo;
+    }
+    Chart rotated = chart;
+    rotated.extent = f.extent;
+    f.content = contentSize(rotated, density);
+    return f;
+}
+
+// Triangles of each chart (a chart's baked vertices are contiguous, so its first corner says).
+std::vector<std::vector<uint32_t>> chartTriangles(const ChartedMesh& charted) {
+    std::vector<uint32_t> chartOfVertex(charted.local.size(), 0);
+    for (uint32_t c = 0; c < charted.charts.size(); ++c)
+        for (uint32_t v = 0; v < charted.charts[c].vertexCount; ++v)
+            chartOfVertex[charted.charts[c].firstVertex + v] = c;
+    std::vector<std::vector<uint32_t>> triangles(charted.charts.size());
+    for (uint32_t t = 0; t < charted.indices.size() / 3; ++t)
+        triangles[chartOfVertex[charted.indices[3 * t]]].push_back(t);
+    return triangles;
+}
+
+// A chart vertex in shadels inside the content box of orientation k: spare space split evenly.
+glm::dvec2 orientedPosition(const ChartedMesh& charted, const Chart& chart, uint32_t vertex,
+                            const std::array<ChartFrame, kFrames>& frames, uint32_t k, double density) {
+    const ChartFrame& f = frames[k / 4];
+    double scale = chartScale(chart, density);
+    glm::dvec2 centring = (glm::dvec2(f.content) - f.extent * scale) * 0.5;
+    glm::dvec2 q = (frameTurn(charted.local[vertex], k / 4) - f.low) * scale + centring;
+    return turnQuarter(q, glm::dvec2(f.content), k % 4);
+}
+
+// Packs the charts by their outlines (chart_packing.h); padded bounding rectangles
+// (packing.h) are kept instead when they happen to pack smaller, so shapes never lose.
+Layout layoutCharts(const ChartedMesh& charted, const std::vector<std::vector<uint32_t>>& triangles,
+                    double density, uint32_t gutter) {
     Layout layout;
     std::vector<PackRect> rects;
-    rects.reserve(charted.charts.size());
-    for (const Chart& chart : charted.charts) {
-        glm::uvec2 c = contentSize(chart, density);
-        layout.content.push_back(c);
-        rects.push_back({c.x + 2 * gutter, c.y + 2 * gutter});
+    std::vector<std::array<ChartOutline, kOrientations>> outlines(charted.charts.size());
+    std::vector<glm::dvec2> corners;
+    bool eighthTurns = charted.charts.size() <= kEighthTurnsUpToCharts;
+    bool sixteenthTurns = charted.charts.size() <= kSixteenthTurnsUpToCharts;
+    for (size_t c = 0; c < charted.charts.size(); ++c) {
+        const Chart& chart = charted.charts[c];
+        std::array<ChartFrame, kFrames> frames;
+        frames[0] = chartFrame(charted, chart, 0, density);
+        bool turnable = eighthTurns && chart.kind != ChartKind::DegenerateCells;
+        // Frames left out keep a zero extent, and their outlines width 0 (never tried).
+        for (uint32_t r = 1; r < kFrames && turnable; ++r)
+            if (r == kFrames / 2 || sixteenthTurns) frames[r] = chartFrame(charted, chart, r, density);
+        layout.frames.push_back(frames);
+        glm::uvec2 content = frames[0].content;
+        rects.push_back({content.x + 2 * gutter, content.y + 2 * gutter});
+        for (uint32_t k = 0; k < (turnable ? kOrientations : 4); ++k) {
+            if (k >= 4 && frames[k / 4].content == glm::uvec2(0)) continue;
+            corners.clear();
+            for (uint32_t t : triangles[c])
+                for (uint32_t i = 0; i < 3; ++i)
+                    corners.push_back(orientedPosition(charted, chart, charted.indices[3 * t + i],
+                                                       frames, k, density));
+            glm::uvec2 box = frames[k / 4].content;
+            if (k % 2) box = glm::uvec2(box.y, box.x);
+            outlines[c][k] = chartOutline(corners, box, gutter);
+        }
     }
-    layout.pack = packNearSquare(rects, kChunk);
+    layout.pack = packOutlines(outlines, gutter, kChunk);
+    PackResult boxes = packNearSquare(rects, kChunk);
+    if (boxes.width != 0 &&
+        uint64_t(boxes.width) * boxes.height < uint64_t(layout.pack.width) * layout.pack.height) {
+        layout.pack.width = boxes.width, layout.pack.height = boxes.height;
+        for (size_t c = 0; c < rects.size(); ++c)
+            layout.pack.placements[c] = {boxes.placements[c].x + gutter,
+                                         boxes.placements[c].y + gutter,
+                                         boxes.placements[c].turned ? 1u : 0u};
+    }
     return layout;
 }
 
 // Chart-local coordinates -> shadel UVs of the packed rect (width x height shadels).
 std::vector<glm::vec2> placeCharts(const ChartedMesh& charted, const Layout& layout, double density,
-                                   uint32_t gutter, uint32_t width, uint32_t height) {
+                                   uint32_t width, uint32_t height) {
     std::vector<glm::vec2> uv(charted.local.size());
     for (size_t c = 0; c < charted.charts.size(); ++c) {
         const Chart& chart = charted.charts[c];
-        const PackPlacement& place = layout.pack.placements[c];
-        double scale = chartScale(chart, density);
-        glm::dvec2 content(layout.content[c]);
-        glm::dvec2 centring = (content - chart.extent * scale) * 0.5; // spare space split evenly
-        glm::dvec2 origin(place.x + gutter, place.y + gutter);
+        const OutlinePlacement& place = layout.pack.placements[c];
+        glm::dvec2 origin(place.x, place.y);
         for (uint32_t v = chart.firstVertex; v < chart.firstVertex + chart.vertexCount; ++v) {
-            glm::dvec2 q = charted.local[v] * scale + centring;
-            if (place.turned) q = glm::dvec2(q.y, content.x - q.x); // quarter turn, no mirror
+            glm::dvec2 q =
+                orientedPosition(charted, chart, v, layout.frames[c], place.orientation, density);
             glm::dvec2 texel = origin + q;
             uv[v] = glm::vec2(float(texel.x / width), float(texel.y / height));
             uv[v] = glm::clamp(uv[v], glm::vec2(0.0f), glm::vec2(1.0f));
@@ -110,6 +206,13 @@ BakedMesh bakeMesh(const Mesh& mesh, const BakeSettings& settings) {
     out.degenerateTriangles = charted.degenerateTriangles;
     out.surfaceArea = charted.surfaceArea;
     out.chartCount = uint32_t(charted.charts.size());
+    double stretchArea = 0, stretchSum = 0;
+    for (const Chart& chart : charted.charts) {
+        if (chart.kind == ChartKind::DegenerateCells) continue;
+        stretchArea += chart.surfaceArea, stretchSum += chart.surfaceArea * chart.meanStretch;
+        out.maxStretch = std::max(out.maxStretch, float(chart.maxStretch));
+    }
+    if (stretchArea > 0) out.meanStretch = float(stretchSum / stretchArea);
     out.vertexRemap = std::move(charted.vertexRemap);
     out.indices = charted.indices;
 
@@ -129,8 +232,9 @@ BakedMesh bakeMesh(const Mesh& mesh, const BakeSettings& settings) {
     double density = settings.shadelsPerMetre;
     int growthsToMinimum = 0;
     IdMapStats stats0;
+    std::vector<std::vector<uint32_t>> triangles = chartTriangles(charted);
     for (int attempt = 0;; ++attempt) {
-        Layout layout = layoutCharts(charted, density, gutter);
+        Layout layout = layoutCharts(charted, triangles, density, gutter);
         uint32_t packedSide = std::max(layout.pack.width, layout.pack.height);
         if (packedSide > maxResolution) {
             if (attempt > 40 || density < 1e-9)
@@ -149,7 +253,7 @@ BakedMesh bakeMesh(const Mesh& mesh, const BakeSettings& settings) {
         }
         uint32_t width = std::max(layout.pack.width, minResolution);
         uint32_t height = std::max(layout.pack.height, minResolution);
-        std::vector<glm::vec2> uv = placeCharts(charted, layout, density, gutter, width, height);
+        std::vector<glm::vec2> uv = placeCharts(charted, layout, density, width, height);
         options.forceOwnership = true;
         std::vector<uint16_t> level0 = buildIdMap(uv, out.indices, width, height, options, &stats0);
         bool canGrow = std::max(width, height) < maxResolution && attempt < 40;
@@ -304,6 +408,7 @@ std::vector<BakedMesh> bakeScene(const Scene& scene, const BakeSettings& setting
 std::string bakeReport(const std::vector<BakedMesh>& meshes, double wallSeconds) {
     uint64_t triangles = 0, charts = 0, shadels = 0, covered = 0, degenerate = 0, forced = 0,
              unowned = 0;
+    double stretchArea = 0, stretchSum = 0, maxStretch = 1;
     size_t fromCache = 0;
     double bakeSeconds = 0, area = 0;
     uint32_t maxSide = 0, mips = 0;
@@ -317,6 +422,8 @@ std::string bakeReport(const std::vector<BakedMesh>& meshes, double wallSeconds)
         fromCache += m.fromCache;
         bakeSeconds += m.bakeSeconds;
         area += m.surfaceArea;
+        stretchArea += m.surfaceArea, stretchSum += m.surfaceArea * m.meanStretch;
+        maxStretch = std::max(maxStretch, double(m.maxStretch));
         maxSide = std::max({maxSide, m.width, m.height});
         mips = std::max(mips, m.mipCount());
     }
@@ -330,6 +437,8 @@ std::string bakeReport(const std::vector<BakedMesh>& meshes, double wallSeconds)
                 (unsigned long long)shadels, maxSide, mips);
     r += format("utilisation: %.1f%% (covered / allocated MIP-0 shadels)\n",
                 shadels ? 100.0 * double(covered) / double(shadels) : 0.0);
+    r += format("stretch: mean %.3f, max %.3f (shadel spacing on the surface / requested)\n",
+                stretchArea > 0 ? stretchSum / stretchArea : 1.0, maxStretch);
     r += format("surface: %.3f m^2\n", area);
     r += format("bake time: %.2f s wall, %.2f s summed over meshes\n", wallSeconds, bakeSeconds);
     return r;

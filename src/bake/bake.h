@@ -2,14 +2,15 @@
 // Shadel baking: a unique chart atlas ("shadel UVs") and per-MIP triangle-ID maps per mesh.
 //
 // Resolution and blocks. A mesh's charts are laid out at `shadelsPerMetre` shadels per metre of
-// object-space surface, packed with gutters into a near-square rect whose sides are rounded up to
-// multiples of 8 (one chunk) and clamped to [minResolution, maxResolution]. The renderer places
-// the object in the virtual sheet in 64x64-shadel blocks: at MIP k the object needs
-// ceil((width >> k) / 64) x ceil((height >> k) / 64) blocks, and once a side drops below 64 it is
-// snapped up to one block (the seed's snapping of small MIPs). The density is raised above the
-// setting only when needed: for tiny objects (to fill minResolution) and for meshes whose
-// triangles are too small for each to own a shadel at MIP 0; lowered only to fit maxResolution.
-// BakedMesh::shadelsPerMetre is the density actually used.
+// object-space surface (at most: conformal charts are scaled never to magnify, so parts of them
+// get up to stretch^2 fewer shadels per m^2, see stretch.h), packed with gutters into a near-square
+// rect whose sides are rounded up to multiples of 8 (one chunk) and clamped to [minResolution,
+// maxResolution]. The renderer places the object in the virtual sheet in 64x64-shadel blocks: at
+// MIP k the object needs ceil((width >> k) / 64) x ceil((height >> k) / 64) blocks, and once a side
+// drops below 64 it is snapped up to one block (the seed's snapping of small MIPs). The density is
+// raised above the setting only when needed: for tiny objects (to fill minResolution) and for
+// meshes whose triangles are too small for each to own a shadel at MIP 0; lowered only to fit
+// maxResolution. BakedMesh::shadelsPerMetre is the density actually used.
 //
 // MIP levels. ID maps exist for levels k = 0 .. mipCount-1 with mipCount = 1 + floor(log2(
 // min(width, height) / 8)): the coarsest level is the first where a side is one chunk (8).
@@ -18,17 +19,19 @@
 // over-shades by a bounded amount). The packer keeps rects near-square so both sides hit 8
 // together.
 //
-// Gutters. Each chart's rect is padded by gutterShadels on every side, so charts are >= 2*g MIP-0
-// shadels apart and >= g from the rect border. A bilinear tap at MIP k reads shadels whose
-// centres lie within 2^k MIP-0 shadels of the sample, so two charts never compete for a shadel
-// the filter reads while 2 * 2^k <= 2 * g, i.e. for all k <= log2(g) (g = 2: MIPs 0 and 1, and the
-// trilinear blend between them). Every level's ID map is flooded: each empty shadel near a
-// chart takes the ID of the *nearest* triangle (true 2-D distance, not flood steps), so within
-// the clean levels every shadel a filter reads belongs to the sampled chart and extrapolates the
-// right surface. Coarser levels can mix neighbouring charts in shared shadels (the usual mipmap
-// chart bleeding) but every shadel the filter reads still has a valid ID, so shading never reads
-// an unshaded shadel. The renderer must clamp shadel coordinates to [0, (W>>k) - 1] so taps on
-// the rect border never leave the object's rect at coarse levels.
+// Gutters. Charts are packed by their outlines: the shadels they touch grown by gutterShadels on
+// every side (chart_packing.h), and outlines never overlap, so charts are >= 2*g MIP-0 shadels
+// apart. Outlines may overhang the rect border (a chart may touch it): the renderer clamps taps
+// to the rect, so a tap past the border reads the chart's own border shadel. A bilinear tap at MIP
+// k reads shadels whose centres lie within 2^k MIP-0 shadels of the sample, so two charts never
+// compete for a shadel the filter reads while 2 * 2^k <= 2 * g, i.e. for all k <= log2(g) (g = 2:
+// MIPs 0 and 1, and the trilinear blend between them). Every level's ID map is flooded: each empty
+// shadel near a chart takes the ID of the *nearest* triangle (true 2-D distance, not flood steps),
+// so within the clean levels every shadel a filter reads belongs to the sampled chart and
+// extrapolates the right surface. Coarser levels can mix neighbouring charts in shared shadels (the
+// usual mipmap chart bleeding) but every shadel the filter reads still has a valid ID, so shading
+// never reads an unshaded shadel. The renderer must clamp shadel coordinates to [0, (W>>k) - 1] so
+// taps on the rect border never leave the object's rect at coarse levels.
 #include <cstdint>
 #include <functional>
 #include <string>
@@ -71,7 +74,10 @@ struct BakedMesh {
     uint32_t forcedTriangles = 0;     // triangles that got their MIP-0 shadel by force-assignment
     uint32_t unownedTriangles = 0;    // triangles with no MIP-0 shadel (0 unless maxResolution hit)
     double surfaceArea = 0;           // object-space m^2 of non-degenerate triangles
-    double bakeSeconds = 0;           // wall time of the bake (or of the cache load)
+    // Shadel spacing on the surface relative to the density, over chart triangles (1 = no
+    // distortion; stretch.h): area-weighted mean and worst chart.
+    float meanStretch = 1, maxStretch = 1;
+    double bakeSeconds = 0; // wall time of the bake (or of the cache load)
     bool fromCache = false;
 
     uint32_t mipCount() const { return uint32_t(idMaps.size()); }

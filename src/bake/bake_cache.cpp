@@ -113,6 +113,7 @@ std::vector<uint8_t> serializePayload(const BakedMesh& b) {
     w.put(b.degenerateTriangles), w.put(b.forcedTriangles), w.put(b.unownedTriangles);
     w.put(uint32_t(b.idMaps.size()));
     w.put(b.utilisation), w.put(b.shadelsPerMetre), w.put(b.surfaceArea);
+    w.put(b.meanStretch), w.put(b.maxStretch);
     w.put(uint64_t(b.vertexRemap.size()));
     w.putArray(b.vertexRemap);
     w.putArray(b.shadelUv);
@@ -134,11 +135,15 @@ bool parsePayload(const uint8_t* data, size_t size, const Mesh& mesh, BakedMesh&
     if (!r.get(b.width) || !r.get(b.height) || !r.get(b.chartCount) || !r.get(b.triangleCount) ||
         !r.get(b.degenerateTriangles) || !r.get(b.forcedTriangles) || !r.get(b.unownedTriangles) ||
         !r.get(mipCount) || !r.get(b.utilisation) || !r.get(b.shadelsPerMetre) ||
-        !r.get(b.surfaceArea) || !r.get(vertexCount))
+        !r.get(b.surfaceArea) || !r.get(b.meanStretch) || !r.get(b.maxStretch) ||
+        !r.get(vertexCount))
         return fail("truncated header fields");
     if (b.width == 0 || b.height == 0 || b.width % 8 || b.height % 8 || b.width > 65536 ||
         b.height > 65536 || mipCount != bakedMipCount(b.width, b.height))
         return fail("bad resolution");
+    if (!(b.meanStretch >= 0.999f && b.maxStretch >= 0.999f * b.meanStretch &&
+          std::isfinite(b.maxStretch)))
+        return fail("bad stretch");
     if (b.triangleCount != mesh.triangleCount() || vertexCount > mesh.indices.size())
         return fail("does not match the mesh");
     if (!r.getArray(b.vertexRemap, vertexCount) || !r.getArray(b.shadelUv, vertexCount) ||

@@ -14,7 +14,10 @@
 namespace shadel {
 
 // Bump whenever the bake output for the same input can change (algorithm or layout).
-constexpr uint32_t kBakeFormatVersion = 1;
+constexpr uint32_t kBakeFormatVersion = 5; // 2: conformal charts, outline packing, stretch;
+                                           // 3: charts bounded by the mesh density CV;
+                                           // 4: waste-aware packing of few charts;
+                                           // 5: 22.5-degree orientations
 
 struct BakeKey {
     uint64_t lo = 0, hi = 0;

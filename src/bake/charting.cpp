@@ -6,6 +6,9 @@
 #include <numeric>
 #include <unordered_map>
 
+#include "bake/arap.h"
+#include "bake/lscm.h"
+#include "bake/stretch.h"
 #include "core/error.h"
 #include "core/log.h"
 
@@ -13,6 +16,7 @@ namespace shadel {
 namespace {
 
 constexpr uint32_t kNone = ~0u;
+constexpr uint32_t kOutside = ~0u - 1; // growCharts: triangle not in the subset being grown
 // A chart filling less than this fraction of its bounding rectangle is cut in two.
 constexpr double kMinRectFill = 0.5;
 constexpr size_t kMinTrianglesToSplitForFill = 8;
@@ -20,6 +24,29 @@ constexpr size_t kMinTrianglesToSplitForFill = 8;
 constexpr double kMinSplitGain = 0.8;
 // Charts of at most this many triangles try to merge into a neighbour after growth.
 constexpr size_t kSmallChartTriangles = 16;
+// Charts grow over a wider normal cone than planar projection could take: a conformal map unrolls
+// curved patches that a projection would squash. The stretch check decides what is kept, so the
+// cone only has to keep charts far from closing on themselves. Growth first tries the wide cone
+// (fewer, bigger charts on smooth curved surfaces); a wide chart that does not flatten is grown
+// again with the narrow one within its own triangles before any cutting in halves (halves of a
+// wide chart are worse charts than narrow growth makes).
+constexpr double kConformalExtraConeDegrees = 25;
+constexpr double kWideConformalExtraConeDegrees = 35;
+constexpr double kMaxGrowthConeDegrees = 75;
+// Conformal charts are accepted up to the planar stretch bound (1/cos(cone + 10), what
+// bake_validate.h checks), with a margin, and while their density stays within a deviation of the
+// requested one (ChartDistortion::densityDeviation). kSafeChartDensityDeviation = 0.16 bounds the
+// mesh's density coefficient of variation by 0.16 / 0.84 = 0.19 <= 0.2 whatever the charts; the
+// first attempt allows kLooseChartDensityDeviation per chart (bigger charts, less gutter) and is
+// kept only if the mesh's CV, measured over all charts, stays within kMaxMeshDensityCv; else the
+// mesh is charted again with the safe bound.
+constexpr double kStretchMargin = 0.99;
+constexpr double kSafeChartDensityDeviation = 0.16;
+constexpr double kLooseChartDensityDeviation = 0.2;
+// Below bake_validate.h's 0.2: UVs are rounded to float and chart placement to shadels.
+constexpr double kMaxMeshDensityCv = 0.18;
+// Local/global iterations of the ARAP rescue (arap.h); it converges fast from an LSCM start.
+constexpr int kArapIterations = 8;
 
 struct TriangleInfo {
     glm::dvec3 normal{0.0};
@@ -271,10 +298,17 @@ glm::dvec2 alignToMinAreaRect(std::vector<glm::dvec2>& coords) {
 
 class Charter {
 public:
-    Charter(const Mesh& mesh, const ChartingSettings& settings)
-        : mesh_(mesh), cosCone_(std::cos(glm::radians(double(settings.coneDegrees)))),
-          cosKeep_(std::cos(glm::radians(std::min(double(settings.coneDegrees) + 10.0, 80.0)))),
-          mergeLimit_(glm::radians(std::min(double(settings.coneDegrees) + 5.0, 75.0))) {}
+    Charter(const Mesh& mesh, const ChartingSettings& settings, double maxChartDensityDeviation)
+        : mesh_(mesh), maxChartDensityDeviation_(maxChartDensityDeviation) {
+        double cone = double(settings.coneDegrees);
+        narrowGrowth_ = std::min(cone + kConformalExtraConeDegrees, kMaxGrowthConeDegrees);
+        wideGrowth_ = std::min(cone + kWideConformalExtraConeDegrees, kMaxGrowthConeDegrees);
+        // Merging only absorbs slivers left between charts; across creases (box edges) it would
+        // make folded nets that pack worse than their faces, so it keeps the planar bound.
+        mergeLimit_ = glm::radians(std::min(cone + 5.0, 75.0));
+        cosPlanar_ = std::cos(glm::radians(std::min(cone + 10.0, 80.0)));
+        maxConformalStretch_ = kStretchMargin / cosPlanar_;
+    }
 
     ChartedMesh run();
 
@@ -284,25 +318,49 @@ private:
         return weldPosition_[weld_[mesh_.indices[3 * t + corner]]];
     }
     void classifyTriangles();
-    std::vector<std::vector<uint32_t>> growCharts();
+    // Charts grown over `subset` (non-degenerate triangles) within a cone of growthDegrees.
+    std::vector<std::vector<uint32_t>> growCharts(std::vector<uint32_t> subset,
+                                                  double growthDegrees);
     void mergeSmallCharts(std::vector<std::vector<uint32_t>>& charts,
                           std::vector<uint32_t>& chartOf);
     std::vector<std::vector<uint32_t>> connectedPieces(const std::vector<uint32_t>& tris);
-    void flattenAndEmit(std::vector<uint32_t> tris);
+    // A flattened piece, accepted as a chart.
+    struct Flattened {
+        std::vector<uint32_t> tris;
+        std::vector<glm::dvec2> corners;
+        ChartKind kind = ChartKind::Conformal;
+        ChartDistortion distortion;
+    };
+    void flattenPieces(std::vector<std::vector<uint32_t>> work, std::vector<Flattened>& charts);
+    void chartPiece(std::vector<uint32_t> piece, bool wide);
+    bool flattenConformal(const std::vector<uint32_t>& tris, std::vector<glm::dvec2>& corners,
+                          ChartDistortion& distortion);
+    bool flattenPlanar(const std::vector<uint32_t>& tris, std::vector<glm::dvec2>& corners,
+                       ChartDistortion& distortion);
+    std::vector<glm::dvec3> surfaceCorners(const std::vector<uint32_t>& tris) const;
+    double subsetRectArea(const std::vector<uint32_t>& subset,
+                          const std::vector<glm::dvec2>& corners);
     void splitInHalves(const std::vector<uint32_t>& tris, std::vector<uint32_t>& lower,
                        std::vector<uint32_t>& upper) const;
-    double projectedRectArea(const std::vector<uint32_t>& tris) const;
-    void emitChart(const std::vector<uint32_t>& tris, const std::vector<glm::dvec2>& corners);
+    void emitChart(const std::vector<uint32_t>& tris, const std::vector<glm::dvec2>& corners,
+                   ChartKind kind, const ChartDistortion& distortion);
     void emitDegenerateCells();
 
     const Mesh& mesh_;
-    double cosCone_, cosKeep_, mergeLimit_; // mergeLimit_ in radians
+    double maxChartDensityDeviation_;
+    double narrowGrowth_, wideGrowth_;      // growth cones, degrees
+    double mergeLimit_;                     // radians
+    std::vector<uint32_t> chartOf_;         // per triangle, scratch of growCharts
+    double cosPlanar_;                      // planar charts: every normal within this of the axis
+    double maxConformalStretch_;
     std::vector<uint32_t> weld_;
     std::vector<glm::dvec3> weldPosition_;
     std::vector<TriangleInfo> tris_;
     std::vector<uint32_t> neighbour_;
     std::vector<uint32_t> stamp_; // per triangle, scratch membership marks
     uint32_t stampValue_ = 0;
+    std::vector<uint32_t> localOf_;     // per welded vertex, scratch: its index in a patch
+    std::vector<uint32_t> slotOf_;      // per triangle, scratch: its index in the piece flattened
     std::vector<uint32_t> vertexStamp_; // per source vertex: chart index + 1 that baked it
     std::vector<uint32_t> vertexBaked_; // per source vertex: its baked vertex in that chart
     ChartedMesh out_;
@@ -334,16 +392,16 @@ void Charter::classifyTriangles() {
     }
 }
 
-std::vector<std::vector<uint32_t>> Charter::growCharts() {
-    uint32_t n = uint32_t(tris_.size());
-    std::vector<uint32_t> pending;
-    for (uint32_t t = 0; t < n; ++t)
-        if (!tris_[t].degenerate) pending.push_back(t);
+std::vector<std::vector<uint32_t>> Charter::growCharts(std::vector<uint32_t> pending,
+                                                       double growthDegrees) {
+    double cosCone = std::cos(glm::radians(growthDegrees));
+    double cosKeep = std::cos(glm::radians(growthDegrees + 10.0));
     // Seed from the largest triangles so big flat regions become big charts.
     std::stable_sort(pending.begin(), pending.end(),
                      [&](uint32_t a, uint32_t b) { return tris_[a].area > tris_[b].area; });
-
-    std::vector<uint32_t> chartOf(n, kNone);
+    // Triangles outside the subset stay kOutside, so growth never enters them.
+    std::vector<uint32_t>& chartOf = chartOf_;
+    for (uint32_t t : pending) chartOf[t] = kNone;
     std::vector<std::vector<uint32_t>> charts;
     std::vector<uint32_t> members;
     std::vector<std::pair<double, uint32_t>> frontier; // max-heap on alignment with the mean
@@ -373,7 +431,7 @@ std::vector<std::vector<uint32_t>> Charter::growCharts() {
                 frontier.pop_back();
                 if (chartOf[u] != kNone) continue;
                 glm::dvec3 nu = tris_[u].normal;
-                if (glm::dot(nu, glm::normalize(sum)) < cosCone_) continue;
+                if (glm::dot(nu, glm::normalize(sum)) < cosCone) continue;
                 chartOf[u] = id;
                 members.push_back(u);
                 sum += nu * tris_[u].area;
@@ -385,7 +443,7 @@ std::vector<std::vector<uint32_t>> Charter::growCharts() {
             std::vector<uint32_t> kept;
             kept.reserve(members.size());
             for (uint32_t t : members) {
-                if (t == seed || glm::dot(tris_[t].normal, axis) >= cosKeep_) {
+                if (t == seed || glm::dot(tris_[t].normal, axis) >= cosKeep) {
                     kept.push_back(t);
                 } else {
                     chartOf[t] = kNone;
@@ -397,6 +455,8 @@ std::vector<std::vector<uint32_t>> Charter::growCharts() {
         pending = std::move(retry);
     }
     mergeSmallCharts(charts, chartOf);
+    for (const std::vector<uint32_t>& chart : charts)
+        for (uint32_t t : chart) chartOf[t] = kOutside;
     return charts;
 }
 
@@ -433,7 +493,9 @@ void Charter::mergeSmallCharts(std::vector<std::vector<uint32_t>>& charts,
         for (uint32_t t : charts[s]) {
             for (uint32_t e = 0; e < 3; ++e) {
                 uint32_t u = neighbour_[3 * t + e];
-                if (u == kNone || chartOf[u] == s || chartOf[u] == best) continue;
+                if (u == kNone || chartOf[u] == kOutside || chartOf[u] == s ||
+                    chartOf[u] == best)
+                    continue;
                 uint32_t c = chartOf[u];
                 glm::dvec3 merged = sums[c] + sums[s];
                 if (!(glm::length(merged) > 0)) continue;
@@ -479,62 +541,164 @@ std::vector<std::vector<uint32_t>> Charter::connectedPieces(const std::vector<ui
     return pieces;
 }
 
-// Projects a connected piece on the plane of its mean normal. A planar projection of a piece
-// whose normals all lie in a cone cannot fold locally, but can still overlap globally (a ramp
-// that spirals); such pieces are cut in two across their longest extent until they do not.
-void Charter::flattenAndEmit(std::vector<uint32_t> initial) {
-    std::vector<std::vector<uint32_t>> work{std::move(initial)};
+std::vector<glm::dvec3> Charter::surfaceCorners(const std::vector<uint32_t>& tris) const {
+    std::vector<glm::dvec3> surface(tris.size() * 3);
+    for (size_t i = 0; i < tris.size(); ++i)
+        for (uint32_t c = 0; c < 3; ++c) surface[3 * i + c] = position(tris[i], c);
+    return surface;
+}
+
+// LSCM of a connected piece, on welded vertices so seam duplicates get one coordinate. Accepted
+// when no triangle folds, the stretch is within bounds and the piece does not overlap itself;
+// the corners are then scaled by 1 / maxSigma so the map never magnifies.
+bool Charter::flattenConformal(const std::vector<uint32_t>& tris, std::vector<glm::dvec2>& corners,
+                               ChartDistortion& distortion) {
+    std::vector<glm::dvec3> positions;
+    std::vector<uint32_t> triangles(tris.size() * 3);
+    std::vector<uint32_t> welded;
+    for (size_t i = 0; i < tris.size(); ++i) {
+        for (uint32_t c = 0; c < 3; ++c) {
+            uint32_t w = weld_[mesh_.indices[3 * tris[i] + c]];
+            if (localOf_[w] == kNone) {
+                localOf_[w] = uint32_t(positions.size());
+                positions.push_back(weldPosition_[w]);
+                welded.push_back(w);
+            }
+            triangles[3 * i + c] = localOf_[w];
+        }
+    }
+    for (uint32_t w : welded) localOf_[w] = kNone;
+    std::vector<glm::dvec2> uv;
+    if (!lscmFlatten(positions, triangles, uv)) return false;
+    // The solve is free to return the mirror image (triangles clockwise); mirror it back.
+    double signedArea = 0;
+    for (size_t k = 0; k < triangles.size(); k += 3) {
+        glm::dvec2 e1 = uv[triangles[k + 1]] - uv[triangles[k]];
+        glm::dvec2 e2 = uv[triangles[k + 2]] - uv[triangles[k]];
+        signedArea += e1.x * e2.y - e1.y * e2.x;
+    }
+    if (signedArea < 0)
+        for (glm::dvec2& q : uv) q.x = -q.x;
+    std::vector<glm::dvec3> surface = surfaceCorners(tris);
+    auto measure = [&](const std::vector<glm::dvec2>& flat) {
+        corners.resize(triangles.size());
+        for (size_t k = 0; k < triangles.size(); ++k) corners[k] = flat[triangles[k]];
+        distortion = measureDistortion(surface, corners);
+        return distortion.flippedTriangles == 0 && distortion.maxSigma > 0 &&
+               distortion.maxStretch() <= maxConformalStretch_ &&
+               distortion.densityDeviation() <= maxChartDensityDeviation_;
+    };
+    if (!measure(uv)) {
+        // Too much scale drift for a conformal map: as-rigid-as-possible trades it for mild
+        // anisotropy, which often brings a curved chart within bounds without cutting it.
+        if (!arapRefine(positions, triangles, uv, kArapIterations) || !measure(uv)) return false;
+    }
+    double scale = 1.0 / distortion.maxSigma;
+    for (glm::dvec2& c : corners) c *= scale;
+    return !pieceSelfOverlaps(corners);
+}
+
+// Projection on the plane of the piece's mean normal: cannot fold for triangles facing the axis
+// (all within cosPlanar_), but can still overlap globally (a ramp that spirals).
+bool Charter::flattenPlanar(const std::vector<uint32_t>& tris, std::vector<glm::dvec2>& corners,
+                            ChartDistortion& distortion) {
+    glm::dvec3 sum(0.0);
+    for (uint32_t t : tris) sum += tris_[t].normal * tris_[t].area;
+    glm::dvec3 axis = glm::length(sum) > 0 ? glm::normalize(sum) : tris_[tris[0]].normal;
+    glm::dvec3 u, v;
+    planeBasis(axis, u, v);
+    corners.resize(tris.size() * 3);
+    bool facing = true;
+    for (size_t i = 0; i < tris.size(); ++i) {
+        facing = facing && glm::dot(tris_[tris[i]].normal, axis) >= cosPlanar_;
+        for (uint32_t c = 0; c < 3; ++c) {
+            glm::dvec3 p = position(tris[i], c);
+            corners[3 * i + c] = glm::dvec2(glm::dot(p, u), glm::dot(p, v));
+        }
+    }
+    distortion = measureDistortion(surfaceCorners(tris), corners);
+    return tris.size() == 1 || (facing && !pieceSelfOverlaps(corners));
+}
+
+// Minimum-area rectangle of a subset of the piece whose corners were just flattened.
+double Charter::subsetRectArea(const std::vector<uint32_t>& subset,
+                               const std::vector<glm::dvec2>& corners) {
+    std::vector<glm::dvec2> points;
+    points.reserve(subset.size() * 3);
+    for (uint32_t t : subset)
+        for (uint32_t c = 0; c < 3; ++c) points.push_back(corners[3 * slotOf_[t] + c]);
+    return minAreaRect(points).area;
+}
+
+// Flattens connected pieces conformally, else by projection, else cuts them in two across their
+// longest extent and retries the halves. A single triangle always flattens.
+void Charter::flattenPieces(std::vector<std::vector<uint32_t>> work,
+                            std::vector<Flattened>& charts) {
     std::vector<glm::dvec2> corners;
     while (!work.empty()) {
         std::vector<uint32_t> tris = std::move(work.back());
         work.pop_back();
-        glm::dvec3 sum(0.0);
-        for (uint32_t t : tris) sum += tris_[t].normal * tris_[t].area;
-        glm::dvec3 axis = glm::length(sum) > 0 ? glm::normalize(sum) : tris_[tris[0]].normal;
-        glm::dvec3 u, v;
-        planeBasis(axis, u, v);
-        corners.resize(tris.size() * 3);
-        bool facing = true;
-        for (size_t i = 0; i < tris.size(); ++i) {
-            // Also re-checks the stretch bound: a part cut from a chart has its own mean normal.
-            facing = facing && glm::dot(tris_[tris[i]].normal, axis) >= cosKeep_;
-            for (uint32_t c = 0; c < 3; ++c) {
-                glm::dvec3 p = position(tris[i], c);
-                corners[3 * i + c] = glm::dvec2(glm::dot(p, u), glm::dot(p, v));
-            }
-        }
-        bool overlaps = tris.size() > 1 && (!facing || pieceSelfOverlaps(corners));
+        ChartDistortion distortion;
+        ChartKind kind = ChartKind::Conformal;
+        bool flat = tris.size() > 1 && flattenConformal(tris, corners, distortion);
+        if (!flat) kind = ChartKind::Planar, flat = flattenPlanar(tris, corners, distortion);
         std::vector<uint32_t> lower, upper;
-        if (overlaps || tris.size() >= kMinTrianglesToSplitForFill)
-            splitInHalves(tris, lower, upper);
-        if (overlaps) {
+        if (!flat || tris.size() >= kMinTrianglesToSplitForFill) splitInHalves(tris, lower, upper);
+        if (!flat) {
             for (auto* part : {&lower, &upper})
                 for (auto& piece : connectedPieces(*part)) work.push_back(std::move(piece));
             continue;
         }
         if (!lower.empty() && !upper.empty()) {
-            // Charts are packed by their bounding rectangles: a ring or a long curved strip wastes
-            // most of its rectangle. Cut it in two when the halves' rectangles are clearly
-            // smaller.
+            // Packing follows each chart's outline one column at a time, so a ring or a long
+            // curved strip still wastes its inside. Cut it in two when the halves' rectangles are
+            // clearly smaller.
             double area = 0;
             for (size_t i = 0; i < tris.size(); ++i) {
                 glm::dvec2 e1 = corners[3 * i + 1] - corners[3 * i],
                            e2 = corners[3 * i + 2] - corners[3 * i];
                 area += 0.5 * std::abs(e1.x * e2.y - e1.y * e2.x);
+                slotOf_[tris[i]] = uint32_t(i);
             }
             double rect = minAreaRect(corners).area;
             // Both halves must stay connected: pieces of one chart may only meet along shared
             // edges, else the gap between them would be narrower than a gutter.
             if (area < kMinRectFill * rect &&
-                projectedRectArea(lower) + projectedRectArea(upper) < kMinSplitGain * rect &&
+                subsetRectArea(lower, corners) + subsetRectArea(upper, corners) <
+                    kMinSplitGain * rect &&
                 connectedPieces(lower).size() == 1 && connectedPieces(upper).size() == 1) {
                 work.push_back(std::move(lower));
                 work.push_back(std::move(upper));
                 continue;
             }
         }
-        emitChart(tris, corners);
+        charts.push_back({std::move(tris), corners, kind, distortion});
     }
+}
+
+// Charts a connected piece grown with the wide cone (wide) or the narrow one. A wide piece that
+// does not flatten whole is cut in halves, and also grown again with the narrow cone within its
+// triangles; the way that makes fewer charts (less gutter), then less rectangle area, is kept.
+void Charter::chartPiece(std::vector<uint32_t> piece, bool wide) {
+    std::vector<Flattened> charts;
+    std::vector<uint32_t> copy = wide ? piece : std::vector<uint32_t>();
+    flattenPieces({std::move(piece)}, charts);
+    if (wide && charts.size() > 1) {
+        std::vector<std::vector<uint32_t>> regrown;
+        for (const std::vector<uint32_t>& grown : growCharts(std::move(copy), narrowGrowth_))
+            for (std::vector<uint32_t>& p : connectedPieces(grown)) regrown.push_back(std::move(p));
+        std::vector<Flattened> narrow;
+        flattenPieces(std::move(regrown), narrow);
+        auto rectArea = [](const std::vector<Flattened>& set) {
+            double sum = 0;
+            for (const Flattened& f : set) sum += minAreaRect(f.corners).area;
+            return sum;
+        };
+        if (narrow.size() < charts.size() ||
+            (narrow.size() == charts.size() && rectArea(narrow) < rectArea(charts)))
+            charts = std::move(narrow);
+    }
+    for (const Flattened& f : charts) emitChart(f.tris, f.corners, f.kind, f.distortion);
 }
 
 void Charter::splitInHalves(const std::vector<uint32_t>& tris, std::vector<uint32_t>& lower,
@@ -557,24 +721,18 @@ void Charter::splitInHalves(const std::vector<uint32_t>& tris, std::vector<uint3
         (i < keyed.size() / 2 ? lower : upper).push_back(keyed[i].second);
 }
 
-// Bounding-rectangle area of a set of triangles projected on the plane of their mean normal.
-double Charter::projectedRectArea(const std::vector<uint32_t>& tris) const {
-    glm::dvec3 sum(0.0);
-    for (uint32_t t : tris) sum += tris_[t].normal * tris_[t].area;
-    if (!(glm::length(sum) > 0)) return 0;
-    glm::dvec3 u, v;
-    planeBasis(glm::normalize(sum), u, v);
-    std::vector<glm::dvec2> points;
-    points.reserve(tris.size() * 3);
-    for (uint32_t t : tris)
-        for (uint32_t c = 0; c < 3; ++c)
-            points.emplace_back(glm::dot(position(t, c), u), glm::dot(position(t, c), v));
-    return minAreaRect(points).area;
-}
-
-void Charter::emitChart(const std::vector<uint32_t>& tris, const std::vector<glm::dvec2>& corners) {
+void Charter::emitChart(const std::vector<uint32_t>& tris, const std::vector<glm::dvec2>& corners,
+                        ChartKind kind, const ChartDistortion& distortion) {
     uint32_t chartIndex = uint32_t(out_.charts.size());
     Chart chart;
+    chart.kind = kind;
+    chart.meanStretch = distortion.meanStretch();
+    chart.maxStretch = distortion.maxStretch();
+    if (distortion.maxSigma > 0) {
+        double m2 = distortion.maxSigma * distortion.maxSigma;
+        chart.densitySum = distortion.areaScale / m2;
+        chart.densitySquareSum = distortion.areaScaleSquared / (m2 * m2);
+    }
     chart.firstVertex = uint32_t(out_.vertexRemap.size());
     for (size_t i = 0; i < tris.size(); ++i) {
         uint32_t t = tris[i];
@@ -639,21 +797,43 @@ ChartedMesh Charter::run() {
     classifyTriangles();
     neighbour_ = buildNeighbours(mesh_.indices, weld_, tris_);
     stamp_.assign(tris_.size(), 0);
+    slotOf_.assign(tris_.size(), 0);
+    localOf_.assign(weldPosition_.size(), kNone);
     vertexStamp_.assign(mesh_.vertices.size(), 0);
     vertexBaked_.assign(mesh_.vertices.size(), 0);
     out_.indices.assign(mesh_.indices.size(), 0);
 
-    for (const std::vector<uint32_t>& grown : growCharts())
+    chartOf_.assign(tris_.size(), kOutside);
+    std::vector<uint32_t> all;
+    for (uint32_t t = 0; t < tris_.size(); ++t)
+        if (!tris_[t].degenerate) all.push_back(t);
+    for (const std::vector<uint32_t>& grown : growCharts(std::move(all), wideGrowth_))
         for (std::vector<uint32_t>& piece : connectedPieces(grown))
-            flattenAndEmit(std::move(piece));
+            chartPiece(std::move(piece), wideGrowth_ > narrowGrowth_);
     emitDegenerateCells();
     return std::move(out_);
+}
+
+// Area-weighted coefficient of variation of the density over the non-degenerate charts, each
+// normalized by its maxSigma as packing will (the measure bake_validate.h bounds).
+double meshDensityCv(const ChartedMesh& charted) {
+    double area = 0, sum = 0, sumSquares = 0;
+    for (const Chart& chart : charted.charts) {
+        if (chart.kind == ChartKind::DegenerateCells) continue;
+        area += chart.surfaceArea;
+        sum += chart.densitySum, sumSquares += chart.densitySquareSum;
+    }
+    if (!(area > 0) || !(sum > 0)) return 0;
+    double mean = sum / area;
+    return std::sqrt(std::max(0.0, sumSquares / area - mean * mean)) / mean;
 }
 
 } // namespace
 
 ChartedMesh buildCharts(const Mesh& mesh, const ChartingSettings& settings) {
-    return Charter(mesh, settings).run();
+    ChartedMesh loose = Charter(mesh, settings, kLooseChartDensityDeviation).run();
+    if (meshDensityCv(loose) <= kMaxMeshDensityCv) return loose;
+    return Charter(mesh, settings, kSafeChartDensityDeviation).run();
 }
 
 } // namespace shadel
