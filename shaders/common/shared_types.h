@@ -219,9 +219,9 @@ struct GpuShadelCounters {
     uint markedBlocks;                 // blocks with any marked chunk (may exceed the list)
     uint reconstructionMisses;         // samples that found no marked chunk (must be 0)
     uint overflowSamples;              // samples whose chunk overflowed storage (shaded forward)
-    uint chunksReused;        // chunks carried over from last frame's storage (preserved)
-    uint shadeCount;          // entries in the shading queue
-    uint copyCount;           // entries in the carry-over queue
+    uint chunksReused;                 // chunks carried over from last frame's storage (preserved)
+    uint shadeCount;                   // entries in the shading queue
+    uint copyCount;                    // entries in the carry-over queue
     uint magnifiedPixels;     // sampled reconstructed pixels whose MIP-0 shadel spans > 1 pixel
     uint reconstructedPixels; // sampled (even x and y) pixels the reconstruction drew
     uint chunksPerMip[SHADEL_MAX_MIPS]; // allocated chunks by MIP level
@@ -232,22 +232,22 @@ struct GpuShadelCounters {
 };
 
 struct ShadelFrame {
-    uint64_t objects;        // GpuShadelObject[instanceCount]
-    uint64_t occupancy;      // uint64 per sheet block: one bit per chunk
-    uint64_t offsetMap;      // uint per block: base storage slot of its chunks
-    uint64_t allocId;        // uint per block: (object + 1) << 4 | mip, 0 = free
-    uint64_t counters;       // GpuShadelCounters
-    uint64_t rects;          // GpuShadelRect[rectCount]
-    uint64_t markedBlocks;   // uvec4 {block, place in its counter, object, mip | counter << 8}
-    uint64_t queue;          // GpuShadelWork[capacityChunks]: chunks to shade
-    uint64_t copyQueue;      // GpuShadelWork[capacityChunks]: chunks carried over (chunk = old slot)
-    uint64_t idMaps;         // uint16 triangle ids, packed in uints
-    uint64_t shadelUvs;      // vec2 per vertex of the unified geometry buffer
-    uint sheetBlocks;        // blocks per side of the virtual sheet
+    uint64_t objects;      // GpuShadelObject[instanceCount]
+    uint64_t occupancy;    // uint64 per sheet block: one bit per chunk
+    uint64_t offsetMap;    // uint per block: base storage slot of its chunks
+    uint64_t allocId;      // uint per block: (object + 1) << 4 | mip, 0 = free
+    uint64_t counters;     // GpuShadelCounters
+    uint64_t rects;        // GpuShadelRect[rectCount]
+    uint64_t markedBlocks; // uvec4 {block, place in its counter, object, mip | counter << 8}
+    uint64_t queue;        // GpuShadelWork[capacityChunks]: chunks to shade
+    uint64_t copyQueue;    // GpuShadelWork[capacityChunks]: chunks carried over (chunk = old slot)
+    uint64_t idMaps;       // uint16 triangle ids, packed in uints
+    uint64_t shadelUvs;    // vec2 per vertex of the unified geometry buffer
+    uint sheetBlocks;      // blocks per side of the virtual sheet
     uint rectCount;
     uint rectBlockCount;
-    uint storageWriteSlot; // bindless storage image of this frame's radiance layer
-    uint storageReadSlot;  // bindless sampled view of it
+    uint storageWriteSlot;                 // bindless storage image of this frame's radiance layer
+    uint storageReadSlot;                  // bindless sampled view of it
     uint layerWriteSlot[SHADEL_LAYERS];    // this frame's layers (storage images)
     uint layerReadSlot[SHADEL_LAYERS];     // this frame's layers (sampled)
     uint prevLayerReadSlot[SHADEL_LAYERS]; // last frame's layers (sampled): preserved layers
@@ -260,7 +260,7 @@ struct ShadelFrame {
     uint reuse;         // 0: reshade everything (--reuse off)
     uint storageChunksPerRow;
     uint capacityChunks;
-    uint markedCapacity;    // entries of markedBlocks (= capacityChunks: a block needs >= 1 chunk)
+    uint markedCapacity;     // entries of markedBlocks (= capacityChunks: a block needs >= 1 chunk)
     uint allocationCounters; // hashed counters in use (SHADEL_COUNTERS; fewer only for tests)
     float shadingBias;
     float trilinearBand;  // width of the LOD interval blended between two MIPs (1 = trilinear)

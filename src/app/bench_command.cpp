@@ -88,8 +88,9 @@ nlohmann::json runBench(Gpu& gpu, const BenchOptions& b) {
     auto decoupledOnly = [](const char* key, const char* fmt) {
         return [key, fmt](const nlohmann::json& s) {
             if (!s.contains(key)) return std::string("-");
-            return s[key].is_number_float() ? format(fmt, s[key].get<double>())
-                                            : format("%llu", (unsigned long long)s[key].get<uint64_t>());
+            return s[key].is_number_float()
+                       ? format(fmt, s[key].get<double>())
+                       : format("%llu", (unsigned long long)s[key].get<uint64_t>());
         };
     };
     row("shadels per covered pixel", decoupledOnly("shadels_per_pixel", "%.3f"));

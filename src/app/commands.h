@@ -27,7 +27,7 @@ struct RenderOptions {
     std::optional<TimingMode> timing;
     float exposure = 1.0f;
     float shadelsPerMetre = 0.0f; // 0 = auto: view-driven per mesh (render/view_density.h)
-    std::string cacheDir; // empty = default cache directory
+    std::string cacheDir;         // empty = default cache directory
     // --cache-limit: least recently used bake-cache files beyond it are removed (0 = none).
     uint64_t cacheLimitBytes = 4ull << 30;
     uint32_t shadeStorageSize = 4096;

@@ -152,7 +152,9 @@ int main(int argc, char** argv) {
                      "decoupled: give every visible object rects at all MIPs, not only from the "
                      "finest it can need (for comparison)");
     std::string cameraPath = "static", capacityControl = "on";
-    render->add_option("--camera-path", cameraPath, "static | orbit | walk: camera motion over --frames")
+    render
+        ->add_option("--camera-path", cameraPath,
+                     "static | orbit | walk: camera motion over --frames")
         ->capture_default_str();
     render
         ->add_option("--capacity-control", capacityControl,
@@ -193,8 +195,9 @@ int main(int argc, char** argv) {
     bench->add_option("--camera-path", benchCameraPath, "static | orbit | walk")
         ->capture_default_str();
     bench->add_flag("--animate-lights", bo.animateLights, "move point and spot lights");
-    bench->add_option("--reuse-refresh", bo.reuseRefreshPeriod,
-                      "reuse mode: reshade every carried-over chunk once per N frames")
+    bench
+        ->add_option("--reuse-refresh", bo.reuseRefreshPeriod,
+                     "reuse mode: reshade every carried-over chunk once per N frames")
         ->capture_default_str();
 
     // bake
@@ -294,8 +297,8 @@ int main(int argc, char** argv) {
             ro.shadelsPerMetre = parseDensity(density);
             ro.cameraPath = parseCameraPath(cameraPath);
             if (capacityControl != "on" && capacityControl != "off")
-                throw InputError(format("--capacity-control %s: expected on or off",
-                                        capacityControl.c_str()));
+                throw InputError(
+                    format("--capacity-control %s: expected on or off", capacityControl.c_str()));
             ro.capacityControl = capacityControl == "on";
             if (reuse != "on" && reuse != "off")
                 throw InputError(format("--reuse %s: expected on or off", reuse.c_str()));

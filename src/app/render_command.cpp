@@ -8,8 +8,8 @@
 
 #include "app/cli_validate.h"
 #include "app/commands.h"
-#include "app/trace_export.h"
 #include "app/output_files.h"
+#include "app/trace_export.h"
 #include "bake/bake.h"
 #include "bake/bake_cache.h"
 #include "core/error.h"
@@ -199,8 +199,8 @@ RenderRun runRender(Gpu& gpu, const RenderOptions& o) {
         for (uint32_t i = 0; i < o.frames; ++i) {
             glm::vec2 jitter = o.jitter ? subpixelJitter(i) : glm::vec2(0.0f);
             Camera onPath = cameraOnPath(camera, o.cameraPath, i, o.frames, bounds);
-            CameraView view = makeCameraView(onPath, o.width * o.ssaa, o.height * o.ssaa,
-                                             jitter * float(o.ssaa));
+            CameraView view =
+                makeCameraView(onPath, o.width * o.ssaa, o.height * o.ssaa, jitter * float(o.ssaa));
             run.frames.push_back(renderFrame(renderer, gpuScene, view));
             if (o.progress && o.frames > 1 && tty)
                 std::fprintf(stderr, "\rrender: frame %u/%u (%.1f ms)", i + 1, o.frames,
@@ -292,7 +292,8 @@ RenderRun runRender(Gpu& gpu, const RenderOptions& o) {
 
     if (!o.stats.empty()) writeOutputFile(o.stats, s.dump(2) + "\n");
     if (!o.trace.empty())
-        writeOutputFile(o.trace, chromeTrace(run.frames, o.scene + " " + modeName(o.mode)).dump() + "\n");
+        writeOutputFile(o.trace,
+                        chromeTrace(run.frames, o.scene + " " + modeName(o.mode)).dump() + "\n");
     if (o.printPasses) printPassTable(s);
     return run;
 }

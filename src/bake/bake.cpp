@@ -107,7 +107,8 @@ std::vector<std::vector<uint32_t>> chartTriangles(const ChartedMesh& charted) {
 
 // A chart vertex in shadels inside the content box of orientation k: spare space split evenly.
 glm::dvec2 orientedPosition(const ChartedMesh& charted, const Chart& chart, uint32_t vertex,
-                            const std::array<ChartFrame, kFrames>& frames, uint32_t k, double density) {
+                            const std::array<ChartFrame, kFrames>& frames, uint32_t k,
+                            double density) {
     const ChartFrame& f = frames[k / 4];
     double scale = chartScale(chart, density);
     glm::dvec2 centring = (glm::dvec2(f.content) - f.extent * scale) * 0.5;
@@ -132,7 +133,8 @@ Layout layoutCharts(const ChartedMesh& charted, const std::vector<std::vector<ui
         bool turnable = eighthTurns && chart.kind != ChartKind::DegenerateCells;
         // Frames left out keep a zero extent, and their outlines width 0 (never tried).
         for (uint32_t r = 1; r < kFrames && turnable; ++r)
-            if (r == kFrames / 2 || sixteenthTurns) frames[r] = chartFrame(charted, chart, r, density);
+            if (r == kFrames / 2 || sixteenthTurns)
+                frames[r] = chartFrame(charted, chart, r, density);
         layout.frames.push_back(frames);
         glm::uvec2 content = frames[0].content;
         rects.push_back({content.x + 2 * gutter, content.y + 2 * gutter});

@@ -2,9 +2,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <iterator>
 #include <limits>
 #include <numeric>
-#include <iterator>
 
 namespace shadel {
 namespace {
@@ -193,8 +193,7 @@ OutlinePack packAtWidth(const std::vector<std::array<ChartOutline, kOrientations
                 if (wasteWeight > 0 && s == 1) {
                     // The score is at least the top: positions that cannot beat it are cut.
                     if (best.found && best.score <= double(maxTop)) return;
-                    uint64_t limit =
-                        best.found ? uint64_t(best.score) - maxTop : ~0ull >> 2;
+                    uint64_t limit = best.found ? uint64_t(best.score) - maxTop : ~0ull >> 2;
                     uint64_t y = lowestFit(search, so, x, limit);
                     if (y > limit) return;
                     double waste = 0;
@@ -366,7 +365,8 @@ OutlinePack packOutlines(const std::vector<std::array<ChartOutline, kOrientation
                 roundUp(std::max(minWidthNeeded, uint32_t(std::ceil(side * factor))), granularity);
             if (width == lastWidth) continue;
             lastWidth = width;
-            OutlinePack pack = packAtWidth(outlines, order, width, gutter, granularity, wasteWeight);
+            OutlinePack pack =
+                packAtWidth(outlines, order, width, gutter, granularity, wasteWeight);
             if (pack.width == 0) continue;
             double aspect =
                 double(std::max(pack.width, pack.height)) / std::min(pack.width, pack.height);

@@ -348,10 +348,10 @@ private:
 
     const Mesh& mesh_;
     double maxChartDensityDeviation_;
-    double narrowGrowth_, wideGrowth_;      // growth cones, degrees
-    double mergeLimit_;                     // radians
-    std::vector<uint32_t> chartOf_;         // per triangle, scratch of growCharts
-    double cosPlanar_;                      // planar charts: every normal within this of the axis
+    double narrowGrowth_, wideGrowth_; // growth cones, degrees
+    double mergeLimit_;                // radians
+    std::vector<uint32_t> chartOf_;    // per triangle, scratch of growCharts
+    double cosPlanar_;                 // planar charts: every normal within this of the axis
     double maxConformalStretch_;
     std::vector<uint32_t> weld_;
     std::vector<glm::dvec3> weldPosition_;
@@ -493,8 +493,7 @@ void Charter::mergeSmallCharts(std::vector<std::vector<uint32_t>>& charts,
         for (uint32_t t : charts[s]) {
             for (uint32_t e = 0; e < 3; ++e) {
                 uint32_t u = neighbour_[3 * t + e];
-                if (u == kNone || chartOf[u] == kOutside || chartOf[u] == s ||
-                    chartOf[u] == best)
+                if (u == kNone || chartOf[u] == kOutside || chartOf[u] == s || chartOf[u] == best)
                     continue;
                 uint32_t c = chartOf[u];
                 glm::dvec3 merged = sums[c] + sums[s];

@@ -67,8 +67,8 @@ Camera cameraOnPath(const Camera& start, CameraPath path, uint32_t frame, uint32
     if (path == CameraPath::Static || frames < 2) return start;
     float t = float(frame) / float(frames - 1);
     glm::vec3 center = sceneBounds.valid() ? sceneBounds.center() : glm::vec3(0.0f);
-    float radius = sceneBounds.valid() ? std::max(glm::length(sceneBounds.extent()) * 0.5f, 1e-3f)
-                                       : 1.0f;
+    float radius =
+        sceneBounds.valid() ? std::max(glm::length(sceneBounds.extent()) * 0.5f, 1e-3f) : 1.0f;
     glm::vec3 forward = glm::normalize(start.forward);
     Camera c = start;
     if (path == CameraPath::Orbit) {
@@ -85,8 +85,8 @@ Camera cameraOnPath(const Camera& start, CameraPath path, uint32_t frame, uint32
         flat = glm::length(flat) > 1e-4f ? glm::normalize(flat) : glm::vec3(0.0f, 0.0f, -1.0f);
         c.position = start.position + flat * (0.05f * radius * t);
         float sway = glm::radians(5.0f) * std::sin(t * 6.2831853f);
-        c.forward = glm::mat3(glm::rotate(glm::mat4(1.0f), sway, glm::vec3(0.0f, 1.0f, 0.0f))) *
-                    forward;
+        c.forward =
+            glm::mat3(glm::rotate(glm::mat4(1.0f), sway, glm::vec3(0.0f, 1.0f, 0.0f))) * forward;
     }
     return c;
 }

@@ -15,7 +15,7 @@ struct BakedMesh;
 // A mesh's shadel space as the decoupled path sees it.
 struct ShadelMeshInfo {
     glm::uvec2 mip0Size{0};
-    uint32_t mipCount = 0;                               // 0: no shadel space (drawn forward)
+    uint32_t mipCount = 0;    // 0: no shadel space (drawn forward)
     float shadelsPerUnit = 0; // MIP-0 shadels per object-space unit (BakedMesh::shadelsPerMetre)
     std::array<uint32_t, SHADEL_MAX_MIPS> idMapOffset{}; // 16-bit units into GpuScene::idMaps
     uint64_t idMapTexels = 0;

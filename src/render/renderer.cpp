@@ -179,7 +179,8 @@ static void updateLights(Renderer& r, const GpuScene& scene, gpu::FrameConstants
     std::memcpy(mapped(*r.gpu, r.animatedLights), lights.data(),
                 lights.size() * sizeof(gpu::GpuLight));
     constants.lights = address(*r.gpu, r.animatedLights);
-    if (r.framesRendered > 0) r.changedLightVolumes = changedLightVolumes(r.lightsLastFrame, lights);
+    if (r.framesRendered > 0)
+        r.changedLightVolumes = changedLightVolumes(r.lightsLastFrame, lights);
     r.lightsLastFrame = std::move(lights);
 }
 

@@ -41,16 +41,17 @@ struct RenderSettings {
     TimingMode timing = TimingMode::SubmitPerPass;
     uint32_t shadeStorageSize = 4096; // decoupled: physical shade storage, shadels per side
     uint32_t sheetShadels = 65536;    // decoupled: virtual sheet, shadels per side
-    float shadingBias = 0.0f; // decoupled: base MIP bias (the capacity controller adds to it)
-    float trilinearBand = 1.0f;    // decoupled: LOD band blended between MIPs (1 = trilinear)
-    uint32_t materialSamples = 4;  // decoupled: material evaluations per shadel above MIP 0
-    float forwardBelowPixels = 8;  // decoupled: objects smaller on screen drawn forward (0 = never)
+    float shadingBias = 0.0f;     // decoupled: base MIP bias (the capacity controller adds to it)
+    float trilinearBand = 1.0f;   // decoupled: LOD band blended between MIPs (1 = trilinear)
+    uint32_t materialSamples = 4; // decoupled: material evaluations per shadel above MIP 0
+    float forwardBelowPixels = 8; // decoupled: objects smaller on screen drawn forward (0 = never)
     uint32_t allocationCounters = SHADEL_COUNTERS; // decoupled: hashed counters used (tests)
     bool sheetAllMips = false;
-    bool capacityControl = true; // decoupled: steer the shading bias from storage use
-    bool reuse = true;           // decoupled: carry unchanged shadels over from last frame
+    bool capacityControl = true;     // decoupled: steer the shading bias from storage use
+    bool reuse = true;               // decoupled: carry unchanged shadels over from last frame
     uint32_t reuseRefreshPeriod = 8; // decoupled: reshade every carried chunk this often
-    bool animateLights = false;  // point and spot lights move on small circles // decoupled: rects at every MIP (the old policy, for comparison)
+    bool animateLights = false; // point and spot lights move on small circles // decoupled: rects
+                                // at every MIP (the old policy, for comparison)
 };
 
 struct FrameResult {

@@ -64,10 +64,10 @@ struct CountLimit {
     size_t max;
 };
 constexpr CountLimit kMaxCounts[] = {
-    {"nodes", 1u << 18},   {"meshes", 1u << 16},   {"accessors", 1u << 18},
+    {"nodes", 1u << 18},       {"meshes", 1u << 16},  {"accessors", 1u << 18},
     {"bufferViews", 1u << 18}, {"buffers", 1u << 12}, {"materials", 1u << 16},
-    {"textures", 1u << 16}, {"images", 1u << 14},   {"samplers", 1u << 12},
-    {"cameras", 1u << 12},  {"scenes", 1u << 12},   {"skins", 1u << 12},
+    {"textures", 1u << 16},    {"images", 1u << 14},  {"samplers", 1u << 12},
+    {"cameras", 1u << 12},     {"scenes", 1u << 12},  {"skins", 1u << 12},
     {"animations", 1u << 12},
 };
 // Primitives summed over all meshes (each becomes at least one Mesh).
@@ -162,8 +162,8 @@ void checkCounts(const json& root, const std::string& input) {
     for (const CountLimit& limit : kMaxCounts) {
         auto it = root.find(limit.array);
         if (it != root.end() && it->is_array() && it->size() > limit.max)
-            fail(input, format("%zu %s, more than the limit of %zu", it->size(), limit.array,
-                               limit.max));
+            fail(input,
+                 format("%zu %s, more than the limit of %zu", it->size(), limit.array, limit.max));
     }
     auto meshes = root.find("meshes");
     if (meshes == root.end() || !meshes->is_array()) return;
@@ -174,8 +174,8 @@ void checkCounts(const json& root, const std::string& input) {
         if (list != mesh.end() && list->is_array()) primitives += list->size();
     }
     if (primitives > kMaxPrimitives)
-        fail(input, format("%zu mesh primitives, more than the limit of %zu", primitives,
-                           kMaxPrimitives));
+        fail(input,
+             format("%zu mesh primitives, more than the limit of %zu", primitives, kMaxPrimitives));
 }
 
 // Refuses buffer and image URIs that leave the model's folder (unless allowed): a model is a

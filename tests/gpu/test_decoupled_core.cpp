@@ -64,7 +64,8 @@ TEST(DecoupledCore, StorageIsSharedByTheHashedCounters) {
     for (uint32_t counters : {1u, 2u, 16u}) {
         o.allocationCounters = counters;
         RenderRun tight = renderChecked(o);
-        double use = double(stat(tight, "chunks_requested")) / double(stat(tight, "chunks_capacity"));
+        double use =
+            double(stat(tight, "chunks_requested")) / double(stat(tight, "chunks_capacity"));
         std::printf("[ figures ] smooth 256x144, storage %u^2, %u counter(s): %.1f%% of storage "
                     "requested, %llu chunks overflowed\n",
                     side, counters, 100.0 * use,
@@ -86,8 +87,9 @@ TEST(DecoupledCore, ShadingBiasLowersShadedShadels) {
     RenderRun two = renderChecked(o);
     uint64_t s0 = stat(none, "shadels_shaded"), s1 = stat(one, "shadels_shaded"),
              s2 = stat(two, "shadels_shaded");
-    std::printf("[ figures ] smooth 256x144 shadels shaded: bias 0 %llu, bias 1 %llu, bias 2 %llu\n",
-                (unsigned long long)s0, (unsigned long long)s1, (unsigned long long)s2);
+    std::printf(
+        "[ figures ] smooth 256x144 shadels shaded: bias 0 %llu, bias 1 %llu, bias 2 %llu\n",
+        (unsigned long long)s0, (unsigned long long)s1, (unsigned long long)s2);
     EXPECT_LT(double(s1), 0.7 * double(s0));
     EXPECT_LT(s2, s1);
     EXPECT_EQ(stat(two, "reconstruction_misses"), 0u);
@@ -144,9 +146,10 @@ TEST(DecoupledCore, CapacityControlEndsOverflowWithinFiveFrames) {
         trace += format(" %.2f/%llu", bias[i].get<double>(),
                         (unsigned long long)overflow[i].get<uint64_t>());
     double p = psnr(run.frames.back().rgba, roomy.frames[0].rgba);
-    std::printf("[ figures ] default 1280x720, storage %u^2 (%llu chunks needed): bias/overflow per "
-                "frame%s; last frame %.2f dB against unconstrained\n",
-                side, (unsigned long long)requested, trace.c_str(), p);
+    std::printf(
+        "[ figures ] default 1280x720, storage %u^2 (%llu chunks needed): bias/overflow per "
+        "frame%s; last frame %.2f dB against unconstrained\n",
+        side, (unsigned long long)requested, trace.c_str(), p);
     EXPECT_GT(overflow[0].get<uint64_t>(), 0u); // the test really starts over capacity
     for (size_t i = 5; i < overflow.size(); ++i) EXPECT_EQ(overflow[i].get<uint64_t>(), 0u) << i;
     EXPECT_GT(run.stats["shading_bias"].get<double>(), 0.0);

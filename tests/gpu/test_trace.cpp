@@ -10,9 +10,9 @@ using namespace shadel;
 using namespace shadel::test;
 
 TEST(Trace, OneEventPerPassPerFrameNamedAsThePasses) {
-    std::string path =
-        (std::filesystem::temp_directory_path() / ("shadel-trace-" + std::to_string(::getpid()) + ".json"))
-            .string();
+    std::string path = (std::filesystem::temp_directory_path() /
+                        ("shadel-trace-" + std::to_string(::getpid()) + ".json"))
+                           .string();
     RenderOptions o;
     o.scene = "builtin:smooth";
     o.mode = RenderMode::Decoupled;

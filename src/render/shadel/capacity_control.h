@@ -8,10 +8,10 @@
 namespace shadel {
 
 struct CapacityController {
-    float bias = 0.0f;       // added to the user's --shading-bias
-    float high = 0.92f;      // raise above this fraction of storage requested
-    float target = 0.8f;     // aim here when raising
-    float low = 0.6f;        // relax only below this
+    float bias = 0.0f;        // added to the user's --shading-bias
+    float high = 0.92f;       // raise above this fraction of storage requested
+    float target = 0.8f;      // aim here when raising
+    float low = 0.6f;         // relax only below this
     float relaxStep = 0.125f; // MIP levels per frame when relaxing
     float maxBias = 8.0f;
 };

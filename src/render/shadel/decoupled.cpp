@@ -54,9 +54,9 @@ struct FrameCounters {
 } // namespace
 
 struct DecoupledState {
-    uint32_t sheetBlocks = 1024; // 64k x 64k shadels
-    uint32_t storageSize = 4096; // shadels per side of the physical storage
-    float frustumMargin = 0.1f;  // fraction of an object's radius
+    uint32_t sheetBlocks = 1024;  // 64k x 64k shadels
+    uint32_t storageSize = 4096;  // shadels per side of the physical storage
+    float frustumMargin = 0.1f;   // fraction of an object's radius
     float baseShadingBias = 0.0f; // --shading-bias
     float shadingBias = 0.0f;     // this frame's: base + the capacity controller's
     bool capacityControl = true;
@@ -85,11 +85,11 @@ struct DecoupledState {
     uint32_t refreshPeriod = 8;
     glm::vec3 lastCameraPosition{0.0f}; // the previous frame's (view drift of carried shadels)
     uint32_t objectsReusable = 0;
-    BufferHandle allocId;      // uint per block (upload: written by the CPU allocator)
-    BufferHandle counters;     // GpuShadelCounters (readback, also indirect args)
-    BufferHandle markedBlocks; // uvec4 per marked block, capacityChunks of them
-    BufferHandle queue;        // GpuShadelWork[capacity]: chunks to shade
-    BufferHandle copyQueue;    // GpuShadelWork[capacity]: chunks carried over from last frame
+    BufferHandle allocId;       // uint per block (upload: written by the CPU allocator)
+    BufferHandle counters;      // GpuShadelCounters (readback, also indirect args)
+    BufferHandle markedBlocks;  // uvec4 per marked block, capacityChunks of them
+    BufferHandle queue;         // GpuShadelWork[capacity]: chunks to shade
+    BufferHandle copyQueue;     // GpuShadelWork[capacity]: chunks carried over from last frame
     BufferHandle changedLights; // vec4[SHADEL_MAX_CHANGED_LIGHTS] (upload)
     bool changedLightsOverflow = false;
     ShadeStorage storage;
@@ -217,9 +217,9 @@ void destroyDecoupled(Renderer& r, DecoupledStatePtr& state) {
                         &d.carryOver, &d.shade, &d.sheetView, &d.mark, &d.reconstruct})
         destroy(gpu, *p);
     destroyShadeStorage(gpu, d.storage);
-    for (BufferHandle b : {d.frameInfo, d.changedLights, d.objectBuffer, d.rectBuffer, d.occupancy[0],
-                           d.occupancy[1], d.offsetMap[0], d.offsetMap[1], d.allocId, d.counters,
-                           d.markedBlocks, d.queue, d.copyQueue})
+    for (BufferHandle b : {d.frameInfo, d.changedLights, d.objectBuffer, d.rectBuffer,
+                           d.occupancy[0], d.occupancy[1], d.offsetMap[0], d.offsetMap[1],
+                           d.allocId, d.counters, d.markedBlocks, d.queue, d.copyQueue})
         destroy(gpu, b);
     state.reset();
 }
@@ -328,8 +328,8 @@ static LightReach reachOf(const std::vector<glm::vec4>& spheres, glm::vec3 bmin,
 // drift by about that much before the carried shading visibly lags (at most --reuse-refresh
 // frames, also when the camera stands still). Roughness textures only lower the factor's
 // roughness, so glossier texels than the factor can lag somewhat more.
-static uint32_t refreshPeriodFor(const DecoupledState& d, const CameraView& camera,
-                                 glm::vec3 bmin, glm::vec3 bmax, float roughness) {
+static uint32_t refreshPeriodFor(const DecoupledState& d, const CameraView& camera, glm::vec3 bmin,
+                                 glm::vec3 bmax, float roughness) {
     float maxViewDrift = std::clamp(1.0f * roughness * roughness, 0.01f, 0.4f);
     float step = glm::length(camera.position - d.lastCameraPosition);
     if (d.frameNumber == 0 || step <= 0.0f) return d.refreshPeriod;
@@ -396,11 +396,11 @@ void prepareDecoupledFrame(Renderer& r, const GpuScene& scene, const CameraView&
             if (small) d.objectsSmallForward++, d.objectsForward++;
             continue;
         }
-        uint32_t wantFirst = r.settings.sheetAllMips
-                                 ? 0
-                                 : finestMipNeeded(camera, float(r.internalHeight), inst, mesh,
-                                                   inst.worldMin - margin, inst.worldMax + margin,
-                                                   d.shadingBias);
+        uint32_t wantFirst =
+            r.settings.sheetAllMips
+                ? 0
+                : finestMipNeeded(camera, float(r.internalHeight), inst, mesh,
+                                  inst.worldMin - margin, inst.worldMax + margin, d.shadingBias);
         bool limited = false;
         // No room in the sheet: drawn forward this frame, retried next frame.
         if (!updateObjectRects(gpu, d, o, i, mesh, wantFirst, limited)) {
@@ -664,7 +664,8 @@ void decoupledStats(const Renderer& r, nlohmann::json& s) {
     }
     // Stored: every allocated chunk (the MIP chain's density); shaded: those not carried over.
     uint64_t chunksStored = last.counters.chunksAllocated;
-    uint64_t chunksShaded = chunksStored - std::min<uint64_t>(last.counters.chunksReused, chunksStored);
+    uint64_t chunksShaded =
+        chunksStored - std::min<uint64_t>(last.counters.chunksReused, chunksStored);
     uint64_t stored = chunksStored * SHADEL_CHUNK * SHADEL_CHUNK;
     uint64_t shaded = chunksShaded * SHADEL_CHUNK * SHADEL_CHUNK;
     uint64_t covered = s.value("pixels_covered", uint64_t(0));

@@ -16,7 +16,7 @@ struct ShadeLayer {
 };
 
 struct ShadeStorage {
-    uint32_t size = 0; // shadels per side
+    uint32_t size = 0;                                             // shadels per side
     std::array<std::array<ShadeLayer, SHADEL_LAYERS>, 2> frames{}; // [frame parity][layer]
 };
 
