@@ -11,26 +11,13 @@
 #include <unistd.h>
 
 #include "core/atomic_file.h"
+#include "temp_dir.h"
 
 using namespace shadel;
+using shadel::test::TempDir;
 namespace fs = std::filesystem;
 
 namespace {
-
-struct TempDir {
-    TempDir() {
-        path = fs::temp_directory_path() /
-               ("shadel_atomic_test_" + std::to_string(getpid()) + "_" +
-                ::testing::UnitTest::GetInstance()->current_test_info()->name());
-        fs::remove_all(path);
-        fs::create_directories(path);
-    }
-    ~TempDir() { fs::remove_all(path); }
-    size_t entries() const {
-        return size_t(std::distance(fs::directory_iterator(path), fs::directory_iterator()));
-    }
-    fs::path path;
-};
 
 std::string readText(const fs::path& p) {
     std::ifstream in(p, std::ios::binary);
@@ -63,7 +50,7 @@ private:
 } // namespace
 
 TEST(AtomicFile, WritesTheWholeFileAndNothingElse) {
-    TempDir dir;
+    TempDir dir("shadel_atomic_test");
     std::string path = (dir.path / "out.json").string();
     EXPECT_EQ(writeFileAtomically(path, "first", 5), "");
     EXPECT_EQ(writeFileAtomically(path, "second", 6), "");
@@ -72,7 +59,7 @@ TEST(AtomicFile, WritesTheWholeFileAndNothingElse) {
 }
 
 TEST(AtomicFile, FullDiskLeavesThePreviousFileAndNoTemporary) {
-    TempDir dir;
+    TempDir dir("shadel_atomic_test");
     std::string path = (dir.path / "image.png").string();
     ASSERT_EQ(writeFileAtomically(path, "old", 3), "");
     std::string big(256 * 1024, 'x');
@@ -93,7 +80,7 @@ TEST(AtomicFile, DeviceTargetsAreWrittenInPlaceWithErrorsReported) {
 }
 
 TEST(AtomicFile, MissingFolderAndDirectoryTargetsAreOneLineErrors) {
-    TempDir dir;
+    TempDir dir("shadel_atomic_test");
     std::string missing = (dir.path / "no/such/folder/out.png").string();
     EXPECT_EQ(writeFileAtomically(missing, "x", 1), missing + ": No such file or directory");
     EXPECT_EQ(checkFileCreatable(missing), missing + ": No such file or directory");

@@ -11,22 +11,13 @@
 #include "bake/bake.h"
 #include "bake/bake_cache.h"
 #include "scene/mesh_utils.h"
+#include "temp_dir.h"
 
 using namespace shadel;
+using shadel::test::TempDir;
 namespace fs = std::filesystem;
 
 namespace {
-
-struct TempDir {
-    TempDir() {
-        path = fs::temp_directory_path() /
-               ("shadel_bake_test_" + std::to_string(getpid()) + "_" +
-                ::testing::UnitTest::GetInstance()->current_test_info()->name());
-        fs::remove_all(path);
-    }
-    ~TempDir() { fs::remove_all(path); }
-    fs::path path;
-};
 
 Scene twoMeshScene() {
     Scene scene;
@@ -61,7 +52,7 @@ void writeAll(const fs::path& p, const std::vector<char>& bytes) {
 } // namespace
 
 TEST(BakeCache, RoundTripAndDuplicatesBakedOnce) {
-    TempDir dir;
+    TempDir dir("shadel_bake_test");
     Scene scene = twoMeshScene();
     BakeSettings settings;
     std::vector<std::pair<size_t, size_t>> calls;
@@ -87,7 +78,7 @@ TEST(BakeCache, RoundTripAndDuplicatesBakedOnce) {
 }
 
 TEST(BakeCache, CorruptedTruncatedAndStaleFilesAreRebuilt) {
-    TempDir dir;
+    TempDir dir("shadel_bake_test");
     Scene scene;
     scene.meshes.push_back(makeBox("crate", {1, 0.5f, 0.7f}, 0));
     BakeSettings settings;

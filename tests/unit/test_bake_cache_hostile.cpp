@@ -13,23 +13,13 @@
 #include "bake/bake.h"
 #include "bake/bake_cache.h"
 #include "scene/mesh_utils.h"
+#include "temp_dir.h"
 
 using namespace shadel;
+using shadel::test::TempDir;
 namespace fs = std::filesystem;
 
 namespace {
-
-struct TempDir {
-    TempDir() {
-        path = fs::temp_directory_path() /
-               ("shadel_bake_hostile_" + std::to_string(getpid()) + "_" +
-                ::testing::UnitTest::GetInstance()->current_test_info()->name());
-        fs::remove_all(path);
-        fs::create_directories(path);
-    }
-    ~TempDir() { fs::remove_all(path); }
-    fs::path path;
-};
 
 std::vector<uint8_t> readAll(const fs::path& p) {
     std::ifstream f(p, std::ios::binary);
@@ -72,7 +62,7 @@ void editIds(std::vector<uint8_t>& file, const BakedMesh& b, uint16_t (*edit)(ui
 }
 
 struct Fixture {
-    TempDir dir;
+    TempDir dir{"shadel_bake_hostile"};
     Scene scene;
     BakeSettings settings;
     BakeKey key;
@@ -158,7 +148,7 @@ TEST(BakeCacheHostile, DirectoryInPlaceOfACacheFileIsARebake) {
 }
 
 TEST(BakeCacheHostile, UnwritableCacheWarnsOnceNotPerMesh) {
-    TempDir dir;
+    TempDir dir("shadel_bake_hostile");
     fs::path blocker = dir.path / "a-file";
     std::ofstream(blocker) << "not a folder";
     Scene scene;

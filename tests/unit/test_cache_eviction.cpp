@@ -12,23 +12,13 @@
 #include "bake/bake_cache.h"
 #include "bake/cache_eviction.h"
 #include "scene/mesh_utils.h"
+#include "temp_dir.h"
 
 using namespace shadel;
+using shadel::test::TempDir;
 namespace fs = std::filesystem;
 
 namespace {
-
-struct TempDir {
-    TempDir() {
-        path = fs::temp_directory_path() /
-               ("shadel_eviction_" + std::to_string(getpid()) + "_" +
-                ::testing::UnitTest::GetInstance()->current_test_info()->name());
-        fs::remove_all(path);
-        fs::create_directories(path);
-    }
-    ~TempDir() { fs::remove_all(path); }
-    fs::path path;
-};
 
 // A cache-named file of `bytes` bytes last used `ageSeconds` ago.
 fs::path cacheFile(const fs::path& dir, char tag, size_t bytes, int ageSeconds) {
@@ -57,7 +47,7 @@ TEST(CacheEviction, ByteSizes) {
 }
 
 TEST(CacheEviction, LeastRecentlyUsedGoFirstKeptFilesNever) {
-    TempDir dir;
+    TempDir dir("shadel_eviction");
     fs::path oldest = cacheFile(dir.path, 'a', 1000, 400);
     fs::path kept = cacheFile(dir.path, 'b', 1000, 300);
     fs::path middle = cacheFile(dir.path, 'c', 1000, 200);
@@ -76,7 +66,7 @@ TEST(CacheEviction, LeastRecentlyUsedGoFirstKeptFilesNever) {
 }
 
 TEST(CacheEviction, BakeSceneTrimsToTheLimitAndHitsCountAsUse) {
-    TempDir dir;
+    TempDir dir("shadel_eviction");
     std::string cache = dir.path.string();
     Scene first, second;
     first.meshes.push_back(makeBox("first", {1, 2, 3}, 0));
@@ -101,7 +91,7 @@ TEST(CacheEviction, BakeSceneTrimsToTheLimitAndHitsCountAsUse) {
 }
 
 TEST(CacheEviction, CleanRemovesCacheAndLeftoverTemporariesOnly) {
-    TempDir dir;
+    TempDir dir("shadel_eviction");
     cacheFile(dir.path, 'a', 10, 0);
     cacheFile(dir.path, 'b', 10, 0);
     std::ofstream(dir.path / (".bake-" + std::string(32, 'c') + ".bin.tmp.123.0")) << "partial";

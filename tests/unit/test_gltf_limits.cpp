@@ -13,8 +13,10 @@
 #include "scene/gltf_uri.h"
 #include "scene/json_limits.h"
 #include "scene/load.h"
+#include "temp_dir.h"
 
 using namespace shadel;
+using shadel::test::TempDir;
 namespace fs = std::filesystem;
 
 namespace {
@@ -28,17 +30,9 @@ constexpr double kMaxSeconds = 60.0;
 constexpr double kMaxSeconds = 5.0;
 #endif
 
-struct TempDir {
-    TempDir() {
-        path = fs::temp_directory_path() /
-               ("shadel_gltf_limits_" + std::to_string(getpid()) + "_" +
-                ::testing::UnitTest::GetInstance()->current_test_info()->name());
-        fs::remove_all(path);
-        fs::create_directories(path / "model");
-    }
-    ~TempDir() { fs::remove_all(path); }
-    std::string file(const std::string& name) const { return (path / name).string(); }
-    fs::path path;
+// A test folder with a model/ subfolder (URIs resolve inside the model's folder).
+struct ModelDir : TempDir {
+    ModelDir() : TempDir("shadel_gltf_limits") { fs::create_directories(path / "model"); }
 };
 
 void writeFile(const std::string& path, const std::string& text) {
@@ -105,7 +99,7 @@ Outcome timedLoad(const std::string& path, const SceneFileOptions& options = {})
 } // namespace
 
 TEST(GltfLimits, MillionNodeChainIsRejectedQuickly) {
-    TempDir dir;
+    ModelDir dir;
     std::string path = dir.file("model/chain.gltf");
     writeFile(dir.file("model/tri.bin"), triangleBytes());
     writeFile(path, gltfWithNodes("[0]", chainOfNodes(1000000)));
@@ -116,7 +110,7 @@ TEST(GltfLimits, MillionNodeChainIsRejectedQuickly) {
 }
 
 TEST(GltfLimits, FourHundredThousandEmptyNodesAreRejectedQuickly) {
-    TempDir dir;
+    ModelDir dir;
     std::string path = dir.file("model/flat.gltf"), sceneNodes;
     writeFile(dir.file("model/tri.bin"), triangleBytes());
     writeFile(path, gltfWithNodes(sceneNodes, emptyNodes(400000, sceneNodes)));
@@ -128,7 +122,7 @@ TEST(GltfLimits, FourHundredThousandEmptyNodesAreRejectedQuickly) {
 // Just under the limit the file is imported, and in linear time: the depth-limit parser
 // callback took 8.6 s for 200 000 empty nodes.
 TEST(GltfLimits, NodeCountsAtTheLimitImportInLinearTime) {
-    TempDir dir;
+    ModelDir dir;
     writeFile(dir.file("model/tri.bin"), triangleBytes());
     std::string chain = dir.file("model/chain.gltf"), flat = dir.file("model/flat.gltf");
     std::string sceneNodes;
@@ -166,7 +160,7 @@ TEST(GltfLimits, UriEscapesAreDetectedLexically) {
 }
 
 TEST(GltfLimits, BufferOutsideTheModelFolderIsRefusedUnlessAllowed) {
-    TempDir dir;
+    ModelDir dir;
     writeFile(dir.file("outside.bin"), triangleBytes()); // next to the model's folder
     for (const std::string uri :
          {"../outside.bin", "%2e%2e/outside.bin", "sub/../../outside.bin"}) {
@@ -185,7 +179,7 @@ TEST(GltfLimits, BufferOutsideTheModelFolderIsRefusedUnlessAllowed) {
 }
 
 TEST(GltfLimits, ImageOutsideTheModelFolderIsRefused) {
-    TempDir dir;
+    ModelDir dir;
     std::string path = dir.file("model/image.gltf");
     std::string text = gltfWithNodes("[0]", R"([{"mesh":0}])");
     text.insert(text.rfind('}'), R"(,"images":[{"uri":"../../../../etc/passwd"}])");
@@ -198,7 +192,7 @@ TEST(GltfLimits, ImageOutsideTheModelFolderIsRefused) {
 
 // tinygltf also searches the working directory for a relative URI; that is outside too.
 TEST(GltfLimits, WorkingDirectoryIsNotSearchedForBuffers) {
-    TempDir dir;
+    ModelDir dir;
     writeFile(dir.file("cwd_only.bin"), triangleBytes());
     std::string path = dir.file("model/cwd.gltf");
     writeFile(path, gltfWithNodes("[0]", R"([{"mesh":0}])", "cwd_only.bin"));
