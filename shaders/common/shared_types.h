@@ -246,8 +246,7 @@ struct ShadelFrame {
     uint sheetBlocks;      // blocks per side of the virtual sheet
     uint rectCount;
     uint rectBlockCount;
-    uint storageWriteSlot;                 // bindless storage image of this frame's radiance layer
-    uint storageReadSlot;                  // bindless sampled view of it
+    uint storageReadSlot;                  // bindless sampled view of this frame's radiance layer
     uint layerWriteSlot[SHADEL_LAYERS];    // this frame's layers (storage images)
     uint layerReadSlot[SHADEL_LAYERS];     // this frame's layers (sampled)
     uint prevLayerReadSlot[SHADEL_LAYERS]; // last frame's layers (sampled): preserved layers
@@ -255,9 +254,8 @@ struct ShadelFrame {
     uint64_t prevOffsetMap;                // last frame's offset map
     uint64_t changedLights; // vec4 (centre, radius) of what lights that changed reach
     uint changedLightCount;
-    uint frameNumber;   // frames rendered by this renderer (refresh phase)
-    uint refreshPeriod; // a carried-over chunk is reshaded at least every this many frames
-    uint reuse;         // 0: reshade everything (--reuse off)
+    uint frameNumber; // frames rendered by this renderer (refresh phase)
+    uint reuse;       // 0: reshade everything (--reuse off)
     uint storageChunksPerRow;
     uint capacityChunks;
     uint markedCapacity;     // entries of markedBlocks (= capacityChunks: a block needs >= 1 chunk)

@@ -175,19 +175,19 @@ RenderRun runRender(Gpu& gpu, const RenderOptions& o) {
     settings.sheetShadels = o.sheetShadels;
     settings.shadingBias = o.shadingBias;
     settings.trilinearBand = o.trilinearBand;
-    if (o.materialSamples < 1 || o.materialSamples > 64)
-        throw InputError(format("--material-samples %u: expected 1..64", o.materialSamples));
+    auto requireCount = [](const char* flag, uint32_t value, uint32_t lo, uint32_t hi) {
+        if (value < lo || value > hi)
+            throw InputError(format("%s %u: expected %u..%u", flag, value, lo, hi));
+    };
+    requireCount("--material-samples", o.materialSamples, 1, 64);
+    requireCount("--allocation-counters", o.allocationCounters, 1, SHADEL_COUNTERS);
+    requireCount("--reuse-refresh", o.reuseRefreshPeriod, 1, 1024);
     settings.materialSamples = o.materialSamples;
     settings.forwardBelowPixels = o.forwardBelowPixels;
-    if (o.allocationCounters < 1 || o.allocationCounters > SHADEL_COUNTERS)
-        throw InputError(format("--allocation-counters %u: expected 1..%u", o.allocationCounters,
-                                SHADEL_COUNTERS));
     settings.allocationCounters = o.allocationCounters;
     settings.sheetAllMips = o.sheetAllMips;
     settings.capacityControl = o.capacityControl;
     settings.reuse = o.reuse;
-    if (o.reuseRefreshPeriod < 1 || o.reuseRefreshPeriod > 1024)
-        throw InputError(format("--reuse-refresh %u: expected 1..1024", o.reuseRefreshPeriod));
     settings.reuseRefreshPeriod = o.reuseRefreshPeriod;
     settings.animateLights = o.animateLights;
     settings.timing = o.timing ? *o.timing : defaultTimingMode(gpu);

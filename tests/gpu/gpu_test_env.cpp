@@ -54,4 +54,25 @@ double psnr(const std::vector<uint8_t>& a, const std::vector<uint8_t>& b) {
     return mse == 0 ? 99.0 : 10.0 * std::log10(255.0 * 255.0 / mse);
 }
 
+RenderOptions renderOptions(const std::string& scene, RenderMode mode, uint32_t w, uint32_t h) {
+    RenderOptions o;
+    o.scene = scene;
+    o.mode = mode;
+    o.width = w;
+    o.height = h;
+    return o;
+}
+
+double meanFrameDelta(const RenderRun& run) {
+    double sum = 0;
+    size_t n = 0;
+    for (size_t f = 1; f < run.frames.size(); ++f) {
+        const auto& a = run.frames[f - 1].rgba;
+        const auto& b = run.frames[f].rgba;
+        for (size_t i = 0; i < a.size(); i += 4)
+            for (int c = 0; c < 3; ++c, ++n) sum += std::abs(double(a[i + c]) - double(b[i + c]));
+    }
+    return sum / double(std::max<size_t>(n, 1));
+}
+
 } // namespace shadel::test

@@ -16,4 +16,10 @@ RenderRun renderChecked(const RenderOptions& options);
 
 double psnr(const std::vector<uint8_t>& a, const std::vector<uint8_t>& b);
 
+// Options for rendering `scene` in `mode` at w x h (everything else default).
+RenderOptions renderOptions(const std::string& scene, RenderMode mode, uint32_t w, uint32_t h);
+
+// Flicker: mean absolute difference between consecutive frames, over all colour channels.
+double meanFrameDelta(const RenderRun& run);
+
 } // namespace shadel::test

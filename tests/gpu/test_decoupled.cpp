@@ -13,28 +13,6 @@ using namespace shadel::test;
 
 namespace {
 
-RenderOptions options(const std::string& scene, RenderMode mode, uint32_t w, uint32_t h) {
-    RenderOptions o;
-    o.scene = scene;
-    o.mode = mode;
-    o.width = w;
-    o.height = h;
-    return o;
-}
-
-// Mean absolute difference between consecutive frames, over all channels.
-double flicker(const RenderRun& run) {
-    double sum = 0;
-    size_t n = 0;
-    for (size_t f = 1; f < run.frames.size(); ++f) {
-        const auto& a = run.frames[f - 1].rgba;
-        const auto& b = run.frames[f].rgba;
-        for (size_t i = 0; i < a.size(); i += 4)
-            for (int c = 0; c < 3; ++c, ++n) sum += std::abs(double(a[i + c]) - double(b[i + c]));
-    }
-    return sum / double(std::max<size_t>(n, 1));
-}
-
 const char* markingName(MarkingMode m) {
     return m == MarkingMode::Raster ? "raster" : "visibility";
 }
@@ -45,16 +23,16 @@ const char* markingName(MarkingMode m) {
 // buffer's compute marking + resolve.
 class Decoupled : public ::testing::TestWithParam<MarkingMode> {
 protected:
-    RenderOptions options(const std::string& scene, RenderMode mode, uint32_t w, uint32_t h) {
-        RenderOptions o = ::options(scene, mode, w, h);
+    RenderOptions renderOptions(const std::string& scene, RenderMode mode, uint32_t w, uint32_t h) {
+        RenderOptions o = shadel::test::renderOptions(scene, mode, w, h);
         o.marking = GetParam();
         return o;
     }
 };
 
 TEST_P(Decoupled, SmoothSceneMatchesForward) {
-    RenderRun fwd = renderChecked(options("builtin:smooth", RenderMode::Forward, 256, 144));
-    RenderRun dec = renderChecked(options("builtin:smooth", RenderMode::Decoupled, 256, 144));
+    RenderRun fwd = renderChecked(renderOptions("builtin:smooth", RenderMode::Forward, 256, 144));
+    RenderRun dec = renderChecked(renderOptions("builtin:smooth", RenderMode::Decoupled, 256, 144));
     double p = psnr(dec.frames[0].rgba, fwd.frames[0].rgba);
     std::printf(
         "[ figures ] smooth 256x144 %s: PSNR(decoupled, forward) = %.2f dB, %.2f shadels/pixel\n",
@@ -65,11 +43,12 @@ TEST_P(Decoupled, SmoothSceneMatchesForward) {
 }
 
 TEST_P(Decoupled, CheckerIsCloserToSupersampledReferenceThanForward) {
-    RenderOptions ref = options("builtin:checker", RenderMode::Forward, 192, 108);
+    RenderOptions ref = renderOptions("builtin:checker", RenderMode::Forward, 192, 108);
     ref.ssaa = 8;
     RenderRun reference = renderChecked(ref);
-    RenderRun fwd = renderChecked(options("builtin:checker", RenderMode::Forward, 192, 108));
-    RenderRun dec = renderChecked(options("builtin:checker", RenderMode::Decoupled, 192, 108));
+    RenderRun fwd = renderChecked(renderOptions("builtin:checker", RenderMode::Forward, 192, 108));
+    RenderRun dec =
+        renderChecked(renderOptions("builtin:checker", RenderMode::Decoupled, 192, 108));
     double pf = psnr(fwd.frames[0].rgba, reference.frames[0].rgba);
     double pd = psnr(dec.frames[0].rgba, reference.frames[0].rgba);
     std::printf("[ figures ] checker 192x108 vs 8x8 SSAA: forward %.2f dB, decoupled (%s) %.2f dB "
@@ -82,13 +61,13 @@ TEST_P(Decoupled, CheckerIsCloserToSupersampledReferenceThanForward) {
 // At 1280x720 (the bench resolution): geometric edges alias the same in both modes, so at low
 // resolutions they dominate both figures and hide what decoupled shading changes.
 TEST_P(Decoupled, FlickersFarLessThanForwardUnderJitter) {
-    RenderOptions o = options("builtin:default", RenderMode::Forward, 1280, 720);
+    RenderOptions o = renderOptions("builtin:default", RenderMode::Forward, 1280, 720);
     o.frames = 16;
     o.jitter = true;
     RenderRun fwd = renderChecked(o);
     o.mode = RenderMode::Decoupled;
     RenderRun dec = renderChecked(o);
-    double ff = flicker(fwd), fd = flicker(dec);
+    double ff = meanFrameDelta(fwd), fd = meanFrameDelta(dec);
     std::printf("[ figures ] default 1280x720, 16 jittered frames: mean |frame delta| forward "
                 "%.3f, decoupled "
                 "%.3f (ratio %.3f)\n",
@@ -102,7 +81,7 @@ TEST_P(Decoupled, NoReconstructionMissesOnAnyBuiltinSceneAndCamera) {
     for (const std::string scene : {"builtin:default", "builtin:checker", "builtin:smooth"}) {
         Scene s = loadScene(scene);
         for (const Camera& camera : s.cameras) {
-            RenderOptions o = options(scene, RenderMode::Decoupled, 128, 72);
+            RenderOptions o = renderOptions(scene, RenderMode::Decoupled, 128, 72);
             o.camera = camera.name;
             RenderRun run = renderChecked(o);
             EXPECT_EQ(run.stats["reconstruction_misses"].get<uint64_t>(), 0u)
@@ -111,7 +90,7 @@ TEST_P(Decoupled, NoReconstructionMissesOnAnyBuiltinSceneAndCamera) {
                 << scene << " camera " << camera.name;
             EXPECT_GT(run.stats["shadels_shaded"].get<uint64_t>(), 0u)
                 << scene << " camera " << camera.name;
-            RenderOptions f = options(scene, RenderMode::Forward, 128, 72);
+            RenderOptions f = renderOptions(scene, RenderMode::Forward, 128, 72);
             f.camera = camera.name;
             EXPECT_EQ(run.stats["pixels_covered"], renderChecked(f).stats["pixels_covered"])
                 << scene << " camera " << camera.name;
@@ -122,9 +101,10 @@ TEST_P(Decoupled, NoReconstructionMissesOnAnyBuiltinSceneAndCamera) {
 // On smooth content forward and decoupled agree, so an overflowing frame (part decoupled, part
 // shaded forward as the fallback) must agree with both.
 TEST_P(Decoupled, StorageOverflowIsCountedAndNeverCorrupts) {
-    RenderRun fwd = renderChecked(options("builtin:smooth", RenderMode::Forward, 256, 144));
-    RenderRun full = renderChecked(options("builtin:smooth", RenderMode::Decoupled, 256, 144));
-    RenderOptions o = options("builtin:smooth", RenderMode::Decoupled, 256, 144);
+    RenderRun fwd = renderChecked(renderOptions("builtin:smooth", RenderMode::Forward, 256, 144));
+    RenderRun full =
+        renderChecked(renderOptions("builtin:smooth", RenderMode::Decoupled, 256, 144));
+    RenderOptions o = renderOptions("builtin:smooth", RenderMode::Decoupled, 256, 144);
     o.shadeStorageSize = 128; // 256 chunks: far too few for this view
     RenderRun dec = renderChecked(o);
     EXPECT_EQ(full.stats["chunks_overflowed"].get<uint64_t>(), 0u);
@@ -139,7 +119,7 @@ TEST_P(Decoupled, StorageOverflowIsCountedAndNeverCorrupts) {
 }
 
 TEST_P(Decoupled, DebugViewsRenderAndDiffer) {
-    RenderOptions o = options("builtin:default", RenderMode::Decoupled, 128, 72);
+    RenderOptions o = renderOptions("builtin:default", RenderMode::Decoupled, 128, 72);
     std::vector<std::vector<uint8_t>> images;
     for (Visualize v : {Visualize::None, Visualize::Marking, Visualize::Mips, Visualize::Chunks,
                         Visualize::Sheet}) {
@@ -156,12 +136,12 @@ TEST_P(Decoupled, NoReconstructionMissesOnRealGltfModels) {
     for (const std::string model :
          {"2CylinderEngine-glTF-Binary/2CylinderEngine.glb",
           "BoxTextured-glTF-Binary/BoxTextured.glb", "ClearCoat-glTF/ClearCoatTest.gltf"}) {
-        RenderOptions o = options(dir + model, RenderMode::Decoupled, 160, 120);
+        RenderOptions o = renderOptions(dir + model, RenderMode::Decoupled, 160, 120);
         RenderRun run = renderChecked(o);
         EXPECT_EQ(run.stats["reconstruction_misses"].get<uint64_t>(), 0u) << model;
         EXPECT_GT(run.stats["pixels_covered"].get<uint64_t>(), 100u) << model;
         EXPECT_GT(run.stats["shadels_shaded"].get<uint64_t>(), 0u) << model;
-        RenderRun fwd = renderChecked(options(dir + model, RenderMode::Forward, 160, 120));
+        RenderRun fwd = renderChecked(renderOptions(dir + model, RenderMode::Forward, 160, 120));
         EXPECT_EQ(run.stats["pixels_covered"], fwd.stats["pixels_covered"]) << model;
         double p = psnr(run.frames[0].rgba, fwd.frames[0].rgba);
         std::printf("[ figures ] %s 160x120: PSNR(decoupled, forward) = %.2f dB\n", model.c_str(),
@@ -172,7 +152,7 @@ TEST_P(Decoupled, NoReconstructionMissesOnRealGltfModels) {
 
 // Hybrid forward: objects below the size threshold are drawn forward in the same frame.
 TEST_P(Decoupled, SmallObjectsFallBackToForwardInTheSameFrame) {
-    RenderOptions o = options("builtin:default", RenderMode::Decoupled, 320, 180);
+    RenderOptions o = renderOptions("builtin:default", RenderMode::Decoupled, 320, 180);
     o.forwardBelowPixels = 0.0f;
     RenderRun none = renderChecked(o);
     EXPECT_EQ(none.stats["objects_forward_small"].get<uint64_t>(), 0u);
@@ -190,7 +170,7 @@ TEST_P(Decoupled, SmallObjectsFallBackToForwardInTheSameFrame) {
     EXPECT_LE(most.stats["objects_decoupled"].get<uint64_t>(), 2u);
     EXPECT_GT(most.stats["objects_forward_small"].get<uint64_t>(),
               some.stats["objects_forward_small"].get<uint64_t>());
-    RenderRun fwd = renderChecked(options("builtin:default", RenderMode::Forward, 320, 180));
+    RenderRun fwd = renderChecked(renderOptions("builtin:default", RenderMode::Forward, 320, 180));
     EXPECT_GT(psnr(most.frames[0].rgba, fwd.frames[0].rgba), 30.0);
 }
 

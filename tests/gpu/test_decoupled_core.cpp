@@ -13,12 +13,7 @@ using namespace shadel::test;
 namespace {
 
 RenderOptions decoupled(const std::string& scene, uint32_t w, uint32_t h) {
-    RenderOptions o;
-    o.scene = scene;
-    o.mode = RenderMode::Decoupled;
-    o.width = w;
-    o.height = h;
-    return o;
+    return renderOptions(scene, RenderMode::Decoupled, w, h);
 }
 
 uint64_t stat(const RenderRun& run, const char* name) {

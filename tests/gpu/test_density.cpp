@@ -13,27 +13,6 @@ using namespace shadel::test;
 
 namespace {
 
-RenderOptions options(const std::string& scene, RenderMode mode, uint32_t w, uint32_t h) {
-    RenderOptions o;
-    o.scene = scene;
-    o.mode = mode;
-    o.width = w;
-    o.height = h;
-    return o;
-}
-
-double flicker(const RenderRun& run) {
-    double sum = 0;
-    size_t n = 0;
-    for (size_t f = 1; f < run.frames.size(); ++f) {
-        const auto& a = run.frames[f - 1].rgba;
-        const auto& b = run.frames[f].rgba;
-        for (size_t i = 0; i < a.size(); i += 4)
-            for (int c = 0; c < 3; ++c, ++n) sum += std::abs(double(a[i + c]) - double(b[i + c]));
-    }
-    return sum / double(std::max<size_t>(n, 1));
-}
-
 double stat(const RenderRun& run, const char* name) {
     return run.stats[name].get<double>();
 }
@@ -45,13 +24,13 @@ double stat(const RenderRun& run, const char* name) {
 TEST(Density, CheckerBeatsForwardByTwoDecibelsAtEverySize) {
     const uint32_t sizes[][2] = {{192, 108}, {480, 270}, {960, 540}};
     for (const auto& size : sizes) {
-        RenderOptions ref = options("builtin:checker", RenderMode::Forward, size[0], size[1]);
+        RenderOptions ref = renderOptions("builtin:checker", RenderMode::Forward, size[0], size[1]);
         ref.ssaa = 8;
         RenderRun reference = renderChecked(ref);
         RenderRun fwd =
-            renderChecked(options("builtin:checker", RenderMode::Forward, size[0], size[1]));
-        RenderRun dec =
-            renderChecked(options("builtin:checker", RenderMode::Decoupled, size[0], size[1]));
+            renderChecked(renderOptions("builtin:checker", RenderMode::Forward, size[0], size[1]));
+        RenderRun dec = renderChecked(
+            renderOptions("builtin:checker", RenderMode::Decoupled, size[0], size[1]));
         double pf = psnr(fwd.frames[0].rgba, reference.frames[0].rgba);
         double pd = psnr(dec.frames[0].rgba, reference.frames[0].rgba);
         std::printf("[ figures ] checker %ux%u vs 8x8 SSAA: forward %.2f dB, decoupled %.2f dB "
@@ -64,7 +43,7 @@ TEST(Density, CheckerBeatsForwardByTwoDecibelsAtEverySize) {
         EXPECT_GT(dec.stats["view_density"]["chunks"].get<uint64_t>(), 1u);
         if (size[0] == 480) {
             // Without the prefilter (one material sample per shadel) the far field aliases.
-            RenderOptions one = options("builtin:checker", RenderMode::Decoupled, 480, 270);
+            RenderOptions one = renderOptions("builtin:checker", RenderMode::Decoupled, 480, 270);
             one.materialSamples = 1;
             double p1 = psnr(renderChecked(one).frames[0].rgba, reference.frames[0].rgba);
             std::printf("[ figures ] checker 480x270, 1 material sample: %.2f dB\n", p1);
@@ -77,7 +56,7 @@ TEST(Density, CheckerBeatsForwardByTwoDecibelsAtEverySize) {
 // larger than the pixel. One global density (the old default) fails the second on the checker.
 TEST(Density, ShadelsPerPixelAndMagnificationAt720p) {
     for (const std::string scene : {"builtin:default", "builtin:checker"}) {
-        RenderRun run = renderChecked(options(scene, RenderMode::Decoupled, 1280, 720));
+        RenderRun run = renderChecked(renderOptions(scene, RenderMode::Decoupled, 1280, 720));
         double perPixel = stat(run, "shadels_per_pixel");
         double magnified = stat(run, "magnified_pixel_fraction");
         std::printf("[ figures ] %s 1280x720: %.2f shadels/pixel, magnified pixel fraction %.4f, "
@@ -91,19 +70,19 @@ TEST(Density, ShadelsPerPixelAndMagnificationAt720p) {
         EXPECT_EQ(run.stats["reconstruction_misses"].get<uint64_t>(), 0u) << scene;
         EXPECT_EQ(run.stats["chunks_overflowed"].get<uint64_t>(), 0u) << scene;
     }
-    RenderOptions global = options("builtin:checker", RenderMode::Decoupled, 1280, 720);
+    RenderOptions global = renderOptions("builtin:checker", RenderMode::Decoupled, 1280, 720);
     global.shadelsPerMetre = 32.0f;
     EXPECT_GT(stat(renderChecked(global), "magnified_pixel_fraction"), 0.3);
 }
 
 TEST(Density, FlickersFarLessThanForwardAt480x270) {
-    RenderOptions o = options("builtin:default", RenderMode::Forward, 480, 270);
+    RenderOptions o = renderOptions("builtin:default", RenderMode::Forward, 480, 270);
     o.frames = 16;
     o.jitter = true;
     RenderRun fwd = renderChecked(o);
     o.mode = RenderMode::Decoupled;
     RenderRun dec = renderChecked(o);
-    double ff = flicker(fwd), fd = flicker(dec);
+    double ff = meanFrameDelta(fwd), fd = meanFrameDelta(dec);
     std::printf("[ figures ] default 480x270, 16 jittered frames: mean |frame delta| forward %.3f, "
                 "decoupled %.3f (ratio %.3f)\n",
                 ff, fd, fd / ff);
@@ -115,7 +94,7 @@ TEST(Density, FlickersFarLessThanForwardAt480x270) {
 // Over budget every density is scaled down by one factor, reported in the stats; the frame
 // stays correct (coarser, more magnified).
 TEST(Density, BudgetScalesEveryDensityDown) {
-    RenderOptions o = options("builtin:checker", RenderMode::Decoupled, 480, 270);
+    RenderOptions o = renderOptions("builtin:checker", RenderMode::Decoupled, 480, 270);
     RenderRun roomy = renderChecked(o);
     o.shadelBudget = 2e5;
     RenderRun tight = renderChecked(o);

@@ -13,12 +13,8 @@ using namespace shadel::test;
 namespace {
 
 RenderOptions decoupled(const std::string& scene, MarkingMode marking, uint32_t w, uint32_t h) {
-    RenderOptions o;
-    o.scene = scene;
-    o.mode = RenderMode::Decoupled;
+    RenderOptions o = renderOptions(scene, RenderMode::Decoupled, w, h);
     o.marking = marking;
-    o.width = w;
-    o.height = h;
     return o;
 }
 

@@ -159,6 +159,10 @@ void recordDepthPrepass(Renderer& r, VkCommandBuffer cmd, uint64_t frame) {
     beginSceneDepthPass(r, cmd, true);
     bind(gpu, cmd, r.depthPrepass);
     pushConstants(gpu, cmd, RasterPush{frame, 0});
+    drawPrepassListsAndEnd(r, cmd);
+}
+
+void drawPrepassListsAndEnd(Renderer& r, VkCommandBuffer cmd) {
     drawCameraList(r, cmd, DRAW_LIST_OPAQUE);
     drawCameraList(r, cmd, DRAW_LIST_DECOUPLED);
     vkCmdEndRendering(cmd);

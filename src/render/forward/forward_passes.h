@@ -31,6 +31,9 @@ void drawForwardLists(Renderer& r, VkCommandBuffer cmd, uint64_t frame);
 void drawCameraList(Renderer& r, VkCommandBuffer cmd, uint32_t list);
 // Begins depth-only rendering into the scene depth (cleared for the prepass, loaded after).
 void beginSceneDepthPass(Renderer& r, VkCommandBuffer cmd, bool clear);
+// Inside a prepass: draws the opaque and decoupled camera lists (what writes depth), ends
+// rendering, and makes the depth visible to the passes that test against it.
+void drawPrepassListsAndEnd(Renderer& r, VkCommandBuffer cmd);
 // Begins dynamic rendering into the HDR target with the prepass depth (loaded, not cleared).
 void beginSceneColorPass(Renderer& r, VkCommandBuffer cmd, bool clearColor);
 

@@ -471,12 +471,10 @@ void prepareDecoupledFrame(Renderer& r, const GpuScene& scene, const CameraView&
         s.layerReadSlot[l] = slot(gpu, d.storage.frames[now][l].read).value;
         s.prevLayerReadSlot[l] = slot(gpu, d.storage.frames[prev][l].read).value;
     }
-    s.storageWriteSlot = s.layerWriteSlot[SHADEL_LAYER_RADIANCE];
     s.storageReadSlot = s.layerReadSlot[SHADEL_LAYER_RADIANCE];
     s.changedLights = address(gpu, d.changedLights);
     s.changedLightCount = d.changedLightsOverflow ? 0u : uint32_t(r.changedLightVolumes.size());
     s.frameNumber = uint32_t(d.frameNumber);
-    s.refreshPeriod = d.refreshPeriod;
     s.reuse = d.reuse ? 1u : 0u;
     s.storageChunksPerRow = d.storageSize / SHADEL_CHUNK;
     s.capacityChunks = d.capacityChunks;
@@ -563,7 +561,8 @@ void recordDecoupledPasses(Renderer& r, FrameRecorder& rec, uint64_t frame, cons
 
     // Preserved layers: chunks whose inputs did not change copy last frame's shadels.
     pass(rec, "carryOver", [&](VkCommandBuffer cmd) {
-        // Reconstruction two frames ago read this storage: order the writes after it.
+        // Reconstruction two frames ago read this storage: order this pass's writes and the
+        // shading pass's after it.
         memoryBarrier(cmd, VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT,
                       VK_ACCESS_2_SHADER_SAMPLED_READ_BIT, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
                       VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT);
@@ -574,9 +573,6 @@ void recordDecoupledPasses(Renderer& r, FrameRecorder& rec, uint64_t frame, cons
     });
 
     pass(rec, "shadelShading", [&](VkCommandBuffer cmd) {
-        memoryBarrier(cmd, VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT,
-                      VK_ACCESS_2_SHADER_SAMPLED_READ_BIT, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
-                      VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT);
         bind(gpu, cmd, d.shade);
         pushConstants(gpu, cmd, FramePush{frame});
         vkCmdDispatchIndirect(cmd, vkBuffer(gpu, d.counters),

@@ -120,15 +120,7 @@ void recordVisibilityPrepass(Renderer& r, VkCommandBuffer cmd, uint64_t frame) {
     vkCmdBeginRendering(cmd, &ri);
     bind(gpu, cmd, v.prepass);
     pushConstants(gpu, cmd, RasterPush{frame, 0});
-    drawCameraList(r, cmd, DRAW_LIST_OPAQUE);
-    drawCameraList(r, cmd, DRAW_LIST_DECOUPLED);
-    vkCmdEndRendering(cmd);
-    memoryBarrier(cmd, VK_PIPELINE_STAGE_2_LATE_FRAGMENT_TESTS_BIT,
-                  VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT,
-                  VK_PIPELINE_STAGE_2_EARLY_FRAGMENT_TESTS_BIT |
-                      VK_PIPELINE_STAGE_2_LATE_FRAGMENT_TESTS_BIT,
-                  VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_READ_BIT |
-                      VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT);
+    drawPrepassListsAndEnd(r, cmd);
     imageBarrier(cmd, vkImage(gpu, v.ids), VK_IMAGE_ASPECT_COLOR_BIT,
                  VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL,
                  VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT,
