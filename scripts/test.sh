@@ -33,7 +33,7 @@ cmake --build build-fuzz -j"$jobs" --target shadel_fuzz_allocators shadel_fuzz_g
 # A finding makes libFuzzer exit non-zero; pipefail turns that into a failed suite.
 echo "== fuzz: allocators (libFuzzer, 60 s)"
 mkdir -p build-fuzz/corpus
-./build-fuzz/fuzz/shadel_fuzz_allocators -max_total_time=60 -seed=1 build-fuzz/corpus 2>&1 | tail -3
+./build-fuzz/fuzz/shadel_fuzz_allocators -max_total_time=60 -seed=1 build-fuzz/corpus fuzz/regressions/allocators 2>&1 | tail -3
 
 echo "== fuzz: glTF import (libFuzzer, 60 s, seeded with the malformed test files)"
 mkdir -p build-fuzz/corpus-gltf
