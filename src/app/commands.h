@@ -33,7 +33,7 @@ struct RenderOptions {
     uint32_t shadeStorageSize = 4096;
     uint32_t sheetShadels = 65536;
     float shadingBias = 0.0f;
-    float trilinearBand = 1.0f;
+    float trilinearBand = 0.5f; // decoupled: LOD band blended between MIPs (1 = full trilinear)
     uint32_t materialSamples = 16; // cap of material samples per shadel (prefilter.glsl)
     float forwardBelowPixels = 8.0f;
     uint32_t allocationCounters = SHADEL_COUNTERS;

@@ -42,7 +42,11 @@ struct RenderSettings {
     uint32_t shadeStorageSize = 4096; // decoupled: physical shade storage, shadels per side
     uint32_t sheetShadels = 65536;    // decoupled: virtual sheet, shadels per side
     float shadingBias = 0.0f;     // decoupled: base MIP bias (the capacity controller adds to it)
-    float trilinearBand = 1.0f;   // decoupled: LOD band blended between MIPs (1 = trilinear)
+    // decoupled: LOD band blended between MIPs (1 = full trilinear). 0.5 ("brilinear"): only
+    // the middle half of each LOD interval reads two MIPs. At 1280x720 it shades 24% fewer
+    // chunks on builtin:default for -0.3 dB against the supersampled forward render, and 22% /
+    // 12% fewer on builtin:many / 2CylinderEngine at the same PSNR (to 0.01 dB).
+    float trilinearBand = 0.5f;
     uint32_t materialSamples = 4; // decoupled: material evaluations per shadel above MIP 0
     float forwardBelowPixels = 8; // decoupled: objects smaller on screen drawn forward (0 = never)
     uint32_t allocationCounters = SHADEL_COUNTERS; // decoupled: hashed counters used (tests)
