@@ -91,6 +91,9 @@ struct GpuMaterial {
     uint flags;
     uint procedural;
     float proceduralScale;
+    // Transparent materials: 0 = alpha-blended, 1 = additive (fire, glows), in between a mix;
+    // weighted blended OIT composites both without sorting (render/oit).
+    float additiveness;
 };
 
 struct GpuLight {
