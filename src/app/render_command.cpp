@@ -272,6 +272,7 @@ RenderRun runRender(Gpu& gpu, const RenderOptions& o) {
     s["lights"] = scene.lights.size();
     s["oit"] = o.oit == OitMode::Wboit ? "wboit" : "sorted";
     s["transparent_draws"] = run.frames.back().transparentDraws;
+    s["transparent_draws_decoupled"] = run.frames.back().transparentDecoupledDraws;
     s["density_mode"] = autoDensity ? "auto" : "explicit";
     if (autoDensity)
         s["view_density"] = {{"budget_scale", viewDensity.budgetScale},

@@ -238,7 +238,9 @@ FrameResult renderFrame(Renderer& r, const GpuScene& scene, const CameraView& ca
     // inside the passes, so this is an upper bound there).
     result.cpuFrameMs = prepareMs + std::max(0.0, msSince(cpuStart) - prepareMs - rec.gpuWaitMs);
     result.shaderAsserts = collectShaderMessages(gpu, r.messages);
-    result.transparentDraws = uint32_t(transparentDrawOrder(r).size());
+    result.transparentDecoupledDraws = decoupledTransparentDraws(r);
+    result.transparentDraws =
+        uint32_t(transparentDrawOrder(r).size()) + result.transparentDecoupledDraws;
     if (r.decoupled) finishDecoupledFrame(r);
     r.framesRendered++;
     size_t bytes = size_t(r.settings.width) * r.settings.height * 4;

@@ -68,7 +68,8 @@ struct FrameResult {
     double cpuPrepareMs = 0.0; // of which the CPU frontend: constants, decoupled coarse allocation
     double startMs = 0.0;      // since the renderer was created (trace export)
     uint32_t shaderAsserts = 0;
-    uint32_t transparentDraws = 0; // blended instances drawn (render/oit)
+    uint32_t transparentDraws = 0;          // blended instances drawn (render/oit)
+    uint32_t transparentDecoupledDraws = 0; // ... of which shaded in shadel space
 };
 
 struct DecoupledState; // render/shadel/decoupled.h

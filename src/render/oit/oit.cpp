@@ -5,6 +5,7 @@
 #include "core/error.h"
 #include "core/log.h"
 #include "render/forward/forward_passes.h"
+#include "render/shadel/decoupled.h"
 
 namespace shadel {
 
@@ -19,7 +20,9 @@ struct OitState {
     TextureHandle accum, reveal;
     RenderTargetView accumTarget, revealTarget;
     TextureReadView accumRead, revealRead;
+    uint32_t decoupledDraws = 0; // blended instances shaded in shadel space this frame
     Pipeline accumulate, composite, sortedBackFaces, sortedFrontFaces;
+    Pipeline reconstruct; // decoupled mode: transparent surfaces read their shadels
 };
 
 void OitStateDeleter::operator()(OitState* state) const {
@@ -127,6 +130,12 @@ OitStatePtr createOit(Renderer& r, const GpuScene& scene) {
                             blendState(VK_BLEND_FACTOR_ZERO, VK_BLEND_FACTOR_ONE_MINUS_SRC_COLOR,
                                        VK_BLEND_FACTOR_ONE, VK_BLEND_FACTOR_ONE)};
     o.accumulate = createGraphicsPipeline(gpu, acc);
+    if (r.settings.mode == RenderMode::Decoupled) {
+        GraphicsPipelineDesc recon = acc;
+        recon.name = "oitReconstruct";
+        recon.fragmentShader = "oit_reconstruct.frag.spv";
+        o.reconstruct = createGraphicsPipeline(gpu, recon);
+    }
 
     GraphicsPipelineDesc comp;
     comp.name = "oitComposite";
@@ -167,6 +176,7 @@ void destroyOit(Renderer& r, OitStatePtr& state) {
     OitState& o = *state;
     for (Pipeline* p : {&o.accumulate, &o.composite, &o.sortedBackFaces, &o.sortedFrontFaces})
         destroy(gpu, *p);
+    if (o.reconstruct.pipeline) destroy(gpu, o.reconstruct);
     destroy(gpu, o.accumTarget);
     destroy(gpu, o.revealTarget);
     destroy(gpu, o.accumRead);
@@ -181,8 +191,13 @@ void prepareTransparentDraws(Renderer& r, const GpuScene& scene, const CameraVie
     OitState& o = *r.oit;
     o.draws.clear();
     auto planes = frustumPlanes(camera.proj * camera.view);
+    o.decoupledDraws = 0;
     for (uint32_t i : o.blended) {
         const gpu::GpuInstance& inst = scene.instanceInfo[i];
+        if (drawnDecoupled(r, i)) {
+            o.decoupledDraws++; // the GPU lists it (DRAW_LIST_DECOUPLED_BLEND)
+            continue;
+        }
         if (!boxOutside(planes, inst.worldMin, inst.worldMax)) o.draws.push_back(i);
     }
     if (r.settings.shuffleDraws) {
@@ -207,6 +222,10 @@ void prepareTransparentDraws(Renderer& r, const GpuScene& scene, const CameraVie
         });
         for (size_t k = 0; k < keyed.size(); ++k) o.draws[k] = keyed[k].second;
     }
+}
+
+uint32_t decoupledTransparentDraws(const Renderer& r) {
+    return r.oit ? r.oit->decoupledDraws : 0u;
 }
 
 const std::vector<uint32_t>& transparentDrawOrder(const Renderer& r) {
@@ -265,7 +284,7 @@ static void afterOpaquePasses(VkCommandBuffer cmd) {
 }
 
 void recordTransparencyPasses(Renderer& r, FrameRecorder& rec, uint64_t frame) {
-    if (!r.oit || r.oit->draws.empty()) return;
+    if (!r.oit || (r.oit->draws.empty() && r.oit->decoupledDraws == 0)) return;
     Gpu& gpu = *r.gpu;
     OitState& o = *r.oit;
     auto meshOf = [&](uint32_t instance) -> const gpu::GpuMesh& {
@@ -297,6 +316,11 @@ void recordTransparencyPasses(Renderer& r, FrameRecorder& rec, uint64_t frame) {
         pushConstants(gpu, cmd, RasterPush{frame, 0});
         vkCmdBindIndexBuffer(cmd, vkBuffer(gpu, r.sceneIndices), 0, VK_INDEX_TYPE_UINT32);
         for (uint32_t i : o.draws) drawInstance(cmd, meshOf(i), i);
+        if (o.decoupledDraws) { // reconstructed from shadel space into the same targets
+            bind(gpu, cmd, o.reconstruct);
+            pushConstants(gpu, cmd, RasterPush{frame, 0});
+            drawCameraList(r, cmd, DRAW_LIST_DECOUPLED_BLEND);
+        }
         vkCmdEndRendering(cmd);
         for (TextureHandle t : {o.accum, o.reveal})
             imageBarrier(

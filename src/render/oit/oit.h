@@ -25,6 +25,9 @@ void prepareTransparentDraws(Renderer& r, const GpuScene& scene, const CameraVie
 // The order prepareTransparentDraws chose, as instance ids (tests, stats).
 const std::vector<uint32_t>& transparentDrawOrder(const Renderer& r);
 
+// Blended instances shaded in shadel space this frame (decoupled mode with wboit).
+uint32_t decoupledTransparentDraws(const Renderer& r);
+
 // wboit: `oitAccumulate` (two targets) then `oitComposite` over the scene colour; sorted:
 // `sortedTransparency`. Nothing when the frame has no transparent draw.
 void recordTransparencyPasses(Renderer& r, FrameRecorder& rec, uint64_t frame);
