@@ -521,7 +521,7 @@ Scene makeTransparency() {
     // Fire: additive sprites (core) inside partly additive flames.
     for (int i = 0; i < 6; ++i) {
         float t = float(i) / 5.0f;
-        glm::vec3 at{2.7f + 0.12f * std::sin(float(i) * 2.1f), 0.3f + 0.9f * t,
+        glm::vec3 at{2.7f + 0.12f * std::sin(float(i) * 2.1f), 0.6f + 0.9f * t,
                      -0.4f + 0.04f * float(i)};
         std::string name = "fire " + std::to_string(i);
         float size = 0.9f - 0.4f * t;
@@ -530,7 +530,7 @@ Scene makeTransparency() {
     }
 
     b.sun({-0.4f, -1.0f, -0.5f}, 2.5f);
-    b.pointLight("fire light", {2.7f, 0.8f, -0.2f}, {1.0f, 0.55f, 0.2f}, 8.0f, 8.0f);
+    b.pointLight("fire light", {2.7f, 1.1f, -0.2f}, {1.0f, 0.55f, 0.2f}, 8.0f, 8.0f);
     b.camera("main", eye, {0.0f, 1.1f, 0.0f}, 0.8f, 0.1f, 100.0f);
     b.camera("side", {-5.5f, 2.0f, 4.0f}, {0.0f, 1.2f, -0.5f}, 0.8f, 0.1f, 100.0f);
     return scene;
