@@ -392,9 +392,8 @@ void prepareDecoupledFrame(Renderer& r, const GpuScene& scene, const CameraView&
         // sees only the nearest surface) keep them forward.
         bool blended = inst.material < scene.materialInfo.size() &&
                        (scene.materialInfo[inst.material].flags & MATERIAL_ALPHA_BLEND) != 0u;
-        bool transparentForward =
-            blended && (r.settings.oit != OitMode::Wboit || r.visibility != nullptr ||
-                        r.settings.marking == MarkingMode::Visibility);
+        bool transparentForward = blended && (r.settings.oit != OitMode::Wboit ||
+                                              r.settings.marking == MarkingMode::Visibility);
         bool wanted = mesh.mipCount > 0 && !transparentForward &&
                       boxVisible(planes, inst.worldMin - margin, inst.worldMax + margin);
         // Hybrid (seed: "small objects fall back to a direct only render"): an object a few
