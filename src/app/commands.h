@@ -42,6 +42,8 @@ struct RenderOptions {
     bool reuse = true;
     uint32_t reuseRefreshPeriod = 8;
     bool animateLights = false;
+    OitMode oit = OitMode::Wboit;             // --oit wboit|sorted
+    std::optional<uint64_t> shuffleDrawsSeed; // --shuffle-draws SEED
     CameraPath cameraPath = CameraPath::Static;
     double shadelBudget = 64e6; // MIP-0 shadels the bake may use for the whole scene
     bool printPasses = false;
@@ -58,6 +60,7 @@ void parseSize(const std::string& text, uint32_t& width, uint32_t& height);
 RenderMode parseMode(const std::string& text);
 Visualize parseVisualize(const std::string& text);
 MarkingMode parseMarking(const std::string& text);
+OitMode parseOit(const std::string& text);
 // The bake cache folder when --cache-dir is not given (see defaultBakeCacheDir()).
 std::string defaultCacheDir();
 

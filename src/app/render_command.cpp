@@ -56,6 +56,12 @@ MarkingMode parseMarking(const std::string& text) {
     throw InputError(format("--marking %s: expected raster or visibility", text.c_str()));
 }
 
+OitMode parseOit(const std::string& text) {
+    if (text == "wboit") return OitMode::Wboit;
+    if (text == "sorted") return OitMode::Sorted;
+    throw InputError(format("--oit %s: expected wboit or sorted", text.c_str()));
+}
+
 std::string defaultCacheDir() {
     return defaultBakeCacheDir();
 }
@@ -190,6 +196,9 @@ RenderRun runRender(Gpu& gpu, const RenderOptions& o) {
     settings.reuse = o.reuse;
     settings.reuseRefreshPeriod = o.reuseRefreshPeriod;
     settings.animateLights = o.animateLights;
+    settings.oit = o.oit;
+    settings.shuffleDraws = o.shuffleDrawsSeed.has_value();
+    settings.shuffleSeed = o.shuffleDrawsSeed.value_or(0);
     settings.timing = o.timing ? *o.timing : defaultTimingMode(gpu);
     Renderer renderer;
     RenderRun run;
@@ -261,6 +270,9 @@ RenderRun runRender(Gpu& gpu, const RenderOptions& o) {
     s["instances"] = gpuScene.instanceCount;
     s["triangles"] = scene.triangleCount();
     s["lights"] = scene.lights.size();
+    s["oit"] = o.oit == OitMode::Wboit ? "wboit" : "sorted";
+    s["transparent_draws"] = run.frames.back().transparentDraws;
+    s["transparent_draws_decoupled"] = run.frames.back().transparentDecoupledDraws;
     s["density_mode"] = autoDensity ? "auto" : "explicit";
     if (autoDensity)
         s["view_density"] = {{"budget_scale", viewDensity.budgetScale},

@@ -7,6 +7,7 @@
 #include "core/log.h"
 #include "render/forward/forward_passes.h"
 #include "render/lighting/light_animation.h"
+#include "render/oit/oit.h"
 #include "render/post/tonemap.h"
 #include "render/shadel/decoupled.h"
 #include "render/shadel/visibility.h"
@@ -93,6 +94,7 @@ void initRenderer(Renderer& r, Gpu& gpu, const RenderSettings& settings, const G
     initFrameRecorder(gpu, r.recorder, settings.timing);
     if (settings.mode == RenderMode::Decoupled) r.decoupled = createDecoupled(r, scene);
     if (usesVisibilityBuffer(settings)) r.visibility = createVisibility(r);
+    r.oit = createOit(r, scene);
 }
 
 void destroyRenderer(Renderer& r) {
@@ -100,6 +102,7 @@ void destroyRenderer(Renderer& r) {
     Gpu& gpu = *r.gpu;
     vkDeviceWaitIdle(gpu.device.device);
     if (r.visibility) destroyVisibility(r, r.visibility);
+    destroyOit(r, r.oit);
     if (r.decoupled) destroyDecoupled(r, r.decoupled);
     destroyFrameRecorder(r.recorder);
     destroyShaderMessages(gpu, r.messages);
@@ -200,6 +203,7 @@ FrameResult renderFrame(Renderer& r, const GpuScene& scene, const CameraView& ca
     gpu::FrameConstants constants = makeFrameConstants(r, scene, camera);
     updateLights(r, scene, constants);
     if (r.decoupled) prepareDecoupledFrame(r, scene, camera, constants);
+    prepareTransparentDraws(r, scene, camera);
     std::memcpy(mapped(gpu, r.frameConstants), &constants, sizeof(constants));
     uint64_t frame = address(gpu, r.frameConstants);
     double prepareMs = msSince(cpuStart);
@@ -220,6 +224,7 @@ FrameResult renderFrame(Renderer& r, const GpuScene& scene, const CameraView& ca
     } else {
         recordDecoupledPasses(r, rec, frame, scene);
     }
+    recordTransparencyPasses(r, rec, frame); // blended materials, after every opaque surface
     pass(rec, "tonemap", [&](VkCommandBuffer cmd) { recordTonemap(r, cmd, frame); });
     if (r.decoupled) recordDecoupledPostPasses(r, rec, frame);
     endFrame(rec);
@@ -233,6 +238,9 @@ FrameResult renderFrame(Renderer& r, const GpuScene& scene, const CameraView& ca
     // inside the passes, so this is an upper bound there).
     result.cpuFrameMs = prepareMs + std::max(0.0, msSince(cpuStart) - prepareMs - rec.gpuWaitMs);
     result.shaderAsserts = collectShaderMessages(gpu, r.messages);
+    result.transparentDecoupledDraws = decoupledTransparentDraws(r);
+    result.transparentDraws =
+        uint32_t(transparentDrawOrder(r).size()) + result.transparentDecoupledDraws;
     if (r.decoupled) finishDecoupledFrame(r);
     r.framesRendered++;
     size_t bytes = size_t(r.settings.width) * r.settings.height * 4;

@@ -18,6 +18,8 @@ enum class RenderMode { Forward, Decoupled };
 // Decoupled marking + reconstruction: raster passes over the objects, or compute passes over
 // the pixels of a visibility buffer (render/shadel/visibility.h).
 enum class MarkingMode { Raster, Visibility };
+// Transparency: weighted blended OIT, or the CPU-sorted back-to-front reference (tests).
+enum class OitMode { Wboit, Sorted };
 enum class Visualize : uint32_t {
     None = 0,
     Marking = 1,
@@ -54,8 +56,11 @@ struct RenderSettings {
     bool capacityControl = true;     // decoupled: steer the shading bias from storage use
     bool reuse = true;               // decoupled: carry unchanged shadels over from last frame
     uint32_t reuseRefreshPeriod = 8; // decoupled: reshade every carried chunk this often
-    bool animateLights = false; // point and spot lights move on small circles // decoupled: rects
-                                // at every MIP (the old policy, for comparison)
+    bool animateLights = false;   // point and spot lights move on small circles // decoupled: rects
+                                  // at every MIP (the old policy, for comparison)
+    OitMode oit = OitMode::Wboit; // transparency: render/oit
+    bool shuffleDraws = false;    // --shuffle-draws SEED: transparent draws in a random order
+    uint64_t shuffleSeed = 0;
 };
 
 struct FrameResult {
@@ -67,6 +72,8 @@ struct FrameResult {
     double cpuPrepareMs = 0.0; // of which the CPU frontend: constants, decoupled coarse allocation
     double startMs = 0.0;      // since the renderer was created (trace export)
     uint32_t shaderAsserts = 0;
+    uint32_t transparentDraws = 0;          // blended instances drawn (render/oit)
+    uint32_t transparentDecoupledDraws = 0; // ... of which shaded in shadel space
 };
 
 struct DecoupledState; // render/shadel/decoupled.h
@@ -74,6 +81,11 @@ struct DecoupledStateDeleter {
     void operator()(DecoupledState* state) const; // defined with the state
 };
 using DecoupledStatePtr = std::unique_ptr<DecoupledState, DecoupledStateDeleter>;
+struct OitState; // render/oit/oit.h
+struct OitStateDeleter {
+    void operator()(OitState* state) const;
+};
+using OitStatePtr = std::unique_ptr<OitState, OitStateDeleter>;
 
 struct Renderer {
     Gpu* gpu = nullptr;
@@ -94,7 +106,7 @@ struct Renderer {
     uint32_t maxDraws = 0;
     BufferHandle sceneIndices; // the unified index buffer of the scene being drawn
     glm::vec3 skyColor{0.5f};
-    Pipeline instanceCull, depthPrepass, shadowPass, forwardOpaque, forwardBlend, tonemap;
+    Pipeline instanceCull, depthPrepass, shadowPass, forwardOpaque, tonemap;
     ShaderMessageChannel messages;
     FrameRecorder recorder;
     DecoupledStatePtr decoupled;
@@ -105,6 +117,7 @@ struct Renderer {
     std::vector<glm::vec4> changedLightVolumes;
     uint64_t framesRendered = 0;
     VisibilityStatePtr visibility; // decoupled with --marking visibility
+    OitStatePtr oit;               // scenes with blended materials (render/oit)
     std::chrono::steady_clock::time_point createdAt = std::chrono::steady_clock::now();
 };
 
