@@ -42,6 +42,8 @@ struct RenderOptions {
     bool reuse = true;
     uint32_t reuseRefreshPeriod = 8;
     bool animateLights = false;
+    LightCulling lightCulling = LightCulling::Tiled; // --light-culling tiled|none
+    bool lightBlockers = true;                       // --blockers on|off
     CameraPath cameraPath = CameraPath::Static;
     double shadelBudget = 64e6; // MIP-0 shadels the bake may use for the whole scene
     bool printPasses = false;
@@ -58,6 +60,8 @@ void parseSize(const std::string& text, uint32_t& width, uint32_t& height);
 RenderMode parseMode(const std::string& text);
 Visualize parseVisualize(const std::string& text);
 MarkingMode parseMarking(const std::string& text);
+LightCulling parseLightCulling(const std::string& text);
+bool parseOnOff(const char* flag, const std::string& text); // "on" / "off", else InputError
 // The bake cache folder when --cache-dir is not given (see defaultBakeCacheDir()).
 std::string defaultCacheDir();
 
@@ -83,6 +87,10 @@ struct BenchOptions {
     bool animateLights = false;
     uint32_t reuseRefreshPeriod = 8;
     uint64_t cacheLimitBytes = 4ull << 30;
+    LightCulling lightCulling = LightCulling::Tiled;
+    // --light-culling compare: forward and decoupled rendered again with no culling, and
+    // ratios.light_culling_forward|decoupled = tiled / none median frame time.
+    bool compareLightCulling = false;
 };
 nlohmann::json runBench(Gpu& gpu, const BenchOptions& options);
 

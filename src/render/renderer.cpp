@@ -93,12 +93,14 @@ void initRenderer(Renderer& r, Gpu& gpu, const RenderSettings& settings, const G
     initFrameRecorder(gpu, r.recorder, settings.timing);
     if (settings.mode == RenderMode::Decoupled) r.decoupled = createDecoupled(r, scene);
     if (usesVisibilityBuffer(settings)) r.visibility = createVisibility(r);
+    r.lightCulling = createLightCulling(r, scene);
 }
 
 void destroyRenderer(Renderer& r) {
     if (!r.gpu) return;
     Gpu& gpu = *r.gpu;
     vkDeviceWaitIdle(gpu.device.device);
+    destroyLightCulling(r, r.lightCulling);
     if (r.visibility) destroyVisibility(r, r.visibility);
     if (r.decoupled) destroyDecoupled(r, r.decoupled);
     destroyFrameRecorder(r.recorder);
@@ -199,6 +201,7 @@ FrameResult renderFrame(Renderer& r, const GpuScene& scene, const CameraView& ca
     r.skyColor = scene.skyColor;
     gpu::FrameConstants constants = makeFrameConstants(r, scene, camera);
     updateLights(r, scene, constants);
+    constants.lighting = prepareLightCulling(r, scene);
     if (r.decoupled) prepareDecoupledFrame(r, scene, camera, constants);
     std::memcpy(mapped(gpu, r.frameConstants), &constants, sizeof(constants));
     uint64_t frame = address(gpu, r.frameConstants);
@@ -214,6 +217,8 @@ FrameResult renderFrame(Renderer& r, const GpuScene& scene, const CameraView& ca
              [&](VkCommandBuffer cmd) { recordVisibilityPrepass(r, cmd, frame); });
     else
         pass(rec, "depthPrepass", [&](VkCommandBuffer cmd) { recordDepthPrepass(r, cmd, frame); });
+    if (r.settings.lightCulling == LightCulling::Tiled)
+        pass(rec, "lightCulling", [&](VkCommandBuffer cmd) { recordLightCulling(r, cmd, frame); });
     if (r.settings.mode == RenderMode::Forward) {
         pass(rec, "forwardShading",
              [&](VkCommandBuffer cmd) { recordForwardShading(r, cmd, frame); });
@@ -234,6 +239,7 @@ FrameResult renderFrame(Renderer& r, const GpuScene& scene, const CameraView& ca
     result.cpuFrameMs = prepareMs + std::max(0.0, msSince(cpuStart) - prepareMs - rec.gpuWaitMs);
     result.shaderAsserts = collectShaderMessages(gpu, r.messages);
     if (r.decoupled) finishDecoupledFrame(r);
+    readLightCullingStats(r);
     r.framesRendered++;
     size_t bytes = size_t(r.settings.width) * r.settings.height * 4;
     result.rgba.resize(bytes);

@@ -8,6 +8,7 @@
 #include <glm/gtc/matrix_transform.hpp>
 
 #include "core/error.h"
+#include "scene/builtin_lights.h"
 #include "scene/mesh_utils.h"
 
 namespace shadel {
@@ -423,6 +424,8 @@ const std::vector<std::pair<std::string, std::function<Scene()>>>& registry() {
         {"checker", makeChecker},
         {"smooth", makeSmooth},
         {"many", makeMany},
+        {"lights", [] { return makeLightsScene(makeDefault()); }},
+        {"blockers", makeBlockersScene},
     };
     return scenes;
 }
