@@ -90,10 +90,15 @@ shared uint sBoxMin[3], sBoxMax[3];
 
 // Light culling per chunk (render/lighting): shading here is not in screen space, so the
 // chunk's own world-space box (the positions its 64 shadels are lit at) is the culling volume.
-// It is computed here, in the shading workgroup, from positions shading rebuilds anyway: a pass
-// before would rebuild them once more for the whole queue. The list goes to shared memory in
-// light order; blockers are classified against the box as for screen tiles. Call in uniform
-// control flow; `shading`: this invocation shades a shadel at p.
+// It is computed here, in the shading workgroup, from positions shading rebuilds anyway: culling
+// per block would need a pass before this one rebuilding every marked chunk's positions (or
+// per-block bounds baked per MIP), and gives longer lists. Measured on builtin:lights at
+// 640x360 (lavapipe, reuse off): chunk boxes kept 158,705 (light, chunk) pairs, 27 per chunk,
+// and shading took 3.2 s; the same in-workgroup culling against the object's world box (an
+// upper bound of any block's) kept 347,142 pairs and took 7.9 s; no culling took ~50 s. Blocks
+// lie between the two, so per chunk it is. The list goes to shared memory in light order;
+// blockers are classified against the box as for screen tiles. Call in uniform control flow;
+// `shading`: this invocation shades a shadel at p.
 void cullChunkLights(FrameConstants f, bool shading, vec3 p) {
     LightingFrame lf = LightingFrameRef(f.lighting).l;
     uint tid = gl_LocalInvocationIndex;

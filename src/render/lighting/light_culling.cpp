@@ -123,6 +123,11 @@ void recordLightCulling(Renderer& r, VkCommandBuffer cmd, uint64_t frame) {
 void readLightCullingStats(Renderer& r) {
     LightCullingState& s = *r.lightCulling;
     Gpu& gpu = *r.gpu;
+    if (r.settings.lightCulling != LightCulling::Tiled) { // nothing counted (nor cleared)
+        s.last = {};
+        s.lightsVisible = 0;
+        return;
+    }
     std::memcpy(&s.last, mapped(gpu, s.counters), sizeof(s.last));
     const uint32_t* bits = static_cast<const uint32_t*>(mapped(gpu, s.visibleLights));
     size_t words = size(gpu, s.visibleLights) / 4;
