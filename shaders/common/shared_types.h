@@ -170,6 +170,11 @@ struct LightingFrame {
     uint blockersOn;   // --blockers on
     uint poolCapacity; // entries of the tile list pool
     uint blockerCount;
+    // Lights whose range meets the camera frustum, in light order (the CPU's cull): only these
+    // can reach a screen tile, so the tile pass tests these alone.
+    uint64_t frustumLights; // uint light indices
+    uint frustumLightCount;
+    uint pad0;
 };
 
 struct DrawIndexedCommand { // VkDrawIndexedIndirectCommand

@@ -84,10 +84,11 @@ void main() {
 
     // Lights against the tile, 256 at a time, kept in light order.
     LightBuffer lights = LightBuffer(f.lights);
-    for (uint base = 0u; base < f.lightCount; base += THREADS) {
-        uint index = base + tid;
+    UintBuffer frustumLights = UintBuffer(lf.frustumLights);
+    for (uint base = 0u; base < lf.frustumLightCount; base += THREADS) {
+        uint index = base + tid < lf.frustumLightCount ? frustumLights.v[base + tid] : LIGHT_INVALID;
         bool keep = false;
-        if (index < f.lightCount) {
+        if (index != LIGHT_INVALID) {
             GpuLight light = lights.l[index];
             vec4 sphere = lightSphere(light);
             keep = true;

@@ -201,7 +201,8 @@ FrameResult renderFrame(Renderer& r, const GpuScene& scene, const CameraView& ca
     r.skyColor = scene.skyColor;
     gpu::FrameConstants constants = makeFrameConstants(r, scene, camera);
     updateLights(r, scene, constants);
-    constants.lighting = prepareLightCulling(r, scene);
+    constants.lighting = prepareLightCulling(
+        r, scene, r.settings.animateLights ? r.lightsLastFrame : scene.lightInfo, constants.viewProj);
     if (r.decoupled) prepareDecoupledFrame(r, scene, camera, constants);
     std::memcpy(mapped(gpu, r.frameConstants), &constants, sizeof(constants));
     uint64_t frame = address(gpu, r.frameConstants);

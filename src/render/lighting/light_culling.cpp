@@ -4,6 +4,7 @@
 #include <bit>
 #include <cstring>
 
+#include "render/camera.h"
 #include "render/renderer.h"
 
 namespace shadel {
@@ -15,6 +16,7 @@ struct LightCullingState {
     BufferHandle tileLights;    // the pool of list entries
     BufferHandle counters;      // gpu::LightingCounters (readback)
     BufferHandle visibleLights; // uint bit set (readback)
+    BufferHandle frustumLights; // uint light indices (upload), the CPU's frustum cull
     uint32_t tilesX = 0, tilesY = 0, poolCapacity = 0;
     // Last frame's counts (read after the GPU finished).
     gpu::LightingCounters last{};
@@ -54,6 +56,9 @@ LightCullingStatePtr createLightCulling(Renderer& r, const GpuScene& scene) {
     s->visibleLights = need(createBuffer(
         gpu, {"lighting.visibleLights", std::max<uint64_t>((scene.lightCount + 31) / 32, 1) * 4, 0,
               MemoryKind::Readback}));
+    s->frustumLights = need(createBuffer(
+        gpu, {"lighting.frustumLights", std::max<uint64_t>(scene.lightCount, 1) * 4, 0,
+              MemoryKind::Upload}));
     s->tileCull = createComputePipeline(gpu, "lightTileCull", "lighting_tile_cull.comp.spv");
     return s;
 }
@@ -63,15 +68,32 @@ void destroyLightCulling(Renderer& r, LightCullingStatePtr& state) {
     Gpu& gpu = *r.gpu;
     destroy(gpu, state->tileCull);
     for (BufferHandle b : {state->frame, state->tileRanges, state->tileLights, state->counters,
-                           state->visibleLights})
+                           state->visibleLights, state->frustumLights})
         destroy(gpu, b);
     state.reset();
 }
 
-uint64_t prepareLightCulling(Renderer& r, const GpuScene& scene) {
+uint64_t prepareLightCulling(Renderer& r, const GpuScene& scene,
+                             const std::vector<gpu::GpuLight>& lights, const glm::mat4& viewProj) {
     Gpu& gpu = *r.gpu;
     LightCullingState& s = *r.lightCulling;
     gpu::LightingFrame f{};
+    // Spheres against the camera frustum; a light without a finite range always passes.
+    std::array<glm::vec4, 6> planes = frustumPlanes(viewProj);
+    uint32_t* visible = static_cast<uint32_t*>(mapped(gpu, s.frustumLights));
+    uint32_t count = 0;
+    for (uint32_t i = 0; i < lights.size(); ++i) {
+        const gpu::GpuLight& l = lights[i];
+        bool in = true;
+        if (l.type != LIGHT_DIRECTIONAL && l.range > 0.0f) {
+            float radius = l.range + (l.type == LIGHT_TUBE ? l.halfLength : 0.0f);
+            for (const glm::vec4& p : planes)
+                in = in && glm::dot(glm::vec3(p), l.position) + p.w >= -radius;
+        }
+        if (in) visible[count++] = i;
+    }
+    f.frustumLights = address(gpu, s.frustumLights);
+    f.frustumLightCount = count;
     f.tileLights = address(gpu, s.tileLights);
     f.tileRanges = address(gpu, s.tileRanges);
     f.blockers = address(gpu, scene.blockers);

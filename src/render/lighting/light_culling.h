@@ -7,6 +7,7 @@
 // shadeSurface (shaders/common/lighting.glsl).
 #include <cstdint>
 #include <memory>
+#include <vector>
 
 #include <nlohmann/json.hpp>
 
@@ -27,8 +28,11 @@ using LightCullingStatePtr = std::unique_ptr<LightCullingState, LightCullingStat
 LightCullingStatePtr createLightCulling(Renderer& r, const GpuScene& scene);
 void destroyLightCulling(Renderer& r, LightCullingStatePtr& state);
 
-// This frame's LightingFrame (host-visible); returns its address for FrameConstants::lighting.
-uint64_t prepareLightCulling(Renderer& r, const GpuScene& scene);
+// This frame's LightingFrame (host-visible), with the lights that meet the camera frustum
+// (`lights`: this frame's, `viewProj`: the camera's); returns its address for
+// FrameConstants::lighting.
+uint64_t prepareLightCulling(Renderer& r, const GpuScene& scene,
+                             const std::vector<gpu::GpuLight>& lights, const glm::mat4& viewProj);
 // The culling pass (tiled mode); with --light-culling none it records nothing.
 void recordLightCulling(Renderer& r, VkCommandBuffer cmd, uint64_t frame);
 // After the frame: counters into the stats (lights, lights_visible, light_tile_pairs, ...).
