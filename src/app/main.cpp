@@ -90,7 +90,8 @@ int main(int argc, char** argv) {
     render->add_option("--ssaa", ro.ssaa, "N: NxN supersampled reference")->capture_default_str();
     render
         ->add_option("--visualize", visualize,
-                     "none | marking | mips | chunks | sheet | layer:radiance | layer:material")
+                     "none | marking | mips | chunks | sheet | layer:radiance | layer:material | "
+                     "light-count | blockers")
         ->capture_default_str();
     std::string marking = "raster";
     render
