@@ -133,8 +133,17 @@ Scene makeBlockersScene() {
                        30.0f, 14.0f);
     lamp.blockers = walls;
     scene.lights.push_back(lamp);
+    // Every built-in scene has one shadowed directional light; this one is dark, so that
+    // everything outside the room shows only what leaks from the lamp.
+    Light moon;
+    moon.name = "moon (dark)";
+    moon.type = LightType::Directional;
+    moon.direction = glm::normalize(glm::vec3(-0.3f, -1.0f, -0.2f));
+    moon.intensity = 0.0f;
+    moon.castsShadow = true;
+    scene.lights.push_back(moon);
     Camera top; // looking straight down: pixels map to the ground plane (the leak test)
-    top.name = "top";
+    top.name = "main";
     top.position = {0.0f, 22.0f, 0.0f};
     top.forward = {0, -1, 0};
     top.up = {0, 0, -1};
@@ -239,8 +248,10 @@ Scene makeLightsScene(Scene scene) {
         }
     }
     // The first camera is the default: down the avenue at night, the rooms on the right.
+    for (Camera& c : scene.cameras)
+        if (c.name == "main") c.name = "plaza"; // the town's main camera; ours comes first
     Camera night;
-    night.name = "night";
+    night.name = "main";
     night.position = {-54.0f, 2.2f, 4.0f};
     night.forward = glm::normalize(glm::vec3(0.0f, 1.0f, -3.0f) - night.position);
     night.up = glm::normalize(glm::vec3(0, 1, 0) - night.forward * night.forward.y);
