@@ -1,8 +1,69 @@
 // Lighting shared by the forward and decoupled paths: GGX specular + Lambert diffuse, the
-// sun with a PCF shadow map, point and spot lights with glTF's range falloff.
+// sun with a PCF shadow map, and one buffer of lights of several kinds (seed 001): omni, spot
+// with a round or square cone, tube (representative-point specular), darks (negative lights),
+// each optionally limited by a clip plane and stopped by light blockers with portals.
+//
+// Which lights a surface loops over is chosen by the caller before shadeSurface (render/lighting):
+// every light (LIGHT_LIST_ALL), a screen tile's list in memory (forward, useTileLightList) or the
+// workgroup's list in shared memory (shadel chunks; the shader defines SHADEL_LIGHT_LIST_SHARED).
+// A list entry is (light, mask): bit k of the mask asks for the per-pixel test of the light's
+// k-th blocker; culling has already removed lights a blocker hides from the whole tile.
 #ifndef SHADEL_LIGHTING_GLSL
 #define SHADEL_LIGHTING_GLSL
 #include "common/material.glsl"
+
+layout(buffer_reference, scalar) readonly buffer LightingFrameRef { LightingFrame l; };
+layout(buffer_reference, scalar) readonly buffer LightBlockerBuffer { GpuLightBlocker b[]; };
+layout(buffer_reference, scalar) readonly buffer LightPortalBuffer { GpuLightPortal p[]; };
+layout(buffer_reference, scalar) readonly buffer LightListBuffer { uvec2 e[]; };
+layout(buffer_reference, scalar) buffer LightingCountersRef { LightingCounters c; };
+
+#define LIGHT_LIST_ALL 0u
+#define LIGHT_LIST_BUFFER 1u
+#define LIGHT_LIST_SHARED 2u
+#define LIGHT_TILE_MAX_LIGHTS 1024u // lights a tile's list can hold (shared memory while culling)
+#define LIGHT_CHUNK_MAX_LIGHTS 512u // entries of a shadel chunk's list (shared memory)
+#define LIGHT_INVALID 0xFFFFFFFFu   // an entry culling removed in place
+
+uint gLightListMode = LIGHT_LIST_ALL;
+uint64_t gLightListAddress = 0ul;
+uint gLightListCount = 0u;
+
+#ifdef SHADEL_LIGHT_LIST_SHARED
+shared uvec2 sLightList[LIGHT_CHUNK_MAX_LIGHTS];
+shared uint sLightListCount;
+#endif
+
+// Forward shading: the list of the 16x16 tile holding this pixel, when tiled culling ran.
+void useTileLightList(FrameConstants f, vec2 fragCoord) {
+    if (f.lighting == 0ul) return;
+    LightingFrame lf = LightingFrameRef(f.lighting).l;
+    if (lf.tiled == 0u) return;
+    uvec2 tile = uvec2(fragCoord) / LIGHT_TILE_SIZE;
+    uint index = min(tile.y, lf.tilesY - 1u) * lf.tilesX + min(tile.x, lf.tilesX - 1u);
+    uvec2 range = LightListBuffer(lf.tileRanges).e[index];
+    gLightListMode = LIGHT_LIST_BUFFER;
+    gLightListAddress = lf.tileLights + uint64_t(range.x) * 8ul;
+    gLightListCount = range.y;
+}
+
+uint lightListLength(FrameConstants f) {
+    if (gLightListMode == LIGHT_LIST_BUFFER) return gLightListCount;
+#ifdef SHADEL_LIGHT_LIST_SHARED
+    if (gLightListMode == LIGHT_LIST_SHARED) return min(sLightListCount, LIGHT_CHUNK_MAX_LIGHTS);
+#endif
+    return f.lightCount;
+}
+
+uvec2 lightListEntry(FrameConstants f, uint i) {
+    if (gLightListMode == LIGHT_LIST_BUFFER) return LightListBuffer(gLightListAddress).e[i];
+#ifdef SHADEL_LIGHT_LIST_SHARED
+    if (gLightListMode == LIGHT_LIST_SHARED) return sLightList[i];
+#endif
+    // Every light: no culling happened, so every blocker a light lists is tested per pixel.
+    bool blockers = f.lighting != 0ul && LightingFrameRef(f.lighting).l.blockersOn != 0u;
+    return uvec2(i, blockers ? 0xFFFFFFFFu : 0u);
+}
 
 const float PI = 3.14159265358979;
 
@@ -65,6 +126,115 @@ float rangeAttenuation(float distance, float range) {
     return invSquare * window * window;
 }
 
+// Whether blocker b stops light travelling from `lightPos` to p: the segment crosses the
+// blocker's rectangle outside every portal.
+bool blockerStops(GpuLightBlocker b, LightPortalBuffer portals, vec3 p, vec3 lightPos) {
+    float dp = dot(b.normal, p - b.center);
+    float dl = dot(b.normal, lightPos - b.center);
+    if (dp * dl >= 0.0) return false; // same side (or on the plane)
+    vec3 hit = p + (lightPos - p) * (dp / (dp - dl)) - b.center;
+    vec2 uv = vec2(dot(hit, b.axisU), dot(hit, b.axisV));
+    if (abs(uv.x) > b.halfU || abs(uv.y) > b.halfV) return false;
+    for (uint k = 0u; k < b.portalCount; ++k) {
+        GpuLightPortal portal = portals.p[b.firstPortal + k];
+        if (all(greaterThanEqual(uv, portal.minUv)) && all(lessThanEqual(uv, portal.maxUv)))
+            return false;
+    }
+    return true;
+}
+
+// The per-pixel blocker test of the blockers `mask` selects among the light's list.
+bool lightBlockedAt(FrameConstants f, GpuLight light, uint mask, vec3 p) {
+    if (mask == 0u || light.blockerCount == 0u || f.lighting == 0ul) return false;
+    LightingFrame lf = LightingFrameRef(f.lighting).l;
+    if (lf.blockersOn == 0u) return false;
+    LightBlockerBuffer blockers = LightBlockerBuffer(lf.blockers);
+    LightPortalBuffer portals = LightPortalBuffer(lf.portals);
+    UintBuffer list = UintBuffer(lf.lightBlockers);
+    uint n = min(light.blockerCount, LIGHT_MAX_BLOCKERS_PER_LIGHT);
+    for (uint k = 0u; k < n; ++k) {
+        if ((mask & (1u << k)) == 0u) continue;
+        if (blockerStops(blockers.b[list.v[light.blockerFirst + k]], portals, p, light.position))
+            return true;
+    }
+    return false;
+}
+
+// Cone factor of round and square spots (1 inside the inner cone, 0 outside the outer).
+float spotFactor(GpuLight light, vec3 dirToLight) {
+    if (light.type == LIGHT_SPOT) {
+        float cd = dot(light.direction, -dirToLight);
+        float s = clamp(cd * light.spotScale + light.spotOffset, 0.0, 1.0);
+        return s * s;
+    }
+    if (light.type == LIGHT_SPOT_SQUARE) {
+        float z = dot(light.direction, -dirToLight);
+        if (z <= 0.0) return 0.0;
+        vec3 up = cross(light.direction, light.axis);
+        float t = max(abs(dot(light.axis, -dirToLight)), abs(dot(up, -dirToLight))) / z;
+        float s = clamp(light.spotOffset - t * light.spotScale, 0.0, 1.0);
+        return s * s;
+    }
+    return 1.0;
+}
+
+// Specular of a tube light from its representative point: the point of the segment closest to
+// the reflection ray (Karis 2013), with the lobe widened by the tube's radius to keep energy.
+vec3 tubeLight(GpuLight light, MaterialSample m, vec3 n, vec3 v, vec3 p) {
+    vec3 a = light.position - light.axis * light.halfLength - p;
+    vec3 b = light.position + light.axis * light.halfLength - p;
+    vec3 ab = b - a;
+    // Diffuse: the segment's point closest to the surface point.
+    float td = clamp(-dot(a, ab) / max(dot(ab, ab), 1e-8), 0.0, 1.0);
+    vec3 ld = a + ab * td;
+    float distD = length(ld);
+    vec3 dirD = ld / max(distD, 1e-4);
+    // Specular: the point closest to the reflection ray.
+    vec3 r = reflect(-v, n);
+    float rab = dot(r, ab);
+    float ts = (dot(r, a) * rab - dot(a, ab)) / max(dot(ab, ab) - rab * rab, 1e-8);
+    ts = clamp(ts, 0.0, 1.0);
+    vec3 ls = a + ab * ts;
+    float distS = length(ls);
+    vec3 dirS = ls / max(distS, 1e-4);
+
+    float nlD = dot(n, dirD);
+    float nlS = dot(n, dirS);
+    vec3 f0 = mix(vec3(0.04), m.baseColor, m.metallic);
+    float alpha = m.roughness * m.roughness;
+    vec3 color = vec3(0.0);
+    if (nlD > 0.0) {
+        vec3 radiance = light.color * rangeAttenuation(distD, light.range);
+        vec3 f = fresnelSchlick(f0, max(dot(v, normalize(v + dirD)), 0.0));
+        color += (1.0 - f) * (1.0 - m.metallic) * m.baseColor / PI * radiance * nlD;
+    }
+    if (nlS > 0.0) {
+        vec3 radiance = light.color * rangeAttenuation(distS, light.range);
+        float widened = clamp(alpha + light.radius / (2.0 * max(distS, 1e-4)), 0.0, 1.0);
+        float energy = (alpha * alpha) / max(widened * widened, 1e-6);
+        vec3 h = normalize(v + dirS);
+        float a2 = widened * widened;
+        vec3 f = fresnelSchlick(f0, max(dot(v, h), 0.0));
+        vec3 spec = f * distributionGgx(max(dot(n, h), 0.0), a2) *
+                    visibilitySmithGgx(max(dot(n, v), 1e-4), nlS, a2);
+        color += spec * energy * radiance * nlS;
+    }
+    return color;
+}
+
+// One light of the buffer at surface point p (not counting blockers).
+vec3 evaluateLight(GpuLight light, MaterialSample m, vec3 n, vec3 v, vec3 p) {
+    if ((light.flags & LIGHT_FLAG_CLIP_PLANE) != 0u && dot(light.clipPlane.xyz, p) + light.clipPlane.w < 0.0)
+        return vec3(0.0);
+    if (light.type == LIGHT_DIRECTIONAL) return brdf(m, n, v, -light.direction, light.color);
+    if (light.type == LIGHT_TUBE) return tubeLight(light, m, n, v, p);
+    vec3 toLight = light.position - p;
+    float dist = length(toLight);
+    vec3 dir = toLight / max(dist, 1e-4);
+    vec3 radiance = light.color * rangeAttenuation(dist, light.range) * spotFactor(light, dir);
+    return brdf(m, n, v, dir, radiance);
+}
+
 // Everything that lights a surface point, evaluated for a viewer at f.cameraPosition.
 vec3 shadeSurface(FrameConstants f, MaterialSample m, vec3 worldPos, vec3 geometricNormal) {
     vec3 n = m.normal;
@@ -80,25 +250,16 @@ vec3 shadeSurface(FrameConstants f, MaterialSample m, vec3 worldPos, vec3 geomet
         color += brdf(m, n, v, l, f.sunColor * sunShadow(f, worldPos, geometricNormal));
 
     LightBuffer lights = LightBuffer(f.lights);
-    for (uint i = 0u; i < f.lightCount; ++i) {
-        GpuLight light = lights.l[i];
-        vec3 radiance = light.color;
-        vec3 dir;
-        if (light.type == LIGHT_DIRECTIONAL) {
-            dir = -light.direction;
-        } else {
-            vec3 toLight = light.position - worldPos;
-            float dist = length(toLight);
-            dir = toLight / max(dist, 1e-4);
-            radiance *= rangeAttenuation(dist, light.range);
-            if (light.type == LIGHT_SPOT) {
-                float cd = dot(light.direction, -dir);
-                float s = clamp(cd * light.spotScale + light.spotOffset, 0.0, 1.0);
-                radiance *= s * s;
-            }
-        }
-        color += brdf(m, n, v, dir, radiance) * m.occlusion;
+    vec3 direct = vec3(0.0);
+    uint count = lightListLength(f);
+    for (uint i = 0u; i < count; ++i) {
+        uvec2 entry = lightListEntry(f, i);
+        if (entry.x == LIGHT_INVALID) continue;
+        GpuLight light = lights.l[entry.x];
+        if (lightBlockedAt(f, light, entry.y, worldPos)) continue;
+        direct += evaluateLight(light, m, n, v, worldPos);
     }
-    return color;
+    // Darks subtract light; they never make a surface emit negative light.
+    return color + max(direct * m.occlusion, -color);
 }
 #endif

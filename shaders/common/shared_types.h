@@ -29,7 +29,16 @@ using uint = uint32_t;
 
 #define LIGHT_DIRECTIONAL 0u
 #define LIGHT_POINT 1u
-#define LIGHT_SPOT 2u
+#define LIGHT_SPOT 2u        // round cone
+#define LIGHT_SPOT_SQUARE 3u // square cone (a pyramid): spotScale/Offset act on tan of the angle
+#define LIGHT_TUBE 4u        // a segment of 2 * halfLength along axis (representative point)
+#define LIGHT_KIND_COUNT 5u
+// GpuLight::flags
+#define LIGHT_FLAG_DARK 1u       // a negative light: subtracts its radiance (colour is negated)
+#define LIGHT_FLAG_CLIP_PLANE 2u // lights only where dot(clipPlane, vec4(p, 1)) >= 0
+// Light blockers (render/lighting): a light lists up to this many blockers.
+#define LIGHT_MAX_BLOCKERS_PER_LIGHT 32u
+#define LIGHT_TILE_SIZE 16u // pixels per side of a forward light culling tile
 
 #define NO_TEXTURE 0xFFFFFFFFu
 
@@ -48,6 +57,8 @@ using uint = uint32_t;
 #define VISUALIZE_CHUNKS 3u
 #define VISUALIZE_SHEET 4u
 #define VISUALIZE_LAYER_MATERIAL 5u // --visualize layer:material
+#define VISUALIZE_LIGHT_COUNT 16u   // --visualize light-count: lights per tile / chunk (heat)
+#define VISUALIZE_BLOCKERS 17u      // --visualize blockers: tiles with per-pixel blocker checks
 
 // One vertex of the unified geometry buffer (matches shadel::Vertex).
 struct GpuVertex {
@@ -99,16 +110,76 @@ struct GpuMaterial {
 };
 
 struct GpuLight {
-    vec3 position;
+    vec3 position; // the centre of tube lights
     uint type;
-    vec3 direction;   // the way light travels
-    float range;      // 0 = infinite
-    vec3 color;       // colour * intensity
-    float spotScale;  // 1 / max(cos(inner) - cos(outer), 1e-4)
-    float spotOffset; // -cos(outer) * spotScale
-    float pad0;
-    float pad1;
-    float pad2;
+    vec3 direction;    // the way light travels (spots)
+    float range;       // 0 = infinite
+    vec3 color;        // colour * intensity; negated for darks
+    float spotScale;   // round: 1 / max(cos(inner) - cos(outer), 1e-4); square: on tan(angle)
+    float spotOffset;  // round: -cos(outer) * spotScale; square: tan(outer) * spotScale
+    uint flags;        // LIGHT_FLAG_*
+    float halfLength;  // tube: half the segment's length
+    float radius;      // tube: the tube's radius (widens the specular lobe)
+    vec3 axis;         // tube: the segment's direction; square spot: the cone's "right" axis
+    uint blockerFirst; // into LightingFrame::lightBlockers
+    vec4 clipPlane;    // LIGHT_FLAG_CLIP_PLANE: world-space plane, lit side positive
+    uint blockerCount; // blockers this light lists (<= LIGHT_MAX_BLOCKERS_PER_LIGHT)
+    uint pad0;
+    uint pad1;
+    uint pad2;
+};
+
+// A light blocker (seed 001): an artist-placed rectangle (a wall's mid-plane) that stops the
+// lights listing it, without a shadow map. Portals are rectangular holes in it.
+struct GpuLightBlocker {
+    vec3 center;
+    uint firstPortal; // into LightingFrame::portals
+    vec3 axisU;       // unit, in the plane
+    float halfU;
+    vec3 axisV; // unit, in the plane, orthogonal to axisU
+    float halfV;
+    vec3 normal; // cross(axisU, axisV)
+    uint portalCount;
+};
+
+// A hole in a blocker: a rectangle in the blocker's (u, v) coordinates (metres from its centre).
+struct GpuLightPortal {
+    vec2 minUv;
+    vec2 maxUv;
+};
+
+// Light culling counters, read back for the stats.
+struct LightingCounters {
+    uint lightTilePairs;       // (light, tile) pairs kept by tiled culling (forward tiles)
+    uint perPixelBlockerTiles; // tiles with any (light, blocker) pair checked per pixel
+    uint tilesOverflowed;      // tiles with more lights than a list holds (lights dropped)
+    uint lightChunkPairs;      // (light, chunk) pairs of the shadel path's chunk culling
+    uint perPixelBlockerChunks;
+    uint chunksOverflowed;
+    uint lightsCulledByBlockers; // (light, tile) pairs a blocker removed whole
+    uint tileListEntries;        // entries taken from the tile list pool (may exceed it)
+};
+
+// What the tiled-lighting passes share with shading (FrameConstants::lighting).
+struct LightingFrame {
+    uint64_t tileLights;    // pool of uvec2 entries: light index, mask of its blockers to test
+    uint64_t tileRanges;    // uvec2 per tile: first entry in the pool, entries
+    uint64_t blockers;      // GpuLightBlocker[]
+    uint64_t portals;       // GpuLightPortal[]
+    uint64_t lightBlockers; // uint blocker indices, GpuLight::blockerFirst/Count index them
+    uint64_t counters;      // LightingCounters
+    uint64_t visibleLights; // uint bit set: lights in at least one list
+    uint tilesX;
+    uint tilesY;
+    uint tiled;        // 1: shading reads per-tile / per-chunk lists; 0: every light everywhere
+    uint blockersOn;   // --blockers on
+    uint poolCapacity; // entries of the tile list pool
+    uint blockerCount;
+    // Lights whose range meets the camera frustum, in light order (the CPU's cull): only these
+    // can reach a screen tile, so the tile pass tests these alone.
+    uint64_t frustumLights; // uint light indices
+    uint frustumLightCount;
+    uint pad0;
 };
 
 struct DrawIndexedCommand { // VkDrawIndexedIndirectCommand
@@ -151,6 +222,7 @@ struct FrameConstants {
     uint64_t lights;    // GpuLight[]
     uint64_t messages;  // ShaderMessages (shader asserts)
     uint64_t shadel;    // ShadelFrame (decoupled path), 0 when forward
+    uint64_t lighting;  // LightingFrame (render/lighting), 0 when absent
 };
 
 // Shader -> CPU message channel (shader asserts). Written with atomics, read after the frame.

@@ -1,6 +1,7 @@
 #version 460
 // Forward shading: the shared material + lighting code evaluated per pixel.
 #include "common/lighting.glsl"
+#include "lighting/light_debug.glsl"
 
 layout(push_constant, scalar) uniform Push {
     uint64_t frame;
@@ -29,7 +30,10 @@ void main() {
     s.frontFacing = gl_FrontFacing;
     MaterialSample m = evaluateMaterial(mat, s);
     if ((mat.flags & MATERIAL_ALPHA_MASK) != 0u && m.alpha < mat.alphaCutoff) discard;
+    // Opaque pixels lie on the prepass depth the tile's bounds came from; blended ones need not.
+    if ((mat.flags & MATERIAL_ALPHA_BLEND) == 0u) useTileLightList(f, gl_FragCoord.xy);
     vec3 color = shadeSurface(f, m, inPosition, s.normal);
+    color = visualizeLighting(f, color);
     float alpha = (mat.flags & MATERIAL_ALPHA_BLEND) != 0u ? m.alpha : 1.0;
     outColor = vec4(color, alpha);
 }

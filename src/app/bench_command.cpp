@@ -27,6 +27,7 @@ nlohmann::json runBench(Gpu& gpu, const BenchOptions& b) {
     o.animateLights = b.animateLights;
     o.reuseRefreshPeriod = b.reuseRefreshPeriod;
     o.cacheLimitBytes = b.cacheLimitBytes;
+    o.lightCulling = b.lightCulling;
     o.progress = false;
 
     struct Mode {
@@ -56,6 +57,23 @@ nlohmann::json runBench(Gpu& gpu, const BenchOptions& b) {
     for (const char* name : {"decoupled", "reuse"}) {
         double ms = out["modes"][name]["frame_ms"]["median"];
         out["ratios"][name] = fwd > 0 ? ms / fwd : 0.0;
+    }
+
+    if (b.compareLightCulling) {
+        // The same forward and decoupled (reuse off) runs without light culling.
+        for (RenderMode mode : {RenderMode::Forward, RenderMode::Decoupled}) {
+            const char* name = mode == RenderMode::Forward ? "forward" : "decoupled";
+            std::fprintf(stderr, "bench: %s, light culling none\n", name);
+            o.mode = mode;
+            o.reuse = false;
+            o.lightCulling = LightCulling::None;
+            nlohmann::json none = runRender(gpu, o).stats;
+            double tiledMs = out["modes"][name]["frame_ms"]["median"];
+            double noneMs = none["frame_ms"]["median"];
+            out["modes"][std::string(name) + "_no_light_culling"] = none;
+            out["ratios"][std::string("light_culling_") + name] =
+                noneMs > 0 ? tiledMs / noneMs : 0.0;
+        }
     }
 
     std::printf("shadel bench: %s at %ux%u on %s, %u frames, %s camera, medians (timing: %s)\n",
@@ -98,6 +116,13 @@ nlohmann::json runBench(Gpu& gpu, const BenchOptions& b) {
     row("reuse fraction", decoupledOnly("reuse_fraction", "%.3f"));
     row("occupancy bits per shadel", decoupledOnly("occupancy_bits_per_shadel", "%.3f"));
     row("reconstruction misses", decoupledOnly("reconstruction_misses", ""));
+    if (b.compareLightCulling)
+        for (const char* name : {"forward", "decoupled"})
+            std::printf("light culling, %s: tiled %.3f ms / none %.3f ms = %.3f\n", name,
+                        out["modes"][name]["frame_ms"]["median"].get<double>(),
+                        out["modes"][std::string(name) + "_no_light_culling"]["frame_ms"]["median"]
+                            .get<double>(),
+                        out["ratios"][std::string("light_culling_") + name].get<double>());
     if (!b.json.empty()) {
         writeOutputFile(b.json, out.dump(2) + "\n");
     }

@@ -44,6 +44,8 @@ struct RenderOptions {
     bool animateLights = false;
     OitMode oit = OitMode::Wboit;             // --oit wboit|sorted
     std::optional<uint64_t> shuffleDrawsSeed; // --shuffle-draws SEED
+    LightCulling lightCulling = LightCulling::Tiled; // --light-culling tiled|none
+    bool lightBlockers = true;                       // --blockers on|off
     CameraPath cameraPath = CameraPath::Static;
     double shadelBudget = 64e6; // MIP-0 shadels the bake may use for the whole scene
     bool printPasses = false;
@@ -61,6 +63,8 @@ RenderMode parseMode(const std::string& text);
 Visualize parseVisualize(const std::string& text);
 MarkingMode parseMarking(const std::string& text);
 OitMode parseOit(const std::string& text);
+LightCulling parseLightCulling(const std::string& text);
+bool parseOnOff(const char* flag, const std::string& text); // "on" / "off", else InputError
 // The bake cache folder when --cache-dir is not given (see defaultBakeCacheDir()).
 std::string defaultCacheDir();
 
@@ -86,6 +90,10 @@ struct BenchOptions {
     bool animateLights = false;
     uint32_t reuseRefreshPeriod = 8;
     uint64_t cacheLimitBytes = 4ull << 30;
+    LightCulling lightCulling = LightCulling::Tiled;
+    // --light-culling compare: forward and decoupled rendered again with no culling, and
+    // ratios.light_culling_forward|decoupled = tiled / none median frame time.
+    bool compareLightCulling = false;
 };
 nlohmann::json runBench(Gpu& gpu, const BenchOptions& options);
 

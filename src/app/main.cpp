@@ -90,7 +90,8 @@ int main(int argc, char** argv) {
     render->add_option("--ssaa", ro.ssaa, "N: NxN supersampled reference")->capture_default_str();
     render
         ->add_option("--visualize", visualize,
-                     "none | marking | mips | chunks | sheet | layer:radiance | layer:material")
+                     "none | marking | mips | chunks | sheet | layer:radiance | layer:material | "
+                     "light-count | blockers")
         ->capture_default_str();
     std::string marking = "raster";
     render
@@ -181,6 +182,15 @@ int main(int argc, char** argv) {
     render->add_option("--shuffle-draws", ro.shuffleDrawsSeed,
                        "SEED: draw the transparent instances in a random order (order "
                        "independence tests)");
+    std::string lightCulling = "tiled", blockers = "on";
+    render
+        ->add_option("--light-culling", lightCulling,
+                     "tiled | none: per-tile (forward) and per-chunk (shadel) light lists")
+        ->capture_default_str();
+    render
+        ->add_option("--blockers", blockers,
+                     "on | off: light blockers and portals stop the lights that list them")
+        ->capture_default_str();
     render->add_option("--trace", ro.trace,
                        "FILE.json: Chrome trace events (CPU frontend and GPU passes per frame; "
                        "chrome://tracing, Perfetto)");
@@ -204,6 +214,12 @@ int main(int argc, char** argv) {
     bench->add_option("--camera-path", benchCameraPath, "static | orbit | walk")
         ->capture_default_str();
     bench->add_flag("--animate-lights", bo.animateLights, "move point and spot lights");
+    std::string benchLightCulling = "tiled";
+    bench
+        ->add_option("--light-culling", benchLightCulling,
+                     "tiled | none | compare: compare also renders forward and decoupled "
+                     "without culling and reports tiled / none frame-time ratios")
+        ->capture_default_str();
     bench
         ->add_option("--reuse-refresh", bo.reuseRefreshPeriod,
                      "reuse mode: reshade every carried-over chunk once per N frames")
@@ -313,6 +329,8 @@ int main(int argc, char** argv) {
             if (reuse != "on" && reuse != "off")
                 throw InputError(format("--reuse %s: expected on or off", reuse.c_str()));
             ro.reuse = reuse == "on";
+            ro.lightCulling = parseLightCulling(lightCulling);
+            ro.lightBlockers = parseOnOff("--blockers", blockers);
             RenderRun run = runRender(g.gpu, ro);
             const auto& s = run.stats;
             std::printf(
@@ -333,6 +351,8 @@ int main(int argc, char** argv) {
             bo.timing = parseTiming(benchTiming);
             bo.shadelsPerMetre = parseDensity(benchDensity);
             bo.cameraPath = parseCameraPath(benchCameraPath);
+            bo.compareLightCulling = benchLightCulling == "compare";
+            if (!bo.compareLightCulling) bo.lightCulling = parseLightCulling(benchLightCulling);
             runBench(g.gpu, bo);
             return 0;
         }

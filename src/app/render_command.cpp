@@ -45,9 +45,23 @@ Visualize parseVisualize(const std::string& text) {
     if (text == "sheet") return Visualize::Sheet;
     if (text == "layer:radiance") return Visualize::None; // the image is the radiance layer
     if (text == "layer:material") return Visualize::LayerMaterial;
+    if (text == "light-count") return Visualize::LightCount;
+    if (text == "blockers") return Visualize::Blockers;
     throw InputError(format("--visualize %s: expected none, marking, mips, chunks, sheet, "
-                            "layer:radiance or layer:material",
+                            "layer:radiance, layer:material, light-count or blockers",
                             text.c_str()));
+}
+
+LightCulling parseLightCulling(const std::string& text) {
+    if (text == "tiled") return LightCulling::Tiled;
+    if (text == "none") return LightCulling::None;
+    throw InputError(format("--light-culling %s: expected tiled or none", text.c_str()));
+}
+
+bool parseOnOff(const char* flag, const std::string& text) {
+    if (text == "on") return true;
+    if (text == "off") return false;
+    throw InputError(format("%s %s: expected on or off", flag, text.c_str()));
 }
 
 MarkingMode parseMarking(const std::string& text) {
@@ -199,6 +213,8 @@ RenderRun runRender(Gpu& gpu, const RenderOptions& o) {
     settings.oit = o.oit;
     settings.shuffleDraws = o.shuffleDrawsSeed.has_value();
     settings.shuffleSeed = o.shuffleDrawsSeed.value_or(0);
+    settings.lightCulling = o.lightCulling;
+    settings.lightBlockers = o.lightBlockers;
     settings.timing = o.timing ? *o.timing : defaultTimingMode(gpu);
     Renderer renderer;
     RenderRun run;
@@ -273,6 +289,7 @@ RenderRun runRender(Gpu& gpu, const RenderOptions& o) {
     s["oit"] = o.oit == OitMode::Wboit ? "wboit" : "sorted";
     s["transparent_draws"] = run.frames.back().transparentDraws;
     s["transparent_draws_decoupled"] = run.frames.back().transparentDecoupledDraws;
+    lightCullingStats(renderer, gpuScene, s);
     s["density_mode"] = autoDensity ? "auto" : "explicit";
     if (autoDensity)
         s["view_density"] = {{"budget_scale", viewDensity.budgetScale},

@@ -21,6 +21,45 @@ static uint32_t mipCount(uint32_t w, uint32_t h) {
     return 1 + uint32_t(std::floor(std::log2(double(std::max(w, h)))));
 }
 
+gpu::GpuLight gpuLight(const Light& l, std::vector<uint32_t>& blockerLists) {
+    gpu::GpuLight g{};
+    g.position = l.position;
+    g.type = uint32_t(l.type);
+    g.direction = glm::normalize(l.direction);
+    g.range = l.range;
+    g.color = l.color * l.intensity * (l.dark ? -1.0f : 1.0f);
+    g.flags = (l.dark ? LIGHT_FLAG_DARK : 0u) | (l.hasClipPlane ? LIGHT_FLAG_CLIP_PLANE : 0u);
+    g.clipPlane = l.clipPlane;
+    if (l.type == LightType::SquareSpot) {
+        // On the tangent of the angle off the axis, per side of the square.
+        float tanOuter = std::tan(std::min(l.outerConeAngle, 1.5f));
+        float tanInner = std::tan(std::min(l.innerConeAngle, 1.5f));
+        g.spotScale = 1.0f / std::max(tanOuter - tanInner, 1e-4f);
+        g.spotOffset = tanOuter * g.spotScale;
+    } else {
+        float cosOuter = std::cos(l.outerConeAngle), cosInner = std::cos(l.innerConeAngle);
+        g.spotScale = 1.0f / std::max(cosInner - cosOuter, 1e-4f);
+        g.spotOffset = -cosOuter * g.spotScale;
+    }
+    // The square cone's right axis and the tube's segment: orthogonal to the direction for spots.
+    glm::vec3 axis = glm::length(l.axis) > 0.0f ? glm::normalize(l.axis) : glm::vec3(1, 0, 0);
+    if (l.type == LightType::SquareSpot) {
+        axis -= g.direction * glm::dot(axis, g.direction);
+        if (glm::length(axis) < 1e-4f)
+            axis = glm::cross(g.direction, std::abs(g.direction.y) < 0.9f ? glm::vec3(0, 1, 0)
+                                                                          : glm::vec3(1, 0, 0));
+        axis = glm::normalize(axis);
+    }
+    g.axis = axis;
+    g.halfLength = l.type == LightType::Tube ? 0.5f * l.tubeLength : 0.0f;
+    g.radius = l.tubeRadius;
+    g.blockerFirst = uint32_t(blockerLists.size());
+    g.blockerCount = uint32_t(std::min<size_t>(l.blockers.size(), LIGHT_MAX_BLOCKERS_PER_LIGHT));
+    blockerLists.insert(blockerLists.end(), l.blockers.begin(),
+                        l.blockers.begin() + g.blockerCount);
+    return g;
+}
+
 void uploadScene(Gpu& gpu, const Scene& scene, GpuScene& out, const std::vector<BakedMesh>* baked) {
     // Textures: sRGB for colour data. Every texture gets a full mip chain and a bindless slot.
     std::vector<bool> srgb(scene.textures.size(), false);
@@ -163,6 +202,7 @@ void uploadScene(Gpu& gpu, const Scene& scene, GpuScene& out, const std::vector<
     }
 
     std::vector<gpu::GpuLight> lights;
+    std::vector<uint32_t> lightBlockers;
     bool haveSun = false;
     for (const Light& l : scene.lights) {
         if (l.type == LightType::Directional && !haveSun) {
@@ -172,16 +212,22 @@ void uploadScene(Gpu& gpu, const Scene& scene, GpuScene& out, const std::vector<
             out.sunCastsShadow = true;
             continue;
         }
-        gpu::GpuLight g{};
-        g.position = l.position;
-        g.type = uint32_t(l.type);
-        g.direction = glm::normalize(l.direction);
-        g.range = l.range;
-        g.color = l.color * l.intensity;
-        float cosOuter = std::cos(l.outerConeAngle), cosInner = std::cos(l.innerConeAngle);
-        g.spotScale = 1.0f / std::max(cosInner - cosOuter, 1e-4f);
-        g.spotOffset = -cosOuter * g.spotScale;
-        lights.push_back(g);
+        lights.push_back(gpuLight(l, lightBlockers));
+    }
+    std::vector<gpu::GpuLightBlocker> blockers;
+    std::vector<gpu::GpuLightPortal> portals;
+    for (const LightBlocker& b : scene.blockers) {
+        gpu::GpuLightBlocker g{};
+        g.center = b.center;
+        g.axisU = glm::normalize(b.axisU);
+        g.axisV = glm::normalize(b.axisV);
+        g.halfU = b.halfSize.x;
+        g.halfV = b.halfSize.y;
+        g.normal = glm::normalize(glm::cross(g.axisU, g.axisV));
+        g.firstPortal = uint32_t(portals.size());
+        g.portalCount = uint32_t(b.portals.size());
+        for (const LightBlocker::Portal& p : b.portals) portals.push_back({p.min, p.max});
+        blockers.push_back(g);
     }
     out.skyColor = scene.skyColor;
     out.ambientColor = scene.ambientColor;
@@ -202,6 +248,13 @@ void uploadScene(Gpu& gpu, const Scene& scene, GpuScene& out, const std::vector<
                                 materials.size() * sizeof(gpu::GpuMaterial));
     out.lights =
         uploadArray(gpu, "scene.lights", lights.data(), lights.size() * sizeof(gpu::GpuLight));
+    out.blockers = uploadArray(gpu, "scene.lightBlockers", blockers.data(),
+                               blockers.size() * sizeof(gpu::GpuLightBlocker));
+    out.portals = uploadArray(gpu, "scene.lightPortals", portals.data(),
+                              portals.size() * sizeof(gpu::GpuLightPortal));
+    out.lightBlockerLists =
+        uploadArray(gpu, "scene.lightBlockerLists", lightBlockers.data(), lightBlockers.size() * 4);
+    out.blockerCount = uint32_t(blockers.size());
     out.instanceCount = uint32_t(instances.size());
     out.lightCount = uint32_t(lights.size());
     out.lightInfo = lights;
@@ -212,7 +265,7 @@ void destroyScene(Gpu& gpu, GpuScene& s) {
     for (TextureReadView v : s.textureViews) destroy(gpu, v);
     for (TextureHandle t : s.textures) destroy(gpu, t);
     for (BufferHandle b : {s.vertices, s.shadelUvs, s.indices, s.meshes, s.instances, s.materials,
-                           s.lights, s.idMaps})
+                           s.lights, s.idMaps, s.blockers, s.portals, s.lightBlockerLists})
         destroy(gpu, b);
     s = GpuScene{};
 }

@@ -28,7 +28,11 @@ struct GpuScene {
     BufferHandle meshes;    // gpu::GpuMesh[]
     BufferHandle instances; // gpu::GpuInstance[]
     BufferHandle materials; // gpu::GpuMaterial[]
-    BufferHandle lights;    // gpu::GpuLight[] (point and spot; the first directional is the sun)
+    BufferHandle lights;    // gpu::GpuLight[] (every kind but the sun: the first directional light)
+    BufferHandle blockers;  // gpu::GpuLightBlocker[]
+    BufferHandle portals;   // gpu::GpuLightPortal[]
+    BufferHandle lightBlockerLists; // uint blocker indices (GpuLight::blockerFirst/Count)
+    uint32_t blockerCount = 0;
     std::vector<TextureHandle> textures;
     std::vector<TextureReadView> textureViews;
     std::vector<gpu::GpuMesh> meshInfo;
@@ -54,6 +58,8 @@ struct GpuScene {
 // (duplicated along chart seams) so forward and decoupled paths draw identical geometry.
 void uploadScene(Gpu& gpu, const Scene& scene, GpuScene& out,
                  const std::vector<BakedMesh>* baked = nullptr);
+// One scene light as the GPU sees it; appends the blockers it lists to `blockerLists`.
+gpu::GpuLight gpuLight(const Light& light, std::vector<uint32_t>& blockerLists);
 void destroyScene(Gpu& gpu, GpuScene& scene);
 
 } // namespace shadel

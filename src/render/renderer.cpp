@@ -95,12 +95,14 @@ void initRenderer(Renderer& r, Gpu& gpu, const RenderSettings& settings, const G
     if (settings.mode == RenderMode::Decoupled) r.decoupled = createDecoupled(r, scene);
     if (usesVisibilityBuffer(settings)) r.visibility = createVisibility(r);
     r.oit = createOit(r, scene);
+    r.lightCulling = createLightCulling(r, scene);
 }
 
 void destroyRenderer(Renderer& r) {
     if (!r.gpu) return;
     Gpu& gpu = *r.gpu;
     vkDeviceWaitIdle(gpu.device.device);
+    destroyLightCulling(r, r.lightCulling);
     if (r.visibility) destroyVisibility(r, r.visibility);
     destroyOit(r, r.oit);
     if (r.decoupled) destroyDecoupled(r, r.decoupled);
@@ -202,6 +204,8 @@ FrameResult renderFrame(Renderer& r, const GpuScene& scene, const CameraView& ca
     r.skyColor = scene.skyColor;
     gpu::FrameConstants constants = makeFrameConstants(r, scene, camera);
     updateLights(r, scene, constants);
+    constants.lighting = prepareLightCulling(
+        r, scene, r.settings.animateLights ? r.lightsLastFrame : scene.lightInfo, constants.viewProj);
     if (r.decoupled) prepareDecoupledFrame(r, scene, camera, constants);
     prepareTransparentDraws(r, scene, camera);
     std::memcpy(mapped(gpu, r.frameConstants), &constants, sizeof(constants));
@@ -218,6 +222,8 @@ FrameResult renderFrame(Renderer& r, const GpuScene& scene, const CameraView& ca
              [&](VkCommandBuffer cmd) { recordVisibilityPrepass(r, cmd, frame); });
     else
         pass(rec, "depthPrepass", [&](VkCommandBuffer cmd) { recordDepthPrepass(r, cmd, frame); });
+    if (r.settings.lightCulling == LightCulling::Tiled)
+        pass(rec, "lightCulling", [&](VkCommandBuffer cmd) { recordLightCulling(r, cmd, frame); });
     if (r.settings.mode == RenderMode::Forward) {
         pass(rec, "forwardShading",
              [&](VkCommandBuffer cmd) { recordForwardShading(r, cmd, frame); });
@@ -242,6 +248,7 @@ FrameResult renderFrame(Renderer& r, const GpuScene& scene, const CameraView& ca
     result.transparentDraws =
         uint32_t(transparentDrawOrder(r).size()) + result.transparentDecoupledDraws;
     if (r.decoupled) finishDecoupledFrame(r);
+    readLightCullingStats(r);
     r.framesRendered++;
     size_t bytes = size_t(r.settings.width) * r.settings.height * 4;
     result.rgba.resize(bytes);

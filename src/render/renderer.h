@@ -7,6 +7,7 @@
 
 #include "render/camera.h"
 #include "render/gpu_scene.h"
+#include "render/lighting/light_culling.h"
 #include "render/shadel/visibility.h"
 #include "rhi/frame.h"
 #include "rhi/pipeline.h"
@@ -27,7 +28,13 @@ enum class Visualize : uint32_t {
     Chunks = 3,
     Sheet = 4,
     LayerMaterial = 5, // --visualize layer:material (the shade storage's material layer)
+    LightCount = VISUALIZE_LIGHT_COUNT, // lights per tile (forward) or chunk (shadel)
+    Blockers = VISUALIZE_BLOCKERS,      // tiles / chunks with per-pixel blocker checks
 };
+
+// --light-culling: per-tile (forward) and per-chunk (shadel) light lists, or every light for
+// every pixel / shadel.
+enum class LightCulling { None, Tiled };
 
 struct RenderSettings {
     uint32_t width = 1280, height = 720;
@@ -52,15 +59,16 @@ struct RenderSettings {
     uint32_t materialSamples = 4; // decoupled: material evaluations per shadel above MIP 0
     float forwardBelowPixels = 8; // decoupled: objects smaller on screen drawn forward (0 = never)
     uint32_t allocationCounters = SHADEL_COUNTERS; // decoupled: hashed counters used (tests)
-    bool sheetAllMips = false;
+    bool sheetAllMips = false; // decoupled: rects at every MIP (the old policy, for comparison)
     bool capacityControl = true;     // decoupled: steer the shading bias from storage use
     bool reuse = true;               // decoupled: carry unchanged shadels over from last frame
     uint32_t reuseRefreshPeriod = 8; // decoupled: reshade every carried chunk this often
-    bool animateLights = false;   // point and spot lights move on small circles // decoupled: rects
-                                  // at every MIP (the old policy, for comparison)
+    bool animateLights = false;   // point and spot lights move on small circles
     OitMode oit = OitMode::Wboit; // transparency: render/oit
     bool shuffleDraws = false;    // --shuffle-draws SEED: transparent draws in a random order
     uint64_t shuffleSeed = 0;
+    LightCulling lightCulling = LightCulling::Tiled;
+    bool lightBlockers = true; // --blockers: light blockers and portals stop the lights listing them
 };
 
 struct FrameResult {
@@ -118,6 +126,8 @@ struct Renderer {
     uint64_t framesRendered = 0;
     VisibilityStatePtr visibility; // decoupled with --marking visibility
     OitStatePtr oit;               // scenes with blended materials (render/oit)
+    VisibilityStatePtr visibility;     // decoupled with --marking visibility
+    LightCullingStatePtr lightCulling; // light lists (render/lighting/light_culling.h)
     std::chrono::steady_clock::time_point createdAt = std::chrono::steady_clock::now();
 };
 

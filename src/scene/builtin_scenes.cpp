@@ -9,6 +9,7 @@
 #include <glm/gtc/matrix_transform.hpp>
 
 #include "core/error.h"
+#include "scene/builtin_lights.h"
 #include "scene/mesh_utils.h"
 
 namespace shadel {
@@ -540,6 +541,12 @@ const std::vector<std::pair<std::string, std::function<Scene()>>>& registry() {
     static const std::vector<std::pair<std::string, std::function<Scene()>>> scenes = {
         {"default", makeDefault}, {"checker", makeChecker},           {"smooth", makeSmooth},
         {"many", makeMany},       {"transparency", makeTransparency},
+        {"default", makeDefault},
+        {"checker", makeChecker},
+        {"smooth", makeSmooth},
+        {"many", makeMany},
+        {"lights", [] { return makeLightsScene(makeDefault()); }},
+        {"blockers", makeBlockersScene},
     };
     return scenes;
 }

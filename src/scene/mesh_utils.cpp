@@ -230,6 +230,17 @@ std::string sceneInvariantViolation(const Scene& scene) {
         if (!isFinite(light.position) || !unit(light.direction) || !isFinite(light.color) ||
             !std::isfinite(light.intensity) || light.intensity < 0.0f)
             return "light '" + light.name + "': invalid";
+        for (uint32_t b : light.blockers)
+            if (b >= scene.blockers.size())
+                return "light '" + light.name + "': blocker " + std::to_string(b) +
+                       " does not exist";
+        if (light.blockers.size() > 32) return "light '" + light.name + "': more than 32 blockers";
+    }
+    for (const LightBlocker& b : scene.blockers) {
+        if (!isFinite(b.center) || !unit(b.axisU) || !unit(b.axisV) ||
+            std::abs(glm::dot(b.axisU, b.axisV)) > 1e-3f || !(b.halfSize.x > 0.0f) ||
+            !(b.halfSize.y > 0.0f) || !std::isfinite(b.halfSize.x) || !std::isfinite(b.halfSize.y))
+            return "light blocker '" + b.name + "': invalid";
     }
     return {};
 }

@@ -85,7 +85,11 @@ struct Instance {
     glm::mat4 transform{1.0f}; // object to world
 };
 
-enum class LightType : uint32_t { Directional = 0, Point = 1, Spot = 2 };
+// Point is the omni light; Spot has a round cone, SquareSpot a square one (a pyramid whose
+// half-angles are the cone angles, turned about the direction by `axis`); Tube is a line light
+// of `tubeLength` along `axis` (seed 001's "realistic" tube lights). glTF KHR_lights_punctual
+// gives Directional, Point and Spot.
+enum class LightType : uint32_t { Directional = 0, Point = 1, Spot = 2, SquareSpot = 3, Tube = 4 };
 
 struct Light {
     std::string name;
@@ -98,6 +102,27 @@ struct Light {
     float innerConeAngle = 0.0f;
     float outerConeAngle = 0.7853982f;
     bool castsShadow = false;
+    bool dark = false;         // a negative light: subtracts what it would add
+    glm::vec3 axis{1, 0, 0};   // tube: the segment; square spot: the cone's "right" axis
+    float tubeLength = 0.0f;   // tube: the segment's length
+    float tubeRadius = 0.0f;   // tube: its radius (softens the highlight)
+    bool hasClipPlane = false; // lights only where dot(clipPlane, (p, 1)) >= 0
+    glm::vec4 clipPlane{0, 1, 0, 0};
+    std::vector<uint32_t> blockers; // indices into Scene::blockers that stop this light
+};
+
+// A light blocker (seed 001): an artist-placed rectangle (say a wall's mid-plane) that stops
+// the lights listing it, without shadow maps. Portals are rectangular holes in it (doorways).
+struct LightBlocker {
+    std::string name;
+    glm::vec3 center{0.0f};
+    glm::vec3 axisU{1, 0, 0}; // unit, in the plane
+    glm::vec3 axisV{0, 1, 0}; // unit, in the plane, orthogonal to axisU
+    glm::vec2 halfSize{1.0f}; // along axisU, axisV
+    struct Portal {
+        glm::vec2 min, max; // in metres along axisU, axisV from the centre
+    };
+    std::vector<Portal> portals;
 };
 
 struct Camera {
@@ -117,6 +142,7 @@ struct Scene {
     std::vector<Texture> textures;
     std::vector<Instance> instances;
     std::vector<Light> lights;
+    std::vector<LightBlocker> blockers;
     std::vector<Camera> cameras; // the first is the default
     glm::vec3 skyColor{0.55f, 0.7f, 0.95f};
     glm::vec3 ambientColor{0.08f, 0.09f, 0.11f};

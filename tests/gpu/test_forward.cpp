@@ -19,7 +19,7 @@ TEST(Forward, RendersDefaultSceneWithCoverageAndTimings) {
     std::vector<std::string> passes;
     for (auto& p : s["passes"]) passes.push_back(p["name"]);
     EXPECT_EQ(passes, (std::vector<std::string>{"instanceCull", "shadowMap", "depthPrepass",
-                                                "forwardShading", "tonemap"}));
+                                                "lightCulling", "forwardShading", "tonemap"}));
     for (auto& p : s["passes"]) EXPECT_GE(p["gpu_ms"].get<double>(), 0.0);
     // The image is not flat: sky and lit geometry differ.
     const auto& px = run.frames[0].rgba;

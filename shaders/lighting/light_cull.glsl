@@ -1,0 +1,152 @@
+// Culling tests shared by the forward tile pass (tile_cull.comp) and the shadel path's chunk
+// culling (shaders/shadel/shade.comp): a light's bounding sphere, its clip plane, and the
+// "shadow" volume a blocker casts from the light (seed 001) against a convex volume given by
+// its 8 corners (a tile's depth-bounded frustum or a chunk's box). Every test is conservative:
+// what culling removes contributes exactly nothing per pixel, so the image does not change.
+#ifndef SHADEL_LIGHT_CULL_GLSL
+#define SHADEL_LIGHT_CULL_GLSL
+#include "common/lighting.glsl"
+#ifdef LIGHT_CULL_ORDERED_APPEND
+#extension GL_KHR_shader_subgroup_ballot : require
+#endif
+
+#define SHADOW_MISSES 0u  // the blocker's shadow does not reach the volume
+#define SHADOW_PARTIAL 1u // part of the volume: test per pixel
+#define SHADOW_COVERS 2u  // all of it, through no portal: the light is culled
+
+// xyz centre, w radius; w < 0 for lights without a finite range (never culled by distance).
+vec4 lightSphere(GpuLight l) {
+    if (l.type == LIGHT_DIRECTIONAL || l.range <= 0.0) return vec4(l.position, -1.0);
+    float extra = l.type == LIGHT_TUBE ? l.halfLength : 0.0;
+    return vec4(l.position, l.range + extra);
+}
+
+// Whether the light's clip plane leaves every corner unlit.
+bool clipPlaneCulls(GpuLight l, vec3 corners[8]) {
+    if ((l.flags & LIGHT_FLAG_CLIP_PLANE) == 0u) return false;
+    for (int i = 0; i < 8; ++i)
+        if (dot(l.clipPlane.xyz, corners[i]) + l.clipPlane.w >= 0.0) return false;
+    return true;
+}
+
+// The shadow volume of the quad q0..q3 (in order around it) seen from lightPos: four planes
+// through the light and each edge, and the quad's own plane (its far side), all facing inward.
+// Returns SHADOW_MISSES when every corner is outside one plane, SHADOW_COVERS when all are
+// inside every plane, SHADOW_PARTIAL otherwise.
+uint quadShadowClass(vec3 lightPos, vec3 q[4], vec3 corners[8]) {
+    vec3 centre = (q[0] + q[1] + q[2] + q[3]) * 0.25;
+    vec3 quadNormal = cross(q[1] - q[0], q[3] - q[0]);
+    float side = dot(quadNormal, centre - lightPos);
+    if (abs(side) < 1e-6 * length(quadNormal)) return SHADOW_MISSES; // light in the plane
+    vec4 planes[5];
+    for (int e = 0; e < 4; ++e) {
+        vec3 n = cross(q[e] - lightPos, q[(e + 1) & 3] - lightPos);
+        if (dot(n, centre - lightPos) < 0.0) n = -n;
+        planes[e] = vec4(n, -dot(n, lightPos));
+    }
+    vec3 away = side > 0.0 ? quadNormal : -quadNormal;
+    planes[4] = vec4(away, -dot(away, centre));
+    bool allInside = true;
+    for (int p = 0; p < 5; ++p) {
+        uint inside = 0u;
+        for (int i = 0; i < 8; ++i) inside += dot(planes[p].xyz, corners[i]) + planes[p].w > 0.0 ? 1u : 0u;
+        if (inside == 0u) return SHADOW_MISSES;
+        allInside = allInside && inside == 8u;
+    }
+    return allInside ? SHADOW_COVERS : SHADOW_PARTIAL;
+}
+
+// A blocker's shadow from lightPos, holes included: covered only if no portal's own shadow
+// volume (the light through the hole) reaches the volume.
+uint blockerShadowClass(GpuLightBlocker b, LightPortalBuffer portals, vec3 lightPos, vec3 corners[8]) {
+    vec3 u = b.axisU * b.halfU, v = b.axisV * b.halfV;
+    vec3 q[4] = vec3[4](b.center - u - v, b.center + u - v, b.center + u + v, b.center - u + v);
+    uint c = quadShadowClass(lightPos, q, corners);
+    if (c != SHADOW_COVERS) return c;
+    for (uint k = 0u; k < b.portalCount; ++k) {
+        GpuLightPortal portal = portals.p[b.firstPortal + k];
+        vec3 o = b.center;
+        vec3 h[4] = vec3[4](o + b.axisU * portal.minUv.x + b.axisV * portal.minUv.y,
+                            o + b.axisU * portal.maxUv.x + b.axisV * portal.minUv.y,
+                            o + b.axisU * portal.maxUv.x + b.axisV * portal.maxUv.y,
+                            o + b.axisU * portal.minUv.x + b.axisV * portal.maxUv.y);
+        if (quadShadowClass(lightPos, h, corners) != SHADOW_MISSES) return SHADOW_PARTIAL;
+    }
+    return SHADOW_COVERS;
+}
+
+// The blockers of `light` against a volume given twice, both containing every point the light
+// reaches in it: `corners` (a tile's frustum or a chunk's box) and the part of its bounding box
+// [boxMin, boxMax] within the light's range (often far smaller for long tiles). A blocker
+// misses if it misses either, covers if it covers either. Returns LIGHT_INVALID when one
+// blocker hides the light from the whole volume, else the mask of those to test per pixel.
+uint lightBlockerMask(LightingFrame lf, GpuLight light, vec3 corners[8], vec3 boxMin, vec3 boxMax) {
+    if (lf.blockersOn == 0u || light.blockerCount == 0u) return 0u;
+    vec4 sphere = lightSphere(light);
+    vec3 inRange[8] = corners;
+    if (sphere.w >= 0.0) {
+        vec3 lo = max(boxMin, sphere.xyz - sphere.w), hi = min(boxMax, sphere.xyz + sphere.w);
+        for (int i = 0; i < 8; ++i)
+            inRange[i] = vec3((i & 1) != 0 ? hi.x : lo.x, (i & 2) != 0 ? hi.y : lo.y,
+                              (i & 4) != 0 ? hi.z : lo.z);
+    }
+    LightBlockerBuffer blockers = LightBlockerBuffer(lf.blockers);
+    LightPortalBuffer portals = LightPortalBuffer(lf.portals);
+    UintBuffer list = UintBuffer(lf.lightBlockers);
+    uint mask = 0u;
+    uint n = min(light.blockerCount, LIGHT_MAX_BLOCKERS_PER_LIGHT);
+    for (uint k = 0u; k < n; ++k) {
+        GpuLightBlocker b = blockers.b[list.v[light.blockerFirst + k]];
+        uint c = blockerShadowClass(b, portals, light.position, corners);
+        if (c != SHADOW_MISSES && sphere.w >= 0.0) {
+            uint c2 = blockerShadowClass(b, portals, light.position, inRange);
+            c = c2 == SHADOW_MISSES ? SHADOW_MISSES : max(c, c2);
+        }
+        if (c == SHADOW_COVERS) return LIGHT_INVALID;
+        if (c == SHADOW_PARTIAL) mask |= 1u << k;
+    }
+    return mask;
+}
+
+// Order-preserving float <-> uint (for atomicMin/Max on signed floats in shared memory).
+uint orderedFloatBits(float x) {
+    uint b = floatBitsToUint(x);
+    return (b & 0x80000000u) != 0u ? ~b : b | 0x80000000u;
+}
+float orderedBitsFloat(uint b) {
+    return uintBitsToFloat((b & 0x80000000u) != 0u ? b & 0x7FFFFFFFu : ~b);
+}
+
+#ifdef LIGHT_CULL_ORDERED_APPEND
+// Compute only: appends the `keep` invocations' items in invocation order after the
+// sAppendCount already placed and returns each keeper's slot (LIGHT_INVALID for the others).
+// Keeping the lights' order makes culled shading sum exactly as unculled shading does. Call in
+// uniform control flow.
+shared uint sAppendCount;
+shared uint sSubgroupCounts[256];
+uint orderedAppend(bool keep) {
+    uvec4 ballot = subgroupBallot(keep);
+    uint within = subgroupBallotExclusiveBitCount(ballot);
+    if (subgroupElect()) sSubgroupCounts[gl_SubgroupID] = subgroupBallotBitCount(ballot);
+    barrier();
+    uint base = sAppendCount;
+    for (uint s = 0u; s < gl_SubgroupID; ++s) base += sSubgroupCounts[s];
+    uint total = 0u;
+    if (gl_LocalInvocationIndex == 0u)
+        for (uint s = 0u; s < gl_NumSubgroups; ++s) total += sSubgroupCounts[s];
+    barrier();
+    if (gl_LocalInvocationIndex == 0u) sAppendCount += total;
+    barrier();
+    return keep ? base + within : LIGHT_INVALID;
+}
+#endif
+
+// Heat colour of a light count (--visualize light-count): black, blue, green, yellow, red, white.
+vec3 lightCountHeat(uint n) {
+    const vec3 ramp[6] = vec3[6](vec3(0.0), vec3(0.0, 0.2, 1.0), vec3(0.0, 0.9, 0.2),
+                                 vec3(1.0, 0.9, 0.0), vec3(1.0, 0.1, 0.0), vec3(1.0));
+    float t = clamp(log2(float(n) + 1.0) / 1.5, 0.0, 4.999); // 0, 1.8, 5, 12, 36, 180 lights
+    int i = int(t);
+    return mix(ramp[i], ramp[i + 1], fract(t));
+}
+#endif

@@ -1,0 +1,151 @@
+#version 460
+// Tiled light culling (seed 001): one 16x16 workgroup per 16x16-pixel screen tile. The tile's
+// depth bounds come from the prepass depth; every light's sphere is tested against the tile's
+// depth-bounded frustum (and its clip plane against the frustum's corners); then, for lights
+// with blockers, each blocker's shadow volume from the light: a blocker that covers the whole
+// tile removes the light, one that covers part of it is kept as a (light, blocker) pair for the
+// per-pixel test. Lists keep the lights' order (ordered compaction), so tiled shading sums in
+// the same order as shading without culling.
+#define LIGHT_CULL_ORDERED_APPEND
+#include "lighting/light_cull.glsl"
+
+layout(local_size_x = 16, local_size_y = 16) in;
+layout(push_constant, scalar) uniform Push {
+    uint64_t frame;
+    uint depthSlot;
+} pc;
+
+#define THREADS 256u
+shared uint sDepthMin, sDepthMax;
+shared uvec2 sList[LIGHT_TILE_MAX_LIGHTS];
+shared bool sAnyPerPixel;
+shared uint sKept, sPoolBase;
+
+void main() {
+    FrameConstants f = FrameConstantsRef(pc.frame).f;
+    LightingFrame lf = LightingFrameRef(f.lighting).l;
+    uint tid = gl_LocalInvocationIndex;
+    uint tile = gl_WorkGroupID.y * lf.tilesX + gl_WorkGroupID.x;
+    if (tid == 0u) {
+        sDepthMin = 0xFFFFFFFFu;
+        sDepthMax = 0u;
+        sAppendCount = 0u;
+        sAnyPerPixel = false;
+        sKept = 0u;
+    }
+    barrier();
+    // Depth bounds of the tile's covered pixels (reversed Z: 0 is the far plane, the sky).
+    ivec2 pixel = ivec2(gl_GlobalInvocationID.xy);
+    ivec2 size = ivec2(f.viewportSize);
+    if (all(lessThan(pixel, size))) {
+        float d = fetchTextureUniform(pc.depthSlot, pixel, 0).r;
+        if (d > 0.0) {
+            atomicMin(sDepthMin, floatBitsToUint(d));
+            atomicMax(sDepthMax, floatBitsToUint(d));
+        }
+    }
+    barrier();
+    if (sDepthMax == 0u) { // nothing but sky
+        if (tid == 0u) LightListBuffer(lf.tileRanges).e[tile] = uvec2(0u);
+        return;
+    }
+    // The tile's frustum between its depth bounds: 8 world-space corners.
+    vec2 lo = vec2(gl_WorkGroupID.xy * LIGHT_TILE_SIZE) * f.invViewportSize * 2.0 - 1.0;
+    vec2 hi = min(vec2((gl_WorkGroupID.xy + 1u) * LIGHT_TILE_SIZE) * f.invViewportSize, vec2(1.0)) * 2.0 - 1.0;
+    float dNear = uintBitsToFloat(sDepthMax), dFar = uintBitsToFloat(sDepthMin);
+    vec3 corners[8];
+    for (int i = 0; i < 8; ++i) {
+        vec4 clip = vec4((i & 1) != 0 ? hi.x : lo.x, (i & 2) != 0 ? hi.y : lo.y,
+                         (i & 4) != 0 ? dFar : dNear, 1.0);
+        vec4 w = f.invViewProj * clip;
+        corners[i] = w.xyz / w.w;
+    }
+    // Planes of that volume, facing inward: four sides through the eye, near and far.
+    vec3 eye = f.cameraPosition;
+    vec3 centre = vec3(0.0);
+    for (int i = 0; i < 8; ++i) centre += corners[i] * 0.125;
+    vec4 planes[6];
+    const ivec2 edges[4] = ivec2[4](ivec2(0, 1), ivec2(1, 3), ivec2(3, 2), ivec2(2, 0));
+    for (int e = 0; e < 4; ++e) {
+        vec3 n = normalize(cross(corners[edges[e].x + 4] - eye, corners[edges[e].y + 4] - eye));
+        if (dot(n, centre - eye) < 0.0) n = -n;
+        planes[e] = vec4(n, -dot(n, eye));
+    }
+    vec3 forward = normalize(-vec3(f.view[0][2], f.view[1][2], f.view[2][2]));
+    float zMin = 1e30, zMax = -1e30;
+    for (int i = 0; i < 8; ++i) {
+        float z = dot(corners[i] - eye, forward);
+        zMin = min(zMin, z), zMax = max(zMax, z);
+    }
+    planes[4] = vec4(forward, -dot(forward, eye) - zMin);
+    planes[5] = vec4(-forward, dot(forward, eye) + zMax);
+    vec3 boxMin = corners[0], boxMax = corners[0];
+    for (int i = 1; i < 8; ++i) boxMin = min(boxMin, corners[i]), boxMax = max(boxMax, corners[i]);
+
+    // Lights against the tile, 256 at a time, kept in light order.
+    LightBuffer lights = LightBuffer(f.lights);
+    UintBuffer frustumLights = UintBuffer(lf.frustumLights);
+    for (uint base = 0u; base < lf.frustumLightCount; base += THREADS) {
+        uint index = base + tid < lf.frustumLightCount ? frustumLights.v[base + tid] : LIGHT_INVALID;
+        bool keep = false;
+        if (index != LIGHT_INVALID) {
+            GpuLight light = lights.l[index];
+            vec4 sphere = lightSphere(light);
+            keep = true;
+            if (sphere.w >= 0.0) {
+                for (int p = 0; p < 6; ++p)
+                    keep = keep && dot(planes[p].xyz, sphere.xyz) + planes[p].w >= -sphere.w;
+                vec3 nearest = clamp(sphere.xyz, boxMin, boxMax);
+                keep = keep && distance(nearest, sphere.xyz) <= sphere.w;
+            }
+            keep = keep && !clipPlaneCulls(light, corners);
+        }
+        uint slot = orderedAppend(keep);
+        if (slot < LIGHT_TILE_MAX_LIGHTS) sList[slot] = uvec2(index, 0u);
+    }
+    uint candidates = min(sAppendCount, LIGHT_TILE_MAX_LIGHTS);
+    if (tid == 0u && sAppendCount > LIGHT_TILE_MAX_LIGHTS)
+        atomicAdd(LightingCountersRef(lf.counters).c.tilesOverflowed, 1u);
+    barrier();
+
+    // Blockers: remove the lights a blocker hides from the whole tile, mark the partial ones.
+    uint kept = 0u;
+    for (uint i = tid; i < candidates; i += THREADS) {
+        GpuLight light = lights.l[sList[i].x];
+        uint mask = lightBlockerMask(lf, light, corners, boxMin, boxMax);
+        sList[i].y = mask;
+        if (mask == LIGHT_INVALID) sList[i].x = LIGHT_INVALID;
+        kept += mask == LIGHT_INVALID ? 0u : 1u;
+    }
+    atomicAdd(sKept, kept);
+    barrier();
+    // The tile's place in the shared pool (lists take what they need, not a worst case each).
+    LightingCountersRef counters = LightingCountersRef(lf.counters);
+    if (tid == 0u) {
+        atomicAdd(counters.c.lightsCulledByBlockers, candidates - sKept);
+        uint base = atomicAdd(counters.c.tileListEntries, sKept);
+        uint room = base < lf.poolCapacity ? lf.poolCapacity - base : 0u;
+        if (room < sKept) atomicAdd(counters.c.tilesOverflowed, 1u);
+        sPoolBase = base;
+        sKept = min(sKept, room);
+        LightListBuffer(lf.tileRanges).e[tile] = uvec2(base, sKept);
+        atomicAdd(counters.c.lightTilePairs, sKept);
+        sAppendCount = 0u;
+    }
+    barrier();
+    LightListBuffer outList = LightListBuffer(lf.tileLights + uint64_t(sPoolBase) * 8ul);
+    uint room = sKept;
+    for (uint base = 0u; base < candidates; base += THREADS) {
+        uint i = base + tid;
+        uvec2 entry = i < candidates ? sList[i] : uvec2(LIGHT_INVALID);
+        bool keep = entry.x != LIGHT_INVALID;
+        uint slot = orderedAppend(keep);
+        if (keep && slot < room) {
+            outList.e[slot] = entry;
+            if (entry.y != 0u) sAnyPerPixel = true;
+            atomicOr(UintBuffer(lf.visibleLights).v[entry.x >> 5], 1u << (entry.x & 31u));
+        }
+    }
+    barrier();
+    if (tid == 0u && sAnyPerPixel) atomicAdd(counters.c.perPixelBlockerTiles, 1u);
+}

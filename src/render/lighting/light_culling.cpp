@@ -1,0 +1,178 @@
+#include "render/lighting/light_culling.h"
+
+#include <algorithm>
+#include <bit>
+#include <cstring>
+
+#include "render/camera.h"
+#include "render/renderer.h"
+
+namespace shadel {
+
+struct LightCullingState {
+    Pipeline tileCull;
+    BufferHandle frame;         // gpu::LightingFrame (upload)
+    BufferHandle tileRanges;    // uvec2 per tile
+    BufferHandle tileLights;    // the pool of list entries
+    BufferHandle counters;      // gpu::LightingCounters (readback)
+    BufferHandle visibleLights; // uint bit set (readback)
+    BufferHandle frustumLights; // uint light indices (upload), the CPU's frustum cull
+    uint32_t tilesX = 0, tilesY = 0, poolCapacity = 0;
+    // Last frame's counts (read after the GPU finished).
+    gpu::LightingCounters last{};
+    uint32_t lightsVisible = 0;
+};
+
+void LightCullingStateDeleter::operator()(LightCullingState* state) const {
+    delete state;
+}
+
+namespace {
+struct CullPush {
+    uint64_t frame;
+    uint32_t depthSlot;
+};
+} // namespace
+
+LightCullingStatePtr createLightCulling(Renderer& r, const GpuScene& scene) {
+    Gpu& gpu = *r.gpu;
+    LightCullingStatePtr s(new LightCullingState);
+    s->tilesX = (r.internalWidth + LIGHT_TILE_SIZE - 1) / LIGHT_TILE_SIZE;
+    s->tilesY = (r.internalHeight + LIGHT_TILE_SIZE - 1) / LIGHT_TILE_SIZE;
+    uint32_t tiles = s->tilesX * s->tilesY;
+    // Lists share one pool sized for 256 lights per tile on average (at least 1 M entries, at
+    // most 8 M = 64 MiB); a frame that needs more counts the tiles that overflowed.
+    s->poolCapacity = uint32_t(std::clamp<uint64_t>(uint64_t(tiles) * 256u, 1u << 20, 1u << 23));
+    auto need = [](BufferHandle b) {
+        if (!b) throw DeviceError("out of GPU memory for the light culling buffers");
+        return b;
+    };
+    s->frame = need(
+        createBuffer(gpu, {"lighting.frame", sizeof(gpu::LightingFrame), 0, MemoryKind::Upload}));
+    s->tileRanges = need(createBuffer(gpu, {"lighting.tileRanges", uint64_t(tiles) * 8}));
+    s->tileLights = need(createBuffer(gpu, {"lighting.tileLights", uint64_t(s->poolCapacity) * 8}));
+    s->counters = need(createBuffer(
+        gpu, {"lighting.counters", sizeof(gpu::LightingCounters), 0, MemoryKind::Readback}));
+    s->visibleLights = need(createBuffer(
+        gpu, {"lighting.visibleLights", std::max<uint64_t>((scene.lightCount + 31) / 32, 1) * 4, 0,
+              MemoryKind::Readback}));
+    s->frustumLights = need(createBuffer(
+        gpu, {"lighting.frustumLights", std::max<uint64_t>(scene.lightCount, 1) * 4, 0,
+              MemoryKind::Upload}));
+    s->tileCull = createComputePipeline(gpu, "lightTileCull", "lighting_tile_cull.comp.spv");
+    return s;
+}
+
+void destroyLightCulling(Renderer& r, LightCullingStatePtr& state) {
+    if (!state) return;
+    Gpu& gpu = *r.gpu;
+    destroy(gpu, state->tileCull);
+    for (BufferHandle b : {state->frame, state->tileRanges, state->tileLights, state->counters,
+                           state->visibleLights, state->frustumLights})
+        destroy(gpu, b);
+    state.reset();
+}
+
+uint64_t prepareLightCulling(Renderer& r, const GpuScene& scene,
+                             const std::vector<gpu::GpuLight>& lights, const glm::mat4& viewProj) {
+    Gpu& gpu = *r.gpu;
+    LightCullingState& s = *r.lightCulling;
+    gpu::LightingFrame f{};
+    // Spheres against the camera frustum; a light without a finite range always passes.
+    std::array<glm::vec4, 6> planes = frustumPlanes(viewProj);
+    uint32_t* visible = static_cast<uint32_t*>(mapped(gpu, s.frustumLights));
+    uint32_t count = 0;
+    for (uint32_t i = 0; i < lights.size(); ++i) {
+        const gpu::GpuLight& l = lights[i];
+        bool in = true;
+        if (l.type != LIGHT_DIRECTIONAL && l.range > 0.0f) {
+            float radius = l.range + (l.type == LIGHT_TUBE ? l.halfLength : 0.0f);
+            for (const glm::vec4& p : planes)
+                in = in && glm::dot(glm::vec3(p), l.position) + p.w >= -radius;
+        }
+        if (in) visible[count++] = i;
+    }
+    f.frustumLights = address(gpu, s.frustumLights);
+    f.frustumLightCount = count;
+    f.tileLights = address(gpu, s.tileLights);
+    f.tileRanges = address(gpu, s.tileRanges);
+    f.blockers = address(gpu, scene.blockers);
+    f.portals = address(gpu, scene.portals);
+    f.lightBlockers = address(gpu, scene.lightBlockerLists);
+    f.counters = address(gpu, s.counters);
+    f.visibleLights = address(gpu, s.visibleLights);
+    f.tilesX = s.tilesX;
+    f.tilesY = s.tilesY;
+    f.tiled = r.settings.lightCulling == LightCulling::Tiled ? 1u : 0u;
+    f.blockersOn = r.settings.lightBlockers && scene.blockerCount > 0 ? 1u : 0u;
+    f.poolCapacity = s.poolCapacity;
+    f.blockerCount = scene.blockerCount;
+    std::memcpy(mapped(gpu, s.frame), &f, sizeof(f));
+    return address(gpu, s.frame);
+}
+
+void recordLightCulling(Renderer& r, VkCommandBuffer cmd, uint64_t frame) {
+    Gpu& gpu = *r.gpu;
+    LightCullingState& s = *r.lightCulling;
+    vkCmdFillBuffer(cmd, vkBuffer(gpu, s.counters), 0, VK_WHOLE_SIZE, 0);
+    vkCmdFillBuffer(cmd, vkBuffer(gpu, s.visibleLights), 0, VK_WHOLE_SIZE, 0);
+    memoryBarrier(cmd, VK_PIPELINE_STAGE_2_CLEAR_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT,
+                  VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
+                  VK_ACCESS_2_SHADER_STORAGE_READ_BIT | VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT);
+    if (r.settings.lightCulling != LightCulling::Tiled) return;
+    // The prepass depth is sampled here, then goes back to the attachment layout the passes
+    // after this one test against.
+    imageBarrier(cmd, vkImage(gpu, r.depth), VK_IMAGE_ASPECT_DEPTH_BIT,
+                 VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL,
+                 VK_PIPELINE_STAGE_2_LATE_FRAGMENT_TESTS_BIT,
+                 VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT,
+                 VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_SHADER_SAMPLED_READ_BIT);
+    bind(gpu, cmd, s.tileCull);
+    pushConstants(gpu, cmd, CullPush{frame, slot(gpu, r.depthRead).value});
+    vkCmdDispatch(cmd, s.tilesX, s.tilesY, 1);
+    imageBarrier(cmd, vkImage(gpu, r.depth), VK_IMAGE_ASPECT_DEPTH_BIT,
+                 VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL,
+                 VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, 0,
+                 VK_PIPELINE_STAGE_2_EARLY_FRAGMENT_TESTS_BIT |
+                     VK_PIPELINE_STAGE_2_LATE_FRAGMENT_TESTS_BIT,
+                 VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_READ_BIT |
+                     VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT);
+    memoryBarrier(cmd, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT,
+                  VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT | VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
+                  VK_ACCESS_2_SHADER_STORAGE_READ_BIT | VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT);
+}
+
+void readLightCullingStats(Renderer& r) {
+    LightCullingState& s = *r.lightCulling;
+    Gpu& gpu = *r.gpu;
+    if (r.settings.lightCulling != LightCulling::Tiled) { // nothing counted (nor cleared)
+        s.last = {};
+        s.lightsVisible = 0;
+        return;
+    }
+    std::memcpy(&s.last, mapped(gpu, s.counters), sizeof(s.last));
+    const uint32_t* bits = static_cast<const uint32_t*>(mapped(gpu, s.visibleLights));
+    size_t words = size(gpu, s.visibleLights) / 4;
+    s.lightsVisible = 0;
+    for (size_t i = 0; i < words; ++i) s.lightsVisible += uint32_t(std::popcount(bits[i]));
+}
+
+void lightCullingStats(const Renderer& r, const GpuScene& scene, nlohmann::json& stats) {
+    const LightCullingState& s = *r.lightCulling;
+    bool tiled = r.settings.lightCulling == LightCulling::Tiled;
+    stats["light_culling"] = tiled ? "tiled" : "none";
+    stats["blockers"] = r.settings.lightBlockers ? "on" : "off";
+    stats["light_blockers"] = scene.blockerCount;
+    // Without culling every light is considered everywhere.
+    stats["lights_visible"] = tiled ? s.lightsVisible : scene.lightCount;
+    stats["light_tile_pairs"] = tiled ? s.last.lightTilePairs : 0u;
+    stats["light_tiles"] = s.tilesX * s.tilesY;
+    stats["per_pixel_blocker_tiles"] = s.last.perPixelBlockerTiles;
+    stats["light_tiles_overflowed"] = s.last.tilesOverflowed;
+    stats["light_chunk_pairs"] = s.last.lightChunkPairs;
+    stats["per_pixel_blocker_chunks"] = s.last.perPixelBlockerChunks;
+    stats["light_chunks_overflowed"] = s.last.chunksOverflowed;
+    stats["lights_culled_by_blockers"] = s.last.lightsCulledByBlockers;
+}
+
+} // namespace shadel

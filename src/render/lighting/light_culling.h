@@ -1,0 +1,42 @@
+#pragma once
+// Tiled light culling (seed 001): after the depth prepass, one compute workgroup per 16x16-pixel
+// tile builds that tile's light list from its depth bounds, with light blockers and portals
+// classified per tile (shaders/lighting/tile_cull.comp). Forward shading reads the list of
+// its pixel's tile; the shadel path culls per chunk inside its shading workgroup
+// (shaders/shadel/shade.comp) against the same lights and blockers. Both call the shared
+// shadeSurface (shaders/common/lighting.glsl).
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "common/shared_types.h"
+#include "rhi/vk.h"
+
+namespace shadel {
+
+struct Renderer;
+struct GpuScene;
+
+struct LightCullingState;
+struct LightCullingStateDeleter {
+    void operator()(LightCullingState* state) const;
+};
+using LightCullingStatePtr = std::unique_ptr<LightCullingState, LightCullingStateDeleter>;
+
+LightCullingStatePtr createLightCulling(Renderer& r, const GpuScene& scene);
+void destroyLightCulling(Renderer& r, LightCullingStatePtr& state);
+
+// This frame's LightingFrame (host-visible), with the lights that meet the camera frustum
+// (`lights`: this frame's, `viewProj`: the camera's); returns its address for
+// FrameConstants::lighting.
+uint64_t prepareLightCulling(Renderer& r, const GpuScene& scene,
+                             const std::vector<gpu::GpuLight>& lights, const glm::mat4& viewProj);
+// The culling pass (tiled mode); with --light-culling none it records nothing.
+void recordLightCulling(Renderer& r, VkCommandBuffer cmd, uint64_t frame);
+// After the frame: counters into the stats (lights, lights_visible, light_tile_pairs, ...).
+void readLightCullingStats(Renderer& r);
+void lightCullingStats(const Renderer& r, const GpuScene& scene, nlohmann::json& stats);
+
+} // namespace shadel
