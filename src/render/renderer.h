@@ -124,9 +124,8 @@ struct Renderer {
     std::vector<gpu::GpuLight> lightsLastFrame;
     std::vector<glm::vec4> changedLightVolumes;
     uint64_t framesRendered = 0;
-    VisibilityStatePtr visibility; // decoupled with --marking visibility
-    OitStatePtr oit;               // scenes with blended materials (render/oit)
     VisibilityStatePtr visibility;     // decoupled with --marking visibility
+    OitStatePtr oit;                   // scenes with blended materials (render/oit)
     LightCullingStatePtr lightCulling; // light lists (render/lighting/light_culling.h)
     std::chrono::steady_clock::time_point createdAt = std::chrono::steady_clock::now();
 };
