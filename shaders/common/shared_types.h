@@ -46,6 +46,7 @@ using uint = uint32_t;
 #define VISUALIZE_CHUNKS 3u
 #define VISUALIZE_SHEET 4u
 #define VISUALIZE_LAYER_MATERIAL 5u // --visualize layer:material
+#define VISUALIZE_GI 6u             // --visualize gi: the LPV indirect light only
 
 // One vertex of the unified geometry buffer (matches shadel::Vertex).
 struct GpuVertex {
@@ -146,6 +147,7 @@ struct FrameConstants {
     uint64_t lights;    // GpuLight[]
     uint64_t messages;  // ShaderMessages (shader asserts)
     uint64_t shadel;    // ShadelFrame (decoupled path), 0 when forward
+    uint64_t gi;        // GiFrame (render/gi, shaders/gi/gi_types.h), 0 when GI is off
 };
 
 // Shader -> CPU message channel (shader asserts). Written with atomics, read after the frame.

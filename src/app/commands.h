@@ -43,6 +43,9 @@ struct RenderOptions {
     uint32_t reuseRefreshPeriod = 8;
     bool animateLights = false;
     CameraPath cameraPath = CameraPath::Static;
+    GiMode gi = GiMode::Off;    // --gi lpv|off
+    uint32_t giIterations = 8;  // --gi-iterations
+    bool giSnap = true;         // --gi-snap on|off (off: debug, cascades slide with the camera)
     double shadelBudget = 64e6; // MIP-0 shadels the bake may use for the whole scene
     bool printPasses = false;
     bool progress = true;
@@ -58,6 +61,7 @@ void parseSize(const std::string& text, uint32_t& width, uint32_t& height);
 RenderMode parseMode(const std::string& text);
 Visualize parseVisualize(const std::string& text);
 MarkingMode parseMarking(const std::string& text);
+GiMode parseGi(const std::string& text); // --gi lpv|off
 // The bake cache folder when --cache-dir is not given (see defaultBakeCacheDir()).
 std::string defaultCacheDir();
 

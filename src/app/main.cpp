@@ -90,7 +90,8 @@ int main(int argc, char** argv) {
     render->add_option("--ssaa", ro.ssaa, "N: NxN supersampled reference")->capture_default_str();
     render
         ->add_option("--visualize", visualize,
-                     "none | marking | mips | chunks | sheet | layer:radiance | layer:material")
+                     "none | marking | mips | chunks | sheet | layer:radiance | layer:material | "
+                     "gi (indirect light only, with --gi lpv)")
         ->capture_default_str();
     std::string marking = "raster";
     render
@@ -176,6 +177,19 @@ int main(int argc, char** argv) {
                        "FILE.json: Chrome trace events (CPU frontend and GPU passes per frame; "
                        "chrome://tracing, Perfetto)");
     render->add_flag("--passes", ro.printPasses, "print the per-pass timing table");
+    std::string gi = "off", giSnap = "on";
+    render
+        ->add_option("--gi", gi,
+                     "lpv | off: light propagation volume GI (sun + shadow-casting spot RSMs, "
+                     "3 camera cascades of 32^3)")
+        ->capture_default_str();
+    render->add_option("--gi-iterations", ro.giIterations, "GI: propagation steps (0..64)")
+        ->capture_default_str();
+    render
+        ->add_option("--gi-snap", giSnap,
+                     "GI: on | off: snap the cascades to their cell size (off only to measure "
+                     "swimming)")
+        ->capture_default_str();
 
     // bench
     BenchOptions bo;
@@ -303,6 +317,10 @@ int main(int argc, char** argv) {
             if (reuse != "on" && reuse != "off")
                 throw InputError(format("--reuse %s: expected on or off", reuse.c_str()));
             ro.reuse = reuse == "on";
+            ro.gi = parseGi(gi);
+            if (giSnap != "on" && giSnap != "off")
+                throw InputError(format("--gi-snap %s: expected on or off", giSnap.c_str()));
+            ro.giSnap = giSnap == "on";
             RenderRun run = runRender(g.gpu, ro);
             const auto& s = run.stats;
             std::printf(

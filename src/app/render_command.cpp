@@ -45,9 +45,16 @@ Visualize parseVisualize(const std::string& text) {
     if (text == "sheet") return Visualize::Sheet;
     if (text == "layer:radiance") return Visualize::None; // the image is the radiance layer
     if (text == "layer:material") return Visualize::LayerMaterial;
+    if (text == "gi") return Visualize::Gi;
     throw InputError(format("--visualize %s: expected none, marking, mips, chunks, sheet, "
-                            "layer:radiance or layer:material",
+                            "layer:radiance, layer:material or gi",
                             text.c_str()));
+}
+
+GiMode parseGi(const std::string& text) {
+    if (text == "off") return GiMode::Off;
+    if (text == "lpv") return GiMode::Lpv;
+    throw InputError(format("--gi %s: expected lpv or off", text.c_str()));
 }
 
 MarkingMode parseMarking(const std::string& text) {
@@ -190,6 +197,12 @@ RenderRun runRender(Gpu& gpu, const RenderOptions& o) {
     settings.reuse = o.reuse;
     settings.reuseRefreshPeriod = o.reuseRefreshPeriod;
     settings.animateLights = o.animateLights;
+    requireCount("--gi-iterations", o.giIterations, 0, 64);
+    if (o.visualize == Visualize::Gi && o.gi == GiMode::Off)
+        throw InputError("--visualize gi: shows the indirect light of --gi lpv; GI is off");
+    settings.gi = o.gi;
+    settings.giIterations = o.giIterations;
+    settings.giSnap = o.giSnap;
     settings.timing = o.timing ? *o.timing : defaultTimingMode(gpu);
     Renderer renderer;
     RenderRun run;
@@ -285,6 +298,7 @@ RenderRun runRender(Gpu& gpu, const RenderOptions& o) {
         s["mip0_shadels"] = mip0;
         s["id_map_bytes"] = gpuScene.idMapBytes;
     }
+    if (renderer.gi) giStats(renderer, s);
     run.stats = s;
 
     destroyRenderer(renderer);

@@ -179,6 +179,7 @@ void uploadScene(Gpu& gpu, const Scene& scene, GpuScene& out, const std::vector<
         g.spotScale = 1.0f / std::max(cosInner - cosOuter, 1e-4f);
         g.spotOffset = -cosOuter * g.spotScale;
         lights.push_back(g);
+        out.lightCastsShadow.push_back(l.castsShadow ? 1 : 0);
     }
     out.skyColor = scene.skyColor;
     out.ambientColor = scene.ambientColor;

@@ -93,12 +93,14 @@ void initRenderer(Renderer& r, Gpu& gpu, const RenderSettings& settings, const G
     initFrameRecorder(gpu, r.recorder, settings.timing);
     if (settings.mode == RenderMode::Decoupled) r.decoupled = createDecoupled(r, scene);
     if (usesVisibilityBuffer(settings)) r.visibility = createVisibility(r);
+    if (settings.gi == GiMode::Lpv) r.gi = createGi(r, scene);
 }
 
 void destroyRenderer(Renderer& r) {
     if (!r.gpu) return;
     Gpu& gpu = *r.gpu;
     vkDeviceWaitIdle(gpu.device.device);
+    if (r.gi) destroyGi(r, r.gi);
     if (r.visibility) destroyVisibility(r, r.visibility);
     if (r.decoupled) destroyDecoupled(r, r.decoupled);
     destroyFrameRecorder(r.recorder);
@@ -199,6 +201,7 @@ FrameResult renderFrame(Renderer& r, const GpuScene& scene, const CameraView& ca
     r.skyColor = scene.skyColor;
     gpu::FrameConstants constants = makeFrameConstants(r, scene, camera);
     updateLights(r, scene, constants);
+    if (r.gi) prepareGiFrame(r, scene, camera, constants);
     if (r.decoupled) prepareDecoupledFrame(r, scene, camera, constants);
     std::memcpy(mapped(gpu, r.frameConstants), &constants, sizeof(constants));
     uint64_t frame = address(gpu, r.frameConstants);
@@ -209,6 +212,12 @@ FrameResult renderFrame(Renderer& r, const GpuScene& scene, const CameraView& ca
     pass(rec, "instanceCull",
          [&](VkCommandBuffer cmd) { recordInstanceCull(r, cmd, frame, scene); });
     pass(rec, "shadowMap", [&](VkCommandBuffer cmd) { recordShadowMap(r, cmd, frame); });
+    if (r.gi) { // light propagation volumes (render/gi): RSMs, injection, propagation
+        pass(rec, "giReflectiveShadowMaps",
+             [&](VkCommandBuffer cmd) { recordGiReflectiveShadowMaps(r, cmd, frame); });
+        pass(rec, "giInject", [&](VkCommandBuffer cmd) { recordGiInjection(r, cmd); });
+        pass(rec, "giPropagate", [&](VkCommandBuffer cmd) { recordGiPropagation(r, cmd); });
+    }
     if (r.visibility)
         pass(rec, "visibilityPrepass",
              [&](VkCommandBuffer cmd) { recordVisibilityPrepass(r, cmd, frame); });

@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "render/camera.h"
+#include "render/gi/lpv.h"
 #include "render/gpu_scene.h"
 #include "render/shadel/visibility.h"
 #include "rhi/frame.h"
@@ -18,6 +19,8 @@ enum class RenderMode { Forward, Decoupled };
 // Decoupled marking + reconstruction: raster passes over the objects, or compute passes over
 // the pixels of a visibility buffer (render/shadel/visibility.h).
 enum class MarkingMode { Raster, Visibility };
+// Global illumination: none, or light propagation volumes (render/gi/lpv.h).
+enum class GiMode { Off, Lpv };
 enum class Visualize : uint32_t {
     None = 0,
     Marking = 1,
@@ -25,6 +28,7 @@ enum class Visualize : uint32_t {
     Chunks = 3,
     Sheet = 4,
     LayerMaterial = 5, // --visualize layer:material (the shade storage's material layer)
+    Gi = 6,            // --visualize gi: the LPV's indirect light only
 };
 
 struct RenderSettings {
@@ -52,6 +56,10 @@ struct RenderSettings {
     uint32_t reuseRefreshPeriod = 8; // decoupled: reshade every carried chunk this often
     bool animateLights = false; // point and spot lights move on small circles // decoupled: rects
                                 // at every MIP (the old policy, for comparison)
+    GiMode gi = GiMode::Off;    // --gi (off by default: see render/gi/lpv.h for its cost)
+    uint32_t giIterations = 8;  // --gi-iterations: LPV propagation steps
+    bool giSnap = true;         // --gi-snap off: cascades slide with the camera (debug)
+    float giIntensity = 1.0f;   // scale of the indirect term
 };
 
 struct FrameResult {
@@ -101,6 +109,7 @@ struct Renderer {
     std::vector<glm::vec4> changedLightVolumes;
     uint64_t framesRendered = 0;
     VisibilityStatePtr visibility; // decoupled with --marking visibility
+    GiStatePtr gi;                 // --gi lpv
     std::chrono::steady_clock::time_point createdAt = std::chrono::steady_clock::now();
 };
 

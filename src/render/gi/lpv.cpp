@@ -1,0 +1,371 @@
+#include "render/gi/lpv.h"
+
+#include <cmath>
+#include <cstring>
+
+#include <glm/gtc/matrix_transform.hpp>
+#include <nlohmann/json.hpp>
+
+#include "gi/gi_types.h"
+#include "render/renderer.h"
+
+namespace shadel {
+
+namespace {
+
+constexpr uint32_t kRsmSize = 256;
+constexpr uint32_t kCells = GI_GRID * GI_GRID * GI_GRID;
+constexpr VkFormat kRsmFormats[3] = {VK_FORMAT_R32G32B32A32_SFLOAT,  // position
+                                     VK_FORMAT_R16G16B16A16_SFLOAT,  // normal + area
+                                     VK_FORMAT_R16G16B16A16_SFLOAT}; // flux
+
+struct RsmPush { // shaders/gi/rsm_push.glsl
+    glm::mat4 viewProj;
+    uint64_t frame;
+    uint32_t light;
+    float texelArea;
+    float texelSolidAngle;
+};
+
+struct InjectPush { // shaders/gi/inject.comp
+    uint64_t gi;
+    uint64_t inject[GI_CASCADES];
+    uint32_t positionSlot, normalSlot, fluxSlot, size;
+};
+
+struct PropagatePush { // shaders/gi/propagate.comp
+    uint64_t inject, source, target, accum, geometry;
+    uint32_t mode;
+};
+
+// One light's reflective shadow map: three colour targets and a depth buffer.
+struct Rsm {
+    TextureHandle targets[3], depth;
+    RenderTargetView targetViews[3];
+    TextureReadView readViews[3];
+    DepthTargetView depthView;
+    uint32_t light = 0xFFFFFFFFu; // light index, 0xFFFFFFFF = the sun
+    glm::mat4 viewProj{1.0f};
+    float texelArea = 0.0f, texelSolidAngle = 0.0f;
+};
+
+struct CascadeBuffers {
+    BufferHandle inject;   // int[GI_INJECT_INTS] per cell
+    BufferHandle light[2]; // ping-pong propagation steps, vec4[3] per cell
+    BufferHandle accum;    // vec4[3] per cell (the apply reads it)
+    BufferHandle geometry; // vec4 per cell
+};
+
+} // namespace
+
+struct GiState {
+    std::vector<Rsm> rsms;
+    CascadeBuffers cascades[GI_CASCADES];
+    BufferHandle frame; // host-visible GiFrame
+    gpu::GiFrame constants{};
+    float baseCellSize = 1.0f;
+    Pipeline rsmPass, inject, propagate;
+};
+
+void GiStateDeleter::operator()(GiState* state) const {
+    delete state;
+}
+
+static void createRsmTargets(Gpu& gpu, Rsm& rsm, uint32_t index) {
+    static const char* names[3] = {"position", "normal", "flux"};
+    for (int k = 0; k < 3; ++k) {
+        TextureDesc d;
+        d.name = "gi.rsm" + std::to_string(index) + "." + names[k];
+        d.format = kRsmFormats[k];
+        d.width = d.height = kRsmSize;
+        d.usage = VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT | VK_IMAGE_USAGE_SAMPLED_BIT;
+        rsm.targets[k] = createTexture(gpu, d);
+        if (!rsm.targets[k])
+            throw DeviceError("out of GPU memory for the GI reflective shadow maps");
+        rsm.targetViews[k] = createRenderTargetView(gpu, rsm.targets[k]);
+        rsm.readViews[k] = createReadView(gpu, rsm.targets[k]);
+    }
+    TextureDesc d;
+    d.name = "gi.rsm" + std::to_string(index) + ".depth";
+    d.format = VK_FORMAT_D32_SFLOAT;
+    d.width = d.height = kRsmSize;
+    d.usage = VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT;
+    rsm.depth = createTexture(gpu, d);
+    if (!rsm.depth) throw DeviceError("out of GPU memory for the GI reflective shadow maps");
+    rsm.depthView = createDepthTargetView(gpu, rsm.depth);
+}
+
+// The spot's perspective view: its cone (outer angle, from the shading constants) fills the map.
+static void spotView(const gpu::GpuLight& l, Rsm& rsm) {
+    float cosOuter = std::clamp(-l.spotOffset / std::max(l.spotScale, 1e-6f), 0.05f, 0.9999f);
+    float fov = std::min(2.0f * std::acos(cosOuter), glm::radians(170.0f));
+    glm::vec3 dir = glm::normalize(l.direction);
+    glm::vec3 up = std::abs(dir.y) > 0.99f ? glm::vec3(1, 0, 0) : glm::vec3(0, 1, 0);
+    float range = l.range > 0.0f ? l.range : 200.0f;
+    glm::mat4 view = glm::lookAt(l.position, l.position + dir, up);
+    glm::mat4 proj = glm::perspectiveRH_ZO(fov, 1.0f, 0.05f, range);
+    rsm.viewProj = proj * view;
+    float texel = 2.0f * std::tan(fov * 0.5f) / float(kRsmSize);
+    rsm.texelSolidAngle = texel * texel; // at the centre; the shader applies cos^3
+}
+
+GiStatePtr createGi(Renderer& r, const GpuScene& scene) {
+    Gpu& gpu = *r.gpu;
+    GiStatePtr gi(new GiState);
+    if (scene.sunCastsShadow && glm::dot(scene.sunColor, scene.sunColor) > 0.0f) {
+        gi->rsms.emplace_back();
+        gi->rsms.back().light = 0xFFFFFFFFu;
+    }
+    for (uint32_t i = 0; i < scene.lightInfo.size() && gi->rsms.size() < GI_MAX_RSMS; ++i)
+        if (scene.lightInfo[i].type == LIGHT_SPOT && i < scene.lightCastsShadow.size() &&
+            scene.lightCastsShadow[i]) {
+            gi->rsms.emplace_back();
+            gi->rsms.back().light = i;
+            spotView(scene.lightInfo[i], gi->rsms.back());
+        }
+    for (uint32_t i = 0; i < gi->rsms.size(); ++i) createRsmTargets(gpu, gi->rsms[i], i);
+
+    for (uint32_t c = 0; c < GI_CASCADES; ++c) {
+        CascadeBuffers& b = gi->cascades[c];
+        std::string prefix = "gi.cascade" + std::to_string(c) + ".";
+        b.inject = createBuffer(gpu, {prefix + "inject", VkDeviceSize(kCells) * GI_INJECT_INTS * 4,
+                                      VK_BUFFER_USAGE_TRANSFER_DST_BIT});
+        for (int k = 0; k < 2; ++k)
+            b.light[k] =
+                createBuffer(gpu, {prefix + (k ? "lightB" : "lightA"), VkDeviceSize(kCells) * 48});
+        b.accum = createBuffer(gpu, {prefix + "radiance", VkDeviceSize(kCells) * 48});
+        b.geometry = createBuffer(gpu, {prefix + "geometry", VkDeviceSize(kCells) * 16});
+        if (!b.inject || !b.light[0] || !b.light[1] || !b.accum || !b.geometry)
+            throw DeviceError("out of GPU memory for the GI volumes");
+    }
+    gi->frame = createBuffer(gpu, {"gi.frame", sizeof(gpu::GiFrame), 0, MemoryKind::Upload});
+    if (!gi->frame) throw DeviceError("out of GPU memory for the GI constants");
+
+    // Cascade 0's cells: a room-sized scene fits in cascade 0 (8 steps carry light a quarter of
+    // the way across it); larger scenes get 1-unit cells (a metre in the built-in scenes), but
+    // never so small that the coarsest cascade (4x the cell) misses most of the scene.
+    Aabb bounds = scene.bounds.valid() ? scene.bounds : Aabb{glm::vec3(-1), glm::vec3(1)};
+    glm::vec3 e = bounds.extent();
+    float extent = std::max(std::max(e.x, std::max(e.y, e.z)), 1e-3f);
+    gi->baseCellSize = std::max(std::min(extent / float(GI_GRID), 1.0f), extent / (4.0f * GI_GRID));
+
+    GraphicsPipelineDesc rsm;
+    rsm.name = "giReflectiveShadowMap";
+    rsm.vertexShader = "gi_rsm.vert.spv";
+    rsm.fragmentShader = "gi_rsm.frag.spv";
+    rsm.colorFormats = {kRsmFormats[0], kRsmFormats[1], kRsmFormats[2]};
+    rsm.depthFormat = VK_FORMAT_D32_SFLOAT;
+    rsm.depthCompare = VK_COMPARE_OP_LESS; // standard Z: the light's nearest surface
+    rsm.cullMode = VK_CULL_MODE_NONE;
+    rsm.depthClamp = true; // casters behind the sun's near plane still land in the map
+    gi->rsmPass = createGraphicsPipeline(gpu, rsm);
+    gi->inject = createComputePipeline(gpu, "giInject", "gi_inject.comp.spv");
+    gi->propagate = createComputePipeline(gpu, "giPropagate", "gi_propagate.comp.spv");
+    return gi;
+}
+
+void destroyGi(Renderer& r, GiStatePtr& state) {
+    if (!state) return;
+    Gpu& gpu = *r.gpu;
+    for (Rsm& rsm : state->rsms) {
+        for (int k = 0; k < 3; ++k) {
+            destroy(gpu, rsm.targetViews[k]);
+            destroy(gpu, rsm.readViews[k]);
+            destroy(gpu, rsm.targets[k]);
+        }
+        destroy(gpu, rsm.depthView);
+        destroy(gpu, rsm.depth);
+    }
+    for (CascadeBuffers& b : state->cascades)
+        for (BufferHandle h : {b.inject, b.light[0], b.light[1], b.accum, b.geometry})
+            destroy(gpu, h);
+    destroy(gpu, state->frame);
+    destroy(gpu, state->rsmPass);
+    destroy(gpu, state->inject);
+    destroy(gpu, state->propagate);
+    state.reset();
+}
+
+void prepareGiFrame(Renderer& r, const GpuScene& scene, const CameraView& camera,
+                    gpu::FrameConstants& constants) {
+    (void)scene;
+    GiState& gi = *r.gi;
+    gpu::GiFrame& g = gi.constants;
+    g = {};
+    g.cascadeCount = GI_CASCADES;
+    g.intensity = r.settings.giIntensity;
+    for (uint32_t c = 0; c < GI_CASCADES; ++c) {
+        float cell = gi.baseCellSize * float(1u << c);
+        // Snapped: the grid moves in whole cells, so a surface keeps its cell (and its light)
+        // while the camera moves; unsnapped (a debug option) it slides and the light swims.
+        glm::vec3 corner = camera.position / cell - float(GI_GRID / 2);
+        if (r.settings.giSnap) corner = glm::floor(corner);
+        gpu::GiCascade& gc = g.cascades[c];
+        gc.origin = corner * cell;
+        gc.cellSize = cell;
+        gc.radiance = address(*r.gpu, gi.cascades[c].accum);
+        gc.geometry = address(*r.gpu, gi.cascades[c].geometry);
+    }
+    std::memcpy(mapped(*r.gpu, gi.frame), &g, sizeof(g));
+    for (Rsm& rsm : gi.rsms)
+        if (rsm.light == 0xFFFFFFFFu) {
+            rsm.viewProj = constants.sunViewProj;
+            // The shadow map's texel is 2 r / shadowMapSize; the RSM spans the same square.
+            float texel = constants.shadowTexelSize * float(r.settings.shadowMapSize) / kRsmSize;
+            rsm.texelArea = texel * texel;
+        }
+    constants.gi = address(*r.gpu, gi.frame);
+}
+
+void recordGiReflectiveShadowMaps(Renderer& r, VkCommandBuffer cmd, uint64_t frame) {
+    Gpu& gpu = *r.gpu;
+    GiState& gi = *r.gi;
+    for (Rsm& rsm : gi.rsms) {
+        for (int k = 0; k < 3; ++k)
+            imageBarrier(cmd, vkImage(gpu, rsm.targets[k]), VK_IMAGE_ASPECT_COLOR_BIT,
+                         VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL,
+                         VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, 0,
+                         VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT,
+                         VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT);
+        imageBarrier(cmd, vkImage(gpu, rsm.depth), VK_IMAGE_ASPECT_DEPTH_BIT,
+                     VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL,
+                     VK_PIPELINE_STAGE_2_LATE_FRAGMENT_TESTS_BIT, 0,
+                     VK_PIPELINE_STAGE_2_EARLY_FRAGMENT_TESTS_BIT |
+                         VK_PIPELINE_STAGE_2_LATE_FRAGMENT_TESTS_BIT,
+                     VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT |
+                         VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_READ_BIT);
+        VkRenderingAttachmentInfo colors[3];
+        for (int k = 0; k < 3; ++k) {
+            colors[k] = {VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO};
+            colors[k].imageView = vkView(gpu, rsm.targetViews[k]);
+            colors[k].imageLayout = VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL;
+            colors[k].loadOp = VK_ATTACHMENT_LOAD_OP_CLEAR; // w = 0: no surface
+            colors[k].storeOp = VK_ATTACHMENT_STORE_OP_STORE;
+            colors[k].clearValue.color = {{0.0f, 0.0f, 0.0f, 0.0f}};
+        }
+        VkRenderingAttachmentInfo depth{VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO};
+        depth.imageView = vkView(gpu, rsm.depthView);
+        depth.imageLayout = VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL;
+        depth.loadOp = VK_ATTACHMENT_LOAD_OP_CLEAR;
+        depth.storeOp = VK_ATTACHMENT_STORE_OP_DONT_CARE;
+        depth.clearValue.depthStencil = {1.0f, 0};
+        VkRenderingInfo ri{VK_STRUCTURE_TYPE_RENDERING_INFO};
+        ri.renderArea = {{0, 0}, {kRsmSize, kRsmSize}};
+        ri.layerCount = 1;
+        ri.colorAttachmentCount = 3;
+        ri.pColorAttachments = colors;
+        ri.pDepthAttachment = &depth;
+        vkCmdBeginRendering(cmd, &ri);
+        bind(gpu, cmd, gi.rsmPass);
+        VkViewport vp{0, 0, float(kRsmSize), float(kRsmSize), 0, 1};
+        VkRect2D scissor{{0, 0}, {kRsmSize, kRsmSize}};
+        vkCmdSetViewport(cmd, 0, 1, &vp);
+        vkCmdSetScissor(cmd, 0, 1, &scissor);
+        pushConstants(gpu, cmd,
+                      RsmPush{rsm.viewProj, frame, rsm.light, rsm.texelArea, rsm.texelSolidAngle});
+        vkCmdBindIndexBuffer(cmd, vkBuffer(gpu, r.sceneIndices), 0, VK_INDEX_TYPE_UINT32);
+        // The sun's shadow list: its volume is fitted to the whole scene, so it also holds
+        // every opaque instance a spot inside the scene can see (the GPU clips the rest).
+        vkCmdDrawIndexedIndirectCount(
+            cmd, vkBuffer(gpu, r.shadowDraws),
+            VkDeviceSize(DRAW_LIST_OPAQUE) * r.maxDraws * sizeof(gpu::DrawIndexedCommand),
+            vkBuffer(gpu, r.drawCounts), (DRAW_LIST_COUNT + DRAW_LIST_OPAQUE) * 4, r.maxDraws,
+            sizeof(gpu::DrawIndexedCommand));
+        vkCmdEndRendering(cmd);
+        for (int k = 0; k < 3; ++k)
+            imageBarrier(
+                cmd, vkImage(gpu, rsm.targets[k]), VK_IMAGE_ASPECT_COLOR_BIT,
+                VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL,
+                VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT,
+                VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
+                VK_ACCESS_2_SHADER_SAMPLED_READ_BIT);
+    }
+}
+
+void recordGiInjection(Renderer& r, VkCommandBuffer cmd) {
+    Gpu& gpu = *r.gpu;
+    GiState& gi = *r.gi;
+    for (CascadeBuffers& b : gi.cascades)
+        vkCmdFillBuffer(cmd, vkBuffer(gpu, b.inject), 0, VK_WHOLE_SIZE, 0);
+    memoryBarrier(cmd, VK_PIPELINE_STAGE_2_CLEAR_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT,
+                  VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
+                  VK_ACCESS_2_SHADER_STORAGE_READ_BIT | VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT);
+    bind(gpu, cmd, gi.inject);
+    for (Rsm& rsm : gi.rsms) {
+        InjectPush push{};
+        push.gi = address(gpu, gi.frame);
+        for (uint32_t c = 0; c < GI_CASCADES; ++c)
+            push.inject[c] = address(gpu, gi.cascades[c].inject);
+        push.positionSlot = slot(gpu, rsm.readViews[0]).value;
+        push.normalSlot = slot(gpu, rsm.readViews[1]).value;
+        push.fluxSlot = slot(gpu, rsm.readViews[2]).value;
+        push.size = kRsmSize;
+        pushConstants(gpu, cmd, push);
+        vkCmdDispatch(cmd, kRsmSize / 8, kRsmSize / 8, 1);
+    }
+    // Resolve: fixed-point sums into the first propagation source, the accumulated light and
+    // the geometry volume.
+    memoryBarrier(cmd, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT,
+                  VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
+                  VK_ACCESS_2_SHADER_STORAGE_READ_BIT | VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT);
+    bind(gpu, cmd, gi.propagate);
+    for (CascadeBuffers& b : gi.cascades) {
+        PropagatePush push{address(gpu, b.inject),   0,
+                           address(gpu, b.light[0]), address(gpu, b.accum),
+                           address(gpu, b.geometry), 0};
+        pushConstants(gpu, cmd, push);
+        vkCmdDispatch(cmd, GI_GRID / 4, GI_GRID / 4, GI_GRID / 4);
+    }
+    memoryBarrier(cmd, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT,
+                  VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
+                  VK_ACCESS_2_SHADER_STORAGE_READ_BIT | VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT);
+}
+
+void recordGiPropagation(Renderer& r, VkCommandBuffer cmd) {
+    Gpu& gpu = *r.gpu;
+    GiState& gi = *r.gi;
+    bind(gpu, cmd, gi.propagate);
+    for (uint32_t step = 0; step < r.settings.giIterations; ++step) {
+        // The three cascades are independent: one barrier per step serves them all.
+        for (CascadeBuffers& b : gi.cascades) {
+            PropagatePush push{0,
+                               address(gpu, b.light[step & 1]),
+                               address(gpu, b.light[(step + 1) & 1]),
+                               address(gpu, b.accum),
+                               address(gpu, b.geometry),
+                               1};
+            pushConstants(gpu, cmd, push);
+            vkCmdDispatch(cmd, GI_GRID / 4, GI_GRID / 4, GI_GRID / 4);
+        }
+        memoryBarrier(
+            cmd, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT,
+            VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT,
+            VK_ACCESS_2_SHADER_STORAGE_READ_BIT | VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT);
+    }
+    if (r.settings.giIterations == 0)
+        memoryBarrier(cmd, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
+                      VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT, VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT,
+                      VK_ACCESS_2_SHADER_STORAGE_READ_BIT);
+}
+
+void giStats(const Renderer& r, nlohmann::json& stats) {
+    const GiState& gi = *r.gi;
+    nlohmann::json cascades = nlohmann::json::array();
+    for (uint32_t c = 0; c < GI_CASCADES; ++c) {
+        const gpu::GiCascade& gc = gi.constants.cascades[c];
+        cascades.push_back({{"cell_size", gc.cellSize},
+                            {"extent", gc.cellSize * GI_GRID},
+                            {"origin", {gc.origin.x, gc.origin.y, gc.origin.z}},
+                            {"cells", kCells}});
+    }
+    stats["gi"] = {{"mode", "lpv"},
+                   {"cascades", cascades},
+                   {"grid", GI_GRID},
+                   {"cells", kCells * GI_CASCADES},
+                   {"iterations", r.settings.giIterations},
+                   {"snap", r.settings.giSnap},
+                   {"reflective_shadow_maps", gi.rsms.size()},
+                   {"rsm_size", kRsmSize}};
+}
+
+} // namespace shadel
