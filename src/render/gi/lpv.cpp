@@ -147,7 +147,8 @@ GiStatePtr createGi(Renderer& r, const GpuScene& scene) {
     Aabb bounds = scene.bounds.valid() ? scene.bounds : Aabb{glm::vec3(-1), glm::vec3(1)};
     glm::vec3 e = bounds.extent();
     float extent = std::max(std::max(e.x, std::max(e.y, e.z)), 1e-3f);
-    gi->baseCellSize = std::max(std::min(extent / float(GI_GRID), 1.0f), extent / (4.0f * GI_GRID));
+    gi->baseCellSize =
+        std::max(std::min(2.0f * extent / float(GI_GRID), 1.0f), extent / (4.0f * GI_GRID));
 
     GraphicsPipelineDesc rsm;
     rsm.name = "giReflectiveShadowMap";
