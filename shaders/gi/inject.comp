@@ -18,6 +18,7 @@ layout(push_constant, scalar) uniform Push {
     uint normalSlot;
     uint fluxSlot;
     uint size; // RSM texels per side
+    uint cascadeMask; // bit c: cascade c moved and is injected again this frame
 } pc;
 
 void addFixed(GiInjectBuffer b, uint index, float value) {
@@ -48,6 +49,7 @@ void main() {
                                 lobe * (flux.b / PI_GI));
     GiFrame g = GiFrameRef(pc.gi).g;
     for (uint i = 0u; i < g.cascadeCount; ++i) {
+        if ((pc.cascadeMask & (1u << i)) == 0u) continue;
         GiCascade c = g.cascades[i];
         GiInjectBuffer b = GiInjectBuffer(pc.inject[i]);
         uint cell;

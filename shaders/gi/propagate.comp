@@ -5,6 +5,7 @@
 // neighbour sends through the five faces of this cell it sees is re-emitted as a cosine lobe
 // from each face, attenuated by the geometry volume's blocking potential between the two cells.
 #include "common/bindless.glsl"
+#extension GL_EXT_control_flow_attributes : require
 #include "gi/gi_types.h"
 #include "gi/sh.glsl"
 
@@ -56,42 +57,43 @@ void main() {
     GiShBuffer geometry = GiShBuffer(pc.geometry);
     vec4 here = geometry.c[index];
     vec4 gathered[3] = vec4[3](vec4(0.0), vec4(0.0), vec4(0.0));
-    for (int axis = 0; axis < 3; ++axis) {
-        for (int sgn = -1; sgn <= 1; sgn += 2) {
-            // Light travelling along d from the neighbour at cell - d into this cell.
-            ivec3 d = ivec3(0);
-            d[axis] = sgn;
-            ivec3 from = cell - d;
-            if (any(lessThan(from, ivec3(0))) || any(greaterThanEqual(from, ivec3(int(GI_GRID)))))
-                continue;
-            uint fromIndex = cellIndex(from);
-            vec4 src[3] = vec4[3](source.c[fromIndex * 3u], source.c[fromIndex * 3u + 1u],
-                                  source.c[fromIndex * 3u + 2u]);
-            // Surfaces facing the light (normal against d) between the two cells block it.
-            vec4 between = 0.5 * (here + geometry.c[fromIndex]);
-            float transmit = 1.0 - clamp(dot(between, shBasis(-vec3(d))), 0.0, 1.0);
-            if (transmit <= 0.0) continue;
-            for (int face = 0; face < 5; ++face) {
-                vec3 evalDir, faceNormal;
-                float solidAngle;
-                if (face == 0) {
-                    evalDir = vec3(d);
-                    faceNormal = vec3(d);
-                    solidAngle = DIRECT_FACE;
-                } else {
-                    // The four side faces: the two other axes, both signs.
-                    int other = (axis + 1 + ((face - 1) >> 1)) % 3;
-                    vec3 side = vec3(0.0);
-                    side[other] = ((face - 1) & 1) == 0 ? 1.0 : -1.0;
-                    evalDir = normalize(vec3(d) + 0.5 * side);
-                    faceNormal = side;
-                    solidAngle = SIDE_FACE;
-                }
-                vec4 towardFace = shBasis(evalDir);
-                vec4 reemit = shCosineLobe(faceNormal) * (solidAngle * transmit);
-                for (int ch = 0; ch < 3; ++ch)
-                    gathered[ch] += max(dot(src[ch], towardFace), 0.0) * reemit;
+    // Unrolled, so every direction, face and lobe below is a compile-time constant.
+    [[unroll]] for (int dir = 0; dir < 6; ++dir) {
+        // Light travelling along d from the neighbour at cell - d into this cell.
+        int axis = dir >> 1;
+        ivec3 d = ivec3(0);
+        d[axis] = (dir & 1) == 0 ? 1 : -1;
+        ivec3 from = cell - d;
+        if (any(lessThan(from, ivec3(0))) || any(greaterThanEqual(from, ivec3(int(GI_GRID)))))
+            continue;
+        uint fromIndex = cellIndex(from);
+        vec4 src[3] = vec4[3](source.c[fromIndex * 3u], source.c[fromIndex * 3u + 1u],
+                              source.c[fromIndex * 3u + 2u]);
+        if (src[0] == vec4(0.0) && src[1] == vec4(0.0) && src[2] == vec4(0.0)) continue;
+        // Surfaces facing the light (normal against d) between the two cells block it; the
+        // mean of the two cells' blocking potential stands for the face between them.
+        vec4 between = 0.5 * (here + geometry.c[fromIndex]);
+        float transmit = 1.0 - clamp(dot(between, shBasis(-vec3(d))), 0.0, 1.0);
+        [[unroll]] for (int face = 0; face < 5; ++face) {
+            vec3 evalDir, faceNormal;
+            float solidAngle;
+            if (face == 0) {
+                evalDir = vec3(d);
+                faceNormal = vec3(d);
+                solidAngle = DIRECT_FACE;
+            } else {
+                // The four side faces: the two other axes, both signs.
+                int other = (axis + 1 + ((face - 1) >> 1)) % 3;
+                vec3 side = vec3(0.0);
+                side[other] = ((face - 1) & 1) == 0 ? 1.0 : -1.0;
+                evalDir = vec3(d) * 0.894427191 + side * 0.447213595; // normalize(d + side / 2)
+                faceNormal = side;
+                solidAngle = SIDE_FACE;
             }
+            vec4 towardFace = shBasis(evalDir);
+            vec4 reemit = shCosineLobe(faceNormal) * (solidAngle * transmit);
+            for (int ch = 0; ch < 3; ++ch)
+                gathered[ch] += max(dot(src[ch], towardFace), 0.0) * reemit;
         }
     }
     for (uint ch = 0u; ch < 3u; ++ch) {

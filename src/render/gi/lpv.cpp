@@ -31,6 +31,7 @@ struct InjectPush { // shaders/gi/inject.comp
     uint64_t gi;
     uint64_t inject[GI_CASCADES];
     uint32_t positionSlot, normalSlot, fluxSlot, size;
+    uint32_t cascadeMask; // cascades injected this frame
 };
 
 struct PropagatePush { // shaders/gi/propagate.comp
@@ -65,6 +66,14 @@ struct GiState {
     gpu::GiFrame constants{};
     float baseCellSize = 1.0f;
     Pipeline rsmPass, inject, propagate;
+    // What is still valid from earlier frames. The lights' views are fixed (the sun's is fitted
+    // to the scene, spots do not move for GI), so the RSMs are drawn once; a cascade is injected
+    // and propagated again only when it moved (snapped to a new cell) since its last update.
+    bool rsmsDrawn = false;
+    bool cascadeValid[GI_CASCADES] = {};
+    glm::vec3 cascadeOrigin[GI_CASCADES] = {};
+    uint32_t dirtyMask = 0; // cascades updated this frame
+    uint64_t frames = 0, cascadeUpdates = 0, rsmRenders = 0;
 };
 
 void GiStateDeleter::operator()(GiState* state) const {
@@ -193,6 +202,8 @@ void prepareGiFrame(Renderer& r, const GpuScene& scene, const CameraView& camera
     GiState& gi = *r.gi;
     gpu::GiFrame& g = gi.constants;
     g = {};
+    gi.dirtyMask = 0;
+    gi.frames++;
     g.cascadeCount = GI_CASCADES;
     g.intensity = r.settings.giIntensity;
     for (uint32_t c = 0; c < GI_CASCADES; ++c) {
@@ -203,6 +214,9 @@ void prepareGiFrame(Renderer& r, const GpuScene& scene, const CameraView& camera
         if (r.settings.giSnap) corner = glm::floor(corner);
         gpu::GiCascade& gc = g.cascades[c];
         gc.origin = corner * cell;
+        if (!gi.cascadeValid[c] || gi.cascadeOrigin[c] != gc.origin) gi.dirtyMask |= 1u << c;
+        gi.cascadeOrigin[c] = gc.origin;
+        gi.cascadeValid[c] = true;
         gc.cellSize = cell;
         gc.radiance = address(*r.gpu, gi.cascades[c].accum);
         gc.geometry = address(*r.gpu, gi.cascades[c].geometry);
@@ -221,6 +235,9 @@ void prepareGiFrame(Renderer& r, const GpuScene& scene, const CameraView& camera
 void recordGiReflectiveShadowMaps(Renderer& r, VkCommandBuffer cmd, uint64_t frame) {
     Gpu& gpu = *r.gpu;
     GiState& gi = *r.gi;
+    if (gi.rsmsDrawn) return;
+    gi.rsmsDrawn = true;
+    gi.rsmRenders++;
     for (Rsm& rsm : gi.rsms) {
         for (int k = 0; k < 3; ++k)
             imageBarrier(cmd, vkImage(gpu, rsm.targets[k]), VK_IMAGE_ASPECT_COLOR_BIT,
@@ -286,8 +303,12 @@ void recordGiReflectiveShadowMaps(Renderer& r, VkCommandBuffer cmd, uint64_t fra
 void recordGiInjection(Renderer& r, VkCommandBuffer cmd) {
     Gpu& gpu = *r.gpu;
     GiState& gi = *r.gi;
-    for (CascadeBuffers& b : gi.cascades)
-        vkCmdFillBuffer(cmd, vkBuffer(gpu, b.inject), 0, VK_WHOLE_SIZE, 0);
+    if (!gi.dirtyMask) return;
+    for (uint32_t c = 0; c < GI_CASCADES; ++c)
+        if (gi.dirtyMask & (1u << c)) {
+            vkCmdFillBuffer(cmd, vkBuffer(gpu, gi.cascades[c].inject), 0, VK_WHOLE_SIZE, 0);
+            gi.cascadeUpdates++;
+        }
     memoryBarrier(cmd, VK_PIPELINE_STAGE_2_CLEAR_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT,
                   VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
                   VK_ACCESS_2_SHADER_STORAGE_READ_BIT | VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT);
@@ -301,6 +322,7 @@ void recordGiInjection(Renderer& r, VkCommandBuffer cmd) {
         push.normalSlot = slot(gpu, rsm.readViews[1]).value;
         push.fluxSlot = slot(gpu, rsm.readViews[2]).value;
         push.size = kRsmSize;
+        push.cascadeMask = gi.dirtyMask;
         pushConstants(gpu, cmd, push);
         vkCmdDispatch(cmd, kRsmSize / 8, kRsmSize / 8, 1);
     }
@@ -310,7 +332,9 @@ void recordGiInjection(Renderer& r, VkCommandBuffer cmd) {
                   VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
                   VK_ACCESS_2_SHADER_STORAGE_READ_BIT | VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT);
     bind(gpu, cmd, gi.propagate);
-    for (CascadeBuffers& b : gi.cascades) {
+    for (uint32_t c = 0; c < GI_CASCADES; ++c) {
+        if (!(gi.dirtyMask & (1u << c))) continue;
+        CascadeBuffers& b = gi.cascades[c];
         PropagatePush push{address(gpu, b.inject),   0,
                            address(gpu, b.light[0]), address(gpu, b.accum),
                            address(gpu, b.geometry), 0};
@@ -325,10 +349,13 @@ void recordGiInjection(Renderer& r, VkCommandBuffer cmd) {
 void recordGiPropagation(Renderer& r, VkCommandBuffer cmd) {
     Gpu& gpu = *r.gpu;
     GiState& gi = *r.gi;
+    if (!gi.dirtyMask) return;
     bind(gpu, cmd, gi.propagate);
     for (uint32_t step = 0; step < r.settings.giIterations; ++step) {
         // The three cascades are independent: one barrier per step serves them all.
-        for (CascadeBuffers& b : gi.cascades) {
+        for (uint32_t c = 0; c < GI_CASCADES; ++c) {
+            if (!(gi.dirtyMask & (1u << c))) continue;
+            CascadeBuffers& b = gi.cascades[c];
             PropagatePush push{0,
                                address(gpu, b.light[step & 1]),
                                address(gpu, b.light[(step + 1) & 1]),
@@ -366,6 +393,11 @@ void giStats(const Renderer& r, nlohmann::json& stats) {
                    {"iterations", r.settings.giIterations},
                    {"snap", r.settings.giSnap},
                    {"reflective_shadow_maps", gi.rsms.size()},
+                   {"rsm_renders", gi.rsmRenders},
+                   // Injections + propagations of one cascade over the run (a cascade is
+                   // updated when it snaps to a new cell; frames x 3 would be every frame).
+                   {"cascade_updates", gi.cascadeUpdates},
+                   {"frames", gi.frames},
                    {"rsm_size", kRsmSize}};
 }
 
