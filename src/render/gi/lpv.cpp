@@ -71,7 +71,8 @@ struct GiState {
     // and propagated again only when it moved (snapped to a new cell) since its last update.
     bool rsmsDrawn = false;
     bool cascadeValid[GI_CASCADES] = {};
-    glm::vec3 cascadeOrigin[GI_CASCADES] = {};
+    glm::vec3 cascadeOrigin[GI_CASCADES] = {}; // where its light was computed (the apply's too)
+    uint64_t cascadeUpdatedFrame[GI_CASCADES] = {};
     uint32_t dirtyMask = 0; // cascades updated this frame
     uint64_t frames = 0, cascadeUpdates = 0, rsmRenders = 0;
 };
@@ -206,18 +207,42 @@ void prepareGiFrame(Renderer& r, const GpuScene& scene, const CameraView& camera
     gi.frames++;
     g.cascadeCount = GI_CASCADES;
     g.intensity = r.settings.giIntensity;
+    glm::vec3 wanted[GI_CASCADES];
+    uint32_t moved = 0;
+    bool allValid = true;
     for (uint32_t c = 0; c < GI_CASCADES; ++c) {
         float cell = gi.baseCellSize * float(1u << c);
         // Snapped: the grid moves in whole cells, so a surface keeps its cell (and its light)
         // while the camera moves; unsnapped (a debug option) it slides and the light swims.
         glm::vec3 corner = camera.position / cell - float(GI_GRID / 2);
         if (r.settings.giSnap) corner = glm::floor(corner);
+        wanted[c] = corner * cell;
+        if (!gi.cascadeValid[c] || gi.cascadeOrigin[c] != wanted[c]) moved |= 1u << c;
+        allValid = allValid && gi.cascadeValid[c];
+    }
+    // Time slicing: after the first frame at most one cascade is injected and propagated per
+    // frame, the one waiting longest; the others keep the origin their light was computed at
+    // (a few cells behind the camera at most, inside their 16-cell margin).
+    // Without snapping (the debug baseline) every cascade follows the camera every frame.
+    if (!allValid || !r.settings.giSnap) {
+        gi.dirtyMask = moved;
+    } else if (moved) {
+        uint32_t pick = GI_CASCADES;
+        for (uint32_t c = 0; c < GI_CASCADES; ++c)
+            if ((moved & (1u << c)) &&
+                (pick == GI_CASCADES || gi.cascadeUpdatedFrame[c] < gi.cascadeUpdatedFrame[pick]))
+                pick = c;
+        gi.dirtyMask = 1u << pick;
+    }
+    for (uint32_t c = 0; c < GI_CASCADES; ++c) {
+        if (gi.dirtyMask & (1u << c)) {
+            gi.cascadeOrigin[c] = wanted[c];
+            gi.cascadeValid[c] = true;
+            gi.cascadeUpdatedFrame[c] = gi.frames;
+        }
         gpu::GiCascade& gc = g.cascades[c];
-        gc.origin = corner * cell;
-        if (!gi.cascadeValid[c] || gi.cascadeOrigin[c] != gc.origin) gi.dirtyMask |= 1u << c;
-        gi.cascadeOrigin[c] = gc.origin;
-        gi.cascadeValid[c] = true;
-        gc.cellSize = cell;
+        gc.origin = gi.cascadeOrigin[c];
+        gc.cellSize = gi.baseCellSize * float(1u << c);
         gc.radiance = address(*r.gpu, gi.cascades[c].accum);
         gc.geometry = address(*r.gpu, gi.cascades[c].geometry);
     }
