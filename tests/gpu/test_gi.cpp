@@ -123,3 +123,21 @@ TEST(Gi, BadFlagsAreOneLineAndExitCode2) {
         EXPECT_NE(text.find("shadel: "), std::string::npos) << args;
     }
 }
+
+// The lights' views are fixed, so the RSMs are drawn once and a cascade is updated only when it
+// moves: a static camera updates each cascade once and keeps the same image. A moving spot
+// (--animate-lights) needs its RSM and every cascade again each frame.
+TEST(Gi, StaticCameraReusesTheVolumesAndMovingSpotsRedrawThem) {
+    RenderOptions o = cornell(GiMode::Lpv);
+    o.width = 64;
+    o.height = 36;
+    o.frames = 3;
+    RenderRun still = renderChecked(o);
+    EXPECT_EQ(still.stats["gi"]["rsm_renders"].get<uint64_t>(), 1u);
+    EXPECT_EQ(still.stats["gi"]["cascade_updates"].get<uint64_t>(), 3u);
+    EXPECT_EQ(still.frames[0].rgba, still.frames[2].rgba);
+    o.animateLights = true;
+    RenderRun moving = renderChecked(o);
+    EXPECT_EQ(moving.stats["gi"]["rsm_renders"].get<uint64_t>(), 3u);
+    EXPECT_EQ(moving.stats["gi"]["cascade_updates"].get<uint64_t>(), 9u);
+}

@@ -48,6 +48,7 @@ struct Rsm {
     uint32_t light = 0xFFFFFFFFu; // light index, 0xFFFFFFFF = the sun
     glm::mat4 viewProj{1.0f};
     float texelArea = 0.0f, texelSolidAngle = 0.0f;
+    glm::vec3 lightPosition{0.0f}, lightDirection{0.0f}; // the spot's view the map was drawn for
 };
 
 struct CascadeBuffers {
@@ -117,6 +118,8 @@ static void spotView(const gpu::GpuLight& l, Rsm& rsm) {
     rsm.viewProj = proj * view;
     float texel = 2.0f * std::tan(fov * 0.5f) / float(kRsmSize);
     rsm.texelSolidAngle = texel * texel; // at the centre; the shader applies cos^3
+    rsm.lightPosition = l.position;
+    rsm.lightDirection = l.direction;
 }
 
 GiStatePtr createGi(Renderer& r, const GpuScene& scene) {
@@ -205,6 +208,20 @@ void prepareGiFrame(Renderer& r, const GpuScene& scene, const CameraView& camera
     g = {};
     gi.dirtyMask = 0;
     gi.frames++;
+    // --animate-lights: a spot that moved needs its RSM again, and every cascade its light.
+    bool lightsMoved = false;
+    if (r.settings.animateLights && !r.lightsLastFrame.empty())
+        for (Rsm& rsm : gi.rsms) {
+            if (rsm.light == 0xFFFFFFFFu || rsm.light >= r.lightsLastFrame.size()) continue;
+            const gpu::GpuLight& l = r.lightsLastFrame[rsm.light]; // this frame's lights
+            if (l.position == rsm.lightPosition && l.direction == rsm.lightDirection) continue;
+            spotView(l, rsm);
+            lightsMoved = true;
+        }
+    if (lightsMoved) {
+        gi.rsmsDrawn = false;
+        for (bool& valid : gi.cascadeValid) valid = false;
+    }
     g.cascadeCount = GI_CASCADES;
     g.intensity = r.settings.giIntensity;
     glm::vec3 wanted[GI_CASCADES];
