@@ -17,6 +17,18 @@ namespace shadel::gpu {
 // Per cell of the injection buffer: 12 ints of radiance SH (R, G, B x 4) + 4 of geometry SH.
 #define GI_INJECT_INTS 16u
 
+#define GI_MAX_BLOCKERS 64u
+
+// A light blocker for GI: a rectangle light does not propagate through (render/gi/lpv.h).
+struct GpuGiBlocker {
+    vec3 center;
+    float halfU;
+    vec3 axisU; // unit
+    float halfV;
+    vec3 axisV; // unit, orthogonal to axisU
+    float pad;
+};
+
 // One cascade as the apply reads it.
 struct GiCascade {
     vec3 origin;      // world position of the min corner of cell (0, 0, 0)
@@ -28,9 +40,10 @@ struct GiCascade {
 struct GiFrame {
     GiCascade cascades[GI_CASCADES];
     uint cascadeCount;
-    float intensity; // scale of the indirect term (1 = physical estimate)
+    float intensity;   // scale of the indirect term (1 = physical estimate)
+    uint blockerCount; // light blockers: the apply drops trilinear taps behind one
     uint pad0;
-    uint pad1;
+    uint64_t blockers; // GpuGiBlocker[blockerCount]
 };
 
 #ifdef __cplusplus

@@ -5,6 +5,7 @@
 #include "common/bindless.glsl"
 #include "gi/gi_types.h"
 #include "gi/sh.glsl"
+#include "gi/blockers.glsl"
 
 layout(local_size_x = 8, local_size_y = 8) in;
 
@@ -27,10 +28,14 @@ void addFixed(GiInjectBuffer b, uint index, float value) {
     if (fixedValue != 0) atomicAdd(b.v[index], fixedValue);
 }
 
-bool cellOf(GiCascade c, vec3 p, out uint index) {
+bool cellOf(GiFrame g, GiCascade c, vec3 p, out uint index) {
     ivec3 cell = ivec3(floor((p - c.origin) / c.cellSize));
     index = 0u;
     if (any(lessThan(cell, ivec3(0))) || any(greaterThanEqual(cell, ivec3(int(GI_GRID)))))
+        return false;
+    // A point whose cell centre lies behind a blocker would put its light on the other side.
+    if (g.blockerCount > 0u && giSegmentBlocked(g.blockers, g.blockerCount, p,
+                                                c.origin + (vec3(cell) + 0.5) * c.cellSize))
         return false;
     index = (uint(cell.z) * GI_GRID + uint(cell.y)) * GI_GRID + uint(cell.x);
     return true;
@@ -53,13 +58,13 @@ void main() {
         GiCascade c = g.cascades[i];
         GiInjectBuffer b = GiInjectBuffer(pc.inject[i]);
         uint cell;
-        if (dot(flux, flux) > 0.0 && cellOf(c, position.xyz + n * (0.5 * c.cellSize), cell)) {
+        if (dot(flux, flux) > 0.0 && cellOf(g, c, position.xyz + n * (0.5 * c.cellSize), cell)) {
             for (uint ch = 0u; ch < 3u; ++ch)
                 for (uint k = 0u; k < 4u; ++k)
                     addFixed(b, cell * GI_INJECT_INTS + ch * 4u + k, intensity[ch][k]);
         }
         // Blocking potential: the fraction of the cell's cross-section the surface covers.
-        if (cellOf(c, position.xyz, cell)) {
+        if (cellOf(g, c, position.xyz, cell)) {
             float coverage = clamp(normal.w / (c.cellSize * c.cellSize), 0.0, 1.0);
             for (uint k = 0u; k < 4u; ++k)
                 addFixed(b, cell * GI_INJECT_INTS + 12u + k, lobe[k] * coverage);

@@ -20,8 +20,46 @@ layout(push_constant, scalar) uniform Push {
     uint64_t target;   // vec4[3] per cell: this step's light
     uint64_t accum;    // vec4[3] per cell: sum of every step (what the apply reads)
     uint64_t geometry; // vec4 per cell: blocking potential
+    uint64_t axial;    // vec4 per cell: blocker coverage of its -x, -y, -z faces (xyz)
+    uint64_t blockers; // GpuGiBlocker[blockerCount] (mode 0)
+    vec3 origin;       // the cascade's min corner and cell size (mode 0)
+    float cellSize;
+    uint blockerCount;
     uint mode;
 } pc;
+
+layout(buffer_reference, scalar) readonly buffer GiBlockerBuffer { GpuGiBlocker b[]; };
+
+// Whether the segment a -> b crosses blocker k.
+bool segmentHitsBlocker(GpuGiBlocker k, vec3 a, vec3 b) {
+    vec3 n = cross(k.axisU, k.axisV);
+    float da = dot(a - k.center, n), db = dot(b - k.center, n);
+    if ((da > 0.0) == (db > 0.0)) return false;
+    vec3 p = mix(a, b, da / (da - db)) - k.center;
+    return abs(dot(p, k.axisU)) <= k.halfU && abs(dot(p, k.axisV)) <= k.halfV;
+}
+
+// Axial occlusion of the face between cell - e_axis and cell: the fraction of four rays
+// between the two cells (spread over the face) that a blocker stops.
+float faceCoverage(ivec3 cell, int axis) {
+    GiBlockerBuffer blockers = GiBlockerBuffer(pc.blockers);
+    vec3 b = pc.origin + (vec3(cell) + 0.5) * pc.cellSize;
+    vec3 e = vec3(0.0);
+    e[axis] = pc.cellSize;
+    vec3 u = vec3(0.0), v = vec3(0.0);
+    u[(axis + 1) % 3] = 0.25 * pc.cellSize;
+    v[(axis + 2) % 3] = 0.25 * pc.cellSize;
+    float blocked = 0.0;
+    for (int r = 0; r < 4; ++r) {
+        vec3 offset = ((r & 1) == 0 ? -u : u) + ((r & 2) == 0 ? -v : v);
+        for (uint k = 0u; k < pc.blockerCount; ++k)
+            if (segmentHitsBlocker(blockers.b[k], b - e + offset, b + offset)) {
+                blocked += 0.25;
+                break;
+            }
+    }
+    return blocked;
+}
 
 // Solid angles (over 4 pi... normalised by pi as in the reference implementation) a face of the
 // neighbouring cell subtends from a cell's centre: the face straight ahead and a side face.
@@ -51,11 +89,16 @@ void main() {
         GiShBuffer(pc.geometry).c[index] =
             vec4(inject.v[base + 12u], inject.v[base + 13u], inject.v[base + 14u],
                  inject.v[base + 15u]) / float(GI_FIXED_SCALE);
+        vec4 axial = vec4(0.0);
+        if (pc.blockerCount > 0u)
+            for (int axis = 0; axis < 3; ++axis) axial[axis] = faceCoverage(cell, axis);
+        GiShBuffer(pc.axial).c[index] = axial;
         return;
     }
     GiShBuffer source = GiShBuffer(pc.source);
     GiShBuffer geometry = GiShBuffer(pc.geometry);
     vec4 here = geometry.c[index];
+    vec4 axialHere = GiShBuffer(pc.axial).c[index];
     vec4 gathered[3] = vec4[3](vec4(0.0), vec4(0.0), vec4(0.0));
     // Unrolled, so every direction, face and lobe below is a compile-time constant.
     [[unroll]] for (int dir = 0; dir < 6; ++dir) {
@@ -74,6 +117,10 @@ void main() {
         // mean of the two cells' blocking potential stands for the face between them.
         vec4 between = 0.5 * (here + geometry.c[fromIndex]);
         float transmit = 1.0 - clamp(dot(between, shBasis(-vec3(d))), 0.0, 1.0);
+        // Blockers (axial occlusion): the face crossed is this cell's -axis face when d points
+        // along +axis, else the neighbour's.
+        float blocked = d[axis] > 0 ? axialHere[axis] : GiShBuffer(pc.axial).c[fromIndex][axis];
+        transmit *= 1.0 - blocked;
         [[unroll]] for (int face = 0; face < 5; ++face) {
             vec3 evalDir, faceNormal;
             float solidAngle;

@@ -43,10 +43,11 @@ struct RenderOptions {
     uint32_t reuseRefreshPeriod = 8;
     bool animateLights = false;
     CameraPath cameraPath = CameraPath::Static;
-    GiMode gi = GiMode::Off;    // --gi lpv|off
-    uint32_t giIterations = 8;  // --gi-iterations
-    bool giSnap = true;         // --gi-snap on|off (off: debug, cascades slide with the camera)
-    double shadelBudget = 64e6; // MIP-0 shadels the bake may use for the whole scene
+    GiMode gi = GiMode::Off;   // --gi lpv|off
+    uint32_t giIterations = 8; // --gi-iterations
+    bool giSnap = true;        // --gi-snap on|off (off: debug, cascades slide with the camera)
+    std::vector<GiBlocker> giBlockers; // GI light blockers (no flag yet: scenes will carry them)
+    double shadelBudget = 64e6;        // MIP-0 shadels the bake may use for the whole scene
     bool printPasses = false;
     bool progress = true;
 };

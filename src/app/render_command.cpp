@@ -203,6 +203,7 @@ RenderRun runRender(Gpu& gpu, const RenderOptions& o) {
     settings.gi = o.gi;
     settings.giIterations = o.giIterations;
     settings.giSnap = o.giSnap;
+    settings.giBlockers = o.giBlockers;
     settings.timing = o.timing ? *o.timing : defaultTimingMode(gpu);
     Renderer renderer;
     RenderRun run;

@@ -60,6 +60,7 @@ struct RenderSettings {
     uint32_t giIterations = 8;  // --gi-iterations: LPV propagation steps
     bool giSnap = true;         // --gi-snap off: cascades slide with the camera (debug)
     float giIntensity = 1.0f;   // scale of the indirect term
+    std::vector<GiBlocker> giBlockers; // GI light blockers (axial occlusion in propagation)
 };
 
 struct FrameResult {

@@ -6,6 +6,7 @@
 #include <glm/gtc/matrix_transform.hpp>
 #include <nlohmann/json.hpp>
 
+#include "core/log.h"
 #include "gi/gi_types.h"
 #include "render/renderer.h"
 
@@ -35,7 +36,10 @@ struct InjectPush { // shaders/gi/inject.comp
 };
 
 struct PropagatePush { // shaders/gi/propagate.comp
-    uint64_t inject, source, target, accum, geometry;
+    uint64_t inject, source, target, accum, geometry, axial, blockers;
+    glm::vec3 origin;
+    float cellSize;
+    uint32_t blockerCount;
     uint32_t mode;
 };
 
@@ -56,6 +60,7 @@ struct CascadeBuffers {
     BufferHandle light[2]; // ping-pong propagation steps, vec4[3] per cell
     BufferHandle accum;    // vec4[3] per cell (the apply reads it)
     BufferHandle geometry; // vec4 per cell
+    BufferHandle axial;    // vec4 per cell: blocker coverage of its -x, -y, -z faces
 };
 
 } // namespace
@@ -63,7 +68,9 @@ struct CascadeBuffers {
 struct GiState {
     std::vector<Rsm> rsms;
     CascadeBuffers cascades[GI_CASCADES];
-    BufferHandle frame; // host-visible GiFrame
+    BufferHandle frame;    // host-visible GiFrame
+    BufferHandle blockers; // GpuGiBlocker[], when there are any
+    uint32_t blockerCount = 0;
     gpu::GiFrame constants{};
     float baseCellSize = 1.0f;
     Pipeline rsmPass, inject, propagate;
@@ -148,11 +155,27 @@ GiStatePtr createGi(Renderer& r, const GpuScene& scene) {
                 createBuffer(gpu, {prefix + (k ? "lightB" : "lightA"), VkDeviceSize(kCells) * 48});
         b.accum = createBuffer(gpu, {prefix + "radiance", VkDeviceSize(kCells) * 48});
         b.geometry = createBuffer(gpu, {prefix + "geometry", VkDeviceSize(kCells) * 16});
-        if (!b.inject || !b.light[0] || !b.light[1] || !b.accum || !b.geometry)
+        b.axial = createBuffer(gpu, {prefix + "axialOcclusion", VkDeviceSize(kCells) * 16});
+        if (!b.inject || !b.light[0] || !b.light[1] || !b.accum || !b.geometry || !b.axial)
             throw DeviceError("out of GPU memory for the GI volumes");
     }
     gi->frame = createBuffer(gpu, {"gi.frame", sizeof(gpu::GiFrame), 0, MemoryKind::Upload});
     if (!gi->frame) throw DeviceError("out of GPU memory for the GI constants");
+    const std::vector<GiBlocker>& blockers = r.settings.giBlockers;
+    if (blockers.size() > GI_MAX_BLOCKERS)
+        throw InputError(
+            format("%zu GI light blockers: at most %u", blockers.size(), GI_MAX_BLOCKERS));
+    if (!blockers.empty()) {
+        std::vector<gpu::GpuGiBlocker> packed;
+        for (const GiBlocker& b : blockers)
+            packed.push_back({b.center, b.halfSize.x, glm::normalize(b.axisU), b.halfSize.y,
+                              glm::normalize(b.axisV), 0.0f});
+        gi->blockers = createBuffer(
+            gpu, {"gi.blockers", packed.size() * sizeof(packed[0]), 0, MemoryKind::Upload});
+        if (!gi->blockers) throw DeviceError("out of GPU memory for the GI blockers");
+        std::memcpy(mapped(gpu, gi->blockers), packed.data(), packed.size() * sizeof(packed[0]));
+        gi->blockerCount = uint32_t(packed.size());
+    }
 
     // Cascade 0's cells: a room-sized scene fits in cascade 0 (8 steps carry light a quarter of
     // the way across it); larger scenes get 1-unit cells (a metre in the built-in scenes), but
@@ -191,9 +214,10 @@ void destroyGi(Renderer& r, GiStatePtr& state) {
         destroy(gpu, rsm.depth);
     }
     for (CascadeBuffers& b : state->cascades)
-        for (BufferHandle h : {b.inject, b.light[0], b.light[1], b.accum, b.geometry})
+        for (BufferHandle h : {b.inject, b.light[0], b.light[1], b.accum, b.geometry, b.axial})
             destroy(gpu, h);
     destroy(gpu, state->frame);
+    if (state->blockers) destroy(gpu, state->blockers);
     destroy(gpu, state->rsmPass);
     destroy(gpu, state->inject);
     destroy(gpu, state->propagate);
@@ -224,6 +248,8 @@ void prepareGiFrame(Renderer& r, const GpuScene& scene, const CameraView& camera
     }
     g.cascadeCount = GI_CASCADES;
     g.intensity = r.settings.giIntensity;
+    g.blockerCount = gi.blockerCount;
+    g.blockers = gi.blockers ? address(*r.gpu, gi.blockers) : 0;
     glm::vec3 wanted[GI_CASCADES];
     uint32_t moved = 0;
     bool allValid = true;
@@ -377,9 +403,17 @@ void recordGiInjection(Renderer& r, VkCommandBuffer cmd) {
     for (uint32_t c = 0; c < GI_CASCADES; ++c) {
         if (!(gi.dirtyMask & (1u << c))) continue;
         CascadeBuffers& b = gi.cascades[c];
-        PropagatePush push{address(gpu, b.inject),   0,
-                           address(gpu, b.light[0]), address(gpu, b.accum),
-                           address(gpu, b.geometry), 0};
+        PropagatePush push{};
+        push.inject = address(gpu, b.inject);
+        push.target = address(gpu, b.light[0]);
+        push.accum = address(gpu, b.accum);
+        push.geometry = address(gpu, b.geometry);
+        push.axial = address(gpu, b.axial);
+        push.blockers = gi.blockers ? address(gpu, gi.blockers) : 0;
+        push.origin = gi.constants.cascades[c].origin;
+        push.cellSize = gi.constants.cascades[c].cellSize;
+        push.blockerCount = gi.blockerCount;
+        push.mode = 0;
         pushConstants(gpu, cmd, push);
         vkCmdDispatch(cmd, GI_GRID / 4, GI_GRID / 4, GI_GRID / 4);
     }
@@ -398,12 +432,13 @@ void recordGiPropagation(Renderer& r, VkCommandBuffer cmd) {
         for (uint32_t c = 0; c < GI_CASCADES; ++c) {
             if (!(gi.dirtyMask & (1u << c))) continue;
             CascadeBuffers& b = gi.cascades[c];
-            PropagatePush push{0,
-                               address(gpu, b.light[step & 1]),
-                               address(gpu, b.light[(step + 1) & 1]),
-                               address(gpu, b.accum),
-                               address(gpu, b.geometry),
-                               1};
+            PropagatePush push{};
+            push.source = address(gpu, b.light[step & 1]);
+            push.target = address(gpu, b.light[(step + 1) & 1]);
+            push.accum = address(gpu, b.accum);
+            push.geometry = address(gpu, b.geometry);
+            push.axial = address(gpu, b.axial);
+            push.mode = 1;
             pushConstants(gpu, cmd, push);
             vkCmdDispatch(cmd, GI_GRID / 4, GI_GRID / 4, GI_GRID / 4);
         }
@@ -434,6 +469,7 @@ void giStats(const Renderer& r, nlohmann::json& stats) {
                    {"cells", kCells * GI_CASCADES},
                    {"iterations", r.settings.giIterations},
                    {"snap", r.settings.giSnap},
+                   {"blockers", gi.blockerCount},
                    {"reflective_shadow_maps", gi.rsms.size()},
                    {"rsm_renders", gi.rsmRenders},
                    // Injections + propagations of one cascade over the run (a cascade is

@@ -5,6 +5,9 @@
 // propagated N steps with geometry occlusion, and read by the shared lighting code
 // (shaders/gi/lpv_sample.glsl via shaders/common/lighting.glsl).
 #include <memory>
+#include <vector>
+
+#include <glm/glm.hpp>
 
 #include <nlohmann/json_fwd.hpp>
 
@@ -17,6 +20,17 @@ struct Renderer;
 struct GpuScene;
 struct CameraView;
 struct GiState;
+
+// A light blocker (seed 001) as GI uses it: a rectangle (say a wall's mid-plane) that light does
+// not propagate through, stored per cascade as axial occlusion (how much of each cell face it
+// covers along x, y, z). The same fields as the lighting branch's Scene::LightBlocker (issue 10,
+// without its portals yet): when both land, GI should read the scene's blockers instead.
+struct GiBlocker {
+    glm::vec3 center{0.0f};
+    glm::vec3 axisU{1, 0, 0}; // unit, in the plane
+    glm::vec3 axisV{0, 1, 0}; // unit, in the plane, orthogonal to axisU
+    glm::vec2 halfSize{1.0f}; // along axisU, axisV
+};
 
 struct GiStateDeleter {
     void operator()(GiState* state) const;
