@@ -11,6 +11,7 @@
 #ifndef SHADEL_LIGHTING_GLSL
 #define SHADEL_LIGHTING_GLSL
 #include "common/material.glsl"
+#include "gi/lpv_sample.glsl"
 
 layout(buffer_reference, scalar) readonly buffer LightingFrameRef { LightingFrame l; };
 layout(buffer_reference, scalar) readonly buffer LightBlockerBuffer { GpuLightBlocker b[]; };
@@ -240,6 +241,11 @@ vec3 shadeSurface(FrameConstants f, MaterialSample m, vec3 worldPos, vec3 geomet
     vec3 n = m.normal;
     vec3 v = normalize(f.cameraPosition - worldPos);
     vec3 color = m.emissive;
+    // Indirect diffuse light from the light propagation volume (0 when GI is off).
+    vec3 indirect = giIrradiance(f.gi, worldPos, n) * m.baseColor * (1.0 - m.metallic) *
+                    m.occlusion / PI;
+    if (f.visualize == VISUALIZE_GI) return indirect;
+    color += indirect;
     // Ambient: a hemisphere term so shadowed sides are not black.
     float up = n.y * 0.5 + 0.5;
     vec3 ambient = mix(f.ambientColor * 0.5, f.ambientColor + f.skyColor * 0.15, up);

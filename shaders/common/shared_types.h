@@ -59,6 +59,7 @@ using uint = uint32_t;
 #define VISUALIZE_LAYER_MATERIAL 5u // --visualize layer:material
 #define VISUALIZE_LIGHT_COUNT 16u   // --visualize light-count: lights per tile / chunk (heat)
 #define VISUALIZE_BLOCKERS 17u      // --visualize blockers: tiles with per-pixel blocker checks
+#define VISUALIZE_GI 6u             // --visualize gi: the LPV indirect light only
 
 // One vertex of the unified geometry buffer (matches shadel::Vertex).
 struct GpuVertex {
@@ -223,6 +224,7 @@ struct FrameConstants {
     uint64_t messages;  // ShaderMessages (shader asserts)
     uint64_t shadel;    // ShadelFrame (decoupled path), 0 when forward
     uint64_t lighting;  // LightingFrame (render/lighting), 0 when absent
+    uint64_t gi;        // GiFrame (render/gi, shaders/gi/gi_types.h), 0 when GI is off
 };
 
 // Shader -> CPU message channel (shader asserts). Written with atomics, read after the frame.

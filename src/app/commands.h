@@ -47,7 +47,11 @@ struct RenderOptions {
     LightCulling lightCulling = LightCulling::Tiled; // --light-culling tiled|none
     bool lightBlockers = true;                       // --blockers on|off
     CameraPath cameraPath = CameraPath::Static;
-    double shadelBudget = 64e6; // MIP-0 shadels the bake may use for the whole scene
+    GiMode gi = GiMode::Off;   // --gi lpv|off
+    uint32_t giIterations = 8; // --gi-iterations
+    bool giSnap = true;        // --gi-snap on|off (off: debug, cascades slide with the camera)
+    std::vector<GiBlocker> giBlockers; // GI light blockers (no flag yet: scenes will carry them)
+    double shadelBudget = 64e6;        // MIP-0 shadels the bake may use for the whole scene
     bool printPasses = false;
     bool progress = true;
 };
@@ -65,6 +69,7 @@ MarkingMode parseMarking(const std::string& text);
 OitMode parseOit(const std::string& text);
 LightCulling parseLightCulling(const std::string& text);
 bool parseOnOff(const char* flag, const std::string& text); // "on" / "off", else InputError
+GiMode parseGi(const std::string& text); // --gi lpv|off
 // The bake cache folder when --cache-dir is not given (see defaultBakeCacheDir()).
 std::string defaultCacheDir();
 

@@ -91,7 +91,7 @@ int main(int argc, char** argv) {
     render
         ->add_option("--visualize", visualize,
                      "none | marking | mips | chunks | sheet | layer:radiance | layer:material | "
-                     "light-count | blockers")
+                     "light-count | blockers | gi (indirect light only, with --gi lpv)")
         ->capture_default_str();
     std::string marking = "raster";
     render
@@ -195,6 +195,19 @@ int main(int argc, char** argv) {
                        "FILE.json: Chrome trace events (CPU frontend and GPU passes per frame; "
                        "chrome://tracing, Perfetto)");
     render->add_flag("--passes", ro.printPasses, "print the per-pass timing table");
+    std::string gi = "off", giSnap = "on";
+    render
+        ->add_option("--gi", gi,
+                     "lpv | off: light propagation volume GI (sun + shadow-casting spot RSMs, "
+                     "3 camera cascades of 32^3)")
+        ->capture_default_str();
+    render->add_option("--gi-iterations", ro.giIterations, "GI: propagation steps (0..64)")
+        ->capture_default_str();
+    render
+        ->add_option("--gi-snap", giSnap,
+                     "GI: on | off: snap the cascades to their cell size (off only to measure "
+                     "swimming)")
+        ->capture_default_str();
 
     // bench
     BenchOptions bo;
@@ -331,6 +344,10 @@ int main(int argc, char** argv) {
             ro.reuse = reuse == "on";
             ro.lightCulling = parseLightCulling(lightCulling);
             ro.lightBlockers = parseOnOff("--blockers", blockers);
+            ro.gi = parseGi(gi);
+            if (giSnap != "on" && giSnap != "off")
+                throw InputError(format("--gi-snap %s: expected on or off", giSnap.c_str()));
+            ro.giSnap = giSnap == "on";
             RenderRun run = runRender(g.gpu, ro);
             const auto& s = run.stats;
             std::printf(

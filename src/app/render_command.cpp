@@ -47,8 +47,9 @@ Visualize parseVisualize(const std::string& text) {
     if (text == "layer:material") return Visualize::LayerMaterial;
     if (text == "light-count") return Visualize::LightCount;
     if (text == "blockers") return Visualize::Blockers;
+    if (text == "gi") return Visualize::Gi;
     throw InputError(format("--visualize %s: expected none, marking, mips, chunks, sheet, "
-                            "layer:radiance, layer:material, light-count or blockers",
+                            "layer:radiance, layer:material, light-count, blockers or gi",
                             text.c_str()));
 }
 
@@ -62,6 +63,12 @@ bool parseOnOff(const char* flag, const std::string& text) {
     if (text == "on") return true;
     if (text == "off") return false;
     throw InputError(format("%s %s: expected on or off", flag, text.c_str()));
+}
+
+GiMode parseGi(const std::string& text) {
+    if (text == "off") return GiMode::Off;
+    if (text == "lpv") return GiMode::Lpv;
+    throw InputError(format("--gi %s: expected lpv or off", text.c_str()));
 }
 
 MarkingMode parseMarking(const std::string& text) {
@@ -215,6 +222,13 @@ RenderRun runRender(Gpu& gpu, const RenderOptions& o) {
     settings.shuffleSeed = o.shuffleDrawsSeed.value_or(0);
     settings.lightCulling = o.lightCulling;
     settings.lightBlockers = o.lightBlockers;
+    requireCount("--gi-iterations", o.giIterations, 0, 64);
+    if (o.visualize == Visualize::Gi && o.gi == GiMode::Off)
+        throw InputError("--visualize gi: shows the indirect light of --gi lpv; GI is off");
+    settings.gi = o.gi;
+    settings.giIterations = o.giIterations;
+    settings.giSnap = o.giSnap;
+    settings.giBlockers = o.giBlockers;
     settings.timing = o.timing ? *o.timing : defaultTimingMode(gpu);
     Renderer renderer;
     RenderRun run;
@@ -314,6 +328,7 @@ RenderRun runRender(Gpu& gpu, const RenderOptions& o) {
         s["mip0_shadels"] = mip0;
         s["id_map_bytes"] = gpuScene.idMapBytes;
     }
+    if (renderer.gi) giStats(renderer, s);
     run.stats = s;
 
     destroyRenderer(renderer);

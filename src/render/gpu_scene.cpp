@@ -213,6 +213,7 @@ void uploadScene(Gpu& gpu, const Scene& scene, GpuScene& out, const std::vector<
             continue;
         }
         lights.push_back(gpuLight(l, lightBlockers));
+        out.lightCastsShadow.push_back(l.castsShadow ? 1 : 0);
     }
     std::vector<gpu::GpuLightBlocker> blockers;
     std::vector<gpu::GpuLightPortal> portals;

@@ -40,6 +40,7 @@ struct GpuScene {
     BufferHandle idMaps;                      // every mesh's triangle-ID maps, all MIPs
     std::vector<gpu::GpuInstance> instanceInfo;
     std::vector<gpu::GpuLight> lightInfo;       // what `lights` holds
+    std::vector<uint8_t> lightCastsShadow;      // per lightInfo entry (GI light views)
     std::vector<gpu::GpuMaterial> materialInfo; // what `materials` holds
     uint32_t instanceCount = 0;
     uint32_t lightCount = 0;

@@ -96,6 +96,7 @@ void initRenderer(Renderer& r, Gpu& gpu, const RenderSettings& settings, const G
     if (usesVisibilityBuffer(settings)) r.visibility = createVisibility(r);
     r.oit = createOit(r, scene);
     r.lightCulling = createLightCulling(r, scene);
+    if (settings.gi == GiMode::Lpv) r.gi = createGi(r, scene);
 }
 
 void destroyRenderer(Renderer& r) {
@@ -103,6 +104,7 @@ void destroyRenderer(Renderer& r) {
     Gpu& gpu = *r.gpu;
     vkDeviceWaitIdle(gpu.device.device);
     destroyLightCulling(r, r.lightCulling);
+    if (r.gi) destroyGi(r, r.gi);
     if (r.visibility) destroyVisibility(r, r.visibility);
     destroyOit(r, r.oit);
     if (r.decoupled) destroyDecoupled(r, r.decoupled);
@@ -206,6 +208,7 @@ FrameResult renderFrame(Renderer& r, const GpuScene& scene, const CameraView& ca
     updateLights(r, scene, constants);
     constants.lighting = prepareLightCulling(
         r, scene, r.settings.animateLights ? r.lightsLastFrame : scene.lightInfo, constants.viewProj);
+    if (r.gi) prepareGiFrame(r, scene, camera, constants);
     if (r.decoupled) prepareDecoupledFrame(r, scene, camera, constants);
     prepareTransparentDraws(r, scene, camera);
     std::memcpy(mapped(gpu, r.frameConstants), &constants, sizeof(constants));
@@ -217,6 +220,12 @@ FrameResult renderFrame(Renderer& r, const GpuScene& scene, const CameraView& ca
     pass(rec, "instanceCull",
          [&](VkCommandBuffer cmd) { recordInstanceCull(r, cmd, frame, scene); });
     pass(rec, "shadowMap", [&](VkCommandBuffer cmd) { recordShadowMap(r, cmd, frame); });
+    if (r.gi) { // light propagation volumes (render/gi): RSMs, injection, propagation
+        pass(rec, "giReflectiveShadowMaps",
+             [&](VkCommandBuffer cmd) { recordGiReflectiveShadowMaps(r, cmd, frame); });
+        pass(rec, "giInject", [&](VkCommandBuffer cmd) { recordGiInjection(r, cmd); });
+        pass(rec, "giPropagate", [&](VkCommandBuffer cmd) { recordGiPropagation(r, cmd); });
+    }
     if (r.visibility)
         pass(rec, "visibilityPrepass",
              [&](VkCommandBuffer cmd) { recordVisibilityPrepass(r, cmd, frame); });

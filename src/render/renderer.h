@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "render/camera.h"
+#include "render/gi/lpv.h"
 #include "render/gpu_scene.h"
 #include "render/lighting/light_culling.h"
 #include "render/shadel/visibility.h"
@@ -21,6 +22,8 @@ enum class RenderMode { Forward, Decoupled };
 enum class MarkingMode { Raster, Visibility };
 // Transparency: weighted blended OIT, or the CPU-sorted back-to-front reference (tests).
 enum class OitMode { Wboit, Sorted };
+// Global illumination: none, or light propagation volumes (render/gi/lpv.h).
+enum class GiMode { Off, Lpv };
 enum class Visualize : uint32_t {
     None = 0,
     Marking = 1,
@@ -30,6 +33,7 @@ enum class Visualize : uint32_t {
     LayerMaterial = 5, // --visualize layer:material (the shade storage's material layer)
     LightCount = VISUALIZE_LIGHT_COUNT, // lights per tile (forward) or chunk (shadel)
     Blockers = VISUALIZE_BLOCKERS,      // tiles / chunks with per-pixel blocker checks
+    Gi = 6,            // --visualize gi: the LPV's indirect light only
 };
 
 // --light-culling: per-tile (forward) and per-chunk (shadel) light lists, or every light for
@@ -69,6 +73,11 @@ struct RenderSettings {
     uint64_t shuffleSeed = 0;
     LightCulling lightCulling = LightCulling::Tiled;
     bool lightBlockers = true; // --blockers: light blockers and portals stop the lights listing them
+    GiMode gi = GiMode::Off;    // --gi (off by default: see render/gi/lpv.h for its cost)
+    uint32_t giIterations = 8;  // --gi-iterations: LPV propagation steps
+    bool giSnap = true;         // --gi-snap off: cascades slide with the camera (debug)
+    float giIntensity = 1.0f;   // scale of the indirect term
+    std::vector<GiBlocker> giBlockers; // GI light blockers (axial occlusion in propagation)
 };
 
 struct FrameResult {
@@ -127,6 +136,7 @@ struct Renderer {
     VisibilityStatePtr visibility;     // decoupled with --marking visibility
     OitStatePtr oit;                   // scenes with blended materials (render/oit)
     LightCullingStatePtr lightCulling; // light lists (render/lighting/light_culling.h)
+    GiStatePtr gi;                     // --gi lpv
     std::chrono::steady_clock::time_point createdAt = std::chrono::steady_clock::now();
 };
 

@@ -534,19 +534,53 @@ Scene makeTransparency() {
     b.pointLight("fire light", {2.7f, 1.1f, -0.2f}, {1.0f, 0.55f, 0.2f}, 8.0f, 8.0f);
     b.camera("main", eye, {0.0f, 1.1f, 0.0f}, 0.8f, 0.1f, 100.0f);
     b.camera("side", {-5.5f, 2.0f, 4.0f}, {0.0f, 1.2f, -0.5f}, 0.8f, 0.1f, 100.0f);
+
+// The GI test box: a closed room with a red wall (left, -x) and a green wall (right, +x), lit
+// only by a shadow-casting spot through an opening in the ceiling, aimed high on the red wall.
+// The floor along the red wall lies just outside the spot's cone, so what colours it there is
+// the ambient term and whatever the GI carries.
+Scene makeCornell() {
+    Scene scene;
+    scene.name = "cornell";
+    scene.skyColor = glm::vec3(0.02f);
+    scene.ambientColor = glm::vec3(0.02f);
+    SceneBuilder b(scene);
+    uint32_t white = b.material("white", {0.8f, 0.8f, 0.8f}, 0.9f);
+    uint32_t red = b.material("red", {0.8f, 0.08f, 0.06f}, 0.9f);
+    uint32_t green = b.material("green", {0.1f, 0.7f, 0.12f}, 0.9f);
+    // Interior: x and z in [-half, half], y in [t, t + height] (the floor slab is y in [0, t]).
+    const float half = 2.0f, height = 3.0f, t = 0.1f, hole = 0.7f, top = t + height;
+    b.box("floor", {2 * half + 2 * t, t, 2 * half + 2 * t}, white, {0.0f, 0.0f, 0.0f});
+    b.box("back wall", {2 * half, height, t}, white, {0.0f, t, -half - t * 0.5f});
+    b.box("front wall", {2 * half, height, t}, white, {0.0f, t, half + t * 0.5f});
+    b.box("red wall", {t, height, 2 * half + 2 * t}, red, {-half - t * 0.5f, t, 0.0f});
+    b.box("green wall", {t, height, 2 * half + 2 * t}, green, {half + t * 0.5f, t, 0.0f});
+    // The ceiling: four slabs around a square opening of 2 * hole.
+    float side = half + t - hole;
+    b.box("ceiling left", {side, t, 2 * half + 2 * t}, white, {-hole - side * 0.5f, top, 0.0f});
+    b.box("ceiling right", {side, t, 2 * half + 2 * t}, white, {hole + side * 0.5f, top, 0.0f});
+    b.box("ceiling back", {2 * hole, t, side}, white, {0.0f, top, -hole - side * 0.5f});
+    b.box("ceiling front", {2 * hole, t, side}, white, {0.0f, top, hole + side * 0.5f});
+    b.box("block", {0.8f, 1.2f, 0.8f}, white, {0.8f, t, -0.9f}, 0.3f);
+    b.spotLight("spot", {0.0f, top + 0.4f, 0.0f}, {-half, t + 2.1f, 0.0f}, {1.0f, 0.95f, 0.85f},
+                40.0f, 12.0f, 0.3f, 0.45f);
+    scene.lights.back().castsShadow = true; // a GI light view (reflective shadow map)
+    // Every scene has a sun (the renderer's shadow pass expects one); this one is off.
+    b.sun({0.3f, -1.0f, 0.2f}, 0.0f);
+    b.camera("main", {0.0f, t + 2.3f, half - 0.1f}, {-0.3f, t + 0.4f, -1.2f}, 0.9f, 0.05f, 30.0f);
     return scene;
 }
 
 const std::vector<std::pair<std::string, std::function<Scene()>>>& registry() {
     static const std::vector<std::pair<std::string, std::function<Scene()>>> scenes = {
-        {"default", makeDefault}, {"checker", makeChecker},           {"smooth", makeSmooth},
-        {"many", makeMany},       {"transparency", makeTransparency},
         {"default", makeDefault},
         {"checker", makeChecker},
         {"smooth", makeSmooth},
         {"many", makeMany},
+        {"transparency", makeTransparency},
         {"lights", [] { return makeLightsScene(makeDefault()); }},
         {"blockers", makeBlockersScene},
+        {"cornell", makeCornell},
     };
     return scenes;
 }

@@ -1,0 +1,52 @@
+// Light propagation volume layouts shared by C++ (render/gi) and GLSL (shaders/gi).
+// C++ includes this inside namespace shadel::gpu through shared_types.h's conventions.
+#ifndef SHADEL_GI_TYPES_H
+#define SHADEL_GI_TYPES_H
+
+#ifdef __cplusplus
+#include "common/shared_types.h"
+namespace shadel::gpu {
+#endif
+
+#define GI_CASCADES 3u   // camera-centred cascades, each twice the cell size of the last
+#define GI_GRID 32u      // cells per side of every cascade
+#define GI_MAX_RSMS 3u   // the sun + up to two shadow-casting spots
+// Injection adds fixed-point integers (no float atomics are required of the device): one unit
+// is 2^-20 of a radiant-intensity SH coefficient.
+#define GI_FIXED_SCALE 1048576.0
+// Per cell of the injection buffer: 12 ints of radiance SH (R, G, B x 4) + 4 of geometry SH.
+#define GI_INJECT_INTS 16u
+
+#define GI_MAX_BLOCKERS 64u
+
+// A light blocker for GI: a rectangle light does not propagate through (render/gi/lpv.h).
+struct GpuGiBlocker {
+    vec3 center;
+    float halfU;
+    vec3 axisU; // unit
+    float halfV;
+    vec3 axisV; // unit, orthogonal to axisU
+    float pad;
+};
+
+// One cascade as the apply reads it.
+struct GiCascade {
+    vec3 origin;      // world position of the min corner of cell (0, 0, 0)
+    float cellSize;   // metres per cell
+    uint64_t radiance; // vec4[3] per cell: propagated radiant intensity, SH (R, G, B)
+    uint64_t geometry; // vec4 per cell: blocking potential, SH (geometry volume)
+};
+
+struct GiFrame {
+    GiCascade cascades[GI_CASCADES];
+    uint cascadeCount;
+    float intensity;   // scale of the indirect term (1 = physical estimate)
+    uint blockerCount; // light blockers: the apply drops trilinear taps behind one
+    uint pad0;
+    uint64_t blockers; // GpuGiBlocker[blockerCount]
+};
+
+#ifdef __cplusplus
+} // namespace shadel::gpu
+#endif
+#endif

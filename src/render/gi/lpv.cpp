@@ -1,0 +1,482 @@
+#include "render/gi/lpv.h"
+
+#include <cmath>
+#include <cstring>
+
+#include <glm/gtc/matrix_transform.hpp>
+#include <nlohmann/json.hpp>
+
+#include "core/log.h"
+#include "gi/gi_types.h"
+#include "render/renderer.h"
+
+namespace shadel {
+
+namespace {
+
+constexpr uint32_t kRsmSize = 256;
+constexpr uint32_t kCells = GI_GRID * GI_GRID * GI_GRID;
+constexpr VkFormat kRsmFormats[3] = {VK_FORMAT_R32G32B32A32_SFLOAT,  // position
+                                     VK_FORMAT_R16G16B16A16_SFLOAT,  // normal + area
+                                     VK_FORMAT_R16G16B16A16_SFLOAT}; // flux
+
+struct RsmPush { // shaders/gi/rsm_push.glsl
+    glm::mat4 viewProj;
+    uint64_t frame;
+    uint32_t light;
+    float texelArea;
+    float texelSolidAngle;
+};
+
+struct InjectPush { // shaders/gi/inject.comp
+    uint64_t gi;
+    uint64_t inject[GI_CASCADES];
+    uint32_t positionSlot, normalSlot, fluxSlot, size;
+    uint32_t cascadeMask; // cascades injected this frame
+};
+
+struct PropagatePush { // shaders/gi/propagate.comp
+    uint64_t inject, source, target, accum, geometry, axial, blockers;
+    glm::vec3 origin;
+    float cellSize;
+    uint32_t blockerCount;
+    uint32_t mode;
+};
+
+// One light's reflective shadow map: three colour targets and a depth buffer.
+struct Rsm {
+    TextureHandle targets[3], depth;
+    RenderTargetView targetViews[3];
+    TextureReadView readViews[3];
+    DepthTargetView depthView;
+    uint32_t light = 0xFFFFFFFFu; // light index, 0xFFFFFFFF = the sun
+    glm::mat4 viewProj{1.0f};
+    float texelArea = 0.0f, texelSolidAngle = 0.0f;
+    glm::vec3 lightPosition{0.0f}, lightDirection{0.0f}; // the spot's view the map was drawn for
+};
+
+struct CascadeBuffers {
+    BufferHandle inject;   // int[GI_INJECT_INTS] per cell
+    BufferHandle light[2]; // ping-pong propagation steps, vec4[3] per cell
+    BufferHandle accum;    // vec4[3] per cell (the apply reads it)
+    BufferHandle geometry; // vec4 per cell
+    BufferHandle axial;    // vec4 per cell: blocker coverage of its -x, -y, -z faces
+};
+
+} // namespace
+
+struct GiState {
+    std::vector<Rsm> rsms;
+    CascadeBuffers cascades[GI_CASCADES];
+    BufferHandle frame;    // host-visible GiFrame
+    BufferHandle blockers; // GpuGiBlocker[], when there are any
+    uint32_t blockerCount = 0;
+    gpu::GiFrame constants{};
+    float baseCellSize = 1.0f;
+    Pipeline rsmPass, inject, propagate;
+    // What is still valid from earlier frames. The lights' views are fixed (the sun's is fitted
+    // to the scene, spots do not move for GI), so the RSMs are drawn once; a cascade is injected
+    // and propagated again only when it moved (snapped to a new cell) since its last update.
+    bool rsmsDrawn = false;
+    bool cascadeValid[GI_CASCADES] = {};
+    glm::vec3 cascadeOrigin[GI_CASCADES] = {}; // where its light was computed (the apply's too)
+    uint64_t cascadeUpdatedFrame[GI_CASCADES] = {};
+    uint32_t dirtyMask = 0; // cascades updated this frame
+    uint64_t frames = 0, cascadeUpdates = 0, rsmRenders = 0;
+};
+
+void GiStateDeleter::operator()(GiState* state) const {
+    delete state;
+}
+
+static void createRsmTargets(Gpu& gpu, Rsm& rsm, uint32_t index) {
+    static const char* names[3] = {"position", "normal", "flux"};
+    for (int k = 0; k < 3; ++k) {
+        TextureDesc d;
+        d.name = "gi.rsm" + std::to_string(index) + "." + names[k];
+        d.format = kRsmFormats[k];
+        d.width = d.height = kRsmSize;
+        d.usage = VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT | VK_IMAGE_USAGE_SAMPLED_BIT;
+        rsm.targets[k] = createTexture(gpu, d);
+        if (!rsm.targets[k])
+            throw DeviceError("out of GPU memory for the GI reflective shadow maps");
+        rsm.targetViews[k] = createRenderTargetView(gpu, rsm.targets[k]);
+        rsm.readViews[k] = createReadView(gpu, rsm.targets[k]);
+    }
+    TextureDesc d;
+    d.name = "gi.rsm" + std::to_string(index) + ".depth";
+    d.format = VK_FORMAT_D32_SFLOAT;
+    d.width = d.height = kRsmSize;
+    d.usage = VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT;
+    rsm.depth = createTexture(gpu, d);
+    if (!rsm.depth) throw DeviceError("out of GPU memory for the GI reflective shadow maps");
+    rsm.depthView = createDepthTargetView(gpu, rsm.depth);
+}
+
+// The spot's perspective view: its cone (outer angle, from the shading constants) fills the map.
+static void spotView(const gpu::GpuLight& l, Rsm& rsm) {
+    float cosOuter = std::clamp(-l.spotOffset / std::max(l.spotScale, 1e-6f), 0.05f, 0.9999f);
+    float fov = std::min(2.0f * std::acos(cosOuter), glm::radians(170.0f));
+    glm::vec3 dir = glm::normalize(l.direction);
+    glm::vec3 up = std::abs(dir.y) > 0.99f ? glm::vec3(1, 0, 0) : glm::vec3(0, 1, 0);
+    float range = l.range > 0.0f ? l.range : 200.0f;
+    glm::mat4 view = glm::lookAt(l.position, l.position + dir, up);
+    glm::mat4 proj = glm::perspectiveRH_ZO(fov, 1.0f, 0.05f, range);
+    rsm.viewProj = proj * view;
+    float texel = 2.0f * std::tan(fov * 0.5f) / float(kRsmSize);
+    rsm.texelSolidAngle = texel * texel; // at the centre; the shader applies cos^3
+    rsm.lightPosition = l.position;
+    rsm.lightDirection = l.direction;
+}
+
+GiStatePtr createGi(Renderer& r, const GpuScene& scene) {
+    Gpu& gpu = *r.gpu;
+    GiStatePtr gi(new GiState);
+    if (scene.sunCastsShadow && glm::dot(scene.sunColor, scene.sunColor) > 0.0f) {
+        gi->rsms.emplace_back();
+        gi->rsms.back().light = 0xFFFFFFFFu;
+    }
+    for (uint32_t i = 0; i < scene.lightInfo.size() && gi->rsms.size() < GI_MAX_RSMS; ++i)
+        if (scene.lightInfo[i].type == LIGHT_SPOT && i < scene.lightCastsShadow.size() &&
+            scene.lightCastsShadow[i]) {
+            gi->rsms.emplace_back();
+            gi->rsms.back().light = i;
+            spotView(scene.lightInfo[i], gi->rsms.back());
+        }
+    for (uint32_t i = 0; i < gi->rsms.size(); ++i) createRsmTargets(gpu, gi->rsms[i], i);
+
+    for (uint32_t c = 0; c < GI_CASCADES; ++c) {
+        CascadeBuffers& b = gi->cascades[c];
+        std::string prefix = "gi.cascade" + std::to_string(c) + ".";
+        b.inject = createBuffer(gpu, {prefix + "inject", VkDeviceSize(kCells) * GI_INJECT_INTS * 4,
+                                      VK_BUFFER_USAGE_TRANSFER_DST_BIT});
+        for (int k = 0; k < 2; ++k)
+            b.light[k] =
+                createBuffer(gpu, {prefix + (k ? "lightB" : "lightA"), VkDeviceSize(kCells) * 48});
+        b.accum = createBuffer(gpu, {prefix + "radiance", VkDeviceSize(kCells) * 48});
+        b.geometry = createBuffer(gpu, {prefix + "geometry", VkDeviceSize(kCells) * 16});
+        b.axial = createBuffer(gpu, {prefix + "axialOcclusion", VkDeviceSize(kCells) * 16});
+        if (!b.inject || !b.light[0] || !b.light[1] || !b.accum || !b.geometry || !b.axial)
+            throw DeviceError("out of GPU memory for the GI volumes");
+    }
+    gi->frame = createBuffer(gpu, {"gi.frame", sizeof(gpu::GiFrame), 0, MemoryKind::Upload});
+    if (!gi->frame) throw DeviceError("out of GPU memory for the GI constants");
+    const std::vector<GiBlocker>& blockers = r.settings.giBlockers;
+    if (blockers.size() > GI_MAX_BLOCKERS)
+        throw InputError(
+            format("%zu GI light blockers: at most %u", blockers.size(), GI_MAX_BLOCKERS));
+    if (!blockers.empty()) {
+        std::vector<gpu::GpuGiBlocker> packed;
+        for (const GiBlocker& b : blockers)
+            packed.push_back({b.center, b.halfSize.x, glm::normalize(b.axisU), b.halfSize.y,
+                              glm::normalize(b.axisV), 0.0f});
+        gi->blockers = createBuffer(
+            gpu, {"gi.blockers", packed.size() * sizeof(packed[0]), 0, MemoryKind::Upload});
+        if (!gi->blockers) throw DeviceError("out of GPU memory for the GI blockers");
+        std::memcpy(mapped(gpu, gi->blockers), packed.data(), packed.size() * sizeof(packed[0]));
+        gi->blockerCount = uint32_t(packed.size());
+    }
+
+    // Cascade 0's cells: a room-sized scene fits in cascade 0 (8 steps carry light a quarter of
+    // the way across it); larger scenes get 1-unit cells (a metre in the built-in scenes), but
+    // never so small that the coarsest cascade (4x the cell) misses most of the scene.
+    Aabb bounds = scene.bounds.valid() ? scene.bounds : Aabb{glm::vec3(-1), glm::vec3(1)};
+    glm::vec3 e = bounds.extent();
+    float extent = std::max(std::max(e.x, std::max(e.y, e.z)), 1e-3f);
+    gi->baseCellSize =
+        std::max(std::min(2.0f * extent / float(GI_GRID), 1.0f), extent / (4.0f * GI_GRID));
+
+    GraphicsPipelineDesc rsm;
+    rsm.name = "giReflectiveShadowMap";
+    rsm.vertexShader = "gi_rsm.vert.spv";
+    rsm.fragmentShader = "gi_rsm.frag.spv";
+    rsm.colorFormats = {kRsmFormats[0], kRsmFormats[1], kRsmFormats[2]};
+    rsm.depthFormat = VK_FORMAT_D32_SFLOAT;
+    rsm.depthCompare = VK_COMPARE_OP_LESS; // standard Z: the light's nearest surface
+    rsm.cullMode = VK_CULL_MODE_NONE;
+    rsm.depthClamp = true; // casters behind the sun's near plane still land in the map
+    gi->rsmPass = createGraphicsPipeline(gpu, rsm);
+    gi->inject = createComputePipeline(gpu, "giInject", "gi_inject.comp.spv");
+    gi->propagate = createComputePipeline(gpu, "giPropagate", "gi_propagate.comp.spv");
+    return gi;
+}
+
+void destroyGi(Renderer& r, GiStatePtr& state) {
+    if (!state) return;
+    Gpu& gpu = *r.gpu;
+    for (Rsm& rsm : state->rsms) {
+        for (int k = 0; k < 3; ++k) {
+            destroy(gpu, rsm.targetViews[k]);
+            destroy(gpu, rsm.readViews[k]);
+            destroy(gpu, rsm.targets[k]);
+        }
+        destroy(gpu, rsm.depthView);
+        destroy(gpu, rsm.depth);
+    }
+    for (CascadeBuffers& b : state->cascades)
+        for (BufferHandle h : {b.inject, b.light[0], b.light[1], b.accum, b.geometry, b.axial})
+            destroy(gpu, h);
+    destroy(gpu, state->frame);
+    if (state->blockers) destroy(gpu, state->blockers);
+    destroy(gpu, state->rsmPass);
+    destroy(gpu, state->inject);
+    destroy(gpu, state->propagate);
+    state.reset();
+}
+
+void prepareGiFrame(Renderer& r, const GpuScene& scene, const CameraView& camera,
+                    gpu::FrameConstants& constants) {
+    (void)scene;
+    GiState& gi = *r.gi;
+    gpu::GiFrame& g = gi.constants;
+    g = {};
+    gi.dirtyMask = 0;
+    gi.frames++;
+    // --animate-lights: a spot that moved needs its RSM again, and every cascade its light.
+    bool lightsMoved = false;
+    if (r.settings.animateLights && !r.lightsLastFrame.empty())
+        for (Rsm& rsm : gi.rsms) {
+            if (rsm.light == 0xFFFFFFFFu || rsm.light >= r.lightsLastFrame.size()) continue;
+            const gpu::GpuLight& l = r.lightsLastFrame[rsm.light]; // this frame's lights
+            if (l.position == rsm.lightPosition && l.direction == rsm.lightDirection) continue;
+            spotView(l, rsm);
+            lightsMoved = true;
+        }
+    if (lightsMoved) {
+        gi.rsmsDrawn = false;
+        for (bool& valid : gi.cascadeValid) valid = false;
+    }
+    g.cascadeCount = GI_CASCADES;
+    g.intensity = r.settings.giIntensity;
+    g.blockerCount = gi.blockerCount;
+    g.blockers = gi.blockers ? address(*r.gpu, gi.blockers) : 0;
+    glm::vec3 wanted[GI_CASCADES];
+    uint32_t moved = 0;
+    bool allValid = true;
+    for (uint32_t c = 0; c < GI_CASCADES; ++c) {
+        float cell = gi.baseCellSize * float(1u << c);
+        // Snapped: the grid moves in whole cells, so a surface keeps its cell (and its light)
+        // while the camera moves; unsnapped (a debug option) it slides and the light swims.
+        glm::vec3 corner = camera.position / cell - float(GI_GRID / 2);
+        if (r.settings.giSnap) corner = glm::floor(corner);
+        wanted[c] = corner * cell;
+        if (!gi.cascadeValid[c] || gi.cascadeOrigin[c] != wanted[c]) moved |= 1u << c;
+        allValid = allValid && gi.cascadeValid[c];
+    }
+    // Time slicing: after the first frame at most one cascade is injected and propagated per
+    // frame, the one waiting longest; the others keep the origin their light was computed at
+    // (a few cells behind the camera at most, inside their 16-cell margin).
+    // Without snapping (the debug baseline) every cascade follows the camera every frame.
+    if (!allValid || !r.settings.giSnap) {
+        gi.dirtyMask = moved;
+    } else if (moved) {
+        uint32_t pick = GI_CASCADES;
+        for (uint32_t c = 0; c < GI_CASCADES; ++c)
+            if ((moved & (1u << c)) &&
+                (pick == GI_CASCADES || gi.cascadeUpdatedFrame[c] < gi.cascadeUpdatedFrame[pick]))
+                pick = c;
+        gi.dirtyMask = 1u << pick;
+    }
+    for (uint32_t c = 0; c < GI_CASCADES; ++c) {
+        if (gi.dirtyMask & (1u << c)) {
+            gi.cascadeOrigin[c] = wanted[c];
+            gi.cascadeValid[c] = true;
+            gi.cascadeUpdatedFrame[c] = gi.frames;
+        }
+        gpu::GiCascade& gc = g.cascades[c];
+        gc.origin = gi.cascadeOrigin[c];
+        gc.cellSize = gi.baseCellSize * float(1u << c);
+        gc.radiance = address(*r.gpu, gi.cascades[c].accum);
+        gc.geometry = address(*r.gpu, gi.cascades[c].geometry);
+    }
+    std::memcpy(mapped(*r.gpu, gi.frame), &g, sizeof(g));
+    for (Rsm& rsm : gi.rsms)
+        if (rsm.light == 0xFFFFFFFFu) {
+            rsm.viewProj = constants.sunViewProj;
+            // The shadow map's texel is 2 r / shadowMapSize; the RSM spans the same square.
+            float texel = constants.shadowTexelSize * float(r.settings.shadowMapSize) / kRsmSize;
+            rsm.texelArea = texel * texel;
+        }
+    constants.gi = address(*r.gpu, gi.frame);
+}
+
+void recordGiReflectiveShadowMaps(Renderer& r, VkCommandBuffer cmd, uint64_t frame) {
+    Gpu& gpu = *r.gpu;
+    GiState& gi = *r.gi;
+    if (gi.rsmsDrawn) return;
+    gi.rsmsDrawn = true;
+    gi.rsmRenders++;
+    for (Rsm& rsm : gi.rsms) {
+        for (int k = 0; k < 3; ++k)
+            imageBarrier(cmd, vkImage(gpu, rsm.targets[k]), VK_IMAGE_ASPECT_COLOR_BIT,
+                         VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL,
+                         VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, 0,
+                         VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT,
+                         VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT);
+        imageBarrier(cmd, vkImage(gpu, rsm.depth), VK_IMAGE_ASPECT_DEPTH_BIT,
+                     VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL,
+                     VK_PIPELINE_STAGE_2_LATE_FRAGMENT_TESTS_BIT, 0,
+                     VK_PIPELINE_STAGE_2_EARLY_FRAGMENT_TESTS_BIT |
+                         VK_PIPELINE_STAGE_2_LATE_FRAGMENT_TESTS_BIT,
+                     VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT |
+                         VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_READ_BIT);
+        VkRenderingAttachmentInfo colors[3];
+        for (int k = 0; k < 3; ++k) {
+            colors[k] = {VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO};
+            colors[k].imageView = vkView(gpu, rsm.targetViews[k]);
+            colors[k].imageLayout = VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL;
+            colors[k].loadOp = VK_ATTACHMENT_LOAD_OP_CLEAR; // w = 0: no surface
+            colors[k].storeOp = VK_ATTACHMENT_STORE_OP_STORE;
+            colors[k].clearValue.color = {{0.0f, 0.0f, 0.0f, 0.0f}};
+        }
+        VkRenderingAttachmentInfo depth{VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO};
+        depth.imageView = vkView(gpu, rsm.depthView);
+        depth.imageLayout = VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL;
+        depth.loadOp = VK_ATTACHMENT_LOAD_OP_CLEAR;
+        depth.storeOp = VK_ATTACHMENT_STORE_OP_DONT_CARE;
+        depth.clearValue.depthStencil = {1.0f, 0};
+        VkRenderingInfo ri{VK_STRUCTURE_TYPE_RENDERING_INFO};
+        ri.renderArea = {{0, 0}, {kRsmSize, kRsmSize}};
+        ri.layerCount = 1;
+        ri.colorAttachmentCount = 3;
+        ri.pColorAttachments = colors;
+        ri.pDepthAttachment = &depth;
+        vkCmdBeginRendering(cmd, &ri);
+        bind(gpu, cmd, gi.rsmPass);
+        VkViewport vp{0, 0, float(kRsmSize), float(kRsmSize), 0, 1};
+        VkRect2D scissor{{0, 0}, {kRsmSize, kRsmSize}};
+        vkCmdSetViewport(cmd, 0, 1, &vp);
+        vkCmdSetScissor(cmd, 0, 1, &scissor);
+        pushConstants(gpu, cmd,
+                      RsmPush{rsm.viewProj, frame, rsm.light, rsm.texelArea, rsm.texelSolidAngle});
+        vkCmdBindIndexBuffer(cmd, vkBuffer(gpu, r.sceneIndices), 0, VK_INDEX_TYPE_UINT32);
+        // The sun's shadow list: its volume is fitted to the whole scene, so it also holds
+        // every opaque instance a spot inside the scene can see (the GPU clips the rest).
+        vkCmdDrawIndexedIndirectCount(
+            cmd, vkBuffer(gpu, r.shadowDraws),
+            VkDeviceSize(DRAW_LIST_OPAQUE) * r.maxDraws * sizeof(gpu::DrawIndexedCommand),
+            vkBuffer(gpu, r.drawCounts), (DRAW_LIST_COUNT + DRAW_LIST_OPAQUE) * 4, r.maxDraws,
+            sizeof(gpu::DrawIndexedCommand));
+        vkCmdEndRendering(cmd);
+        for (int k = 0; k < 3; ++k)
+            imageBarrier(
+                cmd, vkImage(gpu, rsm.targets[k]), VK_IMAGE_ASPECT_COLOR_BIT,
+                VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL,
+                VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT,
+                VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
+                VK_ACCESS_2_SHADER_SAMPLED_READ_BIT);
+    }
+}
+
+void recordGiInjection(Renderer& r, VkCommandBuffer cmd) {
+    Gpu& gpu = *r.gpu;
+    GiState& gi = *r.gi;
+    if (!gi.dirtyMask) return;
+    for (uint32_t c = 0; c < GI_CASCADES; ++c)
+        if (gi.dirtyMask & (1u << c)) {
+            vkCmdFillBuffer(cmd, vkBuffer(gpu, gi.cascades[c].inject), 0, VK_WHOLE_SIZE, 0);
+            gi.cascadeUpdates++;
+        }
+    memoryBarrier(cmd, VK_PIPELINE_STAGE_2_CLEAR_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT,
+                  VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
+                  VK_ACCESS_2_SHADER_STORAGE_READ_BIT | VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT);
+    bind(gpu, cmd, gi.inject);
+    for (Rsm& rsm : gi.rsms) {
+        InjectPush push{};
+        push.gi = address(gpu, gi.frame);
+        for (uint32_t c = 0; c < GI_CASCADES; ++c)
+            push.inject[c] = address(gpu, gi.cascades[c].inject);
+        push.positionSlot = slot(gpu, rsm.readViews[0]).value;
+        push.normalSlot = slot(gpu, rsm.readViews[1]).value;
+        push.fluxSlot = slot(gpu, rsm.readViews[2]).value;
+        push.size = kRsmSize;
+        push.cascadeMask = gi.dirtyMask;
+        pushConstants(gpu, cmd, push);
+        vkCmdDispatch(cmd, kRsmSize / 8, kRsmSize / 8, 1);
+    }
+    // Resolve: fixed-point sums into the first propagation source, the accumulated light and
+    // the geometry volume.
+    memoryBarrier(cmd, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT,
+                  VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
+                  VK_ACCESS_2_SHADER_STORAGE_READ_BIT | VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT);
+    bind(gpu, cmd, gi.propagate);
+    for (uint32_t c = 0; c < GI_CASCADES; ++c) {
+        if (!(gi.dirtyMask & (1u << c))) continue;
+        CascadeBuffers& b = gi.cascades[c];
+        PropagatePush push{};
+        push.inject = address(gpu, b.inject);
+        push.target = address(gpu, b.light[0]);
+        push.accum = address(gpu, b.accum);
+        push.geometry = address(gpu, b.geometry);
+        push.axial = address(gpu, b.axial);
+        push.blockers = gi.blockers ? address(gpu, gi.blockers) : 0;
+        push.origin = gi.constants.cascades[c].origin;
+        push.cellSize = gi.constants.cascades[c].cellSize;
+        push.blockerCount = gi.blockerCount;
+        push.mode = 0;
+        pushConstants(gpu, cmd, push);
+        vkCmdDispatch(cmd, GI_GRID / 4, GI_GRID / 4, GI_GRID / 4);
+    }
+    memoryBarrier(cmd, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT,
+                  VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
+                  VK_ACCESS_2_SHADER_STORAGE_READ_BIT | VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT);
+}
+
+void recordGiPropagation(Renderer& r, VkCommandBuffer cmd) {
+    Gpu& gpu = *r.gpu;
+    GiState& gi = *r.gi;
+    if (!gi.dirtyMask) return;
+    bind(gpu, cmd, gi.propagate);
+    for (uint32_t step = 0; step < r.settings.giIterations; ++step) {
+        // The three cascades are independent: one barrier per step serves them all.
+        for (uint32_t c = 0; c < GI_CASCADES; ++c) {
+            if (!(gi.dirtyMask & (1u << c))) continue;
+            CascadeBuffers& b = gi.cascades[c];
+            PropagatePush push{};
+            push.source = address(gpu, b.light[step & 1]);
+            push.target = address(gpu, b.light[(step + 1) & 1]);
+            push.accum = address(gpu, b.accum);
+            push.geometry = address(gpu, b.geometry);
+            push.axial = address(gpu, b.axial);
+            push.mode = 1;
+            pushConstants(gpu, cmd, push);
+            vkCmdDispatch(cmd, GI_GRID / 4, GI_GRID / 4, GI_GRID / 4);
+        }
+        memoryBarrier(
+            cmd, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT,
+            VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT,
+            VK_ACCESS_2_SHADER_STORAGE_READ_BIT | VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT);
+    }
+    if (r.settings.giIterations == 0)
+        memoryBarrier(cmd, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
+                      VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT, VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT,
+                      VK_ACCESS_2_SHADER_STORAGE_READ_BIT);
+}
+
+void giStats(const Renderer& r, nlohmann::json& stats) {
+    const GiState& gi = *r.gi;
+    nlohmann::json cascades = nlohmann::json::array();
+    for (uint32_t c = 0; c < GI_CASCADES; ++c) {
+        const gpu::GiCascade& gc = gi.constants.cascades[c];
+        cascades.push_back({{"cell_size", gc.cellSize},
+                            {"extent", gc.cellSize * GI_GRID},
+                            {"origin", {gc.origin.x, gc.origin.y, gc.origin.z}},
+                            {"cells", kCells}});
+    }
+    stats["gi"] = {{"mode", "lpv"},
+                   {"cascades", cascades},
+                   {"grid", GI_GRID},
+                   {"cells", kCells * GI_CASCADES},
+                   {"iterations", r.settings.giIterations},
+                   {"snap", r.settings.giSnap},
+                   {"blockers", gi.blockerCount},
+                   {"reflective_shadow_maps", gi.rsms.size()},
+                   {"rsm_renders", gi.rsmRenders},
+                   // Injections + propagations of one cascade over the run (a cascade is
+                   // updated when it snaps to a new cell; frames x 3 would be every frame).
+                   {"cascade_updates", gi.cascadeUpdates},
+                   {"frames", gi.frames},
+                   {"rsm_size", kRsmSize}};
+}
+
+} // namespace shadel

@@ -1,0 +1,181 @@
+// Light propagation volume GI (issue 11, render/gi): colour bleeding on builtin:cornell, stable
+// cascades under camera motion, stats and bad input.
+#include "gpu_test_env.h"
+
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <sys/wait.h>
+
+using namespace shadel;
+using namespace shadel::test;
+
+namespace {
+
+constexpr uint32_t kW = 160, kH = 90;
+// Floor only, along the red wall, in the main camera's 160x90 view (outside the spot's cone).
+constexpr int kFloorX0 = 34, kFloorY0 = 62, kFloorX1 = 56, kFloorY1 = 88;
+
+RenderOptions cornell(GiMode gi) {
+    RenderOptions o = renderOptions("builtin:cornell", RenderMode::Forward, kW, kH);
+    o.gi = gi;
+    return o;
+}
+
+// Mean red, green over a pixel rectangle of an RGBA8 image.
+std::pair<double, double> meanRedGreen(const std::vector<uint8_t>& rgba, int x0, int y0, int x1,
+                                       int y1) {
+    double r = 0, g = 0;
+    for (int y = y0; y < y1; ++y)
+        for (int x = x0; x < x1; ++x) {
+            size_t i = (size_t(y) * kW + size_t(x)) * 4;
+            r += rgba[i];
+            g += rgba[i + 1];
+        }
+    double n = double(x1 - x0) * double(y1 - y0);
+    return {r / n, g / n};
+}
+
+double floorRedOverGreen(const RenderRun& run) {
+    auto [r, g] = meanRedGreen(run.frames[0].rgba, kFloorX0, kFloorY0, kFloorX1, kFloorY1);
+    return r / std::max(g, 1.0);
+}
+
+} // namespace
+
+// The floor by the front half of the red wall gets no direct light (the spot lights the wall's
+// back half), so with GI off it is the white floor under grey ambient: red/green about 1. The
+// LPV carries the light the red wall reflects onto it.
+TEST(Gi, CornellFloorByTheRedWallBleedsRed) {
+    RenderRun off = renderChecked(cornell(GiMode::Off));
+    RenderRun on = renderChecked(cornell(GiMode::Lpv));
+    // Measured 1.00 off, 1.27 on (8 propagation steps); the margin asked is 1.15x.
+    double ratioOff = floorRedOverGreen(off), ratioOn = floorRedOverGreen(on);
+    std::printf("floor by the red wall, red/green: GI off %.3f, on %.3f\n", ratioOff, ratioOn);
+    EXPECT_GT(ratioOn, ratioOff * 1.15) << "off " << ratioOff << ", on " << ratioOn;
+    // What GI adds there is red light: not a brightening that happens to raise the ratio.
+    auto [rOff, gOff] = meanRedGreen(off.frames[0].rgba, kFloorX0, kFloorY0, kFloorX1, kFloorY1);
+    auto [rOn, gOn] = meanRedGreen(on.frames[0].rgba, kFloorX0, kFloorY0, kFloorX1, kFloorY1);
+    EXPECT_GT(rOn - rOff, 4.0 * std::max(gOn - gOff, 0.25)) << rOn << " " << gOn;
+
+    const auto& s = on.stats;
+    ASSERT_TRUE(s.contains("gi"));
+    EXPECT_EQ(s["gi"]["cascades"].size(), 3u);
+    EXPECT_EQ(s["gi"]["iterations"].get<uint32_t>(), 8u);
+    EXPECT_EQ(s["gi"]["reflective_shadow_maps"].get<uint32_t>(), 1u) << "the cornell spot";
+    double c0 = s["gi"]["cascades"][0]["cell_size"].get<double>();
+    EXPECT_DOUBLE_EQ(s["gi"]["cascades"][1]["cell_size"].get<double>(), 2 * c0);
+    std::vector<std::string> passes;
+    for (auto& p : s["passes"]) passes.push_back(p["name"]);
+    for (const char* name : {"giReflectiveShadowMaps", "giInject", "giPropagate"})
+        EXPECT_NE(std::find(passes.begin(), passes.end(), name), passes.end()) << name;
+    EXPECT_FALSE(off.stats.contains("gi"));
+}
+
+// The decoupled path shades with the same lighting code, so it bleeds too.
+TEST(Gi, DecoupledShadelsGetTheIndirectLight) {
+    RenderOptions o = cornell(GiMode::Off);
+    o.mode = RenderMode::Decoupled;
+    RenderRun off = renderChecked(o);
+    o.gi = GiMode::Lpv;
+    RenderRun on = renderChecked(o);
+    EXPECT_GT(floorRedOverGreen(on), floorRedOverGreen(off) * 1.15);
+}
+
+// Cascades snapped to their cell size keep every surface in its cells while the camera moves;
+// sliding cascades re-sample the light each frame (swimming). Measured on the GI-only image.
+TEST(Gi, SnappedCascadesSwimAtMostHalfAsMuchUnderOrbit) {
+    RenderOptions o = cornell(GiMode::Lpv);
+    o.visualize = Visualize::Gi;
+    o.cameraPath = CameraPath::Orbit;
+    // 12 frames over the 40-degree orbit: steps of about a cell of cascade 0. Measured: mean
+    // frame delta 0.80 snapped, 2.34 sliding (0.34x).
+    o.width = 128;
+    o.height = 72;
+    o.frames = 12;
+    RenderRun snapped = renderChecked(o);
+    o.giSnap = false;
+    RenderRun sliding = renderChecked(o);
+    double dSnapped = meanFrameDelta(snapped), dSliding = meanFrameDelta(sliding);
+    std::printf("GI-only mean frame delta: snapped %.3f, sliding %.3f\n", dSnapped, dSliding);
+    EXPECT_GT(dSliding, 0.0);
+    EXPECT_LE(dSnapped, 0.5 * dSliding) << "snapped " << dSnapped << ", sliding " << dSliding;
+}
+
+TEST(Gi, BadFlagsAreOneLineAndExitCode2) {
+    std::string err = (std::filesystem::temp_directory_path() / "shadel_gi_stderr.txt").string();
+    for (const std::string args :
+         {"render --size 16x16 --gi radiosity", "render --size 16x16 --gi-snap maybe",
+          "render --size 16x16 --scene builtin:cornell --gi lpv --gi-iterations 65",
+          "render --size 16x16 --scene builtin:cornell --visualize gi"}) {
+        std::string cmd =
+            std::string("timeout 120 ") + SHADEL_BINARY + " " + args + " >/dev/null 2>" + err;
+        int status = std::system(cmd.c_str());
+        EXPECT_EQ(WIFEXITED(status) ? WEXITSTATUS(status) : -1, 2) << args;
+        std::ifstream in(err);
+        std::stringstream ss;
+        ss << in.rdbuf();
+        std::string text = ss.str();
+        EXPECT_EQ(std::count(text.begin(), text.end(), '\n'), 1) << args << ": " << text;
+        EXPECT_NE(text.find("--gi"), std::string::npos) << args << ": " << text;
+        EXPECT_NE(text.find("shadel: "), std::string::npos) << args;
+    }
+}
+
+// The lights' views are fixed, so the RSMs are drawn once and a cascade is updated only when it
+// moves: a static camera updates each cascade once and keeps the same image. A moving spot
+// (--animate-lights) needs its RSM and every cascade again each frame.
+TEST(Gi, StaticCameraReusesTheVolumesAndMovingSpotsRedrawThem) {
+    RenderOptions o = cornell(GiMode::Lpv);
+    o.width = 64;
+    o.height = 36;
+    o.frames = 3;
+    RenderRun still = renderChecked(o);
+    EXPECT_EQ(still.stats["gi"]["rsm_renders"].get<uint64_t>(), 1u);
+    EXPECT_EQ(still.stats["gi"]["cascade_updates"].get<uint64_t>(), 3u);
+    EXPECT_EQ(still.frames[0].rgba, still.frames[2].rgba);
+    o.animateLights = true;
+    RenderRun moving = renderChecked(o);
+    EXPECT_EQ(moving.stats["gi"]["rsm_renders"].get<uint64_t>(), 3u);
+    EXPECT_EQ(moving.stats["gi"]["cascade_updates"].get<uint64_t>(), 9u);
+}
+
+// A blocker (a rectangle light does not propagate through) across the room and beyond, 0.7 m in
+// front of the red wall, the only lit surface: the room beyond it gets at most 10% of the
+// indirect light it gets without the blocker, while the red wall's side keeps its light.
+TEST(Gi, BlockerStopsPropagationIntoTheRoomBeyondIt) {
+    RenderOptions o = cornell(GiMode::Lpv);
+    o.visualize = Visualize::Gi;
+    o.exposure = 16.0f; // the light beyond is dim: lift it well above 8-bit quantisation
+    RenderRun open = renderChecked(o);
+    GiBlocker wall;
+    wall.center = glm::vec3(-1.3f, 1.6f, 0.0f);
+    wall.axisU = glm::vec3(0, 0, 1);
+    wall.axisV = glm::vec3(0, 1, 0);
+    // Larger than the room: light must not go round it either (through cells outside the
+    // room, whose walls the spot's RSM does not see, so they do not occlude).
+    wall.halfSize = glm::vec2(20.0f, 20.0f);
+    o.giBlockers = {wall};
+    RenderRun blocked = renderChecked(o);
+    EXPECT_EQ(blocked.stats["gi"]["blockers"].get<uint32_t>(), 1u);
+    // Columns from 64 on see the room at x > -1.0 (back wall, floor, block, green wall). The red
+    // wall's light is counted as red above green: the spot also grazes the white top of the
+    // ceiling by the opening, on the room's side of the blocker, and that light may enter.
+    auto light = [](const RenderRun& run, uint32_t x0, uint32_t x1) {
+        double sum = 0;
+        for (uint32_t y = 0; y < kH; ++y)
+            for (uint32_t x = x0; x < x1; ++x) {
+                const uint8_t* p = &run.frames[0].rgba[(y * kW + x) * 4];
+                sum += std::max(0, int(p[0]) - int(p[1]));
+            }
+        return sum;
+    };
+    double beyondOpen = light(open, 64, kW), beyondBlocked = light(blocked, 64, kW);
+    std::printf("GI-only red light beyond the blocker: %.0f without, %.0f with (%.1f%%)\n",
+                beyondOpen, beyondBlocked, 100.0 * beyondBlocked / beyondOpen);
+    EXPECT_GT(beyondOpen, 0.0);
+    EXPECT_LE(beyondBlocked, 0.1 * beyondOpen);
+    EXPECT_GE(light(blocked, 0, 24), 0.5 * light(open, 0, 24)) << "the red wall's side";
+}
