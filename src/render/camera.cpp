@@ -32,10 +32,30 @@ Camera findCamera(const Scene& scene, const std::string& name) {
     c.up = {0, 1, 0};
     c.znear = std::max(distance - radius * 1.5f, distance * 0.001f);
     c.zfar = distance + radius * 2.0f;
+    c.automatic = true;
     return c;
 }
 
-CameraView makeCameraView(const Camera& camera, uint32_t width, uint32_t height, glm::vec2 jitter) {
+// An orthographic camera is drawn as a telephoto perspective one from kOrthoBackoff view
+// heights behind it: every pass, the view-driven density and the decoupled MIP estimates
+// assume a perspective projection, and at that distance a point's image size changes by only
+// depth / backoff (0.4% per view height of depth), below what shading resolves.
+constexpr float kOrthoBackoff = 256.0f;
+
+Camera perspectiveEquivalent(const Camera& camera) {
+    if (!(camera.orthoHalfHeight > 0.0f)) return camera;
+    Camera c = camera;
+    float back = kOrthoBackoff * camera.orthoHalfHeight;
+    c.position = camera.position - camera.forward * back;
+    c.yfov = 2.0f * std::atan(camera.orthoHalfHeight / back);
+    c.znear = back + camera.znear;
+    c.zfar = back + camera.zfar;
+    c.orthoHalfHeight = 0.0f;
+    return c;
+}
+
+CameraView makeCameraView(const Camera& ortho, uint32_t width, uint32_t height, glm::vec2 jitter) {
+    Camera camera = perspectiveEquivalent(ortho);
     CameraView v;
     v.position = camera.position;
     v.yfov = camera.yfov;

@@ -33,6 +33,9 @@
 #include <stb/stb_image.h>
 #include <stb/stb_image_write.h>
 
+// Declares tinygltf's types first (tiny_gltf.h guards its declarations, not its implementation).
+#include "scene/gltf_materials.h"
+
 #define TINYGLTF_IMPLEMENTATION
 #define TINYGLTF_NO_INCLUDE_STB_IMAGE
 #define TINYGLTF_NO_INCLUDE_STB_IMAGE_WRITE
@@ -40,6 +43,7 @@
 
 #include "core/error.h"
 #include "core/log.h"
+#include "scene/gltf_extensions.h"
 #include "scene/gltf_uri.h"
 #include "scene/json_limits.h"
 #include "scene/mesh_utils.h"
@@ -210,16 +214,6 @@ public:
         checkAsset();
         optStringArray(root_, "extensionsUsed", "");
         optStringArray(root_, "extensionsRequired", "");
-        // Other unsupported extensions only change the look (warned later); without these the
-        // geometry itself cannot be read.
-        if (const json* required = member(root_, "extensionsRequired")) {
-            for (const json& ext : *required) {
-                std::string name = ext.get<std::string>();
-                if (name == "KHR_draco_mesh_compression" || name == "EXT_meshopt_compression")
-                    bad("",
-                        "required extension " + name + " (compressed geometry) is not supported");
-            }
-        }
         checkExtensions(root_, "");
         optIndex(root_, "scene", "", "scenes");
         objectArray(root_, "scenes", "", [&](const json& s, const std::string& p) {
@@ -527,7 +521,57 @@ private:
             optNumber(t, "scale", tp);
             optNumber(t, "strength", tp);
             checkExtensions(t, tp);
+            if (const json* ext = member(t, "extensions"))
+                optObject(*ext, "KHR_texture_transform", child(tp, "extensions"),
+                          [&](const json& tt, const std::string& ttp) {
+                              optNumberArray(tt, "offset", ttp, 2);
+                              optNumberArray(tt, "scale", ttp, 2);
+                              optNumber(tt, "rotation", ttp);
+                              optUint(tt, "texCoord", ttp);
+                          });
         });
+    }
+
+    // The material extensions gltf_materials.cpp reads: numbers, colours and texture infos.
+    void checkMaterialExtensions(const json& ext, const std::string& p) {
+        struct Field {
+            const char* key;
+            size_t size; // 0: a number; otherwise an array of that many numbers
+        };
+        struct Known {
+            const char* name;
+            std::vector<Field> numbers;
+            std::vector<const char*> textures;
+        };
+        static const Known known[] = {
+            {"KHR_materials_emissive_strength", {{"emissiveStrength", 0}}, {}},
+            {"KHR_materials_unlit", {}, {}},
+            {"KHR_materials_pbrSpecularGlossiness",
+             {{"diffuseFactor", 4}, {"specularFactor", 3}, {"glossinessFactor", 0}},
+             {"diffuseTexture", "specularGlossinessTexture"}},
+            {"KHR_materials_clearcoat",
+             {{"clearcoatFactor", 0}, {"clearcoatRoughnessFactor", 0}},
+             {"clearcoatTexture", "clearcoatRoughnessTexture", "clearcoatNormalTexture"}},
+            {"KHR_materials_ior", {{"ior", 0}}, {}},
+            {"KHR_materials_specular",
+             {{"specularFactor", 0}, {"specularColorFactor", 3}},
+             {"specularTexture", "specularColorTexture"}},
+            {"KHR_materials_sheen",
+             {{"sheenColorFactor", 3}, {"sheenRoughnessFactor", 0}},
+             {"sheenColorTexture", "sheenRoughnessTexture"}},
+        };
+        for (const Known& k : known) {
+            const json* e = member(ext, k.name);
+            if (!e) continue;
+            std::string ep = child(p, k.name);
+            for (const Field& f : k.numbers) {
+                if (f.size == 0)
+                    optNumber(*e, f.key, ep, 0.0);
+                else
+                    optNumberArray(*e, f.key, ep, f.size);
+            }
+            for (const char* t : k.textures) checkTextureInfo(*e, t, ep);
+        }
     }
 
     void checkMaterial(const json& m, const std::string& p) {
@@ -553,11 +597,8 @@ private:
         optNumber(m, "alphaCutoff", p, 0.0);
         optBool(m, "doubleSided", p);
         checkExtensions(m, p);
-        if (const json* ext = member(m, "extensions")) {
-            if (const json* es = member(*ext, "KHR_materials_emissive_strength"))
-                optNumber(*es, "emissiveStrength",
-                          child(child(p, "extensions"), "KHR_materials_emissive_strength"), 0.0);
-        }
+        if (const json* ext = member(m, "extensions"))
+            checkMaterialExtensions(*ext, child(p, "extensions"));
     }
 
     void checkImage(const json& i, const std::string& p) {
@@ -781,7 +822,6 @@ public:
         : model_(model), input_(input), scene_(scene) {}
 
     void run() {
-        warnAboutExtensions();
         for (size_t i = 0; i < model_.accessors.size(); ++i) validateAccessor(int(i));
         for (size_t i = 0; i < model_.materials.size(); ++i)
             scene_.materials.push_back(convertMaterial(int(i)));
@@ -830,20 +870,6 @@ private:
         ++skippedPrimitives_;
         if (skipReasons_.find(reason) == std::string::npos)
             skipReasons_ += (skipReasons_.empty() ? "" : ", ") + reason;
-    }
-
-    void warnAboutExtensions() {
-        static const std::set<std::string> supported = {
-            "KHR_lights_punctual", "KHR_materials_emissive_strength", "KHR_mesh_quantization"};
-        std::set<std::string> required(model_.extensionsRequired.begin(),
-                                       model_.extensionsRequired.end());
-        std::set<std::string> all(model_.extensionsUsed.begin(), model_.extensionsUsed.end());
-        all.insert(required.begin(), required.end());
-        for (const std::string& ext : all) {
-            if (supported.count(ext)) continue;
-            warn(format("%sextension %s is not supported; ignored, the scene may look different",
-                        required.count(ext) ? "required " : "", ext.c_str()));
-        }
     }
 
     // Resolves an accessor to bytes, checking that every element lies inside its buffer view
@@ -1022,11 +1048,6 @@ private:
         if (m.emissiveFactor.size() == 3)
             out.emissiveFactor = glm::vec3(float(m.emissiveFactor[0]), float(m.emissiveFactor[1]),
                                            float(m.emissiveFactor[2]));
-        if (auto it = m.extensions.find("KHR_materials_emissive_strength");
-            it != m.extensions.end()) {
-            const tinygltf::Value& strength = it->second.Get("emissiveStrength");
-            if (strength.IsNumber()) out.emissiveFactor *= float(strength.GetNumberAsDouble());
-        }
         out.normalScale = float(m.normalTexture.scale);
         out.occlusionStrength = std::clamp(float(m.occlusionTexture.strength), 0.0f, 1.0f);
         out.alphaCutoff = float(m.alphaCutoff);
@@ -1045,7 +1066,41 @@ private:
                                        "occlusion", index);
         out.emissiveTexture =
             texture(m.emissiveTexture.index, m.emissiveTexture.texCoord, true, "emissive", index);
+        MaterialTextures textures;
+        textures.resolve = [&](int t, int texCoord, bool srgb, const char* slot) {
+            return texture(t, texCoord, srgb, slot, index);
+        };
+        textures.clamps = [&](int t) {
+            int sampler = model_.textures[size_t(t)].sampler;
+            if (sampler < 0 || size_t(sampler) >= model_.samplers.size()) return false;
+            const tinygltf::Sampler& s = model_.samplers[size_t(sampler)];
+            return s.wrapS == TINYGLTF_TEXTURE_WRAP_CLAMP_TO_EDGE &&
+                   s.wrapT == TINYGLTF_TEXTURE_WRAP_CLAMP_TO_EDGE;
+        };
+        textures.glossinessToRoughness = [&](int t, float glossinessFactor) {
+            return glossinessToRoughness(t, glossinessFactor, index);
+        };
+        textures.warn = [&](const std::string& what) { warnOnce(what); };
+        applyMaterialExtensions(m, index, out, textures);
         return out;
+    }
+
+    // A metallic-roughness texture (G = 1 - alpha x glossinessFactor, B = 0) from a
+    // specularGlossinessTexture (glossiness in alpha).
+    int32_t glossinessToRoughness(int textureIndex, float glossinessFactor, int material) {
+        int32_t source = texture(textureIndex, 0, false, "specular-glossiness", material);
+        if (source == kNoTexture) return kNoTexture;
+        Texture tex = scene_.textures[size_t(source)];
+        tex.name += " (roughness from glossiness)";
+        for (size_t i = 0; i + 3 < tex.rgba8.size(); i += 4) {
+            float gloss = tex.rgba8[i + 3] / 255.0f * glossinessFactor;
+            tex.rgba8[i] = 0;
+            tex.rgba8[i + 1] = uint8_t(std::lround((1.0f - gloss) * 255.0f));
+            tex.rgba8[i + 2] = 0;
+            tex.rgba8[i + 3] = 255;
+        }
+        scene_.textures.push_back(std::move(tex));
+        return int32_t(scene_.textures.size() - 1);
     }
 
     uint32_t defaultMaterial() {
@@ -1115,11 +1170,8 @@ private:
             noteSkip("points/lines");
             return std::nullopt;
         }
-        if (prim.extensions.count("KHR_draco_mesh_compression")) {
-            warn(where + ": KHR_draco_mesh_compression is not supported; skipped");
-            noteSkip("Draco-compressed");
-            return std::nullopt;
-        }
+        // An optional KHR_draco_mesh_compression (ignored, warned once for the file) leaves the
+        // primitive's uncompressed accessors as the fallback; a required one was refused.
         auto attribute = [&](const char* name) {
             auto it = prim.attributes.find(name);
             return it == prim.attributes.end() ? -1 : it->second;
@@ -1260,9 +1312,9 @@ private:
     void addCamera(const tinygltf::Node& node, int nodeIndex, glm::vec3 position, glm::vec3 forward,
                    glm::vec3 up) {
         const tinygltf::Camera& cam = model_.cameras[size_t(node.camera)];
-        if (cam.type != "perspective") {
-            warn(format("camera %d is %s; only perspective cameras are imported", node.camera,
-                        cam.type.c_str()));
+        bool ortho = cam.type == "orthographic";
+        if (cam.type != "perspective" && !ortho) {
+            warn(format("camera %d has unknown type '%s'; skipped", node.camera, cam.type.c_str()));
             return;
         }
         Camera out;
@@ -1279,10 +1331,25 @@ private:
         out.forward = forward / fl;
         up -= out.forward * glm::dot(up, out.forward);
         out.up = glm::length(up) > 1e-12f ? glm::normalize(up) : glm::vec3(0, 1, 0);
-        out.yfov = float(cam.perspective.yfov);
-        out.znear = float(cam.perspective.znear);
-        bool hasFar = cam.perspective.zfar > cam.perspective.znear;
-        if (hasFar) out.zfar = float(cam.perspective.zfar);
+        bool hasFar = false;
+        if (ortho) {
+            // The node's scale does not scale the view (glTF: camera transforms are rigid).
+            float ymag = std::abs(float(cam.orthographic.ymag));
+            if (!(ymag > 0.0f) || !std::isfinite(ymag)) {
+                warn(format("orthographic camera %d has ymag %g; skipped", node.camera,
+                            cam.orthographic.ymag));
+                return;
+            }
+            out.orthoHalfHeight = ymag;
+            out.znear = std::max(float(cam.orthographic.znear), ymag * 1e-6f);
+            hasFar = cam.orthographic.zfar > cam.orthographic.znear;
+            if (hasFar) out.zfar = float(cam.orthographic.zfar);
+        } else {
+            out.yfov = float(cam.perspective.yfov);
+            out.znear = float(cam.perspective.znear);
+            hasFar = cam.perspective.zfar > cam.perspective.znear;
+            if (hasFar) out.zfar = float(cam.perspective.zfar);
+        }
         scene_.cameras.push_back(out);
         cameraZfarGiven_.push_back(hasFar);
     }
@@ -1376,6 +1443,7 @@ private:
             cam.up = glm::normalize(up);
             cam.znear = std::max(distance - radius, radius * 0.01f) * 0.5f;
             cam.zfar = (distance + radius) * 2.0f;
+            cam.automatic = true; // refitted tightly for the run (render/camera_framing.h)
             scene_.cameras.push_back(cam);
             SHADEL_INFO("%s: no camera in the file; using an automatic one framing the scene",
                         input_.c_str());
@@ -1408,6 +1476,8 @@ Scene importGltfBytes(std::vector<uint8_t> bytes, const std::string& path,
     json document = parseJson(jsonTextOf(bytes, binary, input), input);
     checkCounts(document, input);
     JsonSchemaCheck(document, input).run();
+    checkRequiredGltfExtensions(document, input);
+    std::string extensionsWarning = ignoredExtensionsWarning(ignoredGltfExtensions(document));
     if (!options.allowExternalFiles) checkUrisStayInFolder(document, input);
     document = json(); // tinygltf parses its own copy
 
@@ -1439,6 +1509,7 @@ Scene importGltfBytes(std::vector<uint8_t> bytes, const std::string& path,
 
     Scene scene;
     scene.name = std::filesystem::path(path).stem().string();
+    if (!extensionsWarning.empty()) SHADEL_WARN("%s: %s", input.c_str(), extensionsWarning.c_str());
     GltfConverter(model, input, scene).run();
     return scene;
 }
