@@ -1,5 +1,8 @@
 #include "render/camera.h"
 
+#include <algorithm>
+#include <cmath>
+
 #include <glm/gtc/matrix_transform.hpp>
 
 #include "core/error.h"
@@ -36,16 +39,20 @@ Camera findCamera(const Scene& scene, const std::string& name) {
     return c;
 }
 
-// An orthographic camera is drawn as a telephoto perspective one from kOrthoBackoff view
-// heights behind it: every pass, the view-driven density and the decoupled MIP estimates
-// assume a perspective projection, and at that distance a point's image size changes by only
-// depth / backoff (0.4% per view height of depth), below what shading resolves.
-constexpr float kOrthoBackoff = 256.0f;
+// An orthographic camera is drawn as a telephoto perspective one from far behind it: every
+// pass, the view-driven density and the decoupled MIP estimates assume a perspective projection.
+// A point at depth z in front of the orthographic camera then shows at back / (back + z) of its
+// size, so the distance is 256 x the far plane (0.4% at the far plane), at least 256 view
+// heights, and at most 4096 view heights, where float positions keep 1e-3 of the view's height.
+float orthoBackoff(const Camera& camera) {
+    float h = camera.orthoHalfHeight;
+    return std::clamp(256.0f * std::max(camera.zfar, h), 256.0f * h, 4096.0f * h);
+}
 
 Camera perspectiveEquivalent(const Camera& camera) {
     if (!(camera.orthoHalfHeight > 0.0f)) return camera;
     Camera c = camera;
-    float back = kOrthoBackoff * camera.orthoHalfHeight;
+    float back = orthoBackoff(camera);
     c.position = camera.position - camera.forward * back;
     c.yfov = 2.0f * std::atan(camera.orthoHalfHeight / back);
     c.znear = back + camera.znear;

@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <iterator>
+#include <vector>
 
 #include "core/error.h"
 #include "core/log.h"
@@ -43,6 +45,69 @@ void fitDepthRange(Camera& c, const Aabb& bounds) {
     c.zfar = std::max(farthest * 1.05f + radius * 0.01f, c.znear * 2.0f);
 }
 
+// Candidate directions (from the scene toward the camera) for automatic framing; the first is
+// the preferred three-quarter view.
+constexpr glm::vec3 kCandidateSides[] = {
+    {1.0f, 0.6f, 1.0f},  {-1.0f, 0.6f, 1.0f}, {0.0f, 0.3f, 1.0f},  {1.0f, 0.3f, 0.0f},
+    {-1.0f, 0.3f, 0.0f}, {0.0f, 0.3f, -1.0f}, {1.0f, 0.6f, -1.0f}, {-1.0f, 0.6f, -1.0f},
+    {0.0f, 1.0f, 1.0f},  {1.0f, 1.0f, 0.0f},  {0.0f, 1.0f, -1.0f}, {-1.0f, 1.0f, 0.0f},
+    {0.2f, 1.0f, 0.3f},
+};
+// The preferred direction is kept when it covers at least this much of the image, or when no
+// other covers 25% more.
+constexpr float kPreferredCoverage = 0.3f;
+constexpr float kPreferredBonus = 1.25f;
+
+// Fraction of the image the scene's triangles cover seen by `c`, on a coarse grid (cell
+// centres inside a triangle, either winding). Linear in the triangles plus the cells they
+// cover.
+float estimatedCoverage(const Scene& scene, const Camera& c, float aspect) {
+    constexpr int kGridH = 48;
+    const int gridW = std::clamp(int(std::lround(kGridH * aspect)), 1, 16 * kGridH);
+    CameraView view = makeCameraView(c, uint32_t(gridW), uint32_t(kGridH));
+    glm::mat4 viewProj = view.proj * view.view;
+    std::vector<uint8_t> grid(size_t(gridW) * kGridH, 0);
+    std::vector<glm::vec3> projected;
+    for (const Instance& inst : scene.instances) {
+        if (inst.mesh >= scene.meshes.size()) continue;
+        const Mesh& mesh = scene.meshes[inst.mesh];
+        glm::mat4 m = viewProj * inst.transform;
+        projected.resize(mesh.vertices.size());
+        for (size_t i = 0; i < mesh.vertices.size(); ++i) {
+            glm::vec4 clip = m * glm::vec4(mesh.vertices[i].position, 1.0f);
+            projected[i] =
+                clip.w > 1e-12f
+                    ? glm::vec3((glm::vec2(clip) / clip.w * 0.5f + 0.5f) * glm::vec2(gridW, kGridH),
+                                1.0f)
+                    : glm::vec3(0.0f); // behind: z = 0 marks it
+        }
+        for (size_t t = 0; t + 2 < mesh.indices.size(); t += 3) {
+            glm::vec3 a = projected[mesh.indices[t]], b = projected[mesh.indices[t + 1]],
+                      d = projected[mesh.indices[t + 2]];
+            if (a.z == 0.0f || b.z == 0.0f || d.z == 0.0f) continue;
+            float area = (b.x - a.x) * (d.y - a.y) - (b.y - a.y) * (d.x - a.x);
+            if (area == 0.0f) continue;
+            int x0 = std::max(0, int(std::floor(std::min({a.x, b.x, d.x}))));
+            int x1 = std::min(gridW - 1, int(std::ceil(std::max({a.x, b.x, d.x}))));
+            int y0 = std::max(0, int(std::floor(std::min({a.y, b.y, d.y}))));
+            int y1 = std::min(kGridH - 1, int(std::ceil(std::max({a.y, b.y, d.y}))));
+            for (int y = y0; y <= y1; ++y) {
+                for (int x = x0; x <= x1; ++x) {
+                    glm::vec2 p(float(x) + 0.5f, float(y) + 0.5f);
+                    auto edge = [&](glm::vec3 u, glm::vec3 v) {
+                        return ((v.x - u.x) * (p.y - u.y) - (v.y - u.y) * (p.x - u.x)) * area;
+                    };
+                    if (edge(a, b) >= 0.0f && edge(b, d) >= 0.0f && edge(d, a) >= 0.0f)
+                        grid[size_t(y) * size_t(gridW) + size_t(x)] = 1;
+                }
+            }
+        }
+    }
+    size_t covered = 0;
+    for (uint8_t g : grid) covered += g;
+    return float(covered) / float(grid.size());
+}
+
 } // namespace
 
 glm::vec3 automaticViewDirection() {
@@ -82,6 +147,20 @@ Camera frameScene(const Scene& scene, glm::vec3 forward, float yfov, float aspec
     return c;
 }
 
+Camera frameAutomatically(const Scene& scene, float yfov, float aspect) {
+    Camera preferred = frameScene(scene, -glm::normalize(kCandidateSides[0]), yfov, aspect);
+    float preferredCoverage = estimatedCoverage(scene, preferred, aspect);
+    if (preferredCoverage >= kPreferredCoverage) return preferred;
+    Camera best = preferred;
+    float bestCoverage = preferredCoverage * kPreferredBonus;
+    for (size_t i = 1; i < std::size(kCandidateSides); ++i) {
+        Camera c = frameScene(scene, -glm::normalize(kCandidateSides[i]), yfov, aspect);
+        float coverage = estimatedCoverage(scene, c, aspect);
+        if (coverage > bestCoverage) best = c, bestCoverage = coverage;
+    }
+    return best;
+}
+
 Camera runCamera(const Scene& scene, const std::string& name, const CameraOverrides& o,
                  float aspect) {
     Camera c;
@@ -96,7 +175,7 @@ Camera runCamera(const Scene& scene, const std::string& name, const CameraOverri
     float fov = o.fovDegrees > 0.0f ? glm::radians(o.fovDegrees) : c.yfov;
     if (o.fovDegrees > 0.0f) c.orthoHalfHeight = 0.0f;
     if (c.automatic) {
-        c = frameScene(scene, c.forward, fov, aspect);
+        c = frameAutomatically(scene, fov, aspect);
         if (!name.empty()) c.name = name;
     }
     c.yfov = fov;

@@ -9,7 +9,7 @@
 namespace shadel {
 
 // How much of the limiting image dimension (height or width) the framed geometry spans.
-constexpr float kFramingFill = 0.9f;
+constexpr float kFramingFill = 0.92f;
 
 // A perspective camera looking along `forward` (up +Y) that fits every vertex of the scene's
 // instances inside `fill` of the image, centred: for each vertex q (relative to the bounds'
@@ -20,8 +20,15 @@ constexpr float kFramingFill = 0.9f;
 Camera frameScene(const Scene& scene, glm::vec3 forward, float yfov, float aspect,
                   float fill = kFramingFill);
 
-// The direction automatic cameras look along: down and across the scene from +X +Y +Z.
+// The direction automatic cameras prefer: down and across the scene from +X +Y +Z.
 glm::vec3 automaticViewDirection();
+
+// The automatic camera: frameScene from a few directions around the scene (three-quarter views,
+// front, sides, back, top), keeping the one whose triangles cover the most of a coarse grid of
+// the image (the three-quarter view from +X +Y +Z when it covers 30%, or unless another covers
+// 25% more; the elevated views foreshorten tall models, which 16:9 images show small). Flat or
+// elongated models are then seen from the side that shows them, not edge-on.
+Camera frameAutomatically(const Scene& scene, float yfov, float aspect);
 
 struct CameraOverrides {
     std::optional<glm::vec3> from;   // --from: camera position
