@@ -35,6 +35,7 @@
 
 // Declares tinygltf's types first (tiny_gltf.h guards its declarations, not its implementation).
 #include "scene/gltf_materials.h"
+#include "scene/gltf_meshopt.h"
 
 #define TINYGLTF_IMPLEMENTATION
 #define TINYGLTF_NO_INCLUDE_STB_IMAGE
@@ -141,6 +142,25 @@ std::string_view jsonTextOf(const std::vector<uint8_t>& bytes, bool binary,
     if (chunkType != kGlbChunkJson) fail(input, "first GLB chunk is not JSON");
     if (uint64_t(chunkLength) + 20 > length) fail(input, "GLB JSON chunk exceeds the file");
     return {reinterpret_cast<const char*>(bytes.data()) + 20, chunkLength};
+}
+
+// The same file with its JSON replaced (a .gltf is its JSON; a .glb keeps its other chunks).
+std::vector<uint8_t> withJsonText(const std::vector<uint8_t>& bytes, bool binary,
+                                  std::string text) {
+    if (!binary) return std::vector<uint8_t>(text.begin(), text.end());
+    while (text.size() % 4 != 0) text.push_back(' ');
+    uint32_t oldChunk = readU32(&bytes[12]);
+    size_t rest = 20 + size_t(oldChunk); // checked by jsonTextOf
+    std::vector<uint8_t> out(20);
+    std::memcpy(out.data(), bytes.data(), 12);
+    uint32_t chunk = uint32_t(text.size()), type = kGlbChunkJson;
+    std::memcpy(&out[12], &chunk, 4);
+    std::memcpy(&out[16], &type, 4);
+    out.insert(out.end(), text.begin(), text.end());
+    if (rest < bytes.size()) out.insert(out.end(), bytes.begin() + long(rest), bytes.end());
+    uint32_t length = uint32_t(out.size());
+    std::memcpy(&out[8], &length, 4);
+    return out;
 }
 
 json parseJson(std::string_view text, const std::string& input) {
@@ -1479,6 +1499,8 @@ Scene importGltfBytes(std::vector<uint8_t> bytes, const std::string& path,
     checkRequiredGltfExtensions(document, input);
     std::string extensionsWarning = ignoredExtensionsWarning(ignoredGltfExtensions(document));
     if (!options.allowExternalFiles) checkUrisStayInFolder(document, input);
+    MeshoptPlan meshopt = prepareMeshopt(document, input);
+    if (!meshopt.fallbacks.empty()) bytes = withJsonText(bytes, binary, document.dump());
     document = json(); // tinygltf parses its own copy
 
     tinygltf::TinyGLTF loader;
@@ -1504,6 +1526,7 @@ Scene importGltfBytes(std::vector<uint8_t> bytes, const std::string& path,
         }
     }
     if (!ok || !err.empty()) fail(input, oneLine(err.empty() ? "glTF loader failed" : err));
+    decodeMeshopt(meshopt, model, input);
     bytes.clear();
     bytes.shrink_to_fit();
 

@@ -267,3 +267,48 @@ INSTANTIATE_TEST_SUITE_P(
             if (!std::isalnum(static_cast<unsigned char>(c))) c = '_';
         return name;
     });
+
+// --- geometry: EXT_meshopt_compression -------------------------------------------------------
+
+// Runs Debian's gltfpack (scripts/setup.sh installs it) on `model` into `dir`.
+std::string gltfpack(const std::string& model, const fs::path& dir, const std::string& name,
+                     const std::string& flags) {
+    fs::path out = dir / name;
+    std::string cmd = "gltfpack " + flags + " -i " + model + " -o " + out.string() + " >/dev/null";
+    EXPECT_EQ(std::system(cmd.c_str()), 0) << cmd << " (gltfpack missing? run scripts/setup.sh)";
+    return out.string();
+}
+
+TEST(GltfFeatures, MeshoptCompressedModelsRenderLikeTheirSource) {
+    fs::path dir = scratch("meshopt");
+    // A textured box (its texture beside it) and a 121k-triangle engine.
+    fs::copy(kAssimp + "/BoxTextured-glTF", dir);
+    const std::string box = (dir / "BoxTextured.gltf").string();
+    const std::string engine = kAssimp + "/2CylinderEngine-glTF-Binary/2CylinderEngine.glb";
+    struct Pair {
+        std::string reference, packed, what;
+    };
+    const Pair pairs[] = {
+        // -cc: quantized (KHR_mesh_quantization) and compressed; against the original.
+        {box, gltfpack(box, dir, "box_cc.gltf", "-cc"), "box -cc vs original"},
+        // -noq keeps float attributes: compression alone must change nothing visible.
+        {engine, gltfpack(engine, dir, "engine_cc_noq.glb", "-cc -noq"),
+         "engine -cc -noq vs original"},
+        // The same quantization uncompressed: the decoder returns exactly those values.
+        {gltfpack(engine, dir, "engine_q.glb", ""), gltfpack(engine, dir, "engine_cc.glb", "-cc"),
+         "engine -cc vs engine quantized, uncompressed"},
+    };
+    for (const Pair& p : pairs) {
+        RenderOptions o = renderOptions(p.reference, RenderMode::Forward, 160, 90);
+        o.progress = false;
+        o.camera = "auto";
+        RenderRun a = renderChecked(o);
+        o.scene = p.packed;
+        RenderRun b = renderChecked(o);
+        double db = psnr(a.frames[0].rgba, b.frames[0].rgba);
+        std::printf("%s: %.1f dB (%llu px covered)\n", p.what.c_str(), db,
+                    (unsigned long long)b.frames[0].pixelsCovered);
+        EXPECT_GE(db, 50.0) << p.what;
+        EXPECT_GT(b.frames[0].pixelsCovered, 160u * 90u / 4u) << p.what;
+    }
+}
