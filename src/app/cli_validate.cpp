@@ -103,6 +103,10 @@ void validateRenderOptions(const RenderOptions& o) {
     for (const auto& [flag, value, range] : floats)
         if (std::string problem = checkFiniteInRange(flag, value, range); !problem.empty())
             throw InputError(problem);
+    if (o.time)
+        if (std::string problem = checkFiniteInRange("--time", *o.time, kTimeRange);
+            !problem.empty())
+            throw InputError(problem);
     const CameraOverrides& c = o.cameraOverrides;
     if (c.fovDegrees != 0.0f)
         if (std::string problem = checkFiniteInRange("--fov", c.fovDegrees, kFovRange);

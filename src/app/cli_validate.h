@@ -28,6 +28,7 @@ constexpr FloatRange kTrilinearBandRange{0, 1};         // fraction of a MIP lev
 constexpr FloatRange kShadelBudgetRange{0, 1e12, true}; // MIP-0 shadels
 constexpr FloatRange kForwardBelowRange{0, 1e12};       // pixels; 0 = never
 constexpr FloatRange kFovRange{0, 179, true};           // degrees, vertical
+constexpr FloatRange kTimeRange{0, 1e6};                // seconds (--time)
 constexpr FloatRange kCoordinateRange{-1e9, 1e9};       // world units (--from, --look-at)
 
 // Accepts a finite number in the range. CLI11 reports a rejection as "<flag>: <reason>".

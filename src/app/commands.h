@@ -20,6 +20,7 @@ struct RenderOptions {
     uint32_t frames = 1;
     std::string camera;
     CameraOverrides cameraOverrides; // --from, --look-at, --fov
+    std::optional<double> time;      // --time: glTF animations posed at this time (seconds)
     bool jitter = false;
     uint32_t ssaa = 1;
     Visualize visualize = Visualize::None;

@@ -90,6 +90,11 @@ int main(int argc, char** argv) {
         ->check(finiteVec3(kCoordinateRange));
     render->add_option("--look-at", lookAt, "X,Y,Z: the point the camera aims at")
         ->check(finiteVec3(kCoordinateRange));
+    double timeSeconds = -1.0;
+    render
+        ->add_option("--time", timeSeconds,
+                     "SECONDS: pose glTF animations (node TRS, morph weights) at this time")
+        ->check(finiteInRange(kTimeRange));
     render
         ->add_option("--fov", ro.cameraOverrides.fovDegrees,
                      "vertical field of view in degrees (default: the camera's)")
@@ -306,6 +311,7 @@ int main(int argc, char** argv) {
             ro.timing = parseTiming(timing);
             ro.shadelsPerMetre = parseDensity(density);
             ro.cameraPath = parseCameraPath(cameraPath);
+            if (timeSeconds >= 0.0) ro.time = timeSeconds;
             if (!from.empty())
                 ro.cameraOverrides.from = parseVec3("--from", from, kCoordinateRange);
             if (!lookAt.empty())

@@ -34,6 +34,7 @@
 #include <stb/stb_image_write.h>
 
 // Declares tinygltf's types first (tiny_gltf.h guards its declarations, not its implementation).
+#include "scene/gltf_animation.h"
 #include "scene/gltf_materials.h"
 #include "scene/gltf_meshopt.h"
 
@@ -1165,12 +1166,14 @@ private:
         return tris;
     }
 
-    void convertMesh(int meshIndex) {
+    // `weights`: the morph target weights of the node that first uses the mesh (or the mesh's).
+    void convertMesh(int meshIndex, const std::vector<double>& nodeWeights) {
         meshConverted_[size_t(meshIndex)] = true;
         const tinygltf::Mesh& gm = model_.meshes[size_t(meshIndex)];
+        const std::vector<double>& weights = nodeWeights.empty() ? gm.weights : nodeWeights;
         for (size_t p = 0; p < gm.primitives.size(); ++p) {
             std::string where = format("mesh %d primitive %zu", meshIndex, p);
-            std::optional<Mesh> mesh = convertPrimitive(gm.primitives[p], where);
+            std::optional<Mesh> mesh = convertPrimitive(gm.primitives[p], where, weights);
             if (!mesh) continue;
             mesh->name = (gm.name.empty() ? format("mesh%d", meshIndex) : gm.name) +
                          (gm.primitives.size() > 1 ? format("/%zu", p) : std::string());
@@ -1181,8 +1184,8 @@ private:
         }
     }
 
-    std::optional<Mesh> convertPrimitive(const tinygltf::Primitive& prim,
-                                         const std::string& where) {
+    std::optional<Mesh> convertPrimitive(const tinygltf::Primitive& prim, const std::string& where,
+                                         const std::vector<double>& weights) {
         int mode = prim.mode < 0 ? TINYGLTF_MODE_TRIANGLES : prim.mode;
         if (mode != TINYGLTF_MODE_TRIANGLES && mode != TINYGLTF_MODE_TRIANGLE_STRIP &&
             mode != TINYGLTF_MODE_TRIANGLE_FAN) {
@@ -1198,8 +1201,6 @@ private:
         };
         int positionAccessor = attribute("POSITION");
         if (positionAccessor < 0) error(where + " has no POSITION attribute");
-        if (!prim.targets.empty()) warnOnce("morph targets are ignored (base shape shown)");
-
         std::vector<float> positions = readFloats(positionAccessor, 3, "POSITION");
         size_t vertexCount = positions.size() / 3;
         Mesh mesh;
@@ -1222,6 +1223,7 @@ private:
         };
         std::vector<float> normals = readAttribute("NORMAL", 3);
         std::vector<float> tangents = readAttribute("TANGENT", 4);
+        applyMorphTargets(prim, weights, vertexCount, mesh, normals);
         std::vector<float> uvs = readAttribute("TEXCOORD_0", 2);
         for (size_t v = 0; v < vertexCount; ++v) {
             Vertex& vert = mesh.vertices[v];
@@ -1260,6 +1262,35 @@ private:
                         repaired));
         computeBounds(mesh);
         return mesh;
+    }
+
+    // Adds sum(weight x target) to positions and normals (glTF morph targets hold deltas).
+    void applyMorphTargets(const tinygltf::Primitive& prim, const std::vector<double>& weights,
+                           size_t vertexCount, Mesh& mesh, std::vector<float>& normals) {
+        for (size_t t = 0; t < prim.targets.size() && t < weights.size(); ++t) {
+            float w = float(weights[t]);
+            if (w == 0.0f || !std::isfinite(w)) continue;
+            for (const auto& [name, accessor] : prim.targets[t]) {
+                bool position = name == "POSITION";
+                if (!position && (name != "NORMAL" || normals.empty())) continue;
+                std::vector<float> delta = readFloats(accessor, 3, name.c_str());
+                if (delta.size() != vertexCount * 3)
+                    error(format("morph target %zu %s has %zu elements but POSITION has %zu", t,
+                                 name.c_str(), delta.size() / 3, vertexCount));
+                for (size_t v = 0; v < vertexCount; ++v) {
+                    glm::vec3 d = glm::make_vec3(&delta[v * 3]) * w;
+                    if (position) {
+                        mesh.vertices[v].position += d;
+                        if (!finite3(mesh.vertices[v].position))
+                            error(format("morph target %zu moves vertex %zu to a non-finite "
+                                         "position",
+                                         t, v));
+                    } else {
+                        for (int c = 0; c < 3; ++c) normals[v * 3 + size_t(c)] += d[c];
+                    }
+                }
+            }
+        }
     }
 
     glm::mat4 localMatrix(const tinygltf::Node& node, int index) {
@@ -1306,7 +1337,7 @@ private:
         std::string nodeName = node.name.empty() ? format("node%d", index) : node.name;
         if (node.skin >= 0) warnOnce("skinning is ignored (meshes shown in bind pose)");
         if (node.mesh >= 0) {
-            if (!meshConverted_[size_t(node.mesh)]) convertMesh(node.mesh);
+            if (!meshConverted_[size_t(node.mesh)]) convertMesh(node.mesh, node.weights);
             // A mirroring transform turns CCW into CW: give those instances a mesh with the
             // winding reversed so front faces stay front faces.
             bool mirrored = glm::determinant(glm::mat3(world)) < 0.0f;
@@ -1527,6 +1558,9 @@ Scene importGltfBytes(std::vector<uint8_t> bytes, const std::string& path,
     }
     if (!ok || !err.empty()) fail(input, oneLine(err.empty() ? "glTF loader failed" : err));
     decodeMeshopt(meshopt, model, input);
+    if (options.time)
+        poseAnimations(model, *options.time, input,
+                       [&](const std::string& w) { SHADEL_WARN("%s", w.c_str()); });
     bytes.clear();
     bytes.shrink_to_fit();
 

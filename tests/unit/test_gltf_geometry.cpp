@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cstring>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -145,4 +146,39 @@ TEST(GltfGeometry, QuantizedAttributesDecodeToTheirValues) {
     EXPECT_NEAR(m.vertices[0].normal.y, 1.0f, 1e-6f);
     glm::vec3 world = glm::vec3(s.instances[0].transform * glm::vec4(m.vertices[2].position, 1));
     EXPECT_NEAR(glm::distance(world, glm::vec3(1, 1, 0)), 0.0f, 1e-5f);
+}
+
+TEST(GltfGeometry, AnimationsArePosedAtTheRequestedTime) {
+    std::vector<uint8_t> b;
+    append<float>(b, {0, 0, 0, 1, 0, 0, 0, 1, 0}); // 0..36: a triangle
+    append<float>(b, {0, 2});                      // 36..44: key times
+    append<float>(b, {0, 0, 0, 4, 0, 0});          // 44..68: translations
+    nlohmann::json doc = document(b);
+    doc["bufferViews"] = {{{"buffer", 0}, {"byteOffset", 0}, {"byteLength", 36}},
+                          {{"buffer", 0}, {"byteOffset", 36}, {"byteLength", 8}},
+                          {{"buffer", 0}, {"byteOffset", 44}, {"byteLength", 24}}};
+    doc["accessors"] = {
+        {{"bufferView", 0}, {"componentType", 5126}, {"count", 3}, {"type", "VEC3"}},
+        {{"bufferView", 1}, {"componentType", 5126}, {"count", 2}, {"type", "SCALAR"}},
+        {{"bufferView", 2}, {"componentType", 5126}, {"count", 2}, {"type", "VEC3"}}};
+    doc["meshes"] = {{{"primitives", {{{"attributes", {{"POSITION", 0}}}}}}}};
+    doc["nodes"][0]["translation"] = {0, 7, 0}; // the rest pose
+    doc["animations"] = {
+        {{"channels", {{{"sampler", 0}, {"target", {{"node", 0}, {"path", "translation"}}}}}},
+         {"samplers", {{{"input", 1}, {"output", 2}, {"interpolation", "LINEAR"}}}}}};
+    auto at = [&](std::optional<double> time) {
+        std::string text = doc.dump();
+        SceneFileOptions o;
+        o.time = time;
+        Scene s = importGltfBytes(std::vector<uint8_t>(text.begin(), text.end()), "/tmp/a.gltf", o);
+        return glm::vec3(s.instances[0].transform[3]);
+    };
+    EXPECT_EQ(at(std::nullopt), glm::vec3(0, 7, 0));
+    EXPECT_EQ(at(0.5), glm::vec3(1, 0, 0));
+    EXPECT_EQ(at(9.0), glm::vec3(4, 0, 0)); // after the last key: the last value
+    doc["animations"][0]["samplers"][0]["interpolation"] = "STEP";
+    EXPECT_EQ(at(1.5), glm::vec3(0, 0, 0));
+    // Key times read from a VEC3 accessor are malformed (one InputError, not a misread).
+    doc["animations"][0]["samplers"][0]["input"] = 2;
+    EXPECT_THROW(at(0.5), InputError);
 }
