@@ -93,7 +93,7 @@ int main(int argc, char** argv) {
     double timeSeconds = -1.0;
     render
         ->add_option("--time", timeSeconds,
-                     "SECONDS: pose glTF animations (node TRS, morph weights) at this time")
+                     "SECONDS: pose glTF animations (node TRS, morph weights, skins) at this time")
         ->check(finiteInRange(kTimeRange));
     render
         ->add_option("--fov", ro.cameraOverrides.fovDegrees,

@@ -3,7 +3,8 @@
 // its node's translation, rotation, scale or morph weights to the sampler's value at that time
 // (STEP, LINEAR with slerp for rotations, CUBICSPLINE; times before the first key or after the
 // last clamp to it). Applied to the tinygltf model before conversion, so the importer then
-// builds the posed scene (node TRS, morph targets). Skins are not evaluated (bind pose).
+// builds the posed scene (node TRS, morph targets; the importer skins meshes by their posed
+// joints when a time is given).
 #include <functional>
 #include <string>
 

@@ -839,8 +839,11 @@ bool finiteMatrix(const glm::mat4& m) {
 
 class GltfConverter {
 public:
-    GltfConverter(const tinygltf::Model& model, const std::string& input, Scene& scene)
-        : model_(model), input_(input), scene_(scene) {}
+    // `skinning`: skinned meshes are posed by their joints (with --time); otherwise drawn in
+    // their bind pose.
+    GltfConverter(const tinygltf::Model& model, const std::string& input, Scene& scene,
+                  bool skinning = false)
+        : model_(model), input_(input), scene_(scene), skinning_(skinning) {}
 
     void run() {
         for (size_t i = 0; i < model_.accessors.size(); ++i) validateAccessor(int(i));
@@ -881,6 +884,8 @@ private:
     std::string skipReasons_;
     std::set<std::string> warnedOnce_;
     std::vector<bool> cameraZfarGiven_;
+    bool skinning_ = false;
+    std::vector<glm::mat4> worldOf_; // every node's world transform (identity if unreached)
 
     [[noreturn]] void error(const std::string& reason) { fail(input_, reason); }
     void warn(const std::string& what) { SHADEL_WARN("%s: %s", input_.c_str(), what.c_str()); }
@@ -1335,8 +1340,11 @@ private:
 
     void addNodeContent(const tinygltf::Node& node, int index, const glm::mat4& world) {
         std::string nodeName = node.name.empty() ? format("node%d", index) : node.name;
-        if (node.skin >= 0) warnOnce("skinning is ignored (meshes shown in bind pose)");
-        if (node.mesh >= 0) {
+        if (node.skin >= 0 && node.mesh >= 0 && skinning_) {
+            addSkinnedMesh(node, index, nodeName);
+        } else if (node.mesh >= 0) {
+            if (node.skin >= 0)
+                warnOnce("skinned meshes are drawn in their bind pose without --time");
             if (!meshConverted_[size_t(node.mesh)]) convertMesh(node.mesh, node.weights);
             // A mirroring transform turns CCW into CW: give those instances a mesh with the
             // winding reversed so front faces stay front faces.
@@ -1436,6 +1444,77 @@ private:
     // The scene's root nodes, then a depth-first walk with an explicit stack (a long chain of
     // nodes must not overflow the call stack). glTF node graphs are disjoint trees: a node
     // reached twice means a cycle or a shared child, both invalid.
+    // A skinned node's own mesh copy, its vertices moved by sum(weight x world(joint) x
+    // inverseBind) (glTF skinning, evaluated on the CPU once per run); the node's transform is
+    // ignored, as glTF specifies.
+    void addSkinnedMesh(const tinygltf::Node& node, int index, const std::string& nodeName) {
+        const tinygltf::Skin& skin = model_.skins[size_t(node.skin)];
+        std::vector<glm::mat4> joints(skin.joints.size(), glm::mat4(1.0f));
+        std::vector<float> ibm;
+        if (skin.inverseBindMatrices >= 0) {
+            ibm = readFloats(skin.inverseBindMatrices, 16, "inverseBindMatrices");
+            if (ibm.size() / 16 < skin.joints.size())
+                error(format("skin %d has %zu inverse bind matrices for %zu joints", node.skin,
+                             ibm.size() / 16, skin.joints.size()));
+        }
+        for (size_t j = 0; j < skin.joints.size(); ++j) {
+            int joint = skin.joints[j];
+            if (joint < 0 || size_t(joint) >= model_.nodes.size())
+                error(format("skin %d joint %zu is not a node", node.skin, j));
+            glm::mat4 inverseBind = ibm.empty() ? glm::mat4(1.0f) : glm::make_mat4(&ibm[j * 16]);
+            joints[j] = worldOf_[size_t(joint)] * inverseBind;
+        }
+        const tinygltf::Mesh& gm = model_.meshes[size_t(node.mesh)];
+        const std::vector<double>& weights = node.weights.empty() ? gm.weights : node.weights;
+        for (size_t p = 0; p < gm.primitives.size(); ++p) {
+            const tinygltf::Primitive& prim = gm.primitives[p];
+            std::string where =
+                format("mesh %d primitive %zu (skinned, node %d)", node.mesh, p, index);
+            std::optional<Mesh> mesh = convertPrimitive(prim, where, weights);
+            if (!mesh) continue;
+            auto j = prim.attributes.find("JOINTS_0");
+            auto w = prim.attributes.find("WEIGHTS_0");
+            if (j != prim.attributes.end() && w != prim.attributes.end()) {
+                std::vector<float> ji = readFloats(j->second, 4, "JOINTS_0");
+                std::vector<float> wi = readFloats(w->second, 4, "WEIGHTS_0");
+                size_t count = mesh->vertices.size();
+                if (ji.size() != count * 4 || wi.size() != count * 4)
+                    error(where + ": JOINTS_0/WEIGHTS_0 do not match POSITION");
+                for (size_t v = 0; v < count; ++v) {
+                    glm::mat4 m(0.0f);
+                    for (int k = 0; k < 4; ++k) {
+                        float jf = ji[v * 4 + size_t(k)];
+                        if (!(jf >= 0.0f) || size_t(jf) >= joints.size())
+                            error(format("%s: vertex %zu joint %g out of range (%zu joints)",
+                                         where.c_str(), v, jf, joints.size()));
+                        m += joints[size_t(jf)] * wi[v * 4 + size_t(k)];
+                    }
+                    Vertex& vert = mesh->vertices[v];
+                    vert.position = glm::vec3(m * glm::vec4(vert.position, 1.0f));
+                    glm::mat3 n = glm::transpose(glm::inverse(glm::mat3(m)));
+                    vert.normal = n * vert.normal;
+                    vert.tangent =
+                        glm::vec4(glm::mat3(m) * glm::vec3(vert.tangent), vert.tangent.w);
+                    if (!finite3(vert.position))
+                        error(format("%s: vertex %zu skinned to a non-finite position",
+                                     where.c_str(), v));
+                }
+                sanitizeNormalsAndTangents(*mesh);
+                computeBounds(*mesh);
+            }
+            mesh->name = (gm.name.empty() ? format("mesh%d", node.mesh) : gm.name) +
+                         format(" (skinned, node %d)", index);
+            std::vector<Mesh> parts = splitMesh(std::move(*mesh));
+            for (size_t k = 0; k < parts.size(); ++k) {
+                Instance inst;
+                inst.name = nodeName + (parts.size() > 1 ? format("#%zu", k) : std::string());
+                inst.mesh = uint32_t(scene_.meshes.size());
+                scene_.meshes.push_back(std::move(parts[k]));
+                scene_.instances.push_back(std::move(inst)); // identity: already in world space
+            }
+        }
+    }
+
     void traverseNodes() {
         std::vector<int> roots;
         int sceneIndex = model_.defaultScene >= 0 ? model_.defaultScene
@@ -1455,6 +1534,9 @@ private:
         std::vector<std::pair<int, glm::mat4>> stack;
         for (auto it = roots.rbegin(); it != roots.rend(); ++it)
             stack.emplace_back(*it, glm::mat4(1.0f));
+        // World transforms first (skins need their joints'), then the content in walk order.
+        worldOf_.assign(model_.nodes.size(), glm::mat4(1.0f));
+        std::vector<int> order;
         while (!stack.empty()) {
             auto [index, parent] = stack.back();
             stack.pop_back();
@@ -1465,10 +1547,13 @@ private:
             glm::mat4 world = parent * localMatrix(node, index);
             if (!finiteMatrix(world))
                 error(format("node %d has a non-finite world transform", index));
-            addNodeContent(node, index, world);
+            worldOf_[size_t(index)] = world;
+            order.push_back(index);
             for (auto c = node.children.rbegin(); c != node.children.rend(); ++c)
                 stack.emplace_back(*c, world);
         }
+        for (int index : order)
+            addNodeContent(model_.nodes[size_t(index)], index, worldOf_[size_t(index)]);
     }
 
     void finishCamerasAndLights() {
@@ -1567,7 +1652,7 @@ Scene importGltfBytes(std::vector<uint8_t> bytes, const std::string& path,
     Scene scene;
     scene.name = std::filesystem::path(path).stem().string();
     if (!extensionsWarning.empty()) SHADEL_WARN("%s: %s", input.c_str(), extensionsWarning.c_str());
-    GltfConverter(model, input, scene).run();
+    GltfConverter(model, input, scene, options.time.has_value()).run();
     return scene;
 }
 
