@@ -83,21 +83,58 @@ vec3 fresnelSchlick(vec3 f0, float vh) {
     return f0 + (1.0 - f0) * pow(1.0 - vh, 5.0);
 }
 
-// Radiance reflected toward v from a light of `radiance` arriving from direction l.
+// KHR_materials_sheen: Charlie distribution and Neubelt's visibility (Estevez and Kulla 2017).
+float distributionCharlie(float nh, float alpha) {
+    float inv = 1.0 / alpha;
+    float sin2 = max(1.0 - nh * nh, 0.0078125);
+    return (2.0 + inv) * pow(sin2, inv * 0.5) / (2.0 * PI);
+}
+
+// Radiance reflected toward v from a light of `radiance` arriving from direction l: the base
+// layer (GGX + Lambert, dielectric F0/F90 from ior and specular), under sheen (its albedo taken
+// from the layer below by max(sheen colour)), under the clear coat (Fresnel 0.04 on its own
+// normal; what it reflects does not reach the layers below).
 vec3 brdf(MaterialSample m, vec3 n, vec3 v, vec3 l, vec3 radiance) {
     float nl = dot(n, l);
-    if (nl <= 0.0) return vec3(0.0);
+    float coatNl = m.clearcoat > 0.0 ? dot(m.clearcoatNormal, l) : 0.0;
+    if (nl <= 0.0 && coatNl <= 0.0) return vec3(0.0);
     vec3 h = normalize(v + l);
-    float nv = max(dot(n, v), 1e-4);
-    float nh = max(dot(n, h), 0.0);
     float vh = max(dot(v, h), 0.0);
-    float a = m.roughness * m.roughness;
-    float a2 = a * a;
-    vec3 f0 = mix(vec3(0.04), m.baseColor, m.metallic);
-    vec3 f = fresnelSchlick(f0, vh);
-    vec3 specular = f * distributionGgx(nh, a2) * visibilitySmithGgx(nv, nl, a2);
-    vec3 diffuse = (1.0 - f) * (1.0 - m.metallic) * m.baseColor / PI;
-    return (diffuse + specular) * radiance * nl;
+    vec3 color = vec3(0.0);
+    if (nl > 0.0) {
+        float nv = max(dot(n, v), 1e-4);
+        float nh = max(dot(n, h), 0.0);
+        float a = m.roughness * m.roughness;
+        float a2 = a * a;
+        vec3 f0 = mix(m.specularF0, m.baseColor, m.metallic);
+        float f90 = mix(m.specularF90, 1.0, m.metallic);
+        vec3 f = f0 + (f90 - f0) * pow(1.0 - vh, 5.0);
+        vec3 specular = f * distributionGgx(nh, a2) * visibilitySmithGgx(nv, nl, a2);
+        vec3 diffuse = (1.0 - f) * (1.0 - m.metallic) * m.baseColor / PI;
+        color = diffuse + specular;
+        float sheenMax = max(m.sheenColor.r, max(m.sheenColor.g, m.sheenColor.b));
+        if (sheenMax > 0.0) {
+            float alpha = m.sheenRoughness * m.sheenRoughness;
+            vec3 sheen = m.sheenColor * distributionCharlie(nh, alpha) /
+                         (4.0 * (nl + nv - nl * nv));
+            color = color * (1.0 - sheenMax * 0.25) + sheen;
+        }
+        color *= nl;
+    }
+    if (m.clearcoat > 0.0) {
+        vec3 cn = m.clearcoatNormal;
+        float cnv = max(dot(cn, v), 1e-4);
+        float fcView = 0.04 + 0.96 * pow(1.0 - cnv, 5.0);
+        color *= 1.0 - m.clearcoat * fcView;
+        if (coatNl > 0.0) {
+            float ca = m.clearcoatRoughness * m.clearcoatRoughness;
+            float ca2 = ca * ca;
+            float fc = 0.04 + 0.96 * pow(1.0 - vh, 5.0);
+            color += m.clearcoat * fc * distributionGgx(max(dot(cn, h), 0.0), ca2) *
+                     visibilitySmithGgx(cnv, coatNl, ca2) * coatNl;
+        }
+    }
+    return color * radiance;
 }
 
 // 3x3 PCF on the sun's shadow map (reversed-Z is not used for the orthographic shadow map).
@@ -238,6 +275,7 @@ vec3 evaluateLight(GpuLight light, MaterialSample m, vec3 n, vec3 v, vec3 p) {
 
 // Everything that lights a surface point, evaluated for a viewer at f.cameraPosition.
 vec3 shadeSurface(FrameConstants f, MaterialSample m, vec3 worldPos, vec3 geometricNormal) {
+    if (m.unlit) return m.baseColor;
     vec3 n = m.normal;
     vec3 v = normalize(f.cameraPosition - worldPos);
     vec3 color = m.emissive;
@@ -249,7 +287,16 @@ vec3 shadeSurface(FrameConstants f, MaterialSample m, vec3 worldPos, vec3 geomet
     // Ambient: a hemisphere term so shadowed sides are not black.
     float up = n.y * 0.5 + 0.5;
     vec3 ambient = mix(f.ambientColor * 0.5, f.ambientColor + f.skyColor * 0.15, up);
-    color += ambient * m.baseColor * (1.0 - m.metallic * 0.5) * m.occlusion;
+    vec3 ambientLit = ambient * m.baseColor * (1.0 - m.metallic * 0.5) * m.occlusion;
+    if (m.clearcoat > 0.0) {
+        // The coat mirrors the same hemisphere (sky above, ground below) by its Fresnel; what it
+        // reflects does not reach the base.
+        float fc = m.clearcoat * (0.04 + 0.96 * pow(1.0 - max(dot(m.clearcoatNormal, v), 0.0), 5.0));
+        vec3 r = reflect(-v, m.clearcoatNormal);
+        vec3 mirrored = mix(f.ambientColor * 0.5, f.ambientColor + f.skyColor, r.y * 0.5 + 0.5);
+        ambientLit = ambientLit * (1.0 - fc) + fc * mirrored * m.occlusion;
+    }
+    color += ambientLit;
 
     vec3 l = -f.sunDirection;
     if (dot(f.sunColor, f.sunColor) > 0.0)

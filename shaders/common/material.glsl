@@ -23,7 +23,17 @@ struct MaterialSample {
     float roughness;
     float occlusion;
     vec3 emissive;
+    // glTF material extensions (defaults: plain metal/rough).
+    vec3 specularF0;          // dielectric F0: ior and KHR_materials_specular (0.04 by default)
+    float specularF90;        // dielectric F90 (1 by default)
+    float clearcoat;          // coat weight, 0 = no coat
+    float clearcoatRoughness; // perceptual
+    vec3 clearcoatNormal;     // world
+    vec3 sheenColor;          // 0 = no sheen
+    float sheenRoughness;
+    bool unlit;               // KHR_materials_unlit: the output is baseColor
 };
+
 
 // One-texel checker: the seed's `IntTexCoord.x % 2` shader. It is a point function of the
 // texel coordinate and has no filtered form, so any path that point-samples it aliases.
@@ -52,11 +62,35 @@ float toksvigRoughness(float roughness, float meanNormalLength) {
     return clamp(sqrt(sqrt(alpha * alpha + (1.0 - len) / len)), 0.04, 1.0);
 }
 
+// A material texture through its slot's KHR_texture_transform (derivatives transformed with it)
+// and its sampler's wrap mode.
+vec4 sampleMaterialTexture(GpuMaterial m, uint slot, uint tex, SurfaceInput s) {
+    vec2 c0 = m.uvTransform[slot * 3u], c1 = m.uvTransform[slot * 3u + 1u];
+    vec2 uv = c0 * s.uv.x + c1 * s.uv.y + m.uvTransform[slot * 3u + 2u];
+    vec2 dx = c0 * s.uvDx.x + c1 * s.uvDx.y;
+    vec2 dy = c0 * s.uvDy.x + c1 * s.uvDy.y;
+    uint samplerId = ((m.clampMask >> slot) & 1u) != 0u ? SAMPLER_LINEAR_CLAMP : SAMPLER_LINEAR_REPEAT;
+    return sampleTexture(tex, samplerId, uv, dx, dy);
+}
+
+// A tangent-space normal map applied to n; `roughness` widened by Toksvig (filtered normals
+// are shorter).
+vec3 applyNormalMap(GpuMaterial m, uint slot, uint tex, float scale, SurfaceInput s, vec3 n,
+                    inout float roughness) {
+    if (tex == NO_TEXTURE || dot(s.tangent.xyz, s.tangent.xyz) <= 1e-8) return n;
+    vec3 t = normalize(s.tangent.xyz - n * dot(n, s.tangent.xyz));
+    vec3 b = cross(n, t) * (s.tangent.w < 0.0 ? -1.0 : 1.0);
+    vec3 tn = sampleMaterialTexture(m, slot, tex, s).xyz * 2.0 - 1.0;
+    roughness = toksvigRoughness(roughness, length(tn));
+    tn.xy *= scale;
+    return normalize(t * tn.x + b * tn.y + n * max(tn.z, 1e-3));
+}
+
 MaterialSample evaluateMaterial(GpuMaterial m, SurfaceInput s) {
     MaterialSample o;
     vec4 base = m.baseColorFactor;
     if (m.baseColorTexture != NO_TEXTURE)
-        base *= sampleTexture(m.baseColorTexture, SAMPLER_LINEAR_REPEAT, s.uv, s.uvDx, s.uvDy);
+        base *= sampleMaterialTexture(m, TEXTURE_SLOT_BASE_COLOR, m.baseColorTexture, s);
     if (m.procedural == PROCEDURAL_TEXEL_CHECKER)
         base.rgb *= mix(0.08, 1.0, texelChecker(s.uv, m.proceduralScale));
     else if (m.procedural == PROCEDURAL_BRICKS)
@@ -67,7 +101,7 @@ MaterialSample evaluateMaterial(GpuMaterial m, SurfaceInput s) {
     o.metallic = m.metallicFactor;
     o.roughness = m.roughnessFactor;
     if (m.metallicRoughnessTexture != NO_TEXTURE) {
-        vec4 mr = sampleTexture(m.metallicRoughnessTexture, SAMPLER_LINEAR_REPEAT, s.uv, s.uvDx, s.uvDy);
+        vec4 mr = sampleMaterialTexture(m, TEXTURE_SLOT_METALLIC_ROUGHNESS, m.metallicRoughnessTexture, s);
         o.roughness *= mr.g;
         o.metallic *= mr.b;
     }
@@ -76,25 +110,36 @@ MaterialSample evaluateMaterial(GpuMaterial m, SurfaceInput s) {
 
     o.occlusion = 1.0;
     if (m.occlusionTexture != NO_TEXTURE) {
-        float ao = sampleTexture(m.occlusionTexture, SAMPLER_LINEAR_REPEAT, s.uv, s.uvDx, s.uvDy).r;
+        float ao = sampleMaterialTexture(m, TEXTURE_SLOT_OCCLUSION, m.occlusionTexture, s).r;
         o.occlusion = mix(1.0, ao, m.occlusionStrength);
     }
 
     o.emissive = m.emissiveFactor;
     if (m.emissiveTexture != NO_TEXTURE)
-        o.emissive *= sampleTexture(m.emissiveTexture, SAMPLER_LINEAR_REPEAT, s.uv, s.uvDx, s.uvDy).rgb;
+        o.emissive *= sampleMaterialTexture(m, TEXTURE_SLOT_EMISSIVE, m.emissiveTexture, s).rgb;
 
     vec3 n = normalize(s.normal);
     if ((m.flags & MATERIAL_DOUBLE_SIDED) != 0u && !s.frontFacing) n = -n;
-    if (m.normalTexture != NO_TEXTURE && dot(s.tangent.xyz, s.tangent.xyz) > 1e-8) {
-        vec3 t = normalize(s.tangent.xyz - n * dot(n, s.tangent.xyz));
-        vec3 b = cross(n, t) * (s.tangent.w < 0.0 ? -1.0 : 1.0);
-        vec3 tn = sampleTexture(m.normalTexture, SAMPLER_LINEAR_REPEAT, s.uv, s.uvDx, s.uvDy).xyz * 2.0 - 1.0;
-        o.roughness = toksvigRoughness(o.roughness, length(tn)); // filtered normals are shorter
-        tn.xy *= m.normalScale;
-        n = normalize(t * tn.x + b * tn.y + n * max(tn.z, 1e-3));
+    o.normal = applyNormalMap(m, TEXTURE_SLOT_NORMAL, m.normalTexture, m.normalScale, s, n, o.roughness);
+
+    o.specularF0 = min(m.dielectricF0Scalar * m.specularColorFactor, vec3(1.0));
+    o.specularF90 = m.specularFactor;
+    o.clearcoat = m.clearcoatFactor;
+    o.clearcoatRoughness = m.clearcoatRoughnessFactor;
+    o.clearcoatNormal = n; // the coat follows the geometry, not the base layer's normal map
+    if (o.clearcoat > 0.0) {
+        if (m.clearcoatTexture != NO_TEXTURE)
+            o.clearcoat *= sampleMaterialTexture(m, TEXTURE_SLOT_CLEARCOAT, m.clearcoatTexture, s).r;
+        if (m.clearcoatRoughnessTexture != NO_TEXTURE)
+            o.clearcoatRoughness *= sampleMaterialTexture(m, TEXTURE_SLOT_CLEARCOAT_ROUGHNESS,
+                                                          m.clearcoatRoughnessTexture, s).g;
+        o.clearcoatRoughness = clamp(o.clearcoatRoughness, 0.04, 1.0);
+        o.clearcoatNormal = applyNormalMap(m, TEXTURE_SLOT_CLEARCOAT_NORMAL, m.clearcoatNormalTexture,
+                                           m.clearcoatNormalScale, s, n, o.clearcoatRoughness);
     }
-    o.normal = n;
+    o.sheenColor = m.sheenColorFactor;
+    o.sheenRoughness = max(m.sheenRoughnessFactor, 0.07);
+    o.unlit = (m.flags & MATERIAL_UNLIT) != 0u;
     return o;
 }
 #endif

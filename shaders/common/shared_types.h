@@ -23,6 +23,16 @@ using uint = uint32_t;
 #define MATERIAL_DOUBLE_SIDED 4u
 #define MATERIAL_UNLIT 8u
 
+// Texture slots of a material (scene.h TextureSlot), for uvTransform and clampMask.
+#define TEXTURE_SLOT_BASE_COLOR 0u
+#define TEXTURE_SLOT_METALLIC_ROUGHNESS 1u
+#define TEXTURE_SLOT_NORMAL 2u
+#define TEXTURE_SLOT_EMISSIVE 3u
+#define TEXTURE_SLOT_OCCLUSION 4u
+#define TEXTURE_SLOT_CLEARCOAT 5u
+#define TEXTURE_SLOT_CLEARCOAT_ROUGHNESS 6u
+#define TEXTURE_SLOT_CLEARCOAT_NORMAL 7u
+
 #define PROCEDURAL_NONE 0u
 #define PROCEDURAL_TEXEL_CHECKER 1u
 #define PROCEDURAL_BRICKS 2u
@@ -108,6 +118,20 @@ struct GpuMaterial {
     // Transparent materials: 0 = alpha-blended, 1 = additive (fire, glows), in between a mix;
     // weighted blended OIT composites both without sorting (render/oit).
     float additiveness;
+    // glTF material extensions (scene.h Material; shaders/common/material.glsl).
+    vec2 uvTransform[24]; // per texture slot (TEXTURE_SLOT_*): columns c0, c1, translation c2
+    uint clampMask;       // bit per texture slot: clamp-to-edge sampler
+    uint clearcoatTexture;
+    uint clearcoatRoughnessTexture;
+    uint clearcoatNormalTexture;
+    float clearcoatFactor;
+    float clearcoatRoughnessFactor;
+    float clearcoatNormalScale;
+    float dielectricF0Scalar;   // ((ior - 1) / (ior + 1))^2 x specularFactor
+    vec3 specularColorFactor;   // tints the dielectric F0 (KHR_materials_specular)
+    float specularFactor;       // dielectric F90
+    vec3 sheenColorFactor;      // 0: no sheen
+    float sheenRoughnessFactor;
 };
 
 struct GpuLight {

@@ -67,17 +67,21 @@ vec3 prefilteredShade(FrameConstants f, GpuMaterial mat, SurfaceInput si, vec2 c
     sum.baseColor = vec3(0.0); sum.alpha = 0.0; sum.normal = vec3(0.0); sum.metallic = 0.0;
     sum.roughness = 0.0; sum.occlusion = 0.0; sum.emissive = vec3(0.0);
     uint h = prefilterHash(seed);
+    MaterialSample last;
     for (uint j = 0u; j < n; ++j) {
         for (uint i = 0u; i < n; ++i) {
             SurfaceInput sub = prefilterSample(si, i, j, n, h, centre, step, s0, s1, s2, t0, t1, t2);
             MaterialSample one = evaluateMaterial(mat, sub);
+            last = one;
             sum.baseColor += one.baseColor; sum.alpha += one.alpha; sum.normal += one.normal;
             sum.metallic += one.metallic; sum.roughness += one.roughness;
             sum.occlusion += one.occlusion; sum.emissive += one.emissive;
         }
     }
     float w = 1.0 / float(n * n);
-    MaterialSample m;
+    // Only procedural materials are supersampled: their extension terms (factors) are the same
+    // in every sample, the last one carries them.
+    MaterialSample m = last;
     m.alpha = sum.alpha * w;
     m.normal = normalize(sum.normal); m.metallic = sum.metallic * w;
     m.roughness = toksvigRoughness(sum.roughness * w, length(sum.normal) * w);

@@ -28,7 +28,42 @@ std::string oneLine(std::string text) {
     return text;
 }
 
+// "" and the three values, or why `text` is not "X,Y,Z" of finite numbers in range.
+std::string vec3Problem(const std::string& text, FloatRange r, glm::vec3& out) {
+    const char* p = text.c_str();
+    for (int i = 0; i < 3; ++i) {
+        char* end = nullptr;
+        double value = std::strtod(p, &end);
+        if (end == p) return "expected X,Y,Z (three numbers separated by commas)";
+        if (std::string problem = rangeProblem(value, r); !problem.empty())
+            return format("%c %s", "XYZ"[i], problem.c_str());
+        out[i] = float(value);
+        p = end;
+        if (i < 2) {
+            if (*p != ',') return "expected X,Y,Z (three numbers separated by commas)";
+            ++p;
+        }
+    }
+    return *p == '\0' ? std::string() : "expected X,Y,Z (three numbers separated by commas)";
+}
+
 } // namespace
+
+CLI::Validator finiteVec3(FloatRange range) {
+    auto check = [=](std::string& text) -> std::string {
+        glm::vec3 v;
+        std::string problem = vec3Problem(text, range, v);
+        return problem.empty() ? problem : text + ": " + problem;
+    };
+    return CLI::Validator(check, "X,Y,Z");
+}
+
+glm::vec3 parseVec3(const char* flag, const std::string& text, FloatRange range) {
+    glm::vec3 v(0.0f);
+    if (std::string problem = vec3Problem(text, range, v); !problem.empty())
+        throw InputError(format("%s %s: %s", flag, text.c_str(), problem.c_str()));
+    return v;
+}
 
 CLI::Validator finiteInRange(FloatRange range) {
     auto check = [=](std::string& text) -> std::string {
@@ -68,6 +103,20 @@ void validateRenderOptions(const RenderOptions& o) {
     for (const auto& [flag, value, range] : floats)
         if (std::string problem = checkFiniteInRange(flag, value, range); !problem.empty())
             throw InputError(problem);
+    if (o.time)
+        if (std::string problem = checkFiniteInRange("--time", *o.time, kTimeRange);
+            !problem.empty())
+            throw InputError(problem);
+    const CameraOverrides& c = o.cameraOverrides;
+    if (c.fovDegrees != 0.0f)
+        if (std::string problem = checkFiniteInRange("--fov", c.fovDegrees, kFovRange);
+            !problem.empty())
+            throw InputError(problem);
+    for (const auto& [flag, v] : {std::pair{"--from", c.from}, std::pair{"--look-at", c.lookAt}})
+        for (int i = 0; v && i < 3; ++i)
+            if (std::string problem = checkFiniteInRange(flag, (*v)[i], kCoordinateRange);
+                !problem.empty())
+                throw InputError(problem);
 }
 
 int exitForParseError(const CLI::App& app, const CLI::ParseError& error) {

@@ -5,6 +5,7 @@
 #include <string>
 
 #include <CLI/CLI.hpp>
+#include <glm/glm.hpp>
 
 namespace shadel {
 
@@ -26,9 +27,17 @@ constexpr FloatRange kShadingBiasRange{-8, 8};          // MIP levels
 constexpr FloatRange kTrilinearBandRange{0, 1};         // fraction of a MIP level
 constexpr FloatRange kShadelBudgetRange{0, 1e12, true}; // MIP-0 shadels
 constexpr FloatRange kForwardBelowRange{0, 1e12};       // pixels; 0 = never
+constexpr FloatRange kFovRange{0, 179, true};           // degrees, vertical
+constexpr FloatRange kTimeRange{0, 1e6};                // seconds (--time)
+constexpr FloatRange kCoordinateRange{-1e9, 1e9};       // world units (--from, --look-at)
 
 // Accepts a finite number in the range. CLI11 reports a rejection as "<flag>: <reason>".
 CLI::Validator finiteInRange(FloatRange range);
+
+// Accepts "X,Y,Z": three finite numbers in `range`, nothing else.
+CLI::Validator finiteVec3(FloatRange range);
+// Parses what finiteVec3 accepted (throws InputError naming the flag otherwise).
+glm::vec3 parseVec3(const char* flag, const std::string& text, FloatRange range);
 
 // Accepts a byte size: digits with an optional k, M, G or T (binary) suffix, e.g. 4G.
 CLI::Validator byteSize();

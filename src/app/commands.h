@@ -6,6 +6,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "render/camera_framing.h"
 #include "render/renderer.h"
 
 namespace shadel {
@@ -18,6 +19,8 @@ struct RenderOptions {
     uint32_t width = 1280, height = 720;
     uint32_t frames = 1;
     std::string camera;
+    CameraOverrides cameraOverrides; // --from, --look-at, --fov
+    std::optional<double> time;      // --time: glTF animations posed at this time (seconds)
     bool jitter = false;
     uint32_t ssaa = 1;
     Visualize visualize = Visualize::None;

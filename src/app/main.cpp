@@ -83,7 +83,22 @@ int main(int argc, char** argv) {
     render->add_option("--mode", mode, "forward | decoupled")->capture_default_str();
     render->add_option("--size", size, "WIDTHxHEIGHT")->capture_default_str();
     render->add_option("--frames", ro.frames, "frames to render")->capture_default_str();
-    render->add_option("--camera", ro.camera, "camera name (default: the scene's first)");
+    render->add_option("--camera", ro.camera,
+                       "camera name (default: the scene's first; auto: frame the scene)");
+    std::string from, lookAt;
+    render->add_option("--from", from, "X,Y,Z: camera position (aims at the scene's centre)")
+        ->check(finiteVec3(kCoordinateRange));
+    render->add_option("--look-at", lookAt, "X,Y,Z: the point the camera aims at")
+        ->check(finiteVec3(kCoordinateRange));
+    double timeSeconds = -1.0;
+    render
+        ->add_option("--time", timeSeconds,
+                     "SECONDS: pose glTF animations (node TRS, morph weights, skins) at this time")
+        ->check(finiteInRange(kTimeRange));
+    render
+        ->add_option("--fov", ro.cameraOverrides.fovDegrees,
+                     "vertical field of view in degrees (default: the camera's)")
+        ->check(finiteInRange(kFovRange));
     render
         ->add_option("--jitter", jitter, "none | subpixel: sub-pixel camera offsets between frames")
         ->capture_default_str();
@@ -335,6 +350,11 @@ int main(int argc, char** argv) {
             ro.timing = parseTiming(timing);
             ro.shadelsPerMetre = parseDensity(density);
             ro.cameraPath = parseCameraPath(cameraPath);
+            if (timeSeconds >= 0.0) ro.time = timeSeconds;
+            if (!from.empty())
+                ro.cameraOverrides.from = parseVec3("--from", from, kCoordinateRange);
+            if (!lookAt.empty())
+                ro.cameraOverrides.lookAt = parseVec3("--look-at", lookAt, kCoordinateRange);
             if (capacityControl != "on" && capacityControl != "off")
                 throw InputError(
                     format("--capacity-control %s: expected on or off", capacityControl.c_str()));

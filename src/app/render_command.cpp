@@ -130,8 +130,8 @@ RenderRun runRender(Gpu& gpu, const RenderOptions& o) {
     if (!o.out.empty()) requireCreatableOutput("--out", outDir ? o.out + "frame_0000.png" : o.out);
     if (!o.stats.empty()) requireCreatableOutput("--stats", o.stats);
     if (!o.trace.empty()) requireCreatableOutput("--trace", o.trace);
-    Scene scene = loadScene(o.scene, {o.allowExternalFiles});
-    Camera camera = findCamera(scene, o.camera);
+    Scene scene = loadScene(o.scene, {o.allowExternalFiles, o.time});
+    Camera camera = runCamera(scene, o.camera, o.cameraOverrides, float(o.width) / float(o.height));
     // The camera path is fixed by the loaded scene's bounds (chunking does not move it).
     Aabb bounds = scene.worldBounds();
 

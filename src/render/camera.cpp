@@ -1,5 +1,8 @@
 #include "render/camera.h"
 
+#include <algorithm>
+#include <cmath>
+
 #include <glm/gtc/matrix_transform.hpp>
 
 #include "core/error.h"
@@ -32,10 +35,34 @@ Camera findCamera(const Scene& scene, const std::string& name) {
     c.up = {0, 1, 0};
     c.znear = std::max(distance - radius * 1.5f, distance * 0.001f);
     c.zfar = distance + radius * 2.0f;
+    c.automatic = true;
     return c;
 }
 
-CameraView makeCameraView(const Camera& camera, uint32_t width, uint32_t height, glm::vec2 jitter) {
+// An orthographic camera is drawn as a telephoto perspective one from far behind it: every
+// pass, the view-driven density and the decoupled MIP estimates assume a perspective projection.
+// A point at depth z in front of the orthographic camera then shows at back / (back + z) of its
+// size, so the distance is 256 x the far plane (0.4% at the far plane), at least 256 view
+// heights, and at most 4096 view heights, where float positions keep 1e-3 of the view's height.
+float orthoBackoff(const Camera& camera) {
+    float h = camera.orthoHalfHeight;
+    return std::clamp(256.0f * std::max(camera.zfar, h), 256.0f * h, 4096.0f * h);
+}
+
+Camera perspectiveEquivalent(const Camera& camera) {
+    if (!(camera.orthoHalfHeight > 0.0f)) return camera;
+    Camera c = camera;
+    float back = orthoBackoff(camera);
+    c.position = camera.position - camera.forward * back;
+    c.yfov = 2.0f * std::atan(camera.orthoHalfHeight / back);
+    c.znear = back + camera.znear;
+    c.zfar = back + camera.zfar;
+    c.orthoHalfHeight = 0.0f;
+    return c;
+}
+
+CameraView makeCameraView(const Camera& ortho, uint32_t width, uint32_t height, glm::vec2 jitter) {
+    Camera camera = perspectiveEquivalent(ortho);
     CameraView v;
     v.position = camera.position;
     v.yfov = camera.yfov;

@@ -19,6 +19,8 @@ struct CameraView {
 // Picks the camera named `name` (empty = the scene's first; a scene without cameras gets one
 // framing its bounds). Throws InputError naming the camera when it does not exist.
 Camera findCamera(const Scene& scene, const std::string& name);
+// Orthographic cameras become their telephoto perspective equivalent (see camera.cpp).
+Camera perspectiveEquivalent(const Camera& camera);
 CameraView makeCameraView(const Camera& camera, uint32_t width, uint32_t height,
                           glm::vec2 jitterPixels = glm::vec2(0.0f));
 // Deterministic camera motion over a run (`--camera-path`), so reuse and stability are measured

@@ -60,6 +60,29 @@ gpu::GpuLight gpuLight(const Light& l, std::vector<uint32_t>& blockerLists) {
     return g;
 }
 
+// The glTF material extensions' part of a GPU material (scene.h Material).
+template <typename SlotOf>
+static void setMaterialExtensions(gpu::GpuMaterial& g, const Material& m, SlotOf&& textureSlot) {
+    for (uint32_t t = 0; t < kTextureSlotCount; ++t) {
+        g.uvTransform[t * 3 + 0] = m.uvTransforms[t].c0;
+        g.uvTransform[t * 3 + 1] = m.uvTransforms[t].c1;
+        g.uvTransform[t * 3 + 2] = m.uvTransforms[t].c2;
+    }
+    g.clampMask = m.clampMask;
+    g.clearcoatTexture = textureSlot(m.clearcoatTexture);
+    g.clearcoatRoughnessTexture = textureSlot(m.clearcoatRoughnessTexture);
+    g.clearcoatNormalTexture = textureSlot(m.clearcoatNormalTexture);
+    g.clearcoatFactor = m.clearcoatFactor;
+    g.clearcoatRoughnessFactor = m.clearcoatRoughnessFactor;
+    g.clearcoatNormalScale = m.clearcoatNormalScale;
+    float r = (m.ior - 1.0f) / (m.ior + 1.0f);
+    g.dielectricF0Scalar = r * r * m.specularFactor;
+    g.specularColorFactor = m.specularColorFactor;
+    g.specularFactor = m.specularFactor;
+    g.sheenColorFactor = m.sheenColorFactor;
+    g.sheenRoughnessFactor = m.sheenRoughnessFactor;
+}
+
 void uploadScene(Gpu& gpu, const Scene& scene, GpuScene& out, const std::vector<BakedMesh>* baked) {
     // Textures: sRGB for colour data. Every texture gets a full mip chain and a bindless slot.
     std::vector<bool> srgb(scene.textures.size(), false);
@@ -112,11 +135,12 @@ void uploadScene(Gpu& gpu, const Scene& scene, GpuScene& out, const std::vector<
         g.occlusionTexture = textureSlot(m.occlusionTexture);
         g.flags = (m.alphaMode == AlphaMode::Mask ? MATERIAL_ALPHA_MASK : 0u) |
                   (m.alphaMode == AlphaMode::Blend ? MATERIAL_ALPHA_BLEND : 0u) |
-                  (m.doubleSided ? MATERIAL_DOUBLE_SIDED : 0u);
+                  (m.doubleSided ? MATERIAL_DOUBLE_SIDED : 0u) | (m.unlit ? MATERIAL_UNLIT : 0u);
         g.procedural = uint32_t(m.procedural);
         g.proceduralScale = m.proceduralScale;
         g.additiveness =
             m.alphaMode == AlphaMode::Blend ? std::clamp(m.additiveness, 0.0f, 1.0f) : 0.0f;
+        setMaterialExtensions(g, m, textureSlot);
         materials.push_back(g);
     }
     if (materials.empty()) {
@@ -125,6 +149,7 @@ void uploadScene(Gpu& gpu, const Scene& scene, GpuScene& out, const std::vector<
         g.roughnessFactor = 0.7f;
         g.baseColorTexture = g.metallicRoughnessTexture = g.normalTexture = g.emissiveTexture =
             g.occlusionTexture = NO_TEXTURE;
+        setMaterialExtensions(g, Material{}, [](int32_t) { return NO_TEXTURE; });
         materials.push_back(g);
     }
 

@@ -33,6 +33,11 @@
 #include <stb/stb_image.h>
 #include <stb/stb_image_write.h>
 
+// Declares tinygltf's types first (tiny_gltf.h guards its declarations, not its implementation).
+#include "scene/gltf_animation.h"
+#include "scene/gltf_materials.h"
+#include "scene/gltf_meshopt.h"
+
 #define TINYGLTF_IMPLEMENTATION
 #define TINYGLTF_NO_INCLUDE_STB_IMAGE
 #define TINYGLTF_NO_INCLUDE_STB_IMAGE_WRITE
@@ -40,6 +45,7 @@
 
 #include "core/error.h"
 #include "core/log.h"
+#include "scene/gltf_extensions.h"
 #include "scene/gltf_uri.h"
 #include "scene/json_limits.h"
 #include "scene/mesh_utils.h"
@@ -139,6 +145,25 @@ std::string_view jsonTextOf(const std::vector<uint8_t>& bytes, bool binary,
     return {reinterpret_cast<const char*>(bytes.data()) + 20, chunkLength};
 }
 
+// The same file with its JSON replaced (a .gltf is its JSON; a .glb keeps its other chunks).
+std::vector<uint8_t> withJsonText(const std::vector<uint8_t>& bytes, bool binary,
+                                  std::string text) {
+    if (!binary) return std::vector<uint8_t>(text.begin(), text.end());
+    while (text.size() % 4 != 0) text.push_back(' ');
+    uint32_t oldChunk = readU32(&bytes[12]);
+    size_t rest = 20 + size_t(oldChunk); // checked by jsonTextOf
+    std::vector<uint8_t> out(20);
+    std::memcpy(out.data(), bytes.data(), 12);
+    uint32_t chunk = uint32_t(text.size()), type = kGlbChunkJson;
+    std::memcpy(&out[12], &chunk, 4);
+    std::memcpy(&out[16], &type, 4);
+    out.insert(out.end(), text.begin(), text.end());
+    if (rest < bytes.size()) out.insert(out.end(), bytes.begin() + long(rest), bytes.end());
+    uint32_t length = uint32_t(out.size());
+    std::memcpy(&out[8], &length, 4);
+    return out;
+}
+
 json parseJson(std::string_view text, const std::string& input) {
     if (text.empty()) fail(input, "empty file");
     // Checked in one pass before parsing: a parser callback (called per value with the value
@@ -210,16 +235,6 @@ public:
         checkAsset();
         optStringArray(root_, "extensionsUsed", "");
         optStringArray(root_, "extensionsRequired", "");
-        // Other unsupported extensions only change the look (warned later); without these the
-        // geometry itself cannot be read.
-        if (const json* required = member(root_, "extensionsRequired")) {
-            for (const json& ext : *required) {
-                std::string name = ext.get<std::string>();
-                if (name == "KHR_draco_mesh_compression" || name == "EXT_meshopt_compression")
-                    bad("",
-                        "required extension " + name + " (compressed geometry) is not supported");
-            }
-        }
         checkExtensions(root_, "");
         optIndex(root_, "scene", "", "scenes");
         objectArray(root_, "scenes", "", [&](const json& s, const std::string& p) {
@@ -527,7 +542,57 @@ private:
             optNumber(t, "scale", tp);
             optNumber(t, "strength", tp);
             checkExtensions(t, tp);
+            if (const json* ext = member(t, "extensions"))
+                optObject(*ext, "KHR_texture_transform", child(tp, "extensions"),
+                          [&](const json& tt, const std::string& ttp) {
+                              optNumberArray(tt, "offset", ttp, 2);
+                              optNumberArray(tt, "scale", ttp, 2);
+                              optNumber(tt, "rotation", ttp);
+                              optUint(tt, "texCoord", ttp);
+                          });
         });
+    }
+
+    // The material extensions gltf_materials.cpp reads: numbers, colours and texture infos.
+    void checkMaterialExtensions(const json& ext, const std::string& p) {
+        struct Field {
+            const char* key;
+            size_t size; // 0: a number; otherwise an array of that many numbers
+        };
+        struct Known {
+            const char* name;
+            std::vector<Field> numbers;
+            std::vector<const char*> textures;
+        };
+        static const Known known[] = {
+            {"KHR_materials_emissive_strength", {{"emissiveStrength", 0}}, {}},
+            {"KHR_materials_unlit", {}, {}},
+            {"KHR_materials_pbrSpecularGlossiness",
+             {{"diffuseFactor", 4}, {"specularFactor", 3}, {"glossinessFactor", 0}},
+             {"diffuseTexture", "specularGlossinessTexture"}},
+            {"KHR_materials_clearcoat",
+             {{"clearcoatFactor", 0}, {"clearcoatRoughnessFactor", 0}},
+             {"clearcoatTexture", "clearcoatRoughnessTexture", "clearcoatNormalTexture"}},
+            {"KHR_materials_ior", {{"ior", 0}}, {}},
+            {"KHR_materials_specular",
+             {{"specularFactor", 0}, {"specularColorFactor", 3}},
+             {"specularTexture", "specularColorTexture"}},
+            {"KHR_materials_sheen",
+             {{"sheenColorFactor", 3}, {"sheenRoughnessFactor", 0}},
+             {"sheenColorTexture", "sheenRoughnessTexture"}},
+        };
+        for (const Known& k : known) {
+            const json* e = member(ext, k.name);
+            if (!e) continue;
+            std::string ep = child(p, k.name);
+            for (const Field& f : k.numbers) {
+                if (f.size == 0)
+                    optNumber(*e, f.key, ep, 0.0);
+                else
+                    optNumberArray(*e, f.key, ep, f.size);
+            }
+            for (const char* t : k.textures) checkTextureInfo(*e, t, ep);
+        }
     }
 
     void checkMaterial(const json& m, const std::string& p) {
@@ -553,11 +618,8 @@ private:
         optNumber(m, "alphaCutoff", p, 0.0);
         optBool(m, "doubleSided", p);
         checkExtensions(m, p);
-        if (const json* ext = member(m, "extensions")) {
-            if (const json* es = member(*ext, "KHR_materials_emissive_strength"))
-                optNumber(*es, "emissiveStrength",
-                          child(child(p, "extensions"), "KHR_materials_emissive_strength"), 0.0);
-        }
+        if (const json* ext = member(m, "extensions"))
+            checkMaterialExtensions(*ext, child(p, "extensions"));
     }
 
     void checkImage(const json& i, const std::string& p) {
@@ -777,11 +839,13 @@ bool finiteMatrix(const glm::mat4& m) {
 
 class GltfConverter {
 public:
-    GltfConverter(const tinygltf::Model& model, const std::string& input, Scene& scene)
-        : model_(model), input_(input), scene_(scene) {}
+    // `skinning`: skinned meshes are posed by their joints (with --time); otherwise drawn in
+    // their bind pose.
+    GltfConverter(const tinygltf::Model& model, const std::string& input, Scene& scene,
+                  bool skinning = false)
+        : model_(model), input_(input), scene_(scene), skinning_(skinning) {}
 
     void run() {
-        warnAboutExtensions();
         for (size_t i = 0; i < model_.accessors.size(); ++i) validateAccessor(int(i));
         for (size_t i = 0; i < model_.materials.size(); ++i)
             scene_.materials.push_back(convertMaterial(int(i)));
@@ -820,6 +884,8 @@ private:
     std::string skipReasons_;
     std::set<std::string> warnedOnce_;
     std::vector<bool> cameraZfarGiven_;
+    bool skinning_ = false;
+    std::vector<glm::mat4> worldOf_; // every node's world transform (identity if unreached)
 
     [[noreturn]] void error(const std::string& reason) { fail(input_, reason); }
     void warn(const std::string& what) { SHADEL_WARN("%s: %s", input_.c_str(), what.c_str()); }
@@ -830,20 +896,6 @@ private:
         ++skippedPrimitives_;
         if (skipReasons_.find(reason) == std::string::npos)
             skipReasons_ += (skipReasons_.empty() ? "" : ", ") + reason;
-    }
-
-    void warnAboutExtensions() {
-        static const std::set<std::string> supported = {
-            "KHR_lights_punctual", "KHR_materials_emissive_strength", "KHR_mesh_quantization"};
-        std::set<std::string> required(model_.extensionsRequired.begin(),
-                                       model_.extensionsRequired.end());
-        std::set<std::string> all(model_.extensionsUsed.begin(), model_.extensionsUsed.end());
-        all.insert(required.begin(), required.end());
-        for (const std::string& ext : all) {
-            if (supported.count(ext)) continue;
-            warn(format("%sextension %s is not supported; ignored, the scene may look different",
-                        required.count(ext) ? "required " : "", ext.c_str()));
-        }
     }
 
     // Resolves an accessor to bytes, checking that every element lies inside its buffer view
@@ -1040,12 +1092,13 @@ private:
         if (m.emissiveFactor.size() == 3)
             out.emissiveFactor = glm::vec3(float(m.emissiveFactor[0]), float(m.emissiveFactor[1]),
                                            float(m.emissiveFactor[2]));
+        // Read here for the additiveness of blended materials; gltf_materials applies it to the
+        // emissive factor with the other material extensions.
         float emissiveStrength = 1.0f;
         if (auto it = m.extensions.find("KHR_materials_emissive_strength");
             it != m.extensions.end()) {
             const tinygltf::Value& strength = it->second.Get("emissiveStrength");
             if (strength.IsNumber()) emissiveStrength = float(strength.GetNumberAsDouble());
-            out.emissiveFactor *= emissiveStrength;
         }
         out.normalScale = float(m.normalTexture.scale);
         out.occlusionStrength = std::clamp(float(m.occlusionTexture.strength), 0.0f, 1.0f);
@@ -1066,7 +1119,41 @@ private:
                                        "occlusion", index);
         out.emissiveTexture =
             texture(m.emissiveTexture.index, m.emissiveTexture.texCoord, true, "emissive", index);
+        MaterialTextures textures;
+        textures.resolve = [&](int t, int texCoord, bool srgb, const char* slot) {
+            return texture(t, texCoord, srgb, slot, index);
+        };
+        textures.clamps = [&](int t) {
+            int sampler = model_.textures[size_t(t)].sampler;
+            if (sampler < 0 || size_t(sampler) >= model_.samplers.size()) return false;
+            const tinygltf::Sampler& s = model_.samplers[size_t(sampler)];
+            return s.wrapS == TINYGLTF_TEXTURE_WRAP_CLAMP_TO_EDGE &&
+                   s.wrapT == TINYGLTF_TEXTURE_WRAP_CLAMP_TO_EDGE;
+        };
+        textures.glossinessToRoughness = [&](int t, float glossinessFactor) {
+            return glossinessToRoughness(t, glossinessFactor, index);
+        };
+        textures.warn = [&](const std::string& what) { warnOnce(what); };
+        applyMaterialExtensions(m, index, out, textures);
         return out;
+    }
+
+    // A metallic-roughness texture (G = 1 - alpha x glossinessFactor, B = 0) from a
+    // specularGlossinessTexture (glossiness in alpha).
+    int32_t glossinessToRoughness(int textureIndex, float glossinessFactor, int material) {
+        int32_t source = texture(textureIndex, 0, false, "specular-glossiness", material);
+        if (source == kNoTexture) return kNoTexture;
+        Texture tex = scene_.textures[size_t(source)];
+        tex.name += " (roughness from glossiness)";
+        for (size_t i = 0; i + 3 < tex.rgba8.size(); i += 4) {
+            float gloss = tex.rgba8[i + 3] / 255.0f * glossinessFactor;
+            tex.rgba8[i] = 0;
+            tex.rgba8[i + 1] = uint8_t(std::lround((1.0f - gloss) * 255.0f));
+            tex.rgba8[i + 2] = 0;
+            tex.rgba8[i + 3] = 255;
+        }
+        scene_.textures.push_back(std::move(tex));
+        return int32_t(scene_.textures.size() - 1);
     }
 
     uint32_t defaultMaterial() {
@@ -1111,12 +1198,14 @@ private:
         return tris;
     }
 
-    void convertMesh(int meshIndex) {
+    // `weights`: the morph target weights of the node that first uses the mesh (or the mesh's).
+    void convertMesh(int meshIndex, const std::vector<double>& nodeWeights) {
         meshConverted_[size_t(meshIndex)] = true;
         const tinygltf::Mesh& gm = model_.meshes[size_t(meshIndex)];
+        const std::vector<double>& weights = nodeWeights.empty() ? gm.weights : nodeWeights;
         for (size_t p = 0; p < gm.primitives.size(); ++p) {
             std::string where = format("mesh %d primitive %zu", meshIndex, p);
-            std::optional<Mesh> mesh = convertPrimitive(gm.primitives[p], where);
+            std::optional<Mesh> mesh = convertPrimitive(gm.primitives[p], where, weights);
             if (!mesh) continue;
             mesh->name = (gm.name.empty() ? format("mesh%d", meshIndex) : gm.name) +
                          (gm.primitives.size() > 1 ? format("/%zu", p) : std::string());
@@ -1127,8 +1216,8 @@ private:
         }
     }
 
-    std::optional<Mesh> convertPrimitive(const tinygltf::Primitive& prim,
-                                         const std::string& where) {
+    std::optional<Mesh> convertPrimitive(const tinygltf::Primitive& prim, const std::string& where,
+                                         const std::vector<double>& weights) {
         int mode = prim.mode < 0 ? TINYGLTF_MODE_TRIANGLES : prim.mode;
         if (mode != TINYGLTF_MODE_TRIANGLES && mode != TINYGLTF_MODE_TRIANGLE_STRIP &&
             mode != TINYGLTF_MODE_TRIANGLE_FAN) {
@@ -1136,19 +1225,14 @@ private:
             noteSkip("points/lines");
             return std::nullopt;
         }
-        if (prim.extensions.count("KHR_draco_mesh_compression")) {
-            warn(where + ": KHR_draco_mesh_compression is not supported; skipped");
-            noteSkip("Draco-compressed");
-            return std::nullopt;
-        }
+        // An optional KHR_draco_mesh_compression (ignored, warned once for the file) leaves the
+        // primitive's uncompressed accessors as the fallback; a required one was refused.
         auto attribute = [&](const char* name) {
             auto it = prim.attributes.find(name);
             return it == prim.attributes.end() ? -1 : it->second;
         };
         int positionAccessor = attribute("POSITION");
         if (positionAccessor < 0) error(where + " has no POSITION attribute");
-        if (!prim.targets.empty()) warnOnce("morph targets are ignored (base shape shown)");
-
         std::vector<float> positions = readFloats(positionAccessor, 3, "POSITION");
         size_t vertexCount = positions.size() / 3;
         Mesh mesh;
@@ -1171,6 +1255,7 @@ private:
         };
         std::vector<float> normals = readAttribute("NORMAL", 3);
         std::vector<float> tangents = readAttribute("TANGENT", 4);
+        applyMorphTargets(prim, weights, vertexCount, mesh, normals);
         std::vector<float> uvs = readAttribute("TEXCOORD_0", 2);
         for (size_t v = 0; v < vertexCount; ++v) {
             Vertex& vert = mesh.vertices[v];
@@ -1209,6 +1294,35 @@ private:
                         repaired));
         computeBounds(mesh);
         return mesh;
+    }
+
+    // Adds sum(weight x target) to positions and normals (glTF morph targets hold deltas).
+    void applyMorphTargets(const tinygltf::Primitive& prim, const std::vector<double>& weights,
+                           size_t vertexCount, Mesh& mesh, std::vector<float>& normals) {
+        for (size_t t = 0; t < prim.targets.size() && t < weights.size(); ++t) {
+            float w = float(weights[t]);
+            if (w == 0.0f || !std::isfinite(w)) continue;
+            for (const auto& [name, accessor] : prim.targets[t]) {
+                bool position = name == "POSITION";
+                if (!position && (name != "NORMAL" || normals.empty())) continue;
+                std::vector<float> delta = readFloats(accessor, 3, name.c_str());
+                if (delta.size() != vertexCount * 3)
+                    error(format("morph target %zu %s has %zu elements but POSITION has %zu", t,
+                                 name.c_str(), delta.size() / 3, vertexCount));
+                for (size_t v = 0; v < vertexCount; ++v) {
+                    glm::vec3 d = glm::make_vec3(&delta[v * 3]) * w;
+                    if (position) {
+                        mesh.vertices[v].position += d;
+                        if (!finite3(mesh.vertices[v].position))
+                            error(format("morph target %zu moves vertex %zu to a non-finite "
+                                         "position",
+                                         t, v));
+                    } else {
+                        for (int c = 0; c < 3; ++c) normals[v * 3 + size_t(c)] += d[c];
+                    }
+                }
+            }
+        }
     }
 
     glm::mat4 localMatrix(const tinygltf::Node& node, int index) {
@@ -1253,9 +1367,12 @@ private:
 
     void addNodeContent(const tinygltf::Node& node, int index, const glm::mat4& world) {
         std::string nodeName = node.name.empty() ? format("node%d", index) : node.name;
-        if (node.skin >= 0) warnOnce("skinning is ignored (meshes shown in bind pose)");
-        if (node.mesh >= 0) {
-            if (!meshConverted_[size_t(node.mesh)]) convertMesh(node.mesh);
+        if (node.skin >= 0 && node.mesh >= 0 && skinning_) {
+            addSkinnedMesh(node, index, nodeName);
+        } else if (node.mesh >= 0) {
+            if (node.skin >= 0)
+                warnOnce("skinned meshes are drawn in their bind pose without --time");
+            if (!meshConverted_[size_t(node.mesh)]) convertMesh(node.mesh, node.weights);
             // A mirroring transform turns CCW into CW: give those instances a mesh with the
             // winding reversed so front faces stay front faces.
             bool mirrored = glm::determinant(glm::mat3(world)) < 0.0f;
@@ -1281,9 +1398,9 @@ private:
     void addCamera(const tinygltf::Node& node, int nodeIndex, glm::vec3 position, glm::vec3 forward,
                    glm::vec3 up) {
         const tinygltf::Camera& cam = model_.cameras[size_t(node.camera)];
-        if (cam.type != "perspective") {
-            warn(format("camera %d is %s; only perspective cameras are imported", node.camera,
-                        cam.type.c_str()));
+        bool ortho = cam.type == "orthographic";
+        if (cam.type != "perspective" && !ortho) {
+            warn(format("camera %d has unknown type '%s'; skipped", node.camera, cam.type.c_str()));
             return;
         }
         Camera out;
@@ -1300,10 +1417,25 @@ private:
         out.forward = forward / fl;
         up -= out.forward * glm::dot(up, out.forward);
         out.up = glm::length(up) > 1e-12f ? glm::normalize(up) : glm::vec3(0, 1, 0);
-        out.yfov = float(cam.perspective.yfov);
-        out.znear = float(cam.perspective.znear);
-        bool hasFar = cam.perspective.zfar > cam.perspective.znear;
-        if (hasFar) out.zfar = float(cam.perspective.zfar);
+        bool hasFar = false;
+        if (ortho) {
+            // The node's scale does not scale the view (glTF: camera transforms are rigid).
+            float ymag = std::abs(float(cam.orthographic.ymag));
+            if (!(ymag > 0.0f) || !std::isfinite(ymag)) {
+                warn(format("orthographic camera %d has ymag %g; skipped", node.camera,
+                            cam.orthographic.ymag));
+                return;
+            }
+            out.orthoHalfHeight = ymag;
+            out.znear = std::max(float(cam.orthographic.znear), ymag * 1e-6f);
+            hasFar = cam.orthographic.zfar > cam.orthographic.znear;
+            if (hasFar) out.zfar = float(cam.orthographic.zfar);
+        } else {
+            out.yfov = float(cam.perspective.yfov);
+            out.znear = float(cam.perspective.znear);
+            hasFar = cam.perspective.zfar > cam.perspective.znear;
+            if (hasFar) out.zfar = float(cam.perspective.zfar);
+        }
         scene_.cameras.push_back(out);
         cameraZfarGiven_.push_back(hasFar);
     }
@@ -1339,6 +1471,77 @@ private:
     // The scene's root nodes, then a depth-first walk with an explicit stack (a long chain of
     // nodes must not overflow the call stack). glTF node graphs are disjoint trees: a node
     // reached twice means a cycle or a shared child, both invalid.
+    // A skinned node's own mesh copy, its vertices moved by sum(weight x world(joint) x
+    // inverseBind) (glTF skinning, evaluated on the CPU once per run); the node's transform is
+    // ignored, as glTF specifies.
+    void addSkinnedMesh(const tinygltf::Node& node, int index, const std::string& nodeName) {
+        const tinygltf::Skin& skin = model_.skins[size_t(node.skin)];
+        std::vector<glm::mat4> joints(skin.joints.size(), glm::mat4(1.0f));
+        std::vector<float> ibm;
+        if (skin.inverseBindMatrices >= 0) {
+            ibm = readFloats(skin.inverseBindMatrices, 16, "inverseBindMatrices");
+            if (ibm.size() / 16 < skin.joints.size())
+                error(format("skin %d has %zu inverse bind matrices for %zu joints", node.skin,
+                             ibm.size() / 16, skin.joints.size()));
+        }
+        for (size_t j = 0; j < skin.joints.size(); ++j) {
+            int joint = skin.joints[j];
+            if (joint < 0 || size_t(joint) >= model_.nodes.size())
+                error(format("skin %d joint %zu is not a node", node.skin, j));
+            glm::mat4 inverseBind = ibm.empty() ? glm::mat4(1.0f) : glm::make_mat4(&ibm[j * 16]);
+            joints[j] = worldOf_[size_t(joint)] * inverseBind;
+        }
+        const tinygltf::Mesh& gm = model_.meshes[size_t(node.mesh)];
+        const std::vector<double>& weights = node.weights.empty() ? gm.weights : node.weights;
+        for (size_t p = 0; p < gm.primitives.size(); ++p) {
+            const tinygltf::Primitive& prim = gm.primitives[p];
+            std::string where =
+                format("mesh %d primitive %zu (skinned, node %d)", node.mesh, p, index);
+            std::optional<Mesh> mesh = convertPrimitive(prim, where, weights);
+            if (!mesh) continue;
+            auto j = prim.attributes.find("JOINTS_0");
+            auto w = prim.attributes.find("WEIGHTS_0");
+            if (j != prim.attributes.end() && w != prim.attributes.end()) {
+                std::vector<float> ji = readFloats(j->second, 4, "JOINTS_0");
+                std::vector<float> wi = readFloats(w->second, 4, "WEIGHTS_0");
+                size_t count = mesh->vertices.size();
+                if (ji.size() != count * 4 || wi.size() != count * 4)
+                    error(where + ": JOINTS_0/WEIGHTS_0 do not match POSITION");
+                for (size_t v = 0; v < count; ++v) {
+                    glm::mat4 m(0.0f);
+                    for (int k = 0; k < 4; ++k) {
+                        float jf = ji[v * 4 + size_t(k)];
+                        if (!(jf >= 0.0f) || size_t(jf) >= joints.size())
+                            error(format("%s: vertex %zu joint %g out of range (%zu joints)",
+                                         where.c_str(), v, jf, joints.size()));
+                        m += joints[size_t(jf)] * wi[v * 4 + size_t(k)];
+                    }
+                    Vertex& vert = mesh->vertices[v];
+                    vert.position = glm::vec3(m * glm::vec4(vert.position, 1.0f));
+                    glm::mat3 n = glm::transpose(glm::inverse(glm::mat3(m)));
+                    vert.normal = n * vert.normal;
+                    vert.tangent =
+                        glm::vec4(glm::mat3(m) * glm::vec3(vert.tangent), vert.tangent.w);
+                    if (!finite3(vert.position))
+                        error(format("%s: vertex %zu skinned to a non-finite position",
+                                     where.c_str(), v));
+                }
+                sanitizeNormalsAndTangents(*mesh);
+                computeBounds(*mesh);
+            }
+            mesh->name = (gm.name.empty() ? format("mesh%d", node.mesh) : gm.name) +
+                         format(" (skinned, node %d)", index);
+            std::vector<Mesh> parts = splitMesh(std::move(*mesh));
+            for (size_t k = 0; k < parts.size(); ++k) {
+                Instance inst;
+                inst.name = nodeName + (parts.size() > 1 ? format("#%zu", k) : std::string());
+                inst.mesh = uint32_t(scene_.meshes.size());
+                scene_.meshes.push_back(std::move(parts[k]));
+                scene_.instances.push_back(std::move(inst)); // identity: already in world space
+            }
+        }
+    }
+
     void traverseNodes() {
         std::vector<int> roots;
         int sceneIndex = model_.defaultScene >= 0 ? model_.defaultScene
@@ -1358,6 +1561,9 @@ private:
         std::vector<std::pair<int, glm::mat4>> stack;
         for (auto it = roots.rbegin(); it != roots.rend(); ++it)
             stack.emplace_back(*it, glm::mat4(1.0f));
+        // World transforms first (skins need their joints'), then the content in walk order.
+        worldOf_.assign(model_.nodes.size(), glm::mat4(1.0f));
+        std::vector<int> order;
         while (!stack.empty()) {
             auto [index, parent] = stack.back();
             stack.pop_back();
@@ -1368,10 +1574,13 @@ private:
             glm::mat4 world = parent * localMatrix(node, index);
             if (!finiteMatrix(world))
                 error(format("node %d has a non-finite world transform", index));
-            addNodeContent(node, index, world);
+            worldOf_[size_t(index)] = world;
+            order.push_back(index);
             for (auto c = node.children.rbegin(); c != node.children.rend(); ++c)
                 stack.emplace_back(*c, world);
         }
+        for (int index : order)
+            addNodeContent(model_.nodes[size_t(index)], index, worldOf_[size_t(index)]);
     }
 
     void finishCamerasAndLights() {
@@ -1397,6 +1606,7 @@ private:
             cam.up = glm::normalize(up);
             cam.znear = std::max(distance - radius, radius * 0.01f) * 0.5f;
             cam.zfar = (distance + radius) * 2.0f;
+            cam.automatic = true; // refitted tightly for the run (render/camera_framing.h)
             scene_.cameras.push_back(cam);
             SHADEL_INFO("%s: no camera in the file; using an automatic one framing the scene",
                         input_.c_str());
@@ -1429,7 +1639,11 @@ Scene importGltfBytes(std::vector<uint8_t> bytes, const std::string& path,
     json document = parseJson(jsonTextOf(bytes, binary, input), input);
     checkCounts(document, input);
     JsonSchemaCheck(document, input).run();
+    checkRequiredGltfExtensions(document, input);
+    std::string extensionsWarning = ignoredExtensionsWarning(ignoredGltfExtensions(document));
     if (!options.allowExternalFiles) checkUrisStayInFolder(document, input);
+    MeshoptPlan meshopt = prepareMeshopt(document, input);
+    if (!meshopt.fallbacks.empty()) bytes = withJsonText(bytes, binary, document.dump());
     document = json(); // tinygltf parses its own copy
 
     tinygltf::TinyGLTF loader;
@@ -1455,12 +1669,17 @@ Scene importGltfBytes(std::vector<uint8_t> bytes, const std::string& path,
         }
     }
     if (!ok || !err.empty()) fail(input, oneLine(err.empty() ? "glTF loader failed" : err));
+    decodeMeshopt(meshopt, model, input);
+    if (options.time)
+        poseAnimations(model, *options.time, input,
+                       [&](const std::string& w) { SHADEL_WARN("%s", w.c_str()); });
     bytes.clear();
     bytes.shrink_to_fit();
 
     Scene scene;
     scene.name = std::filesystem::path(path).stem().string();
-    GltfConverter(model, input, scene).run();
+    if (!extensionsWarning.empty()) SHADEL_WARN("%s: %s", input.c_str(), extensionsWarning.c_str());
+    GltfConverter(model, input, scene, options.time.has_value()).run();
     return scene;
 }
 

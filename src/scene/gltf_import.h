@@ -1,6 +1,7 @@
 #pragma once
 // glTF 2.0 import (.gltf and .glb) into the plain scene model.
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -11,6 +12,9 @@ namespace shadel {
 struct SceneFileOptions {
     // Buffer and image URIs may resolve outside the model's folder (`../`, absolute paths).
     bool allowExternalFiles = false;
+    // --time: animations posed at this time in seconds (node TRS and morph weights); unset =
+    // the file's rest pose.
+    std::optional<double> time;
 };
 
 // Loads a glTF 2.0 file. Every malformed input throws InputError with one line

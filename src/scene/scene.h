@@ -49,6 +49,25 @@ enum class Procedural : uint32_t {
 
 constexpr int32_t kNoTexture = -1;
 
+// The material's texture slots, in the order of Material::uvTransforms and the GPU's.
+enum class TextureSlot : uint32_t {
+    BaseColor = 0,
+    MetallicRoughness,
+    Normal,
+    Emissive,
+    Occlusion,
+    Clearcoat,          // KHR_materials_clearcoat: R = coat weight
+    ClearcoatRoughness, // G = coat roughness
+    ClearcoatNormal,
+    Count
+};
+constexpr uint32_t kTextureSlotCount = uint32_t(TextureSlot::Count);
+
+// KHR_texture_transform: uv' = c0 * u + c1 * v + c2 (identity when absent).
+struct UvTransform {
+    glm::vec2 c0{1.0f, 0.0f}, c1{0.0f, 1.0f}, c2{0.0f, 0.0f};
+};
+
 struct Material {
     std::string name;
     glm::vec4 baseColorFactor{1.0f};
@@ -70,6 +89,22 @@ struct Material {
     // Blended materials only: 0 = alpha-blended, 1 = additive (seed 001's "additiveness"),
     // composited without sorting by weighted blended OIT (render/oit).
     float additiveness = 0.0f;
+
+    // glTF material extensions (scene/gltf_materials.h); the defaults leave core PBR unchanged.
+    UvTransform uvTransforms[kTextureSlotCount];
+    uint32_t clampMask = 0; // bit per TextureSlot: sampled clamp-to-edge instead of repeat
+    bool unlit = false;     // KHR_materials_unlit: the base colour is the output
+    float clearcoatFactor = 0.0f;
+    float clearcoatRoughnessFactor = 0.0f;
+    float clearcoatNormalScale = 1.0f;
+    int32_t clearcoatTexture = kNoTexture;
+    int32_t clearcoatRoughnessTexture = kNoTexture;
+    int32_t clearcoatNormalTexture = kNoTexture;
+    float ior = 1.5f;                    // KHR_materials_ior: dielectric F0 = ((ior-1)/(ior+1))^2
+    float specularFactor = 1.0f;         // KHR_materials_specular: scales dielectric F0 and F90
+    glm::vec3 specularColorFactor{1.0f}; // tints dielectric F0
+    glm::vec3 sheenColorFactor{0.0f};    // KHR_materials_sheen (0: no sheen)
+    float sheenRoughnessFactor = 0.0f;
 };
 
 struct Texture {
@@ -133,6 +168,11 @@ struct Camera {
     float yfov = 0.8f; // radians
     float znear = 0.05f;
     float zfar = 500.0f;
+    // > 0: orthographic, half the view's height in world units (glTF ymag); yfov is unused.
+    float orthoHalfHeight = 0.0f;
+    // Made by the engine, not the file: refitted to the scene for the run's aspect and field of
+    // view (render/camera_framing.h).
+    bool automatic = false;
 };
 
 struct Scene {

@@ -143,6 +143,11 @@ def bad_files():
     out["glb_bad_length.glb"] = glb(g, data, length_delta=1000)
     g2 = copy.deepcopy(g); g2["buffers"][0]["byteLength"] = 4096
     out["glb_buffer_too_long.glb"] = glb(g2, data)
+
+    d = quad()
+    d["extensionsUsed"] = ["EXT_made_up_geometry", "KHR_lights_punctual"]
+    d["extensionsRequired"] = ["KHR_lights_punctual", "EXT_made_up_geometry"]
+    out["required_unsupported_extension.gltf"] = d
     return out
 
 
@@ -161,6 +166,17 @@ def good_files():
     d["materials"][0]["extensions"] = {"KHR_materials_emissive_strength": {"emissiveStrength": 4.0}}
     d["materials"][0]["extensions"]["EXT_made_up_extension"] = {"anything": [1, 2]}
     out["unsupported_extension.gltf"] = d
+
+    # Optional unsupported extensions in several places (root, node, material, texture info,
+    # primitive), some used twice and some missing from extensionsUsed: one warning lists each
+    # once.
+    d = copy.deepcopy(q)
+    d["extensionsUsed"] = ["EXT_made_up_b", "EXT_made_up_a", "KHR_lights_punctual"]
+    d["extensions"] = {"EXT_made_up_a": {}}
+    d["nodes"][0]["extensions"] = {"EXT_made_up_a": {}, "EXT_made_up_c": {}}
+    d["materials"][0]["extensions"] = {"EXT_made_up_b": {}}
+    d["meshes"][0]["primitives"][0]["extensions"] = {"EXT_made_up_d": {"x": 1}}
+    out["optional_extensions.gltf"] = d
 
     # Camera and lights on rotated/translated nodes; the expected world values are easy to derive:
     # a -90 degree rotation about X turns the local -Z (view/light direction) into world -Y.
@@ -204,6 +220,8 @@ def good_files():
     data = quad_buffer()
     g = copy.deepcopy(q); g["buffers"] = [{"byteLength": len(data)}]
     out["quad.glb"] = glb(g, data)
+    # quad_meshopt.glb (EXT_meshopt_compression) is not written here: it is
+    # `gltfpack -cc -i quad.glb -o quad_meshopt.glb` (Debian's gltfpack 0.18).
     return out
 
 

@@ -102,7 +102,6 @@ TEST(BakeUtilisation, AssimpGltf2TestModels) {
         "BoxTextured-glTF-Binary/BoxTextured.glb",
         "BoxTextured-glTF-Embedded/BoxTextured.gltf",
         "BoxTextured-glTF-pbrSpecularGlossiness/BoxTextured.gltf",
-        "BoxTextured-glTF-techniqueWebGL/BoxTextured.gltf",
         "BoxTextured-glTF/BoxTextured.gltf",
         "ClearCoat-glTF/ClearCoatTest.gltf",
         "cameras/Cameras.gltf",

@@ -136,6 +136,8 @@ const BadFile kOurBadFiles[] = {
     {"no_position.gltf", "has no POSITION"},
     {"no_triangles_no_mesh.gltf", "no triangles"},
     {"no_triangles_points.gltf", "no triangles to render (1 primitive(s) skipped: points/lines)"},
+    {"required_unsupported_extension.gltf",
+     "required extension EXT_made_up_geometry is not supported"},
     {"root_not_object.gltf", "root must be an object"},
     {"scene_index_out_of_range.gltf", "/scene: index 3 out of range"},
     {"self_parent_node.gltf", "node 0 is reached twice"},
@@ -189,7 +191,9 @@ const BadFile kAssimpBadFiles[] = {
     {"glTF2/IncorrectVertexArrays/Cube.gltf", "exceeds buffer"},
     {"glTF2/TestNoRootNode/NoScene.gltf", "/scene: index 0 out of range"},
     {"glTF2/TestNoRootNode/SceneWithoutNodes.gltf", "no triangles"},
-    {"glTF2/draco/2CylinderEngine.gltf", "KHR_draco_mesh_compression"},
+    {"glTF2/draco/2CylinderEngine.gltf", "required extension KHR_draco_mesh_compression"},
+    {"glTF2/BoxTextured-glTF-techniqueWebGL/BoxTextured.gltf",
+     "required extension KHR_technique_webgl is not supported"},
     {"glTF2/glTF-Asset-Generator/Mesh_PrimitiveMode/Mesh_PrimitiveMode_00.gltf", "points/lines"},
     {"glTF/BoxTextured-glTF/BoxTextured.gltf", "glTF version '1.0' is not supported"},
     {"glTF/BoxTextured-glTF-Binary/BoxTextured.glb", "binary glTF version 1 is not supported"},
@@ -265,8 +269,16 @@ TEST(GltfImport, BlendMaterialsMapOntoAdditiveness) {
 TEST(GltfImport, CamerasAndPunctualLightsInWorldSpace) {
     Scene scene = loadScene(kData + "/gltf/cameras_lights.gltf");
     EXPECT_EQ(sceneInvariantViolation(scene), "");
-    ASSERT_EQ(scene.cameras.size(), 1u) << "the orthographic camera is skipped";
+    ASSERT_EQ(scene.cameras.size(), 2u);
+    const Camera& ortho = scene.cameras[1];
+    EXPECT_EQ(ortho.name, "ortho");
+    EXPECT_FLOAT_EQ(ortho.orthoHalfHeight, 1.0f);
+    EXPECT_FLOAT_EQ(ortho.znear, 0.1f);
+    EXPECT_FLOAT_EQ(ortho.zfar, 10.0f);
+    EXPECT_NEAR(glm::distance(ortho.position, glm::vec3(10, 0, 0)), 0.0f, 1e-5f);
     const Camera& cam = scene.cameras[0];
+    EXPECT_EQ(cam.orthoHalfHeight, 0.0f);
+    EXPECT_FALSE(cam.automatic);
     EXPECT_EQ(cam.name, "front");
     EXPECT_NEAR(glm::distance(cam.position, glm::vec3(10, 1, 5)), 0.0f, 1e-5f);
     EXPECT_NEAR(glm::distance(cam.forward, glm::vec3(0, 0, -1)), 0.0f, 1e-5f);
@@ -429,7 +441,8 @@ TEST(GltfImportModels, CamerasFile) {
     Scene s = loadScene(kAssimp + "/cameras/Cameras.gltf");
     EXPECT_EQ(sceneInvariantViolation(s), "");
     EXPECT_EQ(s.triangleCount(), 2u);
-    ASSERT_EQ(s.cameras.size(), 1u); // one perspective, one orthographic (skipped)
+    ASSERT_EQ(s.cameras.size(), 2u); // one perspective, one orthographic
+    EXPECT_FLOAT_EQ(s.cameras[1].orthoHalfHeight, 1.0f);
     EXPECT_NEAR(glm::distance(s.cameras[0].position, glm::vec3(0.5f, 0.5f, 3.0f)), 0.0f, 1e-5f);
     EXPECT_FLOAT_EQ(s.cameras[0].yfov, 0.7f);
     EXPECT_FLOAT_EQ(s.cameras[0].zfar, 100.0f);
@@ -466,7 +479,7 @@ TEST(GltfImportModels, OtherModelsLoadWithValidAttributes) {
         {"BoxTexcoords-glTF/boxTexcoords.gltf", 12, 2},
         {"BoxBadNormals-glTF-Binary/BoxBadNormals.glb", 12, 0},
         {"BoxTextured-glTF-pbrSpecularGlossiness/BoxTextured.gltf", 12, 1},
-        {"ClearCoat-glTF/ClearCoatTest.gltf", 37116, 5},
+        {"ClearCoat-glTF/ClearCoatTest.gltf", 37116, 6}, // 5 + the clearcoat weight texture
         {"textureTransform/TextureTransformTest.gltf", 24, 5},
         {"glTF-Sample-Models/AnimatedMorphCube-glTF/AnimatedMorphCube.gltf", 12, 0},
         {"simple_skin/simple_skin.gltf", 8, 0},

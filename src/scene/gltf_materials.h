@@ -1,0 +1,41 @@
+#pragma once
+// glTF material extensions applied to the scene's Material at import (gltf_import.cpp calls
+// this; the shared material code in shaders/common/material.glsl evaluates the result, so the
+// forward and decoupled paths agree):
+//  KHR_texture_transform              uv transform per texture slot (offset, rotation, scale)
+//  KHR_materials_emissive_strength    scales emissiveFactor
+//  KHR_materials_unlit                output = base colour
+//  KHR_materials_pbrSpecularGlossiness converted to metal/rough + specular (see .cpp)
+//  KHR_materials_clearcoat            coat weight, roughness, normal (factors and textures)
+//  KHR_materials_ior, _specular       dielectric F0/F90 (factors)
+//  KHR_materials_sheen                sheen colour and roughness (factors)
+// The JSON values were type- and range-checked by the importer's schema check.
+#include <functional>
+#include <string>
+
+#include "scene/scene.h"
+
+#include <tiny_gltf.h>
+
+namespace shadel {
+
+// Resolves a glTF texture index to a scene texture (kNoTexture when unusable); `slot` names it
+// in warnings.
+struct MaterialTextures {
+    std::function<int32_t(int texture, int texCoord, bool srgb, const char* slot)> resolve;
+    // True when the glTF texture's sampler clamps to the edge in both directions.
+    std::function<bool(int texture)> clamps;
+    // Converts a KHR_materials_pbrSpecularGlossiness specularGlossinessTexture into a
+    // metallic-roughness texture (roughness = 1 - glossiness x factor); kNoTexture when unusable.
+    std::function<int32_t(int texture, float glossinessFactor)> glossinessToRoughness;
+    std::function<void(const std::string&)> warn;
+};
+
+// Reads a texture info's KHR_texture_transform (identity when absent).
+UvTransform uvTransformOf(const tinygltf::ExtensionMap& textureInfoExtensions);
+
+// Applies every supported extension of `gm` to `out` (whose core PBR fields are filled).
+void applyMaterialExtensions(const tinygltf::Material& gm, int materialIndex, Material& out,
+                             const MaterialTextures& textures);
+
+} // namespace shadel
