@@ -46,6 +46,9 @@ struct RenderOptions {
     double shadelBudget = 64e6; // MIP-0 shadels the bake may use for the whole scene
     bool printPasses = false;
     bool progress = true;
+    uint32_t instances = 0; // builtin:many (--instances); 0 = the scene's default
+    bool lod = false;       // --lod: GPU LOD selection (render/culling)
+    bool occlusion = false; // --occlusion: two-phase hierarchical-Z culling (render/culling)
 };
 
 struct RenderRun {
@@ -58,6 +61,8 @@ void parseSize(const std::string& text, uint32_t& width, uint32_t& height);
 RenderMode parseMode(const std::string& text);
 Visualize parseVisualize(const std::string& text);
 MarkingMode parseMarking(const std::string& text);
+// "on" / "off"; anything else throws InputError naming the flag.
+bool parseOnOff(const char* flag, const std::string& text);
 // The bake cache folder when --cache-dir is not given (see defaultBakeCacheDir()).
 std::string defaultCacheDir();
 

@@ -176,6 +176,18 @@ int main(int argc, char** argv) {
                        "FILE.json: Chrome trace events (CPU frontend and GPU passes per frame; "
                        "chrome://tracing, Perfetto)");
     render->add_flag("--passes", ro.printPasses, "print the per-pass timing table");
+    // World scale (render/culling): instance count of builtin:many, LODs, occlusion culling.
+    std::string lod = "off", occlusion = "off";
+    auto* instancesFlag =
+        render->add_option("--instances", ro.instances, "builtin:many: instances, 1..1000000");
+    render
+        ->add_option("--lod", lod,
+                     "on | off: pick each instance's LOD on the GPU by projected error")
+        ->capture_default_str();
+    render
+        ->add_option("--occlusion", occlusion,
+                     "on | off: two-phase hierarchical-Z occlusion culling of instances")
+        ->capture_default_str();
 
     // bench
     BenchOptions bo;
@@ -303,6 +315,10 @@ int main(int argc, char** argv) {
             if (reuse != "on" && reuse != "off")
                 throw InputError(format("--reuse %s: expected on or off", reuse.c_str()));
             ro.reuse = reuse == "on";
+            if (*instancesFlag && ro.instances == 0)
+                throw InputError("--instances 0: expected 1..1000000");
+            ro.lod = parseOnOff("--lod", lod);
+            ro.occlusion = parseOnOff("--occlusion", occlusion);
             RenderRun run = runRender(g.gpu, ro);
             const auto& s = run.stats;
             std::printf(

@@ -1,6 +1,7 @@
 #include "render/renderer.h"
 
 #include <cstring>
+#include <ctime>
 
 #include <glm/gtc/matrix_transform.hpp>
 
@@ -65,6 +66,9 @@ void initRenderer(Renderer& r, Gpu& gpu, const RenderSettings& settings, const G
     r.settings = settings;
     if (settings.width == 0 || settings.height == 0 || settings.ssaa == 0)
         throw InputError("--size and --ssaa must be positive");
+    if ((settings.lod || settings.occlusion) && usesVisibilityBuffer(settings))
+        throw InputError("--lod on and --occlusion on need --marking raster (the visibility "
+                         "buffer rebuilds triangles from LOD 0)");
     createTargets(r);
     r.maxDraws = std::max<uint32_t>(scene.instanceCount, 1);
     VkDeviceSize drawBytes =
@@ -93,6 +97,7 @@ void initRenderer(Renderer& r, Gpu& gpu, const RenderSettings& settings, const G
     initFrameRecorder(gpu, r.recorder, settings.timing);
     if (settings.mode == RenderMode::Decoupled) r.decoupled = createDecoupled(r, scene);
     if (usesVisibilityBuffer(settings)) r.visibility = createVisibility(r);
+    r.culling = createCulling(r, scene);
 }
 
 void destroyRenderer(Renderer& r) {
@@ -101,6 +106,7 @@ void destroyRenderer(Renderer& r) {
     vkDeviceWaitIdle(gpu.device.device);
     if (r.visibility) destroyVisibility(r, r.visibility);
     if (r.decoupled) destroyDecoupled(r, r.decoupled);
+    destroyCulling(r, r.culling);
     destroyFrameRecorder(r.recorder);
     destroyShaderMessages(gpu, r.messages);
     destroyForwardPipelines(r);
@@ -187,8 +193,15 @@ static void updateLights(Renderer& r, const GpuScene& scene, gpu::FrameConstants
 // One frame, top to bottom. Forward: cull, shadow, depth prepass, shading, tonemap.
 // Decoupled replaces shading with marking, allocation, work queues, shadel shading and
 // reconstruction (render/shadel/decoupled.h).
+static double threadCpuMs() {
+    timespec t{};
+    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
+    return double(t.tv_sec) * 1e3 + double(t.tv_nsec) * 1e-6;
+}
+
 FrameResult renderFrame(Renderer& r, const GpuScene& scene, const CameraView& camera) {
     Gpu& gpu = *r.gpu;
+    double threadStart = threadCpuMs();
     using Clock = std::chrono::steady_clock;
     auto msSince = [](Clock::time_point t) {
         return std::chrono::duration<double, std::milli>(Clock::now() - t).count();
@@ -200,6 +213,7 @@ FrameResult renderFrame(Renderer& r, const GpuScene& scene, const CameraView& ca
     gpu::FrameConstants constants = makeFrameConstants(r, scene, camera);
     updateLights(r, scene, constants);
     if (r.decoupled) prepareDecoupledFrame(r, scene, camera, constants);
+    prepareCullingFrame(r, scene, constants);
     std::memcpy(mapped(gpu, r.frameConstants), &constants, sizeof(constants));
     uint64_t frame = address(gpu, r.frameConstants);
     double prepareMs = msSince(cpuStart);
@@ -214,6 +228,7 @@ FrameResult renderFrame(Renderer& r, const GpuScene& scene, const CameraView& ca
              [&](VkCommandBuffer cmd) { recordVisibilityPrepass(r, cmd, frame); });
     else
         pass(rec, "depthPrepass", [&](VkCommandBuffer cmd) { recordDepthPrepass(r, cmd, frame); });
+    if (r.settings.occlusion) recordOcclusionPasses(r, rec, frame, scene);
     if (r.settings.mode == RenderMode::Forward) {
         pass(rec, "forwardShading",
              [&](VkCommandBuffer cmd) { recordForwardShading(r, cmd, frame); });
@@ -234,11 +249,13 @@ FrameResult renderFrame(Renderer& r, const GpuScene& scene, const CameraView& ca
     result.cpuFrameMs = prepareMs + std::max(0.0, msSince(cpuStart) - prepareMs - rec.gpuWaitMs);
     result.shaderAsserts = collectShaderMessages(gpu, r.messages);
     if (r.decoupled) finishDecoupledFrame(r);
+    finishCullingFrame(r);
     r.framesRendered++;
     size_t bytes = size_t(r.settings.width) * r.settings.height * 4;
     result.rgba.resize(bytes);
     std::memcpy(result.rgba.data(), mapped(gpu, r.pixels), bytes);
     for (size_t i = 3; i < bytes; i += 4) result.pixelsCovered += result.rgba[i] != 0;
+    result.cpuThreadMs = threadCpuMs() - threadStart;
     return result;
 }
 

@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "render/camera.h"
+#include "render/culling/culling.h"
 #include "render/gpu_scene.h"
 #include "render/shadel/visibility.h"
 #include "rhi/frame.h"
@@ -50,8 +51,11 @@ struct RenderSettings {
     bool capacityControl = true;     // decoupled: steer the shading bias from storage use
     bool reuse = true;               // decoupled: carry unchanged shadels over from last frame
     uint32_t reuseRefreshPeriod = 8; // decoupled: reshade every carried chunk this often
-    bool animateLights = false; // point and spot lights move on small circles // decoupled: rects
-                                // at every MIP (the old policy, for comparison)
+    bool animateLights = false;  // point and spot lights move on small circles // decoupled: rects
+                                 // at every MIP (the old policy, for comparison)
+    bool lod = false;            // GPU LOD selection by projected error (render/culling)
+    float lodErrorPixels = 0.5f; // the coarsest LOD whose error projects below this is drawn
+    bool occlusion = false;      // two-phase hierarchical-Z occlusion culling (render/culling)
 };
 
 struct FrameResult {
@@ -61,7 +65,10 @@ struct FrameResult {
     double frameMs = 0.0;
     double cpuFrameMs = 0.0;   // CPU time to produce the frame (prepare + record), no GPU wait
     double cpuPrepareMs = 0.0; // of which the CPU frontend: constants, decoupled coarse allocation
-    double startMs = 0.0;      // since the renderer was created (trace export)
+    // CPU time the rendering thread consumed in renderFrame (CLOCK_THREAD_CPUTIME_ID): not
+    // inflated when other processes take the cores, as the wall-clock cpuFrameMs is.
+    double cpuThreadMs = 0.0;
+    double startMs = 0.0; // since the renderer was created (trace export)
     uint32_t shaderAsserts = 0;
 };
 
@@ -101,6 +108,7 @@ struct Renderer {
     std::vector<glm::vec4> changedLightVolumes;
     uint64_t framesRendered = 0;
     VisibilityStatePtr visibility; // decoupled with --marking visibility
+    CullingStatePtr culling;       // LODs, occlusion, per-view counts (render/culling)
     std::chrono::steady_clock::time_point createdAt = std::chrono::steady_clock::now();
 };
 
