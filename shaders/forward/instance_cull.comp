@@ -20,6 +20,10 @@ layout(push_constant, scalar) uniform Push {
     uint maxDraws;
     uint shadowView; // 1: cull against the sun's shadow volume, only casters
     uint phase;      // CullPhase (render/culling/culling.h): 0 = single pass
+    uint pad;
+    // Phase 2: uint[1 + instances], count then the ids of every instance visible this frame
+    // (read back: the decoupled frontend allocates for this set next frame). 0 = none.
+    uint64_t visibleList;
 } pc;
 
 #define PHASE_SINGLE 0u
@@ -64,6 +68,10 @@ void main() {
             } else {
                 hidden = occludedByHiz(f, c, c.hiz, inst.worldMin, inst.worldMax);
                 visible.v[id] = hidden ? 0u : 1u;
+                if (!hidden && pc.visibleList != 0ul) {
+                    UintBuffer list = UintBuffer(pc.visibleList);
+                    list.v[1u + atomicAdd(list.v[0], 1u)] = id;
+                }
                 draw = !hidden && !drawnBefore;
             }
         } else if (!inFrustum && pc.phase == PHASE_REST) {

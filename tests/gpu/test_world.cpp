@@ -268,3 +268,28 @@ TEST(World, InstanceGridQueriesAreSupersetsOfTheOverlaps) {
         EXPECT_LE(found.size(), 4 * overlapping + 200) << "the grid should narrow the search";
     }
 }
+
+// Decoupled with occlusion culling: the coarse allocation takes the GPU's visible set of last
+// frame, so hidden instances hold no sheet space and the CPU visits only what was seen.
+TEST(World, DecoupledAllocatesForTheGpuVisibleSet) {
+    RenderOptions o = manyOptions(2000, 160, 90);
+    o.mode = RenderMode::Decoupled;
+    o.frames = 3;
+    RenderRun open = renderChecked(o);
+    o.occlusion = true;
+    RenderRun culled = renderChecked(o);
+    uint64_t objectsOpen = open.stats["objects_decoupled"].get<uint64_t>();
+    uint64_t objectsCulled = culled.stats["objects_decoupled"].get<uint64_t>();
+    uint32_t drawn = view(culled, "camera")["instances_drawn"].get<uint32_t>();
+    double p = psnr(culled.frames[2].rgba, open.frames[2].rgba);
+    std::printf("[ figures ] decoupled many 2000 at 160x90, frame 3: objects decoupled %llu "
+                "(occlusion off) -> %llu (on, %u drawn), sheet blocks %llu -> %llu, PSNR %.2f dB\n",
+                (unsigned long long)objectsOpen, (unsigned long long)objectsCulled, drawn,
+                (unsigned long long)open.stats["sheet_blocks_allocated"].get<uint64_t>(),
+                (unsigned long long)culled.stats["sheet_blocks_allocated"].get<uint64_t>(), p);
+    EXPECT_LE(objectsCulled, drawn) << "only instances the GPU saw are allocated";
+    EXPECT_LT(objectsCulled * 2, objectsOpen);
+    EXPECT_GT(objectsCulled, 0u);
+    EXPECT_EQ(culled.stats["reconstruction_misses"].get<uint64_t>(), 0u);
+    EXPECT_GE(p, 35.0);
+}

@@ -1,5 +1,6 @@
 #include "render/culling/culling.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <vector>
@@ -19,6 +20,9 @@ struct CullingState {
     BufferHandle pyramid;     // float, every level packed
     BufferHandle phase2Draws; // DrawIndexedCommand[DRAW_LIST_COUNT * maxDraws]
     BufferHandle phase2Counts;
+    BufferHandle visibleList; // uint[1 + instances]: count, then ids (read back)
+    std::vector<uint32_t> visibleLastFrame;
+    bool haveVisible = false;
     std::vector<glm::uvec2> levelSize;
     std::vector<uint32_t> levelOffset;
     Pipeline hizBuild;
@@ -68,7 +72,9 @@ CullingStatePtr createCulling(Renderer& r, const GpuScene& scene) {
             gpu, {"draws.cameraPhase2", drawBytes, VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT});
         c->phase2Counts = createBuffer(gpu, {"draws.cameraPhase2Counts", DRAW_LIST_COUNT * 4,
                                              VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT});
-        ok = ok && c->pyramid && c->phase2Draws && c->phase2Counts;
+        c->visibleList =
+            createBuffer(gpu, {"culling.visibleList", perInstance + 4, 0, MemoryKind::Readback});
+        ok = ok && c->pyramid && c->phase2Draws && c->phase2Counts && c->visibleList;
         c->hizBuild = createComputePipeline(gpu, "hizBuild", "culling_hiz_build.comp.spv");
     }
     if (!ok) {
@@ -86,7 +92,7 @@ void destroyCulling(Renderer& r, CullingStatePtr& c) {
     if (!c) return;
     Gpu& gpu = *r.gpu;
     for (BufferHandle b : {c->frame, c->stats, c->visibility, c->drawnLod, c->pyramid,
-                           c->phase2Draws, c->phase2Counts})
+                           c->phase2Draws, c->phase2Counts, c->visibleList})
         if (b) destroy(gpu, b);
     if (c->hizBuild.pipeline) destroy(gpu, c->hizBuild);
     c.reset();
@@ -120,6 +126,7 @@ void recordCullingReset(Renderer& r, VkCommandBuffer cmd) {
     CullingState& c = *r.culling;
     vkCmdFillBuffer(cmd, vkBuffer(gpu, c.stats), 0, VK_WHOLE_SIZE, 0);
     if (c.phase2Counts) vkCmdFillBuffer(cmd, vkBuffer(gpu, c.phase2Counts), 0, VK_WHOLE_SIZE, 0);
+    if (c.visibleList) vkCmdFillBuffer(cmd, vkBuffer(gpu, c.visibleList), 0, 4, 0);
 }
 
 void recordOcclusionPasses(Renderer& r, FrameRecorder& rec, uint64_t frame, const GpuScene& scene) {
@@ -165,6 +172,7 @@ void recordOcclusionPasses(Renderer& r, FrameRecorder& rec, uint64_t frame, cons
         InstanceCullPush push{
             frame,   address(gpu, c.phase2Draws), address(gpu, c.phase2Counts), r.maxDraws, 0,
             CullRest};
+        push.visibleList = address(gpu, c.visibleList);
         pushConstants(gpu, cmd, push);
         if (scene.instanceCount) vkCmdDispatch(cmd, (scene.instanceCount + 63) / 64, 1, 1);
         memoryBarrier(cmd, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
@@ -204,7 +212,19 @@ void drawPhase2List(Renderer& r, VkCommandBuffer cmd, uint32_t list) {
 }
 
 void finishCullingFrame(Renderer& r) {
-    std::memcpy(&r.culling->last, mapped(*r.gpu, r.culling->stats), sizeof(gpu::GpuCullStats));
+    CullingState& c = *r.culling;
+    std::memcpy(&c.last, mapped(*r.gpu, c.stats), sizeof(gpu::GpuCullStats));
+    if (c.visibleList) {
+        const uint32_t* list = static_cast<const uint32_t*>(mapped(*r.gpu, c.visibleList));
+        uint32_t count = std::min(list[0], c.instances);
+        c.visibleLastFrame.assign(list + 1, list + 1 + count);
+        c.haveVisible = true;
+    }
+}
+
+const std::vector<uint32_t>* visibleLastFrame(const Renderer& r) {
+    const CullingState* c = r.culling.get();
+    return c && c->haveVisible ? &c->visibleLastFrame : nullptr;
 }
 
 void cullingStats(const Renderer& r, nlohmann::json& s) {

@@ -12,6 +12,7 @@
 //   depthPrepassPhase2  the phase-2 lists complete the depth
 // Every later camera pass draws both lists (drawCameraList).
 #include <memory>
+#include <vector>
 
 #include <nlohmann/json.hpp>
 
@@ -32,6 +33,8 @@ struct InstanceCullPush {
     uint32_t maxDraws;
     uint32_t shadowView;
     uint32_t phase; // CullPhase
+    uint32_t pad = 0;
+    uint64_t visibleList = 0; // phase 2: count + ids of the visible instances (read back)
 };
 enum CullPhase : uint32_t { CullSinglePass = 0, CullLastVisible = 1, CullRest = 2 };
 
@@ -53,8 +56,13 @@ void recordOcclusionPasses(Renderer& r, FrameRecorder& rec, uint64_t frame, cons
 // Inside a raster pass drawing the camera's list: the phase-2 part of it (nothing without
 // occlusion culling).
 void drawPhase2List(Renderer& r, VkCommandBuffer cmd, uint32_t list);
-// After the GPU finished the frame: keep its counts for the stats.
+// After the GPU finished the frame: keep its counts for the stats (and, with occlusion, the
+// visible set).
 void finishCullingFrame(Renderer& r);
+// With occlusion culling, the instances the camera saw last frame (the GPU's culled set, so CPU
+// work per visible object follows what is seen, not the world); null before the first frame or
+// without occlusion culling.
+const std::vector<uint32_t>* visibleLastFrame(const Renderer& r);
 // "instances_drawn", "triangles_drawn" (camera) and "culling": the per-view table.
 void cullingStats(const Renderer& r, nlohmann::json& stats);
 

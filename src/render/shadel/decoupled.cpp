@@ -72,6 +72,7 @@ struct DecoupledState {
     std::vector<uint32_t> visit;        // this frame's instances to decide
     std::vector<uint32_t> touched;      // instances with a GpuShadelObject entry or sheet rects
     std::vector<uint64_t> visitedFrame; // per instance: frameNumber + 1 when visited
+    std::vector<uint64_t> seenFrame;    // per instance: frameNumber + 1 when the GPU saw it
     std::vector<gpu::GpuShadelRect> rects;
     uint32_t rectBlockCount = 0;
     uint32_t capacityChunks = 0;
@@ -163,6 +164,7 @@ DecoupledStatePtr createDecoupled(Renderer& r, const GpuScene& scene) {
     std::memset(mapped(gpu, d.objectBuffer), 0, d.gpuObjects.size() * sizeof(gpu::GpuShadelObject));
     d.grid.build(scene.instanceInfo);
     d.visitedFrame.assign(scene.instanceCount, 0);
+    d.seenFrame.assign(scene.instanceCount, 0);
     d.rectBuffer = upload("shadel.rects", std::max<size_t>(scene.instanceCount, 1) *
                                               SHADEL_MAX_MIPS * sizeof(gpu::GpuShadelRect));
     d.occupancy = {device("shadel.chunkOccupancy.frame0", blocks * 8),
@@ -394,7 +396,16 @@ void prepareDecoupledFrame(Renderer& r, const GpuScene& scene, const CameraView&
             invViewProj * glm::vec4((c & 1) ? 1 : -1, (c & 2) ? 1 : -1, (c & 4) ? 1 : 0, 1);
         frustumBox.extend(glm::vec3(p) / p.w);
     }
-    d.grid.query(frustumBox, d.visit);
+    // With occlusion culling the GPU's visible set of last frame is the set to allocate for
+    // (seed 004: the CPU estimator and the GPU agree on what is seen); an instance that appears
+    // is drawn forward for one frame. Otherwise every instance near the frustum.
+    const std::vector<uint32_t>* seen = visibleLastFrame(r);
+    if (seen) {
+        d.visit.insert(d.visit.end(), seen->begin(), seen->end());
+        for (uint32_t i : *seen) d.seenFrame[i] = d.frameNumber + 1;
+    } else {
+        d.grid.query(frustumBox, d.visit);
+    }
     d.visit.insert(d.visit.end(), d.touched.begin(), d.touched.end());
     d.touched.clear();
     for (uint32_t i : d.visit) {
@@ -408,8 +419,9 @@ void prepareDecoupledFrame(Renderer& r, const GpuScene& scene, const CameraView&
         gpu::GpuShadelObject& g = d.gpuObjects[i];
         g = gpu::GpuShadelObject{};
         glm::vec3 margin = (inst.worldMax - inst.worldMin) * d.frustumMargin;
-        bool wanted =
-            mesh.mipCount > 0 && boxVisible(planes, inst.worldMin - margin, inst.worldMax + margin);
+        // Hidden by occlusion last frame: its rects go back (it returns forward for a frame).
+        bool wanted = mesh.mipCount > 0 && (!seen || d.seenFrame[i] == d.frameNumber + 1) &&
+                      boxVisible(planes, inst.worldMin - margin, inst.worldMax + margin);
         // Hybrid (seed: "small objects fall back to a direct only render"): an object a few
         // pixels across would still shade whole chunks at its coarsest MIP; forward is cheaper.
         bool small = wanted && r.settings.forwardBelowPixels > 0.0f &&
