@@ -66,9 +66,9 @@ void initRenderer(Renderer& r, Gpu& gpu, const RenderSettings& settings, const G
     r.settings = settings;
     if (settings.width == 0 || settings.height == 0 || settings.ssaa == 0)
         throw InputError("--size and --ssaa must be positive");
-    if ((settings.lod || settings.occlusion) && usesVisibilityBuffer(settings))
-        throw InputError("--lod on and --occlusion on need --marking raster (the visibility "
-                         "buffer rebuilds triangles from LOD 0)");
+    if (settings.occlusion && usesVisibilityBuffer(settings))
+        throw InputError("--occlusion on needs --marking raster (the phase-2 prepass writes "
+                         "depth only, not the visibility buffer)");
     createTargets(r);
     r.maxDraws = std::max<uint32_t>(scene.instanceCount, 1);
     VkDeviceSize drawBytes =
