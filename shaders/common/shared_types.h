@@ -249,6 +249,55 @@ struct FrameConstants {
     uint64_t shadel;    // ShadelFrame (decoupled path), 0 when forward
     uint64_t lighting;  // LightingFrame (render/lighting), 0 when absent
     uint64_t gi;        // GiFrame (render/gi, shaders/gi/gi_types.h), 0 when GI is off
+    uint64_t culling;   // CullingFrame (render/culling): LODs, occlusion, per-view counts
+};
+
+// ---- GPU-driven world (render/culling) ------------------------------------------------------
+#define CULL_MAX_LODS 8u
+#define CULL_VIEW_CAMERA 0u
+#define CULL_VIEW_SHADOW 1u
+#define CULL_VIEWS 2u
+
+// One level of a mesh's LOD chain: a range of the unified index buffer over the mesh's vertices
+// (the same vertexOffset for every level: simplification only drops vertices).
+struct GpuLod {
+    uint firstIndex;
+    uint indexCount;
+    float error; // object-space deviation from LOD 0 (meshoptimizer's error, in scene units)
+    uint pad;
+};
+
+struct GpuMeshLods {
+    uint lodCount; // >= 1; LOD 0 is GpuMesh's range, the last is the least detailed
+    uint pad0;
+    uint pad1;
+    uint pad2;
+    GpuLod lod[CULL_MAX_LODS];
+};
+
+// Counted by the culling passes, read back after the frame (the stats' per-view table).
+struct GpuCullStats {
+    uint instancesDrawn[CULL_VIEWS];
+    uint trianglesDrawn[CULL_VIEWS];
+    uint frustumVisible[CULL_VIEWS]; // passed the frustum (and, for shadows, the caster) test
+    uint occlusionCulled;            // camera: frustum-visible but behind the depth pyramid
+    uint drawnLastFrameVisible;      // camera: drawn in phase 1 (visible last frame)
+};
+
+struct CullingFrame {
+    uint64_t meshLods;    // GpuMeshLods[meshCount]
+    uint64_t stats;       // GpuCullStats
+    uint64_t visibility;  // uint per instance: 1 when visible to the camera last frame
+    uint64_t drawnLod;    // uint per instance: first index of the camera's LOD this frame
+    uint64_t hiz;         // float depth pyramid, every level packed (level 0 = depth target)
+    uint lod;             // 1: pick LODs by projected error; 0: always LOD 0
+    float lodErrorPixels; // the coarsest LOD whose error projects below this many pixels
+    float lodScale;       // pixels per unit of error at distance 1 (viewport height / 2 * P[1][1])
+    uint occlusion;       // 1: two-phase hierarchical-Z culling of the camera view
+    uint hizLevels;
+    uvec2 hizSize;   // level 0 = the depth target's size
+    float sceneMinY; // the lowest point of the scene: shadows end there
+    uint pad0;
 };
 
 // Shader -> CPU message channel (shader asserts). Written with atomics, read after the frame.

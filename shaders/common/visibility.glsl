@@ -6,6 +6,7 @@
 #ifndef SHADEL_VISIBILITY_GLSL
 #define SHADEL_VISIBILITY_GLSL
 #include "common/bindless.glsl"
+#include "culling/cull.glsl"
 
 // Unsigned view of the bindless sampled-image table (the visibility buffer is R32G32_UINT).
 layout(set = 0, binding = 0) uniform utexture2D gUintTextures[];
@@ -26,10 +27,12 @@ struct VisTriangle {
 // rasterization (Olano & Greer): with M's columns the clip-space (x, y, w) of the vertices, the
 // perspective-correct barycentrics at NDC point q are adj(M) (q, 1), normalised to sum 1. No
 // division by w, so triangles crossing the camera plane are fine.
-VisTriangle loadVisTriangle(FrameConstants f, GpuInstance inst, uint primitive) {
+// `instance` is the instance's id: its draw used the LOD the camera's cull chose this frame
+// (render/culling), whose first index the cull recorded.
+VisTriangle loadVisTriangle(FrameConstants f, GpuInstance inst, uint instance, uint primitive) {
     GpuMesh mesh = MeshBuffer(f.meshes).m[inst.mesh];
     IndexBuffer indices = IndexBuffer(f.indices);
-    uint first = mesh.firstIndex + 3u * primitive;
+    uint first = UintBuffer(CullingFrameRef(f.culling).c.drawnLod).v[instance] + 3u * primitive;
     VisTriangle t;
     t.v0 = uint(int(indices.i[first + 0u]) + mesh.vertexOffset);
     t.v1 = uint(int(indices.i[first + 1u]) + mesh.vertexOffset);

@@ -32,7 +32,7 @@ void main() {
             current = vis;
             o = ShadelObjectBuffer(s.objects).o[vis.x];
             if ((o.flags & SHADEL_OBJECT_DECOUPLED) == 0u) continue;
-            visQuadSetup(f, s, InstanceBuffer(f.instances).i[vis.x], vis.y, origin, q);
+            visQuadSetup(f, s, InstanceBuffer(f.instances).i[vis.x], vis.x, vis.y, origin, q);
         } else if ((o.flags & SHADEL_OBJECT_DECOUPLED) == 0u) {
             continue; // forward (hybrid) instance
         }

@@ -60,7 +60,7 @@ void resolveQuad(FrameConstants f, ShadelFrame s, ivec2 origin, inout uvec4 coun
                 o = ShadelObjectBuffer(s.objects).o[vis.x];
                 if ((o.flags & SHADEL_OBJECT_DECOUPLED) != 0u) {
                     inst = InstanceBuffer(f.instances).i[vis.x];
-                    visQuadSetup(f, s, inst, vis.y, origin, q);
+                    visQuadSetup(f, s, inst, vis.x, vis.y, origin, q);
                 }
             }
             decoupled = (o.flags & SHADEL_OBJECT_DECOUPLED) != 0u;

@@ -57,6 +57,9 @@ struct RenderOptions {
     double shadelBudget = 64e6;        // MIP-0 shadels the bake may use for the whole scene
     bool printPasses = false;
     bool progress = true;
+    uint32_t instances = 0; // builtin:many (--instances); 0 = the scene's default
+    bool lod = false;       // --lod: GPU LOD selection (render/culling)
+    bool occlusion = false; // --occlusion: two-phase hierarchical-Z culling (render/culling)
 };
 
 struct RenderRun {

@@ -222,6 +222,17 @@ int main(int argc, char** argv) {
         ->add_option("--gi-snap", giSnap,
                      "GI: on | off: snap the cascades to their cell size (off only to measure "
                      "swimming)")
+    // World scale (render/culling): instance count of builtin:many, LODs, occlusion culling.
+    std::string lod = "off", occlusion = "off";
+    auto* instancesFlag =
+        render->add_option("--instances", ro.instances, "builtin:many: instances, 1..1000000");
+    render
+        ->add_option("--lod", lod,
+                     "on | off: pick each instance's LOD on the GPU by projected error")
+        ->capture_default_str();
+    render
+        ->add_option("--occlusion", occlusion,
+                     "on | off: two-phase hierarchical-Z occlusion culling of instances")
         ->capture_default_str();
 
     // bench
@@ -368,6 +379,10 @@ int main(int argc, char** argv) {
             if (giSnap != "on" && giSnap != "off")
                 throw InputError(format("--gi-snap %s: expected on or off", giSnap.c_str()));
             ro.giSnap = giSnap == "on";
+            if (*instancesFlag && ro.instances == 0)
+                throw InputError("--instances 0: expected 1..1000000");
+            ro.lod = parseOnOff("--lod", lod);
+            ro.occlusion = parseOnOff("--occlusion", occlusion);
             RenderRun run = runRender(g.gpu, ro);
             const auto& s = run.stats;
             std::printf(

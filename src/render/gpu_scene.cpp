@@ -5,6 +5,7 @@
 
 #include "bake/bake.h"
 #include "core/log.h"
+#include "render/culling/mesh_lods.h"
 
 namespace shadel {
 
@@ -158,31 +159,37 @@ void uploadScene(Gpu& gpu, const Scene& scene, GpuScene& out, const std::vector<
     std::vector<glm::vec2> shadelUvs;
     std::vector<uint32_t> indices;
     out.meshInfo.clear();
+    out.lodInfo.clear();
     for (size_t mi = 0; mi < scene.meshes.size(); ++mi) {
         const Mesh& mesh = scene.meshes[mi];
         gpu::GpuMesh g{};
-        g.firstIndex = uint32_t(indices.size());
         g.vertexOffset = int32_t(vertices.size());
         g.shadelMesh = 0xFFFFFFFFu;
         g.boundsMin = mesh.bounds.min;
         g.boundsMax = mesh.bounds.max;
         const BakedMesh* b = baked ? &(*baked)[mi] : nullptr;
+        MeshGeometry geometry;
         if (b && !b->indices.empty()) {
             for (size_t v = 0; v < b->vertexRemap.size(); ++v) {
                 const Vertex& src = mesh.vertices[b->vertexRemap[v]];
-                vertices.push_back({src.position, src.normal, src.tangent, src.uv0});
-                shadelUvs.push_back(b->shadelUv[v]);
+                geometry.vertices.push_back({src.position, src.normal, src.tangent, src.uv0});
             }
-            indices.insert(indices.end(), b->indices.begin(), b->indices.end());
+            geometry.shadelUvs = b->shadelUv;
+            geometry.indices = b->indices;
+            geometry.keepTriangleOrder = true; // the triangle-ID maps index LOD 0's triangles
             g.shadelMesh = uint32_t(mi);
         } else {
             for (const Vertex& v : mesh.vertices)
-                vertices.push_back({v.position, v.normal, v.tangent, v.uv0});
-            if (baked) shadelUvs.resize(vertices.size(), glm::vec2(0.0f));
-            indices.insert(indices.end(), mesh.indices.begin(), mesh.indices.end());
+                geometry.vertices.push_back({v.position, v.normal, v.tangent, v.uv0});
+            geometry.indices = mesh.indices;
         }
-        g.indexCount = uint32_t(indices.size()) - g.firstIndex;
+        // LOD 0 and its simplified levels, all in the unified buffers (render/culling).
+        gpu::GpuMeshLods lods = appendMeshWithLods(std::move(geometry), vertices,
+                                                   baked ? &shadelUvs : nullptr, indices);
+        g.firstIndex = lods.lod[0].firstIndex;
+        g.indexCount = lods.lod[0].indexCount;
         out.meshInfo.push_back(g);
+        out.lodInfo.push_back(lods);
     }
 
     std::vector<gpu::GpuInstance> instances;
@@ -267,6 +274,8 @@ void uploadScene(Gpu& gpu, const Scene& scene, GpuScene& out, const std::vector<
     out.indices = uploadArray(gpu, "scene.indices", indices.data(), indices.size() * 4, indexUsage);
     out.meshes = uploadArray(gpu, "scene.meshes", out.meshInfo.data(),
                              out.meshInfo.size() * sizeof(gpu::GpuMesh));
+    out.meshLods = uploadArray(gpu, "scene.meshLods", out.lodInfo.data(),
+                               out.lodInfo.size() * sizeof(gpu::GpuMeshLods));
     out.instances = uploadArray(gpu, "scene.instances", instances.data(),
                                 instances.size() * sizeof(gpu::GpuInstance));
     out.materialInfo = materials;
@@ -290,8 +299,9 @@ void uploadScene(Gpu& gpu, const Scene& scene, GpuScene& out, const std::vector<
 void destroyScene(Gpu& gpu, GpuScene& s) {
     for (TextureReadView v : s.textureViews) destroy(gpu, v);
     for (TextureHandle t : s.textures) destroy(gpu, t);
-    for (BufferHandle b : {s.vertices, s.shadelUvs, s.indices, s.meshes, s.instances, s.materials,
-                           s.lights, s.idMaps, s.blockers, s.portals, s.lightBlockerLists})
+    for (BufferHandle b : {s.vertices, s.shadelUvs, s.indices, s.meshes, s.meshLods, s.instances,
+                           s.materials, s.lights, s.idMaps, s.blockers, s.portals,
+                           s.lightBlockerLists})
         destroy(gpu, b);
     s = GpuScene{};
 }

@@ -26,6 +26,7 @@ struct GpuScene {
     BufferHandle shadelUvs; // vec2 per vertex (decoupled path), invalid when not baked
     BufferHandle indices;   // uint32
     BufferHandle meshes;    // gpu::GpuMesh[]
+    BufferHandle meshLods;  // gpu::GpuMeshLods[] per mesh (render/culling/mesh_lods.h)
     BufferHandle instances; // gpu::GpuInstance[]
     BufferHandle materials; // gpu::GpuMaterial[]
     BufferHandle lights;    // gpu::GpuLight[] (every kind but the sun: the first directional light)
@@ -36,6 +37,7 @@ struct GpuScene {
     std::vector<TextureHandle> textures;
     std::vector<TextureReadView> textureViews;
     std::vector<gpu::GpuMesh> meshInfo;
+    std::vector<gpu::GpuMeshLods> lodInfo;    // what `meshLods` holds
     std::vector<ShadelMeshInfo> shadelMeshes; // per mesh, when baked
     BufferHandle idMaps;                      // every mesh's triangle-ID maps, all MIPs
     std::vector<gpu::GpuInstance> instanceInfo;

@@ -1,6 +1,7 @@
 #include "render/renderer.h"
 
 #include <cstring>
+#include <ctime>
 
 #include <glm/gtc/matrix_transform.hpp>
 
@@ -66,6 +67,9 @@ void initRenderer(Renderer& r, Gpu& gpu, const RenderSettings& settings, const G
     r.settings = settings;
     if (settings.width == 0 || settings.height == 0 || settings.ssaa == 0)
         throw InputError("--size and --ssaa must be positive");
+    if (settings.occlusion && usesVisibilityBuffer(settings))
+        throw InputError("--occlusion on needs --marking raster (the phase-2 prepass writes "
+                         "depth only, not the visibility buffer)");
     createTargets(r);
     r.maxDraws = std::max<uint32_t>(scene.instanceCount, 1);
     VkDeviceSize drawBytes =
@@ -97,6 +101,7 @@ void initRenderer(Renderer& r, Gpu& gpu, const RenderSettings& settings, const G
     r.oit = createOit(r, scene);
     r.lightCulling = createLightCulling(r, scene);
     if (settings.gi == GiMode::Lpv) r.gi = createGi(r, scene);
+    r.culling = createCulling(r, scene);
 }
 
 void destroyRenderer(Renderer& r) {
@@ -108,6 +113,7 @@ void destroyRenderer(Renderer& r) {
     if (r.visibility) destroyVisibility(r, r.visibility);
     destroyOit(r, r.oit);
     if (r.decoupled) destroyDecoupled(r, r.decoupled);
+    destroyCulling(r, r.culling);
     destroyFrameRecorder(r.recorder);
     destroyShaderMessages(gpu, r.messages);
     destroyForwardPipelines(r);
@@ -194,8 +200,15 @@ static void updateLights(Renderer& r, const GpuScene& scene, gpu::FrameConstants
 // One frame, top to bottom. Forward: cull, shadow, depth prepass, shading, tonemap.
 // Decoupled replaces shading with marking, allocation, work queues, shadel shading and
 // reconstruction (render/shadel/decoupled.h).
+static double threadCpuMs() {
+    timespec t{};
+    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
+    return double(t.tv_sec) * 1e3 + double(t.tv_nsec) * 1e-6;
+}
+
 FrameResult renderFrame(Renderer& r, const GpuScene& scene, const CameraView& camera) {
     Gpu& gpu = *r.gpu;
+    double threadStart = threadCpuMs();
     using Clock = std::chrono::steady_clock;
     auto msSince = [](Clock::time_point t) {
         return std::chrono::duration<double, std::milli>(Clock::now() - t).count();
@@ -211,6 +224,7 @@ FrameResult renderFrame(Renderer& r, const GpuScene& scene, const CameraView& ca
     if (r.gi) prepareGiFrame(r, scene, camera, constants);
     if (r.decoupled) prepareDecoupledFrame(r, scene, camera, constants);
     prepareTransparentDraws(r, scene, camera);
+    prepareCullingFrame(r, scene, constants);
     std::memcpy(mapped(gpu, r.frameConstants), &constants, sizeof(constants));
     uint64_t frame = address(gpu, r.frameConstants);
     double prepareMs = msSince(cpuStart);
@@ -233,6 +247,7 @@ FrameResult renderFrame(Renderer& r, const GpuScene& scene, const CameraView& ca
         pass(rec, "depthPrepass", [&](VkCommandBuffer cmd) { recordDepthPrepass(r, cmd, frame); });
     if (r.settings.lightCulling == LightCulling::Tiled)
         pass(rec, "lightCulling", [&](VkCommandBuffer cmd) { recordLightCulling(r, cmd, frame); });
+    if (r.settings.occlusion) recordOcclusionPasses(r, rec, frame, scene);
     if (r.settings.mode == RenderMode::Forward) {
         pass(rec, "forwardShading",
              [&](VkCommandBuffer cmd) { recordForwardShading(r, cmd, frame); });
@@ -258,11 +273,13 @@ FrameResult renderFrame(Renderer& r, const GpuScene& scene, const CameraView& ca
         uint32_t(transparentDrawOrder(r).size()) + result.transparentDecoupledDraws;
     if (r.decoupled) finishDecoupledFrame(r);
     readLightCullingStats(r);
+    finishCullingFrame(r);
     r.framesRendered++;
     size_t bytes = size_t(r.settings.width) * r.settings.height * 4;
     result.rgba.resize(bytes);
     std::memcpy(result.rgba.data(), mapped(gpu, r.pixels), bytes);
     for (size_t i = 3; i < bytes; i += 4) result.pixelsCovered += result.rgba[i] != 0;
+    result.cpuThreadMs = threadCpuMs() - threadStart;
     return result;
 }
 

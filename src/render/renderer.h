@@ -7,6 +7,7 @@
 
 #include "render/camera.h"
 #include "render/gi/lpv.h"
+#include "render/culling/culling.h"
 #include "render/gpu_scene.h"
 #include "render/lighting/light_culling.h"
 #include "render/shadel/visibility.h"
@@ -78,6 +79,9 @@ struct RenderSettings {
     bool giSnap = true;         // --gi-snap off: cascades slide with the camera (debug)
     float giIntensity = 1.0f;   // scale of the indirect term
     std::vector<GiBlocker> giBlockers; // GI light blockers (axial occlusion in propagation)
+    bool lod = false;            // GPU LOD selection by projected error (render/culling)
+    float lodErrorPixels = 0.5f; // the coarsest LOD whose error projects below this is drawn
+    bool occlusion = false;      // two-phase hierarchical-Z occlusion culling (render/culling)
 };
 
 struct FrameResult {
@@ -87,7 +91,10 @@ struct FrameResult {
     double frameMs = 0.0;
     double cpuFrameMs = 0.0;   // CPU time to produce the frame (prepare + record), no GPU wait
     double cpuPrepareMs = 0.0; // of which the CPU frontend: constants, decoupled coarse allocation
-    double startMs = 0.0;      // since the renderer was created (trace export)
+    // CPU time the rendering thread consumed in renderFrame (CLOCK_THREAD_CPUTIME_ID): not
+    // inflated when other processes take the cores, as the wall-clock cpuFrameMs is.
+    double cpuThreadMs = 0.0;
+    double startMs = 0.0; // since the renderer was created (trace export)
     uint32_t shaderAsserts = 0;
     uint32_t transparentDraws = 0;          // blended instances drawn (render/oit)
     uint32_t transparentDecoupledDraws = 0; // ... of which shaded in shadel space
@@ -137,6 +144,7 @@ struct Renderer {
     OitStatePtr oit;                   // scenes with blended materials (render/oit)
     LightCullingStatePtr lightCulling; // light lists (render/lighting/light_culling.h)
     GiStatePtr gi;                     // --gi lpv
+    CullingStatePtr culling;           // LODs, occlusion, per-view counts (render/culling)
     std::chrono::steady_clock::time_point createdAt = std::chrono::steady_clock::now();
 };
 

@@ -10,6 +10,7 @@
 
 #include "core/error.h"
 #include "scene/builtin_lights.h"
+#include "core/log.h"
 #include "scene/mesh_utils.h"
 
 namespace shadel {
@@ -381,32 +382,66 @@ Scene makeSmooth() {
     return scene;
 }
 
-// 10 000 small instances sharing a dozen meshes: for scaling tests (culling, instancing).
-Scene makeMany() {
+// A city block grid for scaling tests (GPU culling, LODs, occlusion): `instances` instances in
+// all (the ground, then blocks of four buildings and twelve street props: trees, lamp posts,
+// cars). The camera stands at street level near the centre, so buildings hide most blocks.
+// The tree and lamp meshes are finely tessellated on purpose: LOD selection has work to do.
+Scene makeMany(uint32_t instances) {
     Scene scene;
     scene.name = "many";
     SceneBuilder b(scene);
     Rng rng(0x5ADE1D0004ull);
-    uint32_t ground = b.material("ground", {0.45f, 0.45f, 0.45f}, 0.9f);
-    const glm::vec3 colours[4] = {
-        {0.8f, 0.2f, 0.15f}, {0.9f, 0.8f, 0.2f}, {0.2f, 0.4f, 0.85f}, {0.3f, 0.7f, 0.35f}};
-    std::vector<uint32_t> meshes;
-    for (int c = 0; c < 4; ++c) {
-        uint32_t mat = b.material("colour " + std::to_string(c), colours[c], 0.5f);
-        meshes.push_back(b.mesh(makeBox("box " + std::to_string(c), glm::vec3(0.4f), mat)));
-        meshes.push_back(b.mesh(makeSphere("sphere " + std::to_string(c), 0.22f, mat, 16, 8)));
-        meshes.push_back(
-            b.mesh(makeCylinder("cylinder " + std::to_string(c), 0.18f, 0.5f, mat, 12)));
+    uint32_t ground = b.material("asphalt", {0.32f, 0.32f, 0.34f}, 0.9f);
+    const glm::vec3 facade[3] = {{0.75f, 0.68f, 0.6f}, {0.55f, 0.6f, 0.7f}, {0.7f, 0.45f, 0.4f}};
+    const float height[3] = {12.0f, 21.0f, 34.0f};
+    std::vector<uint32_t> buildings;
+    for (int i = 0; i < 3; ++i) {
+        uint32_t mat = b.material("facade " + std::to_string(i), facade[i], 0.8f);
+        buildings.push_back(b.mesh(
+            makeBox("building " + std::to_string(i), glm::vec3(13.0f, height[i], 13.0f), mat)));
     }
-    b.place("ground", b.mesh(makePlane("ground", 120.0f, 120.0f, ground, 12)), {0, 0, 0});
-    for (int z = 0; z < 100; ++z) {
-        for (int x = 0; x < 100; ++x) {
-            size_t k = size_t(rng.range(0, int(meshes.size()) - 1));
-            int shape = int(k % 3);
-            float lift = shape == 0 ? 0.2f : shape == 1 ? 0.22f : 0.0f;
-            b.place("object " + std::to_string(z * 100 + x), meshes[k],
-                    {(float(x) - 49.5f) * 1.1f, lift, (float(z) - 49.5f) * 1.1f},
-                    rng.uniform(0.0f, 3.14f));
+    uint32_t leaves = b.material("leaves", {0.22f, 0.5f, 0.2f}, 0.7f);
+    uint32_t metal = b.material("lamp metal", {0.25f, 0.25f, 0.27f}, 0.35f, 1.0f);
+    uint32_t paint = b.material("car paint", {0.8f, 0.15f, 0.1f}, 0.3f);
+    uint32_t tree = b.mesh(makeSphere("tree", 2.0f, leaves, 32, 16));
+    uint32_t lamp = b.mesh(makeCylinder("lamp post", 0.15f, 6.0f, metal, 24));
+    uint32_t car = b.mesh(makeBox("car", glm::vec3(4.0f, 1.4f, 1.9f), paint));
+
+    constexpr uint32_t kPerBlock = 16; // 4 buildings + 12 props
+    constexpr float kPitch = 40.0f;    // 30 m blocks, 10 m streets
+    uint32_t rest = instances > 0 ? instances - 1 : 0;
+    uint32_t blocks = (rest + kPerBlock - 1) / kPerBlock;
+    uint32_t side = std::max(1u, uint32_t(std::ceil(std::sqrt(double(blocks)))));
+    float extent = float(side) * kPitch;
+    b.place("ground", b.mesh(makePlane("ground", extent + 40.0f, extent + 40.0f, ground, 8)),
+            {0, 0, 0});
+    auto origin = [&](uint32_t i) { return (float(i) - 0.5f * float(side - 1)) * kPitch; };
+    uint32_t placed = 0;
+    for (uint32_t k = 0; k < blocks; ++k) {
+        glm::vec3 centre(origin(k % side), 0.0f, origin(k / side));
+        for (uint32_t j = 0; j < kPerBlock && placed < rest; ++j, ++placed) {
+            if (j < 4) { // a 2 x 2 lot of buildings, 1 m passages between them
+                glm::vec3 lot((j & 1) ? 7.0f : -7.0f, 0.0f, (j & 2) ? 7.0f : -7.0f);
+                int kind = rng.range(0, 2);
+                b.place("", buildings[kind], centre + lot + glm::vec3(0, height[kind] * 0.5f, 0),
+                        rng.range(0, 3) * 1.5707964f);
+                continue;
+            }
+            // Props on the pavement around the block, 17 m from its centre.
+            int edge = rng.range(0, 3);
+            float t = rng.uniform(-14.0f, 14.0f);
+            glm::vec3 offset = edge == 0   ? glm::vec3(t, 0, -17.0f)
+                               : edge == 1 ? glm::vec3(t, 0, 17.0f)
+                               : edge == 2 ? glm::vec3(-17.0f, 0, t)
+                                           : glm::vec3(17.0f, 0, t);
+            float pick = rng.uniform(0.0f, 1.0f);
+            if (pick < 0.45f)
+                b.place("", tree, centre + offset + glm::vec3(0, 3.0f, 0));
+            else if (pick < 0.75f)
+                b.place("", lamp, centre + offset);
+            else // cars park along the kerb, 3 m further out
+                b.place("", car, centre + offset * (20.0f / 17.0f) + glm::vec3(0, 0.7f, 0),
+                        edge < 2 ? 0.0f : 1.5707964f);
         }
     }
     b.sun({-0.4f, -1.0f, -0.3f}, 3.0f);
@@ -414,8 +449,12 @@ Scene makeMany() {
         b.pointLight("light " + std::to_string(i),
                      {(i & 1) ? 25.0f : -25.0f, 3.0f, (i & 2) ? 25.0f : -25.0f},
                      {1.0f, 0.85f, 0.7f}, 60.0f, 20.0f);
-    b.camera("main", {0.0f, 12.0f, 62.0f}, {0.0f, 0.0f, 10.0f}, 0.8f, 0.1f, 300.0f);
-    b.camera("overview", {0.0f, 90.0f, 0.01f}, {0.0f, 0.0f, 0.0f}, 0.9f, 1.0f, 300.0f);
+    // A street through the centre of the grid (between two blocks), at eye height above a car.
+    float street = (side % 2 == 0) ? 0.0f : -0.5f * kPitch;
+    b.camera("main", {street, 4.0f, street + 3.0f}, {street + 60.0f, 2.0f, street + 140.0f}, 0.9f,
+             0.2f, 800.0f);
+    b.camera("overview", {0.0f, 150.0f + 0.6f * extent, 0.01f}, {0.0f, 0.0f, 0.0f}, 0.9f, 1.0f,
+             400.0f + 1.5f * extent);
     return scene;
 }
 
@@ -576,7 +615,7 @@ const std::vector<std::pair<std::string, std::function<Scene()>>>& registry() {
         {"default", makeDefault},
         {"checker", makeChecker},
         {"smooth", makeSmooth},
-        {"many", makeMany},
+        {"many", [] { return makeMany(kManyDefaultInstances); }},
         {"transparency", makeTransparency},
         {"lights", [] { return makeLightsScene(makeDefault()); }},
         {"blockers", makeBlockersScene},
@@ -593,7 +632,17 @@ std::vector<std::string> builtinSceneNames() {
     return names;
 }
 
-Scene makeBuiltinScene(const std::string& name) {
+Scene makeBuiltinScene(const std::string& name, const BuiltinSceneOptions& options) {
+    if (options.instances != 0 && name != "many")
+        throw InputError(format("--instances %u: only builtin:many takes an instance count (scene "
+                                "builtin:%s)",
+                                options.instances, name.c_str()));
+    if (name == "many" && options.instances != 0) {
+        if (options.instances > kManyMaxInstances)
+            throw InputError(
+                format("--instances %u: expected 1..%u", options.instances, kManyMaxInstances));
+        return makeMany(options.instances);
+    }
     for (const auto& [known, make] : registry())
         if (known == name) return make();
     std::string list;

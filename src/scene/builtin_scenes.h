@@ -11,7 +11,16 @@ namespace shadel {
 // Names accepted after "builtin:", the default first.
 std::vector<std::string> builtinSceneNames();
 
-// Builds the named scene; an unknown name throws InputError.
-Scene makeBuiltinScene(const std::string& name);
+// builtin:many's instance count: its default and the most `--instances` accepts.
+constexpr uint32_t kManyDefaultInstances = 10000;
+constexpr uint32_t kManyMaxInstances = 1000000;
+
+struct BuiltinSceneOptions {
+    uint32_t instances = 0; // builtin:many (--instances): 0 = its default
+};
+
+// Builds the named scene; an unknown name or an option the scene does not take (or out of
+// range) throws InputError.
+Scene makeBuiltinScene(const std::string& name, const BuiltinSceneOptions& options = {});
 
 } // namespace shadel

@@ -11,6 +11,8 @@ namespace shadel {
 
 // `builtin:NAME` (see builtinSceneNames()) or a path to a .gltf / .glb file. Bad input throws
 // InputError with one line naming the input and the reason.
-Scene loadScene(const std::string& spec, const SceneFileOptions& options = {});
+// `builtin` carries options of built-in scenes (--instances); a file scene rejects them.
+Scene loadScene(const std::string& spec, const SceneFileOptions& options = {},
+                const BuiltinSceneOptions& builtin = {});
 
 } // namespace shadel

@@ -1,18 +1,11 @@
 #include "render/forward/forward_passes.h"
 
+#include "render/culling/culling.h"
 #include "render/renderer.h"
 
 namespace shadel {
 
 namespace {
-struct CullPush {
-    uint64_t frame;
-    uint64_t draws;
-    uint64_t counts;
-    uint32_t maxDraws;
-    uint32_t shadowView;
-};
-
 void setViewport(VkCommandBuffer cmd, uint32_t w, uint32_t h) {
     VkViewport vp{0, 0, float(w), float(h), 0, 1};
     VkRect2D scissor{{0, 0}, {w, h}};
@@ -68,16 +61,27 @@ void destroyForwardPipelines(Renderer& r) {
 void recordInstanceCull(Renderer& r, VkCommandBuffer cmd, uint64_t frame, const GpuScene& scene) {
     Gpu& gpu = *r.gpu;
     vkCmdFillBuffer(cmd, vkBuffer(gpu, r.drawCounts), 0, VK_WHOLE_SIZE, 0);
+    recordCullingReset(r, cmd);
     memoryBarrier(cmd, VK_PIPELINE_STAGE_2_CLEAR_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT,
                   VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
                   VK_ACCESS_2_SHADER_STORAGE_READ_BIT | VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT);
     bind(gpu, cmd, r.instanceCull);
     uint32_t groups = (scene.instanceCount + 63) / 64;
-    CullPush push{frame, address(gpu, r.draws), address(gpu, r.drawCounts), r.maxDraws, 0};
+    // With occlusion culling the camera's first phase draws only what was visible last frame.
+    InstanceCullPush push{frame,
+                          address(gpu, r.draws),
+                          address(gpu, r.drawCounts),
+                          r.maxDraws,
+                          0,
+                          r.settings.occlusion ? CullLastVisible : CullSinglePass};
     pushConstants(gpu, cmd, push);
     if (groups) vkCmdDispatch(cmd, groups, 1, 1);
-    push = {frame, address(gpu, r.shadowDraws), address(gpu, r.drawCounts) + DRAW_LIST_COUNT * 4,
-            r.maxDraws, 1};
+    push = {frame,
+            address(gpu, r.shadowDraws),
+            address(gpu, r.drawCounts) + DRAW_LIST_COUNT * 4,
+            r.maxDraws,
+            1,
+            CullSinglePass};
     pushConstants(gpu, cmd, push);
     if (groups) vkCmdDispatch(cmd, groups, 1, 1);
     memoryBarrier(cmd, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT,
@@ -123,6 +127,7 @@ void drawCameraList(Renderer& r, VkCommandBuffer cmd, uint32_t list) {
     setViewport(cmd, r.internalWidth, r.internalHeight);
     vkCmdBindIndexBuffer(cmd, vkBuffer(gpu, r.sceneIndices), 0, VK_INDEX_TYPE_UINT32);
     drawList(r, cmd, r.draws, 0, list);
+    drawPhase2List(r, cmd, list); // occlusion culling's second phase (render/culling)
 }
 
 void beginSceneDepthPass(Renderer& r, VkCommandBuffer cmd, bool clear) {

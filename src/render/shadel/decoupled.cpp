@@ -8,6 +8,7 @@
 #include "core/block_allocator.h"
 #include "core/error.h"
 #include "core/log.h"
+#include "render/culling/instance_grid.h"
 #include "render/forward/forward_passes.h"
 #include "render/renderer.h"
 #include "render/shadel/capacity_control.h"
@@ -65,6 +66,13 @@ struct DecoupledState {
     std::vector<SheetRegion> regions;
     std::vector<ObjectSlot> objects;
     std::vector<gpu::GpuShadelObject> gpuObjects;
+    // The coarse allocation visits only instances near the view (render/culling/instance_grid.h)
+    // and those it touched last frame, so its cost follows the view, not the world's size.
+    InstanceGrid grid;
+    std::vector<uint32_t> visit;        // this frame's instances to decide
+    std::vector<uint32_t> touched;      // instances with a GpuShadelObject entry or sheet rects
+    std::vector<uint64_t> visitedFrame; // per instance: frameNumber + 1 when visited
+    std::vector<uint64_t> seenFrame;    // per instance: frameNumber + 1 when the GPU saw it
     std::vector<gpu::GpuShadelRect> rects;
     uint32_t rectBlockCount = 0;
     uint32_t capacityChunks = 0;
@@ -152,6 +160,11 @@ DecoupledStatePtr createDecoupled(Renderer& r, const GpuScene& scene) {
     d.frameInfo = upload("shadel.frame", sizeof(gpu::ShadelFrame));
     d.changedLights = upload("shadel.changedLights", SHADEL_MAX_CHANGED_LIGHTS * 16);
     d.objectBuffer = upload("shadel.objects", d.gpuObjects.size() * sizeof(gpu::GpuShadelObject));
+    // Every object starts forward; frames rewrite only the entries they visit.
+    std::memset(mapped(gpu, d.objectBuffer), 0, d.gpuObjects.size() * sizeof(gpu::GpuShadelObject));
+    d.grid.build(scene.instanceInfo);
+    d.visitedFrame.assign(scene.instanceCount, 0);
+    d.seenFrame.assign(scene.instanceCount, 0);
     d.rectBuffer = upload("shadel.rects", std::max<size_t>(scene.instanceCount, 1) *
                                               SHADEL_MAX_MIPS * sizeof(gpu::GpuShadelRect));
     d.occupancy = {device("shadel.chunkOccupancy.frame0", blocks * 8),
@@ -378,7 +391,31 @@ void prepareDecoupledFrame(Renderer& r, const GpuScene& scene, const CameraView&
     if (!d.changedLightsOverflow && !r.changedLightVolumes.empty())
         std::memcpy(mapped(gpu, d.changedLights), r.changedLightVolumes.data(),
                     r.changedLightVolumes.size() * sizeof(glm::vec4));
-    for (uint32_t i = 0; i < scene.instanceCount; ++i) {
+    // Instances near the frustum's bounds, and last frame's (to free or clear what they held):
+    // every other instance stays unwanted, with its zero entry and no rects.
+    d.visit.clear();
+    Aabb frustumBox;
+    glm::mat4 invViewProj = glm::inverse(constants.viewProj);
+    for (int c = 0; c < 8; ++c) {
+        glm::vec4 p =
+            invViewProj * glm::vec4((c & 1) ? 1 : -1, (c & 2) ? 1 : -1, (c & 4) ? 1 : 0, 1);
+        frustumBox.extend(glm::vec3(p) / p.w);
+    }
+    // With occlusion culling the GPU's visible set of last frame is the set to allocate for
+    // (seed 004: the CPU estimator and the GPU agree on what is seen); an instance that appears
+    // is drawn forward for one frame. Otherwise every instance near the frustum.
+    const std::vector<uint32_t>* seen = visibleLastFrame(r);
+    if (seen) {
+        d.visit.insert(d.visit.end(), seen->begin(), seen->end());
+        for (uint32_t i : *seen) d.seenFrame[i] = d.frameNumber + 1;
+    } else {
+        d.grid.query(frustumBox, d.visit);
+    }
+    d.visit.insert(d.visit.end(), d.touched.begin(), d.touched.end());
+    d.touched.clear();
+    for (uint32_t i : d.visit) {
+        if (d.visitedFrame[i] == d.frameNumber + 1) continue;
+        d.visitedFrame[i] = d.frameNumber + 1;
         const gpu::GpuInstance& inst = scene.instanceInfo[i];
         const ShadelMeshInfo& mesh = scene.shadelMeshes[inst.mesh];
         ObjectSlot& o = d.objects[i];
@@ -394,7 +431,9 @@ void prepareDecoupledFrame(Renderer& r, const GpuScene& scene, const CameraView&
                        (scene.materialInfo[inst.material].flags & MATERIAL_ALPHA_BLEND) != 0u;
         bool transparentForward = blended && (r.settings.oit != OitMode::Wboit ||
                                               r.settings.marking == MarkingMode::Visibility);
+        // Hidden by occlusion last frame: its rects go back (it returns forward for a frame).
         bool wanted = mesh.mipCount > 0 && !transparentForward &&
+                      (!seen || d.seenFrame[i] == d.frameNumber + 1) &&
                       boxVisible(planes, inst.worldMin - margin, inst.worldMax + margin);
         // Hybrid (seed: "small objects fall back to a direct only render"): an object a few
         // pixels across would still shade whole chunks at its coarsest MIP; forward is cheaper.
@@ -455,8 +494,13 @@ void prepareDecoupledFrame(Renderer& r, const GpuScene& scene, const CameraView&
         }
     }
     d.lastCameraPosition = camera.position;
-    std::memcpy(mapped(gpu, d.objectBuffer), d.gpuObjects.data(),
-                d.gpuObjects.size() * sizeof(gpu::GpuShadelObject));
+    auto* objects = static_cast<gpu::GpuShadelObject*>(mapped(gpu, d.objectBuffer));
+    for (uint32_t i : d.visit) {
+        if (d.visitedFrame[i] != d.frameNumber + 1) continue;
+        d.visitedFrame[i] = 0; // once per instance (visit may list it twice)
+        objects[i] = d.gpuObjects[i];
+        if (d.gpuObjects[i].flags != 0 || d.objects[i].allocated) d.touched.push_back(i);
+    }
     std::memcpy(mapped(gpu, d.rectBuffer), d.rects.data(),
                 d.rects.size() * sizeof(gpu::GpuShadelRect));
 

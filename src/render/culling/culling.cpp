@@ -1,0 +1,254 @@
+#include "render/culling/culling.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <vector>
+
+#include "core/log.h"
+#include "render/forward/forward_passes.h"
+#include "render/renderer.h"
+
+namespace shadel {
+
+struct CullingState {
+    BufferHandle frame;      // host-visible gpu::CullingFrame
+    BufferHandle stats;      // gpu::GpuCullStats, read back
+    BufferHandle visibility; // uint per instance (camera, last frame)
+    BufferHandle drawnLod;   // uint per instance
+    // Occlusion only.
+    BufferHandle pyramid;     // float, every level packed
+    BufferHandle phase2Draws; // DrawIndexedCommand[DRAW_LIST_COUNT * maxDraws]
+    BufferHandle phase2Counts;
+    BufferHandle visibleList; // uint[1 + instances]: count, then ids (read back)
+    std::vector<uint32_t> visibleLastFrame;
+    bool haveVisible = false;
+    std::vector<glm::uvec2> levelSize;
+    std::vector<uint32_t> levelOffset;
+    Pipeline hizBuild;
+    gpu::GpuCullStats last{}; // the last finished frame's counts
+    uint32_t instances = 0;
+};
+
+void CullingStateDeleter::operator()(CullingState* state) const {
+    delete state;
+}
+
+namespace {
+struct HizPush {
+    uint64_t pyramid;
+    uint32_t srcOffset, dstOffset;
+    glm::uvec2 srcSize, dstSize;
+    uint32_t depthSlot, fromDepth;
+};
+} // namespace
+
+CullingStatePtr createCulling(Renderer& r, const GpuScene& scene) {
+    Gpu& gpu = *r.gpu;
+    CullingStatePtr c(new CullingState);
+    c->instances = scene.instanceCount;
+    VkDeviceSize perInstance = VkDeviceSize(std::max(scene.instanceCount, 1u)) * 4;
+    c->frame =
+        createBuffer(gpu, {"culling.frame", sizeof(gpu::CullingFrame), 0, MemoryKind::Upload});
+    c->stats =
+        createBuffer(gpu, {"culling.stats", sizeof(gpu::GpuCullStats), 0, MemoryKind::Readback});
+    c->visibility = createBuffer(gpu, {"culling.visibleLastFrame", perInstance});
+    c->drawnLod = createBuffer(gpu, {"culling.drawnLod", perInstance});
+    bool ok = c->frame && c->stats && c->visibility && c->drawnLod;
+    if (r.settings.occlusion) {
+        glm::uvec2 size(r.internalWidth, r.internalHeight);
+        uint32_t texels = 0;
+        while (true) {
+            c->levelSize.push_back(size);
+            c->levelOffset.push_back(texels);
+            texels += size.x * size.y;
+            if (size.x == 1 && size.y == 1) break;
+            size = glm::max((size + 1u) / 2u, glm::uvec2(1));
+        }
+        c->pyramid = createBuffer(gpu, {"culling.depthPyramid", VkDeviceSize(texels) * 4});
+        VkDeviceSize drawBytes =
+            VkDeviceSize(DRAW_LIST_COUNT) * r.maxDraws * sizeof(gpu::DrawIndexedCommand);
+        c->phase2Draws = createBuffer(
+            gpu, {"draws.cameraPhase2", drawBytes, VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT});
+        c->phase2Counts = createBuffer(gpu, {"draws.cameraPhase2Counts", DRAW_LIST_COUNT * 4,
+                                             VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT});
+        c->visibleList =
+            createBuffer(gpu, {"culling.visibleList", perInstance + 4, 0, MemoryKind::Readback});
+        ok = ok && c->pyramid && c->phase2Draws && c->phase2Counts && c->visibleList;
+        c->hizBuild = createComputePipeline(gpu, "hizBuild", "culling_hiz_build.comp.spv");
+    }
+    if (!ok) {
+        destroyCulling(r, c);
+        throw DeviceError("out of GPU memory for the culling buffers");
+    }
+    // Nothing was visible before the first frame: phase 1 draws nothing, phase 2 everything
+    // the (empty) pyramid does not hide.
+    std::vector<uint32_t> zeros(perInstance / 4, 0u);
+    uploadBuffer(gpu, c->visibility, zeros.data(), perInstance);
+    return c;
+}
+
+void destroyCulling(Renderer& r, CullingStatePtr& c) {
+    if (!c) return;
+    Gpu& gpu = *r.gpu;
+    for (BufferHandle b : {c->frame, c->stats, c->visibility, c->drawnLod, c->pyramid,
+                           c->phase2Draws, c->phase2Counts, c->visibleList})
+        if (b) destroy(gpu, b);
+    if (c->hizBuild.pipeline) destroy(gpu, c->hizBuild);
+    c.reset();
+}
+
+void prepareCullingFrame(Renderer& r, const GpuScene& scene, gpu::FrameConstants& constants) {
+    Gpu& gpu = *r.gpu;
+    CullingState& c = *r.culling;
+    gpu::CullingFrame f{};
+    f.meshLods = address(gpu, scene.meshLods);
+    f.stats = address(gpu, c.stats);
+    f.visibility = address(gpu, c.visibility);
+    f.drawnLod = address(gpu, c.drawnLod);
+    f.hiz = c.pyramid ? address(gpu, c.pyramid) : 0;
+    f.lod = r.settings.lod ? 1u : 0u;
+    f.lodErrorPixels = r.settings.lodErrorPixels;
+    // P[1][1] = cot(fov / 2): a length l at distance d spans l * P[1][1] * height / 2 / d pixels.
+    f.lodScale = std::abs(constants.proj[1][1]) * 0.5f * float(r.internalHeight); // y is flipped
+    f.occlusion = r.settings.occlusion ? 1u : 0u;
+    f.sceneMinY = scene.bounds.valid() ? scene.bounds.min.y : -1e30f;
+    if (!c.levelSize.empty()) {
+        f.hizLevels = uint32_t(c.levelSize.size());
+        f.hizSize = c.levelSize[0];
+    }
+    std::memcpy(mapped(gpu, c.frame), &f, sizeof(f));
+    constants.culling = address(gpu, c.frame);
+}
+
+void recordCullingReset(Renderer& r, VkCommandBuffer cmd) {
+    Gpu& gpu = *r.gpu;
+    CullingState& c = *r.culling;
+    vkCmdFillBuffer(cmd, vkBuffer(gpu, c.stats), 0, VK_WHOLE_SIZE, 0);
+    if (c.phase2Counts) vkCmdFillBuffer(cmd, vkBuffer(gpu, c.phase2Counts), 0, VK_WHOLE_SIZE, 0);
+    if (c.visibleList) vkCmdFillBuffer(cmd, vkBuffer(gpu, c.visibleList), 0, 4, 0);
+}
+
+void recordOcclusionPasses(Renderer& r, FrameRecorder& rec, uint64_t frame, const GpuScene& scene) {
+    Gpu& gpu = *r.gpu;
+    CullingState& c = *r.culling;
+    pass(rec, "hizBuild", [&](VkCommandBuffer cmd) {
+        VkImage depth = vkImage(gpu, r.depth);
+        imageBarrier(cmd, depth, VK_IMAGE_ASPECT_DEPTH_BIT,
+                     VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL,
+                     VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL,
+                     VK_PIPELINE_STAGE_2_EARLY_FRAGMENT_TESTS_BIT |
+                         VK_PIPELINE_STAGE_2_LATE_FRAGMENT_TESTS_BIT,
+                     VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT,
+                     VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_SHADER_SAMPLED_READ_BIT);
+        bind(gpu, cmd, c.hizBuild);
+        for (size_t k = 0; k < c.levelSize.size(); ++k) {
+            HizPush push{};
+            push.pyramid = address(gpu, c.pyramid);
+            push.dstOffset = c.levelOffset[k];
+            push.dstSize = c.levelSize[k];
+            push.fromDepth = k == 0;
+            push.depthSlot = slot(gpu, r.depthRead).value;
+            if (k > 0) push.srcOffset = c.levelOffset[k - 1], push.srcSize = c.levelSize[k - 1];
+            pushConstants(gpu, cmd, push);
+            vkCmdDispatch(cmd, (push.dstSize.x + 7) / 8, (push.dstSize.y + 7) / 8, 1);
+            memoryBarrier(
+                cmd, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT,
+                VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
+                VK_ACCESS_2_SHADER_STORAGE_READ_BIT | VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT);
+        }
+        // Back to a depth target (contents kept) for the phase-2 prepass.
+        imageBarrier(cmd, depth, VK_IMAGE_ASPECT_DEPTH_BIT,
+                     VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL,
+                     VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL,
+                     VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_SHADER_SAMPLED_READ_BIT,
+                     VK_PIPELINE_STAGE_2_EARLY_FRAGMENT_TESTS_BIT |
+                         VK_PIPELINE_STAGE_2_LATE_FRAGMENT_TESTS_BIT,
+                     VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_READ_BIT |
+                         VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT);
+    });
+    pass(rec, "instanceCullPhase2", [&](VkCommandBuffer cmd) {
+        bind(gpu, cmd, r.instanceCull);
+        InstanceCullPush push{
+            frame,   address(gpu, c.phase2Draws), address(gpu, c.phase2Counts), r.maxDraws, 0,
+            CullRest};
+        push.visibleList = address(gpu, c.visibleList);
+        pushConstants(gpu, cmd, push);
+        if (scene.instanceCount) vkCmdDispatch(cmd, (scene.instanceCount + 63) / 64, 1, 1);
+        memoryBarrier(cmd, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
+                      VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT, VK_PIPELINE_STAGE_2_DRAW_INDIRECT_BIT,
+                      VK_ACCESS_2_INDIRECT_COMMAND_READ_BIT);
+    });
+    pass(rec, "depthPrepassPhase2", [&](VkCommandBuffer cmd) {
+        beginSceneDepthPass(r, cmd, false);
+        bind(gpu, cmd, r.depthPrepass);
+        VkViewport vp{0, 0, float(r.internalWidth), float(r.internalHeight), 0, 1};
+        VkRect2D scissor{{0, 0}, {r.internalWidth, r.internalHeight}};
+        vkCmdSetViewport(cmd, 0, 1, &vp);
+        vkCmdSetScissor(cmd, 0, 1, &scissor);
+        pushConstants(gpu, cmd, RasterPush{frame, 0});
+        for (uint32_t list : {DRAW_LIST_OPAQUE, DRAW_LIST_DECOUPLED}) {
+            vkCmdBindIndexBuffer(cmd, vkBuffer(gpu, r.sceneIndices), 0, VK_INDEX_TYPE_UINT32);
+            drawPhase2List(r, cmd, list);
+        }
+        vkCmdEndRendering(cmd);
+        memoryBarrier(cmd, VK_PIPELINE_STAGE_2_LATE_FRAGMENT_TESTS_BIT,
+                      VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT,
+                      VK_PIPELINE_STAGE_2_EARLY_FRAGMENT_TESTS_BIT |
+                          VK_PIPELINE_STAGE_2_LATE_FRAGMENT_TESTS_BIT,
+                      VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_READ_BIT |
+                          VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT);
+    });
+}
+
+void drawPhase2List(Renderer& r, VkCommandBuffer cmd, uint32_t list) {
+    CullingState* c = r.culling.get();
+    if (!c || !c->phase2Draws) return;
+    Gpu& gpu = *r.gpu;
+    vkCmdDrawIndexedIndirectCount(cmd, vkBuffer(gpu, c->phase2Draws),
+                                  VkDeviceSize(list) * r.maxDraws * sizeof(gpu::DrawIndexedCommand),
+                                  vkBuffer(gpu, c->phase2Counts), list * 4, r.maxDraws,
+                                  sizeof(gpu::DrawIndexedCommand));
+}
+
+void finishCullingFrame(Renderer& r) {
+    CullingState& c = *r.culling;
+    std::memcpy(&c.last, mapped(*r.gpu, c.stats), sizeof(gpu::GpuCullStats));
+    if (c.visibleList) {
+        const uint32_t* list = static_cast<const uint32_t*>(mapped(*r.gpu, c.visibleList));
+        uint32_t count = std::min(list[0], c.instances);
+        c.visibleLastFrame.assign(list + 1, list + 1 + count);
+        c.haveVisible = true;
+    }
+}
+
+const std::vector<uint32_t>* visibleLastFrame(const Renderer& r) {
+    const CullingState* c = r.culling.get();
+    return c && c->haveVisible ? &c->visibleLastFrame : nullptr;
+}
+
+void cullingStats(const Renderer& r, nlohmann::json& s) {
+    const CullingState& c = *r.culling;
+    const gpu::GpuCullStats& st = c.last;
+    auto view = [&](uint32_t v) {
+        nlohmann::json j = {{"instances", c.instances},
+                            {"frustum_visible", st.frustumVisible[v]},
+                            {"instances_drawn", st.instancesDrawn[v]},
+                            {"triangles_drawn", st.trianglesDrawn[v]},
+                            {"culled_fraction",
+                             c.instances ? 1.0 - double(st.instancesDrawn[v]) / c.instances : 0.0}};
+        if (v == CULL_VIEW_CAMERA) {
+            j["occlusion_culled"] = st.occlusionCulled;
+            j["drawn_in_phase1"] = st.drawnLastFrameVisible;
+        }
+        return j;
+    };
+    s["instances_drawn"] = st.instancesDrawn[CULL_VIEW_CAMERA];
+    s["triangles_drawn"] = st.trianglesDrawn[CULL_VIEW_CAMERA];
+    s["culling"] = {
+        {"lod", r.settings.lod ? "on" : "off"},
+        {"occlusion", r.settings.occlusion ? "on" : "off"},
+        {"views", {{"camera", view(CULL_VIEW_CAMERA)}, {"shadow", view(CULL_VIEW_SHADOW)}}}};
+}
+
+} // namespace shadel
