@@ -222,6 +222,7 @@ int main(int argc, char** argv) {
         ->add_option("--gi-snap", giSnap,
                      "GI: on | off: snap the cascades to their cell size (off only to measure "
                      "swimming)")
+        ->capture_default_str();
     // World scale (render/culling): instance count of builtin:many, LODs, occlusion culling.
     std::string lod = "off", occlusion = "off";
     auto* instancesFlag =

@@ -573,6 +573,8 @@ Scene makeTransparency() {
     b.pointLight("fire light", {2.7f, 1.1f, -0.2f}, {1.0f, 0.55f, 0.2f}, 8.0f, 8.0f);
     b.camera("main", eye, {0.0f, 1.1f, 0.0f}, 0.8f, 0.1f, 100.0f);
     b.camera("side", {-5.5f, 2.0f, 4.0f}, {0.0f, 1.2f, -0.5f}, 0.8f, 0.1f, 100.0f);
+    return scene;
+}
 
 // The GI test box: a closed room with a red wall (left, -x) and a green wall (right, +x), lit
 // only by a shadow-casting spot through an opening in the ceiling, aimed high on the red wall.
