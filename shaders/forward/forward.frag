@@ -1,6 +1,7 @@
 #version 460
 // Forward shading: the shared material + lighting code evaluated per pixel.
 #include "common/lighting.glsl"
+#include "debug/inspect.glsl"
 
 layout(push_constant, scalar) uniform Push {
     uint64_t frame;
@@ -30,6 +31,14 @@ void main() {
     MaterialSample m = evaluateMaterial(mat, s);
     if ((mat.flags & MATERIAL_ALPHA_MASK) != 0u && m.alpha < mat.alphaCutoff) discard;
     vec3 color = shadeSurface(f, m, inPosition, s.normal);
+    if (inspecting(f, uvec2(gl_FragCoord.xy))) {
+        beginInspect(f, inInstance, uint(gl_PrimitiveID), gl_FragCoord);
+        vec2 footprint = max(abs(s.uvDx), abs(s.uvDy));
+        if (mat.baseColorTexture != NO_TEXTURE)
+            footprint *= vec2(textureSize(gTextures[nonuniformEXT(mat.baseColorTexture)], 0));
+        shaderPrintF(f, PRINT_UV_LOD, log2(max(max(footprint.x, footprint.y), 1e-8)));
+        inspectSurface(f, inInstance, uint(gl_PrimitiveID), m, inPosition, s.normal, color);
+    }
     float alpha = (mat.flags & MATERIAL_ALPHA_BLEND) != 0u ? m.alpha : 1.0;
     outColor = vec4(color, alpha);
 }

@@ -46,11 +46,19 @@ struct RenderOptions {
     double shadelBudget = 64e6; // MIP-0 shadels the bake may use for the whole scene
     bool printPasses = false;
     bool progress = true;
+    // --capture NAME[,NAME...] (or {"list"}) and --capture-dir: the last frame's named
+    // resources (app/capture_output.h); files go to the dir or next to --out.
+    std::vector<std::string> captures;
+    std::string captureDir;
+    // --inspect X,Y: print what the shading computed at that output pixel (last frame).
+    int32_t inspectX = -1, inspectY = -1;
 };
 
 struct RenderRun {
     std::vector<FrameResult> frames;
     nlohmann::json stats;
+    bool listedCaptures = false;           // --capture list: printed, nothing rendered
+    std::vector<std::string> captureFiles; // written by --capture
 };
 
 // Parses "WxH"; throws InputError naming the flag.
@@ -58,6 +66,8 @@ void parseSize(const std::string& text, uint32_t& width, uint32_t& height);
 RenderMode parseMode(const std::string& text);
 Visualize parseVisualize(const std::string& text);
 MarkingMode parseMarking(const std::string& text);
+// "X,Y" -> pixel; throws InputError naming --inspect.
+void parseInspect(const std::string& text, int32_t& x, int32_t& y);
 // The bake cache folder when --cache-dir is not given (see defaultBakeCacheDir()).
 std::string defaultCacheDir();
 

@@ -9,6 +9,7 @@
 #include <CLI/CLI.hpp>
 
 #include "app/cache_command.h"
+#include "app/capture_output.h"
 #include "app/cli_help.h"
 #include "app/cli_validate.h"
 #include "app/commands.h"
@@ -176,6 +177,16 @@ int main(int argc, char** argv) {
                        "FILE.json: Chrome trace events (CPU frontend and GPU passes per frame; "
                        "chrome://tracing, Perfetto)");
     render->add_flag("--passes", ro.printPasses, "print the per-pass timing table");
+    std::string captures;
+    render->add_option("--capture", captures,
+                       "NAME[,NAME...]: write named resources of the last frame (EXR for HDR "
+                       "and depth, PNG, false colour for IDs and masks); list: print the names");
+    std::string inspect;
+    render->add_option("--inspect", inspect,
+                       "X,Y: print what the shading computed at that pixel (instance, triangle, "
+                       "MIP, chunk, material, each light's contribution)");
+    render->add_option("--capture-dir", ro.captureDir,
+                       "DIR for --capture files (default: next to --out)");
 
     // bench
     BenchOptions bo;
@@ -303,7 +314,10 @@ int main(int argc, char** argv) {
             if (reuse != "on" && reuse != "off")
                 throw InputError(format("--reuse %s: expected on or off", reuse.c_str()));
             ro.reuse = reuse == "on";
+            if (!captures.empty()) ro.captures = parseCaptureNames(captures);
+            if (!inspect.empty()) parseInspect(inspect, ro.inspectX, ro.inspectY);
             RenderRun run = runRender(g.gpu, ro);
+            if (run.listedCaptures) return 0;
             const auto& s = run.stats;
             std::printf(
                 "%s %s %ux%u: %u frame(s), median %.2f ms, %llu px covered, %llu shader asserts, "

@@ -4,6 +4,7 @@
 
 #include <glm/gtc/matrix_transform.hpp>
 
+#include "common/print_labels.h"
 #include "core/log.h"
 #include "render/forward/forward_passes.h"
 #include "render/lighting/light_animation.h"
@@ -60,12 +61,30 @@ static void createTargets(Renderer& r) {
     r.shadowRead = createReadView(gpu, r.shadowMap);
 }
 
+// --capture names of the targets every frame has (render/debug/capture.h).
+static void registerTargetCaptures(Renderer& r) {
+    Gpu& gpu = *r.gpu;
+    VkImageLayout hdrLayout = usesVisibilityBuffer(r.settings)
+                                  ? VK_IMAGE_LAYOUT_GENERAL
+                                  : VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL; // after tonemap
+    registerTextureCapture(
+        r.captures, gpu, "hdr", "scene colour before tonemapping (EXR)", CaptureKind::Hdr,
+        [&r] { return r.hdr; }, hdrLayout);
+    registerTextureCapture(
+        r.captures, gpu, "depth", "reversed-Z depth, 1 = near (EXR)", CaptureKind::Depth,
+        [&r] { return r.depth; }, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL);
+    registerTextureCapture(
+        r.captures, gpu, "shadow", "the sun's shadow map depth (EXR)", CaptureKind::Depth,
+        [&r] { return r.shadowMap; }, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL);
+}
+
 void initRenderer(Renderer& r, Gpu& gpu, const RenderSettings& settings, const GpuScene& scene) {
     r.gpu = &gpu;
     r.settings = settings;
     if (settings.width == 0 || settings.height == 0 || settings.ssaa == 0)
         throw InputError("--size and --ssaa must be positive");
     createTargets(r);
+    registerTargetCaptures(r);
     r.maxDraws = std::max<uint32_t>(scene.instanceCount, 1);
     VkDeviceSize drawBytes =
         VkDeviceSize(DRAW_LIST_COUNT) * r.maxDraws * sizeof(gpu::DrawIndexedCommand);
@@ -99,6 +118,7 @@ void destroyRenderer(Renderer& r) {
     if (!r.gpu) return;
     Gpu& gpu = *r.gpu;
     vkDeviceWaitIdle(gpu.device.device);
+    r.captures = {}; // its sources refer to what is destroyed below
     if (r.visibility) destroyVisibility(r, r.visibility);
     if (r.decoupled) destroyDecoupled(r, r.decoupled);
     destroyFrameRecorder(r.recorder);
@@ -160,6 +180,10 @@ static gpu::FrameConstants makeFrameConstants(Renderer& r, const GpuScene& scene
     f.invViewportSize = 1.0f / f.viewportSize;
     f.frameIndex = uint32_t(gpu.frameIndex);
     f.visualize = uint32_t(r.settings.visualize);
+    f.inspectPixel = INSPECT_OFF;
+    if (r.settings.inspectX >= 0 && r.settings.inspectY >= 0) // the SSAA sample at its corner
+        f.inspectPixel = uint32_t(r.settings.inspectX) * r.settings.ssaa |
+                         (uint32_t(r.settings.inspectY) * r.settings.ssaa) << 16;
     f.vertices = address(gpu, scene.vertices);
     f.indices = address(gpu, scene.indices);
     f.meshes = address(gpu, scene.meshes);
@@ -233,6 +257,7 @@ FrameResult renderFrame(Renderer& r, const GpuScene& scene, const CameraView& ca
     // inside the passes, so this is an upper bound there).
     result.cpuFrameMs = prepareMs + std::max(0.0, msSince(cpuStart) - prepareMs - rec.gpuWaitMs);
     result.shaderAsserts = collectShaderMessages(gpu, r.messages);
+    result.prints = r.messages.prints;
     if (r.decoupled) finishDecoupledFrame(r);
     r.framesRendered++;
     size_t bytes = size_t(r.settings.width) * r.settings.height * 4;

@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "render/camera.h"
+#include "render/debug/capture.h"
 #include "render/gpu_scene.h"
 #include "render/shadel/visibility.h"
 #include "rhi/frame.h"
@@ -50,6 +51,8 @@ struct RenderSettings {
     bool capacityControl = true;     // decoupled: steer the shading bias from storage use
     bool reuse = true;               // decoupled: carry unchanged shadels over from last frame
     uint32_t reuseRefreshPeriod = 8; // decoupled: reshade every carried chunk this often
+    // --inspect X,Y: the output pixel whose shading is printed (shaders/debug/inspect.glsl).
+    int32_t inspectX = -1, inspectY = -1;
     bool animateLights = false; // point and spot lights move on small circles // decoupled: rects
                                 // at every MIP (the old policy, for comparison)
 };
@@ -63,6 +66,7 @@ struct FrameResult {
     double cpuPrepareMs = 0.0; // of which the CPU frontend: constants, decoupled coarse allocation
     double startMs = 0.0;      // since the renderer was created (trace export)
     uint32_t shaderAsserts = 0;
+    std::vector<ShaderPrint> prints; // shaderPrint records of this frame (--inspect)
 };
 
 struct DecoupledState; // render/shadel/decoupled.h
@@ -101,6 +105,7 @@ struct Renderer {
     std::vector<glm::vec4> changedLightVolumes;
     uint64_t framesRendered = 0;
     VisibilityStatePtr visibility; // decoupled with --marking visibility
+    CaptureRegistry captures;      // --capture: named resources of the frame (render/debug)
     std::chrono::steady_clock::time_point createdAt = std::chrono::steady_clock::now();
 };
 
