@@ -13,6 +13,7 @@
 #include "app/cli_help.h"
 #include "app/cli_validate.h"
 #include "app/commands.h"
+#include "app/viewer/viewer.h"
 #include "bake/bake.h"
 #include "bake/cache_eviction.h"
 #include "core/error.h"
@@ -229,6 +230,26 @@ int main(int argc, char** argv) {
         ->check(finiteInRange(kShadelBudgetRange));
     bake->add_flag("--no-cache", bakeNoCache, "bake from scratch (still writes the cache)");
 
+    // view
+    ViewOptions vo;
+    std::string viewSize = "1280x720";
+    auto* view = app.add_subcommand("view", "open a window: fly/orbit cameras, forward/decoupled, "
+                                            "debug views, per-pass timings (Xvfb works)");
+    view->add_option("--scene", vo.scene, "builtin:NAME | FILE.gltf | FILE.glb")
+        ->capture_default_str();
+    view->add_option("--camera", vo.camera, "camera name (default: the scene's first)");
+    view->add_option("--mode", vo.mode, "forward | decoupled (switchable in the window)")
+        ->capture_default_str();
+    view->add_option("--marking", vo.marking, "decoupled: raster | visibility")
+        ->capture_default_str();
+    view->add_option("--size", viewSize, "WIDTHxHEIGHT of the window")->capture_default_str();
+    view->add_option("--frames", vo.frames, "quit after N frames (0: when the window closes)")
+        ->capture_default_str();
+    view->add_option("--screenshot", vo.screenshot,
+                     "FILE.png: the window's last frame (with --frames), or on the UI's button");
+    view->add_flag("--no-ui", vo.noUi, "no ImGui panel (screenshots show only the frame)");
+    view->add_option("--cache-dir", vo.cacheDir, "bake cache directory");
+
     auto* info = app.add_subcommand("info", "print the device, driver, features and limits");
     std::string cacheDirForCache;
     auto* cache = app.add_subcommand("cache", "show the bake cache's folder and size");
@@ -293,6 +314,12 @@ int main(int argc, char** argv) {
                 std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
             std::printf("%s", bakeReport(baked, seconds).c_str());
             return 0;
+        }
+        if (*view) {
+            parseSize(viewSize, vo.width, vo.height);
+            vo.allowExternalFiles = allowExternalFiles;
+            vo.cacheLimitBytes = cacheLimitBytes;
+            return runViewer(vo, deviceDesc(device, validation));
         }
         GpuGuard g;
         createGpu(g.gpu, deviceDesc(device, validation));
