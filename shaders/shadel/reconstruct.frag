@@ -3,7 +3,7 @@
 // shaded samples (shadel/resolve.glsl); misses and overflow fall back to forward shading.
 #include "shadel/resolve.glsl"
 #include "common/lighting.glsl"
-#include "debug/inspect.glsl"
+#include "debug/inspect_shadel.glsl"
 
 layout(early_fragment_tests) in;
 
@@ -20,27 +20,6 @@ layout(location = 4) flat in uint inInstance;
 layout(location = 5) in vec2 inShadelUv;
 
 layout(location = 0) out vec4 outColor;
-
-// --inspect: the shadels this pixel reads (LOD, first tap's chunk and slot), what came back, and
-// the material and lights evaluated at the pixel's surface point with the shading code.
-void inspectPixel(FrameConstants f, ShadelFrame s, GpuShadelObject o, Reconstruction r,
-                  vec2 texelDx, vec2 texelDy) {
-    beginInspect(f, inInstance, uint(gl_PrimitiveID), gl_FragCoord);
-    ShadelLevels l = shadelLevels(o, texelDx, texelDy, s.shadingBias, s.trilinearBand);
-    shaderPrintF4(f, PRINT_SHADEL_LOD, vec4(r.lod, float(l.mip0), float(l.mip1), l.blend));
-    ivec2 t0;
-    vec2 w;
-    bilinearFootprint(o, r.mip0, inShadelUv, t0, w);
-    uvec2 sheet = sheetShadel(o, r.mip0, t0);
-    uint block = blockIndex(s, sheet);
-    uint64_t mask = Uint64Buffer(s.occupancy).v[block];
-    uint base = UintBuffer(s.offsetMap).v[block];
-    uint bit = chunkBit(sheet);
-    bool stored = (mask & (1ul << bit)) != 0ul && base != SHADEL_INVALID;
-    uint slot = stored ? chunkSlot(mask, base, bit) : SHADEL_INVALID;
-    shaderPrintU4(f, PRINT_SHADEL_CHUNK, uvec4(sheet / SHADEL_CHUNK, slot, r.mip0));
-    shaderPrintF3(f, PRINT_RECONSTRUCTED, r.color);
-}
 
 vec3 forwardShade(FrameConstants f) {
     GpuInstance inst = InstanceBuffer(f.instances).i[inInstance];
@@ -71,7 +50,10 @@ void main() {
     countReconstruction(s, r);
     vec3 color = r.color;
     bool inspect = inspecting(f, uvec2(gl_FragCoord.xy));
-    if (inspect) inspectPixel(f, s, o, r, texelDx, texelDy);
+    if (inspect) {
+        beginInspect(f, inInstance, uint(gl_PrimitiveID), gl_FragCoord);
+        inspectShadels(f, s, o, r, inShadelUv, texelDx, texelDy);
+    }
     if (r.missing + r.overflowed != 0u || inspect) {
         vec3 forward = forwardShade(f); // also prints the surface under --inspect
         if (r.missing + r.overflowed != 0u) color = forward;

@@ -249,6 +249,9 @@ int main(int argc, char** argv) {
                      "FILE.png: the window's last frame (with --frames), or on the UI's button");
     view->add_flag("--no-ui", vo.noUi, "no ImGui panel (screenshots show only the frame)");
     view->add_option("--cache-dir", vo.cacheDir, "bake cache directory");
+    view->add_option("--shader-source", vo.shaderSource,
+                     "GLSL folder watched for hot reload (recompiled with glslc); empty: off")
+        ->capture_default_str();
 
     auto* info = app.add_subcommand("info", "print the device, driver, features and limits");
     std::string cacheDirForCache;

@@ -171,23 +171,39 @@ TEST(Inspect, ForwardPixelAgreesWithTheCpuBrdfAndTheImage) {
     EXPECT_TRUE(sky.frames.back().prints.empty());
 }
 
-TEST(Inspect, DecoupledPixelPrintsItsChunkAndAgreesWithTheCpuBrdf) {
+// Raster reconstruction and the compute resolve of --marking visibility print the same things.
+class InspectDecoupled : public ::testing::TestWithParam<MarkingMode> {};
+
+TEST_P(InspectDecoupled, PixelPrintsItsChunkAndAgreesWithTheCpuBrdf) {
     Scene scene = loadScene("builtin:smooth", {});
-    RenderRun run = renderChecked(inspectOptions(RenderMode::Decoupled, 52, 48));
+    RenderOptions o = inspectOptions(RenderMode::Decoupled, 52, 48);
+    o.marking = GetParam();
+    std::string where =
+        o.marking == MarkingMode::Raster ? "decoupled raster 52,48" : "decoupled visibility 52,48";
+    RenderRun run = renderChecked(o);
     Printed p = collect(run);
-    ASSERT_TRUE(p.has(PRINT_SHADEL_CHUNK));
+    ASSERT_TRUE(p.has(PRINT_SHADEL_CHUNK)) << where;
     EXPECT_NE(p.u(PRINT_SHADEL_CHUNK, 2), 0xFFFFFFFFu); // the chunk got a storage slot
     const ShaderPrint& lod = p.byLabel.at(PRINT_SHADEL_LOD).at(0);
     EXPECT_TRUE(std::isfinite(lod.f(0)) && lod.f(0) >= 0.0f);
     EXPECT_EQ(p.u(PRINT_SHADEL_CHUNK, 3), uint32_t(lod.f(1))); // chunk of the first MIP
-    glm::vec3 shaded = checkSurface(p, scene, "decoupled 52,48");
+    glm::vec3 shaded = checkSurface(p, scene, where);
     glm::vec3 reconstructed = p.v3(PRINT_RECONSTRUCTED);
     glm::vec3 output = p.v3(PRINT_OUTPUT);
     EXPECT_LT(relError(output, reconstructed), 1e-4f); // no miss: the storage's value is shown
     // Shadels are shaded at shadel centres and filtered: close to, not equal to, the pixel's.
-    std::printf("[ figures ] decoupled 52,48: reconstructed %.4f %.4f %.4f, at the pixel %.4f "
-                "%.4f %.4f, lod %.2f\n",
-                reconstructed.x, reconstructed.y, reconstructed.z, shaded.x, shaded.y, shaded.z,
-                lod.f(0));
+    std::printf("[ figures ] %s: reconstructed %.4f %.4f %.4f, at the pixel %.4f %.4f %.4f, "
+                "lod %.2f\n",
+                where.c_str(), reconstructed.x, reconstructed.y, reconstructed.z, shaded.x,
+                shaded.y, shaded.z, lod.f(0));
     EXPECT_LT(relError(reconstructed, shaded), 0.1f);
+    // The pixel the frame shows is the printed output.
+    const uint8_t* px = &run.frames.back().rgba[(size_t(48) * 160 + 52) * 4];
+    for (int c = 0; c < 3; ++c) EXPECT_NEAR(int(px[c]), int(tonemap(output[c])), 1) << where;
 }
+
+INSTANTIATE_TEST_SUITE_P(Marking, InspectDecoupled,
+                         ::testing::Values(MarkingMode::Raster, MarkingMode::Visibility),
+                         [](const auto& info) {
+                             return info.param == MarkingMode::Raster ? "Raster" : "Visibility";
+                         });

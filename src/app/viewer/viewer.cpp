@@ -2,6 +2,7 @@
 
 #include <chrono>
 #include <cstring>
+#include <filesystem>
 
 #include <GLFW/glfw3.h>
 #include <nlohmann/json.hpp>
@@ -18,6 +19,7 @@
 #include "render/shadel/decoupled.h"
 #include "render/view_density.h"
 #include "rhi/gpu.h"
+#include "rhi/shader_reload.h"
 #include "scene/load.h"
 
 namespace shadel {
@@ -131,6 +133,10 @@ int runViewer(const ViewOptions& o, DeviceDesc deviceDesc) {
         deviceDesc.swapchain = true;
         createGpu(gpu, deviceDesc);
         createSwapchain(window, gpu);
+        bool hotReload = !o.shaderSource.empty() && std::filesystem::is_directory(o.shaderSource);
+        if (hotReload) enableShaderHotReload(gpu, o.shaderSource); // before any pipeline
+        std::string reloadStatus =
+            hotReload ? "hot reload: watching " + o.shaderSource : "hot reload: off";
         if (window.extent.width != o.width || window.extent.height != o.height)
             throw DeviceError(format("shadel view: asked for a %ux%u window, got %ux%u", o.width,
                                      o.height, window.extent.width, window.extent.height));
@@ -147,6 +153,7 @@ int runViewer(const ViewOptions& o, DeviceDesc deviceDesc) {
         CameraControl camera = makeCameraControl(scene.camera, scene.bounds);
         VkDevice dev = gpu.device.device;
         auto last = std::chrono::steady_clock::now();
+        auto lastPoll = last;
         bool tabDown = false;
         while (!glfwWindowShouldClose(window.window)) {
             glfwPollEvents();
@@ -160,6 +167,15 @@ int runViewer(const ViewOptions& o, DeviceDesc deviceDesc) {
             updateCamera(camera, window.window, dt, !uiWantsMouse(ui), gWheel);
             gWheel = 0.0f;
 
+            if (hotReload && now - lastPoll > std::chrono::milliseconds(500)) {
+                lastPoll = now;
+                ShaderReloadResult reload = pollShaderReload(gpu);
+                if (!reload.errors.empty())
+                    reloadStatus = "hot reload failed, old pipeline kept:\n" + reload.errors[0];
+                else if (reload.pipelinesSwapped)
+                    reloadStatus =
+                        format("hot reload: %u pipeline(s) swapped", reload.pipelinesSwapped);
+            }
             FrameResult result =
                 renderFrame(renderer, scene.gpu, makeCameraView(camera.camera, o.width, o.height));
             bool lastFrame = o.frames && frame + 1 >= o.frames;
@@ -168,6 +184,7 @@ int runViewer(const ViewOptions& o, DeviceDesc deviceDesc) {
                 panel.frameMsHistory.push_back(float(result.frameMs));
                 if (panel.frameMsHistory.size() > 120) panel.frameMsHistory.pop_front();
                 panel.statLines = statLines(renderer, result);
+                panel.statLines.push_back(reloadStatus);
                 buildUi(ui, panel);
             }
             bool screenshot = !o.screenshot.empty() && (lastFrame || panel.screenshotRequested);
