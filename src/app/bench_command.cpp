@@ -1,6 +1,7 @@
 #include <cstdio>
 #include <fstream>
 
+#include "app/bench_plot.h"
 #include "app/commands.h"
 #include "app/output_files.h"
 #include "core/error.h"
@@ -13,6 +14,7 @@ namespace shadel {
 // against forward (DESIGN §5, §7).
 nlohmann::json runBench(Gpu& gpu, const BenchOptions& b) {
     if (!b.json.empty()) requireCreatableOutput("--json", b.json); // before minutes of rendering
+    if (!b.plot.empty()) requireCreatableOutput("--plot", b.plot);
     RenderOptions o;
     o.scene = b.scene;
     o.allowExternalFiles = b.allowExternalFiles;
@@ -98,6 +100,7 @@ nlohmann::json runBench(Gpu& gpu, const BenchOptions& b) {
     row("reuse fraction", decoupledOnly("reuse_fraction", "%.3f"));
     row("occupancy bits per shadel", decoupledOnly("occupancy_bits_per_shadel", "%.3f"));
     row("reconstruction misses", decoupledOnly("reconstruction_misses", ""));
+    if (!b.plot.empty()) writeBenchPlot(out, b.plot);
     if (!b.json.empty()) {
         writeOutputFile(b.json, out.dump(2) + "\n");
     }

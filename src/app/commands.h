@@ -93,6 +93,7 @@ struct BenchOptions {
     bool animateLights = false;
     uint32_t reuseRefreshPeriod = 8;
     uint64_t cacheLimitBytes = 4ull << 30;
+    std::string plot; // --plot FILE.png: per-pass bar chart (app/bench_plot.h)
 };
 nlohmann::json runBench(Gpu& gpu, const BenchOptions& options);
 

@@ -200,6 +200,7 @@ int main(int argc, char** argv) {
     bench->add_option("--frames", bo.frames, "frames per mode")->capture_default_str();
     bench->add_option("--camera", bo.camera, "camera name");
     bench->add_option("--json", bo.json, "write the results as JSON");
+    bench->add_option("--plot", bo.plot, "FILE.png: the per-pass comparison as a bar chart");
     bench->add_option("--timing", benchTiming, "auto | timestamps | submit")->capture_default_str();
     bench->add_option("--density", benchDensity, "auto | shadels per metre")->capture_default_str();
     bench->add_option("--cache-dir", bo.cacheDir, "bake cache directory");
