@@ -37,7 +37,9 @@ using uint = uint32_t;
 #define DRAW_LIST_OPAQUE 0u    // forward-shaded opaque and alpha-masked instances
 #define DRAW_LIST_BLEND 1u     // forward-shaded blended instances
 #define DRAW_LIST_DECOUPLED 2u // opaque instances shaded in shadel space this frame
-#define DRAW_LIST_COUNT 3u
+// Blended instances shaded in shadel space this frame (reconstructed into the OIT targets).
+#define DRAW_LIST_DECOUPLED_BLEND 3u
+#define DRAW_LIST_COUNT 4u
 
 // Debug views (--visualize).
 #define VISUALIZE_NONE 0u
@@ -91,6 +93,9 @@ struct GpuMaterial {
     uint flags;
     uint procedural;
     float proceduralScale;
+    // Transparent materials: 0 = alpha-blended, 1 = additive (fire, glows), in between a mix;
+    // weighted blended OIT composites both without sorting (render/oit).
+    float additiveness;
 };
 
 struct GpuLight {

@@ -33,9 +33,9 @@ void main() {
     uint list = (mat.flags & MATERIAL_ALPHA_BLEND) != 0u ? DRAW_LIST_BLEND : DRAW_LIST_OPAQUE;
     if (pc.shadowView != 0u && list == DRAW_LIST_BLEND) return;
     // Instances allocated in the shadel sheet this frame are drawn by the decoupled passes.
-    if (pc.shadowView == 0u && list == DRAW_LIST_OPAQUE && f.shadel != 0ul &&
+    if (pc.shadowView == 0u && f.shadel != 0ul &&
         (ShadelObjectBuffer(ShadelFrameRef(f.shadel).s.objects).o[id].flags & SHADEL_OBJECT_DECOUPLED) != 0u)
-        list = DRAW_LIST_DECOUPLED;
+        list = list == DRAW_LIST_OPAQUE ? DRAW_LIST_DECOUPLED : DRAW_LIST_DECOUPLED_BLEND;
     GpuMesh mesh = MeshBuffer(f.meshes).m[inst.mesh];
     uint slot = atomicAdd(UintBuffer(pc.counts).v[list], 1u);
     SHADEL_ASSERT(f, slot < pc.maxDraws, ASSERT_DRAW_OVERFLOW, slot, pc.maxDraws);

@@ -15,7 +15,27 @@ vec3 sampleLevel(ShadelFrame s, GpuShadelObject o, uint mip, vec2 uv, uint layer
     bilinearFootprint(o, mip, uv, t0, w);
     vec3 sum = vec3(0.0);
     firstMask = 0ul;
-    // The four taps usually share one block: look its mask and base up once.
+    // Most footprints (49 of 64 positions) lie inside one chunk, and a chunk's 8x8 shadels sit
+    // together in storage: one lookup and one hardware-filtered fetch then replace four taps
+    // (as virtual texturing samples inside a page). Chunk edges are at multiples of 8 of the
+    // level's texel coordinate because every level's rect starts on a block.
+    ivec2 levelSize = ivec2(levelSize(o, mip));
+    if (all(greaterThanEqual(t0, ivec2(0))) && all(lessThan(t0 + 1, levelSize)) &&
+        all(notEqual(t0 & 7, ivec2(7)))) {
+        uvec2 sheet = sheetShadel(o, mip, t0);
+        uint block = blockIndex(s, sheet);
+        uint64_t mask = Uint64Buffer(s.occupancy).v[block];
+        uint base = UintBuffer(s.offsetMap).v[block];
+        firstMask = mask;
+        uint bit = chunkBit(sheet);
+        if ((mask & (1ul << bit)) == 0ul) { missing += 4u; return sum; }
+        if (base == SHADEL_INVALID) { overflowed += 4u; return sum; }
+        ivec2 texel = storageTexel(s, chunkSlot(mask, base, bit), sheet % SHADEL_CHUNK);
+        vec2 storageSize = vec2(textureSize(gTextures[layerSlot], 0));
+        vec2 at = (vec2(texel) + 0.5 + w) / storageSize;
+        return textureLod(sampler2D(gTextures[layerSlot], gSamplers[SAMPLER_LINEAR_CLAMP]), at, 0.0).rgb;
+    }
+    // Across chunk edges, four taps. They usually share one block: look its mask and base up once.
     uint cachedBlock = SHADEL_INVALID;
     uint64_t mask = 0ul;
     uint base = SHADEL_INVALID;

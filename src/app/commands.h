@@ -33,7 +33,7 @@ struct RenderOptions {
     uint32_t shadeStorageSize = 4096;
     uint32_t sheetShadels = 65536;
     float shadingBias = 0.0f;
-    float trilinearBand = 1.0f;
+    float trilinearBand = 0.5f;    // decoupled: LOD band blended between MIPs (1 = full trilinear)
     uint32_t materialSamples = 16; // cap of material samples per shadel (prefilter.glsl)
     float forwardBelowPixels = 8.0f;
     uint32_t allocationCounters = SHADEL_COUNTERS;
@@ -42,6 +42,8 @@ struct RenderOptions {
     bool reuse = true;
     uint32_t reuseRefreshPeriod = 8;
     bool animateLights = false;
+    OitMode oit = OitMode::Wboit;             // --oit wboit|sorted
+    std::optional<uint64_t> shuffleDrawsSeed; // --shuffle-draws SEED
     CameraPath cameraPath = CameraPath::Static;
     double shadelBudget = 64e6; // MIP-0 shadels the bake may use for the whole scene
     bool printPasses = false;
@@ -68,6 +70,7 @@ Visualize parseVisualize(const std::string& text);
 MarkingMode parseMarking(const std::string& text);
 // "X,Y" -> pixel; throws InputError naming --inspect.
 void parseInspect(const std::string& text, int32_t& x, int32_t& y);
+OitMode parseOit(const std::string& text);
 // The bake cache folder when --cache-dir is not given (see defaultBakeCacheDir()).
 std::string defaultCacheDir();
 

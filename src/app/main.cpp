@@ -174,6 +174,15 @@ int main(int argc, char** argv) {
         ->capture_default_str();
     render->add_flag("--animate-lights", ro.animateLights,
                      "move point and spot lights on small circles over the frames");
+    std::string oit = "wboit";
+    render
+        ->add_option("--oit", oit,
+                     "transparency: wboit (weighted blended OIT with additiveness) | sorted "
+                     "(CPU-sorted back-to-front reference)")
+        ->capture_default_str();
+    render->add_option("--shuffle-draws", ro.shuffleDrawsSeed,
+                       "SEED: draw the transparent instances in a random order (order "
+                       "independence tests)");
     render->add_option("--trace", ro.trace,
                        "FILE.json: Chrome trace events (CPU frontend and GPU passes per frame; "
                        "chrome://tracing, Perfetto)");
@@ -332,6 +341,7 @@ int main(int argc, char** argv) {
             ro.mode = parseMode(mode);
             ro.visualize = parseVisualize(visualize);
             ro.marking = parseMarking(marking);
+            ro.oit = parseOit(oit);
             if (jitter != "none" && jitter != "subpixel")
                 throw InputError(format("--jitter %s: expected none or subpixel", jitter.c_str()));
             ro.jitter = jitter == "subpixel";

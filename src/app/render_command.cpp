@@ -67,6 +67,12 @@ void parseInspect(const std::string& text, int32_t& x, int32_t& y) {
     x = int32_t(px), y = int32_t(py);
 }
 
+OitMode parseOit(const std::string& text) {
+    if (text == "wboit") return OitMode::Wboit;
+    if (text == "sorted") return OitMode::Sorted;
+    throw InputError(format("--oit %s: expected wboit or sorted", text.c_str()));
+}
+
 std::string defaultCacheDir() {
     return defaultBakeCacheDir();
 }
@@ -218,6 +224,9 @@ RenderRun runRender(Gpu& gpu, const RenderOptions& o) {
     settings.animateLights = o.animateLights;
     settings.inspectX = o.inspectX;
     settings.inspectY = o.inspectY;
+    settings.oit = o.oit;
+    settings.shuffleDraws = o.shuffleDrawsSeed.has_value();
+    settings.shuffleSeed = o.shuffleDrawsSeed.value_or(0);
     settings.timing = o.timing ? *o.timing : defaultTimingMode(gpu);
     Renderer renderer;
     RenderRun run;
@@ -304,6 +313,9 @@ RenderRun runRender(Gpu& gpu, const RenderOptions& o) {
     s["instances"] = gpuScene.instanceCount;
     s["triangles"] = scene.triangleCount();
     s["lights"] = scene.lights.size();
+    s["oit"] = o.oit == OitMode::Wboit ? "wboit" : "sorted";
+    s["transparent_draws"] = run.frames.back().transparentDraws;
+    s["transparent_draws_decoupled"] = run.frames.back().transparentDecoupledDraws;
     s["density_mode"] = autoDensity ? "auto" : "explicit";
     if (autoDensity)
         s["view_density"] = {{"budget_scale", viewDensity.budgetScale},

@@ -1,5 +1,6 @@
 #include "render/gpu_scene.h"
 
+#include <algorithm>
 #include <cmath>
 
 #include "bake/bake.h"
@@ -75,6 +76,8 @@ void uploadScene(Gpu& gpu, const Scene& scene, GpuScene& out, const std::vector<
                   (m.doubleSided ? MATERIAL_DOUBLE_SIDED : 0u);
         g.procedural = uint32_t(m.procedural);
         g.proceduralScale = m.proceduralScale;
+        g.additiveness =
+            m.alphaMode == AlphaMode::Blend ? std::clamp(m.additiveness, 0.0f, 1.0f) : 0.0f;
         materials.push_back(g);
     }
     if (materials.empty()) {

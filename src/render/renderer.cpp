@@ -8,6 +8,7 @@
 #include "core/log.h"
 #include "render/forward/forward_passes.h"
 #include "render/lighting/light_animation.h"
+#include "render/oit/oit.h"
 #include "render/post/tonemap.h"
 #include "render/shadel/decoupled.h"
 #include "render/shadel/visibility.h"
@@ -112,6 +113,7 @@ void initRenderer(Renderer& r, Gpu& gpu, const RenderSettings& settings, const G
     initFrameRecorder(gpu, r.recorder, settings.timing);
     if (settings.mode == RenderMode::Decoupled) r.decoupled = createDecoupled(r, scene);
     if (usesVisibilityBuffer(settings)) r.visibility = createVisibility(r);
+    r.oit = createOit(r, scene);
 }
 
 void destroyRenderer(Renderer& r) {
@@ -120,6 +122,7 @@ void destroyRenderer(Renderer& r) {
     vkDeviceWaitIdle(gpu.device.device);
     r.captures = {}; // its sources refer to what is destroyed below
     if (r.visibility) destroyVisibility(r, r.visibility);
+    destroyOit(r, r.oit);
     if (r.decoupled) destroyDecoupled(r, r.decoupled);
     destroyFrameRecorder(r.recorder);
     destroyShaderMessages(gpu, r.messages);
@@ -224,6 +227,7 @@ FrameResult renderFrame(Renderer& r, const GpuScene& scene, const CameraView& ca
     gpu::FrameConstants constants = makeFrameConstants(r, scene, camera);
     updateLights(r, scene, constants);
     if (r.decoupled) prepareDecoupledFrame(r, scene, camera, constants);
+    prepareTransparentDraws(r, scene, camera);
     std::memcpy(mapped(gpu, r.frameConstants), &constants, sizeof(constants));
     uint64_t frame = address(gpu, r.frameConstants);
     double prepareMs = msSince(cpuStart);
@@ -244,6 +248,7 @@ FrameResult renderFrame(Renderer& r, const GpuScene& scene, const CameraView& ca
     } else {
         recordDecoupledPasses(r, rec, frame, scene);
     }
+    recordTransparencyPasses(r, rec, frame); // blended materials, after every opaque surface
     pass(rec, "tonemap", [&](VkCommandBuffer cmd) { recordTonemap(r, cmd, frame); });
     if (r.decoupled) recordDecoupledPostPasses(r, rec, frame);
     endFrame(rec);
@@ -258,6 +263,9 @@ FrameResult renderFrame(Renderer& r, const GpuScene& scene, const CameraView& ca
     result.cpuFrameMs = prepareMs + std::max(0.0, msSince(cpuStart) - prepareMs - rec.gpuWaitMs);
     result.shaderAsserts = collectShaderMessages(gpu, r.messages);
     result.prints = r.messages.prints;
+    result.transparentDecoupledDraws = decoupledTransparentDraws(r);
+    result.transparentDraws =
+        uint32_t(transparentDrawOrder(r).size()) + result.transparentDecoupledDraws;
     if (r.decoupled) finishDecoupledFrame(r);
     r.framesRendered++;
     size_t bytes = size_t(r.settings.width) * r.settings.height * 4;

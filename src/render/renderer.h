@@ -19,6 +19,8 @@ enum class RenderMode { Forward, Decoupled };
 // Decoupled marking + reconstruction: raster passes over the objects, or compute passes over
 // the pixels of a visibility buffer (render/shadel/visibility.h).
 enum class MarkingMode { Raster, Visibility };
+// Transparency: weighted blended OIT, or the CPU-sorted back-to-front reference (tests).
+enum class OitMode { Wboit, Sorted };
 enum class Visualize : uint32_t {
     None = 0,
     Marking = 1,
@@ -42,8 +44,12 @@ struct RenderSettings {
     TimingMode timing = TimingMode::SubmitPerPass;
     uint32_t shadeStorageSize = 4096; // decoupled: physical shade storage, shadels per side
     uint32_t sheetShadels = 65536;    // decoupled: virtual sheet, shadels per side
-    float shadingBias = 0.0f;     // decoupled: base MIP bias (the capacity controller adds to it)
-    float trilinearBand = 1.0f;   // decoupled: LOD band blended between MIPs (1 = trilinear)
+    float shadingBias = 0.0f; // decoupled: base MIP bias (the capacity controller adds to it)
+    // decoupled: LOD band blended between MIPs (1 = full trilinear). 0.5 ("brilinear"): only
+    // the middle half of each LOD interval reads two MIPs. At 1280x720 it shades 24% fewer
+    // chunks on builtin:default for -0.3 dB against the supersampled forward render, and 22% /
+    // 12% fewer on builtin:many / 2CylinderEngine at the same PSNR (to 0.01 dB).
+    float trilinearBand = 0.5f;
     uint32_t materialSamples = 4; // decoupled: material evaluations per shadel above MIP 0
     float forwardBelowPixels = 8; // decoupled: objects smaller on screen drawn forward (0 = never)
     uint32_t allocationCounters = SHADEL_COUNTERS; // decoupled: hashed counters used (tests)
@@ -53,8 +59,11 @@ struct RenderSettings {
     uint32_t reuseRefreshPeriod = 8; // decoupled: reshade every carried chunk this often
     // --inspect X,Y: the output pixel whose shading is printed (shaders/debug/inspect.glsl).
     int32_t inspectX = -1, inspectY = -1;
-    bool animateLights = false; // point and spot lights move on small circles // decoupled: rects
-                                // at every MIP (the old policy, for comparison)
+    bool animateLights = false;   // point and spot lights move on small circles // decoupled: rects
+                                  // at every MIP (the old policy, for comparison)
+    OitMode oit = OitMode::Wboit; // transparency: render/oit
+    bool shuffleDraws = false;    // --shuffle-draws SEED: transparent draws in a random order
+    uint64_t shuffleSeed = 0;
 };
 
 struct FrameResult {
@@ -66,7 +75,9 @@ struct FrameResult {
     double cpuPrepareMs = 0.0; // of which the CPU frontend: constants, decoupled coarse allocation
     double startMs = 0.0;      // since the renderer was created (trace export)
     uint32_t shaderAsserts = 0;
-    std::vector<ShaderPrint> prints; // shaderPrint records of this frame (--inspect)
+    std::vector<ShaderPrint> prints;        // shaderPrint records of this frame (--inspect)
+    uint32_t transparentDraws = 0;          // blended instances drawn (render/oit)
+    uint32_t transparentDecoupledDraws = 0; // ... of which shaded in shadel space
 };
 
 struct DecoupledState; // render/shadel/decoupled.h
@@ -74,6 +85,11 @@ struct DecoupledStateDeleter {
     void operator()(DecoupledState* state) const; // defined with the state
 };
 using DecoupledStatePtr = std::unique_ptr<DecoupledState, DecoupledStateDeleter>;
+struct OitState; // render/oit/oit.h
+struct OitStateDeleter {
+    void operator()(OitState* state) const;
+};
+using OitStatePtr = std::unique_ptr<OitState, OitStateDeleter>;
 
 struct Renderer {
     Gpu* gpu = nullptr;
@@ -94,7 +110,7 @@ struct Renderer {
     uint32_t maxDraws = 0;
     BufferHandle sceneIndices; // the unified index buffer of the scene being drawn
     glm::vec3 skyColor{0.5f};
-    Pipeline instanceCull, depthPrepass, shadowPass, forwardOpaque, forwardBlend, tonemap;
+    Pipeline instanceCull, depthPrepass, shadowPass, forwardOpaque, tonemap;
     ShaderMessageChannel messages;
     FrameRecorder recorder;
     DecoupledStatePtr decoupled;
@@ -106,6 +122,7 @@ struct Renderer {
     uint64_t framesRendered = 0;
     VisibilityStatePtr visibility; // decoupled with --marking visibility
     CaptureRegistry captures;      // --capture: named resources of the frame (render/debug)
+    OitStatePtr oit;               // scenes with blended materials (render/oit)
     std::chrono::steady_clock::time_point createdAt = std::chrono::steady_clock::now();
 };
 

@@ -119,6 +119,13 @@ Pipeline createGraphicsPipeline(Gpu& gpu, const GraphicsPipelineDesc& desc) {
             b.srcAlphaBlendFactor = b.dstAlphaBlendFactor = VK_BLEND_FACTOR_ONE;
         }
     }
+    if (!desc.attachmentBlends.empty()) {
+        if (desc.attachmentBlends.size() != desc.colorFormats.size())
+            throw DeviceError(format("pipeline %s: %zu attachment blends for %zu colour targets",
+                                     desc.name.c_str(), desc.attachmentBlends.size(),
+                                     desc.colorFormats.size()));
+        blends = desc.attachmentBlends;
+    }
     VkPipelineColorBlendStateCreateInfo blend{
         VK_STRUCTURE_TYPE_PIPELINE_COLOR_BLEND_STATE_CREATE_INFO};
     blend.attachmentCount = uint32_t(blends.size());

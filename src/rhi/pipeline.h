@@ -24,6 +24,9 @@ struct GraphicsPipelineDesc {
     bool depthClamp = false;
     bool depthBias = false;
     enum class Blend { None, Alpha, Additive } blend = Blend::None;
+    // Per colour attachment, overriding `blend` when not empty (e.g. WBOIT's two targets
+    // with their separate colour and alpha blending).
+    std::vector<VkPipelineColorBlendAttachmentState> attachmentBlends;
     std::vector<std::pair<uint32_t, uint32_t>> specialization; // constant id, value
 };
 

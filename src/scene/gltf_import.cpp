@@ -1008,6 +1008,24 @@ private:
         return index;
     }
 
+    // Additiveness of a BLEND material (render/oit): glTF has no such property, so an explicit
+    // `extras.additiveness` in [0, 1] wins; otherwise a material that boosts its emission with
+    // KHR_materials_emissive_strength is taken for a glow: additiveness 1 - 1/strength (0 at
+    // strength 1, 0.5 at 2, 0.9 at 10). Other materials stay alpha-blended.
+    static float blendAdditiveness(const tinygltf::Material& m, float emissiveStrength) {
+        if (m.alphaMode != "BLEND") return 0.0f;
+        if (m.extras.IsObject() && m.extras.Has("additiveness")) {
+            const tinygltf::Value& a = m.extras.Get("additiveness");
+            if (a.IsNumber()) {
+                double v = a.GetNumberAsDouble();
+                if (std::isfinite(v)) return std::clamp(float(v), 0.0f, 1.0f);
+            }
+        }
+        if (emissiveStrength > 1.0f && std::isfinite(emissiveStrength))
+            return std::clamp(1.0f - 1.0f / emissiveStrength, 0.0f, 1.0f);
+        return 0.0f;
+    }
+
     Material convertMaterial(int index) {
         const tinygltf::Material& m = model_.materials[size_t(index)];
         const auto& pbr = m.pbrMetallicRoughness;
@@ -1022,10 +1040,12 @@ private:
         if (m.emissiveFactor.size() == 3)
             out.emissiveFactor = glm::vec3(float(m.emissiveFactor[0]), float(m.emissiveFactor[1]),
                                            float(m.emissiveFactor[2]));
+        float emissiveStrength = 1.0f;
         if (auto it = m.extensions.find("KHR_materials_emissive_strength");
             it != m.extensions.end()) {
             const tinygltf::Value& strength = it->second.Get("emissiveStrength");
-            if (strength.IsNumber()) out.emissiveFactor *= float(strength.GetNumberAsDouble());
+            if (strength.IsNumber()) emissiveStrength = float(strength.GetNumberAsDouble());
+            out.emissiveFactor *= emissiveStrength;
         }
         out.normalScale = float(m.normalTexture.scale);
         out.occlusionStrength = std::clamp(float(m.occlusionTexture.strength), 0.0f, 1.0f);
@@ -1034,6 +1054,7 @@ private:
                         : m.alphaMode == "BLEND" ? AlphaMode::Blend
                                                  : AlphaMode::Opaque;
         out.doubleSided = m.doubleSided;
+        out.additiveness = blendAdditiveness(m, emissiveStrength);
         out.baseColorTexture = texture(pbr.baseColorTexture.index, pbr.baseColorTexture.texCoord,
                                        true, "base colour", index);
         out.metallicRoughnessTexture =

@@ -67,6 +67,9 @@ struct Material {
     int32_t occlusionTexture = kNoTexture;
     Procedural procedural = Procedural::None;
     float proceduralScale = 1.0f; // pattern cells per uv unit
+    // Blended materials only: 0 = alpha-blended, 1 = additive (seed 001's "additiveness"),
+    // composited without sorting by weighted blended OIT (render/oit).
+    float additiveness = 0.0f;
 };
 
 struct Texture {

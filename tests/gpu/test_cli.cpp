@@ -94,7 +94,8 @@ TEST(Cli, BadFlagsAndMissingFilesExitWith2) {
           "render --camera nope --size 16x16", "render --frames 0", "render --ssaa 0",
           "--device 57 render", "render --jitter wobble", "render --density -3",
           "render --density lots", "render --mode decoupled --marking sideways",
-          "render --size 16x16 --mode decoupled --material-samples 0"}) {
+          "render --size 16x16 --mode decoupled --material-samples 0",
+          "render --size 16x16 --oit layered", "render --size 16x16 --shuffle-draws banana"}) {
         Result r = run(args);
         EXPECT_EQ(r.exitCode, 2) << args << ": " << r.stderrText;
         EXPECT_NE(r.stderrText.find("shadel: "), std::string::npos) << args;

@@ -247,6 +247,19 @@ TEST(GltfImport, UnsupportedExtensionWarnsAndEmissiveStrengthApplies) {
     EXPECT_FLOAT_EQ(scene.materials[0].emissiveFactor.z, 1.0f);
 }
 
+// Blended materials: extras.additiveness wins, else KHR_materials_emissive_strength s gives
+// 1 - 1/s, else 0 (render/oit).
+TEST(GltfImport, BlendMaterialsMapOntoAdditiveness) {
+    Scene scene = loadScene(kData + "/gltf/additiveness.gltf");
+    ASSERT_EQ(scene.materials.size(), 3u);
+    EXPECT_EQ(scene.materials[0].alphaMode, AlphaMode::Blend);
+    EXPECT_FLOAT_EQ(scene.materials[0].additiveness, 0.75f) << "emissive strength 4";
+    EXPECT_FLOAT_EQ(scene.materials[1].additiveness, 0.25f) << "extras.additiveness";
+    EXPECT_FLOAT_EQ(scene.materials[2].additiveness, 0.0f) << "plain glass";
+    Scene opaque = loadScene(kData + "/gltf/unsupported_extension.gltf");
+    EXPECT_FLOAT_EQ(opaque.materials[0].additiveness, 0.0f) << "opaque: strength 4 ignored";
+}
+
 // --- content ------------------------------------------------------------------------------
 
 TEST(GltfImport, CamerasAndPunctualLightsInWorldSpace) {

@@ -58,17 +58,10 @@ void createForwardPipelines(Renderer& r) {
     opaque.depthCompare = VK_COMPARE_OP_EQUAL; // the prepass resolved visibility
     opaque.cullMode = VK_CULL_MODE_NONE;
     r.forwardOpaque = createGraphicsPipeline(gpu, opaque);
-
-    GraphicsPipelineDesc blend = opaque;
-    blend.name = "forwardBlend";
-    blend.depthCompare = VK_COMPARE_OP_GREATER_OR_EQUAL;
-    blend.blend = GraphicsPipelineDesc::Blend::Alpha;
-    r.forwardBlend = createGraphicsPipeline(gpu, blend);
 }
 
 void destroyForwardPipelines(Renderer& r) {
-    for (Pipeline* p :
-         {&r.instanceCull, &r.depthPrepass, &r.shadowPass, &r.forwardOpaque, &r.forwardBlend})
+    for (Pipeline* p : {&r.instanceCull, &r.depthPrepass, &r.shadowPass, &r.forwardOpaque})
         destroy(*r.gpu, *p);
 }
 
@@ -207,9 +200,8 @@ void drawForwardLists(Renderer& r, VkCommandBuffer cmd, uint64_t frame) {
     bind(gpu, cmd, r.forwardOpaque);
     pushConstants(gpu, cmd, RasterPush{frame, 0});
     drawCameraList(r, cmd, DRAW_LIST_OPAQUE);
-    bind(gpu, cmd, r.forwardBlend);
-    pushConstants(gpu, cmd, RasterPush{frame, 0});
-    drawCameraList(r, cmd, DRAW_LIST_BLEND);
+    // The blended instances (DRAW_LIST_BLEND) are drawn after every opaque surface by the
+    // transparency passes (render/oit), from a CPU list that can be shuffled or sorted.
 }
 
 void recordForwardShading(Renderer& r, VkCommandBuffer cmd, uint64_t frame) {

@@ -23,8 +23,8 @@ void recordInstanceCull(Renderer& r, VkCommandBuffer cmd, uint64_t frame, const 
 void recordShadowMap(Renderer& r, VkCommandBuffer cmd, uint64_t frame);
 void recordDepthPrepass(Renderer& r, VkCommandBuffer cmd, uint64_t frame);
 void recordForwardShading(Renderer& r, VkCommandBuffer cmd, uint64_t frame);
-// The forward-shaded lists (opaque, then blended) inside an open scene colour pass; the
-// decoupled frame draws them next to reconstruction (hybrid).
+// The forward-shaded opaque list inside an open scene colour pass; the decoupled frame draws it
+// next to reconstruction (hybrid). Blended instances are drawn by render/oit.
 void drawForwardLists(Renderer& r, VkCommandBuffer cmd, uint64_t frame);
 
 // Shared by every raster pass that draws the culled camera list (decoupled passes too).

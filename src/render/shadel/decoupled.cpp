@@ -94,7 +94,7 @@ struct DecoupledState {
     bool changedLightsOverflow = false;
     ShadeStorage storage;
     Pipeline clear, allocate, queueSetup, fillQueue, dispatchSetup, carryOver, shade, sheetView,
-        mark, reconstruct;
+        mark, markTransparent, reconstruct;
     std::vector<FrameCounters> history;
 };
 
@@ -223,6 +223,10 @@ DecoupledStatePtr createDecoupled(Renderer& r, const GpuScene& scene) {
     mark.depthCompare = VK_COMPARE_OP_EQUAL;
     mark.cullMode = VK_CULL_MODE_NONE;
     d.mark = createGraphicsPipeline(gpu, mark);
+    GraphicsPipelineDesc markTransparent = mark;
+    markTransparent.name = "shadelMarkTransparent";
+    markTransparent.depthCompare = VK_COMPARE_OP_GREATER_OR_EQUAL; // in front of opaque depth
+    d.markTransparent = createGraphicsPipeline(gpu, markTransparent);
     GraphicsPipelineDesc recon = mark;
     recon.name = "shadelReconstruct";
     recon.fragmentShader = "shadel_reconstruct.frag.spv";
@@ -236,8 +240,9 @@ void destroyDecoupled(Renderer& r, DecoupledStatePtr& state) {
     if (!state) return;
     Gpu& gpu = *r.gpu;
     DecoupledState& d = *state;
-    for (Pipeline* p : {&d.clear, &d.allocate, &d.queueSetup, &d.fillQueue, &d.dispatchSetup,
-                        &d.carryOver, &d.shade, &d.sheetView, &d.mark, &d.reconstruct})
+    for (Pipeline* p :
+         {&d.clear, &d.allocate, &d.queueSetup, &d.fillQueue, &d.dispatchSetup, &d.carryOver,
+          &d.shade, &d.sheetView, &d.mark, &d.markTransparent, &d.reconstruct})
         destroy(gpu, *p);
     destroyShadeStorage(gpu, d.storage);
     for (BufferHandle b : {d.frameInfo, d.changedLights, d.objectBuffer, d.rectBuffer,
@@ -405,8 +410,15 @@ void prepareDecoupledFrame(Renderer& r, const GpuScene& scene, const CameraView&
         gpu::GpuShadelObject& g = d.gpuObjects[i];
         g = gpu::GpuShadelObject{};
         glm::vec3 margin = (inst.worldMax - inst.worldMin) * d.frustumMargin;
-        bool wanted =
-            mesh.mipCount > 0 && boxVisible(planes, inst.worldMin - margin, inst.worldMax + margin);
+        // Transparent surfaces are shaded in shadel space too and reconstructed into the WBOIT
+        // targets (render/oit); the sorted reference and the visibility-buffer marking (which
+        // sees only the nearest surface) keep them forward.
+        bool blended = inst.material < scene.materialInfo.size() &&
+                       (scene.materialInfo[inst.material].flags & MATERIAL_ALPHA_BLEND) != 0u;
+        bool transparentForward = blended && (r.settings.oit != OitMode::Wboit ||
+                                              r.settings.marking == MarkingMode::Visibility);
+        bool wanted = mesh.mipCount > 0 && !transparentForward &&
+                      boxVisible(planes, inst.worldMin - margin, inst.worldMax + margin);
         // Hybrid (seed: "small objects fall back to a direct only render"): an object a few
         // pixels across would still shade whole chunks at its coarsest MIP; forward is cheaper.
         bool small = wanted && r.settings.forwardBelowPixels > 0.0f &&
@@ -551,6 +563,11 @@ void recordDecoupledPasses(Renderer& r, FrameRecorder& rec, uint64_t frame, cons
         bind(gpu, cmd, d.mark);
         pushConstants(gpu, cmd, RasterPush{frame, 0});
         drawCameraList(r, cmd, DRAW_LIST_DECOUPLED);
+        // Transparent surfaces: tested against the opaque depth only, never against each
+        // other (nothing here writes depth), so every layer marks what it will read.
+        bind(gpu, cmd, d.markTransparent);
+        pushConstants(gpu, cmd, RasterPush{frame, 0});
+        drawCameraList(r, cmd, DRAW_LIST_DECOUPLED_BLEND);
         vkCmdEndRendering(cmd);
         memoryBarrier(cmd, VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT,
                       VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
@@ -646,6 +663,12 @@ void recordDecoupledPostPasses(Renderer& r, FrameRecorder& rec, uint64_t frame) 
                       VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT, VK_PIPELINE_STAGE_2_HOST_BIT,
                       VK_ACCESS_2_HOST_READ_BIT);
     });
+}
+
+bool drawnDecoupled(const Renderer& r, uint32_t instance) {
+    const DecoupledState* d = r.decoupled.get();
+    return d && instance < d->gpuObjects.size() &&
+           (d->gpuObjects[instance].flags & SHADEL_OBJECT_DECOUPLED) != 0u;
 }
 
 void finishDecoupledFrame(Renderer& r) {

@@ -25,6 +25,8 @@ void prepareDecoupledFrame(Renderer& r, const GpuScene& scene, const CameraView&
 void recordDecoupledPasses(Renderer& r, FrameRecorder& rec, uint64_t frame, const GpuScene& scene);
 // Passes after tonemapping (the sheet view).
 void recordDecoupledPostPasses(Renderer& r, FrameRecorder& rec, uint64_t frame);
+// Whether the instance is shaded in shadel space this frame (after prepareDecoupledFrame).
+bool drawnDecoupled(const Renderer& r, uint32_t instance);
 // Reads back the frame's counters (after the GPU finished).
 void finishDecoupledFrame(Renderer& r);
 // Adds the decoupled fields of DESIGN §5 (medians over the frames rendered so far).
