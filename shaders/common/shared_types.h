@@ -238,7 +238,7 @@ struct FrameConstants {
     uint frameIndex;
     uint visualize;
     float shadingBias; // fractional MIP bias of the decoupled path
-    uint pad0;
+    uint inspectPixel; // --inspect: x | y << 16 at the internal resolution, or INSPECT_OFF
     uint64_t vertices;  // GpuVertex[]
     uint64_t indices;   // uint[]
     uint64_t meshes;    // GpuMesh[]
@@ -300,13 +300,13 @@ struct CullingFrame {
     uint pad0;
 };
 
-// Shader -> CPU message channel (shader asserts). Written with atomics, read after the frame.
+// Shader -> CPU message channel (shader asserts and prints). Written with atomics, read after the frame.
 #define SHADER_MESSAGE_CAPACITY 256u
 struct ShaderMessage {
     uint assertId;
     uint shaderId;
     uint line;
-    uint pad;
+    uint format; // prints (assertId has SHADER_PRINT_BIT): value type | count << 4
     uvec4 values;
 };
 

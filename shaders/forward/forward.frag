@@ -2,6 +2,7 @@
 // Forward shading: the shared material + lighting code evaluated per pixel.
 #include "common/lighting.glsl"
 #include "lighting/light_debug.glsl"
+#include "debug/inspect.glsl"
 
 layout(push_constant, scalar) uniform Push {
     uint64_t frame;
@@ -33,6 +34,14 @@ void main() {
     // Opaque pixels lie on the prepass depth the tile's bounds came from; blended ones need not.
     if ((mat.flags & MATERIAL_ALPHA_BLEND) == 0u) useTileLightList(f, gl_FragCoord.xy);
     vec3 color = shadeSurface(f, m, inPosition, s.normal);
+    if (inspecting(f, uvec2(gl_FragCoord.xy))) {
+        beginInspect(f, inInstance, uint(gl_PrimitiveID), gl_FragCoord);
+        vec2 footprint = max(abs(s.uvDx), abs(s.uvDy));
+        if (mat.baseColorTexture != NO_TEXTURE)
+            footprint *= vec2(textureSize(gTextures[nonuniformEXT(mat.baseColorTexture)], 0));
+        shaderPrintF(f, PRINT_UV_LOD, log2(max(max(footprint.x, footprint.y), 1e-8)));
+        inspectSurface(f, inInstance, uint(gl_PrimitiveID), m, inPosition, s.normal, color);
+    }
     color = visualizeLighting(f, color);
     float alpha = (mat.flags & MATERIAL_ALPHA_BLEND) != 0u ? m.alpha : 1.0;
     outColor = vec4(color, alpha);

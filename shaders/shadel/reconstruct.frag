@@ -3,6 +3,7 @@
 // shaded samples (shadel/resolve.glsl); misses and overflow fall back to forward shading.
 #include "shadel/resolve.glsl"
 #include "common/lighting.glsl"
+#include "debug/inspect_shadel.glsl"
 
 layout(early_fragment_tests) in;
 
@@ -32,7 +33,10 @@ vec3 forwardShade(FrameConstants f) {
     si.uvDy = dFdy(inUv);
     si.frontFacing = gl_FrontFacing;
     MaterialSample m = evaluateMaterial(mat, si);
-    return shadeSurface(f, m, inPosition, si.normal);
+    vec3 color = shadeSurface(f, m, inPosition, si.normal);
+    if (inspecting(f, uvec2(gl_FragCoord.xy)))
+        inspectSurface(f, inInstance, uint(gl_PrimitiveID), m, inPosition, si.normal, color);
+    return color;
 }
 
 void main() {
@@ -45,6 +49,15 @@ void main() {
                                          reconstructionLayer(f, s));
     countReconstruction(s, r);
     vec3 color = r.color;
-    if (r.missing + r.overflowed != 0u) color = forwardShade(f);
+    bool inspect = inspecting(f, uvec2(gl_FragCoord.xy));
+    if (inspect) {
+        beginInspect(f, inInstance, uint(gl_PrimitiveID), gl_FragCoord);
+        inspectShadels(f, s, o, r, inShadelUv, texelDx, texelDy);
+    }
+    if (r.missing + r.overflowed != 0u || inspect) {
+        vec3 forward = forwardShade(f); // also prints the surface under --inspect
+        if (r.missing + r.overflowed != 0u) color = forward;
+    }
+    if (inspect) shaderPrintF3(f, PRINT_OUTPUT, color);
     outColor = vec4(visualizeReconstruction(f, o, r, color, inShadelUv, texelDx, texelDy), 1.0);
 }

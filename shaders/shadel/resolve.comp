@@ -9,6 +9,7 @@
 #include "shadel/vis_shadel.glsl"
 #include "common/lighting.glsl"
 #include "common/vertex.glsl"
+#include "debug/inspect_shadel.glsl"
 
 layout(local_size_x = 8, local_size_y = 8) in;
 
@@ -22,7 +23,8 @@ layout(push_constant, scalar) uniform Push {
 
 // The forward material + lighting at the pixel, from the triangle's interpolated attributes
 // (what the forward raster pass's varyings and dFdx/dFdy would give).
-vec3 forwardShade(FrameConstants f, GpuInstance inst, VisTriangle tri, VisBary bary) {
+vec3 forwardShade(FrameConstants f, GpuInstance inst, VisTriangle tri, VisBary bary,
+                  uvec2 vis, bool inspect) {
     GpuMaterial mat = MaterialBuffer(f.materials).m[inst.material];
     WorldVertex a = fetchWorldVertex(f, inst, tri.v0);
     WorldVertex b = fetchWorldVertex(f, inst, tri.v1);
@@ -37,7 +39,9 @@ vec3 forwardShade(FrameConstants f, GpuInstance inst, VisTriangle tri, VisBary b
     si.uvDy = visInterpolate(bary.dy, a.uv0, b.uv0, c.uv0);
     si.frontFacing = tri.frontFacing;
     MaterialSample m = evaluateMaterial(mat, si);
-    return shadeSurface(f, m, si.position, si.normal);
+    vec3 color = shadeSurface(f, m, si.position, si.normal);
+    if (inspect) inspectSurface(f, vis.x, vis.y, m, si.position, si.normal, color);
+    return color;
 }
 
 // The frame's counters summed per workgroup first: one global atomic per group and counter.
@@ -72,7 +76,20 @@ void resolveQuad(FrameConstants f, ShadelFrame s, ivec2 origin, inout uvec4 coun
             counts += uvec4(r.magnified ? 1u : 0u, r.sampled ? 1u : 0u, r.missing != 0u ? 1u : 0u,
                             r.overflowed != 0u ? 1u : 0u);
             vec3 c = r.color;
-            if (r.missing + r.overflowed != 0u) c = forwardShade(f, inst, q.tri, v.bary);
+            bool inspect = inspecting(f, uvec2(pixel));
+            if (inspect) {
+                vec4 clip = f.viewProj * vec4(visInterpolate(v.bary.center,
+                    fetchWorldVertex(f, inst, q.tri.v0).position,
+                    fetchWorldVertex(f, inst, q.tri.v1).position,
+                    fetchWorldVertex(f, inst, q.tri.v2).position), 1.0);
+                beginInspect(f, vis.x, vis.y, vec4(vec2(pixel) + 0.5, clip.z / clip.w, 1.0));
+                inspectShadels(f, s, o, r, v.shadelUv, v.texelDx, v.texelDy);
+            }
+            if (r.missing + r.overflowed != 0u || inspect) {
+                vec3 forward = forwardShade(f, inst, q.tri, v.bary, vis, inspect);
+                if (r.missing + r.overflowed != 0u) c = forward;
+            }
+            if (inspect) shaderPrintF3(f, PRINT_OUTPUT, c);
             color = vec4(visualizeReconstruction(f, o, r, c, v.shadelUv, v.texelDx, v.texelDy), 1.0);
         }
         imageStore(gImagesRgba16f[pc.hdrSlot], pixel, color);

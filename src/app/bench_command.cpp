@@ -1,6 +1,7 @@
 #include <cstdio>
 #include <fstream>
 
+#include "app/bench_plot.h"
 #include "app/commands.h"
 #include "app/output_files.h"
 #include "core/error.h"
@@ -13,6 +14,7 @@ namespace shadel {
 // against forward (DESIGN §5, §7).
 nlohmann::json runBench(Gpu& gpu, const BenchOptions& b) {
     if (!b.json.empty()) requireCreatableOutput("--json", b.json); // before minutes of rendering
+    if (!b.plot.empty()) requireCreatableOutput("--plot", b.plot);
     RenderOptions o;
     o.scene = b.scene;
     o.allowExternalFiles = b.allowExternalFiles;
@@ -123,6 +125,7 @@ nlohmann::json runBench(Gpu& gpu, const BenchOptions& b) {
                         out["modes"][std::string(name) + "_no_light_culling"]["frame_ms"]["median"]
                             .get<double>(),
                         out["ratios"][std::string("light_culling_") + name].get<double>());
+    if (!b.plot.empty()) writeBenchPlot(out, b.plot);
     if (!b.json.empty()) {
         writeOutputFile(b.json, out.dump(2) + "\n");
     }

@@ -36,7 +36,7 @@ struct RenderOptions {
     uint32_t shadeStorageSize = 4096;
     uint32_t sheetShadels = 65536;
     float shadingBias = 0.0f;
-    float trilinearBand = 0.5f; // decoupled: LOD band blended between MIPs (1 = full trilinear)
+    float trilinearBand = 0.5f;    // decoupled: LOD band blended between MIPs (1 = full trilinear)
     uint32_t materialSamples = 16; // cap of material samples per shadel (prefilter.glsl)
     float forwardBelowPixels = 8.0f;
     uint32_t allocationCounters = SHADEL_COUNTERS;
@@ -60,11 +60,19 @@ struct RenderOptions {
     uint32_t instances = 0; // builtin:many (--instances); 0 = the scene's default
     bool lod = false;       // --lod: GPU LOD selection (render/culling)
     bool occlusion = false; // --occlusion: two-phase hierarchical-Z culling (render/culling)
+    // --capture NAME[,NAME...] (or {"list"}) and --capture-dir: the last frame's named
+    // resources (app/capture_output.h); files go to the dir or next to --out.
+    std::vector<std::string> captures;
+    std::string captureDir;
+    // --inspect X,Y: print what the shading computed at that output pixel (last frame).
+    int32_t inspectX = -1, inspectY = -1;
 };
 
 struct RenderRun {
     std::vector<FrameResult> frames;
     nlohmann::json stats;
+    bool listedCaptures = false;           // --capture list: printed, nothing rendered
+    std::vector<std::string> captureFiles; // written by --capture
 };
 
 // Parses "WxH"; throws InputError naming the flag.
@@ -72,6 +80,8 @@ void parseSize(const std::string& text, uint32_t& width, uint32_t& height);
 RenderMode parseMode(const std::string& text);
 Visualize parseVisualize(const std::string& text);
 MarkingMode parseMarking(const std::string& text);
+// "X,Y" -> pixel; throws InputError naming --inspect.
+void parseInspect(const std::string& text, int32_t& x, int32_t& y);
 OitMode parseOit(const std::string& text);
 LightCulling parseLightCulling(const std::string& text);
 bool parseOnOff(const char* flag, const std::string& text); // "on" / "off", else InputError
@@ -105,6 +115,7 @@ struct BenchOptions {
     // --light-culling compare: forward and decoupled rendered again with no culling, and
     // ratios.light_culling_forward|decoupled = tiled / none median frame time.
     bool compareLightCulling = false;
+    std::string plot; // --plot FILE.png: per-pass bar chart (app/bench_plot.h)
 };
 nlohmann::json runBench(Gpu& gpu, const BenchOptions& options);
 

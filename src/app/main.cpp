@@ -9,9 +9,11 @@
 #include <CLI/CLI.hpp>
 
 #include "app/cache_command.h"
+#include "app/capture_output.h"
 #include "app/cli_help.h"
 #include "app/cli_validate.h"
 #include "app/commands.h"
+#include "app/viewer/viewer.h"
 #include "bake/bake.h"
 #include "bake/cache_eviction.h"
 #include "core/error.h"
@@ -235,6 +237,16 @@ int main(int argc, char** argv) {
         ->add_option("--occlusion", occlusion,
                      "on | off: two-phase hierarchical-Z occlusion culling of instances")
         ->capture_default_str();
+    std::string captures;
+    render->add_option("--capture", captures,
+                       "NAME[,NAME...]: write named resources of the last frame (EXR for HDR "
+                       "and depth, PNG, false colour for IDs and masks); list: print the names");
+    std::string inspect;
+    render->add_option("--inspect", inspect,
+                       "X,Y: print what the shading computed at that pixel (instance, triangle, "
+                       "MIP, chunk, material, each light's contribution)");
+    render->add_option("--capture-dir", ro.captureDir,
+                       "DIR for --capture files (default: next to --out)");
 
     // bench
     BenchOptions bo;
@@ -247,6 +259,7 @@ int main(int argc, char** argv) {
     bench->add_option("--frames", bo.frames, "frames per mode")->capture_default_str();
     bench->add_option("--camera", bo.camera, "camera name");
     bench->add_option("--json", bo.json, "write the results as JSON");
+    bench->add_option("--plot", bo.plot, "FILE.png: the per-pass comparison as a bar chart");
     bench->add_option("--timing", benchTiming, "auto | timestamps | submit")->capture_default_str();
     bench->add_option("--density", benchDensity, "auto | shadels per metre")->capture_default_str();
     bench->add_option("--cache-dir", bo.cacheDir, "bake cache directory");
@@ -282,6 +295,29 @@ int main(int argc, char** argv) {
         ->capture_default_str()
         ->check(finiteInRange(kShadelBudgetRange));
     bake->add_flag("--no-cache", bakeNoCache, "bake from scratch (still writes the cache)");
+
+    // view
+    ViewOptions vo;
+    std::string viewSize = "1280x720";
+    auto* view = app.add_subcommand("view", "open a window: fly/orbit cameras, forward/decoupled, "
+                                            "debug views, per-pass timings (Xvfb works)");
+    view->add_option("--scene", vo.scene, "builtin:NAME | FILE.gltf | FILE.glb")
+        ->capture_default_str();
+    view->add_option("--camera", vo.camera, "camera name (default: the scene's first)");
+    view->add_option("--mode", vo.mode, "forward | decoupled (switchable in the window)")
+        ->capture_default_str();
+    view->add_option("--marking", vo.marking, "decoupled: raster | visibility")
+        ->capture_default_str();
+    view->add_option("--size", viewSize, "WIDTHxHEIGHT of the window")->capture_default_str();
+    view->add_option("--frames", vo.frames, "quit after N frames (0: when the window closes)")
+        ->capture_default_str();
+    view->add_option("--screenshot", vo.screenshot,
+                     "FILE.png: the window's last frame (with --frames), or on the UI's button");
+    view->add_flag("--no-ui", vo.noUi, "no ImGui panel (screenshots show only the frame)");
+    view->add_option("--cache-dir", vo.cacheDir, "bake cache directory");
+    view->add_option("--shader-source", vo.shaderSource,
+                     "GLSL folder watched for hot reload (recompiled with glslc); empty: off")
+        ->capture_default_str();
 
     auto* info = app.add_subcommand("info", "print the device, driver, features and limits");
     std::string cacheDirForCache;
@@ -348,6 +384,12 @@ int main(int argc, char** argv) {
             std::printf("%s", bakeReport(baked, seconds).c_str());
             return 0;
         }
+        if (*view) {
+            parseSize(viewSize, vo.width, vo.height);
+            vo.allowExternalFiles = allowExternalFiles;
+            vo.cacheLimitBytes = cacheLimitBytes;
+            return runViewer(vo, deviceDesc(device, validation));
+        }
         GpuGuard g;
         createGpu(g.gpu, deviceDesc(device, validation));
         if (*render) {
@@ -384,7 +426,10 @@ int main(int argc, char** argv) {
                 throw InputError("--instances 0: expected 1..1000000");
             ro.lod = parseOnOff("--lod", lod);
             ro.occlusion = parseOnOff("--occlusion", occlusion);
+            if (!captures.empty()) ro.captures = parseCaptureNames(captures);
+            if (!inspect.empty()) parseInspect(inspect, ro.inspectX, ro.inspectY);
             RenderRun run = runRender(g.gpu, ro);
+            if (run.listedCaptures) return 0;
             const auto& s = run.stats;
             std::printf(
                 "%s %s %ux%u: %u frame(s), median %.2f ms, %llu px covered, %llu shader asserts, "

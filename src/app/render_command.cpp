@@ -6,6 +6,7 @@
 #include <fstream>
 #include <unistd.h>
 
+#include "app/capture_output.h"
 #include "app/cli_validate.h"
 #include "app/commands.h"
 #include "app/output_files.h"
@@ -14,6 +15,7 @@
 #include "bake/bake_cache.h"
 #include "core/error.h"
 #include "core/log.h"
+#include "render/debug/inspect.h"
 #include "render/shadel/decoupled.h"
 #include "render/view_density.h"
 #include "scene/load.h"
@@ -77,6 +79,15 @@ MarkingMode parseMarking(const std::string& text) {
     throw InputError(format("--marking %s: expected raster or visibility", text.c_str()));
 }
 
+void parseInspect(const std::string& text, int32_t& x, int32_t& y) {
+    unsigned px = 0, py = 0;
+    char comma = 0, extra = 0;
+    if (std::sscanf(text.c_str(), "%u%c%u%c", &px, &comma, &py, &extra) != 3 || comma != ',' ||
+        px > 16383 || py > 16383)
+        throw InputError(format("--inspect %s: expected X,Y (a pixel, e.g. 40,20)", text.c_str()));
+    x = int32_t(px), y = int32_t(py);
+}
+
 OitMode parseOit(const std::string& text) {
     if (text == "wboit") return OitMode::Wboit;
     if (text == "sorted") return OitMode::Sorted;
@@ -118,6 +129,9 @@ RenderRun runRender(Gpu& gpu, const RenderOptions& o) {
         throw InputError(format("--frames %u: expected 1..100000", o.frames));
     if (o.ssaa < 1 || o.ssaa > 16) throw InputError(format("--ssaa %u: expected 1..16", o.ssaa));
     validateRenderOptions(o);
+    if (o.inspectX >= int32_t(o.width) || o.inspectY >= int32_t(o.height))
+        throw InputError(format("--inspect %d,%d: outside the %ux%u image", o.inspectX, o.inspectY,
+                                o.width, o.height));
     bool outDir = !o.out.empty() && o.out.back() == '/';
     if (outDir) {
         std::error_code ec;
@@ -130,6 +144,18 @@ RenderRun runRender(Gpu& gpu, const RenderOptions& o) {
     if (!o.out.empty()) requireCreatableOutput("--out", outDir ? o.out + "frame_0000.png" : o.out);
     if (!o.stats.empty()) requireCreatableOutput("--stats", o.stats);
     if (!o.trace.empty()) requireCreatableOutput("--trace", o.trace);
+    bool listCaptures = o.captures.size() == 1 && o.captures[0] == "list";
+    if (!o.captures.empty() && !listCaptures) {
+        if (o.captureDir.empty() && o.out.empty())
+            throw InputError("--capture: needs --capture-dir DIR or --out (files go next to it)");
+        if (!o.captureDir.empty()) {
+            std::error_code ec;
+            std::filesystem::create_directories(o.captureDir, ec);
+            if (ec)
+                throw InputError(format("--capture-dir %s: cannot create (%s)",
+                                        o.captureDir.c_str(), ec.message().c_str()));
+        }
+    }
     BuiltinSceneOptions builtin;
     builtin.instances = o.instances;
     Scene scene = loadScene(o.scene, {o.allowExternalFiles, o.time}, builtin);
@@ -219,6 +245,8 @@ RenderRun runRender(Gpu& gpu, const RenderOptions& o) {
     settings.reuse = o.reuse;
     settings.reuseRefreshPeriod = o.reuseRefreshPeriod;
     settings.animateLights = o.animateLights;
+    settings.inspectX = o.inspectX;
+    settings.inspectY = o.inspectY;
     settings.oit = o.oit;
     settings.shuffleDraws = o.shuffleDrawsSeed.has_value();
     settings.shuffleSeed = o.shuffleDrawsSeed.value_or(0);
@@ -238,6 +266,14 @@ RenderRun runRender(Gpu& gpu, const RenderOptions& o) {
     RenderRun run;
     try {
         initRenderer(renderer, gpu, settings, gpuScene);
+        if (listCaptures) {
+            std::printf("%s", captureListing(renderer.captures).c_str());
+            run.listedCaptures = true;
+            destroyRenderer(renderer);
+            destroyScene(gpu, gpuScene);
+            return run;
+        }
+        requireCapturesExist(renderer.captures, o.captures); // before minutes of rendering
         bool tty = isatty(STDERR_FILENO);
         for (uint32_t i = 0; i < o.frames; ++i) {
             glm::vec2 jitter = o.jitter ? subpixelJitter(i) : glm::vec2(0.0f);
@@ -258,7 +294,14 @@ RenderRun runRender(Gpu& gpu, const RenderOptions& o) {
         destroyScene(gpu, gpuScene);
         throw;
     }
-    if (!o.out.empty() && !outDir) writePng(o.out, run.frames.back().rgba, o.width, o.height);
+    if (!o.out.empty() && !outDir) {
+        if (isExrPath(o.out))
+            writeHdrFrame(renderer.captures, o.ssaa, o.out);
+        else
+            writePng(o.out, run.frames.back().rgba, o.width, o.height);
+    }
+    if (!o.captures.empty())
+        run.captureFiles = writeCaptures(renderer.captures, o.captures, o.captureDir, o.out);
 
     // Stats (DESIGN §5): medians over frames.
     nlohmann::json s;
@@ -337,6 +380,24 @@ RenderRun runRender(Gpu& gpu, const RenderOptions& o) {
         s["id_map_bytes"] = gpuScene.idMapBytes;
     }
     if (renderer.gi) giStats(renderer, s);
+    if (o.inspectX >= 0) {
+        nlohmann::json prints = nlohmann::json::array();
+        InspectedPixel pixel = frontFragment(run.frames.back().prints);
+        std::printf("--inspect %d,%d (%s, last frame, the front of %u fragment(s) shaded "
+                    "there):\n",
+                    o.inspectX, o.inspectY, modeName(o.mode), pixel.fragments);
+        for (const ShaderPrint& p : pixel.prints) {
+            std::printf("  %s\n", p.text().c_str());
+            std::vector<double> values;
+            for (uint32_t i = 0; i < p.count; ++i) values.push_back(p.f(int(i)));
+            prints.push_back({{"label", printLabelName(p.label)},
+                              {"values", values},
+                              {"shader", shaderName(p.shaderId)},
+                              {"line", p.line}});
+        }
+        if (pixel.prints.empty()) std::printf("  nothing was shaded at this pixel (background)\n");
+        s["inspect"] = prints;
+    }
     run.stats = s;
 
     destroyRenderer(renderer);

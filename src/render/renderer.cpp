@@ -5,6 +5,7 @@
 
 #include <glm/gtc/matrix_transform.hpp>
 
+#include "common/print_labels.h"
 #include "core/log.h"
 #include "render/forward/forward_passes.h"
 #include "render/lighting/light_animation.h"
@@ -62,6 +63,23 @@ static void createTargets(Renderer& r) {
     r.shadowRead = createReadView(gpu, r.shadowMap);
 }
 
+// --capture names of the targets every frame has (render/debug/capture.h).
+static void registerTargetCaptures(Renderer& r) {
+    Gpu& gpu = *r.gpu;
+    VkImageLayout hdrLayout = usesVisibilityBuffer(r.settings)
+                                  ? VK_IMAGE_LAYOUT_GENERAL
+                                  : VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL; // after tonemap
+    registerTextureCapture(
+        r.captures, gpu, "hdr", "scene colour before tonemapping (EXR)", CaptureKind::Hdr,
+        [&r] { return r.hdr; }, hdrLayout);
+    registerTextureCapture(
+        r.captures, gpu, "depth", "reversed-Z depth, 1 = near (EXR)", CaptureKind::Depth,
+        [&r] { return r.depth; }, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL);
+    registerTextureCapture(
+        r.captures, gpu, "shadow", "the sun's shadow map depth (EXR)", CaptureKind::Depth,
+        [&r] { return r.shadowMap; }, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL);
+}
+
 void initRenderer(Renderer& r, Gpu& gpu, const RenderSettings& settings, const GpuScene& scene) {
     r.gpu = &gpu;
     r.settings = settings;
@@ -71,6 +89,7 @@ void initRenderer(Renderer& r, Gpu& gpu, const RenderSettings& settings, const G
         throw InputError("--occlusion on needs --marking raster (the phase-2 prepass writes "
                          "depth only, not the visibility buffer)");
     createTargets(r);
+    registerTargetCaptures(r);
     r.maxDraws = std::max<uint32_t>(scene.instanceCount, 1);
     VkDeviceSize drawBytes =
         VkDeviceSize(DRAW_LIST_COUNT) * r.maxDraws * sizeof(gpu::DrawIndexedCommand);
@@ -110,6 +129,7 @@ void destroyRenderer(Renderer& r) {
     vkDeviceWaitIdle(gpu.device.device);
     destroyLightCulling(r, r.lightCulling);
     if (r.gi) destroyGi(r, r.gi);
+    r.captures = {}; // its sources refer to what is destroyed below
     if (r.visibility) destroyVisibility(r, r.visibility);
     destroyOit(r, r.oit);
     if (r.decoupled) destroyDecoupled(r, r.decoupled);
@@ -173,6 +193,10 @@ static gpu::FrameConstants makeFrameConstants(Renderer& r, const GpuScene& scene
     f.invViewportSize = 1.0f / f.viewportSize;
     f.frameIndex = uint32_t(gpu.frameIndex);
     f.visualize = uint32_t(r.settings.visualize);
+    f.inspectPixel = INSPECT_OFF;
+    if (r.settings.inspectX >= 0 && r.settings.inspectY >= 0) // the SSAA sample at its corner
+        f.inspectPixel = uint32_t(r.settings.inspectX) * r.settings.ssaa |
+                         (uint32_t(r.settings.inspectY) * r.settings.ssaa) << 16;
     f.vertices = address(gpu, scene.vertices);
     f.indices = address(gpu, scene.indices);
     f.meshes = address(gpu, scene.meshes);
@@ -268,6 +292,7 @@ FrameResult renderFrame(Renderer& r, const GpuScene& scene, const CameraView& ca
     // inside the passes, so this is an upper bound there).
     result.cpuFrameMs = prepareMs + std::max(0.0, msSince(cpuStart) - prepareMs - rec.gpuWaitMs);
     result.shaderAsserts = collectShaderMessages(gpu, r.messages);
+    result.prints = r.messages.prints;
     result.transparentDecoupledDraws = decoupledTransparentDraws(r);
     result.transparentDraws =
         uint32_t(transparentDrawOrder(r).size()) + result.transparentDecoupledDraws;

@@ -8,6 +8,7 @@
 #include "render/camera.h"
 #include "render/gi/lpv.h"
 #include "render/culling/culling.h"
+#include "render/debug/capture.h"
 #include "render/gpu_scene.h"
 #include "render/lighting/light_culling.h"
 #include "render/shadel/visibility.h"
@@ -55,7 +56,7 @@ struct RenderSettings {
     TimingMode timing = TimingMode::SubmitPerPass;
     uint32_t shadeStorageSize = 4096; // decoupled: physical shade storage, shadels per side
     uint32_t sheetShadels = 65536;    // decoupled: virtual sheet, shadels per side
-    float shadingBias = 0.0f;     // decoupled: base MIP bias (the capacity controller adds to it)
+    float shadingBias = 0.0f; // decoupled: base MIP bias (the capacity controller adds to it)
     // decoupled: LOD band blended between MIPs (1 = full trilinear). 0.5 ("brilinear"): only
     // the middle half of each LOD interval reads two MIPs. At 1280x720 it shades 24% fewer
     // chunks on builtin:default for -0.3 dB against the supersampled forward render, and 22% /
@@ -68,6 +69,8 @@ struct RenderSettings {
     bool capacityControl = true;     // decoupled: steer the shading bias from storage use
     bool reuse = true;               // decoupled: carry unchanged shadels over from last frame
     uint32_t reuseRefreshPeriod = 8; // decoupled: reshade every carried chunk this often
+    // --inspect X,Y: the output pixel whose shading is printed (shaders/debug/inspect.glsl).
+    int32_t inspectX = -1, inspectY = -1;
     bool animateLights = false;   // point and spot lights move on small circles
     OitMode oit = OitMode::Wboit; // transparency: render/oit
     bool shuffleDraws = false;    // --shuffle-draws SEED: transparent draws in a random order
@@ -96,6 +99,7 @@ struct FrameResult {
     double cpuThreadMs = 0.0;
     double startMs = 0.0; // since the renderer was created (trace export)
     uint32_t shaderAsserts = 0;
+    std::vector<ShaderPrint> prints;        // shaderPrint records of this frame (--inspect)
     uint32_t transparentDraws = 0;          // blended instances drawn (render/oit)
     uint32_t transparentDecoupledDraws = 0; // ... of which shaded in shadel space
 };
@@ -145,6 +149,7 @@ struct Renderer {
     LightCullingStatePtr lightCulling; // light lists (render/lighting/light_culling.h)
     GiStatePtr gi;                     // --gi lpv
     CullingStatePtr culling;           // LODs, occlusion, per-view counts (render/culling)
+    CaptureRegistry captures;          // --capture: named resources of the frame (render/debug)
     std::chrono::steady_clock::time_point createdAt = std::chrono::steady_clock::now();
 };
 

@@ -271,6 +271,11 @@ void createDevice(Device& device, const DeviceDesc& desc) {
     std::vector<const char*> extensions;
     bool debugUtils = hasInstanceExtension(VK_EXT_DEBUG_UTILS_EXTENSION_NAME);
     if (debugUtils) extensions.push_back(VK_EXT_DEBUG_UTILS_EXTENSION_NAME);
+    for (const std::string& e : desc.instanceExtensions) {
+        if (!hasInstanceExtension(e.c_str()))
+            throw DeviceError(format("the window needs instance extension %s", e.c_str()));
+        extensions.push_back(e.c_str());
+    }
     if (desc.validation) {
         if (!hasLayer("VK_LAYER_KHRONOS_validation"))
             throw DeviceError("validation requested but VK_LAYER_KHRONOS_validation is not "
@@ -465,6 +470,12 @@ void createDevice(Device& device, const DeviceDesc& desc) {
     dci.pNext = &enable.core;
     dci.queueCreateInfoCount = 1;
     dci.pQueueCreateInfos = &qci;
+    if (desc.swapchain) {
+        if (!hasExtension(exts, VK_KHR_SWAPCHAIN_EXTENSION_NAME))
+            throw DeviceError(
+                format("%s has no VK_KHR_swapchain: cannot open a window", device.name.c_str()));
+        deviceExts.push_back(VK_KHR_SWAPCHAIN_EXTENSION_NAME);
+    }
     dci.enabledExtensionCount = uint32_t(deviceExts.size());
     dci.ppEnabledExtensionNames = deviceExts.data();
     r = vkCreateDevice(device.physical, &dci, nullptr, &device.device);

@@ -3,6 +3,7 @@
 // validation and debug-utils naming.
 #include <atomic>
 #include <string>
+#include <vector>
 
 #include "rhi/vk.h"
 
@@ -12,6 +13,9 @@ struct DeviceDesc {
     std::string selection = "auto"; // auto | cpu | gpu | INDEX
     bool validation = false;        // Khronos validation layer; errors are counted
     bool printValidation = true;
+    // A window (shadel view): the surface's instance extensions and VK_KHR_swapchain.
+    std::vector<std::string> instanceExtensions;
+    bool swapchain = false;
 };
 
 struct DeviceFeatures { // optional features, used when present

@@ -1,5 +1,7 @@
 #include "rhi/gpu.h"
 
+#include "rhi/shader_reload.h"
+
 #include <cmath>
 #include <cstring>
 
@@ -23,6 +25,7 @@ void createGpu(Gpu& gpu, const DeviceDesc& desc) {
 void destroyGpu(Gpu& gpu) {
     if (!gpu.device.device) return;
     vkDeviceWaitIdle(gpu.device.device);
+    disableShaderHotReload(gpu);
     destroyBindless(gpu);
     for (uint32_t i = 0; i < gpu.readViews.items.size(); ++i)
         if (gpu.readViews.contains(i)) destroy(gpu, TextureReadView{i});

@@ -3,6 +3,7 @@
 // amount of frame machinery (command buffers, upload, shader messages). Plain data; the
 // functions that act on it live next to the concept they implement.
 #include <functional>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -53,6 +54,7 @@ struct Gpu {
     VkCommandPool transientPool = VK_NULL_HANDLE;
     uint64_t frameIndex = 0;
     uint64_t failedAllocations = 0;
+    std::shared_ptr<struct ShaderHotReload> hotReload; // rhi/shader_reload.h, when enabled
 };
 
 void createGpu(Gpu& gpu, const DeviceDesc& desc);

@@ -5,6 +5,7 @@
 
 #include "core/log.h"
 #include "rhi/gpu.h"
+#include "rhi/shader_reload.h"
 
 #ifndef SHADEL_SHADER_BINARY_DIR
 #define SHADEL_SHADER_BINARY_DIR "shaders"
@@ -31,7 +32,8 @@ std::vector<uint32_t> loadSpirv(const std::string& fileName) {
 }
 
 static VkShaderModule createModule(Gpu& gpu, const std::string& file) {
-    std::vector<uint32_t> code = loadSpirv(file);
+    const std::vector<uint32_t>* reloaded = reloadedSpirv(gpu, file); // hot reload's newest
+    std::vector<uint32_t> code = reloaded ? *reloaded : loadSpirv(file);
     VkShaderModuleCreateInfo ci{VK_STRUCTURE_TYPE_SHADER_MODULE_CREATE_INFO};
     ci.codeSize = code.size() * 4;
     ci.pCode = code.data();
@@ -159,6 +161,7 @@ Pipeline createGraphicsPipeline(Gpu& gpu, const GraphicsPipelineDesc& desc) {
     setName(gpu.device, out.pipeline, VK_OBJECT_TYPE_PIPELINE, desc.name);
     vkDestroyShaderModule(gpu.device.device, vs, nullptr);
     if (fs) vkDestroyShaderModule(gpu.device.device, fs, nullptr);
+    recordPipeline(gpu, out, &desc, "", desc.specialization);
     return out;
 }
 
@@ -180,16 +183,18 @@ Pipeline createComputePipeline(Gpu& gpu, const std::string& name, const std::str
                                       &out.pipeline));
     setName(gpu.device, out.pipeline, VK_OBJECT_TYPE_PIPELINE, name);
     vkDestroyShaderModule(gpu.device.device, cs, nullptr);
+    recordPipeline(gpu, out, nullptr, shader, specialization);
     return out;
 }
 
 void destroy(Gpu& gpu, Pipeline& pipeline) {
+    forgetPipeline(gpu, pipeline.pipeline); // and its hot-reload replacement
     if (pipeline.pipeline) vkDestroyPipeline(gpu.device.device, pipeline.pipeline, nullptr);
     pipeline.pipeline = VK_NULL_HANDLE;
 }
 
 void bind(const Gpu& gpu, VkCommandBuffer cmd, const Pipeline& pipeline) {
-    vkCmdBindPipeline(cmd, pipeline.bindPoint, pipeline.pipeline);
+    vkCmdBindPipeline(cmd, pipeline.bindPoint, currentPipeline(gpu, pipeline.pipeline));
     VkDescriptorSet set = currentBindlessSet(gpu);
     vkCmdBindDescriptorSets(cmd, pipeline.bindPoint, gpu.bindless.pipelineLayout, 0, 1, &set, 0,
                             nullptr);

@@ -1,8 +1,9 @@
 #pragma once
-// The shader -> CPU message channel (seed 003's GPU inspection, asserts first): a buffer any
-// shader appends to with atomics (shaders/common/bindless.glsl, SHADEL_ASSERT). After each
-// frame the CPU decodes it, prints each distinct assert once with its source location, counts
-// all of them, and resets it.
+// The shader -> CPU message channel (seed 003's GPU inspection): a buffer any shader appends to
+// with atomics: asserts (shaders/common/bindless.glsl, SHADEL_ASSERT) and prints of labelled
+// values (shaders/common/shader_print.glsl, shaderPrintF...). After each frame the CPU decodes
+// it, prints each distinct assert once with its source location, counts all of them, keeps the
+// frame's prints in order, and resets it.
 #include <cstdint>
 #include <set>
 #include <string>
@@ -15,11 +16,26 @@ namespace shadel {
 
 struct Gpu;
 
+// One shaderPrint record: a label (shaders/common/print_labels.h) and up to four values.
+struct ShaderPrint {
+    uint32_t label = 0;
+    uint32_t shaderId = 0, line = 0;
+    uint32_t type = 0, count = 0; // PRINT_UINT | PRINT_INT | PRINT_FLOAT, 1..4 values
+    uint32_t tag = 0;             // the invocation that printed it (gPrintTag)
+    uint32_t bits[4] = {};
+    float f(int i) const;     // value i as a float (converted from ints)
+    uint32_t u(int i) const;  // value i's bits as a uint
+    std::string text() const; // "base colour 0.750 0.150 0.120  (shaders/...:40)"
+};
+const char* printLabelName(uint32_t label);
+
 struct ShaderMessageChannel {
     BufferHandle buffer;
     std::set<std::tuple<uint32_t, uint32_t, uint32_t>> reported; // (assert, shader, line)
     uint64_t totalAsserts = 0;
-    std::vector<std::string> lines; // every distinct message printed so far
+    std::vector<std::string> lines;  // every distinct message printed so far
+    std::vector<ShaderPrint> prints; // the last collected frame's, in the order they arrived
+    uint32_t droppedMessages = 0;    // the last frame's records beyond the buffer's capacity
 };
 
 void initShaderMessages(Gpu& gpu, ShaderMessageChannel& channel);

@@ -300,7 +300,7 @@ TEST(Cli, BufferUriOutsideTheModelFolderIsRefused) {
 // some command's --help.
 TEST(Cli, EveryDocumentedFlagExists) {
     std::string help;
-    for (const char* sub : {"render", "bench", "bake", "info"})
+    for (const char* sub : {"render", "bench", "bake", "info", "view"})
         help += runWithEnv("", std::string(sub) + " --help").stdoutText;
     int flags = 0;
     for (const char* doc : {"/README.md", "/OVERVIEW.md"}) {

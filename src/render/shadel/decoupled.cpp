@@ -115,6 +115,28 @@ static BufferHandle need(BufferHandle b, const char* what) {
     return b;
 }
 
+// --capture names of the decoupled frame (render/debug/capture.h), read after the frame: the
+// layers, masks and offsets at the parity of the frame just rendered.
+static void registerDecoupledCaptures(Renderer& r, DecoupledState& d) {
+    Gpu& gpu = *r.gpu;
+    auto done = [&d] { return uint32_t((d.frameNumber + 1) & 1); }; // frameNumber moved on
+    auto layer = [&d, done](uint32_t l) { return d.storage.frames[done()][l].texture; };
+    registerTextureCapture(
+        r.captures, gpu, "storage.radiance", "shade storage: lit radiance (EXR)", CaptureKind::Hdr,
+        [=] { return layer(SHADEL_LAYER_RADIANCE); }, VK_IMAGE_LAYOUT_GENERAL);
+    registerTextureCapture(
+        r.captures, gpu, "storage.material", "shade storage: base colour, roughness in alpha (PNG)",
+        CaptureKind::Display, [=] { return layer(SHADEL_LAYER_MATERIAL); },
+        VK_IMAGE_LAYOUT_GENERAL);
+    registerCapture(r.captures, "occupancy", "chunks marked per sheet block, 0..64 (heat PNG)",
+                    CaptureKind::Mask, [&gpu, &d, done] {
+                        return readMaskGrid(gpu, d.occupancy[done()], d.sheetBlocks);
+                    });
+    registerCapture(r.captures, "sheet", "virtual sheet blocks by owner object and MIP (PNG)",
+                    CaptureKind::Labels,
+                    [&gpu, &d] { return readLabelGrid(gpu, d.allocId, d.sheetBlocks); });
+}
+
 DecoupledStatePtr createDecoupled(Renderer& r, const GpuScene& scene) {
     Gpu& gpu = *r.gpu;
     if (scene.shadelMeshes.empty())
@@ -223,6 +245,7 @@ DecoupledStatePtr createDecoupled(Renderer& r, const GpuScene& scene) {
     recon.fragmentShader = "shadel_reconstruct.frag.spv";
     recon.colorFormats = {VK_FORMAT_R16G16B16A16_SFLOAT};
     d.reconstruct = createGraphicsPipeline(gpu, recon);
+    registerDecoupledCaptures(r, d);
     return state;
 }
 

@@ -69,6 +69,9 @@ VisibilityStatePtr createVisibility(Renderer& r) {
     v.prepass = createGraphicsPipeline(gpu, prepass);
     v.mark = createComputePipeline(gpu, "shadelMarkVisibility", "shadel_mark_visibility.comp.spv");
     v.resolve = createComputePipeline(gpu, "shadelResolve", "shadel_resolve.comp.spv");
+    registerTextureCapture(
+        r.captures, gpu, "visibility", "visibility buffer: instance, triangle (PNG)",
+        CaptureKind::Ids, [&v] { return v.ids; }, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL);
     return state;
 }
 

@@ -1,0 +1,30 @@
+#pragma once
+// `shadel view`: the renderer in a window (GLFW + Dear ImGui) with fly and orbit cameras, the
+// forward/decoupled switch, the debug views, the per-pass timing graph and the stats. Headless
+// CI runs it under Xvfb: `--frames N --screenshot FILE.png --no-ui` quits after N frames.
+#include <string>
+
+#include "rhi/device.h"
+
+namespace shadel {
+
+struct ViewOptions {
+    std::string scene = "builtin:default";
+    std::string camera;
+    std::string mode = "forward";
+    std::string marking = "raster";
+    uint32_t width = 1280, height = 720;
+    uint32_t frames = 0;    // 0 = until the window closes
+    std::string screenshot; // PNG of the window's last frame (with --frames) or on request
+    bool noUi = false;
+    // Hot reload: the GLSL folder watched (default: the source tree's shaders/); empty = off.
+    std::string shaderSource = SHADEL_SHADER_SOURCE_DIR;
+    std::string cacheDir;
+    bool allowExternalFiles = false;
+    uint64_t cacheLimitBytes = 4ull << 30;
+};
+
+// Returns the process exit code (4 when validation errors or shader asserts happened).
+int runViewer(const ViewOptions& options, DeviceDesc device);
+
+} // namespace shadel

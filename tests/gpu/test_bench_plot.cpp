@@ -1,0 +1,61 @@
+// `shadel bench --plot FILE.png` (app/bench_plot.h): bars proportional to each mode's GPU ms.
+#include "gpu_test_env.h"
+
+#include <filesystem>
+
+#include "app/bench_plot.h"
+
+using namespace shadel;
+using namespace shadel::test;
+
+namespace {
+
+uint64_t pixelsOf(const PlotImage& img, const uint8_t c[3]) {
+    uint64_t n = 0;
+    for (size_t i = 0; i < img.rgba.size(); i += 4)
+        n += img.rgba[i] == c[0] && img.rgba[i + 1] == c[1] && img.rgba[i + 2] == c[2];
+    return n;
+}
+
+} // namespace
+
+// A synthetic bench result: each mode's bar area follows its summed pass times.
+TEST(BenchPlot, BarAreasFollowThePassTimes) {
+    nlohmann::json bench;
+    bench["scene"] = "synthetic";
+    bench["device"] = "none";
+    const double ms[3][3] = {{10, 20, 5}, {4, 40, 8}, {2, 12, 1}};
+    const char* modes[3] = {"forward", "decoupled", "reuse"};
+    double sums[3] = {0, 0, 0};
+    for (int m = 0; m < 3; ++m)
+        for (int p = 0; p < 3; ++p) {
+            bench["modes"][modes[m]]["passes"].push_back(
+                {{"name", "pass" + std::to_string(p)}, {"gpu_ms", ms[m][p]}});
+            sums[m] += ms[m][p];
+        }
+    PlotImage img = plotBench(bench);
+    ASSERT_EQ(img.rgba.size(), size_t(img.width) * img.height * 4);
+    uint64_t area[3];
+    for (int m = 0; m < 3; ++m) area[m] = pixelsOf(img, kPlotModeColours[m]) - 100; // legend
+    for (int m = 1; m < 3; ++m)
+        EXPECT_NEAR(double(area[m]) / double(area[0]), sums[m] / sums[0], 0.03) << modes[m];
+}
+
+TEST(BenchPlot, BenchWritesThePlot) {
+    std::string path = (std::filesystem::temp_directory_path() /
+                        ("shadel-bench-plot-" + std::to_string(::getpid()) + ".png"))
+                           .string();
+    BenchOptions b;
+    b.scene = "builtin:smooth";
+    b.width = 64;
+    b.height = 36;
+    b.frames = 1;
+    b.plot = path;
+    nlohmann::json result = runBench(sharedGpu(), b);
+    ASSERT_TRUE(std::filesystem::exists(path));
+    EXPECT_GT(std::filesystem::file_size(path), 1000u);
+    PlotImage img = plotBench(result);
+    for (int m = 0; m < 3; ++m) EXPECT_GT(pixelsOf(img, kPlotModeColours[m]), 100u) << m;
+    EXPECT_EQ(validationErrors(), 0u);
+    std::filesystem::remove(path);
+}
