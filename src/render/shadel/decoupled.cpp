@@ -193,6 +193,13 @@ DecoupledStatePtr createDecoupled(Renderer& r, const GpuScene& scene) {
                    device("shadel.chunkOccupancy.frame1", blocks * 8)};
     d.offsetMap = {device("shadel.offsetMap.frame0", blocks * 4),
                    device("shadel.offsetMap.frame1", blocks * 4)};
+    // Zeroed once: the clear pass only zeroes the blocks in use each frame, and memory reused
+    // from an earlier renderer would otherwise show stale marks (--capture occupancy reads every
+    // block).
+    immediateSubmit(gpu, [&](VkCommandBuffer cmd) {
+        for (BufferHandle b : {d.occupancy[0], d.occupancy[1], d.offsetMap[0], d.offsetMap[1]})
+            vkCmdFillBuffer(cmd, vkBuffer(gpu, b), 0, VK_WHOLE_SIZE, 0);
+    });
     d.allocId = upload("shadel.allocId", blocks * 4);
     std::memset(mapped(gpu, d.allocId), 0, blocks * 4);
     d.counters =
