@@ -26,9 +26,15 @@ void shaderPrintRecord(uint64_t messages, uint label, uint format, uvec4 bits, u
     }
 }
 
+// True only in pipelines built for --inspect (src/render/debug/inspect.h): otherwise every
+// print is dead code and the driver drops it (compiled in but never taken, the prints made
+// lavapipe's forward shading 2x slower).
+layout(constant_id = 200) const bool kShaderPrintEnabled = false;
+
 // The pixel --inspect picked (internal resolution); false for every pixel without it.
 bool inspecting(FrameConstants f, uvec2 pixel) {
-    return f.inspectPixel != INSPECT_OFF && f.inspectPixel == (pixel.x | (pixel.y << 16));
+    return kShaderPrintEnabled && f.inspectPixel != INSPECT_OFF &&
+           f.inspectPixel == (pixel.x | (pixel.y << 16));
 }
 
 #define SHADEL_PRINT_FMT(type, n) ((type) | ((n) << 4))

@@ -1,6 +1,7 @@
 #include "render/forward/forward_passes.h"
 
 #include "render/culling/culling.h"
+#include "render/debug/inspect.h"
 #include "render/renderer.h"
 
 namespace shadel {
@@ -50,6 +51,7 @@ void createForwardPipelines(Renderer& r) {
     opaque.depthWrite = false;
     opaque.depthCompare = VK_COMPARE_OP_EQUAL; // the prepass resolved visibility
     opaque.cullMode = VK_CULL_MODE_NONE;
+    opaque.specialization = shaderPrintSpecialization(r.settings.inspectX >= 0);
     r.forwardOpaque = createGraphicsPipeline(gpu, opaque);
 }
 

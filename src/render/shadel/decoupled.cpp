@@ -9,6 +9,7 @@
 #include "core/error.h"
 #include "core/log.h"
 #include "render/culling/instance_grid.h"
+#include "render/debug/inspect.h"
 #include "render/forward/forward_passes.h"
 #include "render/renderer.h"
 #include "render/shadel/capacity_control.h"
@@ -251,6 +252,7 @@ DecoupledStatePtr createDecoupled(Renderer& r, const GpuScene& scene) {
     recon.name = "shadelReconstruct";
     recon.fragmentShader = "shadel_reconstruct.frag.spv";
     recon.colorFormats = {VK_FORMAT_R16G16B16A16_SFLOAT};
+    recon.specialization = shaderPrintSpecialization(r.settings.inspectX >= 0);
     d.reconstruct = createGraphicsPipeline(gpu, recon);
     registerDecoupledCaptures(r, d);
     return state;

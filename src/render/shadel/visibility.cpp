@@ -1,6 +1,7 @@
 #include "render/shadel/visibility.h"
 
 #include "core/error.h"
+#include "render/debug/inspect.h"
 #include "render/forward/forward_passes.h"
 #include "render/renderer.h"
 
@@ -68,7 +69,8 @@ VisibilityStatePtr createVisibility(Renderer& r) {
     prepass.cullMode = VK_CULL_MODE_NONE; // as the depth prepass
     v.prepass = createGraphicsPipeline(gpu, prepass);
     v.mark = createComputePipeline(gpu, "shadelMarkVisibility", "shadel_mark_visibility.comp.spv");
-    v.resolve = createComputePipeline(gpu, "shadelResolve", "shadel_resolve.comp.spv");
+    v.resolve = createComputePipeline(gpu, "shadelResolve", "shadel_resolve.comp.spv",
+                                      shaderPrintSpecialization(r.settings.inspectX >= 0));
     registerTextureCapture(
         r.captures, gpu, "visibility", "visibility buffer: instance, triangle (PNG)",
         CaptureKind::Ids, [&v] { return v.ids; }, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL);
