@@ -269,7 +269,7 @@ FrameResult renderFrame(Renderer& r, const GpuScene& scene, const CameraView& ca
              [&](VkCommandBuffer cmd) { recordVisibilityPrepass(r, cmd, frame); });
     else
         pass(rec, "depthPrepass", [&](VkCommandBuffer cmd) { recordDepthPrepass(r, cmd, frame); });
-    if (r.settings.lightCulling == LightCulling::Tiled)
+    if (lightTilesThisFrame(r))
         pass(rec, "lightCulling", [&](VkCommandBuffer cmd) { recordLightCulling(r, cmd, frame); });
     if (r.settings.occlusion) recordOcclusionPasses(r, rec, frame, scene);
     if (r.settings.mode == RenderMode::Forward) {

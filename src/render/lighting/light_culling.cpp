@@ -21,7 +21,13 @@ struct LightCullingState {
     // Last frame's counts (read after the GPU finished).
     gpu::LightingCounters last{};
     uint32_t lightsVisible = 0;
+    bool tiledThisFrame = false; // see kMinLightsForTiles
 };
+
+// Below this many lights in the view (and with no blockers to classify), the tile pass costs
+// more than it saves: on builtin:default (8 lights, 1280x720, lavapipe) it took 92 ms to save
+// forward shading 73 ms. The lights are then looped over directly, the same sum.
+constexpr uint32_t kMinLightsForTiles = 16;
 
 void LightCullingStateDeleter::operator()(LightCullingState* state) const {
     delete state;
@@ -103,8 +109,10 @@ uint64_t prepareLightCulling(Renderer& r, const GpuScene& scene,
     f.visibleLights = address(gpu, s.visibleLights);
     f.tilesX = s.tilesX;
     f.tilesY = s.tilesY;
-    f.tiled = r.settings.lightCulling == LightCulling::Tiled ? 1u : 0u;
     f.blockersOn = r.settings.lightBlockers && scene.blockerCount > 0 ? 1u : 0u;
+    s.tiledThisFrame = r.settings.lightCulling == LightCulling::Tiled &&
+                       (count >= kMinLightsForTiles || f.blockersOn != 0u);
+    f.tiled = s.tiledThisFrame ? 1u : 0u;
     f.poolCapacity = s.poolCapacity;
     f.blockerCount = scene.blockerCount;
     std::memcpy(mapped(gpu, s.frame), &f, sizeof(f));
@@ -142,10 +150,14 @@ void recordLightCulling(Renderer& r, VkCommandBuffer cmd, uint64_t frame) {
                   VK_ACCESS_2_SHADER_STORAGE_READ_BIT | VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT);
 }
 
+bool lightTilesThisFrame(const Renderer& r) {
+    return r.lightCulling && r.lightCulling->tiledThisFrame;
+}
+
 void readLightCullingStats(Renderer& r) {
     LightCullingState& s = *r.lightCulling;
     Gpu& gpu = *r.gpu;
-    if (r.settings.lightCulling != LightCulling::Tiled) { // nothing counted (nor cleared)
+    if (!s.tiledThisFrame) { // nothing counted (nor cleared)
         s.last = {};
         s.lightsVisible = 0;
         return;
@@ -159,8 +171,11 @@ void readLightCullingStats(Renderer& r) {
 
 void lightCullingStats(const Renderer& r, const GpuScene& scene, nlohmann::json& stats) {
     const LightCullingState& s = *r.lightCulling;
-    bool tiled = r.settings.lightCulling == LightCulling::Tiled;
-    stats["light_culling"] = tiled ? "tiled" : "none";
+    bool tiled = s.tiledThisFrame;
+    stats["light_culling"] = tiled ? "tiled"
+                             : r.settings.lightCulling == LightCulling::Tiled
+                                 ? "none (fewer lights in view than tiles pay for)"
+                                 : "none";
     stats["blockers"] = r.settings.lightBlockers ? "on" : "off";
     stats["light_blockers"] = scene.blockerCount;
     // Without culling every light is considered everywhere.

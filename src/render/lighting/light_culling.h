@@ -33,6 +33,9 @@ void destroyLightCulling(Renderer& r, LightCullingStatePtr& state);
 // FrameConstants::lighting.
 uint64_t prepareLightCulling(Renderer& r, const GpuScene& scene,
                              const std::vector<gpu::GpuLight>& lights, const glm::mat4& viewProj);
+// Whether this frame builds tile lists: --light-culling tiled and enough lights in view (or
+// blockers to classify); otherwise shading loops over the lights directly.
+bool lightTilesThisFrame(const Renderer& r);
 // The culling pass (tiled mode); with --light-culling none it records nothing.
 void recordLightCulling(Renderer& r, VkCommandBuffer cmd, uint64_t frame);
 // After the frame: counters into the stats (lights, lights_visible, light_tile_pairs, ...).
