@@ -45,8 +45,8 @@ struct RenderOptions {
     bool reuse = true;
     uint32_t reuseRefreshPeriod = 8;
     bool animateLights = false;
-    OitMode oit = OitMode::Wboit;             // --oit wboit|sorted
-    std::optional<uint64_t> shuffleDrawsSeed; // --shuffle-draws SEED
+    OitMode oit = OitMode::Wboit;                    // --oit wboit|sorted
+    std::optional<uint64_t> shuffleDrawsSeed;        // --shuffle-draws SEED
     LightCulling lightCulling = LightCulling::Tiled; // --light-culling tiled|none
     bool lightBlockers = true;                       // --blockers on|off
     CameraPath cameraPath = CameraPath::Static;
@@ -85,7 +85,7 @@ void parseInspect(const std::string& text, int32_t& x, int32_t& y);
 OitMode parseOit(const std::string& text);
 LightCulling parseLightCulling(const std::string& text);
 bool parseOnOff(const char* flag, const std::string& text); // "on" / "off", else InputError
-GiMode parseGi(const std::string& text); // --gi lpv|off
+GiMode parseGi(const std::string& text);                    // --gi lpv|off
 // The bake cache folder when --cache-dir is not given (see defaultBakeCacheDir()).
 std::string defaultCacheDir();
 

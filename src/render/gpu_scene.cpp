@@ -299,9 +299,9 @@ void uploadScene(Gpu& gpu, const Scene& scene, GpuScene& out, const std::vector<
 void destroyScene(Gpu& gpu, GpuScene& s) {
     for (TextureReadView v : s.textureViews) destroy(gpu, v);
     for (TextureHandle t : s.textures) destroy(gpu, t);
-    for (BufferHandle b : {s.vertices, s.shadelUvs, s.indices, s.meshes, s.meshLods, s.instances,
-                           s.materials, s.lights, s.idMaps, s.blockers, s.portals,
-                           s.lightBlockerLists})
+    for (BufferHandle b :
+         {s.vertices, s.shadelUvs, s.indices, s.meshes, s.meshLods, s.instances, s.materials,
+          s.lights, s.idMaps, s.blockers, s.portals, s.lightBlockerLists})
         destroy(gpu, b);
     s = GpuScene{};
 }

@@ -244,7 +244,8 @@ FrameResult renderFrame(Renderer& r, const GpuScene& scene, const CameraView& ca
     gpu::FrameConstants constants = makeFrameConstants(r, scene, camera);
     updateLights(r, scene, constants);
     constants.lighting = prepareLightCulling(
-        r, scene, r.settings.animateLights ? r.lightsLastFrame : scene.lightInfo, constants.viewProj);
+        r, scene, r.settings.animateLights ? r.lightsLastFrame : scene.lightInfo,
+        constants.viewProj);
     if (r.gi) prepareGiFrame(r, scene, camera, constants);
     if (r.decoupled) prepareDecoupledFrame(r, scene, camera, constants);
     prepareTransparentDraws(r, scene, camera);

@@ -6,9 +6,9 @@
 #include <vector>
 
 #include "render/camera.h"
-#include "render/gi/lpv.h"
 #include "render/culling/culling.h"
 #include "render/debug/capture.h"
+#include "render/gi/lpv.h"
 #include "render/gpu_scene.h"
 #include "render/lighting/light_culling.h"
 #include "render/shadel/visibility.h"
@@ -35,7 +35,7 @@ enum class Visualize : uint32_t {
     LayerMaterial = 5, // --visualize layer:material (the shade storage's material layer)
     LightCount = VISUALIZE_LIGHT_COUNT, // lights per tile (forward) or chunk (shadel)
     Blockers = VISUALIZE_BLOCKERS,      // tiles / chunks with per-pixel blocker checks
-    Gi = 6,            // --visualize gi: the LPV's indirect light only
+    Gi = 6,                             // --visualize gi: the LPV's indirect light only
 };
 
 // --light-culling: per-tile (forward) and per-chunk (shadel) light lists, or every light for
@@ -65,9 +65,9 @@ struct RenderSettings {
     uint32_t materialSamples = 4; // decoupled: material evaluations per shadel above MIP 0
     float forwardBelowPixels = 8; // decoupled: objects smaller on screen drawn forward (0 = never)
     uint32_t allocationCounters = SHADEL_COUNTERS; // decoupled: hashed counters used (tests)
-    bool sheetAllMips = false; // decoupled: rects at every MIP (the old policy, for comparison)
-    bool capacityControl = true;     // decoupled: steer the shading bias from storage use
-    bool reuse = true;               // decoupled: carry unchanged shadels over from last frame
+    bool sheetAllMips = false;   // decoupled: rects at every MIP (the old policy, for comparison)
+    bool capacityControl = true; // decoupled: steer the shading bias from storage use
+    bool reuse = true;           // decoupled: carry unchanged shadels over from last frame
     uint32_t reuseRefreshPeriod = 8; // decoupled: reshade every carried chunk this often
     // --inspect X,Y: the output pixel whose shading is printed (shaders/debug/inspect.glsl).
     int32_t inspectX = -1, inspectY = -1;
@@ -76,15 +76,16 @@ struct RenderSettings {
     bool shuffleDraws = false;    // --shuffle-draws SEED: transparent draws in a random order
     uint64_t shuffleSeed = 0;
     LightCulling lightCulling = LightCulling::Tiled;
-    bool lightBlockers = true; // --blockers: light blockers and portals stop the lights listing them
-    GiMode gi = GiMode::Off;    // --gi (off by default: see render/gi/lpv.h for its cost)
-    uint32_t giIterations = 8;  // --gi-iterations: LPV propagation steps
-    bool giSnap = true;         // --gi-snap off: cascades slide with the camera (debug)
-    float giIntensity = 1.0f;   // scale of the indirect term
+    bool lightBlockers =
+        true;                // --blockers: light blockers and portals stop the lights listing them
+    GiMode gi = GiMode::Off; // --gi (off by default: see render/gi/lpv.h for its cost)
+    uint32_t giIterations = 8;         // --gi-iterations: LPV propagation steps
+    bool giSnap = true;                // --gi-snap off: cascades slide with the camera (debug)
+    float giIntensity = 1.0f;          // scale of the indirect term
     std::vector<GiBlocker> giBlockers; // GI light blockers (axial occlusion in propagation)
-    bool lod = false;            // GPU LOD selection by projected error (render/culling)
-    float lodErrorPixels = 0.5f; // the coarsest LOD whose error projects below this is drawn
-    bool occlusion = false;      // two-phase hierarchical-Z occlusion culling (render/culling)
+    bool lod = false;                  // GPU LOD selection by projected error (render/culling)
+    float lodErrorPixels = 0.5f;       // the coarsest LOD whose error projects below this is drawn
+    bool occlusion = false; // two-phase hierarchical-Z occlusion culling (render/culling)
 };
 
 struct FrameResult {

@@ -9,8 +9,8 @@
 #include <glm/gtc/matrix_transform.hpp>
 
 #include "core/error.h"
-#include "scene/builtin_lights.h"
 #include "core/log.h"
+#include "scene/builtin_lights.h"
 #include "scene/mesh_utils.h"
 
 namespace shadel {

@@ -62,9 +62,9 @@ LightCullingStatePtr createLightCulling(Renderer& r, const GpuScene& scene) {
     s->visibleLights = need(createBuffer(
         gpu, {"lighting.visibleLights", std::max<uint64_t>((scene.lightCount + 31) / 32, 1) * 4, 0,
               MemoryKind::Readback}));
-    s->frustumLights = need(createBuffer(
-        gpu, {"lighting.frustumLights", std::max<uint64_t>(scene.lightCount, 1) * 4, 0,
-              MemoryKind::Upload}));
+    s->frustumLights = need(
+        createBuffer(gpu, {"lighting.frustumLights", std::max<uint64_t>(scene.lightCount, 1) * 4, 0,
+                           MemoryKind::Upload}));
     s->tileCull = createComputePipeline(gpu, "lightTileCull", "lighting_tile_cull.comp.spv");
     return s;
 }
