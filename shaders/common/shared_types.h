@@ -127,10 +127,10 @@ struct GpuMaterial {
     float clearcoatFactor;
     float clearcoatRoughnessFactor;
     float clearcoatNormalScale;
-    float dielectricF0Scalar;   // ((ior - 1) / (ior + 1))^2 x specularFactor
-    vec3 specularColorFactor;   // tints the dielectric F0 (KHR_materials_specular)
-    float specularFactor;       // dielectric F90
-    vec3 sheenColorFactor;      // 0: no sheen
+    float dielectricF0Scalar; // ((ior - 1) / (ior + 1))^2 x specularFactor
+    vec3 specularColorFactor; // tints the dielectric F0 (KHR_materials_specular)
+    float specularFactor;     // dielectric F90
+    vec3 sheenColorFactor;    // 0: no sheen
     float sheenRoughnessFactor;
 };
 
@@ -237,8 +237,8 @@ struct FrameConstants {
     vec2 invViewportSize;
     uint frameIndex;
     uint visualize;
-    float shadingBias; // fractional MIP bias of the decoupled path
-    uint inspectPixel; // --inspect: x | y << 16 at the internal resolution, or INSPECT_OFF
+    float shadingBias;  // fractional MIP bias of the decoupled path
+    uint inspectPixel;  // --inspect: x | y << 16 at the internal resolution, or INSPECT_OFF
     uint64_t vertices;  // GpuVertex[]
     uint64_t indices;   // uint[]
     uint64_t meshes;    // GpuMesh[]
@@ -300,7 +300,8 @@ struct CullingFrame {
     uint pad0;
 };
 
-// Shader -> CPU message channel (shader asserts and prints). Written with atomics, read after the frame.
+// Shader -> CPU message channel (shader asserts and prints). Written with atomics, read after the
+// frame.
 #define SHADER_MESSAGE_CAPACITY 256u
 struct ShaderMessage {
     uint assertId;

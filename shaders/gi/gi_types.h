@@ -8,9 +8,9 @@
 namespace shadel::gpu {
 #endif
 
-#define GI_CASCADES 3u   // camera-centred cascades, each twice the cell size of the last
-#define GI_GRID 32u      // cells per side of every cascade
-#define GI_MAX_RSMS 3u   // the sun + up to two shadow-casting spots
+#define GI_CASCADES 3u // camera-centred cascades, each twice the cell size of the last
+#define GI_GRID 32u    // cells per side of every cascade
+#define GI_MAX_RSMS 3u // the sun + up to two shadow-casting spots
 // Injection adds fixed-point integers (no float atomics are required of the device): one unit
 // is 2^-20 of a radiant-intensity SH coefficient.
 #define GI_FIXED_SCALE 1048576.0
@@ -31,8 +31,8 @@ struct GpuGiBlocker {
 
 // One cascade as the apply reads it.
 struct GiCascade {
-    vec3 origin;      // world position of the min corner of cell (0, 0, 0)
-    float cellSize;   // metres per cell
+    vec3 origin;       // world position of the min corner of cell (0, 0, 0)
+    float cellSize;    // metres per cell
     uint64_t radiance; // vec4[3] per cell: propagated radiant intensity, SH (R, G, B)
     uint64_t geometry; // vec4 per cell: blocking potential, SH (geometry volume)
 };
