@@ -38,6 +38,10 @@ layout(buffer_reference, scalar) buffer Uint64Buffer { uint64_t v[]; };
 layout(buffer_reference, scalar) readonly buffer Vec2Buffer { vec2 v[]; };
 layout(buffer_reference, scalar) readonly buffer ShadelFrameRef { ShadelFrame s; };
 layout(buffer_reference, scalar) readonly buffer ShadelObjectBuffer { GpuShadelObject o[]; };
+// One object read in place: its fields are loaded where they are used. Copying the struct into
+// a local (`GpuShadelObject o = ...o[i]`) loaded all of it, per-MIP arrays included (indexed at
+// run time, so nothing was dead), in every pixel of marking and reconstruction.
+layout(buffer_reference, scalar) readonly buffer ShadelObjectRef { GpuShadelObject v; };
 layout(buffer_reference, scalar) buffer DrawBuffer { DrawIndexedCommand d[]; };
 layout(buffer_reference, scalar) buffer ShaderMessages {
     uint count;

@@ -343,6 +343,10 @@ struct GpuShadelObject {
     uvec4 rect[SHADEL_MAX_MIPS];       // x, y, w, h in blocks of the virtual sheet
 };
 
+// sizeof(GpuShadelObject) in the scalar layout: shaders address one object in place
+// (ShadelObjectRef); static_assert'ed on the C++ side.
+#define GPU_SHADEL_OBJECT_BYTES (28u + 20u * SHADEL_MAX_MIPS)
+
 // One rectangle of the sheet in use this frame (the clear and allocation passes walk these).
 struct GpuShadelRect {
     uvec4 rect; // x, y, w, h in blocks

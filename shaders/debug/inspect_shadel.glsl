@@ -6,7 +6,7 @@
 #include "shadel/resolve.glsl"
 #include "debug/inspect.glsl"
 
-void inspectShadels(FrameConstants f, ShadelFrame s, GpuShadelObject o, Reconstruction r,
+void inspectShadels(FrameConstants f, ShadelFrame s, ShadelObjectRef o, Reconstruction r,
                     vec2 shadelUv, vec2 texelDx, vec2 texelDy) {
     ShadelLevels l = shadelLevels(o, texelDx, texelDy, s.shadingBias, s.trilinearBand);
     shaderPrintF4(f, PRINT_SHADEL_LOD, vec4(r.lod, float(l.mip0), float(l.mip1), l.blend));

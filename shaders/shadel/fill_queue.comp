@@ -31,9 +31,9 @@ void main() {
     atomicAdd(counters.c.chunksAllocated, n);
     atomicAdd(counters.c.chunksPerMip[mip], n);
 
-    GpuShadelObject o = ShadelObjectBuffer(s.objects).o[entry.z];
-    bool copyable = s.reuse != 0u && ((o.reuseLevels >> mip) & 1u) != 0u &&
-                    (o.flags & SHADEL_OBJECT_NEAR_CHANGED_LIGHT) == 0u;
+    ShadelObjectRef o = shadelObject(s, entry.z);
+    bool copyable = s.reuse != 0u && ((o.v.reuseLevels >> mip) & 1u) != 0u &&
+                    (o.v.flags & SHADEL_OBJECT_NEAR_CHANGED_LIGHT) == 0u;
     uint64_t prevMask = copyable ? Uint64Buffer(s.prevOccupancy).v[block] : 0ul;
     uint prevBase = copyable ? UintBuffer(s.prevOffsetMap).v[block] : SHADEL_INVALID;
     uvec2 blockXy = uvec2(block % s.sheetBlocks, block / s.sheetBlocks);

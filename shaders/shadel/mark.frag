@@ -17,7 +17,7 @@ layout(location = 5) in vec2 inShadelUv;
 void main() {
     FrameConstants f = FrameConstantsRef(pc.frame).f;
     ShadelFrame s = ShadelFrameRef(f.shadel).s;
-    GpuShadelObject o = ShadelObjectBuffer(s.objects).o[inInstance];
-    vec2 texel = inShadelUv * vec2(o.mip0Size);
+    ShadelObjectRef o = shadelObject(s, inInstance);
+    vec2 texel = inShadelUv * vec2(o.v.mip0Size);
     markSample(s, o, inShadelUv, dFdx(texel), dFdy(texel));
 }

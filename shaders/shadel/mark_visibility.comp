@@ -22,7 +22,7 @@ void main() {
     ShadelFrame s = ShadelFrameRef(f.shadel).s;
     uvec2 current = uvec2(VISIBILITY_NONE);
     VisQuad q;
-    GpuShadelObject o;
+    ShadelObjectRef o;
     for (int i = 0; i < 4; ++i) {
         ivec2 pixel = origin + ivec2(i & 1, i >> 1);
         if (pixel.x >= int(pc.width) || pixel.y >= int(pc.height)) continue;
@@ -30,10 +30,10 @@ void main() {
         if (vis.x == VISIBILITY_NONE) continue;
         if (vis != current) {
             current = vis;
-            o = ShadelObjectBuffer(s.objects).o[vis.x];
-            if ((o.flags & SHADEL_OBJECT_DECOUPLED) == 0u) continue;
+            o = shadelObject(s, vis.x);
+            if ((o.v.flags & SHADEL_OBJECT_DECOUPLED) == 0u) continue;
             visQuadSetup(f, s, InstanceBuffer(f.instances).i[vis.x], vis.x, vis.y, origin, q);
-        } else if ((o.flags & SHADEL_OBJECT_DECOUPLED) == 0u) {
+        } else if ((o.v.flags & SHADEL_OBJECT_DECOUPLED) == 0u) {
             continue; // forward (hybrid) instance
         }
         VisShadel v = visShadelSample(q, o, i);

@@ -30,7 +30,7 @@ void markChunk(ShadelFrame s, uvec2 sheet) {
     if ((occupancy.v[block] & bit) == 0ul) atomicOr(occupancy.v[block], bit);
 }
 
-void markLevel(ShadelFrame s, GpuShadelObject o, uint mip, vec2 uv) {
+void markLevel(ShadelFrame s, ShadelObjectRef o, uint mip, vec2 uv) {
     ivec2 t0;
     vec2 w;
     bilinearFootprint(o, mip, uv, t0, w);
@@ -44,11 +44,11 @@ void markLevel(ShadelFrame s, GpuShadelObject o, uint mip, vec2 uv) {
 }
 
 // texelDx/Dy: screen derivatives of the sample's MIP-0 shadel coordinate (shadelUv * mip0Size).
-void markSample(ShadelFrame s, GpuShadelObject o, vec2 shadelUv, vec2 texelDx, vec2 texelDy) {
+void markSample(ShadelFrame s, ShadelObjectRef o, vec2 shadelUv, vec2 texelDx, vec2 texelDy) {
     ShadelLevels l = shadelLevels(o, texelDx, texelDy, s.shadingBias, s.trilinearBand);
     ShadelAniso a = shadelAniso(texelDx, texelDy);
     for (uint i = 0u; i < a.taps; ++i) { // the same taps reconstruction reads
-        vec2 uv = shadelTapUv(o.mip0Size, shadelUv, a, i);
+        vec2 uv = shadelTapUv(o.v.mip0Size, shadelUv, a, i);
         markLevel(s, o, l.mip0, uv);
         if (l.two) markLevel(s, o, l.mip1, uv);
     }

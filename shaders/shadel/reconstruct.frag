@@ -42,8 +42,8 @@ vec3 forwardShade(FrameConstants f) {
 void main() {
     FrameConstants f = FrameConstantsRef(pc.frame).f;
     ShadelFrame s = ShadelFrameRef(f.shadel).s;
-    GpuShadelObject o = ShadelObjectBuffer(s.objects).o[inInstance];
-    vec2 texel = inShadelUv * vec2(o.mip0Size);
+    ShadelObjectRef o = shadelObject(s, inInstance);
+    vec2 texel = inShadelUv * vec2(o.v.mip0Size);
     vec2 texelDx = dFdx(texel), texelDy = dFdy(texel);
     Reconstruction r = reconstructSample(s, o, inShadelUv, texelDx, texelDy, ivec2(gl_FragCoord.xy),
                                          reconstructionLayer(f, s));

@@ -50,7 +50,7 @@ shared uint sMagnified, sSampled, sMisses, sOverflow;
 void resolveQuad(FrameConstants f, ShadelFrame s, ivec2 origin, inout uvec4 counts) {
     uvec2 current = uvec2(VISIBILITY_NONE);
     VisQuad q;
-    GpuShadelObject o;
+    ShadelObjectRef o;
     GpuInstance inst;
     for (int i = 0; i < 4; ++i) {
         ivec2 pixel = origin + ivec2(i & 1, i >> 1);
@@ -61,13 +61,13 @@ void resolveQuad(FrameConstants f, ShadelFrame s, ivec2 origin, inout uvec4 coun
         if (vis.x != VISIBILITY_NONE) {
             if (vis != current) {
                 current = vis;
-                o = ShadelObjectBuffer(s.objects).o[vis.x];
-                if ((o.flags & SHADEL_OBJECT_DECOUPLED) != 0u) {
+                o = shadelObject(s, vis.x);
+                if ((o.v.flags & SHADEL_OBJECT_DECOUPLED) != 0u) {
                     inst = InstanceBuffer(f.instances).i[vis.x];
                     visQuadSetup(f, s, inst, vis.x, vis.y, origin, q);
                 }
             }
-            decoupled = (o.flags & SHADEL_OBJECT_DECOUPLED) != 0u;
+            decoupled = (o.v.flags & SHADEL_OBJECT_DECOUPLED) != 0u;
         }
         if (decoupled) {
             VisShadel v = visShadelSample(q, o, i);

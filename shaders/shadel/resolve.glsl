@@ -8,7 +8,7 @@
 #define SHADEL_RESOLVE_GLSL
 #include "shadel/shadel.glsl"
 
-vec3 sampleLevel(ShadelFrame s, GpuShadelObject o, uint mip, vec2 uv, uint layerSlot,
+vec3 sampleLevel(ShadelFrame s, ShadelObjectRef o, uint mip, vec2 uv, uint layerSlot,
                  inout uint missing, inout uint overflowed, out uint64_t firstMask) {
     ivec2 t0;
     vec2 w;
@@ -74,7 +74,7 @@ struct Reconstruction {
 // texelDx/Dy: screen derivatives of the MIP-0 shadel coordinate; pixel: for the sampled
 // statistics (one pixel of every 2x2). The caller counts (countReconstruction or its own sums).
 // layerSlot: the storage layer to read (the radiance layer, or another for --visualize layer:X).
-Reconstruction reconstructSample(ShadelFrame s, GpuShadelObject o, vec2 shadelUv, vec2 texelDx,
+Reconstruction reconstructSample(ShadelFrame s, ShadelObjectRef o, vec2 shadelUv, vec2 texelDx,
                                  vec2 texelDy, ivec2 pixel, uint layerSlot) {
     ShadelLevels l = shadelLevels(o, texelDx, texelDy, s.shadingBias, s.trilinearBand);
     Reconstruction r;
@@ -87,7 +87,7 @@ Reconstruction reconstructSample(ShadelFrame s, GpuShadelObject o, vec2 shadelUv
     ShadelAniso a = shadelAniso(texelDx, texelDy);
     r.color = vec3(0.0);
     for (uint i = 0u; i < a.taps; ++i) { // the same taps marking marked
-        vec2 uv = shadelTapUv(o.mip0Size, shadelUv, a, i);
+        vec2 uv = shadelTapUv(o.v.mip0Size, shadelUv, a, i);
         vec3 c = sampleLevel(s, o, l.mip0, uv, layerSlot, r.missing, r.overflowed, tapMask);
         if (i == 0u) r.mask0 = tapMask;
         if (l.two) c = mix(c, sampleLevel(s, o, l.mip1, uv, layerSlot, r.missing, r.overflowed, mask1), l.blend);
@@ -124,7 +124,7 @@ vec3 heat(float t) {
 }
 
 // The debug views (--visualize marking|mips|chunks) over the reconstructed colour.
-vec3 visualizeReconstruction(FrameConstants f, GpuShadelObject o, Reconstruction r, vec3 color,
+vec3 visualizeReconstruction(FrameConstants f, ShadelObjectRef o, Reconstruction r, vec3 color,
                              vec2 shadelUv, vec2 texelDx, vec2 texelDy) {
     if (f.visualize == VISUALIZE_MARKING) {
         // Seed colours: green = block with any chunk marked, blue = block fully marked.
@@ -133,7 +133,7 @@ vec3 visualizeReconstruction(FrameConstants f, GpuShadelObject o, Reconstruction
     } else if (f.visualize == VISUALIZE_MIPS) {
         color = heat(r.lod / 7.0);
     } else if (f.visualize == VISUALIZE_CHUNKS) {
-        vec2 scale = vec2(levelSize(o, r.mip0)) / (vec2(o.mip0Size) * float(SHADEL_CHUNK));
+        vec2 scale = vec2(levelSize(o, r.mip0)) / (vec2(o.v.mip0Size) * float(SHADEL_CHUNK));
         vec2 level = shadelUv * vec2(levelSize(o, r.mip0)) / float(SHADEL_CHUNK);
         vec2 edge = abs(fract(level) - 0.5);
         vec2 width = (abs(texelDx) + abs(texelDy)) * scale; // fwidth(level)

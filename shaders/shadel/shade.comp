@@ -30,8 +30,8 @@ uint triangleId(ShadelFrame s, uint offset) {
 // chunk must be shaded: reuse off, the object's level changed (reuseLevels, decided on the
 // CPU), or this chunk's turn to be refreshed (each chunk is reshaded once per refresh period,
 // at its own phase, so view-dependent terms never lag for long). Uniform over the workgroup.
-int carrySource(ShadelFrame s, GpuShadelObject o, GpuShadelWork work) {
-    if (s.reuse == 0u || ((o.reuseLevels >> work.mip) & 1u) == 0u) return -1;
+int carrySource(ShadelFrame s, ShadelObjectRef o, GpuShadelWork work) {
+    if (s.reuse == 0u || ((o.v.reuseLevels >> work.mip) & 1u) == 0u) return -1;
     if (shadelRefreshDue(s, o, work.chunk)) return -1;
     uvec2 sheet = uvec2(work.chunk & 0xFFFFu, work.chunk >> 16) * SHADEL_CHUNK;
     uint block = blockIndex(s, sheet);
@@ -55,14 +55,14 @@ shared bool chunkNearChangedLight;
 
 // Whether any shadel of the chunk lies within reach of a light that changed this frame (the
 // object's bounds do, or this is not called). Only positions are rebuilt. Call in uniform flow.
-bool chunkTouchesChangedLight(FrameConstants f, ShadelFrame s, GpuShadelObject o, GpuShadelWork work) {
+bool chunkTouchesChangedLight(FrameConstants f, ShadelFrame s, ShadelObjectRef o, GpuShadelWork work) {
     if (gl_LocalInvocationIndex == 0u) chunkNearChangedLight = false;
     barrier();
     uvec2 size = levelSize(o, work.mip);
     uvec2 shadel = uvec2(work.chunk & 0xFFFFu, work.chunk >> 16) * SHADEL_CHUNK +
-                   gl_LocalInvocationID.xy - o.rect[work.mip].xy * SHADEL_BLOCK;
+                   gl_LocalInvocationID.xy - o.v.rect[work.mip].xy * SHADEL_BLOCK;
     uint tri = all(lessThan(shadel, size))
-                   ? triangleId(s, o.idMapOffset[work.mip] + shadel.y * size.x + shadel.x)
+                   ? triangleId(s, o.v.idMapOffset[work.mip] + shadel.y * size.x + shadel.x)
                    : 0xFFFFu;
     if (tri != 0xFFFFu) {
         GpuInstance inst = InstanceBuffer(f.instances).i[work.object];
@@ -167,12 +167,12 @@ void main() {
     uint workIndex = gl_WorkGroupID.y * 32768u + gl_WorkGroupID.x;
     if (workIndex >= ShadelCountersRef(s.counters).c.shadeDispatch.w) return;
     GpuShadelWork work = ShadelWorkBuffer(s.queue).w[workIndex];
-    GpuShadelObject o = ShadelObjectBuffer(s.objects).o[work.object];
+    ShadelObjectRef o = shadelObject(s, work.object);
     uvec2 local = gl_LocalInvocationID.xy;
     ivec2 outTexel = storageTexel(s, work.slot, local);
     // Chunks of objects a changed light reaches come here even when reusable (the fill pass
     // cannot tell which of their shadels the light reaches): carry over those it does not.
-    int carrySlot = (o.flags & SHADEL_OBJECT_NEAR_CHANGED_LIGHT) != 0u ? carrySource(s, o, work) : -1;
+    int carrySlot = (o.v.flags & SHADEL_OBJECT_NEAR_CHANGED_LIGHT) != 0u ? carrySource(s, o, work) : -1;
     if (carrySlot >= 0 && chunkTouchesChangedLight(f, s, o, work)) carrySlot = -1;
     if (carrySlot >= 0) {
         carryOver(s, uint(carrySlot), outTexel);
@@ -181,11 +181,11 @@ void main() {
 
     uvec2 sheetShadel = uvec2(work.chunk & 0xFFFFu, work.chunk >> 16) * SHADEL_CHUNK + local;
     uvec2 size = levelSize(o, work.mip);
-    uvec2 shadel = sheetShadel - o.rect[work.mip].xy * SHADEL_BLOCK;
+    uvec2 shadel = sheetShadel - o.v.rect[work.mip].xy * SHADEL_BLOCK;
     // Shadels outside the level or in a gutter no filter reads have nothing to shade; they stay
     // in the workgroup until chunk light culling (barriers) is done.
     bool shading = all(lessThan(shadel, size));
-    uint tri = shading ? triangleId(s, o.idMapOffset[work.mip] + shadel.y * size.x + shadel.x) : 0xFFFFu;
+    uint tri = shading ? triangleId(s, o.v.idMapOffset[work.mip] + shadel.y * size.x + shadel.x) : 0xFFFFu;
     shading = shading && tri != 0xFFFFu;
     GpuInstance inst = InstanceBuffer(f.instances).i[work.object];
     GpuMesh mesh = MeshBuffer(f.meshes).m[inst.mesh];

@@ -20,6 +20,10 @@ layout(buffer_reference, scalar) readonly buffer Vec4Buffer { vec4 v[]; };
 // >= the width, so the MIP is never finer than the footprint's narrow side and the CPU's
 // per-object lower bound of the finest MIP (finestMipNeeded in decoupled.cpp, from the shortest
 // span a pixel can have) stays a lower bound.
+ShadelObjectRef shadelObject(ShadelFrame s, uint object) {
+    return ShadelObjectRef(s.objects + uint64_t(object) * GPU_SHADEL_OBJECT_BYTES);
+}
+
 const float SHADEL_MAX_ANISO = 1.5;
 
 struct ShadelAniso {
@@ -55,7 +59,7 @@ float shadelLod(vec2 texelDx, vec2 texelDy, float bias) {
     return log2(max(shadelAniso(texelDx, texelDy).footprint, 1e-8)) + bias;
 }
 
-uvec2 levelSize(GpuShadelObject o, uint mip) { return max(o.mip0Size >> mip, uvec2(1u)); }
+uvec2 levelSize(ShadelObjectRef o, uint mip) { return max(o.v.mip0Size >> mip, uvec2(1u)); }
 
 // The MIPs a sample reads and the weight of the second. Two MIPs are blended only inside a band
 // around the middle of each LOD interval ("brilinear", the seed's aside): near integer LODs one
@@ -69,12 +73,12 @@ struct ShadelLevels {
 };
 
 // texelDx/Dy: screen derivatives of the sample's MIP-0 shadel coordinate.
-ShadelLevels shadelLevels(GpuShadelObject o, vec2 texelDx, vec2 texelDy, float bias, float band) {
+ShadelLevels shadelLevels(ShadelObjectRef o, vec2 texelDx, vec2 texelDy, float bias, float band) {
     // The object has rects only from firstMip on (the CPU's lower bound of what it can need).
-    float lod = clamp(shadelLod(texelDx, texelDy, bias), float(o.firstMip), float(o.mipCount - 1u));
+    float lod = clamp(shadelLod(texelDx, texelDy, bias), float(o.v.firstMip), float(o.v.mipCount - 1u));
     ShadelLevels l;
     l.mip0 = uint(floor(lod));
-    l.mip1 = min(l.mip0 + 1u, o.mipCount - 1u);
+    l.mip1 = min(l.mip0 + 1u, o.v.mipCount - 1u);
     float f = lod - float(l.mip0);
     float t = band >= 1.0 ? f : clamp((f - 0.5 * (1.0 - band)) / max(band, 1e-6), 0.0, 1.0);
     if (t >= 1.0 && l.mip1 != l.mip0) { l.mip0 = l.mip1; t = 0.0; }
@@ -84,7 +88,7 @@ ShadelLevels shadelLevels(GpuShadelObject o, vec2 texelDx, vec2 texelDy, float b
 }
 
 // The 2x2 bilinear footprint at `mip` of the sample at shadel-UV `uv`: first texel + weights.
-void bilinearFootprint(GpuShadelObject o, uint mip, vec2 uv, out ivec2 texel0, out vec2 weight) {
+void bilinearFootprint(ShadelObjectRef o, uint mip, vec2 uv, out ivec2 texel0, out vec2 weight) {
     vec2 size = vec2(levelSize(o, mip));
     vec2 t = uv * size - 0.5;
     texel0 = ivec2(floor(t));
@@ -93,10 +97,10 @@ void bilinearFootprint(GpuShadelObject o, uint mip, vec2 uv, out ivec2 texel0, o
 
 // Sheet shadel coordinate of an object's level texel (clamped to the object's level rect so
 // border taps never leave the object).
-uvec2 sheetShadel(GpuShadelObject o, uint mip, ivec2 texel) {
+uvec2 sheetShadel(ShadelObjectRef o, uint mip, ivec2 texel) {
     uvec2 size = levelSize(o, mip);
     uvec2 t = uvec2(clamp(texel, ivec2(0), ivec2(size) - 1));
-    return o.rect[mip].xy * SHADEL_BLOCK + t;
+    return o.v.rect[mip].xy * SHADEL_BLOCK + t;
 }
 
 uint blockIndex(ShadelFrame s, uvec2 sheetShadel) {
@@ -117,8 +121,8 @@ uint chunkSlot(uint64_t mask, uint base, uint bit) {
 
 // Preserved layers: a carried-over chunk is still reshaded once per its object's refresh
 // period, each chunk at its own phase, so view-dependent terms never lag for long.
-bool shadelRefreshDue(ShadelFrame s, GpuShadelObject o, uint chunk) {
-    return (((chunk * 2654435761u) >> 20) + s.frameNumber) % max(o.refreshPeriod, 1u) == 0u;
+bool shadelRefreshDue(ShadelFrame s, ShadelObjectRef o, uint chunk) {
+    return (((chunk * 2654435761u) >> 20) + s.frameNumber) % max(o.v.refreshPeriod, 1u) == 0u;
 }
 
 ivec2 storageTexel(ShadelFrame s, uint slot, uvec2 inChunk) {

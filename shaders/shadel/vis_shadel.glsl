@@ -33,7 +33,7 @@ struct VisShadel {
 };
 
 // Pixel `i` of the quad (x = i & 1, y = i >> 1).
-VisShadel visShadelSample(VisQuad q, GpuShadelObject o, int i) {
+VisShadel visShadelSample(VisQuad q, ShadelObjectRef o, int i) {
     int row = i >> 1, col = i & 1;
     VisShadel v;
     v.bary.center = q.bary[i];
@@ -41,7 +41,7 @@ VisShadel visShadelSample(VisQuad q, GpuShadelObject o, int i) {
     precise vec3 bdy = q.bary[2 + col] - q.bary[col];
     v.bary.dx = bdx;
     v.bary.dy = bdy;
-    vec2 size = vec2(o.mip0Size);
+    vec2 size = vec2(o.v.mip0Size);
     v.shadelUv = visInterpolate(v.bary.center, q.uv0, q.uv1, q.uv2);
     precise vec2 dx = visInterpolate(bdx, q.uv0, q.uv1, q.uv2) * size;
     precise vec2 dy = visInterpolate(bdy, q.uv0, q.uv1, q.uv2) * size;

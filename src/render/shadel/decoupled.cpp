@@ -18,6 +18,9 @@
 
 namespace shadel {
 
+// Shaders address objects in place with this stride (ShadelObjectRef in bindless.glsl).
+static_assert(sizeof(gpu::GpuShadelObject) == GPU_SHADEL_OBJECT_BYTES);
+
 namespace {
 
 // The virtual sheet is split into one column of blocks per MIP level; finer levels need more
