@@ -1,4 +1,5 @@
 #include "gpu_test_env.h"
+#include <unistd.h>
 
 #include <cmath>
 #include <filesystem>
@@ -73,6 +74,12 @@ double meanFrameDelta(const RenderRun& run) {
             for (int c = 0; c < 3; ++c, ++n) sum += std::abs(double(a[i + c]) - double(b[i + c]));
     }
     return sum / double(std::max<size_t>(n, 1));
+}
+
+std::string tempPath(const std::string& name) {
+    return (std::filesystem::temp_directory_path() /
+            ("shadel-test-" + std::to_string(getpid()) + "-" + name))
+        .string();
 }
 
 } // namespace shadel::test

@@ -19,6 +19,10 @@ double psnr(const std::vector<uint8_t>& a, const std::vector<uint8_t>& b);
 // Options for rendering `scene` in `mode` at w x h (everything else default).
 RenderOptions renderOptions(const std::string& scene, RenderMode mode, uint32_t w, uint32_t h);
 
+// A path in the temp directory private to this test process (`name` prefixed with the pid), so
+// two test runs on one machine never read each other's files.
+std::string tempPath(const std::string& name);
+
 // Flicker: mean absolute difference between consecutive frames, over all colour channels.
 double meanFrameDelta(const RenderRun& run);
 

@@ -9,6 +9,11 @@
 #include <fstream>
 #include <sstream>
 #include <sys/wait.h>
+#include <unistd.h>
+
+#include "gpu_test_env.h"
+
+using shadel::test::tempPath;
 
 namespace {
 
@@ -29,11 +34,15 @@ std::string readText(const std::string& path) {
     return ss.str();
 }
 
+// Where a command's streams go (private to this test process).
+std::string streamFile(const char* name) {
+    return tempPath(std::string("cli_") + name + ".txt");
+}
+
 // Runs `env` (e.g. "XDG_CACHE_HOME=") shadel `args`, keeping both streams.
 Output runWithEnv(const std::string& env, const std::string& args) {
-    auto tmp = std::filesystem::temp_directory_path();
-    std::string outFile = (tmp / "shadel_cli_stdout.txt").string();
-    std::string errFile = (tmp / "shadel_cli_stderr.txt").string();
+    std::string outFile = streamFile("stdout");
+    std::string errFile = streamFile("stderr");
     std::string cmd = "env " + env + " timeout 120 " + SHADEL_BINARY + " " + args + " >" + outFile +
                       " 2>" + errFile;
     int status = std::system(cmd.c_str());
@@ -41,12 +50,13 @@ Output runWithEnv(const std::string& env, const std::string& args) {
     o.exitCode = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
     o.stdoutText = readText(outFile);
     o.stderrText = readText(errFile);
+    std::filesystem::remove(outFile);
+    std::filesystem::remove(errFile);
     return o;
 }
 
 Result run(const std::string& args) {
-    std::string errFile =
-        (std::filesystem::temp_directory_path() / "shadel_cli_stderr.txt").string();
+    std::string errFile = streamFile("stderr");
     std::string cmd =
         std::string("timeout 120 ") + SHADEL_BINARY + " " + args + " >/dev/null 2>" + errFile;
     int status = std::system(cmd.c_str());
@@ -56,6 +66,8 @@ Result run(const std::string& args) {
     std::stringstream ss;
     ss << in.rdbuf();
     r.stderrText = ss.str();
+    in.close();
+    std::filesystem::remove(errFile);
     return r;
 }
 
@@ -103,7 +115,7 @@ TEST(Cli, BadFlagsAndMissingFilesExitWith2) {
 }
 
 TEST(Cli, RenderWritesPngAndStatsJson) {
-    auto dir = std::filesystem::temp_directory_path() / "shadel_cli_out";
+    std::filesystem::path dir = tempPath("cli_out");
     std::filesystem::remove_all(dir);
     std::filesystem::create_directories(dir);
     Result r = run("render --size 48x32 --frames 2 --out " + (dir / "frames/").string() +
@@ -131,9 +143,8 @@ size_t lineCount(const std::string& text) {
 // A scratch folder per test, removed afterwards.
 struct CliTempDir {
     CliTempDir() {
-        path = std::filesystem::temp_directory_path() /
-               ("shadel_cli_" +
-                std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()));
+        path = tempPath(
+            "cli_" + std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()));
         std::filesystem::remove_all(path);
         std::filesystem::create_directories(path);
     }

@@ -105,7 +105,7 @@ TEST(Gi, SnappedCascadesSwimAtMostHalfAsMuchUnderOrbit) {
 }
 
 TEST(Gi, BadFlagsAreOneLineAndExitCode2) {
-    std::string err = (std::filesystem::temp_directory_path() / "shadel_gi_stderr.txt").string();
+    std::string err = tempPath("gi_stderr.txt");
     for (const std::string args :
          {"render --size 16x16 --gi radiosity", "render --size 16x16 --gi-snap maybe",
           "render --size 16x16 --scene builtin:cornell --gi lpv --gi-iterations 65",

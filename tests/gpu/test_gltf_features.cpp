@@ -28,7 +28,7 @@ double coverage(const RenderRun& run, const RenderOptions& o) {
 
 // A scratch folder per test.
 fs::path scratch(const std::string& name) {
-    fs::path dir = fs::temp_directory_path() / ("shadel_gltf_features_" + name);
+    fs::path dir = tempPath("gltf_features_" + name);
     fs::remove_all(dir);
     fs::create_directories(dir);
     return dir;
@@ -67,7 +67,7 @@ std::string withoutExtension(const std::string& model, const std::string& extens
 }
 
 int runShadel(const std::string& args, std::string* err = nullptr) {
-    fs::path errFile = fs::temp_directory_path() / "shadel_gltf_features_stderr.txt";
+    fs::path errFile = tempPath("gltf_features_stderr.txt");
     std::string cmd = std::string("timeout 120 ") + SHADEL_BINARY + " " + args + " >/dev/null 2>" +
                       errFile.string();
     int status = std::system(cmd.c_str());

@@ -188,7 +188,7 @@ TEST(Lighting, BadLightingFlagsAreOneLineErrors) {
     }
     EXPECT_EQ(parseVisualize("light-count"), Visualize::LightCount);
     EXPECT_EQ(parseVisualize("blockers"), Visualize::Blockers);
-    std::string err = (std::filesystem::temp_directory_path() / "shadel-lighting-err.txt").string();
+    std::string err = tempPath("lighting_err.txt");
     std::string cmd =
         std::string("timeout 120 ") + SHADEL_BINARY +
         " render --scene builtin:blockers --size 32x32 --blockers maybe >/dev/null 2>" + err;

@@ -37,8 +37,7 @@ const nlohmann::json& view(const RenderRun& run, const char* name) {
 }
 
 int runShadel(const std::string& args, std::string& err) {
-    std::string errFile =
-        (std::filesystem::temp_directory_path() / "shadel_world_stderr.txt").string();
+    std::string errFile = tempPath("world_stderr.txt");
     std::string cmd =
         std::string("timeout 120 ") + SHADEL_BINARY + " " + args + " >/dev/null 2>" + errFile;
     int status = std::system(cmd.c_str());
