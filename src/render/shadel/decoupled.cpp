@@ -378,12 +378,23 @@ static LightReach reachOf(const std::vector<glm::vec4>& spheres, glm::vec3 bmin,
 // How many frames a carried-over chunk of this object may go unshaded. Specular and Fresnel
 // follow the view direction; seen from the object, the camera's last step turned it by about
 // step / distance radians. A specular lobe is about roughness^2 radians wide, so the view may
-// drift by about that much before the carried shading visibly lags (at most --reuse-refresh
-// frames, also when the camera stands still). Roughness textures only lower the factor's
-// roughness, so glossier texels than the factor can lag somewhat more.
+// drift by about that much before the carried specular visibly lags (at most --reuse-refresh
+// frames, also when the camera stands still). Only the specular part lags, and a dielectric
+// reflects about F0 = 4% of the light specularly (metals all of it): the drift a lag of the whole
+// lobe's width costs is scaled by that share (doubled for Fresnel's rise towards grazing
+// angles), so a rough dielectric is carried over far longer than a polished metal. Roughness
+// textures only lower the factor's roughness, so glossier texels than the factor can lag
+// somewhat more.
+// Cap of the specular-share gain (below). builtin:default 320x180, 24-frame orbit, reuse on vs
+// off: gain 1 (no share) reused 55.2% of the chunks, worst frame 51.0 dB; 2: 67.3%, 46.2 dB;
+// 3: 70.8%, 45.5 dB; 4: 71.7%, 43.5 dB.
+constexpr float SPECULAR_SHARE_MAX_GAIN = 3.0f;
+
 static uint32_t refreshPeriodFor(const DecoupledState& d, const CameraView& camera, glm::vec3 bmin,
-                                 glm::vec3 bmax, float roughness) {
-    float maxViewDrift = std::clamp(1.0f * roughness * roughness, 0.01f, 0.4f);
+                                 glm::vec3 bmax, float roughness, float metallic) {
+    float lobeWidth = std::clamp(roughness * roughness, 0.01f, 0.4f);
+    float specularShare = glm::mix(2.0f * 0.04f, 1.0f, std::clamp(metallic, 0.0f, 1.0f));
+    float maxViewDrift = lobeWidth * std::min(1.0f / specularShare, SPECULAR_SHARE_MAX_GAIN);
     float step = glm::length(camera.position - d.lastCameraPosition);
     if (d.frameNumber == 0 || step <= 0.0f) return d.refreshPeriod;
     glm::vec3 nearest = glm::clamp(camera.position, bmin, bmax);
@@ -511,10 +522,11 @@ void prepareDecoupledFrame(Renderer& r, const GpuScene& scene, const CameraView&
         bool inputsUnchanged = d.reuse && wasDecoupled && reach != LightReach::Everything;
         for (uint32_t k = o.firstMip; k < mesh.mipCount && inputsUnchanged; ++k)
             if (o.levelSince[k] < d.frameNumber) g.reuseLevels |= 1u << k;
-        float roughness = inst.material < scene.materialInfo.size()
-                              ? scene.materialInfo[inst.material].roughnessFactor
-                              : 1.0f;
-        g.refreshPeriod = refreshPeriodFor(d, camera, inst.worldMin, inst.worldMax, roughness);
+        bool known = inst.material < scene.materialInfo.size();
+        float roughness = known ? scene.materialInfo[inst.material].roughnessFactor : 1.0f;
+        float metallic = known ? scene.materialInfo[inst.material].metallicFactor : 1.0f;
+        g.refreshPeriod =
+            refreshPeriodFor(d, camera, inst.worldMin, inst.worldMax, roughness, metallic);
         d.objectsReusable += g.reuseLevels != 0;
         d.firstMipHistogram[o.firstMip]++;
         g.mip0Size = mesh.mip0Size;
