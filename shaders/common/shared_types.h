@@ -237,19 +237,20 @@ struct FrameConstants {
     vec2 invViewportSize;
     uint frameIndex;
     uint visualize;
-    float shadingBias;  // fractional MIP bias of the decoupled path
-    uint inspectPixel;  // --inspect: x | y << 16 at the internal resolution, or INSPECT_OFF
-    uint64_t vertices;  // GpuVertex[]
-    uint64_t indices;   // uint[]
-    uint64_t meshes;    // GpuMesh[]
-    uint64_t instances; // GpuInstance[]
-    uint64_t materials; // GpuMaterial[]
-    uint64_t lights;    // GpuLight[]
-    uint64_t messages;  // ShaderMessages (shader asserts)
-    uint64_t shadel;    // ShadelFrame (decoupled path), 0 when forward
-    uint64_t lighting;  // LightingFrame (render/lighting), 0 when absent
-    uint64_t gi;        // GiFrame (render/gi, shaders/gi/gi_types.h), 0 when GI is off
-    uint64_t culling;   // CullingFrame (render/culling): LODs, occlusion, per-view counts
+    float shadingBias;   // fractional MIP bias of the decoupled path
+    uint inspectPixel;   // --inspect: x | y << 16 at the internal resolution, or INSPECT_OFF
+    uint64_t vertices;   // GpuVertex[]
+    uint64_t indices;    // uint[]
+    uint64_t meshes;     // GpuMesh[]
+    uint64_t instances;  // GpuInstance[]
+    uint64_t materials;  // GpuMaterial[]
+    uint64_t lights;     // GpuLight[]
+    uint64_t messages;   // ShaderMessages (shader asserts)
+    uint64_t shadel;     // ShadelFrame (decoupled path), 0 when forward
+    uint64_t lighting;   // LightingFrame (render/lighting), 0 when absent
+    uint64_t gi;         // GiFrame (render/gi, shaders/gi/gi_types.h), 0 when GI is off
+    uint64_t culling;    // CullingFrame (render/culling): LODs, occlusion, per-view counts
+    uint64_t debugLines; // GpuDebugLines (render/debug/debug_lines.h), 0 when --debug-lines is off
 };
 
 // ---- GPU-driven world (render/culling) ------------------------------------------------------
@@ -341,6 +342,29 @@ struct GpuShadelObject {
     uint refreshPeriod;
     uint idMapOffset[SHADEL_MAX_MIPS]; // in 16-bit units into ShadelFrame::idMaps
     uvec4 rect[SHADEL_MAX_MIPS];       // x, y, w, h in blocks of the virtual sheet
+};
+
+// 3-D debug lines (render/debug/debug_lines.h, shaders/debug/debug_lines.glsl): shaders append
+// world-space segments, drawn over the frame before tonemapping (--debug-lines KIND,...).
+#define DEBUG_LINES_LIGHTS 1u   // light ranges (spheres), spot cones, tube segments
+#define DEBUG_LINES_BLOCKERS 2u // blocker rectangles, their portals, their shadow frusta per light
+#define DEBUG_LINES_CHUNKS 4u   // world boxes of the shadel chunks shaded this frame
+struct GpuDebugLine {
+    vec3 a;
+    uint colorA; // RGBA8 (packUnorm4x8)
+    vec3 b;
+    uint colorB;
+};
+// Header of the line buffer; GpuDebugLine[capacity] follow it.
+struct GpuDebugLines {
+    uint vertexCount; // VkDrawIndirectCommand, written from `count` before the draw
+    uint instanceCount;
+    uint firstVertex;
+    uint firstInstance;
+    uint count; // segments appended this frame (beyond capacity: counted, dropped)
+    uint capacity;
+    uint mask; // DEBUG_LINES_* kinds asked for
+    uint pad;
 };
 
 // sizeof(GpuShadelObject) in the scalar layout: shaders address one object in place

@@ -108,14 +108,7 @@ uint lightBlockerMask(LightingFrame lf, GpuLight light, vec3 corners[8], vec3 bo
     return mask;
 }
 
-// Order-preserving float <-> uint (for atomicMin/Max on signed floats in shared memory).
-uint orderedFloatBits(float x) {
-    uint b = floatBitsToUint(x);
-    return (b & 0x80000000u) != 0u ? ~b : b | 0x80000000u;
-}
-float orderedBitsFloat(uint b) {
-    return uintBitsToFloat((b & 0x80000000u) != 0u ? b & 0x7FFFFFFFu : ~b);
-}
+#include "common/ordered_float.glsl"
 
 #ifdef LIGHT_CULL_ORDERED_APPEND
 // Compute only: appends the `keep` invocations' items in invocation order after the

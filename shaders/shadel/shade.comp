@@ -11,6 +11,8 @@
 #include "lighting/light_debug.glsl"
 #include "common/shadel_bary.h"
 #include "shadel/prefilter.glsl"
+#define DEBUG_LINES_WORKGROUP_BOX
+#include "debug/debug_lines.glsl"
 
 layout(local_size_x = 8, local_size_y = 8) in;
 layout(push_constant, scalar) uniform Push { uint64_t frame; } pc;
@@ -217,6 +219,9 @@ void main() {
     si.uvDy = uvDy;
     if (f.lighting != 0ul && LightingFrameRef(f.lighting).l.tiled != 0u)
         cullChunkLights(f, shading, si.position);
+    // --debug-lines chunks: this chunk's world box, coloured by MIP (uniform over the workgroup).
+    if (debugLinesOn(f, DEBUG_LINES_CHUNKS))
+        debugWorkgroupBox(f, shading, si.position, debugLevelColour(work.mip));
     if (!shading) {
         storeLayers(s, outTexel, vec4(0.0), vec4(0.0));
         return;

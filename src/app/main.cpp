@@ -18,6 +18,7 @@
 #include "bake/cache_eviction.h"
 #include "core/error.h"
 #include "core/log.h"
+#include "render/debug/debug_lines.h"
 #include "scene/load.h"
 
 using namespace shadel;
@@ -237,6 +238,13 @@ int main(int argc, char** argv) {
         ->add_option("--occlusion", occlusion,
                      "on | off: two-phase hierarchical-Z occlusion culling of instances")
         ->capture_default_str();
+    std::string debugLines = "none";
+    render
+        ->add_option("--debug-lines", debugLines,
+                     "none | KIND[,KIND...]: 3-D lines drawn over the frame, emitted by shaders: "
+                     "lights (ranges, cones), blockers (rectangles, portals, shadow frusta), "
+                     "chunks (world boxes of the shadel chunks shaded)")
+        ->capture_default_str();
     std::string captures;
     render->add_option("--capture", captures,
                        "NAME[,NAME...]: write named resources of the last frame (EXR for HDR "
@@ -426,6 +434,7 @@ int main(int argc, char** argv) {
                 throw InputError("--instances 0: expected 1..1000000");
             ro.lod = parseOnOff("--lod", lod);
             ro.occlusion = parseOnOff("--occlusion", occlusion);
+            ro.debugLines = parseDebugLines(debugLines);
             if (!captures.empty()) ro.captures = parseCaptureNames(captures);
             if (!inspect.empty()) parseInspect(inspect, ro.inspectX, ro.inspectY);
             RenderRun run = runRender(g.gpu, ro);

@@ -261,6 +261,8 @@ RenderRun runRender(Gpu& gpu, const RenderOptions& o) {
     settings.giBlockers = o.giBlockers;
     settings.lod = o.lod;
     settings.occlusion = o.occlusion;
+    settings.debugLines = o.debugLines;
+    settings.debugLineCapacity = o.debugLineCapacity;
     settings.timing = o.timing ? *o.timing : defaultTimingMode(gpu);
     Renderer renderer;
     RenderRun run;
@@ -370,6 +372,7 @@ RenderRun runRender(Gpu& gpu, const RenderOptions& o) {
                        {"pools", mem.pools},
                        {"failed_allocations", gpu.failedAllocations}};
     cullingStats(renderer, s);
+    debugLinesStats(renderer, s);
     if (renderer.decoupled) {
         decoupledStats(renderer, s);
         s["shadels_per_metre"] = density; // 0: view-driven (see the density fields)

@@ -121,6 +121,7 @@ void initRenderer(Renderer& r, Gpu& gpu, const RenderSettings& settings, const G
     r.lightCulling = createLightCulling(r, scene);
     if (settings.gi == GiMode::Lpv) r.gi = createGi(r, scene);
     r.culling = createCulling(r, scene);
+    r.debugLines = createDebugLines(r);
 }
 
 void destroyRenderer(Renderer& r) {
@@ -128,6 +129,7 @@ void destroyRenderer(Renderer& r) {
     Gpu& gpu = *r.gpu;
     vkDeviceWaitIdle(gpu.device.device);
     destroyLightCulling(r, r.lightCulling);
+    destroyDebugLines(r, r.debugLines);
     if (r.gi) destroyGi(r, r.gi);
     r.captures = {}; // its sources refer to what is destroyed below
     if (r.visibility) destroyVisibility(r, r.visibility);
@@ -250,12 +252,15 @@ FrameResult renderFrame(Renderer& r, const GpuScene& scene, const CameraView& ca
     if (r.decoupled) prepareDecoupledFrame(r, scene, camera, constants);
     prepareTransparentDraws(r, scene, camera);
     prepareCullingFrame(r, scene, constants);
+    constants.debugLines = debugLinesAddress(r);
     std::memcpy(mapped(gpu, r.frameConstants), &constants, sizeof(constants));
     uint64_t frame = address(gpu, r.frameConstants);
     double prepareMs = msSince(cpuStart);
 
     FrameRecorder& rec = r.recorder;
     beginFrame(rec);
+    if (r.debugLines) // --debug-lines: any later pass may append segments
+        pass(rec, "debugLinesClear", [&](VkCommandBuffer cmd) { recordDebugLinesClear(r, cmd); });
     pass(rec, "instanceCull",
          [&](VkCommandBuffer cmd) { recordInstanceCull(r, cmd, frame, scene); });
     pass(rec, "shadowMap", [&](VkCommandBuffer cmd) { recordShadowMap(r, cmd, frame); });
@@ -280,6 +285,7 @@ FrameResult renderFrame(Renderer& r, const GpuScene& scene, const CameraView& ca
         recordDecoupledPasses(r, rec, frame, scene);
     }
     recordTransparencyPasses(r, rec, frame); // blended materials, after every opaque surface
+    if (r.debugLines) recordDebugLinePasses(r, rec, frame, scene, constants.lightCount);
     pass(rec, "tonemap", [&](VkCommandBuffer cmd) { recordTonemap(r, cmd, frame); });
     if (r.decoupled) recordDecoupledPostPasses(r, rec, frame);
     endFrame(rec);

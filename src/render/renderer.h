@@ -8,6 +8,7 @@
 #include "render/camera.h"
 #include "render/culling/culling.h"
 #include "render/debug/capture.h"
+#include "render/debug/debug_lines.h"
 #include "render/gi/lpv.h"
 #include "render/gpu_scene.h"
 #include "render/lighting/light_culling.h"
@@ -86,6 +87,9 @@ struct RenderSettings {
     bool lod = false;                  // GPU LOD selection by projected error (render/culling)
     float lodErrorPixels = 0.5f;       // the coarsest LOD whose error projects below this is drawn
     bool occlusion = false; // two-phase hierarchical-Z occlusion culling (render/culling)
+    uint32_t debugLines =
+        0; // --debug-lines: DEBUG_LINES_* kinds drawn (render/debug/debug_lines.h)
+    uint32_t debugLineCapacity = 256 * 1024; // segments the line buffer holds (8 MiB)
 };
 
 struct FrameResult {
@@ -149,6 +153,7 @@ struct Renderer {
     OitStatePtr oit;                   // scenes with blended materials (render/oit)
     LightCullingStatePtr lightCulling; // light lists (render/lighting/light_culling.h)
     GiStatePtr gi;                     // --gi lpv
+    DebugLinesStatePtr debugLines;     // --debug-lines (render/debug/debug_lines.h)
     CullingStatePtr culling;           // LODs, occlusion, per-view counts (render/culling)
     CaptureRegistry captures;          // --capture: named resources of the frame (render/debug)
     std::chrono::steady_clock::time_point createdAt = std::chrono::steady_clock::now();

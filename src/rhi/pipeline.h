@@ -21,6 +21,7 @@ struct GraphicsPipelineDesc {
     bool depthWrite = true;
     VkCompareOp depthCompare = VK_COMPARE_OP_GREATER_OR_EQUAL; // reversed Z
     VkCullModeFlags cullMode = VK_CULL_MODE_BACK_BIT;
+    VkPrimitiveTopology topology = VK_PRIMITIVE_TOPOLOGY_TRIANGLE_LIST;
     bool depthClamp = false;
     bool depthBias = false;
     enum class Blend { None, Alpha, Additive } blend = Blend::None;
