@@ -11,6 +11,7 @@
 #include "lighting/light_debug.glsl"
 #include "common/shadel_bary.h"
 #include "shadel/prefilter.glsl"
+#include "raytracing/rt_apply.glsl"
 
 layout(local_size_x = 8, local_size_y = 8) in;
 layout(push_constant, scalar) uniform Push { uint64_t frame; } pc;
@@ -226,6 +227,7 @@ void main() {
                                      cross(v1.position - v0.position, v2.position - v0.position));
     si.frontFacing = dot(geometricNormal, f.cameraPosition - si.position) >= 0.0;
     GpuMaterial mat = MaterialBuffer(f.materials).m[inst.material];
+    useRayTracedShadelTerms(f, work.object, shadelCenterUv(shadel, size)); // --rt-* (RT cache)
     // The shadel's whole footprint, not its centre (prefilter.glsl; --material-samples caps it).
     vec4 material;
     vec3 color = prefilteredShade(f, mat, si, shadelCenterUv(shadel, size), vec2(1.0) / vec2(size),

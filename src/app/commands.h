@@ -60,6 +60,7 @@ struct RenderOptions {
     uint32_t instances = 0; // builtin:many (--instances); 0 = the scene's default
     bool lod = false;       // --lod: GPU LOD selection (render/culling)
     bool occlusion = false; // --occlusion: two-phase hierarchical-Z culling (render/culling)
+    RtSettings rt;          // --rt-*, --rays-per-shadel, --blas-pool-*: render/raytracing
     // --capture NAME[,NAME...] (or {"list"}) and --capture-dir: the last frame's named
     // resources (app/capture_output.h); files go to the dir or next to --out.
     std::vector<std::string> captures;

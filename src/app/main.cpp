@@ -13,6 +13,7 @@
 #include "app/cli_help.h"
 #include "app/cli_validate.h"
 #include "app/commands.h"
+#include "app/rt_flags.h"
 #include "app/viewer/viewer.h"
 #include "bake/bake.h"
 #include "bake/cache_eviction.h"
@@ -237,6 +238,8 @@ int main(int argc, char** argv) {
         ->add_option("--occlusion", occlusion,
                      "on | off: two-phase hierarchical-Z occlusion culling of instances")
         ->capture_default_str();
+    RtFlags rtFlags; // ray tracing (render/raytracing)
+    addRayTracingFlags(*render, rtFlags);
     std::string captures;
     render->add_option("--capture", captures,
                        "NAME[,NAME...]: write named resources of the last frame (EXR for HDR "
@@ -426,6 +429,7 @@ int main(int argc, char** argv) {
                 throw InputError("--instances 0: expected 1..1000000");
             ro.lod = parseOnOff("--lod", lod);
             ro.occlusion = parseOnOff("--occlusion", occlusion);
+            ro.rt = parseRayTracingFlags(rtFlags);
             if (!captures.empty()) ro.captures = parseCaptureNames(captures);
             if (!inspect.empty()) parseInspect(inspect, ro.inspectX, ro.inspectY);
             RenderRun run = runRender(g.gpu, ro);

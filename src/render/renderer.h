@@ -11,6 +11,8 @@
 #include "render/gi/lpv.h"
 #include "render/gpu_scene.h"
 #include "render/lighting/light_culling.h"
+#include "render/raytracing/ray_tracing.h"
+#include "render/raytracing/rt_settings.h"
 #include "render/shadel/visibility.h"
 #include "rhi/frame.h"
 #include "rhi/pipeline.h"
@@ -36,6 +38,7 @@ enum class Visualize : uint32_t {
     LightCount = VISUALIZE_LIGHT_COUNT, // lights per tile (forward) or chunk (shadel)
     Blockers = VISUALIZE_BLOCKERS,      // tiles / chunks with per-pixel blocker checks
     Gi = 6,                             // --visualize gi: the LPV's indirect light only
+    RtAo = VISUALIZE_RT_AO,             // --visualize rt-ao: the ray-traced AO only (--rt-ao on)
 };
 
 // --light-culling: per-tile (forward) and per-chunk (shadel) light lists, or every light for
@@ -86,6 +89,7 @@ struct RenderSettings {
     bool lod = false;                  // GPU LOD selection by projected error (render/culling)
     float lodErrorPixels = 0.5f;       // the coarsest LOD whose error projects below this is drawn
     bool occlusion = false; // two-phase hierarchical-Z occlusion culling (render/culling)
+    RtSettings rt;          // --rt-*: ray-traced shadows, AO, GI (render/raytracing)
 };
 
 struct FrameResult {
@@ -150,6 +154,7 @@ struct Renderer {
     LightCullingStatePtr lightCulling; // light lists (render/lighting/light_culling.h)
     GiStatePtr gi;                     // --gi lpv
     CullingStatePtr culling;           // LODs, occlusion, per-view counts (render/culling)
+    RayTracingStatePtr rt;             // BLASes, TLAS, traced terms (--rt-*, render/raytracing)
     CaptureRegistry captures;          // --capture: named resources of the frame (render/debug)
     std::chrono::steady_clock::time_point createdAt = std::chrono::steady_clock::now();
 };
