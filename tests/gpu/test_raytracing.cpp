@@ -110,7 +110,7 @@ TEST(RayTracing, PoolLimitFallsBackToTheLeastDetailedBlas) {
     EXPECT_EQ(s["tlas_instances"].get<uint64_t>(), full.stats["tlas_instances"].get<uint64_t>());
     // Nothing corrupted: coarser occluders move shadow edges a little, no more.
     double db = psnr(limited.frames.back().rgba, full.frames.back().rgba);
-    std::printf("pool limit %u MiB: %llu fallbacks, %.2f dB against unlimited\n",
+    std::printf("%u pool(s) of 1 MiB: %llu fallbacks, %.2f dB against unlimited\n",
                 o.rt.blasPoolLimit, (unsigned long long)s["blas_fallbacks"].get<uint64_t>(), db);
     EXPECT_GE(db, 25.0);
 }
@@ -166,9 +166,13 @@ TEST(RayTracing, FlagsWithoutRayQueryAreOneClearError) {
 
 namespace {
 
-RenderOptions shadelAoOptions(uint32_t frames, uint32_t raysPerShadel) {
-    RenderOptions o = rtOptions();
-    o.mode = RenderMode::Decoupled;
+// The shadel path's AO alone (--visualize rt-ao) at 96x54: its cache holds every visible
+// instance's whole shadel space, several texels per pixel at this size.
+RenderOptions shadelAoOptions(uint32_t frames, uint32_t raysPerShadel, uint32_t mipOffset) {
+    RenderOptions o = renderOptions("builtin:default", RenderMode::Decoupled, 96, 54);
+    o.progress = false;
+    o.rt.aoRadius = 4.0f;
+    o.rt.shadelMipOffset = mipOffset;
     o.frames = frames;
     o.rt.ao = true;
     o.rt.raysPerShadel = raysPerShadel;
@@ -181,9 +185,9 @@ RenderOptions shadelAoOptions(uint32_t frames, uint32_t raysPerShadel) {
 
 TEST(RayTracing, ShadelAoConvergesToTheHighRayReference) {
     if (!sharedGpu().device.optional.rayQuery) GTEST_SKIP() << "no ray query on this device";
-    RenderRun reference = renderChecked(shadelAoOptions(1, 256));
-    RenderRun one = renderChecked(shadelAoOptions(1, 1));
-    RenderRun sixteen = renderChecked(shadelAoOptions(16, 1));
+    RenderRun reference = renderChecked(shadelAoOptions(1, 256, 4));
+    RenderRun one = renderChecked(shadelAoOptions(1, 1, 4));
+    RenderRun sixteen = renderChecked(shadelAoOptions(16, 1, 4));
     double db1 = psnr(one.frames.back().rgba, reference.frames.back().rgba);
     double db16 = psnr(sixteen.frames.back().rgba, reference.frames.back().rgba);
     std::printf("shadel AO vs 256 rays/shadel: 1 frame %.2f dB, 16 frames %.2f dB; rays/frame "
@@ -196,24 +200,40 @@ TEST(RayTracing, ShadelAoConvergesToTheHighRayReference) {
     EXPECT_GT(sixteen.stats["rt"]["shadel_cache"]["instances"].get<uint64_t>(), 0u);
 }
 
+// Mean absolute change between consecutive frames from frame `first` on (colour channels).
+double flickerFrom(const RenderRun& run, size_t first) {
+    double sum = 0;
+    size_t n = 0;
+    for (size_t f = std::max<size_t>(first, 1); f < run.frames.size(); ++f) {
+        const auto& a = run.frames[f - 1].rgba;
+        const auto& b = run.frames[f].rgba;
+        for (size_t i = 0; i < a.size(); i += 4)
+            for (int c = 0; c < 3; ++c, ++n) sum += std::abs(double(a[i + c]) - double(b[i + c]));
+    }
+    return sum / double(std::max<size_t>(n, 1));
+}
+
+// A static camera, so every change between frames is the estimator's noise: the shadel path's
+// history converges, the per-pixel forward path draws new rays every frame. (Under
+// --camera-path orbit the frame-to-frame change at 96x54 is dominated by the motion itself for
+// both paths; see the report of issue 20.)
 TEST(RayTracing, ShadelAoFlickersLessThanPerPixelAtTheSameRayBudget) {
     if (!sharedGpu().device.optional.rayQuery) GTEST_SKIP() << "no ray query on this device";
-    RenderOptions d = shadelAoOptions(6, 1);
-    d.cameraPath = CameraPath::Orbit;
-    RenderRun shadel = renderChecked(d);
+    RenderRun shadel = renderChecked(shadelAoOptions(16, 1, 3));
     double shadelRays = shadel.stats["rt"]["rays_traced_mean"].get<double>();
     // Forward: as many rays per pixel as the shadel path traced per covered pixel (at least 1).
-    RenderOptions f = d;
+    RenderOptions f = shadelAoOptions(16, 1, 3);
     f.mode = RenderMode::Forward;
     double covered = double(shadel.stats["pixels_covered"].get<uint64_t>());
     f.rt.aoRays = std::max<uint32_t>(1, uint32_t(std::lround(shadelRays / covered)));
     RenderRun forward = renderChecked(f);
     double forwardRays = forward.stats["rt"]["rays_traced_mean"].get<double>();
-    double flickerShadel = meanFrameDelta(shadel);
-    double flickerForward = meanFrameDelta(forward);
-    std::printf("orbit AO flicker: shadel %.3f (%.0f rays/frame), forward %.3f (%u rays/pixel, "
-                "%.0f rays/frame)\n",
+    double flickerShadel = flickerFrom(shadel, 8);
+    double flickerForward = flickerFrom(forward, 8);
+    std::printf("AO flicker (frames 8-15, static): shadel %.3f (%.0f rays/frame), forward %.3f "
+                "(%u rays/pixel + 3x3 filter, %.0f rays/frame)\n",
                 flickerShadel, shadelRays, flickerForward, f.rt.aoRays, forwardRays);
     EXPECT_GE(forwardRays, shadelRays * 0.9);
+    EXPECT_GT(flickerForward, 0.0);
     EXPECT_LE(flickerShadel, 0.5 * flickerForward);
 }
