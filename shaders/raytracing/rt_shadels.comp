@@ -29,8 +29,13 @@ void main() {
     uvec2 texel = uvec2(tile.tile & 0xFFFFu, tile.tile >> 16) * 8u + gl_LocalInvocationID.xy;
     if (any(greaterThanEqual(texel, o.size))) return;
     ivec2 atlas = ivec2(o.origin + texel);
+    vec4 history = imageLoad(gImagesRgba16f[rt.shadelTermsWrite], atlas);
+    float count = (o.flags & RT_SHADEL_RESET) != 0u ? 0.0 : history.w;
+    // Converged: the texel is reused as it is until its inputs change (the seed's "trace once
+    // per shadel and reuse"; a reset starts it again).
+    if (count >= float(rt.historyRays)) return;
     uint tri = cachedTriangle(s, o.idMapOffset + texel.y * o.size.x + texel.x);
-    if (tri == 0xFFFFu) { // no surface here (outside every chart and its gutter)
+    if (tri == 0xFFFFu) { // no surface here (outside every chart and its gutter): never read
         imageStore(gImagesRgba16f[rt.shadelTermsWrite], atlas, vec4(1.0, 1.0, 0.0, 0.0));
         imageStore(gImagesRgba16f[rt.shadelIndirectWrite], atlas, vec4(0.0));
         return;
@@ -55,19 +60,16 @@ void main() {
     vec3 ng = normalize(mat3(inst.normalMatrix) * cross(v1.position - v0.position, v2.position - v0.position));
     if (dot(ng, n) < 0.0) ng = -ng;
 
-    vec4 history = imageLoad(gImagesRgba16f[rt.shadelTermsWrite], atlas);
     vec4 indirectHistory = imageLoad(gImagesRgba16f[rt.shadelIndirectWrite], atlas);
-    float count = (o.flags & RT_SHADEL_RESET) != 0u ? 0.0 : history.w;
     uint rays = rt.raysPerShadel;
     uint seed = rtHash(tile.object * 0x9e3779b9u ^ rtHash(uint(atlas.x) | uint(atlas.y) << 16));
     uint sampleBase = uint(count); // continue the sequence: no sample is drawn twice
     float sun = rt.shadows != 0u ? rtSunVisibility(f, rt, p, ng, seed, sampleBase) : 1.0;
     float ao = rt.ao != 0u ? rtAmbientOcclusion(f, rt, p, n, ng, seed, sampleBase, rays) : 1.0;
     vec3 indirect = rt.gi != 0u ? rtIndirectDiffuse(f, rt, p, n, ng, seed, sampleBase, rays) : vec3(0.0);
-    // The running mean of every ray so far, a moving mean once maxHistory rays are in.
-    float total = min(count + float(rays), float(rt.maxHistory));
+    // The running mean of every ray so far.
+    float total = count + float(rays);
     float w = float(rays) / total;
-    if (count == 0.0) w = 1.0;
     vec4 terms = vec4(mix(history.xy, vec2(sun, ao), w), 0.0, total);
     imageStore(gImagesRgba16f[rt.shadelTermsWrite], atlas, terms);
     imageStore(gImagesRgba16f[rt.shadelIndirectWrite], atlas,

@@ -58,7 +58,7 @@ struct RtFrame {
     uint64_t shadelObjects; // RtShadelObject per instance, 0 when not decoupled
     uint64_t shadelTiles;   // RtShadelTile[shadelTileCount]
     uint shadelTileCount;
-    uint maxHistory;          // accumulated rays beyond which the average becomes a moving one
+    uint historyRays;         // a texel with this many rays accumulated is done: no more are traced
     uint shadelTermsWrite;    // cache atlas: sun, AO, -, rays accumulated (storage, rgba16f)
     uint shadelTermsRead;     //   ... the same, sampled
     uint shadelIndirectWrite; // cache atlas: indirect light, rays accumulated

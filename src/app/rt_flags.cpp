@@ -49,6 +49,11 @@ void addRayTracingFlags(CLI::App& render, RtFlags& f) {
         .add_option("--rt-distance", s.distance,
                     "TLAS: instances within this distance of the camera (0 = all)")
         ->capture_default_str();
+    render
+        .add_option("--rt-history-rays", s.historyRays,
+                    "decoupled: rays a cached texel accumulates, then reuses until its inputs "
+                    "change, 1..1024")
+        ->capture_default_str();
     render.add_option("--blas-pool-mb", s.blasPoolMb, "BLAS memory pool size in MiB, 1..4096")
         ->capture_default_str();
     render
@@ -77,6 +82,7 @@ RtSettings parseRayTracingFlags(const RtFlags& f) {
     count("--rt-gi-rays", s.giRays, 1, 256);
     count("--rays-per-shadel", s.raysPerShadel, 1, 256);
     count("--rt-shadel-mip-offset", s.shadelMipOffset, 0, 8);
+    count("--rt-history-rays", s.historyRays, 1, 1024); // rgba16f counts exactly to 2048
     count("--blas-pool-mb", s.blasPoolMb, 1, 4096);
     count("--blas-pool-limit", s.blasPoolLimit, 1, 1024);
     real("--rt-sun-angle", s.sunAngleDegrees, 0.0f, 10.0f);

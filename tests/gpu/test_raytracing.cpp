@@ -6,6 +6,7 @@
 #include <fstream>
 #include <sstream>
 #include <sys/wait.h>
+#include <unistd.h>
 
 #include "gpu_test_env.h"
 
@@ -37,8 +38,9 @@ double meanLuma(const RenderRun& run) {
 }
 
 int runShadel(const std::string& env, const std::string& args, std::string& err) {
-    std::string errFile =
-        (std::filesystem::temp_directory_path() / "shadel_rt_stderr.txt").string();
+    std::string errFile = (std::filesystem::temp_directory_path() /
+                           ("shadel_rt_stderr_" + std::to_string(getpid()) + ".txt"))
+                              .string();
     std::string cmd =
         env + " timeout 120 " + SHADEL_BINARY + " " + args + " >/dev/null 2>" + errFile;
     int status = std::system(cmd.c_str());

@@ -286,7 +286,8 @@ void rayTracingStats(const Renderer& r, nlohmann::json& stats) {
         {"rays_traced_mean", s.framesTraced ? double(s.raysTotal) / s.framesTraced : 0.0}};
     if (s.shadelCache.terms)
         stats["rt"]["shadel_cache"] = {
-            {"texels_traced", s.shadelCache.texelsTraced},
+            {"texels", s.shadelCache.texelsTraced},
+            {"history_rays", rt.historyRays},
             {"instances", s.shadelCache.instancesCached},
             {"instances_without_room", s.shadelCache.instancesWithoutRoom},
             {"rays_per_shadel", rt.raysPerShadel},

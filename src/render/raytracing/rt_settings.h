@@ -17,6 +17,7 @@ struct RtSettings {
     bool spatialFilter = true;    // forward: 3x3 depth-aware filter of the noisy terms
     uint32_t raysPerShadel = 1;   // shadel path: AO / GI rays per shadel per frame
     uint32_t shadelMipOffset = 2; // shadel path: the RT cache's MIP, this much coarser than needed
+    uint32_t historyRays = 256;   // shadel path: rays per texel after which it is reused as it is
     // BLAS memory (seed 003): pools of this size, sub-allocated with TLSF, at most this many.
     uint32_t blasPoolMb = 128;
     uint32_t blasPoolLimit = 16;

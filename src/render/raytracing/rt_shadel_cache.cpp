@@ -17,7 +17,6 @@ static constexpr uint32_t kAtlasAlignment = 8; // rects in whole tiles
 // Frames an instance out of view keeps its rect (and history), so a short glance away does not
 // restart its convergence.
 static constexpr uint64_t kKeepFrames = 30;
-static constexpr uint32_t kMaxHistory = 1024; // rays; rgba16f counts exactly up to 2048
 
 struct RtShadelPush {
     uint64_t frame;
@@ -127,7 +126,9 @@ void prepareRtShadelCache(Renderer& r, const GpuScene& scene, const CameraView& 
         uint32_t level = cacheLevel(r, *mesh, inst, camera);
         // Hysteresis: a rect is kept while its level stays within one of the wanted one.
         bool keep = e.placement && std::abs(int(level) - int(e.level)) <= 1;
-        bool reset = !keep || e.model != inst.model; // moved: the history no longer holds
+        // Moved, or (GI) a light changed: the history no longer holds.
+        bool reset =
+            !keep || e.model != inst.model || (r.settings.rt.gi && !r.changedLightVolumes.empty());
         if (!keep) {
             if (e.placement) c.atlas->remove(e.placement->id);
             glm::uvec2 size = levelSize(mesh->mip0Size, level);
@@ -158,7 +159,7 @@ void prepareRtShadelCache(Renderer& r, const GpuScene& scene, const CameraView& 
     rt.shadelObjects = address(gpu, c.objectBuffer);
     rt.shadelTiles = address(gpu, c.tileBuffer);
     rt.shadelTileCount = c.tileCount;
-    rt.maxHistory = kMaxHistory;
+    rt.historyRays = r.settings.rt.historyRays;
     rt.shadelTermsWrite = slot(gpu, c.termsWrite).value;
     rt.shadelTermsRead = slot(gpu, c.termsRead).value;
     rt.shadelIndirectWrite = slot(gpu, c.indirectWrite).value;
