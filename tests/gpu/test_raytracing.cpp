@@ -89,6 +89,21 @@ TEST(RayTracing, BuildsCompactedBlasesAndTracesOneSunRayPerPixel) {
     EXPECT_EQ(lodCount(withAo), lodCount(run));
 }
 
+TEST(RayTracing, TlasKeepsTheInstancesWithinTheRayTracingDistance) {
+    if (!sharedGpu().device.optional.rayQuery) GTEST_SKIP() << "no ray query on this device";
+    RenderOptions o = rtOptions();
+    o.width = 64;
+    o.height = 36;
+    o.rt.shadows = true;
+    o.rt.distance = 4.0f;
+    RenderRun near = renderChecked(o);
+    uint64_t kept = near.stats["tlas_instances"].get<uint64_t>();
+    std::printf("--rt-distance 4: %llu of %llu instances in the TLAS\n", (unsigned long long)kept,
+                (unsigned long long)near.stats["instances"].get<uint64_t>());
+    EXPECT_GT(kept, 0u);
+    EXPECT_LT(kept, near.stats["instances"].get<uint64_t>());
+}
+
 TEST(RayTracing, PoolLimitFallsBackToTheLeastDetailedBlas) {
     if (!sharedGpu().device.optional.rayQuery) GTEST_SKIP() << "no ray query on this device";
     RenderOptions o = rtOptions();
