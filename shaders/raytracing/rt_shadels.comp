@@ -59,6 +59,21 @@ void main() {
     vec3 n = normalize(mat3(inst.normalMatrix) * shadelInterpolate(bary, v0.normal, v1.normal, v2.normal));
     vec3 ng = normalize(mat3(inst.normalMatrix) * cross(v1.position - v0.position, v2.position - v0.position));
     if (dot(ng, n) < 0.0) ng = -ng;
+    // Only what the camera can see is traced this frame: texels facing away (single-sided
+    // materials) or outside the view frustum (with a margin for the filters' reach) wait until
+    // they come into view; on a reset they are marked empty, so stale texels are never read.
+    GpuMaterial mat = MaterialBuffer(f.materials).m[inst.material];
+    bool facing = (mat.flags & MATERIAL_DOUBLE_SIDED) != 0u || dot(ng, f.cameraPosition - p) > 0.0;
+    float margin = 0.05 * length(f.cameraPosition - p);
+    bool inView = true;
+    for (int i = 0; i < 6; ++i) inView = inView && dot(f.frustumPlanes[i], vec4(p, 1.0)) >= -margin;
+    if (!facing || !inView) {
+        if (count == 0.0) {
+            imageStore(gImagesRgba16f[rt.shadelTermsWrite], atlas, vec4(1.0, 1.0, 0.0, 0.0));
+            imageStore(gImagesRgba16f[rt.shadelIndirectWrite], atlas, vec4(0.0));
+        }
+        return;
+    }
 
     vec4 indirectHistory = imageLoad(gImagesRgba16f[rt.shadelIndirectWrite], atlas);
     uint rays = rt.raysPerShadel;
