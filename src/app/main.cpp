@@ -109,7 +109,8 @@ int main(int argc, char** argv) {
     render
         ->add_option("--visualize", visualize,
                      "none | marking | mips | chunks | sheet | layer:radiance | layer:material | "
-                     "light-count | blockers | gi (indirect light only, with --gi lpv)")
+                     "light-count | blockers | gi (indirect light only, with --gi lpv) | rt-ao "
+                     "(ray-traced AO only, with --rt-ao on)")
         ->capture_default_str();
     std::string marking = "raster";
     render
