@@ -273,6 +273,14 @@ vec3 evaluateLight(GpuLight light, MaterialSample m, vec3 n, vec3 v, vec3 p) {
     return brdf(m, n, v, dir, radiance);
 }
 
+// Ray-traced terms (render/raytracing, shaders/raytracing): the caller sets them before
+// shadeSurface when the frame traces rays (forward: the pixel's, raytracing/rt_apply.glsl; the
+// shadel path: the shadel's accumulated ones). Left unset: the shadow map and the plain ambient.
+bool gRtSun = false;          // gRtSunVisibility replaces the sun's shadow map
+float gRtSunVisibility = 1.0;
+float gRtOcclusion = 1.0;     // ambient occlusion: multiplies the ambient term
+vec3 gRtIndirect = vec3(0.0); // one-bounce diffuse light: irradiance / pi (times the albedo here)
+
 // Everything that lights a surface point, evaluated for a viewer at f.cameraPosition.
 vec3 shadeSurface(FrameConstants f, MaterialSample m, vec3 worldPos, vec3 geometricNormal) {
     if (m.unlit) return m.baseColor;
@@ -283,7 +291,8 @@ vec3 shadeSurface(FrameConstants f, MaterialSample m, vec3 worldPos, vec3 geomet
     vec3 indirect = giIrradiance(f.gi, worldPos, n) * m.baseColor * (1.0 - m.metallic) *
                     m.occlusion / PI;
     if (f.visualize == VISUALIZE_GI) return indirect;
-    color += indirect;
+    if (f.visualize == VISUALIZE_RT_AO) return vec3(gRtOcclusion);
+    color += indirect + gRtIndirect * m.baseColor * (1.0 - m.metallic) * m.occlusion;
     // Ambient: a hemisphere term so shadowed sides are not black.
     float up = n.y * 0.5 + 0.5;
     vec3 ambient = mix(f.ambientColor * 0.5, f.ambientColor + f.skyColor * 0.15, up);
@@ -296,11 +305,11 @@ vec3 shadeSurface(FrameConstants f, MaterialSample m, vec3 worldPos, vec3 geomet
         vec3 mirrored = mix(f.ambientColor * 0.5, f.ambientColor + f.skyColor, r.y * 0.5 + 0.5);
         ambientLit = ambientLit * (1.0 - fc) + fc * mirrored * m.occlusion;
     }
-    color += ambientLit;
+    color += ambientLit * gRtOcclusion;
 
     vec3 l = -f.sunDirection;
     if (dot(f.sunColor, f.sunColor) > 0.0)
-        color += brdf(m, n, v, l, f.sunColor * sunShadow(f, worldPos, geometricNormal));
+        color += brdf(m, n, v, l, f.sunColor * (gRtSun ? gRtSunVisibility : sunShadow(f, worldPos, geometricNormal)));
 
     LightBuffer lights = LightBuffer(f.lights);
     vec3 direct = vec3(0.0);

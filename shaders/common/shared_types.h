@@ -70,6 +70,7 @@ using uint = uint32_t;
 #define VISUALIZE_LIGHT_COUNT 16u   // --visualize light-count: lights per tile / chunk (heat)
 #define VISUALIZE_BLOCKERS 17u      // --visualize blockers: tiles with per-pixel blocker checks
 #define VISUALIZE_GI 6u             // --visualize gi: the LPV indirect light only
+#define VISUALIZE_RT_AO 7u          // --visualize rt-ao: the ray-traced ambient occlusion only
 
 // One vertex of the unified geometry buffer (matches shadel::Vertex).
 struct GpuVertex {
@@ -251,6 +252,7 @@ struct FrameConstants {
     uint64_t gi;         // GiFrame (render/gi, shaders/gi/gi_types.h), 0 when GI is off
     uint64_t culling;    // CullingFrame (render/culling): LODs, occlusion, per-view counts
     uint64_t debugLines; // GpuDebugLines (render/debug/debug_lines.h), 0 when --debug-lines is off
+    uint64_t rt;        // RtFrame (render/raytracing, shaders/raytracing/rt_types.h), 0 when off
 };
 
 // ---- GPU-driven world (render/culling) ------------------------------------------------------

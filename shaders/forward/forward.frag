@@ -3,6 +3,7 @@
 #include "common/lighting.glsl"
 #include "lighting/light_debug.glsl"
 #include "debug/inspect.glsl"
+#include "raytracing/rt_apply.glsl"
 
 layout(push_constant, scalar) uniform Push {
     uint64_t frame;
@@ -32,7 +33,10 @@ void main() {
     MaterialSample m = evaluateMaterial(mat, s);
     if ((mat.flags & MATERIAL_ALPHA_MASK) != 0u && m.alpha < mat.alphaCutoff) discard;
     // Opaque pixels lie on the prepass depth the tile's bounds came from; blended ones need not.
-    if ((mat.flags & MATERIAL_ALPHA_BLEND) == 0u) useTileLightList(f, gl_FragCoord.xy);
+    if ((mat.flags & MATERIAL_ALPHA_BLEND) == 0u) {
+        useTileLightList(f, gl_FragCoord.xy);
+        useRayTracedPixelTerms(f, gl_FragCoord.xy); // --rt-*: this pixel's traced terms
+    }
     vec3 color = shadeSurface(f, m, inPosition, s.normal);
     if (inspecting(f, uvec2(gl_FragCoord.xy))) {
         beginInspect(f, inInstance, uint(gl_PrimitiveID), gl_FragCoord);

@@ -13,6 +13,7 @@
 #include "shadel/prefilter.glsl"
 #define DEBUG_LINES_WORKGROUP_BOX
 #include "debug/debug_lines.glsl"
+#include "raytracing/rt_apply.glsl"
 
 layout(local_size_x = 8, local_size_y = 8) in;
 layout(push_constant, scalar) uniform Push { uint64_t frame; } pc;
@@ -231,6 +232,7 @@ void main() {
                                      cross(v1.position - v0.position, v2.position - v0.position));
     si.frontFacing = dot(geometricNormal, f.cameraPosition - si.position) >= 0.0;
     GpuMaterial mat = MaterialBuffer(f.materials).m[inst.material];
+    useRayTracedShadelTerms(f, work.object, shadelCenterUv(shadel, size)); // --rt-* (RT cache)
     // The shadel's whole footprint, not its centre (prefilter.glsl; --material-samples caps it).
     vec4 material;
     vec3 color = prefilteredShade(f, mat, si, shadelCenterUv(shadel, size), vec2(1.0) / vec2(size),

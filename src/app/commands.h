@@ -62,6 +62,7 @@ struct RenderOptions {
     bool occlusion = false;  // --occlusion: two-phase hierarchical-Z culling (render/culling)
     uint32_t debugLines = 0; // --debug-lines: DEBUG_LINES_* kinds (render/debug/debug_lines.h)
     uint32_t debugLineCapacity = 256 * 1024; // segments the line buffer holds (tests: smaller)
+    RtSettings rt;          // --rt-*, --rays-per-shadel, --blas-pool-*: render/raytracing
     // --capture NAME[,NAME...] (or {"list"}) and --capture-dir: the last frame's named
     // resources (app/capture_output.h); files go to the dir or next to --out.
     std::vector<std::string> captures;

@@ -13,6 +13,7 @@
 #include "app/cli_help.h"
 #include "app/cli_validate.h"
 #include "app/commands.h"
+#include "app/rt_flags.h"
 #include "app/viewer/viewer.h"
 #include "bake/bake.h"
 #include "bake/cache_eviction.h"
@@ -109,7 +110,8 @@ int main(int argc, char** argv) {
     render
         ->add_option("--visualize", visualize,
                      "none | marking | mips | chunks | sheet | layer:radiance | layer:material | "
-                     "light-count | blockers | gi (indirect light only, with --gi lpv)")
+                     "light-count | blockers | gi (indirect light only, with --gi lpv) | rt-ao "
+                     "(ray-traced AO only, with --rt-ao on)")
         ->capture_default_str();
     std::string marking = "raster";
     render
@@ -245,6 +247,8 @@ int main(int argc, char** argv) {
                      "lights (ranges, cones), blockers (rectangles, portals, shadow frusta), "
                      "chunks (world boxes of the shadel chunks shaded)")
         ->capture_default_str();
+    RtFlags rtFlags; // ray tracing (render/raytracing)
+    addRayTracingFlags(*render, rtFlags);
     std::string captures;
     render->add_option("--capture", captures,
                        "NAME[,NAME...]: write named resources of the last frame (EXR for HDR "
@@ -435,6 +439,7 @@ int main(int argc, char** argv) {
             ro.lod = parseOnOff("--lod", lod);
             ro.occlusion = parseOnOff("--occlusion", occlusion);
             ro.debugLines = parseDebugLines(debugLines);
+            ro.rt = parseRayTracingFlags(rtFlags);
             if (!captures.empty()) ro.captures = parseCaptureNames(captures);
             if (!inspect.empty()) parseInspect(inspect, ro.inspectX, ro.inspectY);
             RenderRun run = runRender(g.gpu, ro);

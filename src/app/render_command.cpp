@@ -50,8 +50,9 @@ Visualize parseVisualize(const std::string& text) {
     if (text == "light-count") return Visualize::LightCount;
     if (text == "blockers") return Visualize::Blockers;
     if (text == "gi") return Visualize::Gi;
+    if (text == "rt-ao") return Visualize::RtAo;
     throw InputError(format("--visualize %s: expected none, marking, mips, chunks, sheet, "
-                            "layer:radiance, layer:material, light-count, blockers or gi",
+                            "layer:radiance, layer:material, light-count, blockers, gi or rt-ao",
                             text.c_str()));
 }
 
@@ -263,6 +264,9 @@ RenderRun runRender(Gpu& gpu, const RenderOptions& o) {
     settings.occlusion = o.occlusion;
     settings.debugLines = o.debugLines;
     settings.debugLineCapacity = o.debugLineCapacity;
+    if (o.visualize == Visualize::RtAo && !o.rt.ao)
+        throw InputError("--visualize rt-ao: shows the ray-traced AO of --rt-ao on; it is off");
+    settings.rt = o.rt;
     settings.timing = o.timing ? *o.timing : defaultTimingMode(gpu);
     Renderer renderer;
     RenderRun run;
@@ -383,6 +387,7 @@ RenderRun runRender(Gpu& gpu, const RenderOptions& o) {
         s["id_map_bytes"] = gpuScene.idMapBytes;
     }
     if (renderer.gi) giStats(renderer, s);
+    if (renderer.rt) rayTracingStats(renderer, s);
     if (o.inspectX >= 0) {
         nlohmann::json prints = nlohmann::json::array();
         InspectedPixel pixel = frontFragment(run.frames.back().prints);

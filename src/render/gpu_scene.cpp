@@ -266,12 +266,17 @@ void uploadScene(Gpu& gpu, const Scene& scene, GpuScene& out, const std::vector<
     out.ambientColor = scene.ambientColor;
 
     VkBufferUsageFlags indexUsage = VK_BUFFER_USAGE_INDEX_BUFFER_BIT;
+    // Ray tracing (render/raytracing) builds BLASes straight from the unified geometry.
+    VkBufferUsageFlags rtInput =
+        gpu.device.optional.rayQuery
+            ? VK_BUFFER_USAGE_ACCELERATION_STRUCTURE_BUILD_INPUT_READ_ONLY_BIT_KHR
+            : 0;
     out.vertices = uploadArray(gpu, "scene.vertices", vertices.data(),
-                               vertices.size() * sizeof(gpu::GpuVertex));
+                               vertices.size() * sizeof(gpu::GpuVertex), rtInput);
     if (baked)
         out.shadelUvs = uploadArray(gpu, "scene.shadelUvs", shadelUvs.data(),
                                     shadelUvs.size() * sizeof(glm::vec2));
-    out.indices = uploadArray(gpu, "scene.indices", indices.data(), indices.size() * 4, indexUsage);
+    out.indices = uploadArray(gpu, "scene.indices", indices.data(), indices.size() * 4, indexUsage | rtInput);
     out.meshes = uploadArray(gpu, "scene.meshes", out.meshInfo.data(),
                              out.meshInfo.size() * sizeof(gpu::GpuMesh));
     out.meshLods = uploadArray(gpu, "scene.meshLods", out.lodInfo.data(),

@@ -122,12 +122,14 @@ void initRenderer(Renderer& r, Gpu& gpu, const RenderSettings& settings, const G
     if (settings.gi == GiMode::Lpv) r.gi = createGi(r, scene);
     r.culling = createCulling(r, scene);
     r.debugLines = createDebugLines(r);
+    if (settings.rt.enabled()) r.rt = createRayTracing(r, scene);
 }
 
 void destroyRenderer(Renderer& r) {
     if (!r.gpu) return;
     Gpu& gpu = *r.gpu;
     vkDeviceWaitIdle(gpu.device.device);
+    destroyRayTracing(r, r.rt);
     destroyLightCulling(r, r.lightCulling);
     destroyDebugLines(r, r.debugLines);
     if (r.gi) destroyGi(r, r.gi);
@@ -253,6 +255,7 @@ FrameResult renderFrame(Renderer& r, const GpuScene& scene, const CameraView& ca
     prepareTransparentDraws(r, scene, camera);
     prepareCullingFrame(r, scene, constants);
     constants.debugLines = debugLinesAddress(r);
+    if (r.rt) prepareRayTracingFrame(r, scene, camera, constants);
     std::memcpy(mapped(gpu, r.frameConstants), &constants, sizeof(constants));
     uint64_t frame = address(gpu, r.frameConstants);
     double prepareMs = msSince(cpuStart);
@@ -264,6 +267,7 @@ FrameResult renderFrame(Renderer& r, const GpuScene& scene, const CameraView& ca
     pass(rec, "instanceCull",
          [&](VkCommandBuffer cmd) { recordInstanceCull(r, cmd, frame, scene); });
     pass(rec, "shadowMap", [&](VkCommandBuffer cmd) { recordShadowMap(r, cmd, frame); });
+    if (r.rt) pass(rec, "rtBuildTlas", [&](VkCommandBuffer cmd) { recordTlasBuild(r, cmd); });
     if (r.gi) { // light propagation volumes (render/gi): RSMs, injection, propagation
         pass(rec, "giReflectiveShadowMaps",
              [&](VkCommandBuffer cmd) { recordGiReflectiveShadowMaps(r, cmd, frame); });
@@ -279,9 +283,15 @@ FrameResult renderFrame(Renderer& r, const GpuScene& scene, const CameraView& ca
         pass(rec, "lightCulling", [&](VkCommandBuffer cmd) { recordLightCulling(r, cmd, frame); });
     if (r.settings.occlusion) recordOcclusionPasses(r, rec, frame, scene);
     if (r.settings.mode == RenderMode::Forward) {
+        if (r.rt) // sun visibility, AO, indirect light per pixel (render/raytracing)
+            pass(rec, "rtPixelTerms",
+                 [&](VkCommandBuffer cmd) { recordRayTracedPixels(r, cmd, frame); });
         pass(rec, "forwardShading",
              [&](VkCommandBuffer cmd) { recordForwardShading(r, cmd, frame); });
     } else {
+        if (r.rt) // the RT cache the shadel shading reads (render/raytracing)
+            pass(rec, "rtShadelTrace",
+                 [&](VkCommandBuffer cmd) { recordRayTracedShadels(r, cmd, frame); });
         recordDecoupledPasses(r, rec, frame, scene);
     }
     recordTransparencyPasses(r, rec, frame); // blended materials, after every opaque surface
@@ -306,6 +316,7 @@ FrameResult renderFrame(Renderer& r, const GpuScene& scene, const CameraView& ca
     if (r.decoupled) finishDecoupledFrame(r);
     readLightCullingStats(r);
     finishCullingFrame(r);
+    if (r.rt) finishRayTracingFrame(r);
     r.framesRendered++;
     size_t bytes = size_t(r.settings.width) * r.settings.height * 4;
     result.rgba.resize(bytes);

@@ -12,6 +12,8 @@
 #include "render/gi/lpv.h"
 #include "render/gpu_scene.h"
 #include "render/lighting/light_culling.h"
+#include "render/raytracing/ray_tracing.h"
+#include "render/raytracing/rt_settings.h"
 #include "render/shadel/visibility.h"
 #include "rhi/frame.h"
 #include "rhi/pipeline.h"
@@ -37,6 +39,7 @@ enum class Visualize : uint32_t {
     LightCount = VISUALIZE_LIGHT_COUNT, // lights per tile (forward) or chunk (shadel)
     Blockers = VISUALIZE_BLOCKERS,      // tiles / chunks with per-pixel blocker checks
     Gi = 6,                             // --visualize gi: the LPV's indirect light only
+    RtAo = VISUALIZE_RT_AO,             // --visualize rt-ao: the ray-traced AO only (--rt-ao on)
 };
 
 // --light-culling: per-tile (forward) and per-chunk (shadel) light lists, or every light for
@@ -90,6 +93,7 @@ struct RenderSettings {
     uint32_t debugLines =
         0; // --debug-lines: DEBUG_LINES_* kinds drawn (render/debug/debug_lines.h)
     uint32_t debugLineCapacity = 256 * 1024; // segments the line buffer holds (8 MiB)
+    RtSettings rt;          // --rt-*: ray-traced shadows, AO, GI (render/raytracing)
 };
 
 struct FrameResult {
@@ -155,6 +159,7 @@ struct Renderer {
     GiStatePtr gi;                     // --gi lpv
     DebugLinesStatePtr debugLines;     // --debug-lines (render/debug/debug_lines.h)
     CullingStatePtr culling;           // LODs, occlusion, per-view counts (render/culling)
+    RayTracingStatePtr rt;             // BLASes, TLAS, traced terms (--rt-*, render/raytracing)
     CaptureRegistry captures;          // --capture: named resources of the frame (render/debug)
     std::chrono::steady_clock::time_point createdAt = std::chrono::steady_clock::now();
 };

@@ -1,0 +1,75 @@
+// Hands the ray-traced terms to the shared lighting code (gRt* in common/lighting.glsl).
+// Forward path: the pixel's ray-traced terms (written by rt_pixel.frag, the pass before
+// forward shading) to the shared lighting code (gRt* in common/lighting.glsl). AO, indirect
+// light and soft shadows are noisy per pixel (a few rays each), so they are read through a
+// small depth-aware 3x3 filter; hard shadows are exact and read as they are.
+#ifndef SHADEL_RT_APPLY_GLSL
+#define SHADEL_RT_APPLY_GLSL
+#include "common/lighting.glsl"
+#include "raytracing/rt_frame.glsl"
+
+void useRayTracedPixelTerms(FrameConstants f, vec2 fragCoord) {
+    if (f.rt == 0ul) return;
+    RtFrame rt = RtFrameRef(f.rt).r;
+    if (rt.pixelTermsSlot == NO_TEXTURE) return;
+    ivec2 p = ivec2(fragCoord);
+    ivec2 size = textureSize(gTextures[rt.pixelTermsSlot], 0);
+    vec4 centre = texelFetch(gTextures[rt.pixelTermsSlot], p, 0); // sun, AO, -, view distance
+    if (centre.w <= 0.0) return; // nothing traced here (not an opaque surface)
+    vec4 terms = centre;
+    vec3 indirect = rt.gi != 0u ? texelFetch(gTextures[rt.pixelIndirectSlot], p, 0).rgb : vec3(0.0);
+    if (rt.spatialFilter != 0u) {
+        vec4 sum = vec4(0.0);
+        vec3 indirectSum = vec3(0.0);
+        float weight = 0.0;
+        for (int y = -1; y <= 1; ++y)
+            for (int x = -1; x <= 1; ++x) {
+                ivec2 q = clamp(p + ivec2(x, y), ivec2(0), size - 1);
+                vec4 t = texelFetch(gTextures[rt.pixelTermsSlot], q, 0);
+                if (t.w <= 0.0 || abs(t.w - centre.w) > 0.03 * centre.w) continue;
+                sum += t;
+                if (rt.gi != 0u) indirectSum += texelFetch(gTextures[rt.pixelIndirectSlot], q, 0).rgb;
+                weight += 1.0;
+            }
+        terms.y = sum.y / weight; // the centre always passes
+        if (rt.shadowRays > 1u) terms.x = sum.x / weight;
+        indirect = indirectSum / weight;
+    }
+    gRtSun = rt.shadows != 0u;
+    gRtSunVisibility = terms.x;
+    gRtOcclusion = rt.ao != 0u ? terms.y : 1.0;
+    gRtIndirect = indirect;
+}
+layout(buffer_reference, scalar) readonly buffer RtShadelObjectRefs { RtShadelObject o[]; };
+
+// Shadel path: the object's RT cache (rt_shadels.comp), read bilinearly at the shadel's UV in
+// the object's shadel space (texels with no surface are left out of the filter).
+void useRayTracedShadelTerms(FrameConstants f, uint object, vec2 shadelUv) {
+    if (f.rt == 0ul) return;
+    RtFrame rt = RtFrameRef(f.rt).r;
+    if (rt.shadelObjects == 0ul) return;
+    RtShadelObject o = RtShadelObjectRefs(rt.shadelObjects).o[object];
+    if ((o.flags & RT_SHADEL_VALID) == 0u) return;
+    vec2 t = clamp(shadelUv * vec2(o.size) - 0.5, vec2(0.0), vec2(o.size) - 1.0);
+    ivec2 t0 = ivec2(floor(t));
+    vec2 fr = t - vec2(t0);
+    vec4 terms = vec4(0.0);
+    vec3 indirect = vec3(0.0);
+    float weight = 0.0;
+    for (int k = 0; k < 4; ++k) {
+        ivec2 d = ivec2(k & 1, k >> 1);
+        ivec2 q = ivec2(o.origin) + min(t0 + d, ivec2(o.size) - 1);
+        vec4 v = texelFetch(gTextures[rt.shadelTermsRead], q, 0);
+        float w = (d.x == 1 ? fr.x : 1.0 - fr.x) * (d.y == 1 ? fr.y : 1.0 - fr.y);
+        if (v.w <= 0.0) continue; // no surface there
+        terms += v * w;
+        if (rt.gi != 0u) indirect += texelFetch(gTextures[rt.shadelIndirectRead], q, 0).rgb * w;
+        weight += w;
+    }
+    if (weight <= 0.0) return;
+    gRtSun = rt.shadows != 0u;
+    gRtSunVisibility = terms.x / weight;
+    gRtOcclusion = rt.ao != 0u ? terms.y / weight : 1.0;
+    gRtIndirect = indirect / weight;
+}
+#endif

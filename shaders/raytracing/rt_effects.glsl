@@ -1,0 +1,161 @@
+// Ray-traced lighting terms with rayQueryEXT (render/raytracing), shared by the forward path
+// (per pixel, shaders/raytracing/rt_pixel.frag) and the shadel path (per shadel,
+// shaders/raytracing/rt_shadels.comp): the sun's visibility (one ray: hard; several jittered
+// rays over the sun's disc: soft), ambient occlusion (cosine rays of a fixed length) and one
+// bounce of diffuse light (cosine rays; the hit is shaded from its material, the sun with a
+// shadow ray, the other lights unshadowed and the ambient term; no recursion).
+// The TLAS is reached by its device address (FrameConstants::rt -> RtFrame::tlas), like every
+// other resource here.
+#ifndef SHADEL_RT_EFFECTS_GLSL
+#define SHADEL_RT_EFFECTS_GLSL
+#extension GL_EXT_ray_query : require
+#include "common/lighting.glsl"
+#include "common/vertex.glsl"
+#include "raytracing/rt_frame.glsl"
+
+uint rtHash(uint x) {
+    x ^= x >> 16;
+    x *= 0x7feb352du;
+    x ^= x >> 15;
+    x *= 0x846ca68bu;
+    x ^= x >> 16;
+    return x;
+}
+
+// Sample `i` of a 2-D R2 low-discrepancy sequence, rotated per `seed` (Cranley-Patterson): a
+// sample point accumulating over frames walks one sequence (i grows), so it converges faster
+// than independent random rays would.
+vec2 rtSample2(uint seed, uint i) {
+    vec2 rotation = vec2(rtHash(seed), rtHash(seed ^ 0x9e3779b9u)) * (1.0 / 4294967296.0);
+    return fract(rotation + float(i) * vec2(0.7548776662466927, 0.5698402909980532));
+}
+
+mat3 rtBasis(vec3 n) {
+    vec3 t = abs(n.y) < 0.99 ? normalize(cross(vec3(0, 1, 0), n)) : normalize(cross(vec3(1, 0, 0), n));
+    return mat3(t, cross(n, t), n);
+}
+
+vec3 rtCosineDirection(vec3 n, vec2 u) {
+    float r = sqrt(u.x);
+    float phi = 6.28318530718 * u.y;
+    vec3 local = vec3(r * cos(phi), r * sin(phi), sqrt(max(0.0, 1.0 - u.x)));
+    return rtBasis(n) * local;
+}
+
+// A direction inside the cone of half angle `angle` around `axis` (uniform over the disc).
+vec3 rtConeDirection(vec3 axis, float angle, vec2 u) {
+    float r = sqrt(u.x) * tan(angle);
+    float phi = 6.28318530718 * u.y;
+    return normalize(rtBasis(axis) * vec3(r * cos(phi), r * sin(phi), 1.0));
+}
+
+accelerationStructureEXT rtTlas(RtFrame rt) { return accelerationStructureEXT(rt.tlas); }
+
+bool rtOccluded(RtFrame rt, vec3 origin, vec3 dir, float tMax) {
+    rayQueryEXT q;
+    rayQueryInitializeEXT(q, rtTlas(rt), gl_RayFlagsTerminateOnFirstHitEXT | gl_RayFlagsOpaqueEXT,
+                          0xFFu, origin, 0.0, dir, tMax);
+    while (rayQueryProceedEXT(q)) {}
+    return rayQueryGetIntersectionTypeEXT(q, true) != gl_RayQueryCommittedIntersectionNoneEXT;
+}
+
+// Ray origins leave the surface along its geometric normal (on the side the ray goes), by an
+// amount that grows with the distance to the camera (the precision of the position does).
+vec3 rtOrigin(FrameConstants f, RtFrame rt, vec3 p, vec3 ng, vec3 dir) {
+    float offset = rt.normalOffset * max(1.0, length(p - f.cameraPosition));
+    return p + (dot(ng, dir) >= 0.0 ? ng : -ng) * offset;
+}
+
+void rtCountRays(RtFrame rt, uint rays) {
+    if (rays != 0u) atomicAdd(RtCountersRef(rt.counters).c.raysTraced, rays);
+}
+
+// Fraction of the sun's disc visible from p (1 ray: 0 or 1).
+float rtSunVisibility(FrameConstants f, RtFrame rt, vec3 p, vec3 ng, uint seed, uint sampleBase) {
+    vec3 toSun = -f.sunDirection;
+    uint rays = max(rt.shadowRays, 1u);
+    float visible = 0.0;
+    for (uint i = 0u; i < rays; ++i) {
+        vec3 dir = rays == 1u ? toSun : rtConeDirection(toSun, rt.sunAngle, rtSample2(seed, sampleBase + i));
+        visible += rtOccluded(rt, rtOrigin(f, rt, p, ng, dir), dir, 1e30) ? 0.0 : 1.0;
+    }
+    rtCountRays(rt, rays);
+    return visible / float(rays);
+}
+
+// Unoccluded fraction of `rays` cosine rays of length aoRadius (1 = open).
+float rtAmbientOcclusion(FrameConstants f, RtFrame rt, vec3 p, vec3 n, vec3 ng, uint seed,
+                         uint sampleBase, uint rays) {
+    float open = 0.0;
+    for (uint i = 0u; i < rays; ++i) {
+        vec3 dir = rtCosineDirection(n, rtSample2(seed ^ 0x51ed27u, sampleBase + i));
+        open += rtOccluded(rt, rtOrigin(f, rt, p, ng, dir), dir, rt.aoRadius) ? 0.0 : 1.0;
+    }
+    rtCountRays(rt, rays);
+    return rays == 0u ? 1.0 : open / float(rays);
+}
+
+// Radiance leaving the committed hit of `q` toward the ray's origin (diffuse only).
+vec3 rtShadeHit(FrameConstants f, RtFrame rt, uint instanceId, uint primitive, vec2 bary,
+                bool frontFace, vec3 rayDir) {
+    GpuInstance inst = InstanceBuffer(f.instances).i[instanceId];
+    GpuMesh mesh = MeshBuffer(f.meshes).m[inst.mesh];
+    uint first = UintBuffer(rt.instanceLods).v[instanceId] + primitive * 3u;
+    IndexBuffer indices = IndexBuffer(f.indices);
+    WorldVertex a = fetchWorldVertex(f, inst, uint(int(indices.i[first]) + mesh.vertexOffset));
+    WorldVertex b = fetchWorldVertex(f, inst, uint(int(indices.i[first + 1u]) + mesh.vertexOffset));
+    WorldVertex c = fetchWorldVertex(f, inst, uint(int(indices.i[first + 2u]) + mesh.vertexOffset));
+    vec3 w = vec3(1.0 - bary.x - bary.y, bary.x, bary.y);
+    SurfaceInput s;
+    s.position = a.position * w.x + b.position * w.y + c.position * w.z;
+    s.normal = normalize(a.normal * w.x + b.normal * w.y + c.normal * w.z);
+    s.tangent = a.tangent * w.x + b.tangent * w.y + c.tangent * w.z;
+    s.uv = a.uv0 * w.x + b.uv0 * w.y + c.uv0 * w.z;
+    s.uvDx = vec2(0.0);
+    s.uvDy = vec2(0.0);
+    s.frontFacing = frontFace;
+    GpuMaterial mat = MaterialBuffer(f.materials).m[inst.material];
+    MaterialSample m = evaluateMaterial(mat, s);
+    if (m.unlit) return m.baseColor;
+    vec3 ng = normalize(cross(b.position - a.position, c.position - a.position));
+    vec3 n = dot(m.normal, rayDir) > 0.0 ? -m.normal : m.normal; // the side the ray sees
+    m.metallic = 0.0; // diffuse bounce only
+    m.roughness = 1.0;
+    vec3 v = -rayDir;
+    vec3 color = m.emissive;
+    float up = n.y * 0.5 + 0.5;
+    color += mix(f.ambientColor * 0.5, f.ambientColor + f.skyColor * 0.15, up) * m.baseColor;
+    vec3 toSun = -f.sunDirection;
+    if (dot(f.sunColor, f.sunColor) > 0.0 && dot(n, toSun) > 0.0) {
+        bool shadowed = rtOccluded(rt, rtOrigin(f, rt, s.position, ng, toSun), toSun, 1e30);
+        rtCountRays(rt, 1u);
+        if (!shadowed) color += m.baseColor / PI * f.sunColor * dot(n, toSun);
+    }
+    LightBuffer lights = LightBuffer(f.lights);
+    for (uint i = 0u; i < f.lightCount; ++i)
+        color += max(evaluateLight(lights.l[i], m, n, v, s.position), vec3(0.0));
+    return color;
+}
+
+// One bounce of diffuse light: the mean radiance of `rays` cosine rays' hits, i.e. the
+// irradiance / pi; the receiver multiplies it by its diffuse albedo. Misses add nothing (the
+// ambient term stands for the sky).
+vec3 rtIndirectDiffuse(FrameConstants f, RtFrame rt, vec3 p, vec3 n, vec3 ng, uint seed,
+                       uint sampleBase, uint rays) {
+    vec3 sum = vec3(0.0);
+    for (uint i = 0u; i < rays; ++i) {
+        vec3 dir = rtCosineDirection(n, rtSample2(seed ^ 0xa511e9b3u, sampleBase + i));
+        rayQueryEXT q;
+        rayQueryInitializeEXT(q, rtTlas(rt), gl_RayFlagsOpaqueEXT, 0xFFu, rtOrigin(f, rt, p, ng, dir),
+                              0.0, dir, 1e30);
+        while (rayQueryProceedEXT(q)) {}
+        if (rayQueryGetIntersectionTypeEXT(q, true) == gl_RayQueryCommittedIntersectionNoneEXT) continue;
+        sum += rtShadeHit(f, rt, uint(rayQueryGetIntersectionInstanceCustomIndexEXT(q, true)),
+                          uint(rayQueryGetIntersectionPrimitiveIndexEXT(q, true)),
+                          rayQueryGetIntersectionBarycentricsEXT(q, true),
+                          rayQueryGetIntersectionFrontFaceEXT(q, true), dir);
+    }
+    rtCountRays(rt, rays);
+    return rays == 0u ? vec3(0.0) : sum / float(rays);
+}
+#endif

@@ -1,0 +1,92 @@
+#version 460
+// Shadel path: traces the RT cache (render/raytracing/rt_shadel_cache.h). One 8x8 workgroup
+// per tile of a visible instance's rect, one thread per texel of its shadel space at the cache's
+// MIP: the texel's triangle (the level's triangle-ID map) and clamped barycentrics rebuild the
+// surface as the shading pass does, then --rays-per-shadel AO and GI rays (and the sun's) are
+// traced and averaged into the history, each frame continuing the texel's low-discrepancy
+// sequence where the last one stopped.
+#include "raytracing/rt_effects.glsl"
+#include "common/shadel_bary.h"
+
+layout(local_size_x = 8, local_size_y = 8) in;
+layout(push_constant, scalar) uniform Push { uint64_t frame; } pc;
+layout(buffer_reference, scalar) readonly buffer RtShadelObjects { RtShadelObject o[]; };
+layout(buffer_reference, scalar) readonly buffer RtShadelTiles { RtShadelTile t[]; };
+
+uint cachedTriangle(ShadelFrame s, uint offset) {
+    uint word = UintBuffer(s.idMaps).v[offset >> 1];
+    return (word >> ((offset & 1u) * 16u)) & 0xFFFFu;
+}
+
+void main() {
+    FrameConstants f = FrameConstantsRef(pc.frame).f;
+    RtFrame rt = RtFrameRef(f.rt).r;
+    ShadelFrame s = ShadelFrameRef(f.shadel).s;
+    uint tileIndex = gl_WorkGroupID.y * 32768u + gl_WorkGroupID.x;
+    if (tileIndex >= rt.shadelTileCount) return;
+    RtShadelTile tile = RtShadelTiles(rt.shadelTiles).t[tileIndex];
+    RtShadelObject o = RtShadelObjects(rt.shadelObjects).o[tile.object];
+    uvec2 texel = uvec2(tile.tile & 0xFFFFu, tile.tile >> 16) * 8u + gl_LocalInvocationID.xy;
+    if (any(greaterThanEqual(texel, o.size))) return;
+    ivec2 atlas = ivec2(o.origin + texel);
+    vec4 history = imageLoad(gImagesRgba16f[rt.shadelTermsWrite], atlas);
+    float count = (o.flags & RT_SHADEL_RESET) != 0u ? 0.0 : history.w;
+    // Converged: the texel is reused as it is until its inputs change (the seed's "trace once
+    // per shadel and reuse"; a reset starts it again).
+    if (count >= float(rt.historyRays)) return;
+    uint tri = cachedTriangle(s, o.idMapOffset + texel.y * o.size.x + texel.x);
+    if (tri == 0xFFFFu) { // no surface here (outside every chart and its gutter): never read
+        imageStore(gImagesRgba16f[rt.shadelTermsWrite], atlas, vec4(1.0, 1.0, 0.0, 0.0));
+        imageStore(gImagesRgba16f[rt.shadelIndirectWrite], atlas, vec4(0.0));
+        return;
+    }
+    GpuInstance inst = InstanceBuffer(f.instances).i[tile.object];
+    GpuMesh mesh = MeshBuffer(f.meshes).m[inst.mesh];
+    IndexBuffer indices = IndexBuffer(f.indices);
+    uint i0 = indices.i[mesh.firstIndex + tri * 3u] + uint(mesh.vertexOffset);
+    uint i1 = indices.i[mesh.firstIndex + tri * 3u + 1u] + uint(mesh.vertexOffset);
+    uint i2 = indices.i[mesh.firstIndex + tri * 3u + 2u] + uint(mesh.vertexOffset);
+    Vec2Buffer uvs = Vec2Buffer(s.shadelUvs);
+    vec3 bary = shadelBarycentrics(shadelCenterUv(texel, o.size), uvs.v[i0], uvs.v[i1], uvs.v[i2]);
+    // At coarse MIPs a texel's centre can lie far outside the triangle its ID map names (the
+    // gutter flood, or a triangle smaller than the texel): the point is pulled onto the triangle
+    // so that rays leave the surface, not the inside of the object.
+    bary = max(bary, vec3(0.0));
+    bary /= max(bary.x + bary.y + bary.z, 1e-6);
+    VertexBuffer vb = VertexBuffer(f.vertices);
+    GpuVertex v0 = vb.v[i0], v1 = vb.v[i1], v2 = vb.v[i2];
+    vec3 p = (inst.model * vec4(shadelInterpolate(bary, v0.position, v1.position, v2.position), 1.0)).xyz;
+    vec3 n = normalize(mat3(inst.normalMatrix) * shadelInterpolate(bary, v0.normal, v1.normal, v2.normal));
+    vec3 ng = normalize(mat3(inst.normalMatrix) * cross(v1.position - v0.position, v2.position - v0.position));
+    if (dot(ng, n) < 0.0) ng = -ng;
+    // Only what the camera can see is traced this frame: texels facing away (single-sided
+    // materials) or outside the view frustum (with a margin for the filters' reach) wait until
+    // they come into view; on a reset they are marked empty, so stale texels are never read.
+    GpuMaterial mat = MaterialBuffer(f.materials).m[inst.material];
+    bool facing = (mat.flags & MATERIAL_DOUBLE_SIDED) != 0u || dot(ng, f.cameraPosition - p) > 0.0;
+    float margin = 0.05 * length(f.cameraPosition - p);
+    bool inView = true;
+    for (int i = 0; i < 6; ++i) inView = inView && dot(f.frustumPlanes[i], vec4(p, 1.0)) >= -margin;
+    if (!facing || !inView) {
+        if (count == 0.0) {
+            imageStore(gImagesRgba16f[rt.shadelTermsWrite], atlas, vec4(1.0, 1.0, 0.0, 0.0));
+            imageStore(gImagesRgba16f[rt.shadelIndirectWrite], atlas, vec4(0.0));
+        }
+        return;
+    }
+
+    vec4 indirectHistory = imageLoad(gImagesRgba16f[rt.shadelIndirectWrite], atlas);
+    uint rays = rt.raysPerShadel;
+    uint seed = rtHash(tile.object * 0x9e3779b9u ^ rtHash(uint(atlas.x) | uint(atlas.y) << 16));
+    uint sampleBase = uint(count); // continue the sequence: no sample is drawn twice
+    float sun = rt.shadows != 0u ? rtSunVisibility(f, rt, p, ng, seed, sampleBase) : 1.0;
+    float ao = rt.ao != 0u ? rtAmbientOcclusion(f, rt, p, n, ng, seed, sampleBase, rays) : 1.0;
+    vec3 indirect = rt.gi != 0u ? rtIndirectDiffuse(f, rt, p, n, ng, seed, sampleBase, rays) : vec3(0.0);
+    // The running mean of every ray so far.
+    float total = count + float(rays);
+    float w = float(rays) / total;
+    vec4 terms = vec4(mix(history.xy, vec2(sun, ao), w), 0.0, total);
+    imageStore(gImagesRgba16f[rt.shadelTermsWrite], atlas, terms);
+    imageStore(gImagesRgba16f[rt.shadelIndirectWrite], atlas,
+               vec4(mix(indirectHistory.rgb, indirect, w), total));
+}

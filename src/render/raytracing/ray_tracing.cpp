@@ -1,0 +1,297 @@
+#include "render/raytracing/ray_tracing.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+
+#include <nlohmann/json.hpp>
+
+#include "core/log.h"
+#include "raytracing/rt_types.h"
+#include "render/forward/forward_passes.h"
+#include "render/raytracing/acceleration_structures.h"
+#include "render/raytracing/rt_shadel_cache.h"
+#include "render/renderer.h"
+
+namespace shadel {
+
+struct RayTracingState {
+    RtFunctions fn;
+    std::unique_ptr<BlasPools> pools;
+    BlasSet blases;
+    Tlas tlas;
+    BufferHandle frame;        // gpu::RtFrame (host-visible)
+    BufferHandle instanceLods; // uint per instance: first index of its BLAS's LOD (host-visible)
+    BufferHandle counters;     // gpu::RtCounters (readback)
+    // Forward path: the per-pixel terms (sun, AO, -, distance) and the indirect light.
+    TextureHandle terms, indirect;
+    RenderTargetView termsTarget, indirectTarget;
+    TextureReadView termsRead, indirectRead;
+    Pipeline pixelTerms;
+    RtShadelCache shadelCache; // decoupled mode: the terms per shadel, accumulated over frames
+    uint32_t raysLastFrame = 0;
+    uint64_t raysTotal = 0;
+    uint32_t framesTraced = 0;
+    uint32_t fallbackInstances = 0; // TLAS instances this frame whose LOD used the fallback BLAS
+};
+
+void RayTracingStateDeleter::operator()(RayTracingState* state) const {
+    delete state;
+}
+
+static const char* firstEffectFlag(const RtSettings& s) {
+    return s.shadows ? "--rt-shadows on" : s.ao ? "--rt-ao on" : "--rt-gi on";
+}
+
+static bool tracesPerPixel(const Renderer& r) {
+    return r.settings.mode == RenderMode::Forward;
+}
+
+static void createPixelTargets(Renderer& r, RayTracingState& s) {
+    Gpu& gpu = *r.gpu;
+    TextureDesc d;
+    d.format = VK_FORMAT_R16G16B16A16_SFLOAT;
+    d.width = r.internalWidth;
+    d.height = r.internalHeight;
+    d.usage = VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT | VK_IMAGE_USAGE_SAMPLED_BIT;
+    d.name = "rt.pixelTerms";
+    s.terms = createTexture(gpu, d);
+    d.name = "rt.pixelIndirect";
+    s.indirect = createTexture(gpu, d);
+    if (!s.terms || !s.indirect) throw DeviceError("out of GPU memory for the ray-traced terms");
+    s.termsTarget = createRenderTargetView(gpu, s.terms);
+    s.indirectTarget = createRenderTargetView(gpu, s.indirect);
+    s.termsRead = createReadView(gpu, s.terms);
+    s.indirectRead = createReadView(gpu, s.indirect);
+    GraphicsPipelineDesc p;
+    p.name = "rtPixelTerms";
+    p.vertexShader = "forward_forward.vert.spv";
+    p.fragmentShader = "raytracing_rt_pixel.frag.spv";
+    p.colorFormats = {VK_FORMAT_R16G16B16A16_SFLOAT, VK_FORMAT_R16G16B16A16_SFLOAT};
+    p.depthFormat = VK_FORMAT_D32_SFLOAT;
+    p.depthWrite = false;
+    p.depthCompare = VK_COMPARE_OP_EQUAL; // the prepass resolved visibility
+    p.cullMode = VK_CULL_MODE_NONE;
+    s.pixelTerms = createGraphicsPipeline(gpu, p);
+}
+
+RayTracingStatePtr createRayTracing(Renderer& r, const GpuScene& scene) {
+    Gpu& gpu = *r.gpu;
+    const RtSettings& rt = r.settings.rt;
+    if (!gpu.device.optional.rayQuery)
+        throw InputError(format("%s: %s cannot trace rays (it lacks VK_KHR_ray_query or "
+                                "VK_KHR_acceleration_structure)",
+                                firstEffectFlag(rt), gpu.device.name.c_str()));
+    RayTracingStatePtr state(new RayTracingState);
+    RayTracingState& s = *state;
+    s.fn = loadRtFunctions(gpu.device);
+    s.pools = std::make_unique<BlasPools>(gpu, uint64_t(rt.blasPoolMb) << 20, rt.blasPoolLimit);
+    buildBlases(gpu, s.fn, *s.pools, scene, s.blases);
+    createTlas(gpu, s.fn, scene.instanceCount, s.tlas);
+    s.frame = createBuffer(gpu, {"rt.frame", sizeof(gpu::RtFrame), 0, MemoryKind::Upload});
+    s.instanceLods =
+        createBuffer(gpu, {"rt.instanceLods", std::max<size_t>(scene.instanceCount, 1) * 4, 0,
+                           MemoryKind::Upload});
+    s.counters =
+        createBuffer(gpu, {"rt.counters", sizeof(gpu::RtCounters), 0, MemoryKind::Readback});
+    if (!s.frame || !s.instanceLods || !s.counters)
+        throw DeviceError("out of GPU memory for the ray-tracing frame buffers");
+    if (tracesPerPixel(r))
+        createPixelTargets(r, s);
+    else
+        createRtShadelCache(r, scene, s.shadelCache);
+    return state;
+}
+
+void destroyRayTracing(Renderer& r, RayTracingStatePtr& state) {
+    if (!state) return;
+    Gpu& gpu = *r.gpu;
+    RayTracingState& s = *state;
+    destroyRtShadelCache(r, s.shadelCache);
+    destroyTlas(gpu, s.fn, s.tlas);
+    destroyBlases(gpu, s.fn, *s.pools, s.blases);
+    s.pools.reset();
+    for (BufferHandle b : {s.frame, s.instanceLods, s.counters})
+        if (b) destroy(gpu, b);
+    if (s.terms) {
+        destroy(gpu, s.pixelTerms);
+        destroy(gpu, s.termsTarget);
+        destroy(gpu, s.indirectTarget);
+        destroy(gpu, s.termsRead);
+        destroy(gpu, s.indirectRead);
+        destroy(gpu, s.terms);
+        destroy(gpu, s.indirect);
+    }
+    state.reset();
+}
+
+// Distance from p to the box (0 inside).
+static float distanceToBox(glm::vec3 p, glm::vec3 lo, glm::vec3 hi) {
+    return glm::length(glm::max(glm::max(lo - p, p - hi), glm::vec3(0.0f)));
+}
+
+void prepareRayTracingFrame(Renderer& r, const GpuScene& scene, const CameraView& camera,
+                            gpu::FrameConstants& constants) {
+    Gpu& gpu = *r.gpu;
+    RayTracingState& s = *r.rt;
+    const RtSettings& rt = r.settings.rt;
+    // The TLAS's instances: every instance within the ray-tracing distance of the camera, in
+    // front of it or not (shadow and AO rays reach what the camera does not see). Each traces
+    // the LOD the raster draws (--lod on: the coarsest whose error projects below the threshold
+    // at its distance; off: LOD 0), so rays leave the very surface that is shaded: a coarser
+    // BLAS of the same object would cut through it and shadow it (the least-detailed fallback
+    // can, where its allocation failed).
+    auto* out = static_cast<VkAccelerationStructureInstanceKHR*>(mapped(gpu, s.tlas.instances));
+    auto* lods = static_cast<uint32_t*>(mapped(gpu, s.instanceLods));
+    float pixelsPerUnit = std::abs(camera.proj[1][1]) * 0.5f * float(r.internalHeight);
+    uint32_t count = 0;
+    s.fallbackInstances = 0;
+    for (uint32_t i = 0; i < scene.instanceCount; ++i) {
+        const gpu::GpuInstance& inst = scene.instanceInfo[i];
+        const std::vector<int32_t>& chain = s.blases.meshLods[inst.mesh];
+        float d = distanceToBox(camera.position, inst.worldMin, inst.worldMax);
+        if (chain.empty() || (rt.distance > 0.0f && d > rt.distance)) continue;
+        const gpu::GpuMeshLods& info = scene.lodInfo[inst.mesh];
+        float scale =
+            std::max({glm::length(glm::vec3(inst.model[0])), glm::length(glm::vec3(inst.model[1])),
+                      glm::length(glm::vec3(inst.model[2]))});
+        uint32_t lod = 0;
+        while (r.settings.lod && lod + 1 < info.lodCount &&
+               info.lod[lod + 1].error * scale * pixelsPerUnit <=
+                   r.settings.lodErrorPixels * std::max(d, 1e-3f))
+            ++lod;
+        int32_t b = chain[lod];
+        if (b < 0) continue; // no BLAS at all for this mesh (even the least-detailed failed)
+        const Blas& blas = s.blases.blases[b];
+        s.fallbackInstances += blas.lod != lod;
+        VkAccelerationStructureInstanceKHR& o = out[count++];
+        for (int row = 0; row < 3; ++row)
+            for (int col = 0; col < 4; ++col) o.transform.matrix[row][col] = inst.model[col][row];
+        o.instanceCustomIndex = i;
+        o.mask = 0xFF;
+        o.instanceShaderBindingTableRecordOffset = 0;
+        o.flags = VK_GEOMETRY_INSTANCE_TRIANGLE_FACING_CULL_DISABLE_BIT_KHR;
+        o.accelerationStructureReference = blas.address;
+        lods[i] = blas.firstIndex;
+    }
+    s.tlas.instanceCount = count;
+
+    gpu::RtFrame f{};
+    f.tlas = s.tlas.address;
+    f.instanceLods = address(gpu, s.instanceLods);
+    f.counters = address(gpu, s.counters);
+    f.shadows = rt.shadows;
+    f.ao = rt.ao;
+    f.gi = rt.gi;
+    f.shadowRays = rt.shadowRays;
+    f.sunAngle = glm::radians(rt.sunAngleDegrees);
+    f.aoRays = rt.aoRays;
+    f.aoRadius = rt.aoRadius;
+    f.giRays = rt.giRays;
+    f.pixelTermsSlot = s.terms ? slot(gpu, s.termsRead).value : NO_TEXTURE;
+    f.pixelIndirectSlot = s.indirect ? slot(gpu, s.indirectRead).value : NO_TEXTURE;
+    f.frame = uint32_t(r.framesRendered);
+    f.spatialFilter = rt.spatialFilter;
+    f.normalOffset = 2e-4f;
+    f.raysPerShadel = rt.raysPerShadel;
+    if (s.shadelCache.terms) prepareRtShadelCache(r, scene, camera, s.shadelCache, f);
+    std::memcpy(mapped(gpu, s.frame), &f, sizeof(f));
+    constants.rt = address(gpu, s.frame);
+}
+
+void recordTlasBuild(Renderer& r, VkCommandBuffer cmd) {
+    Gpu& gpu = *r.gpu;
+    RayTracingState& s = *r.rt;
+    vkCmdFillBuffer(cmd, vkBuffer(gpu, s.counters), 0, VK_WHOLE_SIZE, 0);
+    memoryBarrier(cmd, VK_PIPELINE_STAGE_2_CLEAR_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT,
+                  VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT | VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
+                  VK_ACCESS_2_SHADER_STORAGE_READ_BIT | VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT);
+    recordTlasBuild(gpu, s.fn, cmd, s.tlas);
+}
+
+void recordRayTracedPixels(Renderer& r, VkCommandBuffer cmd, uint64_t frame) {
+    Gpu& gpu = *r.gpu;
+    RayTracingState& s = *r.rt;
+    for (TextureHandle t : {s.terms, s.indirect})
+        imageBarrier(cmd, vkImage(gpu, t), VK_IMAGE_ASPECT_COLOR_BIT, VK_IMAGE_LAYOUT_UNDEFINED,
+                     VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL,
+                     VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT, 0,
+                     VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT,
+                     VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT);
+    VkRenderingAttachmentInfo color[2]{};
+    RenderTargetView views[2] = {s.termsTarget, s.indirectTarget};
+    for (int i = 0; i < 2; ++i) {
+        color[i] = {VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO};
+        color[i].imageView = vkView(gpu, views[i]);
+        color[i].imageLayout = VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL;
+        color[i].loadOp = VK_ATTACHMENT_LOAD_OP_CLEAR; // distance 0: nothing traced
+        color[i].storeOp = VK_ATTACHMENT_STORE_OP_STORE;
+    }
+    VkRenderingAttachmentInfo depth{VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO};
+    depth.imageView = vkView(gpu, r.depthTarget);
+    depth.imageLayout = VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL;
+    depth.loadOp = VK_ATTACHMENT_LOAD_OP_LOAD;
+    depth.storeOp = VK_ATTACHMENT_STORE_OP_STORE;
+    VkRenderingInfo ri{VK_STRUCTURE_TYPE_RENDERING_INFO};
+    ri.renderArea = {{0, 0}, {r.internalWidth, r.internalHeight}};
+    ri.layerCount = 1;
+    ri.colorAttachmentCount = 2;
+    ri.pColorAttachments = color;
+    ri.pDepthAttachment = &depth;
+    vkCmdBeginRendering(cmd, &ri);
+    bind(gpu, cmd, s.pixelTerms);
+    pushConstants(gpu, cmd, RasterPush{frame, 0});
+    drawCameraList(r, cmd, DRAW_LIST_OPAQUE);
+    vkCmdEndRendering(cmd);
+    for (TextureHandle t : {s.terms, s.indirect})
+        imageBarrier(
+            cmd, vkImage(gpu, t), VK_IMAGE_ASPECT_COLOR_BIT,
+            VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL,
+            VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT, VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT,
+            VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT, VK_ACCESS_2_SHADER_SAMPLED_READ_BIT);
+}
+
+void recordRayTracedShadels(Renderer& r, VkCommandBuffer cmd, uint64_t frame) {
+    recordRtShadelTrace(r, cmd, frame, r.rt->shadelCache);
+}
+
+void finishRayTracingFrame(Renderer& r) {
+    RayTracingState& s = *r.rt;
+    gpu::RtCounters c{};
+    std::memcpy(&c, mapped(*r.gpu, s.counters), sizeof(c));
+    s.raysLastFrame = c.raysTraced;
+    s.raysTotal += c.raysTraced;
+    s.framesTraced++;
+}
+
+void rayTracingStats(const Renderer& r, nlohmann::json& stats) {
+    const RayTracingState& s = *r.rt;
+    PoolSetStats pools = s.pools->stats();
+    stats["blas_count"] = s.blases.stats.built;
+    stats["blas_bytes"] = s.blases.stats.bytes;
+    stats["blas_pools"] = pools.poolCount;
+    stats["blas_fallbacks"] = s.blases.stats.fallbacks;
+    stats["tlas_instances"] = s.tlas.instanceCount;
+    stats["rays_traced"] = s.raysLastFrame;
+    const RtSettings& rt = r.settings.rt;
+    stats["rt"] = {
+        {"shadows", rt.shadows},
+        {"ao", rt.ao},
+        {"gi", rt.gi},
+        {"blas_uncompacted_bytes", s.blases.stats.uncompactedBytes},
+        {"blas_pool_bytes", pools.poolBytes},
+        {"blas_pool_failed_allocations", pools.failedAllocations},
+        {"meshes_without_blas", s.blases.stats.meshesWithoutBlas},
+        {"tlas_fallback_instances", s.fallbackInstances},
+        {"rays_traced_mean", s.framesTraced ? double(s.raysTotal) / s.framesTraced : 0.0}};
+    if (s.shadelCache.terms)
+        stats["rt"]["shadel_cache"] = {
+            {"texels", s.shadelCache.texelsTraced},
+            {"history_rays", rt.historyRays},
+            {"instances", s.shadelCache.instancesCached},
+            {"instances_without_room", s.shadelCache.instancesWithoutRoom},
+            {"rays_per_shadel", rt.raysPerShadel},
+            {"mip_offset", rt.shadelMipOffset}};
+}
+
+} // namespace shadel
