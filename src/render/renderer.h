@@ -36,7 +36,10 @@ enum class Visualize : uint32_t {
     LightCount = VISUALIZE_LIGHT_COUNT, // lights per tile (forward) or chunk (shadel)
     Blockers = VISUALIZE_BLOCKERS,      // tiles / chunks with per-pixel blocker checks
     Gi = 6,                             // --visualize gi: the LPV's indirect light only
+    ParticleAtlas = 24,                 // --visualize particle-atlas (render/particles)
 };
+// --particle-lighting: lit particle sprites read the atlas, or are lit per pixel / per vertex.
+enum class ParticleLighting : uint32_t { Atlas = 0, Pixel = 1, Vertex = 2 };
 
 // --light-culling: per-tile (forward) and per-chunk (shadel) light lists, or every light for
 // every pixel / shadel.
@@ -86,6 +89,9 @@ struct RenderSettings {
     bool lod = false;                  // GPU LOD selection by projected error (render/culling)
     float lodErrorPixels = 0.5f;       // the coarsest LOD whose error projects below this is drawn
     bool occlusion = false; // two-phase hierarchical-Z occlusion culling (render/culling)
+    bool particles = true;  // the scene's GPU particle emitters (render/particles)
+    ParticleLighting particleLighting = ParticleLighting::Atlas;
+    uint32_t particleAtlasSize = 1024; // texels per side of the particle lightmap atlas
 };
 
 struct FrameResult {
@@ -115,6 +121,11 @@ struct OitStateDeleter {
     void operator()(OitState* state) const;
 };
 using OitStatePtr = std::unique_ptr<OitState, OitStateDeleter>;
+struct ParticleState; // render/particles/particles.h
+struct ParticleStateDeleter {
+    void operator()(ParticleState* state) const;
+};
+using ParticleStatePtr = std::unique_ptr<ParticleState, ParticleStateDeleter>;
 
 struct Renderer {
     Gpu* gpu = nullptr;
@@ -147,6 +158,7 @@ struct Renderer {
     uint64_t framesRendered = 0;
     VisibilityStatePtr visibility;     // decoupled with --marking visibility
     OitStatePtr oit;                   // scenes with blended materials (render/oit)
+    ParticleStatePtr particles;        // scenes with particle emitters (render/particles)
     LightCullingStatePtr lightCulling; // light lists (render/lighting/light_culling.h)
     GiStatePtr gi;                     // --gi lpv
     CullingStatePtr culling;           // LODs, occlusion, per-view counts (render/culling)
