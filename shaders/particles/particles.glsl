@@ -78,23 +78,20 @@ float puffHeight(vec2 q, uint seed) {
     return dome + 0.22 * particleNoise(q * 2.5 + 7.0, seed) + 0.08 * particleNoise(q * 5.0 + 3.0, seed + 1u);
 }
 
-// The sprite texture at uv: opacity (soft disc broken up by noise) and the normal map
-// (tangent space, z towards the camera) from the height field's gradient.
-struct ParticleSprite {
-    float opacity;
-    vec3 normal;
-};
-ParticleSprite particleSprite(vec2 uv, uint seed, float normalScale) {
+// The sprite texture at uv: opacity (a soft disc broken up by noise) and the normal map
+// (tangent space, z towards the camera) from the height field's gradient. Separate functions:
+// sprites lit from the atlas never evaluate the normal map per pixel.
+float particleSpriteOpacity(vec2 uv, uint seed) {
     vec2 q = uv * 2.0 - 1.0;
-    float r2 = dot(q, q);
-    ParticleSprite s;
-    float disc = clamp(1.0 - r2, 0.0, 1.0);
-    s.opacity = disc * disc * (0.6 + 0.4 * particleNoise(q * 3.0 + 11.0, seed + 2u));
+    float disc = clamp(1.0 - dot(q, q), 0.0, 1.0);
+    return disc * disc * (0.6 + 0.4 * particleNoise(q * 3.0 + 11.0, seed + 2u));
+}
+vec3 particleSpriteNormal(vec2 uv, uint seed, float normalScale) {
+    vec2 q = uv * 2.0 - 1.0;
     const float e = 1.0 / 64.0;
     float hx = puffHeight(q + vec2(e, 0.0), seed) - puffHeight(q - vec2(e, 0.0), seed);
     float hy = puffHeight(q + vec2(0.0, e), seed) - puffHeight(q - vec2(0.0, e), seed);
-    s.normal = normalize(vec3(-hx / (2.0 * e) * normalScale, -hy / (2.0 * e) * normalScale, 1.0));
-    return s;
+    return normalize(vec3(-hx / (2.0 * e) * normalScale, -hy / (2.0 * e) * normalScale, 1.0));
 }
 vec3 particleWorldNormal(ParticleBasis b, vec3 tangentNormal) {
     return normalize(tangentNormal.x * b.right + tangentNormal.y * b.up +
@@ -109,8 +106,8 @@ uint particleSpriteSeed(GpuParticleEmitter e, uint particle, GpuParticle p) {
 vec3 particleLightingAt(FrameConstants f, GpuParticleEmitter e, GpuParticle p, uint particle,
                         vec2 uv) {
     ParticleBasis b = particleBasis(f, p);
-    ParticleSprite s = particleSprite(uv, particleSpriteSeed(e, particle, p), e.normalScale);
+    vec3 n = particleSpriteNormal(uv, particleSpriteSeed(e, particle, p), e.normalScale);
     vec3 pos = particlePoint(b, p, particleSize(e, p), uv);
-    return shadeParticle(f, pos, particleWorldNormal(b, s.normal), e.wrap);
+    return shadeParticle(f, pos, particleWorldNormal(b, n), e.wrap);
 }
 #endif

@@ -15,17 +15,14 @@ layout(location = 0) in vec3 inPosition;
 layout(location = 1) in vec2 inUv;
 layout(location = 2) flat in uint inParticle;
 layout(location = 3) in vec3 inVertexLight;
+layout(location = 4) flat in uvec4 inAtlasRect;
 
 layout(location = 0) out vec4 outAccum;
 layout(location = 1) out vec4 outReveal;
 
-vec3 atlasLighting(ParticleFrame pf, GpuParticle p, vec2 uv) {
-    uint lod = p.atlasEntry >> 24;
-    uvec4 rect = particleAtlasRect(ParticleAtlasCountsRef(pf.atlasCounts).c.perLod, lod,
-                                   p.atlasEntry & 0xFFFFFFu, pf.atlasSize);
-    if (rect.w == 0u) return vec3(-1.0);
-    // Texel centres sit at (k + 0.5) / side; clamping to the outer centres keeps the bilinear
-    // taps inside the rectangle (no bleeding from the neighbours).
+// Bilinear inside the sprite's rectangle: texel centres sit at (k + 0.5) / side, and clamping to
+// the outer centres keeps the taps off the neighbours' texels.
+vec3 atlasLighting(ParticleFrame pf, uvec4 rect, vec2 uv) {
     vec2 texel = clamp(uv * float(rect.z), vec2(0.5), vec2(float(rect.z) - 0.5)) + vec2(rect.xy);
     return sampleTextureLod(pf.atlasReadSlot, SAMPLER_LINEAR_CLAMP, texel / float(pf.atlasSize), 0.0).rgb;
 }
@@ -36,18 +33,22 @@ void main() {
     GpuParticle p = ParticleBuffer(pf.particles).p[inParticle];
     GpuParticleEmitter e = ParticleEmitterBuffer(pf.emitters).e[p.emitter];
     vec4 color = particleColor(e, p);
-    ParticleSprite s = particleSprite(inUv, particleSpriteSeed(e, inParticle, p), e.normalScale);
+    uint seed = particleSpriteSeed(e, inParticle, p);
     vec3 shaded = color.rgb; // unlit: emission
     if ((e.flags & PARTICLE_EMITTER_LIT) != 0u) {
         vec3 light = vec3(-1.0);
-        if (pf.lighting == PARTICLE_LIGHTING_ATLAS && p.atlasEntry != PARTICLE_NO_ATLAS)
-            light = atlasLighting(pf, p, inUv);
+        if (pf.lighting == PARTICLE_LIGHTING_ATLAS && inAtlasRect.w != 0u)
+            light = atlasLighting(pf, inAtlasRect, inUv);
         else if (pf.lighting == PARTICLE_LIGHTING_VERTEX)
             light = inVertexLight;
         if (light.r < 0.0) // per pixel (and atlas sprites that found no room)
-            light = shadeParticle(f, inPosition, particleWorldNormal(particleBasis(f, p), s.normal), e.wrap);
+            light = shadeParticle(f, inPosition,
+                                  particleWorldNormal(particleBasis(f, p),
+                                                      particleSpriteNormal(inUv, seed, e.normalScale)),
+                                  e.wrap);
         shaded *= light;
     }
-    TransparentFragment t = transparentFragment(shaded, s.opacity * color.a, e.additiveness);
+    TransparentFragment t =
+        transparentFragment(shaded, particleSpriteOpacity(inUv, seed) * color.a, e.additiveness);
     wboitOutputs(t, viewDepthOf(f, inPosition), outAccum, outReveal);
 }

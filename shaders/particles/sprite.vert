@@ -13,6 +13,7 @@ layout(location = 0) out vec3 outPosition;
 layout(location = 1) out vec2 outUv;
 layout(location = 2) flat out uint outParticle;
 layout(location = 3) out vec3 outVertexLight; // --particle-lighting vertex
+layout(location = 4) flat out uvec4 outAtlasRect; // x, y, side, fits (0: none)
 
 const vec2 kCorners[6] = vec2[](vec2(0, 0), vec2(1, 0), vec2(1, 1), vec2(0, 0), vec2(1, 1), vec2(0, 1));
 
@@ -25,6 +26,7 @@ void main() {
     outParticle = i;
     outUv = uv;
     outVertexLight = vec3(0.0);
+    outAtlasRect = uvec4(0u);
     if (!particleAlive(p)) {
         outPosition = vec3(0.0);
         gl_Position = vec4(0.0, 0.0, -1.0, 1.0); // every vertex alike: a degenerate triangle
@@ -35,6 +37,10 @@ void main() {
     vec3 pos = particlePoint(b, p, particleSize(e, p), uv);
     outPosition = pos;
     gl_Position = f.viewProj * vec4(pos, 1.0);
+    // The sprite's atlas rectangle, once per vertex rather than per fragment.
+    if (p.atlasEntry != PARTICLE_NO_ATLAS)
+        outAtlasRect = particleAtlasRect(ParticleAtlasCountsRef(pf.atlasCounts).c.perLod,
+                                         p.atlasEntry >> 24, p.atlasEntry & 0xFFFFFFu, pf.atlasSize);
     if ((e.flags & PARTICLE_EMITTER_LIT) != 0u && pf.lighting == PARTICLE_LIGHTING_VERTEX) {
         // The corner's normal: the dome of the normal map without its noise (the corners
         // themselves lie outside the disc, so take the disc's edge towards them).
