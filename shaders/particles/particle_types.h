@@ -16,6 +16,9 @@ using uint = uint32_t;
 #endif
 
 #define PARTICLE_EMITTER_LIT 1u // shaded with the scene's lights (smoke); else emissive (fire)
+#define PARTICLE_EMITTER_MESH 2u       // opaque mesh particles (forward path), not sprites
+#define PARTICLE_EMITTER_VERTEX_LIT 4u // mesh particles lit per vertex (else per pixel)
+#define PARTICLE_MESH_VERTICES 36u     // a mesh particle: a box, 12 triangles
 
 // --particle-lighting: where a lit sprite's lighting is computed.
 #define PARTICLE_LIGHTING_ATLAS 0u  // per atlas texel, once per frame (seed 004)
@@ -47,6 +50,7 @@ struct GpuParticleEmitter {
     float turbulence;  // m/s^2 of sideways swirl
     float wrap;        // wrap ("non-directional") shading: 0 = Lambert, 1 = fully wrapped
     float normalScale; // strength of the sprite's normal map
+    float bounce;      // >= 0: particles bounce off the ground plane y = 0 keeping this much speed
 };
 
 // One particle: its simulated state (written by simulate.comp) and this frame's atlas entry.

@@ -2,7 +2,7 @@
 // GPU particle simulation (one thread per particle): `steps` fixed time steps of births,
 // motion (velocity, buoyancy/gravity, drag, a swirl) and respawns, all seeded by the emitter's
 // seed, the particle's index and its generation, so a run is reproducible frame for frame.
-// Then each live lit sprite asks the particle atlas for a rectangle at the LOD its estimated
+// Then each live lit sprite (not mesh particles: they take the forward path) asks the particle atlas for a rectangle at the LOD its estimated
 // screen size calls for (particles/particle_atlas.h): one atomic per sprite is its packing.
 #include "particles/particles.glsl"
 
@@ -49,10 +49,14 @@ void main() {
         p.velocity += (e.acceleration + swirl) * pf.dt;
         p.velocity *= max(1.0 - e.drag * pf.dt, 0.0);
         p.position += p.velocity * pf.dt;
+        if (e.bounce >= 0.0 && p.position.y < 0.0) { // the ground plane
+            p.position.y = -p.position.y * e.bounce;
+            p.velocity = vec3(p.velocity.x * 0.7, -p.velocity.y * e.bounce, p.velocity.z * 0.7);
+        }
     }
 
     p.atlasEntry = PARTICLE_NO_ATLAS;
-    if (particleAlive(p) && (e.flags & PARTICLE_EMITTER_LIT) != 0u &&
+    if (particleAlive(p) && (e.flags & (PARTICLE_EMITTER_LIT | PARTICLE_EMITTER_MESH)) == PARTICLE_EMITTER_LIT &&
         pf.lighting == PARTICLE_LIGHTING_ATLAS) {
         float size = particleSize(e, p);
         bool visible = true;

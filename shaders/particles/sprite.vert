@@ -27,12 +27,12 @@ void main() {
     outUv = uv;
     outVertexLight = vec3(0.0);
     outAtlasRect = uvec4(0u);
-    if (!particleAlive(p)) {
+    GpuParticleEmitter e = ParticleEmitterBuffer(pf.emitters).e[p.emitter];
+    if (!particleAlive(p) || (e.flags & PARTICLE_EMITTER_MESH) != 0u) {
         outPosition = vec3(0.0);
         gl_Position = vec4(0.0, 0.0, -1.0, 1.0); // every vertex alike: a degenerate triangle
         return;
     }
-    GpuParticleEmitter e = ParticleEmitterBuffer(pf.emitters).e[p.emitter];
     ParticleBasis b = particleBasis(f, p);
     vec3 pos = particlePoint(b, p, particleSize(e, p), uv);
     outPosition = pos;

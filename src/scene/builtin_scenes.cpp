@@ -576,10 +576,10 @@ Scene makeTransparency() {
     return scene;
 }
 
-// GPU particles (seed 004, render/particles): a lit smoke column (alpha-blended sprites with a
-// normal map, lit by the sun, a warm light by the fire and a cool one on the left, through the
-// particle lightmap atlas) beside an unlit additive fire, in front of opaque geometry. Seeded:
-// every run simulates the same particles.
+// GPU particles (seed 004, render/particles): rock debris as mesh particles, a lit smoke column
+// (alpha-blended sprites with a normal map, lit by the sun, a warm light by the fire and a cool one
+// on the left, through the particle lightmap atlas) beside an unlit additive fire, in front of
+// opaque geometry. Seeded: every run simulates the same particles.
 Scene makeParticles() {
     Scene scene;
     scene.name = "particles";
@@ -632,6 +632,30 @@ Scene makeParticles() {
     fire.lit = false;
     fire.seed = 0xf12e;
     scene.emitters.push_back(fire);
+
+    // Mesh particles: embers of rock thrown up from the fire pit, bouncing on the ground; opaque,
+    // lit per vertex with wrap shading (the forward path of seed 004's mesh particles).
+    ParticleEmitter debris;
+    debris.name = "debris";
+    debris.position = {1.4f, 0.3f, -0.5f};
+    debris.spawnRadius = 0.3f;
+    debris.velocity = {0.0f, 3.2f, 0.4f};
+    debris.velocitySpread = 1.2f;
+    debris.acceleration = {0.0f, -9.8f, 0.0f};
+    debris.drag = 0.1f;
+    debris.colorStart = {0.35f, 0.3f, 0.26f, 1.0f};
+    debris.colorEnd = {0.2f, 0.18f, 0.16f, 1.0f};
+    debris.sizeStart = 0.12f;
+    debris.sizeEnd = 0.1f;
+    debris.lifetime = 2.5f;
+    debris.particleCount = 24;
+    debris.lit = true;
+    debris.mesh = true;
+    debris.vertexLit = true;
+    debris.wrap = 0.5f;
+    debris.bounce = 0.35f;
+    debris.seed = 0xdeb215;
+    scene.emitters.push_back(debris);
 
     b.sun({-0.4f, -1.0f, -0.5f}, 2.0f);
     b.pointLight("fire light", {1.4f, 1.0f, -0.3f}, {1.0f, 0.55f, 0.2f}, 10.0f, 8.0f);

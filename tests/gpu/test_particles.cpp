@@ -20,16 +20,14 @@ struct ParticleFrameImage {
     ParticleStats stats;
 };
 
-// builtin:particles with only its smoke column (the fire is unlit: identical in every lighting
-// mode, it would only inflate a PSNR), rendered forward at w x h.
-ParticleFrameImage renderSmoke(ParticleLighting lighting, bool particles, uint32_t w, uint32_t h) {
+// builtin:particles with its emitters edited by `edit`, rendered forward at w x h.
+template <typename Edit>
+ParticleFrameImage renderEmitters(Edit edit, ParticleLighting lighting, bool particles, uint32_t w,
+                                  uint32_t h) {
     Gpu& gpu = sharedGpu();
     uint32_t before = validationErrors();
     Scene scene = loadScene("builtin:particles");
-    scene.emitters.erase(std::remove_if(scene.emitters.begin(), scene.emitters.end(),
-                                        [](const ParticleEmitter& e) { return !e.lit; }),
-                         scene.emitters.end());
-    EXPECT_EQ(scene.emitters.size(), 1u);
+    edit(scene.emitters);
     GpuScene gs;
     uploadScene(gpu, scene, gs);
     RenderSettings s;
@@ -47,6 +45,16 @@ ParticleFrameImage renderSmoke(ParticleLighting lighting, bool particles, uint32
     destroyScene(gpu, gs);
     EXPECT_EQ(validationErrors(), before);
     return out;
+}
+
+// Only the smoke column (the fire is unlit and the debris lit per vertex in every mode: they
+// would only inflate a PSNR).
+ParticleFrameImage renderSmoke(ParticleLighting lighting, bool particles, uint32_t w, uint32_t h) {
+    auto smokeOnly = [](std::vector<ParticleEmitter>& emitters) {
+        std::erase_if(emitters, [](const ParticleEmitter& e) { return !e.lit || e.mesh; });
+        EXPECT_EQ(emitters.size(), 1u);
+    };
+    return renderEmitters(smokeOnly, lighting, particles, w, h);
 }
 
 // PSNR over the pixels the smoke changes (against the image without particles).
@@ -106,7 +114,7 @@ TEST(Particles, SimulationIsReproducibleAndMoves) {
     for (size_t f = 0; f < 3; ++f) EXPECT_EQ(a.frames[f].rgba, b.frames[f].rgba) << "frame " << f;
     EXPECT_NE(a.frames[0].rgba, a.frames[2].rgba) << "the particles should move between frames";
     const auto& p = a.stats["particles"];
-    EXPECT_EQ(p["particles"].get<uint32_t>(), 96u + 64u);
+    EXPECT_EQ(p["particles"].get<uint32_t>(), 96u + 64u + 24u); // smoke, fire, debris
     EXPECT_NEAR(p["simulated_seconds"].get<double>(), 4.8 + 3.0 / 60.0, 0.05);
     // Passes of the frame, in order.
     std::vector<std::string> names;
@@ -114,7 +122,9 @@ TEST(Particles, SimulationIsReproducibleAndMoves) {
     auto at = [&](const char* n) {
         return std::find(names.begin(), names.end(), n) - names.begin();
     };
-    EXPECT_LT(at("particleSimulate"), at("particleAtlasLighting"));
+    EXPECT_LT(at("forwardShading"), at("particleSimulate"));
+    EXPECT_LT(at("particleSimulate"), at("particleMeshes"));
+    EXPECT_LT(at("particleMeshes"), at("particleAtlasLighting"));
     EXPECT_LT(at("particleAtlasLighting"), at("oitAccumulate"));
     EXPECT_LT(at("oitAccumulate"), at("particleSprites"));
     EXPECT_LT(at("particleSprites"), at("oitComposite"));
@@ -142,6 +152,52 @@ TEST(Particles, AtlasLodFollowsScreenSize) {
     EXPECT_GT(farSide, 0.0);
     EXPECT_LT(farSide, nearSide * 0.75) << "farther sprites should take smaller rectangles";
     EXPECT_LE(nearSide, 32.0) << "the default bias caps sprites at 32x32";
+}
+
+// Mesh particles take the forward path: opaque boxes, lit per vertex or per pixel with wrap
+// shading. Wrap lights the faces turned from the lights, so it brightens the debris.
+TEST(Particles, MeshParticlesAreLitWithWrapPerVertexOrPixel) {
+    const uint32_t w = 320, h = 180;
+    auto debris = [](bool vertexLit, float wrap) {
+        return [=](std::vector<ParticleEmitter>& emitters) {
+            std::erase_if(emitters, [](const ParticleEmitter& e) { return !e.mesh; });
+            ASSERT_EQ(emitters.size(), 1u);
+            emitters[0].vertexLit = vertexLit;
+            emitters[0].wrap = wrap;
+        };
+    };
+    ParticleFrameImage none =
+        renderEmitters(debris(true, 0.5f), ParticleLighting::Atlas, false, w, h);
+    ParticleFrameImage vertex =
+        renderEmitters(debris(true, 0.5f), ParticleLighting::Atlas, true, w, h);
+    ParticleFrameImage pixel =
+        renderEmitters(debris(false, 0.5f), ParticleLighting::Atlas, true, w, h);
+    ParticleFrameImage lambert =
+        renderEmitters(debris(false, 0.0f), ParticleLighting::Atlas, true, w, h);
+    size_t pixels = 0;
+    double db = smokePsnr(vertex.rgba, pixel.rgba, none.rgba, &pixels);
+    // Mean brightness over the debris pixels (those the particles change).
+    auto mean = [&](const std::vector<uint8_t>& img) {
+        double sum = 0;
+        size_t n = 0;
+        for (size_t i = 0; i + 3 < img.size(); i += 4) {
+            bool debrisPixel = false;
+            for (int c = 0; c < 3; ++c)
+                debrisPixel =
+                    debrisPixel || std::abs(int(pixel.rgba[i + c]) - int(none.rgba[i + c])) > 2;
+            if (!debrisPixel) continue;
+            sum += img[i] + img[i + 1] + img[i + 2];
+            ++n;
+        }
+        return n ? sum / double(3 * n) : 0.0;
+    };
+    std::printf("debris at %ux%u: %zu pixels; per vertex vs per pixel %.2f dB; mean wrap 0.5 %.1f, "
+                "Lambert %.1f\n",
+                w, h, pixels, db, mean(pixel.rgba), mean(lambert.rgba));
+    EXPECT_GT(pixels, 50u) << "the debris should be on screen";
+    EXPECT_EQ(vertex.stats.atlasSprites, 0u) << "mesh particles take no atlas rectangles";
+    EXPECT_GE(db, 25.0) << "flat faces: per-vertex lighting stays close to per-pixel";
+    EXPECT_GT(mean(pixel.rgba), mean(lambert.rgba) + 1.0);
 }
 
 TEST(Particles, BadParticleFlagsExitWith2) {

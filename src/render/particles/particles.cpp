@@ -7,6 +7,7 @@
 #include "core/error.h"
 #include "core/log.h"
 #include "particles/particle_types.h"
+#include "render/forward/forward_passes.h"
 #include "render/oit/oit.h"
 
 namespace shadel {
@@ -28,6 +29,8 @@ struct ParticleState {
     TextureWriteView atlasWrite;
     TextureReadView atlasRead;
     Pipeline simulate, atlasLight, sprites, atlasView;
+    Pipeline meshes; // opaque mesh particles, forward
+    bool hasMeshes = false;
 };
 
 void ParticleStateDeleter::operator()(ParticleState* state) const {
@@ -50,7 +53,9 @@ static gpu::GpuParticleEmitter gpuEmitter(const ParticleEmitter& e, uint32_t fir
     g.additiveness = std::clamp(e.additiveness, 0.0f, 1.0f);
     g.firstParticle = first;
     g.particleCount = e.particleCount;
-    g.flags = e.lit ? PARTICLE_EMITTER_LIT : 0u;
+    g.flags = (e.lit ? PARTICLE_EMITTER_LIT : 0u) | (e.mesh ? PARTICLE_EMITTER_MESH : 0u) |
+              (e.vertexLit ? PARTICLE_EMITTER_VERTEX_LIT : 0u);
+    g.bounce = e.bounce;
     g.seed = e.seed;
     g.lodBias = e.lodBias;
     g.turbulence = e.turbulence;
@@ -76,6 +81,7 @@ ParticleStatePtr createParticles(Renderer& r, const GpuScene& scene) {
                                     "lifetime",
                                     em.name.c_str()));
         emitters.push_back(gpuEmitter(em, uint32_t(particles.size())));
+        s.hasMeshes = s.hasMeshes || em.mesh;
         s.maxLifetime = std::max(s.maxLifetime, em.lifetime * 1.2f);
         for (uint32_t k = 0; k < em.particleCount; ++k) {
             gpu::GpuParticle p{};
@@ -134,6 +140,16 @@ ParticleStatePtr createParticles(Renderer& r, const GpuScene& scene) {
     sprites.cullMode = VK_CULL_MODE_NONE;
     sprites.attachmentBlends = wboitAttachmentBlends();
     s.sprites = createGraphicsPipeline(gpu, sprites);
+    GraphicsPipelineDesc meshes;
+    meshes.name = "particleMeshes";
+    meshes.vertexShader = "particles_mesh.vert.spv";
+    meshes.fragmentShader = "particles_mesh.frag.spv";
+    meshes.colorFormats = {VK_FORMAT_R16G16B16A16_SFLOAT};
+    meshes.depthFormat = VK_FORMAT_D32_SFLOAT;
+    meshes.depthWrite = true; // opaque: later transparency is hidden behind them
+    meshes.depthCompare = VK_COMPARE_OP_GREATER_OR_EQUAL;
+    meshes.cullMode = VK_CULL_MODE_NONE; // closed boxes: depth keeps the front faces
+    s.meshes = createGraphicsPipeline(gpu, meshes);
     GraphicsPipelineDesc view;
     view.name = "particleAtlasView";
     view.vertexShader = "oit_fullscreen.vert.spv";
@@ -150,7 +166,8 @@ void destroyParticles(Renderer& r, ParticleStatePtr& state) {
     if (!state) return;
     Gpu& gpu = *r.gpu;
     ParticleState& s = *state;
-    for (Pipeline* p : {&s.simulate, &s.atlasLight, &s.sprites, &s.atlasView}) destroy(gpu, *p);
+    for (Pipeline* p : {&s.simulate, &s.atlasLight, &s.sprites, &s.atlasView, &s.meshes})
+        destroy(gpu, *p);
     destroy(gpu, s.atlasWrite);
     destroy(gpu, s.atlasRead);
     destroy(gpu, s.atlas);
@@ -214,6 +231,31 @@ void recordParticlePasses(Renderer& r, FrameRecorder& rec, uint64_t frame) {
                 VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT,
             VK_ACCESS_2_SHADER_STORAGE_READ_BIT | VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT);
     });
+    if (s.hasMeshes && !r.visibility) // (--marking visibility leaves the colour in GENERAL)
+        pass(rec, "particleMeshes", [&](VkCommandBuffer cmd) {
+            // After the opaque scene's colour and depth, before the transparency tests them.
+            memoryBarrier(cmd,
+                          VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT |
+                              VK_PIPELINE_STAGE_2_LATE_FRAGMENT_TESTS_BIT,
+                          VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT |
+                              VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT,
+                          VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT |
+                              VK_PIPELINE_STAGE_2_EARLY_FRAGMENT_TESTS_BIT |
+                              VK_PIPELINE_STAGE_2_LATE_FRAGMENT_TESTS_BIT,
+                          VK_ACCESS_2_COLOR_ATTACHMENT_READ_BIT |
+                              VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT |
+                              VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_READ_BIT |
+                              VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT);
+            beginSceneColorPass(r, cmd, false);
+            VkViewport vp{0, 0, float(r.internalWidth), float(r.internalHeight), 0, 1};
+            VkRect2D scissor{{0, 0}, {r.internalWidth, r.internalHeight}};
+            vkCmdSetViewport(cmd, 0, 1, &vp);
+            vkCmdSetScissor(cmd, 0, 1, &scissor);
+            bind(gpu, cmd, s.meshes);
+            pushConstants(gpu, cmd, push);
+            vkCmdDraw(cmd, s.particleCount * PARTICLE_MESH_VERTICES, 1, 0, 0);
+            vkCmdEndRendering(cmd);
+        });
     if (r.settings.particleLighting != ParticleLighting::Atlas) return;
     pass(rec, "particleAtlasLighting", [&](VkCommandBuffer cmd) {
         VkImage atlas = vkImage(gpu, s.atlas);
