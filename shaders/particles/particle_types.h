@@ -15,8 +15,8 @@ using glm::vec4;
 using uint = uint32_t;
 #endif
 
-#define PARTICLE_EMITTER_LIT 1u // shaded with the scene's lights (smoke); else emissive (fire)
-#define PARTICLE_EMITTER_MESH 2u       // opaque mesh particles (forward path), not sprites
+#define PARTICLE_EMITTER_LIT 1u  // shaded with the scene's lights (smoke); else emissive (fire)
+#define PARTICLE_EMITTER_MESH 2u // opaque mesh particles (forward path), not sprites
 #define PARTICLE_EMITTER_VERTEX_LIT 4u // mesh particles lit per vertex (else per pixel)
 #define PARTICLE_MESH_VERTICES 36u     // a mesh particle: a box, 12 triangles
 
