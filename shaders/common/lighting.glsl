@@ -324,4 +324,48 @@ vec3 shadeSurface(FrameConstants f, MaterialSample m, vec3 worldPos, vec3 geomet
     // Darks subtract light; they never make a surface emit negative light.
     return color + max(direct * m.occlusion, -color);
 }
+
+// Wrap ("non-directional") diffuse of seed 004's particles: n.l moved towards 1 by `wrap`, so
+// thin media (smoke, mesh particles) are lit from behind too; wrap 0 is Lambert.
+float wrappedNl(vec3 n, vec3 l, float wrap) {
+    return max((dot(n, l) + wrap) / (1.0 + wrap), 0.0);
+}
+
+// The light reaching a diffuse particle of unit albedo at p with normal n, from the ambient
+// hemisphere, the sun and every light of the caller's list (tube lights from their closest
+// point). Linear in albedo, so the particle atlas stores this and sprites multiply their colour.
+vec3 shadeParticle(FrameConstants f, vec3 p, vec3 n, float wrap) {
+    float up = n.y * 0.5 + 0.5;
+    vec3 color = mix(f.ambientColor * 0.5, f.ambientColor + f.skyColor * 0.15, up);
+    color += giIrradiance(f.gi, p, n) / PI;
+    if (dot(f.sunColor, f.sunColor) > 0.0)
+        color += f.sunColor * wrappedNl(n, -f.sunDirection, wrap) * sunShadow(f, p, n) / PI;
+    LightBuffer lights = LightBuffer(f.lights);
+    vec3 direct = vec3(0.0);
+    uint count = lightListLength(f);
+    for (uint i = 0u; i < count; ++i) {
+        uvec2 entry = lightListEntry(f, i);
+        if (entry.x == LIGHT_INVALID) continue;
+        GpuLight light = lights.l[entry.x];
+        if ((light.flags & LIGHT_FLAG_CLIP_PLANE) != 0u &&
+            dot(light.clipPlane.xyz, p) + light.clipPlane.w < 0.0)
+            continue;
+        if (lightBlockedAt(f, light, entry.y, p)) continue;
+        if (light.type == LIGHT_DIRECTIONAL) {
+            direct += light.color * wrappedNl(n, -light.direction, wrap) / PI;
+            continue;
+        }
+        vec3 at = light.position;
+        if (light.type == LIGHT_TUBE) {
+            float t = clamp(dot(p - light.position, light.axis), -light.halfLength, light.halfLength);
+            at = light.position + light.axis * t;
+        }
+        vec3 toLight = at - p;
+        float dist = length(toLight);
+        vec3 dir = toLight / max(dist, 1e-4);
+        vec3 radiance = light.color * rangeAttenuation(dist, light.range) * spotFactor(light, dir);
+        direct += radiance * wrappedNl(n, dir, wrap) / PI;
+    }
+    return color + max(direct, -color);
+}
 #endif

@@ -9,6 +9,67 @@
 
 namespace shadel {
 
+namespace {
+
+double passMs(const nlohmann::json& stats, const char* name) {
+    for (const auto& p : stats["passes"])
+        if (p["name"] == name) return p["gpu_ms"].get<double>();
+    return 0.0;
+}
+
+// --particle-lighting-compare: the same forward frames with the particles lit through the
+// atlas, per pixel and per vertex. The particle lighting cost of a mode is what its particle
+// passes cost beyond the vertex-lit sprites (whose lighting is 4 evaluations per sprite):
+// atlas = particleAtlasLighting + particleSprites - vertex's particleSprites, pixel =
+// particleSprites - vertex's particleSprites. The total (atlas lighting + sprites against
+// sprites) is reported too.
+nlohmann::json runParticleLightingBench(Gpu& gpu, const BenchOptions& b, RenderOptions o) {
+    nlohmann::json out;
+    out["scene"] = b.scene;
+    out["device"] = gpu.device.name;
+    out["frames"] = b.frames;
+    o.mode = RenderMode::Forward;
+    const std::pair<const char*, ParticleLighting> modes[] = {{"atlas", ParticleLighting::Atlas},
+                                                              {"pixel", ParticleLighting::Pixel},
+                                                              {"vertex", ParticleLighting::Vertex}};
+    for (const auto& [name, lighting] : modes) {
+        std::fprintf(stderr, "bench: particle lighting %s, %u frames at %ux%u\n", name, b.frames,
+                     b.width, b.height);
+        o.particleLighting = lighting;
+        out["modes"][name] = runRender(gpu, o).stats;
+    }
+    double atlasLight = passMs(out["modes"]["atlas"], "particleAtlasLighting");
+    double atlasSprites = passMs(out["modes"]["atlas"], "particleSprites");
+    double pixelSprites = passMs(out["modes"]["pixel"], "particleSprites");
+    double vertexSprites = passMs(out["modes"]["vertex"], "particleSprites");
+    double atlasLighting = atlasLight + atlasSprites - vertexSprites;
+    double pixelLighting = pixelSprites - vertexSprites;
+    out["particle_ms"] = {
+        {"atlas_lighting_pass", atlasLight},    {"atlas_sprites", atlasSprites},
+        {"pixel_sprites", pixelSprites},        {"vertex_sprites", vertexSprites},
+        {"atlas_lighting_cost", atlasLighting}, {"pixel_lighting_cost", pixelLighting}};
+    out["ratios"]["particle_lighting_atlas_over_pixel"] =
+        pixelLighting > 0 ? atlasLighting / pixelLighting : 0.0;
+    out["ratios"]["particle_total_atlas_over_pixel"] =
+        pixelSprites > 0 ? (atlasLight + atlasSprites) / pixelSprites : 0.0;
+    std::printf("shadel bench --particle-lighting-compare: %s at %ux%u on %s, %u frames, "
+                "medians (timing: %s)\n",
+                b.scene.c_str(), b.width, b.height, gpu.device.name.c_str(), b.frames,
+                out["modes"]["atlas"]["timing"].get<std::string>().c_str());
+    std::printf("  particleAtlasLighting (atlas)  %10.3f ms\n", atlasLight);
+    std::printf("  particleSprites atlas / pixel / vertex  %.3f / %.3f / %.3f ms\n", atlasSprites,
+                pixelSprites, vertexSprites);
+    std::printf("  lighting cost atlas %.3f ms / pixel %.3f ms = %.3f\n", atlasLighting,
+                pixelLighting, out["ratios"]["particle_lighting_atlas_over_pixel"].get<double>());
+    std::printf("  particle total atlas %.3f ms / pixel %.3f ms = %.3f\n",
+                atlasLight + atlasSprites, pixelSprites,
+                out["ratios"]["particle_total_atlas_over_pixel"].get<double>());
+    if (!b.json.empty()) writeOutputFile(b.json, out.dump(2) + "\n");
+    return out;
+}
+
+} // namespace
+
 // Renders the same scene over the same camera path forward, decoupled with reuse off and
 // decoupled with reuse on, in one process, and prints per-pass medians and frame-time ratios
 // against forward (DESIGN §5, §7).
@@ -31,6 +92,7 @@ nlohmann::json runBench(Gpu& gpu, const BenchOptions& b) {
     o.cacheLimitBytes = b.cacheLimitBytes;
     o.lightCulling = b.lightCulling;
     o.progress = false;
+    if (b.compareParticleLighting) return runParticleLightingBench(gpu, b, o);
 
     struct Mode {
         const char* name;

@@ -45,10 +45,13 @@ struct RenderOptions {
     bool reuse = true;
     uint32_t reuseRefreshPeriod = 8;
     bool animateLights = false;
-    OitMode oit = OitMode::Wboit;                    // --oit wboit|sorted
-    std::optional<uint64_t> shuffleDrawsSeed;        // --shuffle-draws SEED
-    LightCulling lightCulling = LightCulling::Tiled; // --light-culling tiled|none
-    bool lightBlockers = true;                       // --blockers on|off
+    OitMode oit = OitMode::Wboit;                                // --oit wboit|sorted
+    std::optional<uint64_t> shuffleDrawsSeed;                    // --shuffle-draws SEED
+    bool particles = true;                                       // --particles on|off
+    ParticleLighting particleLighting = ParticleLighting::Atlas; // --particle-lighting
+    uint32_t particleAtlasSize = 1024;                           // --particle-atlas-size
+    LightCulling lightCulling = LightCulling::Tiled;             // --light-culling tiled|none
+    bool lightBlockers = true;                                   // --blockers on|off
     CameraPath cameraPath = CameraPath::Static;
     GiMode gi = GiMode::Off;   // --gi lpv|off
     uint32_t giIterations = 8; // --gi-iterations
@@ -86,6 +89,7 @@ MarkingMode parseMarking(const std::string& text);
 // "X,Y" -> pixel; throws InputError naming --inspect.
 void parseInspect(const std::string& text, int32_t& x, int32_t& y);
 OitMode parseOit(const std::string& text);
+ParticleLighting parseParticleLighting(const std::string& text);
 LightCulling parseLightCulling(const std::string& text);
 bool parseOnOff(const char* flag, const std::string& text); // "on" / "off", else InputError
 GiMode parseGi(const std::string& text);                    // --gi lpv|off
@@ -118,6 +122,9 @@ struct BenchOptions {
     // --light-culling compare: forward and decoupled rendered again with no culling, and
     // ratios.light_culling_forward|decoupled = tiled / none median frame time.
     bool compareLightCulling = false;
+    // --particle-lighting-compare: forward only, particle lighting atlas vs pixel vs vertex
+    // (ratios.particle_lighting_atlas_over_pixel; app/bench_command.cpp).
+    bool compareParticleLighting = false;
     std::string plot; // --plot FILE.png: per-pass bar chart (app/bench_plot.h)
 };
 nlohmann::json runBench(Gpu& gpu, const BenchOptions& options);

@@ -111,7 +111,7 @@ int main(int argc, char** argv) {
         ->add_option("--visualize", visualize,
                      "none | marking | mips | chunks | sheet | layer:radiance | layer:material | "
                      "light-count | blockers | gi (indirect light only, with --gi lpv) | rt-ao "
-                     "(ray-traced AO only, with --rt-ao on)")
+                     "(ray-traced AO only, with --rt-ao on) | particle-atlas")
         ->capture_default_str();
     std::string marking = "raster";
     render
@@ -202,6 +202,18 @@ int main(int argc, char** argv) {
     render->add_option("--shuffle-draws", ro.shuffleDrawsSeed,
                        "SEED: draw the transparent instances in a random order (order "
                        "independence tests)");
+    std::string particleLighting = "atlas", particles = "on";
+    render
+        ->add_option("--particle-lighting", particleLighting,
+                     "atlas | pixel | vertex: lit particle sprites read a lightmap atlas lit "
+                     "per texel at an LOD from their screen size, or are lit per pixel / vertex")
+        ->capture_default_str();
+    render->add_option("--particles", particles, "on | off: the scene's GPU particle emitters")
+        ->capture_default_str();
+    render
+        ->add_option("--particle-atlas-size", ro.particleAtlasSize,
+                     "texels per side of the particle lightmap atlas (128..8192)")
+        ->capture_default_str();
     std::string lightCulling = "tiled", blockers = "on";
     render
         ->add_option("--light-culling", lightCulling,
@@ -280,6 +292,9 @@ int main(int argc, char** argv) {
         ->capture_default_str();
     bench->add_flag("--animate-lights", bo.animateLights, "move point and spot lights");
     std::string benchLightCulling = "tiled";
+    bench->add_flag("--particle-lighting-compare", bo.compareParticleLighting,
+                    "instead of the three modes: forward with --particle-lighting atlas, pixel "
+                    "and vertex, and the particle lighting cost of atlas over pixel");
     bench
         ->add_option("--light-culling", benchLightCulling,
                      "tiled | none | compare: compare also renders forward and decoupled "
@@ -430,6 +445,8 @@ int main(int argc, char** argv) {
             ro.reuse = reuse == "on";
             ro.lightCulling = parseLightCulling(lightCulling);
             ro.lightBlockers = parseOnOff("--blockers", blockers);
+            ro.particleLighting = parseParticleLighting(particleLighting);
+            ro.particles = parseOnOff("--particles", particles);
             ro.gi = parseGi(gi);
             if (giSnap != "on" && giSnap != "off")
                 throw InputError(format("--gi-snap %s: expected on or off", giSnap.c_str()));

@@ -16,6 +16,7 @@
 #include "core/error.h"
 #include "core/log.h"
 #include "render/debug/inspect.h"
+#include "render/particles/particles.h"
 #include "render/shadel/decoupled.h"
 #include "render/view_density.h"
 #include "scene/load.h"
@@ -51,8 +52,10 @@ Visualize parseVisualize(const std::string& text) {
     if (text == "blockers") return Visualize::Blockers;
     if (text == "gi") return Visualize::Gi;
     if (text == "rt-ao") return Visualize::RtAo;
+    if (text == "particle-atlas") return Visualize::ParticleAtlas;
     throw InputError(format("--visualize %s: expected none, marking, mips, chunks, sheet, "
-                            "layer:radiance, layer:material, light-count, blockers, gi or rt-ao",
+                            "layer:radiance, layer:material, light-count, blockers, gi, rt-ao or "
+                            "particle-atlas",
                             text.c_str()));
 }
 
@@ -87,6 +90,14 @@ void parseInspect(const std::string& text, int32_t& x, int32_t& y) {
         px > 16383 || py > 16383)
         throw InputError(format("--inspect %s: expected X,Y (a pixel, e.g. 40,20)", text.c_str()));
     x = int32_t(px), y = int32_t(py);
+}
+
+ParticleLighting parseParticleLighting(const std::string& text) {
+    if (text == "atlas") return ParticleLighting::Atlas;
+    if (text == "pixel") return ParticleLighting::Pixel;
+    if (text == "vertex") return ParticleLighting::Vertex;
+    throw InputError(
+        format("--particle-lighting %s: expected atlas, pixel or vertex", text.c_str()));
 }
 
 OitMode parseOit(const std::string& text) {
@@ -238,6 +249,7 @@ RenderRun runRender(Gpu& gpu, const RenderOptions& o) {
     requireCount("--material-samples", o.materialSamples, 1, 64);
     requireCount("--allocation-counters", o.allocationCounters, 1, SHADEL_COUNTERS);
     requireCount("--reuse-refresh", o.reuseRefreshPeriod, 1, 1024);
+    requireCount("--particle-atlas-size", o.particleAtlasSize, 128, 8192);
     settings.materialSamples = o.materialSamples;
     settings.forwardBelowPixels = o.forwardBelowPixels;
     settings.allocationCounters = o.allocationCounters;
@@ -252,6 +264,9 @@ RenderRun runRender(Gpu& gpu, const RenderOptions& o) {
     settings.shuffleDraws = o.shuffleDrawsSeed.has_value();
     settings.shuffleSeed = o.shuffleDrawsSeed.value_or(0);
     settings.lightCulling = o.lightCulling;
+    settings.particles = o.particles;
+    settings.particleLighting = o.particleLighting;
+    settings.particleAtlasSize = o.particleAtlasSize;
     settings.lightBlockers = o.lightBlockers;
     requireCount("--gi-iterations", o.giIterations, 0, 64);
     if (o.visualize == Visualize::Gi && o.gi == GiMode::Off)
@@ -360,6 +375,7 @@ RenderRun runRender(Gpu& gpu, const RenderOptions& o) {
     s["transparent_draws"] = run.frames.back().transparentDraws;
     s["transparent_draws_decoupled"] = run.frames.back().transparentDecoupledDraws;
     lightCullingStats(renderer, gpuScene, s);
+    if (renderer.particles) particleStats(renderer, s);
     s["density_mode"] = autoDensity ? "auto" : "explicit";
     if (autoDensity)
         s["view_density"] = {{"budget_scale", viewDensity.budgetScale},

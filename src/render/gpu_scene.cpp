@@ -263,6 +263,7 @@ void uploadScene(Gpu& gpu, const Scene& scene, GpuScene& out, const std::vector<
         blockers.push_back(g);
     }
     out.skyColor = scene.skyColor;
+    out.emitters = scene.emitters;
     out.ambientColor = scene.ambientColor;
 
     VkBufferUsageFlags indexUsage = VK_BUFFER_USAGE_INDEX_BUFFER_BIT;

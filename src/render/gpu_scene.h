@@ -44,6 +44,7 @@ struct GpuScene {
     std::vector<gpu::GpuLight> lightInfo;       // what `lights` holds
     std::vector<uint8_t> lightCastsShadow;      // per lightInfo entry (GI light views)
     std::vector<gpu::GpuMaterial> materialInfo; // what `materials` holds
+    std::vector<ParticleEmitter> emitters;      // the scene's, simulated by render/particles
     uint32_t instanceCount = 0;
     uint32_t lightCount = 0;
     Aabb bounds;

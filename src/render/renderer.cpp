@@ -10,6 +10,7 @@
 #include "render/forward/forward_passes.h"
 #include "render/lighting/light_animation.h"
 #include "render/oit/oit.h"
+#include "render/particles/particles.h"
 #include "render/post/tonemap.h"
 #include "render/shadel/decoupled.h"
 #include "render/shadel/visibility.h"
@@ -118,6 +119,7 @@ void initRenderer(Renderer& r, Gpu& gpu, const RenderSettings& settings, const G
     if (settings.mode == RenderMode::Decoupled) r.decoupled = createDecoupled(r, scene);
     if (usesVisibilityBuffer(settings)) r.visibility = createVisibility(r);
     r.oit = createOit(r, scene);
+    r.particles = createParticles(r, scene);
     r.lightCulling = createLightCulling(r, scene);
     if (settings.gi == GiMode::Lpv) r.gi = createGi(r, scene);
     r.culling = createCulling(r, scene);
@@ -135,6 +137,7 @@ void destroyRenderer(Renderer& r) {
     if (r.gi) destroyGi(r, r.gi);
     r.captures = {}; // its sources refer to what is destroyed below
     if (r.visibility) destroyVisibility(r, r.visibility);
+    destroyParticles(r, r.particles);
     destroyOit(r, r.oit);
     if (r.decoupled) destroyDecoupled(r, r.decoupled);
     destroyCulling(r, r.culling);
@@ -253,6 +256,7 @@ FrameResult renderFrame(Renderer& r, const GpuScene& scene, const CameraView& ca
     if (r.gi) prepareGiFrame(r, scene, camera, constants);
     if (r.decoupled) prepareDecoupledFrame(r, scene, camera, constants);
     prepareTransparentDraws(r, scene, camera);
+    prepareParticleFrame(r);
     prepareCullingFrame(r, scene, constants);
     constants.debugLines = debugLinesAddress(r);
     if (r.rt) prepareRayTracingFrame(r, scene, camera, constants);
@@ -294,8 +298,10 @@ FrameResult renderFrame(Renderer& r, const GpuScene& scene, const CameraView& ca
                  [&](VkCommandBuffer cmd) { recordRayTracedShadels(r, cmd, frame); });
         recordDecoupledPasses(r, rec, frame, scene);
     }
+    recordParticlePasses(r, rec, frame);     // GPU particles: simulation, atlas lighting
     recordTransparencyPasses(r, rec, frame); // blended materials, after every opaque surface
     if (r.debugLines) recordDebugLinePasses(r, rec, frame, scene, constants.lightCount);
+    recordParticleAtlasView(r, rec, frame);  // --visualize particle-atlas
     pass(rec, "tonemap", [&](VkCommandBuffer cmd) { recordTonemap(r, cmd, frame); });
     if (r.decoupled) recordDecoupledPostPasses(r, rec, frame);
     endFrame(rec);

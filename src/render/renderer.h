@@ -40,7 +40,10 @@ enum class Visualize : uint32_t {
     Blockers = VISUALIZE_BLOCKERS,      // tiles / chunks with per-pixel blocker checks
     Gi = 6,                             // --visualize gi: the LPV's indirect light only
     RtAo = VISUALIZE_RT_AO,             // --visualize rt-ao: the ray-traced AO only (--rt-ao on)
+    ParticleAtlas = 24,                 // --visualize particle-atlas (render/particles)
 };
+// --particle-lighting: lit particle sprites read the atlas, or are lit per pixel / per vertex.
+enum class ParticleLighting : uint32_t { Atlas = 0, Pixel = 1, Vertex = 2 };
 
 // --light-culling: per-tile (forward) and per-chunk (shadel) light lists, or every light for
 // every pixel / shadel.
@@ -94,6 +97,9 @@ struct RenderSettings {
         0; // --debug-lines: DEBUG_LINES_* kinds drawn (render/debug/debug_lines.h)
     uint32_t debugLineCapacity = 256 * 1024; // segments the line buffer holds (8 MiB)
     RtSettings rt;          // --rt-*: ray-traced shadows, AO, GI (render/raytracing)
+    bool particles = true;  // the scene's GPU particle emitters (render/particles)
+    ParticleLighting particleLighting = ParticleLighting::Atlas;
+    uint32_t particleAtlasSize = 1024; // texels per side of the particle lightmap atlas
 };
 
 struct FrameResult {
@@ -123,6 +129,11 @@ struct OitStateDeleter {
     void operator()(OitState* state) const;
 };
 using OitStatePtr = std::unique_ptr<OitState, OitStateDeleter>;
+struct ParticleState; // render/particles/particles.h
+struct ParticleStateDeleter {
+    void operator()(ParticleState* state) const;
+};
+using ParticleStatePtr = std::unique_ptr<ParticleState, ParticleStateDeleter>;
 
 struct Renderer {
     Gpu* gpu = nullptr;
@@ -155,6 +166,7 @@ struct Renderer {
     uint64_t framesRendered = 0;
     VisibilityStatePtr visibility;     // decoupled with --marking visibility
     OitStatePtr oit;                   // scenes with blended materials (render/oit)
+    ParticleStatePtr particles;        // scenes with particle emitters (render/particles)
     LightCullingStatePtr lightCulling; // light lists (render/lighting/light_culling.h)
     GiStatePtr gi;                     // --gi lpv
     DebugLinesStatePtr debugLines;     // --debug-lines (render/debug/debug_lines.h)

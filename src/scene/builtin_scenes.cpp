@@ -576,6 +576,95 @@ Scene makeTransparency() {
     return scene;
 }
 
+// GPU particles (seed 004, render/particles): rock debris as mesh particles, a lit smoke column
+// (alpha-blended sprites with a normal map, lit by the sun, a warm light by the fire and a cool one
+// on the left, through the particle lightmap atlas) beside an unlit additive fire, in front of
+// opaque geometry. Seeded: every run simulates the same particles.
+Scene makeParticles() {
+    Scene scene;
+    scene.name = "particles";
+    SceneBuilder b(scene);
+    uint32_t ground = b.material("ground", {0.55f, 0.55f, 0.52f}, 0.9f);
+    uint32_t wall = b.material("wall", {0.7f, 0.45f, 0.35f}, 0.8f);
+    uint32_t stone = b.material("stone", {0.35f, 0.33f, 0.3f}, 0.9f);
+    b.place("ground", b.mesh(makePlane("ground", 30.0f, 30.0f, ground, 4)), {0, 0, 0});
+    b.box("back wall", {12.0f, 5.0f, 0.4f}, wall, {0.0f, 0.0f, -3.5f});
+    b.box("fire pit", {1.0f, 0.2f, 1.0f}, stone, {1.4f, 0.0f, -0.5f});
+
+    ParticleEmitter smoke;
+    smoke.name = "smoke column";
+    smoke.position = {-1.2f, 0.2f, -0.6f};
+    smoke.spawnRadius = 0.3f;
+    smoke.velocity = {0.0f, 0.9f, 0.0f};
+    smoke.velocitySpread = 0.2f;
+    smoke.acceleration = {0.12f, 0.25f, 0.0f};
+    smoke.drag = 0.35f;
+    smoke.turbulence = 0.5f;
+    smoke.colorStart = {0.6f, 0.6f, 0.62f, 0.75f};
+    smoke.colorEnd = {0.45f, 0.45f, 0.48f, 0.55f};
+    smoke.sizeStart = 0.6f;
+    smoke.sizeEnd = 2.0f;
+    smoke.lifetime = 4.0f;
+    smoke.particleCount = 96;
+    smoke.additiveness = 0.0f;
+    smoke.lit = true;
+    smoke.wrap = 0.4f;
+    smoke.normalScale = 1.0f;
+    smoke.seed = 0x5a0ce;
+    scene.emitters.push_back(smoke);
+
+    ParticleEmitter fire;
+    fire.name = "fire";
+    fire.position = {1.4f, 0.25f, -0.5f};
+    fire.spawnRadius = 0.25f;
+    fire.velocity = {0.0f, 1.2f, 0.0f};
+    fire.velocitySpread = 0.25f;
+    fire.acceleration = {0.0f, 0.9f, 0.0f};
+    fire.drag = 1.2f;
+    fire.turbulence = 1.0f;
+    fire.colorStart = {3.0f, 1.3f, 0.3f, 0.9f};
+    fire.colorEnd = {1.2f, 0.2f, 0.02f, 0.3f};
+    fire.sizeStart = 0.7f;
+    fire.sizeEnd = 0.25f;
+    fire.lifetime = 1.2f;
+    fire.particleCount = 64;
+    fire.additiveness = 1.0f;
+    fire.lit = false;
+    fire.seed = 0xf12e;
+    scene.emitters.push_back(fire);
+
+    // Mesh particles: embers of rock thrown up from the fire pit, bouncing on the ground; opaque,
+    // lit per vertex with wrap shading (the forward path of seed 004's mesh particles).
+    ParticleEmitter debris;
+    debris.name = "debris";
+    debris.position = {1.4f, 0.3f, -0.5f};
+    debris.spawnRadius = 0.3f;
+    debris.velocity = {0.0f, 3.2f, 0.4f};
+    debris.velocitySpread = 1.2f;
+    debris.acceleration = {0.0f, -9.8f, 0.0f};
+    debris.drag = 0.1f;
+    debris.colorStart = {0.35f, 0.3f, 0.26f, 1.0f};
+    debris.colorEnd = {0.2f, 0.18f, 0.16f, 1.0f};
+    debris.sizeStart = 0.12f;
+    debris.sizeEnd = 0.1f;
+    debris.lifetime = 2.5f;
+    debris.particleCount = 24;
+    debris.lit = true;
+    debris.mesh = true;
+    debris.vertexLit = true;
+    debris.wrap = 0.5f;
+    debris.bounce = 0.35f;
+    debris.seed = 0xdeb215;
+    scene.emitters.push_back(debris);
+
+    b.sun({-0.4f, -1.0f, -0.5f}, 2.0f);
+    b.pointLight("fire light", {1.4f, 1.0f, -0.3f}, {1.0f, 0.55f, 0.2f}, 10.0f, 8.0f);
+    b.pointLight("cool light", {-3.2f, 2.6f, 1.2f}, {0.35f, 0.5f, 1.0f}, 12.0f, 9.0f);
+    b.camera("main", {0.0f, 1.8f, 6.5f}, {0.0f, 1.5f, -0.5f}, 0.8f, 0.1f, 100.0f);
+    b.camera("far", {0.0f, 3.0f, 16.0f}, {0.0f, 1.5f, -0.5f}, 0.8f, 0.1f, 100.0f);
+    return scene;
+}
+
 // The GI test box: a closed room with a red wall (left, -x) and a green wall (right, +x), lit
 // only by a shadow-casting spot through an opening in the ceiling, aimed high on the red wall.
 // The floor along the red wall lies just outside the spot's cone, so what colours it there is
@@ -619,6 +708,7 @@ const std::vector<std::pair<std::string, std::function<Scene()>>>& registry() {
         {"smooth", makeSmooth},
         {"many", [] { return makeMany(kManyDefaultInstances); }},
         {"transparency", makeTransparency},
+        {"particles", makeParticles},
         {"lights", [] { return makeLightsScene(makeDefault()); }},
         {"blockers", makeBlockersScene},
         {"cornell", makeCornell},

@@ -7,6 +7,8 @@
 
 #include <glm/glm.hpp>
 
+#include "scene/particle_emitter.h"
+
 namespace shadel {
 
 struct Aabb {
@@ -183,7 +185,8 @@ struct Scene {
     std::vector<Instance> instances;
     std::vector<Light> lights;
     std::vector<LightBlocker> blockers;
-    std::vector<Camera> cameras; // the first is the default
+    std::vector<Camera> cameras;           // the first is the default
+    std::vector<ParticleEmitter> emitters; // GPU particles (render/particles)
     glm::vec3 skyColor{0.55f, 0.7f, 0.95f};
     glm::vec3 ambientColor{0.08f, 0.09f, 0.11f};
 

@@ -5,6 +5,7 @@
 #include "core/error.h"
 #include "core/log.h"
 #include "render/forward/forward_passes.h"
+#include "render/particles/particles.h"
 #include "render/shadel/decoupled.h"
 
 namespace shadel {
@@ -82,6 +83,14 @@ std::vector<uint32_t> shuffledOrder(uint32_t n, uint64_t seed) {
     return order;
 }
 
+std::vector<VkPipelineColorBlendAttachmentState> wboitAttachmentBlends() {
+    // Seed: "MRT0: (1)S + (1)D; MRT1: (0)S + (1-S)D for colour, (1)S + (1)D for alpha".
+    return {blendState(VK_BLEND_FACTOR_ONE, VK_BLEND_FACTOR_ONE, VK_BLEND_FACTOR_ONE,
+                       VK_BLEND_FACTOR_ONE),
+            blendState(VK_BLEND_FACTOR_ZERO, VK_BLEND_FACTOR_ONE_MINUS_SRC_COLOR,
+                       VK_BLEND_FACTOR_ONE, VK_BLEND_FACTOR_ONE)};
+}
+
 OitStatePtr createOit(Renderer& r, const GpuScene& scene) {
     OitStatePtr state(new OitState());
     OitState& o = *state;
@@ -91,7 +100,8 @@ OitStatePtr createOit(Renderer& r, const GpuScene& scene) {
             (scene.materialInfo[m].flags & MATERIAL_ALPHA_BLEND) != 0u)
             o.blended.push_back(i);
     }
-    if (o.blended.empty()) return nullptr;
+    bool particles = r.settings.particles && !scene.emitters.empty(); // they draw into the targets
+    if (o.blended.empty() && !particles) return nullptr;
     o.meshes = scene.meshInfo;
     for (uint32_t i = 0; i < scene.instanceCount; ++i)
         o.instanceMesh.push_back(scene.instanceInfo[i].mesh);
@@ -124,11 +134,7 @@ OitStatePtr createOit(Renderer& r, const GpuScene& scene) {
     acc.depthWrite = false; // against the opaque depth only, never against each other
     acc.depthCompare = VK_COMPARE_OP_GREATER_OR_EQUAL;
     acc.cullMode = VK_CULL_MODE_NONE;
-    // Seed: "MRT0: (1)S + (1)D; MRT1: (0)S + (1-S)D for colour, (1)S + (1)D for alpha".
-    acc.attachmentBlends = {blendState(VK_BLEND_FACTOR_ONE, VK_BLEND_FACTOR_ONE,
-                                       VK_BLEND_FACTOR_ONE, VK_BLEND_FACTOR_ONE),
-                            blendState(VK_BLEND_FACTOR_ZERO, VK_BLEND_FACTOR_ONE_MINUS_SRC_COLOR,
-                                       VK_BLEND_FACTOR_ONE, VK_BLEND_FACTOR_ONE)};
+    acc.attachmentBlends = wboitAttachmentBlends();
     o.accumulate = createGraphicsPipeline(gpu, acc);
     if (r.settings.mode == RenderMode::Decoupled) {
         GraphicsPipelineDesc recon = acc;
@@ -233,22 +239,32 @@ const std::vector<uint32_t>& transparentDrawOrder(const Renderer& r) {
     return r.oit ? r.oit->draws : none;
 }
 
-static void beginAccumulation(Renderer& r, VkCommandBuffer cmd) {
+void beginWboitTargets(Renderer& r, VkCommandBuffer cmd, bool clear) {
     Gpu& gpu = *r.gpu;
     OitState& o = *r.oit;
-    for (TextureHandle t : {o.accum, o.reveal})
-        imageBarrier(
-            cmd, vkImage(gpu, t), VK_IMAGE_ASPECT_COLOR_BIT, VK_IMAGE_LAYOUT_UNDEFINED,
-            VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL, VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT, 0,
-            VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT,
-            VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT | VK_ACCESS_2_COLOR_ATTACHMENT_READ_BIT);
+    for (TextureHandle t : {o.accum, o.reveal}) {
+        if (clear)
+            imageBarrier(
+                cmd, vkImage(gpu, t), VK_IMAGE_ASPECT_COLOR_BIT, VK_IMAGE_LAYOUT_UNDEFINED,
+                VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL, VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT,
+                0, VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT,
+                VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT | VK_ACCESS_2_COLOR_ATTACHMENT_READ_BIT);
+        else // blending onto what an earlier pass accumulated
+            imageBarrier(
+                cmd, vkImage(gpu, t), VK_IMAGE_ASPECT_COLOR_BIT,
+                VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL, VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL,
+                VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT,
+                VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT,
+                VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT,
+                VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT | VK_ACCESS_2_COLOR_ATTACHMENT_READ_BIT);
+    }
     VkRenderingAttachmentInfo color[2]{};
     RenderTargetView views[2] = {o.accumTarget, o.revealTarget};
     for (int k = 0; k < 2; ++k) {
         color[k].sType = VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO;
         color[k].imageView = vkView(gpu, views[k]);
         color[k].imageLayout = VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL;
-        color[k].loadOp = VK_ATTACHMENT_LOAD_OP_CLEAR;
+        color[k].loadOp = clear ? VK_ATTACHMENT_LOAD_OP_CLEAR : VK_ATTACHMENT_LOAD_OP_LOAD;
         color[k].storeOp = VK_ATTACHMENT_STORE_OP_STORE;
     }
     color[0].clearValue.color = {{0.0f, 0.0f, 0.0f, 0.0f}};
@@ -284,7 +300,8 @@ static void afterOpaquePasses(VkCommandBuffer cmd) {
 }
 
 void recordTransparencyPasses(Renderer& r, FrameRecorder& rec, uint64_t frame) {
-    if (!r.oit || (r.oit->draws.empty() && r.oit->decoupledDraws == 0)) return;
+    if (!r.oit || (r.oit->draws.empty() && r.oit->decoupledDraws == 0 && !particlesThisFrame(r)))
+        return;
     Gpu& gpu = *r.gpu;
     OitState& o = *r.oit;
     auto meshOf = [&](uint32_t instance) -> const gpu::GpuMesh& {
@@ -311,7 +328,7 @@ void recordTransparencyPasses(Renderer& r, FrameRecorder& rec, uint64_t frame) {
 
     pass(rec, "oitAccumulate", [&](VkCommandBuffer cmd) {
         afterOpaquePasses(cmd);
-        beginAccumulation(r, cmd);
+        beginWboitTargets(r, cmd, true);
         bind(gpu, cmd, o.accumulate);
         pushConstants(gpu, cmd, RasterPush{frame, 0});
         vkCmdBindIndexBuffer(cmd, vkBuffer(gpu, r.sceneIndices), 0, VK_INDEX_TYPE_UINT32);
@@ -322,6 +339,10 @@ void recordTransparencyPasses(Renderer& r, FrameRecorder& rec, uint64_t frame) {
             drawCameraList(r, cmd, DRAW_LIST_DECOUPLED_BLEND);
         }
         vkCmdEndRendering(cmd);
+    });
+    recordParticleSprites(r, rec, frame); // GPU particles, into the same targets
+
+    pass(rec, "oitComposite", [&](VkCommandBuffer cmd) {
         for (TextureHandle t : {o.accum, o.reveal})
             imageBarrier(
                 cmd, vkImage(gpu, t), VK_IMAGE_ASPECT_COLOR_BIT,
@@ -329,9 +350,6 @@ void recordTransparencyPasses(Renderer& r, FrameRecorder& rec, uint64_t frame) {
                 VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT,
                 VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT, VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT,
                 VK_ACCESS_2_SHADER_SAMPLED_READ_BIT);
-    });
-
-    pass(rec, "oitComposite", [&](VkCommandBuffer cmd) {
         VkRenderingAttachmentInfo color{VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO};
         color.imageView = vkView(gpu, r.hdrTarget);
         color.imageLayout = VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL;

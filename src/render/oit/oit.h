@@ -32,6 +32,12 @@ uint32_t decoupledTransparentDraws(const Renderer& r);
 // `sortedTransparency`. Nothing when the frame has no transparent draw.
 void recordTransparencyPasses(Renderer& r, FrameRecorder& rec, uint64_t frame);
 
+// The WBOIT targets as colour attachments over the opaque depth (cleared, or loaded to keep
+// accumulating: the particle sprites of render/particles), and the blend states that
+// accumulate into them.
+void beginWboitTargets(Renderer& r, VkCommandBuffer cmd, bool clear);
+std::vector<VkPipelineColorBlendAttachmentState> wboitAttachmentBlends();
+
 // Deterministic permutation of [0, n) for --shuffle-draws (splitmix64 Fisher-Yates, identical on
 // every standard library).
 std::vector<uint32_t> shuffledOrder(uint32_t n, uint64_t seed);
