@@ -57,9 +57,12 @@ struct RenderOptions {
     double shadelBudget = 64e6;        // MIP-0 shadels the bake may use for the whole scene
     bool printPasses = false;
     bool progress = true;
-    uint32_t instances = 0; // builtin:many (--instances); 0 = the scene's default
-    bool lod = false;       // --lod: GPU LOD selection (render/culling)
-    bool occlusion = false; // --occlusion: two-phase hierarchical-Z culling (render/culling)
+    uint32_t instances = 0;   // builtin:many (--instances); 0 = the scene's default
+    bool lod = false;         // --lod: GPU LOD selection (render/culling)
+    bool occlusion = false;   // --occlusion: two-phase hierarchical-Z culling (render/culling)
+    bool screenSpace = false; // --screen-space: sky, SSR, SSS (render/screenspace)
+    bool tileClassification = true; // --tile-classification: per-tile dispatch (render/tiles)
+    bool distanceFields = false;    // --distance-fields: DF shadows + AO (render/distance_fields)
     // --capture NAME[,NAME...] (or {"list"}) and --capture-dir: the last frame's named
     // resources (app/capture_output.h); files go to the dir or next to --out.
     std::vector<std::string> captures;

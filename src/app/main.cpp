@@ -106,9 +106,11 @@ int main(int argc, char** argv) {
         ->capture_default_str();
     render->add_option("--ssaa", ro.ssaa, "N: NxN supersampled reference")->capture_default_str();
     render
-        ->add_option("--visualize", visualize,
-                     "none | marking | mips | chunks | sheet | layer:radiance | layer:material | "
-                     "light-count | blockers | gi (indirect light only, with --gi lpv)")
+        ->add_option(
+            "--visualize", visualize,
+            "none | marking | mips | chunks | sheet | layer:radiance | layer:material | "
+            "light-count | blockers | gi (indirect light only, with --gi lpv) | tiles (the "
+            "8x8 tile classes, with --screen-space on)")
         ->capture_default_str();
     std::string marking = "raster";
     render
@@ -236,6 +238,21 @@ int main(int argc, char** argv) {
     render
         ->add_option("--occlusion", occlusion,
                      "on | off: two-phase hierarchical-Z occlusion culling of instances")
+        ->capture_default_str();
+    // Seed 004's screen-space passes and tile classification (render/screenspace, tiles).
+    std::string screenSpace = "off", tileClassification = "on", distanceFields = "off";
+    render
+        ->add_option("--screen-space", screenSpace,
+                     "on | off: thin G-buffer, sky, screen-space reflections and skin SSS")
+        ->capture_default_str();
+    render
+        ->add_option("--tile-classification", tileClassification,
+                     "on | off: run the screen-space passes only on the 8x8 tiles that need them")
+        ->capture_default_str();
+    render
+        ->add_option("--distance-fields", distanceFields,
+                     "on | off: mesh distance fields in a 3-D atlas: soft sun shadows and AO "
+                     "(needs --screen-space on)")
         ->capture_default_str();
     std::string captures;
     render->add_option("--capture", captures,
@@ -426,6 +443,9 @@ int main(int argc, char** argv) {
                 throw InputError("--instances 0: expected 1..1000000");
             ro.lod = parseOnOff("--lod", lod);
             ro.occlusion = parseOnOff("--occlusion", occlusion);
+            ro.screenSpace = parseOnOff("--screen-space", screenSpace);
+            ro.tileClassification = parseOnOff("--tile-classification", tileClassification);
+            ro.distanceFields = parseOnOff("--distance-fields", distanceFields);
             if (!captures.empty()) ro.captures = parseCaptureNames(captures);
             if (!inspect.empty()) parseInspect(inspect, ro.inspectX, ro.inspectY);
             RenderRun run = runRender(g.gpu, ro);

@@ -16,6 +16,7 @@
 #include "core/error.h"
 #include "core/log.h"
 #include "render/debug/inspect.h"
+#include "render/screenspace/screen_space.h"
 #include "render/shadel/decoupled.h"
 #include "render/view_density.h"
 #include "scene/load.h"
@@ -50,8 +51,9 @@ Visualize parseVisualize(const std::string& text) {
     if (text == "light-count") return Visualize::LightCount;
     if (text == "blockers") return Visualize::Blockers;
     if (text == "gi") return Visualize::Gi;
+    if (text == "tiles") return Visualize::Tiles;
     throw InputError(format("--visualize %s: expected none, marking, mips, chunks, sheet, "
-                            "layer:radiance, layer:material, light-count, blockers or gi",
+                            "layer:radiance, layer:material, light-count, blockers, gi or tiles",
                             text.c_str()));
 }
 
@@ -261,11 +263,22 @@ RenderRun runRender(Gpu& gpu, const RenderOptions& o) {
     settings.giBlockers = o.giBlockers;
     settings.lod = o.lod;
     settings.occlusion = o.occlusion;
+    if (o.visualize == Visualize::Tiles && !o.screenSpace)
+        throw InputError(
+            "--visualize tiles: shows the tile classes of --screen-space on; it is off");
+    settings.screenSpace = o.screenSpace;
+    if (o.distanceFields && !o.screenSpace)
+        throw InputError(
+            "--distance-fields on: runs on the screen-space tiles; add --screen-space on");
+    settings.tileClassification = o.tileClassification;
     settings.timing = o.timing ? *o.timing : defaultTimingMode(gpu);
     Renderer renderer;
     RenderRun run;
     try {
         initRenderer(renderer, gpu, settings, gpuScene);
+        if (o.distanceFields)
+            renderer.distanceFields = createDistanceFields(
+                renderer, scene, gpuScene, o.cacheDir.empty() ? defaultCacheDir() : o.cacheDir);
         if (listCaptures) {
             std::printf("%s", captureListing(renderer.captures).c_str());
             run.listedCaptures = true;
@@ -380,6 +393,8 @@ RenderRun runRender(Gpu& gpu, const RenderOptions& o) {
         s["id_map_bytes"] = gpuScene.idMapBytes;
     }
     if (renderer.gi) giStats(renderer, s);
+    if (renderer.screenSpace) screenSpaceStats(renderer, s);
+    if (renderer.distanceFields) distanceFieldStats(*renderer.distanceFields, s);
     if (o.inspectX >= 0) {
         nlohmann::json prints = nlohmann::json::array();
         InspectedPixel pixel = frontFragment(run.frames.back().prints);

@@ -11,6 +11,7 @@
 #include "render/lighting/light_animation.h"
 #include "render/oit/oit.h"
 #include "render/post/tonemap.h"
+#include "render/screenspace/screen_space.h"
 #include "render/shadel/decoupled.h"
 #include "render/shadel/visibility.h"
 
@@ -40,7 +41,8 @@ static void createTargets(Renderer& r) {
     hdr.width = r.internalWidth;
     hdr.height = r.internalHeight;
     hdr.usage = VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT | VK_IMAGE_USAGE_SAMPLED_BIT;
-    if (usesVisibilityBuffer(r.settings)) hdr.usage |= VK_IMAGE_USAGE_STORAGE_BIT; // resolve
+    if (usesVisibilityBuffer(r.settings) || r.settings.screenSpace) // resolve, screen space
+        hdr.usage |= VK_IMAGE_USAGE_STORAGE_BIT;
     r.hdr = need(createTexture(gpu, hdr), "the scene colour target");
     r.hdrTarget = createRenderTargetView(gpu, r.hdr);
     r.hdrRead = createReadView(gpu, r.hdr);
@@ -66,7 +68,7 @@ static void createTargets(Renderer& r) {
 // --capture names of the targets every frame has (render/debug/capture.h).
 static void registerTargetCaptures(Renderer& r) {
     Gpu& gpu = *r.gpu;
-    VkImageLayout hdrLayout = usesVisibilityBuffer(r.settings)
+    VkImageLayout hdrLayout = usesVisibilityBuffer(r.settings) || r.settings.screenSpace
                                   ? VK_IMAGE_LAYOUT_GENERAL
                                   : VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL; // after tonemap
     registerTextureCapture(
@@ -121,6 +123,7 @@ void initRenderer(Renderer& r, Gpu& gpu, const RenderSettings& settings, const G
     r.lightCulling = createLightCulling(r, scene);
     if (settings.gi == GiMode::Lpv) r.gi = createGi(r, scene);
     r.culling = createCulling(r, scene);
+    createScreenSpace(r);
 }
 
 void destroyRenderer(Renderer& r) {
@@ -128,6 +131,9 @@ void destroyRenderer(Renderer& r) {
     Gpu& gpu = *r.gpu;
     vkDeviceWaitIdle(gpu.device.device);
     destroyLightCulling(r, r.lightCulling);
+    destroyScreenSpace(r);
+    if (r.distanceFields) destroyDistanceFields(r, *r.distanceFields);
+    r.distanceFields.reset();
     if (r.gi) destroyGi(r, r.gi);
     r.captures = {}; // its sources refer to what is destroyed below
     if (r.visibility) destroyVisibility(r, r.visibility);
@@ -273,12 +279,14 @@ FrameResult renderFrame(Renderer& r, const GpuScene& scene, const CameraView& ca
     if (lightTilesThisFrame(r))
         pass(rec, "lightCulling", [&](VkCommandBuffer cmd) { recordLightCulling(r, cmd, frame); });
     if (r.settings.occlusion) recordOcclusionPasses(r, rec, frame, scene);
+    recordThinGBufferPass(r, rec, frame); // --screen-space on (render/screenspace)
     if (r.settings.mode == RenderMode::Forward) {
         pass(rec, "forwardShading",
              [&](VkCommandBuffer cmd) { recordForwardShading(r, cmd, frame); });
     } else {
         recordDecoupledPasses(r, rec, frame, scene);
     }
+    recordScreenSpacePasses(r, rec, frame);  // sky, SSR, SSS over classified tiles
     recordTransparencyPasses(r, rec, frame); // blended materials, after every opaque surface
     pass(rec, "tonemap", [&](VkCommandBuffer cmd) { recordTonemap(r, cmd, frame); });
     if (r.decoupled) recordDecoupledPostPasses(r, rec, frame);
@@ -300,6 +308,7 @@ FrameResult renderFrame(Renderer& r, const GpuScene& scene, const CameraView& ca
     if (r.decoupled) finishDecoupledFrame(r);
     readLightCullingStats(r);
     finishCullingFrame(r);
+    finishScreenSpaceFrame(r);
     r.framesRendered++;
     size_t bytes = size_t(r.settings.width) * r.settings.height * 4;
     result.rgba.resize(bytes);

@@ -8,6 +8,7 @@
 #include "render/camera.h"
 #include "render/culling/culling.h"
 #include "render/debug/capture.h"
+#include "render/distance_fields/distance_fields.h"
 #include "render/gi/lpv.h"
 #include "render/gpu_scene.h"
 #include "render/lighting/light_culling.h"
@@ -36,6 +37,7 @@ enum class Visualize : uint32_t {
     LightCount = VISUALIZE_LIGHT_COUNT, // lights per tile (forward) or chunk (shadel)
     Blockers = VISUALIZE_BLOCKERS,      // tiles / chunks with per-pixel blocker checks
     Gi = 6,                             // --visualize gi: the LPV's indirect light only
+    Tiles = VISUALIZE_TILES,            // --visualize tiles: 8x8 tile classes (render/tiles)
 };
 
 // --light-culling: per-tile (forward) and per-chunk (shadel) light lists, or every light for
@@ -86,6 +88,10 @@ struct RenderSettings {
     bool lod = false;                  // GPU LOD selection by projected error (render/culling)
     float lodErrorPixels = 0.5f;       // the coarsest LOD whose error projects below this is drawn
     bool occlusion = false; // two-phase hierarchical-Z occlusion culling (render/culling)
+    // Seed 004's screen-space passes (render/screenspace: thin G-buffer, sky, SSR, SSS) and
+    // whether they run per classified 8x8 tile (render/tiles) or over every tile.
+    bool screenSpace = false;
+    bool tileClassification = true;
 };
 
 struct FrameResult {
@@ -116,6 +122,12 @@ struct OitStateDeleter {
 };
 using OitStatePtr = std::unique_ptr<OitState, OitStateDeleter>;
 
+struct ScreenSpaceState; // render/screenspace/screen_space.h
+struct ScreenSpaceStateDeleter {
+    void operator()(ScreenSpaceState* state) const;
+};
+using ScreenSpaceStatePtr = std::unique_ptr<ScreenSpaceState, ScreenSpaceStateDeleter>;
+
 struct Renderer {
     Gpu* gpu = nullptr;
     RenderSettings settings;
@@ -145,12 +157,14 @@ struct Renderer {
     std::vector<gpu::GpuLight> lightsLastFrame;
     std::vector<glm::vec4> changedLightVolumes;
     uint64_t framesRendered = 0;
-    VisibilityStatePtr visibility;     // decoupled with --marking visibility
-    OitStatePtr oit;                   // scenes with blended materials (render/oit)
-    LightCullingStatePtr lightCulling; // light lists (render/lighting/light_culling.h)
-    GiStatePtr gi;                     // --gi lpv
-    CullingStatePtr culling;           // LODs, occlusion, per-view counts (render/culling)
-    CaptureRegistry captures;          // --capture: named resources of the frame (render/debug)
+    VisibilityStatePtr visibility;        // decoupled with --marking visibility
+    OitStatePtr oit;                      // scenes with blended materials (render/oit)
+    LightCullingStatePtr lightCulling;    // light lists (render/lighting/light_culling.h)
+    GiStatePtr gi;                        // --gi lpv
+    CullingStatePtr culling;              // LODs, occlusion, per-view counts (render/culling)
+    ScreenSpaceStatePtr screenSpace;      // --screen-space on (render/screenspace, render/tiles)
+    DistanceFieldStatePtr distanceFields; // --distance-fields on (render/distance_fields)
+    CaptureRegistry captures;             // --capture: named resources of the frame (render/debug)
     std::chrono::steady_clock::time_point createdAt = std::chrono::steady_clock::now();
 };
 

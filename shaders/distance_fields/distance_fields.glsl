@@ -1,0 +1,104 @@
+// Sphere tracing through mesh distance fields in the 3-D atlas (render/distance_fields).
+#ifndef SHADEL_DISTANCE_FIELDS_GLSL
+#define SHADEL_DISTANCE_FIELDS_GLSL
+#include "common/bindless.glsl"
+#include "distance_fields/df_types.h"
+
+layout(buffer_reference, scalar) readonly buffer DistanceFieldFrameRef { DistanceFieldFrame d; };
+layout(buffer_reference, scalar) readonly buffer DfAtlas { float v[]; };
+layout(buffer_reference, scalar) readonly buffer DfMeshes { GpuDistanceFieldMesh m[]; };
+layout(buffer_reference, scalar) readonly buffer DfInstances { GpuDistanceFieldInstance i[]; };
+
+float dfVoxel(DistanceFieldFrame df, uvec3 v) {
+    return DfAtlas(df.atlas).v[(v.z * df.atlasSize.y + v.y) * df.atlasSize.x + v.x];
+}
+
+// Trilinear distance (object-space metres) at an object-space point inside the field's box.
+float dfSample(DistanceFieldFrame df, GpuDistanceFieldMesh m, vec3 p) {
+    vec3 v = clamp((p - m.origin) / m.voxelSize, vec3(0.0), vec3(m.resolution) - 1.0001);
+    uvec3 i = uvec3(floor(v));
+    vec3 t = v - vec3(i);
+    uvec3 a = m.atlasOrigin + i;
+    float c000 = dfVoxel(df, a), c100 = dfVoxel(df, a + uvec3(1, 0, 0));
+    float c010 = dfVoxel(df, a + uvec3(0, 1, 0)), c110 = dfVoxel(df, a + uvec3(1, 1, 0));
+    float c001 = dfVoxel(df, a + uvec3(0, 0, 1)), c101 = dfVoxel(df, a + uvec3(1, 0, 1));
+    float c011 = dfVoxel(df, a + uvec3(0, 1, 1)), c111 = dfVoxel(df, a + uvec3(1, 1, 1));
+    return mix(mix(mix(c000, c100, t.x), mix(c010, c110, t.x), t.y),
+               mix(mix(c001, c101, t.x), mix(c011, c111, t.x), t.y), t.z);
+}
+
+// Ray / box overlap as [tNear, tFar] (empty when tNear > tFar).
+vec2 dfRayBox(vec3 o, vec3 invDir, vec3 lo, vec3 hi) {
+    vec3 a = (lo - o) * invDir, b = (hi - o) * invDir;
+    vec3 mn = min(a, b), mx = max(a, b);
+    return vec2(max(max(mn.x, mn.y), mn.z), min(min(mx.x, mx.y), mx.z));
+}
+
+// Soft visibility of a light along `dir` from `o` (world): the smallest k d / t over every
+// field the ray crosses, 0 on a hit. Each instance is traced only inside its own field's box.
+float dfSoftShadow(DistanceFieldFrame df, vec3 o, vec3 dir, float maxDistance) {
+    float visibility = 1.0;
+    DfInstances instances = DfInstances(df.instances);
+    vec3 invDir = 1.0 / (dir + vec3(1e-12));
+    for (uint n = 0u; n < df.instanceCount; ++n) {
+        GpuDistanceFieldInstance inst = instances.i[n];
+        vec2 span = dfRayBox(o, invDir, inst.worldMin, inst.worldMax);
+        if (span.x > min(span.y, maxDistance) || span.y < 0.0) continue;
+        GpuDistanceFieldMesh m = DfMeshes(df.meshes).m[inst.mesh];
+        if (m.valid == 0u) continue;
+        vec3 oo = (inst.worldToObject * vec4(o, 1.0)).xyz;
+        vec3 od = normalize(mat3(inst.worldToObject) * dir);
+        vec3 hi = m.origin + vec3(m.resolution - 1u) * m.voxelSize;
+        vec2 box = dfRayBox(oo, 1.0 / (od + vec3(1e-12)), m.origin, hi);
+        float t = max(box.x, 0.0);
+        float tEnd = min(box.y, maxDistance / inst.scale);
+        for (int step = 0; step < 64 && t < tEnd; ++step) {
+            float d = dfSample(df, m, oo + od * t);
+            if (d < m.voxelSize * 0.05) return 0.0;
+            visibility = min(visibility, df.softness * d * inst.scale / max(t * inst.scale, 1e-3));
+            t += max(d, m.voxelSize * 0.2);
+        }
+    }
+    return clamp(visibility, 0.0, 1.0);
+}
+
+// Distance (world metres) to the nearest field surface around `p`, searching only instances
+// whose box, grown by `radius`, holds p; `radius` when none is nearer.
+float dfNearest(DistanceFieldFrame df, vec3 p, float radius) {
+    float nearest = radius;
+    DfInstances instances = DfInstances(df.instances);
+    for (uint n = 0u; n < df.instanceCount; ++n) {
+        GpuDistanceFieldInstance inst = instances.i[n];
+        if (any(lessThan(p, inst.worldMin - radius)) || any(greaterThan(p, inst.worldMax + radius)))
+            continue;
+        GpuDistanceFieldMesh m = DfMeshes(df.meshes).m[inst.mesh];
+        if (m.valid == 0u) continue;
+        vec3 po = (inst.worldToObject * vec4(p, 1.0)).xyz;
+        vec3 hi = m.origin + vec3(m.resolution - 1u) * m.voxelSize;
+        vec3 outside = max(max(m.origin - po, po - hi), vec3(0.0));
+        float d = dfSample(df, m, po) + length(outside); // beyond the box: a lower bound
+        nearest = min(nearest, d * inst.scale);
+    }
+    return nearest;
+}
+
+// Ambient occlusion from the fields: how much of a few cones around the normal is filled at
+// growing distances (1 = open).
+float dfAmbientOcclusion(DistanceFieldFrame df, vec3 p, vec3 n) {
+    vec3 t = normalize(abs(n.y) < 0.9 ? cross(n, vec3(0, 1, 0)) : cross(n, vec3(1, 0, 0)));
+    vec3 b = cross(n, t);
+    const vec2 dirs[4] = vec2[4](vec2(1, 0), vec2(0, 1), vec2(-1, 0), vec2(0, -1));
+    float occlusion = 0.0, total = 0.0;
+    for (int c = 0; c < 5; ++c) {
+        vec3 dir = c == 0 ? n : normalize(n + 0.9 * (t * dirs[c - 1].x + b * dirs[c - 1].y));
+        float s = 0.12;
+        for (int k = 0; k < 4; ++k, s *= 2.0) {
+            float d = dfNearest(df, p + dir * s, s);
+            float w = 1.0 / float(k + 1);
+            occlusion += w * clamp((s - d) / s, 0.0, 1.0);
+            total += w;
+        }
+    }
+    return clamp(1.0 - 1.5 * occlusion / total, 0.0, 1.0);
+}
+#endif
