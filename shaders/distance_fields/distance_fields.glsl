@@ -34,13 +34,16 @@ vec2 dfRayBox(vec3 o, vec3 invDir, vec3 lo, vec3 hi) {
     return vec2(max(max(mn.x, mn.y), mn.z), min(min(mx.x, mx.y), mx.z));
 }
 
-// Soft visibility of a light along `dir` from `o` (world): the smallest k d / t over every
-// field the ray crosses, 0 on a hit. Each instance is traced only inside its own field's box.
+// Soft visibility of a light along `dir` from `o` (world). Penumbrae are centred on the
+// geometric shadow edge: the ray may pass into an occluder (negative distances, small steps),
+// r = min(k d / t) runs from -1 (deep inside) to 1 (clear), and visibility is a smooth ramp of r
+// that is 0.5 at the edge (Quilez's improved soft shadows), as the shadow map's PCF is centred.
+// Each instance is traced only inside its own field's box; the smallest r over them counts.
 float dfSoftShadow(DistanceFieldFrame df, vec3 o, vec3 dir, float maxDistance) {
-    float visibility = 1.0;
+    float r = 1.0;
     DfInstances instances = DfInstances(df.instances);
     vec3 invDir = 1.0 / (dir + vec3(1e-12));
-    for (uint n = 0u; n < df.instanceCount; ++n) {
+    for (uint n = 0u; n < df.instanceCount && r > -1.0; ++n) {
         GpuDistanceFieldInstance inst = instances.i[n];
         vec2 span = dfRayBox(o, invDir, inst.worldMin, inst.worldMax);
         if (span.x > min(span.y, maxDistance) || span.y < 0.0) continue;
@@ -52,14 +55,16 @@ float dfSoftShadow(DistanceFieldFrame df, vec3 o, vec3 dir, float maxDistance) {
         vec2 box = dfRayBox(oo, 1.0 / (od + vec3(1e-12)), m.origin, hi);
         float t = max(box.x, 0.0);
         float tEnd = min(box.y, maxDistance / inst.scale);
-        for (int step = 0; step < 64 && t < tEnd; ++step) {
+        float minStep = m.voxelSize * 0.1;
+        for (int step = 0; step < 96 && t < tEnd; ++step) {
             float d = dfSample(df, m, oo + od * t);
-            if (d < m.voxelSize * 0.05) return 0.0;
-            visibility = min(visibility, df.softness * d * inst.scale / max(t * inst.scale, 1e-3));
-            t += max(d, m.voxelSize * 0.2);
+            r = min(r, df.softness * d / max(t, 1e-3)); // scale cancels in d / t
+            if (r <= -1.0) break;
+            t += clamp(d, minStep, m.voxelSize * 4.0);
         }
     }
-    return clamp(visibility, 0.0, 1.0);
+    r = max(r, -1.0);
+    return 0.25 * (1.0 + r) * (1.0 + r) * (2.0 - r);
 }
 
 // Distance (world metres) to the nearest field surface around `p`, searching only instances
@@ -91,11 +96,14 @@ float dfAmbientOcclusion(DistanceFieldFrame df, vec3 p, vec3 n) {
     float occlusion = 0.0, total = 0.0;
     for (int c = 0; c < 5; ++c) {
         vec3 dir = c == 0 ? n : normalize(n + 0.9 * (t * dirs[c - 1].x + b * dirs[c - 1].y));
+        // An open flat surface leaves a sample s along `dir` at s cos(theta) from any surface:
+        // only what is nearer than that occludes.
+        float open = dot(dir, n);
         float s = 0.12;
         for (int k = 0; k < 4; ++k, s *= 2.0) {
             float d = dfNearest(df, p + dir * s, s);
             float w = 1.0 / float(k + 1);
-            occlusion += w * clamp((s - d) / s, 0.0, 1.0);
+            occlusion += w * clamp((s * open - d) / (s * open), 0.0, 1.0);
             total += w;
         }
     }

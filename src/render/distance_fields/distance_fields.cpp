@@ -106,7 +106,7 @@ DistanceFieldStatePtr createDistanceFields(Renderer& r, const Scene& scene,
     frame.instances = address(gpu, s->instances);
     frame.instanceCount = s->instancesCasting;
     frame.atlasSize = {kAtlasSize[0], kAtlasSize[1], kAtlasSize[2]};
-    frame.softness = 8.0f;
+    frame.softness = 24.0f; // penumbrae about as wide as the shadow map's 3x3 PCF
     s->frame = buffer("df.frame", &frame, sizeof(frame));
 
     TextureDesc out;
@@ -122,6 +122,11 @@ DistanceFieldStatePtr createDistanceFields(Renderer& r, const Scene& scene,
                                      VK_BUFFER_USAGE_TRANSFER_DST_BIT, MemoryKind::Readback});
     if (!s->output || !s->readback) throw DeviceError("out of GPU memory for df.lighting");
     s->outputWrite = createWriteView(gpu, s->output);
+    DistanceFieldState* state = s.get();
+    registerTextureCapture(
+        r.captures, gpu, "df.lighting",
+        "distance fields: R DF sun visibility, G shadow-map visibility, B DF AO (PNG)",
+        CaptureKind::Display, [state] { return state->output; }, VK_IMAGE_LAYOUT_GENERAL);
     SHADEL_INFO("distance fields: %u meshes (%u from the cache), %u in the atlas, %u instances, "
                 "%.2f s",
                 s->meshesWithField, s->cacheHits, s->meshesPlaced, s->instancesCasting,
