@@ -669,7 +669,7 @@ Scene makeArena() {
     for (int i = 0; i < 12; ++i) {
         float a = float(i) / 12.0f * 6.2832f;
         b.place("bush " + std::to_string(i), bush,
-                {std::cos(a) * 20.0f, 0.6f, std::sin(a) * 20.0f - 4.0f});
+                {std::cos(a) * 20.0f, 1.2f, std::sin(a) * 20.0f - 4.0f});
     }
     for (int i = 0; i < 3; ++i)
         b.box("stand " + std::to_string(i), {14.0f, 2.0f + 2.0f * float(i), 3.0f}, concrete,
