@@ -1,5 +1,6 @@
 #include "render/tiles/tile_classification.h"
 
+#include <algorithm>
 #include <cstring>
 
 #include "core/error.h"
@@ -14,16 +15,24 @@ VkDeviceSize listBytes(const TileClassification& t) {
     return sizeof(gpu::TileBufferHeader) + (TILE_LIST_COUNT + 1) * tiles * sizeof(uint32_t);
 }
 
-// Subgroup OR / AND in compute shaders (Vulkan 1.1 makes them optional).
-bool hasSubgroupArithmetic(const Gpu& gpu) {
+// How many tiles a 64-invocation classification workgroup covers: one per subgroup, counted
+// with the largest subgroup size the device may use (SPIR-V 1.6 lets it vary), so the dispatch
+// always reaches every tile; 64 (one per invocation) without subgroup OR / AND in compute
+// (Vulkan 1.1 makes them optional).
+uint32_t tilesPerClassifyGroup(const Gpu& gpu) {
+    VkPhysicalDeviceVulkan13Properties v13{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_3_PROPERTIES};
     VkPhysicalDeviceSubgroupProperties subgroup{
         VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_SUBGROUP_PROPERTIES};
+    subgroup.pNext = &v13;
     VkPhysicalDeviceProperties2 props{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PROPERTIES_2};
     props.pNext = &subgroup;
     vkGetPhysicalDeviceProperties2(gpu.device.physical, &props);
-    return (subgroup.supportedStages & VK_SHADER_STAGE_COMPUTE_BIT) &&
-           (subgroup.supportedOperations & VK_SUBGROUP_FEATURE_ARITHMETIC_BIT) &&
-           (subgroup.supportedOperations & VK_SUBGROUP_FEATURE_BASIC_BIT);
+    bool arithmetic = (subgroup.supportedStages & VK_SHADER_STAGE_COMPUTE_BIT) &&
+                      (subgroup.supportedOperations & VK_SUBGROUP_FEATURE_ARITHMETIC_BIT) &&
+                      (subgroup.supportedOperations & VK_SUBGROUP_FEATURE_BASIC_BIT);
+    if (!arithmetic) return 64;
+    uint32_t largest = std::max({subgroup.subgroupSize, v13.maxSubgroupSize, 1u});
+    return std::max(64u / largest, 1u);
 }
 } // namespace
 
@@ -38,8 +47,10 @@ TileClassification createTileClassification(Gpu& gpu, uint32_t width, uint32_t h
     t.readback = createBuffer(gpu, {"tiles.counts.readback", sizeof(gpu::TileBufferHeader),
                                     VK_BUFFER_USAGE_TRANSFER_DST_BIT, MemoryKind::Readback});
     if (!t.buffer || !t.readback) throw DeviceError("out of GPU memory for the tile lists");
+    uint32_t perGroup = tilesPerClassifyGroup(gpu);
+    t.classifyGroups = (t.tilesX * t.tilesY + perGroup - 1) / perGroup;
     t.classify = createComputePipeline(gpu, "tileClassify", "tiles_classify.comp.spv",
-                                       {{0, hasSubgroupArithmetic(gpu) ? 1u : 0u}});
+                                       {{0, perGroup == 64 ? 0u : 1u}});
     t.visualize = createComputePipeline(gpu, "tileVisualize", "tiles_visualize.comp.spv");
     return t;
 }
@@ -71,7 +82,7 @@ void recordTileClassification(Gpu& gpu, VkCommandBuffer cmd, TileClassification&
     push.tilesX = t.tilesX;
     bind(gpu, cmd, t.classify);
     pushConstants(gpu, cmd, push);
-    vkCmdDispatch(cmd, t.tilesX, t.tilesY, 1);
+    vkCmdDispatch(cmd, t.classifyGroups, 1, 1);
     memoryBarrier(cmd, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT,
                   VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_2_DRAW_INDIRECT_BIT,
                   VK_ACCESS_2_SHADER_STORAGE_READ_BIT | VK_ACCESS_2_INDIRECT_COMMAND_READ_BIT);

@@ -1,9 +1,9 @@
 #pragma once
 // Tile classification (seed 004): the screen is cut into 8x8 tiles, classified once per frame
-// from the thin G-buffer's pixel flags (subgroup OR / AND), and each tile is appended to the
-// list of every screen-space permutation it needs (TILE_LIST_* in shaders/tiles/tile_types.h),
-// with the indirect dispatch arguments of each list. Passes then dispatch over their lists
-// (dispatchTileList) instead of the whole screen (dispatchAllTiles).
+// from the thin G-buffer's pixel flags (one subgroup per tile: subgroup OR / AND), and each tile is
+// appended to the list of every screen-space permutation it needs (TILE_LIST_* in
+// shaders/tiles/tile_types.h), with the indirect dispatch arguments of each list. Passes then
+// dispatch over their lists (dispatchTileList) instead of the whole screen (dispatchAllTiles).
 #include <array>
 #include <cstdint>
 
@@ -17,8 +17,9 @@ struct Gpu;
 
 struct TileClassification {
     uint32_t tilesX = 0, tilesY = 0;
-    BufferHandle buffer;   // TileBufferHeader, the lists, a class mask per tile
-    BufferHandle readback; // the last frame's list counts (stats)
+    uint32_t classifyGroups = 0; // workgroups of the classification (a tile per subgroup)
+    BufferHandle buffer;         // TileBufferHeader, the lists, a class mask per tile
+    BufferHandle readback;       // the last frame's list counts (stats)
     Pipeline classify, visualize;
     std::array<uint32_t, TILE_LIST_COUNT> counts{}; // read back after the frame
 };
