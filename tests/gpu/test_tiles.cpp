@@ -7,6 +7,7 @@
 #include <fstream>
 #include <sstream>
 #include <sys/wait.h>
+#include <unistd.h>
 
 #include <algorithm>
 
@@ -27,8 +28,9 @@ RenderOptions arena(RenderMode mode, bool screenSpace, bool classification, uint
 }
 
 int runShadel(const std::string& args, std::string& err) {
-    std::string errFile =
-        (std::filesystem::temp_directory_path() / "shadel_tiles_stderr.txt").string();
+    std::string errFile = (std::filesystem::temp_directory_path() /
+                           ("shadel_tiles_stderr_" + std::to_string(getpid()) + ".txt"))
+                              .string();
     std::string cmd =
         std::string("timeout 120 ") + SHADEL_BINARY + " " + args + " >/dev/null 2>" + errFile;
     int status = std::system(cmd.c_str());

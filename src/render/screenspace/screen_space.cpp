@@ -45,7 +45,8 @@ TextureHandle storageTexture(Gpu& gpu, const char* name, VkFormat pixelFormat, u
     d.width = w;
     d.height = h;
     d.mipLevels = mips;
-    d.usage = VK_IMAGE_USAGE_STORAGE_BIT | VK_IMAGE_USAGE_SAMPLED_BIT;
+    d.usage = VK_IMAGE_USAGE_STORAGE_BIT | VK_IMAGE_USAGE_SAMPLED_BIT |
+              VK_IMAGE_USAGE_TRANSFER_SRC_BIT; // --capture
     TextureHandle t = createTexture(gpu, d);
     if (!t) throw DeviceError(format("out of GPU memory for %s", name));
     return t;
@@ -145,6 +146,15 @@ void createScreenSpace(Renderer& r) {
         createComputePipeline(gpu, "screenSpaceComposite", "screenspace_composite.comp.spv");
     s->distanceFieldLighting =
         createComputePipeline(gpu, "distanceFieldLighting", "distance_fields_df_lighting.comp.spv");
+    ScreenSpaceState* state = s.get();
+    registerTextureCapture(
+        r.captures, gpu, "gbuffer.normal",
+        "thin G-buffer: world normal (rgb) + roughness (a) (EXR)", CaptureKind::Hdr,
+        [state] { return state->gbuffer.normalRoughness; },
+        VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL);
+    registerTextureCapture(
+        r.captures, gpu, "ssr", "screen-space reflections: radiance (rgb) + weight (a) (EXR)",
+        CaptureKind::Hdr, [state] { return state->reflection; }, VK_IMAGE_LAYOUT_GENERAL);
     r.screenSpace = std::move(s);
 }
 

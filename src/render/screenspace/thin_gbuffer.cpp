@@ -14,7 +14,8 @@ ThinGBuffer createThinGBuffer(Renderer& r) {
     desc.format = VK_FORMAT_R16G16B16A16_SFLOAT;
     desc.width = r.internalWidth;
     desc.height = r.internalHeight;
-    desc.usage = VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT | VK_IMAGE_USAGE_SAMPLED_BIT;
+    desc.usage = VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT | VK_IMAGE_USAGE_SAMPLED_BIT |
+                 VK_IMAGE_USAGE_TRANSFER_SRC_BIT; // --capture
     g.normalRoughness = createTexture(gpu, desc);
     desc.name = "gbuffer.flags";
     desc.format = VK_FORMAT_R8_UNORM; // PIXEL_* bits and the class, as n / 255
