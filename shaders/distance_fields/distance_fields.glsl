@@ -67,29 +67,52 @@ float dfSoftShadow(DistanceFieldFrame df, vec3 o, vec3 dir, float maxDistance) {
     return 0.25 * (1.0 + r) * (1.0 + r) * (2.0 - r);
 }
 
-// Distance (world metres) to the nearest field surface around `p`, searching only instances
-// whose box, grown by `radius`, holds p; `radius` when none is nearer.
-float dfNearest(DistanceFieldFrame df, vec3 p, float radius) {
-    float nearest = radius;
+// The instances whose box, grown by `radius`, holds `p`: what AO samples around p can meet.
+#define DF_NEAR_MAX 32
+struct DfNearby {
+    uint count;
+    uint index[DF_NEAR_MAX];
+};
+
+DfNearby dfGatherNearby(DistanceFieldFrame df, vec3 p, float radius) {
+    DfNearby near;
+    near.count = 0u;
     DfInstances instances = DfInstances(df.instances);
-    for (uint n = 0u; n < df.instanceCount; ++n) {
+    for (uint n = 0u; n < df.instanceCount && near.count < DF_NEAR_MAX; ++n) {
         GpuDistanceFieldInstance inst = instances.i[n];
         if (any(lessThan(p, inst.worldMin - radius)) || any(greaterThan(p, inst.worldMax + radius)))
             continue;
+        if (DfMeshes(df.meshes).m[inst.mesh].valid == 0u) continue;
+        near.index[near.count++] = n;
+    }
+    return near;
+}
+
+// Distance (world metres) from `p` to the nearest surface of the gathered instances (beyond a
+// field's box, the distance to the box plus the field at its edge: a lower bound), at most
+// `radius`.
+float dfNearest(DistanceFieldFrame df, DfNearby near, vec3 p, float radius) {
+    float nearest = radius;
+    DfInstances instances = DfInstances(df.instances);
+    for (uint k = 0u; k < near.count; ++k) {
+        GpuDistanceFieldInstance inst = instances.i[near.index[k]];
         GpuDistanceFieldMesh m = DfMeshes(df.meshes).m[inst.mesh];
-        if (m.valid == 0u) continue;
         vec3 po = (inst.worldToObject * vec4(p, 1.0)).xyz;
         vec3 hi = m.origin + vec3(m.resolution - 1u) * m.voxelSize;
         vec3 outside = max(max(m.origin - po, po - hi), vec3(0.0));
-        float d = dfSample(df, m, po) + length(outside); // beyond the box: a lower bound
+        float d = dfSample(df, m, po) + length(outside);
         nearest = min(nearest, d * inst.scale);
     }
     return nearest;
 }
 
 // Ambient occlusion from the fields: how much of a few cones around the normal is filled at
-// growing distances (1 = open).
+// growing distances (1 = open). The instances near the point are gathered once.
 float dfAmbientOcclusion(DistanceFieldFrame df, vec3 p, vec3 n) {
+    const float firstStep = 0.12;
+    const int steps = 4;
+    // A sample s from p is within s of what it can meet: gather within twice the last s.
+    DfNearby near = dfGatherNearby(df, p, 2.0 * firstStep * float(1 << (steps - 1)));
     vec3 t = normalize(abs(n.y) < 0.9 ? cross(n, vec3(0, 1, 0)) : cross(n, vec3(1, 0, 0)));
     vec3 b = cross(n, t);
     const vec2 dirs[4] = vec2[4](vec2(1, 0), vec2(0, 1), vec2(-1, 0), vec2(0, -1));
@@ -99,9 +122,9 @@ float dfAmbientOcclusion(DistanceFieldFrame df, vec3 p, vec3 n) {
         // An open flat surface leaves a sample s along `dir` at s cos(theta) from any surface:
         // only what is nearer than that occludes.
         float open = dot(dir, n);
-        float s = 0.12;
-        for (int k = 0; k < 4; ++k, s *= 2.0) {
-            float d = dfNearest(df, p + dir * s, s);
+        float s = firstStep;
+        for (int k = 0; k < steps; ++k, s *= 2.0) {
+            float d = dfNearest(df, near, p + dir * s, s);
             float w = 1.0 / float(k + 1);
             occlusion += w * clamp((s * open - d) / (s * open), 0.0, 1.0);
             total += w;
