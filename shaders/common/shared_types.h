@@ -22,6 +22,9 @@ using uint = uint32_t;
 #define MATERIAL_ALPHA_BLEND 2u
 #define MATERIAL_DOUBLE_SIDED 4u
 #define MATERIAL_UNLIT 8u
+// Bits 8..10: the surface class (scene.h SurfaceClass; render/screenspace's thin G-buffer).
+#define MATERIAL_CLASS_SHIFT 8u
+#define MATERIAL_CLASS_MASK 7u
 
 // Texture slots of a material (scene.h TextureSlot), for uvTransform and clampMask.
 #define TEXTURE_SLOT_BASE_COLOR 0u
@@ -71,6 +74,7 @@ using uint = uint32_t;
 #define VISUALIZE_BLOCKERS 17u      // --visualize blockers: tiles with per-pixel blocker checks
 #define VISUALIZE_GI 6u             // --visualize gi: the LPV indirect light only
 #define VISUALIZE_RT_AO 7u          // --visualize rt-ao: the ray-traced ambient occlusion only
+#define VISUALIZE_TILES 20u         // --visualize tiles: the 8x8 tile classes (render/tiles)
 
 // One vertex of the unified geometry buffer (matches shadel::Vertex).
 struct GpuVertex {

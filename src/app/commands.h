@@ -66,6 +66,9 @@ struct RenderOptions {
     uint32_t debugLines = 0; // --debug-lines: DEBUG_LINES_* kinds (render/debug/debug_lines.h)
     uint32_t debugLineCapacity = 256 * 1024; // segments the line buffer holds (tests: smaller)
     RtSettings rt;          // --rt-*, --rays-per-shadel, --blas-pool-*: render/raytracing
+    bool screenSpace = false; // --screen-space: sky, SSR, SSS (render/screenspace)
+    bool tileClassification = true; // --tile-classification: per-tile dispatch (render/tiles)
+    bool distanceFields = false;    // --distance-fields: DF shadows + AO (render/distance_fields)
     // --capture NAME[,NAME...] (or {"list"}) and --capture-dir: the last frame's named
     // resources (app/capture_output.h); files go to the dir or next to --out.
     std::vector<std::string> captures;

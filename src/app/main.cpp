@@ -111,7 +111,8 @@ int main(int argc, char** argv) {
         ->add_option("--visualize", visualize,
                      "none | marking | mips | chunks | sheet | layer:radiance | layer:material | "
                      "light-count | blockers | gi (indirect light only, with --gi lpv) | rt-ao "
-                     "(ray-traced AO only, with --rt-ao on) | particle-atlas")
+                     "(ray-traced AO only, with --rt-ao on) | particle-atlas | tiles (the 8x8 "
+                     "tile classes, with --screen-space on)")
         ->capture_default_str();
     std::string marking = "raster";
     render
@@ -261,6 +262,15 @@ int main(int argc, char** argv) {
         ->capture_default_str();
     RtFlags rtFlags; // ray tracing (render/raytracing)
     addRayTracingFlags(*render, rtFlags);
+    // Seed 004's screen-space passes and tile classification (render/screenspace, tiles).
+    std::string screenSpace = "off", tileClassification = "on", distanceFields = "off";
+        ->add_option("--screen-space", screenSpace,
+                     "on | off: thin G-buffer, sky, screen-space reflections and skin SSS")
+        ->add_option("--tile-classification", tileClassification,
+                     "on | off: run the screen-space passes only on the 8x8 tiles that need them")
+        ->add_option("--distance-fields", distanceFields,
+                     "on | off: mesh distance fields in a 3-D atlas: soft sun shadows and AO "
+                     "(needs --screen-space on)")
     std::string captures;
     render->add_option("--capture", captures,
                        "NAME[,NAME...]: write named resources of the last frame (EXR for HDR "
@@ -457,6 +467,9 @@ int main(int argc, char** argv) {
             ro.occlusion = parseOnOff("--occlusion", occlusion);
             ro.debugLines = parseDebugLines(debugLines);
             ro.rt = parseRayTracingFlags(rtFlags);
+            ro.screenSpace = parseOnOff("--screen-space", screenSpace);
+            ro.tileClassification = parseOnOff("--tile-classification", tileClassification);
+            ro.distanceFields = parseOnOff("--distance-fields", distanceFields);
             if (!captures.empty()) ro.captures = parseCaptureNames(captures);
             if (!inspect.empty()) parseInspect(inspect, ro.inspectX, ro.inspectY);
             RenderRun run = runRender(g.gpu, ro);

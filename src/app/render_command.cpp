@@ -17,6 +17,7 @@
 #include "core/log.h"
 #include "render/debug/inspect.h"
 #include "render/particles/particles.h"
+#include "render/screenspace/screen_space.h"
 #include "render/shadel/decoupled.h"
 #include "render/view_density.h"
 #include "scene/load.h"
@@ -53,9 +54,10 @@ Visualize parseVisualize(const std::string& text) {
     if (text == "gi") return Visualize::Gi;
     if (text == "rt-ao") return Visualize::RtAo;
     if (text == "particle-atlas") return Visualize::ParticleAtlas;
+    if (text == "tiles") return Visualize::Tiles;
     throw InputError(format("--visualize %s: expected none, marking, mips, chunks, sheet, "
-                            "layer:radiance, layer:material, light-count, blockers, gi, rt-ao or "
-                            "particle-atlas",
+                            "layer:radiance, layer:material, light-count, blockers, gi, rt-ao, "
+                            "particle-atlas or tiles",
                             text.c_str()));
 }
 
@@ -282,11 +284,22 @@ RenderRun runRender(Gpu& gpu, const RenderOptions& o) {
     if (o.visualize == Visualize::RtAo && !o.rt.ao)
         throw InputError("--visualize rt-ao: shows the ray-traced AO of --rt-ao on; it is off");
     settings.rt = o.rt;
+    if (o.visualize == Visualize::Tiles && !o.screenSpace)
+        throw InputError(
+            "--visualize tiles: shows the tile classes of --screen-space on; it is off");
+    settings.screenSpace = o.screenSpace;
+    if (o.distanceFields && !o.screenSpace)
+        throw InputError(
+            "--distance-fields on: runs on the screen-space tiles; add --screen-space on");
+    settings.tileClassification = o.tileClassification;
     settings.timing = o.timing ? *o.timing : defaultTimingMode(gpu);
     Renderer renderer;
     RenderRun run;
     try {
         initRenderer(renderer, gpu, settings, gpuScene);
+        if (o.distanceFields)
+            renderer.distanceFields = createDistanceFields(
+                renderer, scene, gpuScene, o.cacheDir.empty() ? defaultCacheDir() : o.cacheDir);
         if (listCaptures) {
             std::printf("%s", captureListing(renderer.captures).c_str());
             run.listedCaptures = true;
@@ -404,6 +417,8 @@ RenderRun runRender(Gpu& gpu, const RenderOptions& o) {
     }
     if (renderer.gi) giStats(renderer, s);
     if (renderer.rt) rayTracingStats(renderer, s);
+    if (renderer.screenSpace) screenSpaceStats(renderer, s);
+    if (renderer.distanceFields) distanceFieldStats(*renderer.distanceFields, s);
     if (o.inspectX >= 0) {
         nlohmann::json prints = nlohmann::json::array();
         InspectedPixel pixel = frontFragment(run.frames.back().prints);

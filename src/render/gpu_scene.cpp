@@ -137,6 +137,7 @@ void uploadScene(Gpu& gpu, const Scene& scene, GpuScene& out, const std::vector<
         g.flags = (m.alphaMode == AlphaMode::Mask ? MATERIAL_ALPHA_MASK : 0u) |
                   (m.alphaMode == AlphaMode::Blend ? MATERIAL_ALPHA_BLEND : 0u) |
                   (m.doubleSided ? MATERIAL_DOUBLE_SIDED : 0u) | (m.unlit ? MATERIAL_UNLIT : 0u);
+        g.flags |= (uint32_t(m.surfaceClass) & MATERIAL_CLASS_MASK) << MATERIAL_CLASS_SHIFT;
         g.procedural = uint32_t(m.procedural);
         g.proceduralScale = m.proceduralScale;
         g.additiveness =

@@ -12,6 +12,7 @@
 #include "render/oit/oit.h"
 #include "render/particles/particles.h"
 #include "render/post/tonemap.h"
+#include "render/screenspace/screen_space.h"
 #include "render/shadel/decoupled.h"
 #include "render/shadel/visibility.h"
 
@@ -41,7 +42,8 @@ static void createTargets(Renderer& r) {
     hdr.width = r.internalWidth;
     hdr.height = r.internalHeight;
     hdr.usage = VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT | VK_IMAGE_USAGE_SAMPLED_BIT;
-    if (usesVisibilityBuffer(r.settings)) hdr.usage |= VK_IMAGE_USAGE_STORAGE_BIT; // resolve
+    if (usesVisibilityBuffer(r.settings) || r.settings.screenSpace) // resolve, screen space
+        hdr.usage |= VK_IMAGE_USAGE_STORAGE_BIT;
     r.hdr = need(createTexture(gpu, hdr), "the scene colour target");
     r.hdrTarget = createRenderTargetView(gpu, r.hdr);
     r.hdrRead = createReadView(gpu, r.hdr);
@@ -67,7 +69,7 @@ static void createTargets(Renderer& r) {
 // --capture names of the targets every frame has (render/debug/capture.h).
 static void registerTargetCaptures(Renderer& r) {
     Gpu& gpu = *r.gpu;
-    VkImageLayout hdrLayout = usesVisibilityBuffer(r.settings)
+    VkImageLayout hdrLayout = usesVisibilityBuffer(r.settings) || r.settings.screenSpace
                                   ? VK_IMAGE_LAYOUT_GENERAL
                                   : VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL; // after tonemap
     registerTextureCapture(
@@ -125,6 +127,7 @@ void initRenderer(Renderer& r, Gpu& gpu, const RenderSettings& settings, const G
     r.culling = createCulling(r, scene);
     r.debugLines = createDebugLines(r);
     if (settings.rt.enabled()) r.rt = createRayTracing(r, scene);
+    createScreenSpace(r);
 }
 
 void destroyRenderer(Renderer& r) {
@@ -134,6 +137,9 @@ void destroyRenderer(Renderer& r) {
     destroyRayTracing(r, r.rt);
     destroyLightCulling(r, r.lightCulling);
     destroyDebugLines(r, r.debugLines);
+    destroyScreenSpace(r);
+    if (r.distanceFields) destroyDistanceFields(r, *r.distanceFields);
+    r.distanceFields.reset();
     if (r.gi) destroyGi(r, r.gi);
     r.captures = {}; // its sources refer to what is destroyed below
     if (r.visibility) destroyVisibility(r, r.visibility);
@@ -286,6 +292,7 @@ FrameResult renderFrame(Renderer& r, const GpuScene& scene, const CameraView& ca
     if (lightTilesThisFrame(r))
         pass(rec, "lightCulling", [&](VkCommandBuffer cmd) { recordLightCulling(r, cmd, frame); });
     if (r.settings.occlusion) recordOcclusionPasses(r, rec, frame, scene);
+    recordThinGBufferPass(r, rec, frame); // --screen-space on (render/screenspace)
     if (r.settings.mode == RenderMode::Forward) {
         if (r.rt) // sun visibility, AO, indirect light per pixel (render/raytracing)
             pass(rec, "rtPixelTerms",
@@ -299,6 +306,7 @@ FrameResult renderFrame(Renderer& r, const GpuScene& scene, const CameraView& ca
         recordDecoupledPasses(r, rec, frame, scene);
     }
     recordParticlePasses(r, rec, frame);     // GPU particles: simulation, atlas lighting
+    recordScreenSpacePasses(r, rec, frame);  // sky, SSR, SSS over classified tiles
     recordTransparencyPasses(r, rec, frame); // blended materials, after every opaque surface
     if (r.debugLines) recordDebugLinePasses(r, rec, frame, scene, constants.lightCount);
     recordParticleAtlasView(r, rec, frame);  // --visualize particle-atlas
@@ -323,6 +331,7 @@ FrameResult renderFrame(Renderer& r, const GpuScene& scene, const CameraView& ca
     readLightCullingStats(r);
     finishCullingFrame(r);
     if (r.rt) finishRayTracingFrame(r);
+    finishScreenSpaceFrame(r);
     r.framesRendered++;
     size_t bytes = size_t(r.settings.width) * r.settings.height * 4;
     result.rgba.resize(bytes);

@@ -9,6 +9,7 @@
 #include "render/culling/culling.h"
 #include "render/debug/capture.h"
 #include "render/debug/debug_lines.h"
+#include "render/distance_fields/distance_fields.h"
 #include "render/gi/lpv.h"
 #include "render/gpu_scene.h"
 #include "render/lighting/light_culling.h"
@@ -41,6 +42,7 @@ enum class Visualize : uint32_t {
     Gi = 6,                             // --visualize gi: the LPV's indirect light only
     RtAo = VISUALIZE_RT_AO,             // --visualize rt-ao: the ray-traced AO only (--rt-ao on)
     ParticleAtlas = 24,                 // --visualize particle-atlas (render/particles)
+    Tiles = VISUALIZE_TILES,            // --visualize tiles: 8x8 tile classes (render/tiles)
 };
 // --particle-lighting: lit particle sprites read the atlas, or are lit per pixel / per vertex.
 enum class ParticleLighting : uint32_t { Atlas = 0, Pixel = 1, Vertex = 2 };
@@ -100,6 +102,10 @@ struct RenderSettings {
     bool particles = true;  // the scene's GPU particle emitters (render/particles)
     ParticleLighting particleLighting = ParticleLighting::Atlas;
     uint32_t particleAtlasSize = 1024; // texels per side of the particle lightmap atlas
+    // Seed 004's screen-space passes (render/screenspace: thin G-buffer, sky, SSR, SSS) and
+    // whether they run per classified 8x8 tile (render/tiles) or over every tile.
+    bool screenSpace = false;
+    bool tileClassification = true;
 };
 
 struct FrameResult {
@@ -134,6 +140,12 @@ struct ParticleStateDeleter {
     void operator()(ParticleState* state) const;
 };
 using ParticleStatePtr = std::unique_ptr<ParticleState, ParticleStateDeleter>;
+
+struct ScreenSpaceState; // render/screenspace/screen_space.h
+struct ScreenSpaceStateDeleter {
+    void operator()(ScreenSpaceState* state) const;
+};
+using ScreenSpaceStatePtr = std::unique_ptr<ScreenSpaceState, ScreenSpaceStateDeleter>;
 
 struct Renderer {
     Gpu* gpu = nullptr;
@@ -173,6 +185,8 @@ struct Renderer {
     CullingStatePtr culling;           // LODs, occlusion, per-view counts (render/culling)
     RayTracingStatePtr rt;             // BLASes, TLAS, traced terms (--rt-*, render/raytracing)
     CaptureRegistry captures;          // --capture: named resources of the frame (render/debug)
+    ScreenSpaceStatePtr screenSpace;      // --screen-space on (render/screenspace, render/tiles)
+    DistanceFieldStatePtr distanceFields; // --distance-fields on (render/distance_fields)
     std::chrono::steady_clock::time_point createdAt = std::chrono::steady_clock::now();
 };
 

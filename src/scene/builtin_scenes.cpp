@@ -701,6 +701,80 @@ Scene makeCornell() {
     return scene;
 }
 
+// Seed 004's arena: a sand floor with a polished stage (smooth enough for screen-space
+// reflections), a pool of water, fighters with a skin material, foliage, stands, far buildings
+// and open sky. Every surface class of the thin G-buffer (render/screenspace) is on screen.
+Scene makeArena() {
+    Scene scene;
+    scene.name = "arena";
+    SceneBuilder b(scene);
+    Rng rng(0xA4E4A0004ull);
+    uint32_t sand = b.material("sand", {0.76f, 0.66f, 0.48f}, 0.95f);
+    uint32_t stage = b.material("polished stage", {0.35f, 0.36f, 0.4f}, 0.08f, 0.0f);
+    uint32_t rope = b.material("ring post", {0.85f, 0.1f, 0.08f}, 0.25f, 0.0f);
+    uint32_t concrete = b.material("stand concrete", {0.6f, 0.6f, 0.62f}, 0.85f);
+    uint32_t far = b.material("far facade", {0.55f, 0.6f, 0.7f}, 0.7f);
+    uint32_t water = b.material("water", {0.05f, 0.18f, 0.22f}, 0.04f);
+    scene.materials[water].surfaceClass = SurfaceClass::Water;
+    uint32_t leaves = b.material("leaves", {0.2f, 0.48f, 0.16f}, 0.75f);
+    scene.materials[leaves].surfaceClass = SurfaceClass::Foliage;
+    uint32_t skins[3] = {b.material("skin light", {0.92f, 0.7f, 0.58f}, 0.5f),
+                         b.material("skin medium", {0.72f, 0.5f, 0.36f}, 0.5f),
+                         b.material("skin dark", {0.42f, 0.28f, 0.2f}, 0.5f)};
+    for (uint32_t m : skins) scene.materials[m].surfaceClass = SurfaceClass::Skin;
+    uint32_t shorts = b.material("shorts", {0.15f, 0.2f, 0.6f}, 0.6f);
+
+    b.place("sand", b.mesh(makePlane("sand", 90.0f, 90.0f, sand, 9)), {0, 0, 0});
+    b.box("stage", {12.0f, 0.4f, 12.0f}, stage, {0.0f, 0.0f, 0.0f});
+    uint32_t post = b.mesh(makeCylinder("ring post", 0.15f, 1.6f, rope, 16));
+    for (int i = 0; i < 4; ++i)
+        b.place("ring post " + std::to_string(i), post,
+                {i % 2 ? 5.7f : -5.7f, 0.4f, i / 2 ? 5.7f : -5.7f});
+    b.place("pool", b.mesh(makePlane("pool", 10.0f, 14.0f, water, 4)), {-13.0f, 0.05f, 2.0f});
+
+    // Fighters: legs, shorts, torso, arms and head; skin everywhere but the shorts.
+    const glm::vec3 spots[4] = {
+        {-1.6f, 0.4f, 0.6f}, {1.5f, 0.4f, -0.4f}, {0.2f, 0.4f, 2.6f}, {-3.0f, 0.0f, 7.5f}};
+    for (int i = 0; i < 4; ++i) {
+        uint32_t skin = skins[i % 3];
+        std::string n = "fighter " + std::to_string(i);
+        glm::vec3 at = spots[i];
+        float yaw = rng.uniform(0.0f, 6.28f);
+        uint32_t leg = b.mesh(makeCylinder(n + " leg", 0.13f, 0.85f, skin, 16));
+        b.place(n + " left leg", leg, at + glm::vec3(-0.16f, 0.0f, 0.0f), yaw);
+        b.place(n + " right leg", leg, at + glm::vec3(0.16f, 0.0f, 0.0f), yaw);
+        b.place(n + " shorts", b.mesh(makeCylinder(n + " shorts", 0.33f, 0.3f, shorts, 20)),
+                at + glm::vec3(0, 0.8f, 0), yaw);
+        b.place(n + " torso", b.mesh(makeCylinder(n + " torso", 0.3f, 0.65f, skin, 20)),
+                at + glm::vec3(0, 1.1f, 0), yaw);
+        uint32_t arm = b.mesh(makeCylinder(n + " arm", 0.09f, 0.7f, skin, 12));
+        b.place(n + " left arm", arm, at + glm::vec3(-0.42f, 1.05f, 0.0f), yaw);
+        b.place(n + " right arm", arm, at + glm::vec3(0.42f, 1.05f, 0.0f), yaw);
+        b.place(n + " head", b.mesh(makeSphere(n + " head", 0.2f, skin, 24, 12)),
+                at + glm::vec3(0, 1.97f, 0));
+    }
+    // Foliage around the arena, stands behind it, buildings far beyond.
+    uint32_t bush = b.mesh(makeSphere("bush", 1.2f, leaves, 20, 10));
+    for (int i = 0; i < 12; ++i) {
+        float a = float(i) / 12.0f * 6.2832f;
+        b.place("bush " + std::to_string(i), bush,
+                {std::cos(a) * 20.0f, 1.2f, std::sin(a) * 20.0f - 4.0f});
+    }
+    for (int i = 0; i < 3; ++i)
+        b.box("stand " + std::to_string(i), {14.0f, 2.0f + 2.0f * float(i), 3.0f}, concrete,
+              {0.0f, 0.0f, -12.0f - 3.0f * float(i)});
+    for (int i = 0; i < 8; ++i) {
+        float x = -140.0f + 40.0f * float(i);
+        b.box("far building " + std::to_string(i), {18.0f, rng.uniform(20.0f, 60.0f), 18.0f}, far,
+              {x, 0.0f, -160.0f});
+    }
+    b.sun({-0.4f, -1.0f, -0.5f}, 3.0f);
+    b.pointLight("ring light", {0.0f, 5.0f, 3.0f}, {1.0f, 0.9f, 0.8f}, 40.0f, 14.0f);
+    b.camera("main", {4.0f, 2.6f, 11.0f}, {-2.0f, 2.0f, -10.0f}, 0.9f, 0.1f, 400.0f);
+    b.camera("fighters", {1.0f, 1.9f, 5.0f}, {-0.4f, 1.3f, 0.0f}, 0.7f, 0.1f, 400.0f);
+    return scene;
+}
+
 const std::vector<std::pair<std::string, std::function<Scene()>>>& registry() {
     static const std::vector<std::pair<std::string, std::function<Scene()>>> scenes = {
         {"default", makeDefault},
@@ -712,6 +786,7 @@ const std::vector<std::pair<std::string, std::function<Scene()>>>& registry() {
         {"lights", [] { return makeLightsScene(makeDefault()); }},
         {"blockers", makeBlockersScene},
         {"cornell", makeCornell},
+        {"arena", makeArena},
     };
     return scenes;
 }

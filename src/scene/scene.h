@@ -51,6 +51,11 @@ enum class Procedural : uint32_t {
 
 constexpr int32_t kNoTexture = -1;
 
+// What screen-space passes treat a surface as (seed 004's material classes, written to the thin
+// G-buffer, render/screenspace): skin gets subsurface scattering, water the water composite.
+// Unlit materials are SurfaceClass::Unlit whatever this says.
+enum class SurfaceClass : uint32_t { DefaultLit = 0, Foliage = 1, Skin = 2, Water = 3, Unlit = 4 };
+
 // The material's texture slots, in the order of Material::uvTransforms and the GPU's.
 enum class TextureSlot : uint32_t {
     BaseColor = 0,
@@ -107,6 +112,7 @@ struct Material {
     glm::vec3 specularColorFactor{1.0f}; // tints dielectric F0
     glm::vec3 sheenColorFactor{0.0f};    // KHR_materials_sheen (0: no sheen)
     float sheenRoughnessFactor = 0.0f;
+    SurfaceClass surfaceClass = SurfaceClass::DefaultLit;
 };
 
 struct Texture {
