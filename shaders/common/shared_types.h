@@ -250,6 +250,9 @@ struct FrameConstants {
     uint64_t lighting;  // LightingFrame (render/lighting), 0 when absent
     uint64_t gi;        // GiFrame (render/gi, shaders/gi/gi_types.h), 0 when GI is off
     uint64_t culling;   // CullingFrame (render/culling): LODs, occlusion, per-view counts
+    // uint per bindless sampled slot: the finest MIP shading wanted of a 32768^2 texture there,
+    // atomically min-reduced (render/streaming, shaders/streaming/feedback.glsl); 0 = off.
+    uint64_t textureFeedback;
 };
 
 // ---- GPU-driven world (render/culling) ------------------------------------------------------

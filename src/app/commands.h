@@ -8,6 +8,7 @@
 
 #include "render/camera_framing.h"
 #include "render/renderer.h"
+#include "render/streaming/texture_streaming.h"
 
 namespace shadel {
 
@@ -60,6 +61,12 @@ struct RenderOptions {
     uint32_t instances = 0; // builtin:many (--instances); 0 = the scene's default
     bool lod = false;       // --lod: GPU LOD selection (render/culling)
     bool occlusion = false; // --occlusion: two-phase hierarchical-Z culling (render/culling)
+    // Texture streaming (render/streaming): --texture-budget MiB (0 = none: every texture
+    // resident), --streaming, and builtin:textures' texture side (0 = 2048).
+    double textureBudgetMiB = 0.0;
+    StreamingMode streaming = StreamingMode::Layered;
+    uint32_t galleryTextureSize = 0;
+    float textureCpuCap = 512.0f; // side up to which CPU estimates count (0: GPU feedback only)
     // --capture NAME[,NAME...] (or {"list"}) and --capture-dir: the last frame's named
     // resources (app/capture_output.h); files go to the dir or next to --out.
     std::vector<std::string> captures;

@@ -237,6 +237,17 @@ int main(int argc, char** argv) {
         ->add_option("--occlusion", occlusion,
                      "on | off: two-phase hierarchical-Z occlusion culling of instances")
         ->capture_default_str();
+    // Texture streaming (render/streaming).
+    render
+        ->add_option("--texture-budget", ro.textureBudgetMiB,
+                     "MiB: stream textures into a layered cache that never exceeds this "
+                     "(default: every texture resident)")
+        ->check(finiteInRange(kTextureBudgetRange));
+    std::string streaming = "layered";
+    render->add_option("--streaming", streaming, "layered | sparse: texture streaming residency")
+        ->capture_default_str();
+    render->add_option("--gallery-texture-size", ro.galleryTextureSize,
+                       "builtin:textures: side of each texture (power of two, default 2048)");
     std::string captures;
     render->add_option("--capture", captures,
                        "NAME[,NAME...]: write named resources of the last frame (EXR for HDR "
@@ -426,6 +437,10 @@ int main(int argc, char** argv) {
                 throw InputError("--instances 0: expected 1..1000000");
             ro.lod = parseOnOff("--lod", lod);
             ro.occlusion = parseOnOff("--occlusion", occlusion);
+            if (streaming != "layered" && streaming != "sparse")
+                throw InputError(
+                    format("--streaming %s: expected layered or sparse", streaming.c_str()));
+            ro.streaming = streaming == "sparse" ? StreamingMode::Sparse : StreamingMode::Layered;
             if (!captures.empty()) ro.captures = parseCaptureNames(captures);
             if (!inspect.empty()) parseInspect(inspect, ro.inspectX, ro.inspectY);
             RenderRun run = runRender(g.gpu, ro);

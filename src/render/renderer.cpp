@@ -13,6 +13,7 @@
 #include "render/post/tonemap.h"
 #include "render/shadel/decoupled.h"
 #include "render/shadel/visibility.h"
+#include "render/streaming/texture_streaming.h"
 
 namespace shadel {
 
@@ -243,6 +244,12 @@ FrameResult renderFrame(Renderer& r, const GpuScene& scene, const CameraView& ca
     r.skyColor = scene.skyColor;
     gpu::FrameConstants constants = makeFrameConstants(r, scene, camera);
     updateLights(r, scene, constants);
+    // Before beginFrame (streaming rebinds texture slots in the set this frame uses) and before
+    // the decoupled frontend (which must not carry over shading of re-streamed textures).
+    if (r.streaming) {
+        prepareTextureStreaming(*r.streaming, camera, float(r.internalHeight), constants);
+        r.restreamedMaterials = restreamedMaterials(*r.streaming);
+    }
     constants.lighting = prepareLightCulling(
         r, scene, r.settings.animateLights ? r.lightsLastFrame : scene.lightInfo,
         constants.viewProj);
@@ -256,6 +263,9 @@ FrameResult renderFrame(Renderer& r, const GpuScene& scene, const CameraView& ca
 
     FrameRecorder& rec = r.recorder;
     beginFrame(rec);
+    if (r.streaming) // landed texture loads copied in, the feedback buffer cleared
+        pass(rec, "textureStreaming",
+             [&](VkCommandBuffer cmd) { recordTextureStreaming(*r.streaming, cmd); });
     pass(rec, "instanceCull",
          [&](VkCommandBuffer cmd) { recordInstanceCull(r, cmd, frame, scene); });
     pass(rec, "shadowMap", [&](VkCommandBuffer cmd) { recordShadowMap(r, cmd, frame); });
@@ -300,6 +310,7 @@ FrameResult renderFrame(Renderer& r, const GpuScene& scene, const CameraView& ca
     if (r.decoupled) finishDecoupledFrame(r);
     readLightCullingStats(r);
     finishCullingFrame(r);
+    if (r.streaming) finishTextureStreamingFrame(*r.streaming);
     r.framesRendered++;
     size_t bytes = size_t(r.settings.width) * r.settings.height * 4;
     result.rgba.resize(bytes);

@@ -110,7 +110,8 @@ struct DecoupledStateDeleter {
     void operator()(DecoupledState* state) const; // defined with the state
 };
 using DecoupledStatePtr = std::unique_ptr<DecoupledState, DecoupledStateDeleter>;
-struct OitState; // render/oit/oit.h
+struct OitState;         // render/oit/oit.h
+struct TextureStreaming; // render/streaming/texture_streaming.h
 struct OitStateDeleter {
     void operator()(OitState* state) const;
 };
@@ -151,6 +152,9 @@ struct Renderer {
     GiStatePtr gi;                     // --gi lpv
     CullingStatePtr culling;           // LODs, occlusion, per-view counts (render/culling)
     CaptureRegistry captures;          // --capture: named resources of the frame (render/debug)
+    // Texture streaming (render/streaming), owned by the caller; null: textures loaded whole.
+    TextureStreaming* streaming = nullptr;
+    std::vector<uint8_t> restreamedMaterials; // per material: a texture of it changed this frame
     std::chrono::steady_clock::time_point createdAt = std::chrono::steady_clock::now();
 };
 

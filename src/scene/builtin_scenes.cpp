@@ -10,6 +10,7 @@
 
 #include "core/error.h"
 #include "core/log.h"
+#include "scene/builtin_gallery.h"
 #include "scene/builtin_lights.h"
 #include "scene/mesh_utils.h"
 
@@ -622,6 +623,7 @@ const std::vector<std::pair<std::string, std::function<Scene()>>>& registry() {
         {"lights", [] { return makeLightsScene(makeDefault()); }},
         {"blockers", makeBlockersScene},
         {"cornell", makeCornell},
+        {"textures", [] { return makeTextureGallery(); }},
     };
     return scenes;
 }
@@ -645,6 +647,11 @@ Scene makeBuiltinScene(const std::string& name, const BuiltinSceneOptions& optio
                 format("--instances %u: expected 1..%u", options.instances, kManyMaxInstances));
         return makeMany(options.instances);
     }
+    if (options.galleryTextureSize != 0 && name != "textures")
+        throw InputError(format("--gallery-texture-size %u: only builtin:textures takes a texture "
+                                "size (scene builtin:%s)",
+                                options.galleryTextureSize, name.c_str()));
+    if (name == "textures") return makeTextureGallery(options.galleryTextureSize);
     for (const auto& [known, make] : registry())
         if (known == name) return make();
     std::string list;
