@@ -11,18 +11,23 @@
 
 namespace shadel {
 
-// One panel: a 2 x 2 m quad centred at the origin in the XY plane facing +Z, uv (0,0) at its
-// top left (the whole texture once).
+// One panel: a kPanel x kPanel m quad centred at the origin in the XY plane facing +Z, uv (0,0)
+// at its top left (the whole texture once).
+// Panels nearly fill the walls of a narrow corridor: the nearest ones want their textures at
+// full resolution at 1280x720 (about 1500 texels across from 1.6 m), the far end only tails.
+constexpr float kPanel = 2.4f;
+
 static Mesh panelMesh(uint32_t material) {
     Mesh m;
     m.name = "panel";
     m.material = material;
     const glm::vec3 n{0, 0, 1};
     const glm::vec4 t{1, 0, 0, 1};
-    m.vertices = {{{-1, 1, 0}, n, t, {0, 0}},
-                  {{1, 1, 0}, n, t, {1, 0}},
-                  {{1, -1, 0}, n, t, {1, 1}},
-                  {{-1, -1, 0}, n, t, {0, 1}}};
+    const float h = 0.5f * kPanel;
+    m.vertices = {{{-h, h, 0}, n, t, {0, 0}},
+                  {{h, h, 0}, n, t, {1, 0}},
+                  {{h, -h, 0}, n, t, {1, 1}},
+                  {{-h, -h, 0}, n, t, {0, 1}}};
     m.indices = {0, 3, 2, 0, 2, 1};
     for (const Vertex& v : m.vertices) m.bounds.extend(v.position);
     return m;
@@ -53,7 +58,7 @@ Scene makeTextureGallery(uint32_t textureSize) {
     scene.name = "textures";
     scene.skyColor = {0.35f, 0.4f, 0.5f};
     scene.ambientColor = {0.25f, 0.25f, 0.27f};
-    const float spacing = 2.5f, wallX = 3.0f;
+    const float spacing = 2.5f, wallX = 1.6f;
     const uint32_t perWall = kGalleryPanels / 2;
     Material floorMat;
     floorMat.name = "floor";
