@@ -64,7 +64,9 @@ struct CliResult {
 };
 
 CliResult runCli(const std::string& args) {
-    std::string errFile = (fs::temp_directory_path() / "shadel_streaming_stderr.txt").string();
+    std::string errFile = (fs::temp_directory_path() /
+                           ("shadel_streaming_stderr_" + std::to_string(getpid()) + ".txt"))
+                              .string();
     std::string cmd =
         std::string("timeout 120 ") + SHADEL_BINARY + " " + args + " >/dev/null 2>" + errFile;
     int status = std::system(cmd.c_str());
