@@ -255,6 +255,26 @@ TEST(TextureStreaming, WalkMatchesResidentDecoupled) {
     EXPECT_GE(last, 35.0);
 }
 
+// A still camera: decoupled shading carries unchanged chunks over for up to --reuse-refresh
+// frames; a texture that streamed in must be reshaded at once, not when its chunks refresh.
+TEST(TextureStreaming, DecoupledReshadesWhatStreamedIn) {
+    RenderOptions o = galleryOptions(RenderMode::Decoupled, 5, 3.0);
+    o.cameraPath = CameraPath::Static;
+    o.reuseRefreshPeriod = 64;     // carried chunks would stay stale for the whole run
+    o.width = 320, o.height = 180; // where the 64^2 tails alone are visibly too coarse
+    RenderRun streamed = renderChecked(o);
+    o.textureBudgetMiB = 0.0;
+    RenderRun resident = renderChecked(o);
+    EXPECT_GT(streamed.stats["texture_streaming"]["exchanges_committed"].get<uint64_t>(), 0u);
+    EXPECT_GT(streamed.stats["reuse_fraction"].get<double>(), 0.0); // reuse is on and used
+    double first = psnr(streamed.frames.front().rgba, resident.frames.front().rgba);
+    double last = psnr(streamed.frames.back().rgba, resident.frames.back().rgba);
+    RecordProperty("psnr_first", std::to_string(first));
+    RecordProperty("psnr_last", std::to_string(last));
+    EXPECT_LT(first, 35.0); // only tails at first
+    EXPECT_GE(last, 35.0);
+}
+
 TEST(TextureStreaming, GpuFeedbackAloneBringsTheNearTexturesIn) {
     RenderOptions o = galleryOptions(RenderMode::Forward, 6, 3.0);
     o.cameraPath = CameraPath::Static;
