@@ -4,6 +4,7 @@
 #ifndef SHADEL_MATERIAL_GLSL
 #define SHADEL_MATERIAL_GLSL
 #include "common/bindless.glsl"
+#include "streaming/feedback.glsl"
 
 struct SurfaceInput {
     vec3 position;  // world
@@ -70,6 +71,7 @@ vec4 sampleMaterialTexture(GpuMaterial m, uint slot, uint tex, SurfaceInput s) {
     vec2 dx = c0 * s.uvDx.x + c1 * s.uvDx.y;
     vec2 dy = c0 * s.uvDy.x + c1 * s.uvDy.y;
     uint samplerId = ((m.clampMask >> slot) & 1u) != 0u ? SAMPLER_LINEAR_CLAMP : SAMPLER_LINEAR_REPEAT;
+    recordTextureFeedback(tex, dx, dy);
     return sampleTexture(tex, samplerId, uv, dx, dy);
 }
 

@@ -22,6 +22,7 @@ void main() {
     FrameConstants f = FrameConstantsRef(pc.frame).f;
     GpuInstance inst = InstanceBuffer(f.instances).i[inInstance];
     GpuMaterial mat = MaterialBuffer(f.materials).m[inst.material];
+    gTextureFeedback = f.textureFeedback; // texture streaming: the MIPs shading wants
     SurfaceInput s;
     s.position = inPosition;
     s.normal = normalize(inNormal);

@@ -166,6 +166,7 @@ void cullChunkLights(FrameConstants f, bool shading, vec3 p) {
 
 void main() {
     FrameConstants f = FrameConstantsRef(pc.frame).f;
+    gTextureFeedback = f.textureFeedback; // texture streaming: the MIPs the shadels want
     ShadelFrame s = ShadelFrameRef(f.shadel).s;
     uint workIndex = gl_WorkGroupID.y * 32768u + gl_WorkGroupID.x;
     if (workIndex >= ShadelCountersRef(s.counters).c.shadeDispatch.w) return;

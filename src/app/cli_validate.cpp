@@ -103,6 +103,11 @@ void validateRenderOptions(const RenderOptions& o) {
     for (const auto& [flag, value, range] : floats)
         if (std::string problem = checkFiniteInRange(flag, value, range); !problem.empty())
             throw InputError(problem);
+    if (o.textureBudgetMiB != 0.0) // 0: no budget
+        if (std::string problem =
+                checkFiniteInRange("--texture-budget", o.textureBudgetMiB, kTextureBudgetRange);
+            !problem.empty())
+            throw InputError(problem);
     if (o.time)
         if (std::string problem = checkFiniteInRange("--time", *o.time, kTimeRange);
             !problem.empty())

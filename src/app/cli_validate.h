@@ -30,6 +30,7 @@ constexpr FloatRange kForwardBelowRange{0, 1e12};       // pixels; 0 = never
 constexpr FloatRange kFovRange{0, 179, true};           // degrees, vertical
 constexpr FloatRange kTimeRange{0, 1e6};                // seconds (--time)
 constexpr FloatRange kCoordinateRange{-1e9, 1e9};       // world units (--from, --look-at)
+constexpr FloatRange kTextureBudgetRange{0, 1e6, true}; // MiB (--texture-budget)
 
 // Accepts a finite number in the range. CLI11 reports a rejection as "<flag>: <reason>".
 CLI::Validator finiteInRange(FloatRange range);

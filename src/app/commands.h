@@ -8,6 +8,7 @@
 
 #include "render/camera_framing.h"
 #include "render/renderer.h"
+#include "render/streaming/texture_streaming.h"
 
 namespace shadel {
 
@@ -69,6 +70,12 @@ struct RenderOptions {
     bool screenSpace = false; // --screen-space: sky, SSR, SSS (render/screenspace)
     bool tileClassification = true; // --tile-classification: per-tile dispatch (render/tiles)
     bool distanceFields = false;    // --distance-fields: DF shadows + AO (render/distance_fields)
+    // Texture streaming (render/streaming): --texture-budget MiB (0 = none: every texture
+    // resident), --streaming, and builtin:textures' texture side (0 = 2048).
+    double textureBudgetMiB = 0.0;
+    StreamingMode streaming = StreamingMode::Layered;
+    uint32_t galleryTextureSize = 0;
+    float textureCpuCap = 512.0f; // side up to which CPU estimates count (0: GPU feedback only)
     // --capture NAME[,NAME...] (or {"list"}) and --capture-dir: the last frame's named
     // resources (app/capture_output.h); files go to the dir or next to --out.
     std::vector<std::string> captures;

@@ -264,13 +264,30 @@ int main(int argc, char** argv) {
     addRayTracingFlags(*render, rtFlags);
     // Seed 004's screen-space passes and tile classification (render/screenspace, tiles).
     std::string screenSpace = "off", tileClassification = "on", distanceFields = "off";
+    render
         ->add_option("--screen-space", screenSpace,
                      "on | off: thin G-buffer, sky, screen-space reflections and skin SSS")
+        ->capture_default_str();
+    render
         ->add_option("--tile-classification", tileClassification,
                      "on | off: run the screen-space passes only on the 8x8 tiles that need them")
+        ->capture_default_str();
+    render
         ->add_option("--distance-fields", distanceFields,
                      "on | off: mesh distance fields in a 3-D atlas: soft sun shadows and AO "
                      "(needs --screen-space on)")
+        ->capture_default_str();
+    // Texture streaming (render/streaming).
+    render
+        ->add_option("--texture-budget", ro.textureBudgetMiB,
+                     "MiB: stream textures into a layered cache that never exceeds this "
+                     "(default: every texture resident)")
+        ->check(finiteInRange(kTextureBudgetRange));
+    std::string streaming = "layered";
+    render->add_option("--streaming", streaming, "layered | sparse: texture streaming residency")
+        ->capture_default_str();
+    render->add_option("--gallery-texture-size", ro.galleryTextureSize,
+                       "builtin:textures: side of each texture (power of two, default 2048)");
     std::string captures;
     render->add_option("--capture", captures,
                        "NAME[,NAME...]: write named resources of the last frame (EXR for HDR "
@@ -470,6 +487,10 @@ int main(int argc, char** argv) {
             ro.screenSpace = parseOnOff("--screen-space", screenSpace);
             ro.tileClassification = parseOnOff("--tile-classification", tileClassification);
             ro.distanceFields = parseOnOff("--distance-fields", distanceFields);
+            if (streaming != "layered" && streaming != "sparse")
+                throw InputError(
+                    format("--streaming %s: expected layered or sparse", streaming.c_str()));
+            ro.streaming = streaming == "sparse" ? StreamingMode::Sparse : StreamingMode::Layered;
             if (!captures.empty()) ro.captures = parseCaptureNames(captures);
             if (!inspect.empty()) parseInspect(inspect, ro.inspectX, ro.inspectY);
             RenderRun run = runRender(g.gpu, ro);

@@ -172,6 +172,7 @@ RenderRun runRender(Gpu& gpu, const RenderOptions& o) {
     }
     BuiltinSceneOptions builtin;
     builtin.instances = o.instances;
+    builtin.galleryTextureSize = o.galleryTextureSize;
     Scene scene = loadScene(o.scene, {o.allowExternalFiles, o.time}, builtin);
     Camera camera = runCamera(scene, o.camera, o.cameraOverrides, float(o.width) / float(o.height));
     // The camera path is fixed by the loaded scene's bounds (chunking does not move it).
@@ -227,10 +228,22 @@ RenderRun runRender(Gpu& gpu, const RenderOptions& o) {
         }
         bakeSeconds =
             std::chrono::duration<double>(std::chrono::steady_clock::now() - bakeStart).count();
-        uploadScene(gpu, scene, gpuScene, &baked);
-    } else {
-        uploadScene(gpu, scene, gpuScene);
     }
+    // Texture streaming (render/streaming): with a budget, or for textures that exist only as a
+    // streaming file (builtin:textures); otherwise textures load whole as before.
+    TextureStreamingPtr streaming;
+    bool procedural = std::any_of(scene.textures.begin(), scene.textures.end(),
+                                  [](const Texture& t) { return t.procedural.kind != 0; });
+    if (!scene.textures.empty() && (o.textureBudgetMiB > 0.0 || procedural)) {
+        TextureStreamingSettings ts;
+        ts.budgetMiB = o.textureBudgetMiB;
+        ts.mode = o.streaming;
+        ts.cpuCap = o.textureCpuCap;
+        streaming = createTextureStreaming(gpu, scene, ts,
+                                           o.cacheDir.empty() ? defaultCacheDir() : o.cacheDir);
+    }
+    uploadScene(gpu, scene, gpuScene, o.mode == RenderMode::Decoupled ? &baked : nullptr,
+                streaming ? &streamedTextureSlots(*streaming) : nullptr);
 
     RenderSettings settings;
     settings.width = o.width;
@@ -300,6 +313,7 @@ RenderRun runRender(Gpu& gpu, const RenderOptions& o) {
         if (o.distanceFields)
             renderer.distanceFields = createDistanceFields(
                 renderer, scene, gpuScene, o.cacheDir.empty() ? defaultCacheDir() : o.cacheDir);
+        renderer.streaming = streaming.get();
         if (listCaptures) {
             std::printf("%s", captureListing(renderer.captures).c_str());
             run.listedCaptures = true;
@@ -419,6 +433,14 @@ RenderRun runRender(Gpu& gpu, const RenderOptions& o) {
     if (renderer.rt) rayTracingStats(renderer, s);
     if (renderer.screenSpace) screenSpaceStats(renderer, s);
     if (renderer.distanceFields) distanceFieldStats(*renderer.distanceFields, s);
+    if (streaming) {
+        textureStreamingStats(*streaming, s);
+    } else { // textures loaded whole (RGBA8 with MIPs, what the images need at least)
+        uint64_t bytes = 0;
+        for (TextureHandle t : gpuScene.textures)
+            if (t) bytes += uint64_t(desc(gpu, t).width) * desc(gpu, t).height * 4 * 4 / 3;
+        s["texture_memory_peak_bytes"] = bytes;
+    }
     if (o.inspectX >= 0) {
         nlohmann::json prints = nlohmann::json::array();
         InspectedPixel pixel = frontFragment(run.frames.back().prints);

@@ -84,7 +84,8 @@ static void setMaterialExtensions(gpu::GpuMaterial& g, const Material& m, SlotOf
     g.sheenRoughnessFactor = m.sheenRoughnessFactor;
 }
 
-void uploadScene(Gpu& gpu, const Scene& scene, GpuScene& out, const std::vector<BakedMesh>* baked) {
+void uploadScene(Gpu& gpu, const Scene& scene, GpuScene& out, const std::vector<BakedMesh>* baked,
+                 const std::vector<uint32_t>* streamedTextureSlots) {
     // Textures: sRGB for colour data. Every texture gets a full mip chain and a bindless slot.
     std::vector<bool> srgb(scene.textures.size(), false);
     for (const Material& m : scene.materials) {
@@ -93,8 +94,16 @@ void uploadScene(Gpu& gpu, const Scene& scene, GpuScene& out, const std::vector<
         if (m.emissiveTexture >= 0 && size_t(m.emissiveTexture) < srgb.size())
             srgb[m.emissiveTexture] = true;
     }
-    for (size_t i = 0; i < scene.textures.size(); ++i) {
+    // Streamed textures (render/streaming) keep their bindless slots there; none load here.
+    for (size_t i = 0; !streamedTextureSlots && i < scene.textures.size(); ++i) {
         const Texture& t = scene.textures[i];
+        if (t.rgba8.empty()) { // procedural: its texels exist only in the streaming file
+            SHADEL_WARN("texture %zu (%s) has no texels here (it streams): drawn untextured", i,
+                        t.name.c_str());
+            out.textures.push_back({});
+            out.textureViews.push_back({});
+            continue;
+        }
         TextureDesc d;
         d.name = format("texture.%s", t.name.empty() ? std::to_string(i).c_str() : t.name.c_str());
         d.format = (srgb[i] || t.srgb) ? VK_FORMAT_R8G8B8A8_SRGB : VK_FORMAT_R8G8B8A8_UNORM;
@@ -114,6 +123,10 @@ void uploadScene(Gpu& gpu, const Scene& scene, GpuScene& out, const std::vector<
         out.textureViews.push_back(createReadView(gpu, tex));
     }
     auto textureSlot = [&](int32_t index) -> uint32_t {
+        if (streamedTextureSlots)
+            return index >= 0 && size_t(index) < streamedTextureSlots->size()
+                       ? (*streamedTextureSlots)[index]
+                       : NO_TEXTURE;
         if (index < 0 || size_t(index) >= out.textureViews.size() || !out.textureViews[index])
             return NO_TEXTURE;
         return slot(gpu, out.textureViews[index]).value;

@@ -60,8 +60,11 @@ struct GpuScene {
 
 // Uploads the scene. With `baked` (one per mesh), each mesh's vertices are the baked ones
 // (duplicated along chart seams) so forward and decoupled paths draw identical geometry.
+// With `streamedTextureSlots` (one bindless slot per scene texture, render/streaming), textures
+// are not uploaded: materials use those slots, whose contents the streaming system manages.
 void uploadScene(Gpu& gpu, const Scene& scene, GpuScene& out,
-                 const std::vector<BakedMesh>* baked = nullptr);
+                 const std::vector<BakedMesh>* baked = nullptr,
+                 const std::vector<uint32_t>* streamedTextureSlots = nullptr);
 // One scene light as the GPU sees it; appends the blockers it lists to `blockerLists`.
 gpu::GpuLight gpuLight(const Light& light, std::vector<uint32_t>& blockerLists);
 void destroyScene(Gpu& gpu, GpuScene& scene);

@@ -15,6 +15,7 @@
 #include "render/screenspace/screen_space.h"
 #include "render/shadel/decoupled.h"
 #include "render/shadel/visibility.h"
+#include "render/streaming/texture_streaming.h"
 
 namespace shadel {
 
@@ -256,6 +257,12 @@ FrameResult renderFrame(Renderer& r, const GpuScene& scene, const CameraView& ca
     r.skyColor = scene.skyColor;
     gpu::FrameConstants constants = makeFrameConstants(r, scene, camera);
     updateLights(r, scene, constants);
+    // Before beginFrame (streaming rebinds texture slots in the set this frame uses) and before
+    // the decoupled frontend (which must not carry over shading of re-streamed textures).
+    if (r.streaming) {
+        prepareTextureStreaming(*r.streaming, camera, float(r.internalHeight), constants);
+        r.restreamedMaterials = restreamedMaterials(*r.streaming);
+    }
     constants.lighting = prepareLightCulling(
         r, scene, r.settings.animateLights ? r.lightsLastFrame : scene.lightInfo,
         constants.viewProj);
@@ -274,6 +281,9 @@ FrameResult renderFrame(Renderer& r, const GpuScene& scene, const CameraView& ca
     beginFrame(rec);
     if (r.debugLines) // --debug-lines: any later pass may append segments
         pass(rec, "debugLinesClear", [&](VkCommandBuffer cmd) { recordDebugLinesClear(r, cmd); });
+    if (r.streaming) // landed texture loads copied in, the feedback buffer cleared
+        pass(rec, "textureStreaming",
+             [&](VkCommandBuffer cmd) { recordTextureStreaming(*r.streaming, cmd); });
     pass(rec, "instanceCull",
          [&](VkCommandBuffer cmd) { recordInstanceCull(r, cmd, frame, scene); });
     pass(rec, "shadowMap", [&](VkCommandBuffer cmd) { recordShadowMap(r, cmd, frame); });
@@ -332,6 +342,7 @@ FrameResult renderFrame(Renderer& r, const GpuScene& scene, const CameraView& ca
     finishCullingFrame(r);
     if (r.rt) finishRayTracingFrame(r);
     finishScreenSpaceFrame(r);
+    if (r.streaming) finishTextureStreamingFrame(*r.streaming);
     r.framesRendered++;
     size_t bytes = size_t(r.settings.width) * r.settings.height * 4;
     result.rgba.resize(bytes);

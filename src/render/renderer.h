@@ -130,7 +130,8 @@ struct DecoupledStateDeleter {
     void operator()(DecoupledState* state) const; // defined with the state
 };
 using DecoupledStatePtr = std::unique_ptr<DecoupledState, DecoupledStateDeleter>;
-struct OitState; // render/oit/oit.h
+struct OitState;         // render/oit/oit.h
+struct TextureStreaming; // render/streaming/texture_streaming.h
 struct OitStateDeleter {
     void operator()(OitState* state) const;
 };
@@ -187,6 +188,9 @@ struct Renderer {
     CaptureRegistry captures;          // --capture: named resources of the frame (render/debug)
     ScreenSpaceStatePtr screenSpace;      // --screen-space on (render/screenspace, render/tiles)
     DistanceFieldStatePtr distanceFields; // --distance-fields on (render/distance_fields)
+    // Texture streaming (render/streaming), owned by the caller; null: textures loaded whole.
+    TextureStreaming* streaming = nullptr;
+    std::vector<uint8_t> restreamedMaterials; // per material: a texture of it changed this frame
     std::chrono::steady_clock::time_point createdAt = std::chrono::steady_clock::now();
 };
 

@@ -59,6 +59,7 @@ TextureHandle createTexture(Gpu& gpu, const TextureDesc& desc) {
     ci.imageType = VK_IMAGE_TYPE_2D;
     ci.format = desc.format;
     ci.extent = {desc.width, desc.height, 1};
+    ci.flags = desc.flags;
     ci.mipLevels = desc.mipLevels;
     ci.arrayLayers = 1;
     ci.samples = VK_SAMPLE_COUNT_1_BIT;
@@ -220,6 +221,9 @@ VkImageView vkView(const Gpu& gpu, RenderTargetView v) {
 }
 VkImageView vkView(const Gpu& gpu, DepthTargetView v) {
     return gpu.depthViews[v.index].view;
+}
+VkImageView vkView(const Gpu& gpu, TextureReadView v) {
+    return gpu.readViews[v.index].view;
 }
 TextureHandle textureOf(const Gpu& gpu, RenderTargetView v) {
     return gpu.targetViews[v.index].texture;

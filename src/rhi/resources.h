@@ -25,6 +25,7 @@ struct TextureDesc {
     uint32_t width = 1, height = 1;
     uint32_t mipLevels = 1;
     VkImageUsageFlags usage = VK_IMAGE_USAGE_SAMPLED_BIT;
+    VkImageCreateFlags flags = 0; // e.g. MUTABLE_FORMAT: linear and sRGB views of one image
 };
 
 struct ViewDesc {
@@ -79,6 +80,7 @@ VkImage vkImage(const Gpu& gpu, TextureHandle texture);
 const TextureDesc& desc(const Gpu& gpu, TextureHandle texture);
 VkImageView vkView(const Gpu& gpu, RenderTargetView view);
 VkImageView vkView(const Gpu& gpu, DepthTargetView view);
+VkImageView vkView(const Gpu& gpu, TextureReadView view); // to rebind a streamed slot
 TextureHandle textureOf(const Gpu& gpu, RenderTargetView view);
 TextureHandle textureOf(const Gpu& gpu, DepthTargetView view);
 TextureHandle textureOf(const Gpu& gpu, TextureReadView view);

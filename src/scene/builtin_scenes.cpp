@@ -10,6 +10,7 @@
 
 #include "core/error.h"
 #include "core/log.h"
+#include "scene/builtin_gallery.h"
 #include "scene/builtin_lights.h"
 #include "scene/mesh_utils.h"
 
@@ -787,6 +788,7 @@ const std::vector<std::pair<std::string, std::function<Scene()>>>& registry() {
         {"blockers", makeBlockersScene},
         {"cornell", makeCornell},
         {"arena", makeArena},
+        {"textures", [] { return makeTextureGallery(); }},
     };
     return scenes;
 }
@@ -810,6 +812,11 @@ Scene makeBuiltinScene(const std::string& name, const BuiltinSceneOptions& optio
                 format("--instances %u: expected 1..%u", options.instances, kManyMaxInstances));
         return makeMany(options.instances);
     }
+    if (options.galleryTextureSize != 0 && name != "textures")
+        throw InputError(format("--gallery-texture-size %u: only builtin:textures takes a texture "
+                                "size (scene builtin:%s)",
+                                options.galleryTextureSize, name.c_str()));
+    if (name == "textures") return makeTextureGallery(options.galleryTextureSize);
     for (const auto& [known, make] : registry())
         if (known == name) return make();
     std::string list;

@@ -16,7 +16,8 @@ constexpr uint32_t kManyDefaultInstances = 10000;
 constexpr uint32_t kManyMaxInstances = 1000000;
 
 struct BuiltinSceneOptions {
-    uint32_t instances = 0; // builtin:many (--instances): 0 = its default
+    uint32_t instances = 0;          // builtin:many (--instances): 0 = its default
+    uint32_t galleryTextureSize = 0; // builtin:textures (--gallery-texture-size): 0 = 2048
 };
 
 // Builds the named scene; an unknown name or an option the scene does not take (or out of

@@ -207,8 +207,9 @@ std::string sceneInvariantViolation(const Scene& scene) {
     }
     for (size_t i = 0; i < scene.textures.size(); ++i) {
         const Texture& tex = scene.textures[i];
+        size_t texels = size_t(tex.width) * tex.height * 4;
         if (tex.width == 0 || tex.height == 0 ||
-            tex.rgba8.size() != size_t(tex.width) * tex.height * 4)
+            tex.rgba8.size() != (tex.procedural.kind != 0 ? 0 : texels))
             return "texture " + std::to_string(i) + ": size";
     }
     for (size_t i = 0; i < scene.instances.size(); ++i) {

@@ -115,11 +115,19 @@ struct Material {
     SurfaceClass surfaceClass = SurfaceClass::DefaultLit;
 };
 
+// A texture made by code instead of stored pixels (scene/procedural_textures.h): its texels
+// are generated when the streaming file is built (bake/texture_pack.h), never kept in the scene.
+struct ProceduralTexture {
+    uint32_t kind = 0; // 0 = none: the texture has pixels
+    uint32_t seed = 0;
+};
+
 struct Texture {
     std::string name;
     uint32_t width = 0, height = 0;
-    std::vector<uint8_t> rgba8; // width*height*4, top row first
+    std::vector<uint8_t> rgba8; // width*height*4, top row first (empty when procedural)
     bool srgb = false;          // base colour and emissive are sRGB, the rest linear
+    ProceduralTexture procedural;
 };
 
 struct Instance {

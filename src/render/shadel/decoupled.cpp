@@ -519,7 +519,11 @@ void prepareDecoupledFrame(Renderer& r, const GpuScene& scene, const CameraView&
                                ? LightReach::Everything
                                : reachOf(r.changedLightVolumes, inst.worldMin, inst.worldMax);
         if (reach == LightReach::Bounded) g.flags |= SHADEL_OBJECT_NEAR_CHANGED_LIGHT;
-        bool inputsUnchanged = d.reuse && wasDecoupled && reach != LightReach::Everything;
+        // Texture streaming changed what a texture of its material holds: reshade it.
+        bool restreamed = inst.material < r.restreamedMaterials.size() &&
+                          r.restreamedMaterials[inst.material] != 0;
+        bool inputsUnchanged =
+            d.reuse && wasDecoupled && reach != LightReach::Everything && !restreamed;
         for (uint32_t k = o.firstMip; k < mesh.mipCount && inputsUnchanged; ++k)
             if (o.levelSince[k] < d.frameNumber) g.reuseLevels |= 1u << k;
         bool known = inst.material < scene.materialInfo.size();

@@ -1,0 +1,440 @@
+#include "bake/texture_pack.h"
+
+#include <algorithm>
+#include <array>
+#include <atomic>
+#include <cerrno>
+#include <cmath>
+#include <cstring>
+#include <filesystem>
+
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include "core/error.h"
+#include "core/log.h"
+#include "scene/procedural_textures.h"
+
+namespace shadel {
+namespace {
+
+constexpr char kMagic[8] = {'S', 'H', 'D', 'L', 'T', 'E', 'X', 'S'};
+constexpr uint32_t kEndianTag = 0x01020304;
+
+struct FileHeader {
+    char magic[8];
+    uint32_t version;
+    uint32_t endianTag;
+    uint64_t keyLo, keyHi;
+    uint32_t tileSize;
+    uint32_t textureCount;
+    uint64_t directoryBytes;
+    uint64_t directoryChecksum;
+    uint64_t fileSize;
+};
+static_assert(sizeof(FileHeader) == 64);
+
+struct TextureRecord {
+    uint32_t size, levels, srgb, pad;
+};
+struct LevelRecord {
+    uint64_t offset, bytes, checksum;
+};
+
+uint32_t levelCount(uint32_t size) {
+    uint32_t n = 1;
+    while ((size >> (n - 1)) > 1) ++n;
+    return n;
+}
+
+uint64_t directoryBytes(const std::vector<uint32_t>& sizes) {
+    uint64_t bytes = 0;
+    for (uint32_t s : sizes) bytes += sizeof(TextureRecord) + levelCount(s) * sizeof(LevelRecord);
+    return bytes;
+}
+
+// sRGB <-> linear through tables: mips are averaged in linear light, as the GPU's sRGB sampling
+// filters (so a level is what the level above looks like from further away).
+struct SrgbTables {
+    std::array<float, 256> toLinear;
+    std::array<uint8_t, 4096> toSrgb;
+    SrgbTables() {
+        for (int i = 0; i < 256; ++i) {
+            float c = float(i) / 255.0f;
+            toLinear[i] = c <= 0.04045f ? c / 12.92f : std::pow((c + 0.055f) / 1.055f, 2.4f);
+        }
+        for (int i = 0; i < 4096; ++i) {
+            float l = (float(i) + 0.5f) / 4096.0f;
+            float c = l <= 0.0031308f ? l * 12.92f : 1.055f * std::pow(l, 1.0f / 2.4f) - 0.055f;
+            toSrgb[i] = uint8_t(std::clamp(c * 255.0f + 0.5f, 0.0f, 255.0f));
+        }
+    }
+};
+const SrgbTables& srgbTables() {
+    static const SrgbTables tables;
+    return tables;
+}
+
+// 2x2 box filter of a square RGBA8 level.
+std::vector<uint8_t> halve(const std::vector<uint8_t>& src, uint32_t size, bool srgb) {
+    uint32_t half = std::max(size / 2, 1u);
+    std::vector<uint8_t> dst(size_t(half) * half * 4);
+    const SrgbTables& t = srgbTables();
+    for (uint32_t y = 0; y < half; ++y)
+        for (uint32_t x = 0; x < half; ++x)
+            for (int c = 0; c < 4; ++c) {
+                auto at = [&](uint32_t dx, uint32_t dy) {
+                    uint32_t sx = std::min(2 * x + dx, size - 1),
+                             sy = std::min(2 * y + dy, size - 1);
+                    return src[(size_t(sy) * size + sx) * 4 + c];
+                };
+                uint8_t a = at(0, 0), b = at(1, 0), d = at(0, 1), e = at(1, 1);
+                uint8_t out;
+                if (srgb && c < 3) {
+                    float l =
+                        0.25f * (t.toLinear[a] + t.toLinear[b] + t.toLinear[d] + t.toLinear[e]);
+                    out = t.toSrgb[std::min(int(l * 4096.0f), 4095)];
+                } else {
+                    out = uint8_t((unsigned(a) + b + d + e + 2) / 4);
+                }
+                dst[(size_t(y) * half + x) * 4 + c] = out;
+            }
+    return dst;
+}
+
+// Bilinear resample of an image to size x size (images that are not square powers of two).
+std::vector<uint8_t> resample(const Texture& t, uint32_t size) {
+    std::vector<uint8_t> out(size_t(size) * size * 4);
+    for (uint32_t y = 0; y < size; ++y)
+        for (uint32_t x = 0; x < size; ++x) {
+            float fx = (float(x) + 0.5f) * float(t.width) / float(size) - 0.5f;
+            float fy = (float(y) + 0.5f) * float(t.height) / float(size) - 0.5f;
+            int x0 = std::clamp(int(std::floor(fx)), 0, int(t.width) - 1);
+            int y0 = std::clamp(int(std::floor(fy)), 0, int(t.height) - 1);
+            int x1 = std::min(x0 + 1, int(t.width) - 1), y1 = std::min(y0 + 1, int(t.height) - 1);
+            float ax = std::clamp(fx - float(x0), 0.0f, 1.0f),
+                  ay = std::clamp(fy - float(y0), 0.0f, 1.0f);
+            for (int c = 0; c < 4; ++c) {
+                auto px = [&](int xx, int yy) {
+                    return float(t.rgba8[(size_t(yy) * t.width + xx) * 4 + c]);
+                };
+                float top = px(x0, y0) + (px(x1, y0) - px(x0, y0)) * ax;
+                float bottom = px(x0, y1) + (px(x1, y1) - px(x0, y1)) * ax;
+                out[(size_t(y) * size + x) * 4 + c] = uint8_t(top + (bottom - top) * ay + 0.5f);
+            }
+        }
+    return out;
+}
+
+// A level in tile order: tiles row-major, each tile's rows contiguous (levels smaller than a
+// tile are one tile of their own size).
+std::vector<uint8_t> tiled(const std::vector<uint8_t>& level, uint32_t size) {
+    uint32_t tile = std::min(size, kTexturePackTile);
+    std::vector<uint8_t> out(level.size());
+    size_t o = 0;
+    for (uint32_t ty = 0; ty < size; ty += tile)
+        for (uint32_t tx = 0; tx < size; tx += tile)
+            for (uint32_t y = 0; y < tile; ++y) {
+                std::memcpy(&out[o], &level[(size_t(ty + y) * size + tx) * 4], size_t(tile) * 4);
+                o += size_t(tile) * 4;
+            }
+    return out;
+}
+
+int writeAll(int fd, const void* data, size_t size) {
+    const char* bytes = static_cast<const char*>(data);
+    while (size > 0) {
+        ssize_t n = ::write(fd, bytes, size);
+        if (n < 0) {
+            if (errno == EINTR) continue;
+            return errno;
+        }
+        bytes += n, size -= size_t(n);
+    }
+    return 0;
+}
+
+bool preadAll(int fd, void* dst, size_t size, uint64_t offset) {
+    char* bytes = static_cast<char*>(dst);
+    while (size > 0) {
+        ssize_t n = ::pread(fd, bytes, size, off_t(offset));
+        if (n < 0 && errno == EINTR) continue;
+        if (n <= 0) return false;
+        bytes += n, size -= size_t(n), offset += uint64_t(n);
+    }
+    return true;
+}
+
+} // namespace
+
+uint32_t packedTextureSize(const Texture& t) {
+    uint32_t side = std::max({t.width, t.height, 1u});
+    uint32_t size = 1;
+    while (size < side && size < kTexturePackMaxSize) size *= 2;
+    return size;
+}
+
+std::vector<bool> srgbTextures(const Scene& scene) {
+    std::vector<bool> srgb(scene.textures.size(), false);
+    for (size_t i = 0; i < scene.textures.size(); ++i) srgb[i] = scene.textures[i].srgb;
+    for (const Material& m : scene.materials)
+        for (int32_t index : {m.baseColorTexture, m.emissiveTexture})
+            if (index >= 0 && size_t(index) < srgb.size()) srgb[index] = true;
+    return srgb;
+}
+
+BakeKey texturePackKey(const Scene& scene) {
+    std::vector<bool> srgb = srgbTextures(scene);
+    std::vector<uint64_t> words = {kTexturePackVersion, kTexturePackTile, scene.textures.size()};
+    for (size_t i = 0; i < scene.textures.size(); ++i) {
+        const Texture& t = scene.textures[i];
+        words.insert(words.end(),
+                     {t.width, t.height, uint64_t(srgb[i]), t.procedural.kind, t.procedural.seed,
+                      hashBytes(t.rgba8.data(), t.rgba8.size(), 7)});
+    }
+    const size_t bytes = words.size() * sizeof(uint64_t);
+    return {hashBytes(words.data(), bytes, 0x243F6A8885A308D3ull),
+            hashBytes(words.data(), bytes, 0x13198A2E03707344ull)};
+}
+
+std::string texturePackPath(const std::string& cacheDir, const BakeKey& key) {
+    return cacheDir + "/textures-" + key.hex() + ".bin";
+}
+
+bool buildTexturePack(const Scene& scene, const std::string& path, std::string* why) {
+    namespace fs = std::filesystem;
+    std::string scratch;
+    std::string& reason = why ? *why : scratch;
+    std::vector<bool> srgb = srgbTextures(scene);
+    std::vector<uint32_t> sizes;
+    for (const Texture& t : scene.textures) sizes.push_back(packedTextureSize(t));
+    BakeKey key = texturePackKey(scene);
+
+    // Layout first (it depends only on the sizes), so the data streams out in one pass.
+    std::vector<uint8_t> directory(directoryBytes(sizes));
+    uint64_t offset = sizeof(FileHeader) + directory.size();
+    std::vector<LevelRecord> levels;
+    for (uint32_t s : sizes)
+        for (uint32_t l = 0; l < levelCount(s); ++l) {
+            uint64_t side = std::max(s >> l, 1u);
+            levels.push_back({offset, side * side * 4, 0});
+            offset += side * side * 4;
+        }
+    const uint64_t fileSize = offset;
+
+    std::error_code ec;
+    fs::path target(path);
+    if (target.has_parent_path()) fs::create_directories(target.parent_path(), ec);
+    static std::atomic<unsigned long long> counter{0};
+    std::string temp = (target.parent_path() / format(".%s.tmp.%d.%llu", target.filename().c_str(),
+                                                      int(::getpid()), counter.fetch_add(1)))
+                           .string();
+    int fd = ::open(temp.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0644);
+    if (fd < 0) {
+        reason = path + ": " + std::strerror(errno);
+        return false;
+    }
+    int error = 0;
+    // Header and directory are written last, once the checksums are known.
+    if (::lseek(fd, off_t(sizeof(FileHeader) + directory.size()), SEEK_SET) < 0) error = errno;
+    size_t levelIndex = 0;
+    for (size_t i = 0; i < scene.textures.size() && error == 0; ++i) {
+        const Texture& t = scene.textures[i];
+        uint32_t size = sizes[i];
+        std::vector<uint8_t> level;
+        if (t.procedural.kind != 0) {
+            level.resize(size_t(size) * size * 4);
+            generateProceduralTexture(t.procedural, size, level.data());
+        } else if (t.width == size && t.height == size) {
+            level = t.rgba8;
+        } else {
+            level = resample(t, size);
+        }
+        for (uint32_t l = 0; l < levelCount(size) && error == 0; ++l) {
+            uint32_t side = std::max(size >> l, 1u);
+            if (l > 0) level = halve(level, side * 2, srgb[i]);
+            std::vector<uint8_t> tiles = tiled(level, side);
+            levels[levelIndex].checksum = hashBytes(tiles.data(), tiles.size(), 0);
+            ++levelIndex;
+            error = writeAll(fd, tiles.data(), tiles.size());
+        }
+    }
+    // The directory.
+    size_t o = 0;
+    levelIndex = 0;
+    for (size_t i = 0; i < sizes.size(); ++i) {
+        TextureRecord rec{sizes[i], levelCount(sizes[i]), uint32_t(srgb[i]), 0};
+        std::memcpy(&directory[o], &rec, sizeof rec), o += sizeof rec;
+        for (uint32_t l = 0; l < rec.levels; ++l, ++levelIndex)
+            std::memcpy(&directory[o], &levels[levelIndex], sizeof(LevelRecord)),
+                o += sizeof(LevelRecord);
+    }
+    FileHeader header{};
+    std::memcpy(header.magic, kMagic, sizeof kMagic);
+    header.version = kTexturePackVersion;
+    header.endianTag = kEndianTag;
+    header.keyLo = key.lo, header.keyHi = key.hi;
+    header.tileSize = kTexturePackTile;
+    header.textureCount = uint32_t(sizes.size());
+    header.directoryBytes = directory.size();
+    header.directoryChecksum = hashBytes(directory.data(), directory.size(), 0);
+    header.fileSize = fileSize;
+    if (error == 0 && ::lseek(fd, 0, SEEK_SET) < 0) error = errno;
+    if (error == 0) error = writeAll(fd, &header, sizeof header);
+    if (error == 0) error = writeAll(fd, directory.data(), directory.size());
+    // Delayed allocation: a full disk may only show at fsync or close.
+    if (error == 0 && ::fsync(fd) != 0 && errno != EINVAL) error = errno;
+    if (::close(fd) != 0 && error == 0) error = errno;
+    if (error == 0 && ::rename(temp.c_str(), path.c_str()) != 0) error = errno;
+    if (error != 0) {
+        ::unlink(temp.c_str());
+        reason = path + ": " + std::strerror(error);
+        return false;
+    }
+    return true;
+}
+
+bool openTexturePack(const std::string& path, const BakeKey& key, TexturePack& out,
+                     std::string* why, bool verifyData) {
+    std::string scratch;
+    std::string& reason = why ? *why : scratch;
+    int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
+    if (fd < 0) {
+        reason = errno == ENOENT ? "missing" : std::string("cannot open: ") + std::strerror(errno);
+        return false;
+    }
+    struct FdCloser {
+        int fd;
+        ~FdCloser() { ::close(fd); }
+    } closer{fd};
+    struct stat st {};
+    if (::fstat(fd, &st) != 0 || !S_ISREG(st.st_mode)) {
+        reason = "not a regular file";
+        return false;
+    }
+    const uint64_t fileBytes = uint64_t(st.st_size);
+    FileHeader header{};
+    if (fileBytes < sizeof header || !preadAll(fd, &header, sizeof header, 0)) {
+        reason = "truncated header";
+        return false;
+    }
+    if (std::memcmp(header.magic, kMagic, sizeof kMagic) != 0) {
+        reason = "bad magic";
+        return false;
+    }
+    if (header.version != kTexturePackVersion || header.endianTag != kEndianTag) {
+        reason = format("stale format version %u (want %u)", header.version, kTexturePackVersion);
+        return false;
+    }
+    if (header.keyLo != key.lo || header.keyHi != key.hi) {
+        reason = "key mismatch (stale: the scene's textures changed)";
+        return false;
+    }
+    if (header.fileSize != fileBytes) {
+        reason = format("truncated or oversized (%llu bytes, header says %llu)",
+                        (unsigned long long)fileBytes, (unsigned long long)header.fileSize);
+        return false;
+    }
+    if (header.tileSize != kTexturePackTile || header.textureCount > (1u << 20) ||
+        header.directoryBytes > fileBytes - sizeof header) {
+        reason = "bad header fields";
+        return false;
+    }
+    std::vector<uint8_t> directory(header.directoryBytes);
+    if (!preadAll(fd, directory.data(), directory.size(), sizeof header) ||
+        hashBytes(directory.data(), directory.size(), 0) != header.directoryChecksum) {
+        reason = "directory checksum mismatch";
+        return false;
+    }
+    TexturePack pack;
+    pack.path = path;
+    pack.key = key;
+    pack.fileSize = fileBytes;
+    // Every level must lie in the data section, in order, without overlap.
+    uint64_t cursor = sizeof header + header.directoryBytes;
+    size_t o = 0;
+    for (uint32_t i = 0; i < header.textureCount; ++i) {
+        TextureRecord rec{};
+        if (directory.size() - o < sizeof rec) {
+            reason = "directory too short";
+            return false;
+        }
+        std::memcpy(&rec, &directory[o], sizeof rec), o += sizeof rec;
+        if (rec.size == 0 || rec.size > kTexturePackMaxSize || (rec.size & (rec.size - 1)) != 0 ||
+            rec.levels != levelCount(rec.size) || rec.srgb > 1 ||
+            (directory.size() - o) / sizeof(LevelRecord) < rec.levels) {
+            reason = format("texture %u: bad directory entry", i);
+            return false;
+        }
+        PackedTexture t;
+        t.size = rec.size;
+        t.srgb = rec.srgb != 0;
+        for (uint32_t l = 0; l < rec.levels; ++l) {
+            LevelRecord lr{};
+            std::memcpy(&lr, &directory[o], sizeof lr), o += sizeof lr;
+            uint64_t side = std::max(rec.size >> l, 1u);
+            if (lr.bytes != side * side * 4 || lr.offset != cursor || lr.offset > fileBytes ||
+                lr.bytes > fileBytes - lr.offset) {
+                reason = format("texture %u level %u: outside the file or misplaced", i, l);
+                return false;
+            }
+            cursor += lr.bytes;
+            t.levels.push_back({uint32_t(side), lr.offset, lr.bytes, lr.checksum});
+        }
+        pack.textures.push_back(std::move(t));
+    }
+    if (o != directory.size() || cursor != fileBytes) {
+        reason = "directory does not cover the file";
+        return false;
+    }
+    if (verifyData) {
+        std::vector<uint8_t> buffer;
+        for (size_t i = 0; i < pack.textures.size(); ++i)
+            for (const PackedLevel& level : pack.textures[i].levels) {
+                buffer.resize(level.bytes);
+                if (!readPackedLevel(fd, level, buffer.data(), &reason)) {
+                    reason = format("texture %zu level %u: %s", i, level.size, reason.c_str());
+                    return false;
+                }
+            }
+    }
+    out = std::move(pack);
+    return true;
+}
+
+TexturePack openOrBuildTexturePack(const Scene& scene, const std::string& cacheDir) {
+    BakeKey key = texturePackKey(scene);
+    std::string path = texturePackPath(cacheDir, key);
+    TexturePack pack;
+    std::string why;
+    if (openTexturePack(path, key, pack, &why)) return pack;
+    if (why != "missing")
+        SHADEL_WARN("texture streaming file %s unusable (%s): rebuilding", path.c_str(),
+                    why.c_str());
+    uint64_t texels = 0;
+    for (const Texture& t : scene.textures)
+        texels += uint64_t(packedTextureSize(t)) * packedTextureSize(t);
+    SHADEL_INFO("building the texture streaming file of %zu textures (%.0f MiB at level 0): %s",
+                scene.textures.size(), double(texels * 4) / 1048576.0, path.c_str());
+    if (!buildTexturePack(scene, path, &why))
+        throw std::runtime_error("texture streaming file: " + why);
+    if (!openTexturePack(path, key, pack, &why, false))
+        throw std::runtime_error("texture streaming file " + path +
+                                 " unreadable right after writing: " + why);
+    return pack;
+}
+
+bool readPackedLevel(int fd, const PackedLevel& level, uint8_t* dst, std::string* why) {
+    if (!preadAll(fd, dst, level.bytes, level.offset)) {
+        if (why) *why = "read error or truncated";
+        return false;
+    }
+    if (hashBytes(dst, level.bytes, 0) != level.checksum) {
+        if (why) *why = "checksum mismatch";
+        return false;
+    }
+    return true;
+}
+
+} // namespace shadel

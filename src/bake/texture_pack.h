@@ -1,0 +1,68 @@
+#pragma once
+// The streaming file of a scene's textures (seed 003's streamed textures): every texture as a
+// square power-of-two RGBA8 image with all its pre-filtered MIP levels, each level stored as
+// fixed-size tiles (kTexturePackTile^2 texels, row-major tiles, each tile's rows contiguous) so a
+// level uploads as one copy region per tile and a sparse image could page single tiles in.
+//
+// File: header { magic "SHDLTEXS", format version, endianness tag, 128-bit key, tile size,
+// texture count, directory size + checksum, file size } | directory | level data. The directory
+// lists per texture its side, level count and sRGB flag, and per level its offset, size and
+// checksum. Opening checks all of it against the file (sizes, bounds, overlaps, checksums), so a
+// corrupt, truncated or stale file is rejected with a reason and rebuilt, and no reader ever
+// indexes past what the file holds. Written to a temporary file and renamed into place.
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "bake/bake_cache.h"
+#include "scene/scene.h"
+
+namespace shadel {
+
+// Bump whenever the file's bytes for the same scene can change.
+constexpr uint32_t kTexturePackVersion = 1;
+constexpr uint32_t kTexturePackTile = 128;
+constexpr uint32_t kTexturePackMaxSize = 8192;
+
+struct PackedLevel {
+    uint32_t size = 0; // side in texels
+    uint64_t offset = 0, bytes = 0, checksum = 0;
+};
+
+struct PackedTexture {
+    uint32_t size = 0; // level 0 side (power of two)
+    bool srgb = false;
+    std::vector<PackedLevel> levels; // level 0 (full) .. the 1x1 level
+};
+
+struct TexturePack {
+    std::string path;
+    BakeKey key;
+    uint64_t fileSize = 0;
+    std::vector<PackedTexture> textures; // one per Scene::textures entry
+};
+
+// The side a texture is stored at: the next power of two of its larger side, at most
+// kTexturePackMaxSize (non-square and non-power-of-two images are resampled to it).
+uint32_t packedTextureSize(const Texture& texture);
+// Whether each scene texture holds colour (sRGB): flagged, or a base colour / emissive map.
+std::vector<bool> srgbTextures(const Scene& scene);
+// Hash of everything the file's bytes depend on (texels or recipes, sizes, format version).
+BakeKey texturePackKey(const Scene& scene);
+std::string texturePackPath(const std::string& cacheDir, const BakeKey& key);
+
+// Writes the file (false + *why on failure).
+bool buildTexturePack(const Scene& scene, const std::string& path, std::string* why);
+// Reads and checks the header and directory against `key` and the file's size; with
+// verifyData, also every level's checksum. False + *why ("missing", "truncated", ...) else.
+bool openTexturePack(const std::string& path, const BakeKey& key, TexturePack& out,
+                     std::string* why, bool verifyData = true);
+// The scene's pack from the cache folder, built (or rebuilt, with a warning naming the reason)
+// when missing or unusable. Throws std::runtime_error if it cannot be written.
+TexturePack openOrBuildTexturePack(const Scene& scene, const std::string& cacheDir);
+
+// Reads one level's tiles into dst (level.bytes) through an open descriptor and checks its
+// checksum. Safe to call from several threads at once (pread).
+bool readPackedLevel(int fd, const PackedLevel& level, uint8_t* dst, std::string* why);
+
+} // namespace shadel

@@ -1,0 +1,75 @@
+#pragma once
+// Texture streaming (seed 003): a scene's textures stream from their file (bake/texture_pack.h)
+// into a layered cache (texture_cache.h) under a hard memory budget (--texture-budget MiB).
+//
+// Every scene texture is a logical texture with a persistent bindless slot (materials never
+// change); residency changes rebind that slot to another cache image (the table is double-
+// buffered, so a frame in flight never sees it change). Per frame:
+//   prepare (CPU, before the frame's bindless set is written): last frame's GPU feedback and
+//     this frame's CPU estimates merged into priorities; loads that landed are committed
+//     (ownership + bindless); new pairwise exchanges are planned and their loads queued.
+//   textureStreaming (the frame's first pass): clears the feedback buffer; copies the landed
+//     exchanges (the yielding texture's lower levels into the slot it moves down to, then the
+//     staging ring's levels into the upgraded slot).
+//   shading writes the feedback (shaders/streaming/feedback.glsl).
+//   finish (CPU, after the frame): frees the staging the copies used.
+// Loads run on a worker thread that reads the file straight into the staging ring; the frame
+// only looks at finished loads, it never waits for one.
+//
+// Without a budget every texture is loaded whole at start from the same file (the "everything
+// resident" reference for quality and timing).
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "common/shared_types.h"
+#include "render/camera.h"
+#include "render/streaming/texture_cache.h"
+#include "rhi/vk.h"
+#include "scene/scene.h"
+
+namespace shadel {
+
+struct Gpu;
+
+enum class StreamingMode { Layered, Sparse };
+
+struct TextureStreamingSettings {
+    double budgetMiB = 0.0; // 0: no budget, every texture resident at full resolution
+    StreamingMode mode = StreamingMode::Layered;
+    uint32_t stagingMiB = 64; // the staging ring (host memory, not counted in the budget)
+    TextureCacheLimits limits;
+    float cpuCap = 512.0f;       // CPU estimates count up to this side (see mergedWanted)
+    uint32_t feedbackFrames = 8; // a GPU wish holds this many frames after its last sample
+};
+
+struct TextureStreaming;
+struct TextureStreamingDeleter {
+    void operator()(TextureStreaming* s) const;
+};
+using TextureStreamingPtr = std::unique_ptr<TextureStreaming, TextureStreamingDeleter>;
+
+// Opens (or builds) the scene's streaming file in cacheDir and makes the cache. Throws
+// InputError for a budget below what the resident tails need.
+TextureStreamingPtr createTextureStreaming(Gpu& gpu, const Scene& scene,
+                                           const TextureStreamingSettings& settings,
+                                           const std::string& cacheDir);
+// One bindless slot per scene texture, for uploadScene's materials.
+const std::vector<uint32_t>& streamedTextureSlots(const TextureStreaming& s);
+
+void prepareTextureStreaming(TextureStreaming& s, const CameraView& camera, float viewportHeight,
+                             gpu::FrameConstants& constants);
+// Per scene material: 1 when a texture it samples changed residency in this frame's prepare
+// (shading stored in earlier frames is stale: the decoupled path must not carry it over).
+const std::vector<uint8_t>& restreamedMaterials(const TextureStreaming& s);
+void recordTextureStreaming(TextureStreaming& s, VkCommandBuffer cmd);
+void finishTextureStreamingFrame(TextureStreaming& s);
+
+// "texture_memory_peak_bytes" and a "texture_streaming" object (per-frame resident memory,
+// exchanges, loads).
+void textureStreamingStats(const TextureStreaming& s, nlohmann::json& stats);
+uint64_t textureMemoryPeakBytes(const TextureStreaming& s);
+
+} // namespace shadel
