@@ -78,6 +78,10 @@ struct ParticleFrame {
     uint atlasSize;
     uint atlasWriteSlot; // bindless storage image (rgba16f)
     uint atlasReadSlot;  // bindless sampled texture
+    // Half-resolution sprites (--particle-resolution half): each fragment stands for a 2x2
+    // block of full-resolution pixels and tests itself against their depths (sampled here).
+    uint halfRes;
+    uint depthReadSlot;
 };
 
 #ifdef __cplusplus

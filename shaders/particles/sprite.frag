@@ -33,6 +33,19 @@ void main() {
     GpuParticle p = ParticleBuffer(pf.particles).p[inParticle];
     GpuParticleEmitter e = ParticleEmitterBuffer(pf.emitters).e[p.emitter];
     vec4 color = particleColor(e, p);
+    // Half resolution: this fragment covers a 2x2 block of full-resolution pixels; it counts for
+    // the fraction of them whose opaque surface lies behind it (reversed Z: larger is nearer).
+    float visible = 1.0;
+    if (pf.halfRes != 0u) {
+        ivec2 size = textureSize(gTextures[pf.depthReadSlot], 0);
+        ivec2 base = ivec2(gl_FragCoord.xy) * 2;
+        visible = 0.0;
+        for (int k = 0; k < 4; ++k) {
+            ivec2 q = min(base + ivec2(k & 1, k >> 1), size - 1);
+            visible += gl_FragCoord.z >= fetchTextureUniform(pf.depthReadSlot, q, 0).r ? 0.25 : 0.0;
+        }
+        if (visible == 0.0) discard;
+    }
     uint seed = particleSpriteSeed(e, inParticle, p);
     vec3 shaded = color.rgb; // unlit: emission
     if ((e.flags & PARTICLE_EMITTER_LIT) != 0u) {
@@ -49,6 +62,7 @@ void main() {
         shaded *= light;
     }
     TransparentFragment t =
-        transparentFragment(shaded, particleSpriteOpacity(inUv, seed) * color.a, e.additiveness);
+        transparentFragment(shaded, particleSpriteOpacity(inUv, seed) * color.a * visible,
+                            e.additiveness);
     wboitOutputs(t, viewDepthOf(f, inPosition), outAccum, outReveal);
 }

@@ -51,6 +51,7 @@ struct RenderOptions {
     bool particles = true;                                       // --particles on|off
     ParticleLighting particleLighting = ParticleLighting::Atlas; // --particle-lighting
     uint32_t particleAtlasSize = 1024;                           // --particle-atlas-size
+    bool particleHalfRes = true;                                 // --particle-resolution half|full
     LightCulling lightCulling = LightCulling::Tiled;             // --light-culling tiled|none
     bool lightBlockers = true;                                   // --blockers on|off
     CameraPath cameraPath = CameraPath::Static;
@@ -66,8 +67,8 @@ struct RenderOptions {
     bool occlusion = false;  // --occlusion: two-phase hierarchical-Z culling (render/culling)
     uint32_t debugLines = 0; // --debug-lines: DEBUG_LINES_* kinds (render/debug/debug_lines.h)
     uint32_t debugLineCapacity = 256 * 1024; // segments the line buffer holds (tests: smaller)
-    RtSettings rt;          // --rt-*, --rays-per-shadel, --blas-pool-*: render/raytracing
-    bool screenSpace = false; // --screen-space: sky, SSR, SSS (render/screenspace)
+    RtSettings rt;                  // --rt-*, --rays-per-shadel, --blas-pool-*: render/raytracing
+    bool screenSpace = false;       // --screen-space: sky, SSR, SSS (render/screenspace)
     bool tileClassification = true; // --tile-classification: per-tile dispatch (render/tiles)
     bool distanceFields = false;    // --distance-fields: DF shadows + AO (render/distance_fields)
     // Texture streaming (render/streaming): --texture-budget MiB (0 = none: every texture

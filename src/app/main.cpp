@@ -211,6 +211,12 @@ int main(int argc, char** argv) {
         ->capture_default_str();
     render->add_option("--particles", particles, "on | off: the scene's GPU particle emitters")
         ->capture_default_str();
+    std::string particleResolution = "half";
+    render
+        ->add_option("--particle-resolution", particleResolution,
+                     "half | full: particle sprites accumulated at half resolution in their own "
+                     "WBOIT targets, combined with the surfaces' in the composite")
+        ->capture_default_str();
     render
         ->add_option("--particle-atlas-size", ro.particleAtlasSize,
                      "texels per side of the particle lightmap atlas (128..8192)")
@@ -474,6 +480,10 @@ int main(int argc, char** argv) {
             ro.lightBlockers = parseOnOff("--blockers", blockers);
             ro.particleLighting = parseParticleLighting(particleLighting);
             ro.particles = parseOnOff("--particles", particles);
+            if (particleResolution != "half" && particleResolution != "full")
+                throw InputError(format("--particle-resolution %s: expected half or full",
+                                        particleResolution.c_str()));
+            ro.particleHalfRes = particleResolution == "half";
             ro.gi = parseGi(gi);
             if (giSnap != "on" && giSnap != "off")
                 throw InputError(format("--gi-snap %s: expected on or off", giSnap.c_str()));

@@ -282,6 +282,7 @@ RenderRun runRender(Gpu& gpu, const RenderOptions& o) {
     settings.particles = o.particles;
     settings.particleLighting = o.particleLighting;
     settings.particleAtlasSize = o.particleAtlasSize;
+    settings.particleHalfRes = o.particleHalfRes;
     settings.lightBlockers = o.lightBlockers;
     requireCount("--gi-iterations", o.giIterations, 0, 64);
     if (o.visualize == Visualize::Gi && o.gi == GiMode::Off)

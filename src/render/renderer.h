@@ -98,10 +98,13 @@ struct RenderSettings {
     uint32_t debugLines =
         0; // --debug-lines: DEBUG_LINES_* kinds drawn (render/debug/debug_lines.h)
     uint32_t debugLineCapacity = 256 * 1024; // segments the line buffer holds (8 MiB)
-    RtSettings rt;          // --rt-*: ray-traced shadows, AO, GI (render/raytracing)
-    bool particles = true;  // the scene's GPU particle emitters (render/particles)
+    RtSettings rt;         // --rt-*: ray-traced shadows, AO, GI (render/raytracing)
+    bool particles = true; // the scene's GPU particle emitters (render/particles)
     ParticleLighting particleLighting = ParticleLighting::Atlas;
     uint32_t particleAtlasSize = 1024; // texels per side of the particle lightmap atlas
+    // Sprites accumulated at half resolution in their own WBOIT targets, combined with the
+    // full-resolution surfaces' in the composite (seed 001's low-resolution particles).
+    bool particleHalfRes = true;
     // Seed 004's screen-space passes (render/screenspace: thin G-buffer, sky, SSR, SSS) and
     // whether they run per classified 8x8 tile (render/tiles) or over every tile.
     bool screenSpace = false;
@@ -177,15 +180,15 @@ struct Renderer {
     std::vector<gpu::GpuLight> lightsLastFrame;
     std::vector<glm::vec4> changedLightVolumes;
     uint64_t framesRendered = 0;
-    VisibilityStatePtr visibility;     // decoupled with --marking visibility
-    OitStatePtr oit;                   // scenes with blended materials (render/oit)
-    ParticleStatePtr particles;        // scenes with particle emitters (render/particles)
-    LightCullingStatePtr lightCulling; // light lists (render/lighting/light_culling.h)
-    GiStatePtr gi;                     // --gi lpv
-    DebugLinesStatePtr debugLines;     // --debug-lines (render/debug/debug_lines.h)
-    CullingStatePtr culling;           // LODs, occlusion, per-view counts (render/culling)
-    RayTracingStatePtr rt;             // BLASes, TLAS, traced terms (--rt-*, render/raytracing)
-    CaptureRegistry captures;          // --capture: named resources of the frame (render/debug)
+    VisibilityStatePtr visibility;        // decoupled with --marking visibility
+    OitStatePtr oit;                      // scenes with blended materials (render/oit)
+    ParticleStatePtr particles;           // scenes with particle emitters (render/particles)
+    LightCullingStatePtr lightCulling;    // light lists (render/lighting/light_culling.h)
+    GiStatePtr gi;                        // --gi lpv
+    DebugLinesStatePtr debugLines;        // --debug-lines (render/debug/debug_lines.h)
+    CullingStatePtr culling;              // LODs, occlusion, per-view counts (render/culling)
+    RayTracingStatePtr rt;                // BLASes, TLAS, traced terms (--rt-*, render/raytracing)
+    CaptureRegistry captures;             // --capture: named resources of the frame (render/debug)
     ScreenSpaceStatePtr screenSpace;      // --screen-space on (render/screenspace, render/tiles)
     DistanceFieldStatePtr distanceFields; // --distance-fields on (render/distance_fields)
     // Texture streaming (render/streaming), owned by the caller; null: textures loaded whole.

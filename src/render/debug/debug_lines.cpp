@@ -11,6 +11,7 @@
 #include "render/renderer.h"
 #include "rhi/gpu.h"
 #include "rhi/pipeline.h"
+#include "rhi/rendering.h"
 #include "rhi/resources.h"
 
 namespace shadel {
@@ -167,27 +168,8 @@ void recordDebugLinePasses(Renderer& r, FrameRecorder& rec, uint64_t frame, cons
                       VK_ACCESS_2_COLOR_ATTACHMENT_READ_BIT |
                           VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT |
                           VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_READ_BIT);
-        VkRenderingAttachmentInfo color{VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO};
-        color.imageView = vkView(gpu, r.hdrTarget);
-        color.imageLayout = VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL;
-        color.loadOp = VK_ATTACHMENT_LOAD_OP_LOAD;
-        color.storeOp = VK_ATTACHMENT_STORE_OP_STORE;
-        VkRenderingAttachmentInfo depth{VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO};
-        depth.imageView = vkView(gpu, r.depthTarget);
-        depth.imageLayout = VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL;
-        depth.loadOp = VK_ATTACHMENT_LOAD_OP_LOAD;
-        depth.storeOp = VK_ATTACHMENT_STORE_OP_STORE;
-        VkRenderingInfo ri{VK_STRUCTURE_TYPE_RENDERING_INFO};
-        ri.renderArea = {{0, 0}, {r.internalWidth, r.internalHeight}};
-        ri.layerCount = 1;
-        ri.colorAttachmentCount = 1;
-        ri.pColorAttachments = &color;
-        ri.pDepthAttachment = &depth;
-        vkCmdBeginRendering(cmd, &ri);
-        VkViewport vp{0, 0, float(r.internalWidth), float(r.internalHeight), 0, 1};
-        VkRect2D scissor{{0, 0}, {r.internalWidth, r.internalHeight}};
-        vkCmdSetViewport(cmd, 0, 1, &vp);
-        vkCmdSetScissor(cmd, 0, 1, &scissor);
+        beginRendering(cmd, r.internalWidth, r.internalHeight, {{vkView(gpu, r.hdrTarget)}},
+                       {vkView(gpu, r.depthTarget)});
         bind(gpu, cmd, d.draw);
         pushConstants(gpu, cmd, push);
         vkCmdDrawIndirect(cmd, vkBuffer(gpu, d.lines), 0, 1, 0);

@@ -365,8 +365,10 @@ void recordTransparencyPasses(Renderer& r, FrameRecorder& rec, uint64_t frame) {
         bind(gpu, cmd, o.composite);
         struct {
             uint64_t frame;
-            uint32_t accumSlot, revealSlot;
-        } push{frame, slot(gpu, o.accumRead).value, slot(gpu, o.revealRead).value};
+            uint32_t accumSlot, revealSlot, halfAccumSlot, halfRevealSlot;
+        } push{frame, slot(gpu, o.accumRead).value, slot(gpu, o.revealRead).value, NO_TEXTURE,
+               NO_TEXTURE};
+        particleHalfResTargets(r, push.halfAccumSlot, push.halfRevealSlot);
         pushConstants(gpu, cmd, push);
         vkCmdDraw(cmd, 3, 1, 0, 0);
         vkCmdEndRendering(cmd);

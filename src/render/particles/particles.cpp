@@ -9,6 +9,7 @@
 #include "particles/particle_types.h"
 #include "render/forward/forward_passes.h"
 #include "render/oit/oit.h"
+#include "rhi/rendering.h"
 
 namespace shadel {
 
@@ -29,6 +30,13 @@ struct ParticleState {
     TextureWriteView atlasWrite;
     TextureReadView atlasRead;
     Pipeline simulate, atlasLight, sprites, atlasView;
+    // --particle-resolution half: the sprites' own WBOIT targets at half resolution, drawn
+    // without a depth attachment (each fragment tests the 2x2 full-resolution depths itself).
+    uint32_t halfWidth = 0, halfHeight = 0;
+    TextureHandle accumHalf, revealHalf;
+    RenderTargetView accumHalfTarget, revealHalfTarget;
+    TextureReadView accumHalfRead, revealHalfRead;
+    Pipeline spritesHalf;
     Pipeline meshes; // opaque mesh particles, forward
     bool hasMeshes = false;
 };
@@ -140,6 +148,32 @@ ParticleStatePtr createParticles(Renderer& r, const GpuScene& scene) {
     sprites.cullMode = VK_CULL_MODE_NONE;
     sprites.attachmentBlends = wboitAttachmentBlends();
     s.sprites = createGraphicsPipeline(gpu, sprites);
+    if (r.settings.particleHalfRes) {
+        s.halfWidth = (r.internalWidth + 1) / 2;
+        s.halfHeight = (r.internalHeight + 1) / 2;
+        auto target = [&](const char* name) {
+            TextureDesc t;
+            t.name = name;
+            t.format = VK_FORMAT_R16G16B16A16_SFLOAT;
+            t.width = s.halfWidth;
+            t.height = s.halfHeight;
+            t.usage = VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT | VK_IMAGE_USAGE_SAMPLED_BIT;
+            TextureHandle h = createTexture(gpu, t);
+            if (!h) throw DeviceError(format("out of GPU memory for the %s target", name));
+            return h;
+        };
+        s.accumHalf = target("particles.accumulationHalf");
+        s.revealHalf = target("particles.revealageAdditivenessHalf");
+        s.accumHalfTarget = createRenderTargetView(gpu, s.accumHalf);
+        s.revealHalfTarget = createRenderTargetView(gpu, s.revealHalf);
+        s.accumHalfRead = createReadView(gpu, s.accumHalf);
+        s.revealHalfRead = createReadView(gpu, s.revealHalf);
+        GraphicsPipelineDesc half = sprites;
+        half.name = "particleSpritesHalf";
+        half.depthFormat = VK_FORMAT_UNDEFINED;
+        half.depthTest = false;
+        s.spritesHalf = createGraphicsPipeline(gpu, half);
+    }
     GraphicsPipelineDesc meshes;
     meshes.name = "particleMeshes";
     meshes.vertexShader = "particles_mesh.vert.spv";
@@ -168,6 +202,15 @@ void destroyParticles(Renderer& r, ParticleStatePtr& state) {
     ParticleState& s = *state;
     for (Pipeline* p : {&s.simulate, &s.atlasLight, &s.sprites, &s.atlasView, &s.meshes})
         destroy(gpu, *p);
+    if (s.accumHalf) {
+        destroy(gpu, s.spritesHalf);
+        destroy(gpu, s.accumHalfTarget);
+        destroy(gpu, s.revealHalfTarget);
+        destroy(gpu, s.accumHalfRead);
+        destroy(gpu, s.revealHalfRead);
+        destroy(gpu, s.accumHalf);
+        destroy(gpu, s.revealHalf);
+    }
     destroy(gpu, s.atlasWrite);
     destroy(gpu, s.atlasRead);
     destroy(gpu, s.atlas);
@@ -194,6 +237,8 @@ void prepareParticleFrame(Renderer& r) {
     f.atlasSize = r.settings.particleAtlasSize;
     f.atlasWriteSlot = slot(gpu, s.atlasWrite).value;
     f.atlasReadSlot = slot(gpu, s.atlasRead).value;
+    f.halfRes = s.accumHalf ? 1u : 0u;
+    f.depthReadSlot = slot(gpu, r.depthRead).value;
     std::memcpy(mapped(gpu, s.frame), &f, sizeof(f));
     s.stepsTaken += s.stepsThisFrame;
 }
@@ -293,13 +338,64 @@ void recordParticleSprites(Renderer& r, FrameRecorder& rec, uint64_t frame) {
     Gpu& gpu = *r.gpu;
     ParticleState& s = *r.particles;
     ParticlePush push{frame, address(gpu, s.frame)};
-    pass(rec, "particleSprites", [&](VkCommandBuffer cmd) {
-        beginWboitTargets(r, cmd, false);
-        bind(gpu, cmd, s.sprites);
+    if (!s.accumHalf) { // full resolution: into the surfaces' targets
+        pass(rec, "particleSprites", [&](VkCommandBuffer cmd) {
+            beginWboitTargets(r, cmd, false);
+            bind(gpu, cmd, s.sprites);
+            pushConstants(gpu, cmd, push);
+            vkCmdDraw(cmd, s.particleCount * 6, 1, 0, 0);
+            vkCmdEndRendering(cmd);
+        });
+        return;
+    }
+    pass(rec, "particleSpritesHalf", [&](VkCommandBuffer cmd) {
+        // The opaque depth is read (2x2 per fragment) instead of attached.
+        imageBarrier(cmd, vkImage(gpu, r.depth), VK_IMAGE_ASPECT_DEPTH_BIT,
+                     VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL,
+                     VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL,
+                     VK_PIPELINE_STAGE_2_EARLY_FRAGMENT_TESTS_BIT |
+                         VK_PIPELINE_STAGE_2_LATE_FRAGMENT_TESTS_BIT,
+                     VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT,
+                     VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT, VK_ACCESS_2_SHADER_SAMPLED_READ_BIT);
+        for (TextureHandle t : {s.accumHalf, s.revealHalf})
+            imageBarrier(
+                cmd, vkImage(gpu, t), VK_IMAGE_ASPECT_COLOR_BIT, VK_IMAGE_LAYOUT_UNDEFINED,
+                VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL, VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT,
+                0, VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT,
+                VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT | VK_ACCESS_2_COLOR_ATTACHMENT_READ_BIT);
+        // Cleared as the surfaces' targets are: nothing accumulated, nothing hides or adds.
+        ColorAttachment accum{vkView(gpu, s.accumHalfTarget), true};
+        ColorAttachment reveal{vkView(gpu, s.revealHalfTarget), true};
+        reveal.clearValue.float32[0] = 1.0f;
+        reveal.clearValue.float32[1] = 1.0f;
+        beginRendering(cmd, s.halfWidth, s.halfHeight, {accum, reveal});
+        bind(gpu, cmd, s.spritesHalf);
         pushConstants(gpu, cmd, push);
         vkCmdDraw(cmd, s.particleCount * 6, 1, 0, 0);
         vkCmdEndRendering(cmd);
+        for (TextureHandle t : {s.accumHalf, s.revealHalf})
+            imageBarrier(
+                cmd, vkImage(gpu, t), VK_IMAGE_ASPECT_COLOR_BIT,
+                VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL,
+                VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT,
+                VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT, VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT,
+                VK_ACCESS_2_SHADER_SAMPLED_READ_BIT);
+        imageBarrier(cmd, vkImage(gpu, r.depth), VK_IMAGE_ASPECT_DEPTH_BIT,
+                     VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL,
+                     VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL,
+                     VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT, 0,
+                     VK_PIPELINE_STAGE_2_EARLY_FRAGMENT_TESTS_BIT |
+                         VK_PIPELINE_STAGE_2_LATE_FRAGMENT_TESTS_BIT,
+                     VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_READ_BIT |
+                         VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT);
     });
+}
+
+bool particleHalfResTargets(const Renderer& r, uint32_t& accumSlot, uint32_t& revealSlot) {
+    if (!particlesThisFrame(r) || !r.particles->accumHalf) return false;
+    accumSlot = slot(*r.gpu, r.particles->accumHalfRead).value;
+    revealSlot = slot(*r.gpu, r.particles->revealHalfRead).value;
+    return true;
 }
 
 void recordParticleAtlasView(Renderer& r, FrameRecorder& rec, uint64_t frame) {
@@ -312,21 +408,7 @@ void recordParticleAtlasView(Renderer& r, FrameRecorder& rec, uint64_t frame) {
             cmd, VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT,
             VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT, VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT,
             VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT | VK_ACCESS_2_COLOR_ATTACHMENT_READ_BIT);
-        VkRenderingAttachmentInfo color{VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO};
-        color.imageView = vkView(gpu, r.hdrTarget);
-        color.imageLayout = VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL;
-        color.loadOp = VK_ATTACHMENT_LOAD_OP_LOAD;
-        color.storeOp = VK_ATTACHMENT_STORE_OP_STORE;
-        VkRenderingInfo ri{VK_STRUCTURE_TYPE_RENDERING_INFO};
-        ri.renderArea = {{0, 0}, {r.internalWidth, r.internalHeight}};
-        ri.layerCount = 1;
-        ri.colorAttachmentCount = 1;
-        ri.pColorAttachments = &color;
-        vkCmdBeginRendering(cmd, &ri);
-        VkViewport vp{0, 0, float(r.internalWidth), float(r.internalHeight), 0, 1};
-        VkRect2D scissor{{0, 0}, {r.internalWidth, r.internalHeight}};
-        vkCmdSetViewport(cmd, 0, 1, &vp);
-        vkCmdSetScissor(cmd, 0, 1, &scissor);
+        beginRendering(cmd, r.internalWidth, r.internalHeight, {{vkView(gpu, r.hdrTarget)}});
         bind(gpu, cmd, s.atlasView);
         pushConstants(gpu, cmd, push);
         vkCmdDraw(cmd, 3, 1, 0, 0);
@@ -357,6 +439,7 @@ void particleStats(const Renderer& r, nlohmann::json& stats) {
     const char* modes[] = {"atlas", "pixel", "vertex"};
     stats["particles"] = {{"particles", st.particles},
                           {"lighting", modes[uint32_t(r.settings.particleLighting)]},
+                          {"resolution", r.particles && r.particles->accumHalf ? "half" : "full"},
                           {"atlas_sprites", st.atlasSprites},
                           {"atlas_overflowed", st.atlasOverflowed},
                           {"atlas_texels", st.atlasTexels},

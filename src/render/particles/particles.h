@@ -34,7 +34,11 @@ void recordParticlePasses(Renderer& r, FrameRecorder& rec, uint64_t frame);
 // `particleSprites`: into the WBOIT targets, between their accumulation and composite
 // (render/oit records it).
 bool particlesThisFrame(const Renderer& r);
+// With --particle-resolution half (the default) `particleSpritesHalf` draws them into their own
+// half-resolution WBOIT targets instead; the composite (render/oit) reads those through
+// particleHalfResTargets and combines both accumulations before resolving.
 void recordParticleSprites(Renderer& r, FrameRecorder& rec, uint64_t frame);
+bool particleHalfResTargets(const Renderer& r, uint32_t& accumSlot, uint32_t& revealSlot);
 // --visualize particle-atlas: `particleAtlasView` draws the atlas over the scene colour.
 void recordParticleAtlasView(Renderer& r, FrameRecorder& rec, uint64_t frame);
 

@@ -12,6 +12,7 @@
 #include "render/raytracing/acceleration_structures.h"
 #include "render/raytracing/rt_shadel_cache.h"
 #include "render/renderer.h"
+#include "rhi/rendering.h"
 
 namespace shadel {
 
@@ -218,27 +219,10 @@ void recordRayTracedPixels(Renderer& r, VkCommandBuffer cmd, uint64_t frame) {
                      VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT, 0,
                      VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT,
                      VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT);
-    VkRenderingAttachmentInfo color[2]{};
-    RenderTargetView views[2] = {s.termsTarget, s.indirectTarget};
-    for (int i = 0; i < 2; ++i) {
-        color[i] = {VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO};
-        color[i].imageView = vkView(gpu, views[i]);
-        color[i].imageLayout = VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL;
-        color[i].loadOp = VK_ATTACHMENT_LOAD_OP_CLEAR; // distance 0: nothing traced
-        color[i].storeOp = VK_ATTACHMENT_STORE_OP_STORE;
-    }
-    VkRenderingAttachmentInfo depth{VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO};
-    depth.imageView = vkView(gpu, r.depthTarget);
-    depth.imageLayout = VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL;
-    depth.loadOp = VK_ATTACHMENT_LOAD_OP_LOAD;
-    depth.storeOp = VK_ATTACHMENT_STORE_OP_STORE;
-    VkRenderingInfo ri{VK_STRUCTURE_TYPE_RENDERING_INFO};
-    ri.renderArea = {{0, 0}, {r.internalWidth, r.internalHeight}};
-    ri.layerCount = 1;
-    ri.colorAttachmentCount = 2;
-    ri.pColorAttachments = color;
-    ri.pDepthAttachment = &depth;
-    vkCmdBeginRendering(cmd, &ri);
+    // Cleared to 0: distance 0 means nothing traced.
+    beginRendering(cmd, r.internalWidth, r.internalHeight,
+                   {{vkView(gpu, s.termsTarget), true}, {vkView(gpu, s.indirectTarget), true}},
+                   {vkView(gpu, r.depthTarget)});
     bind(gpu, cmd, s.pixelTerms);
     pushConstants(gpu, cmd, RasterPush{frame, 0});
     drawCameraList(r, cmd, DRAW_LIST_OPAQUE);

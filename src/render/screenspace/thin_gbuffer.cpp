@@ -3,6 +3,7 @@
 #include "core/error.h"
 #include "render/forward/forward_passes.h"
 #include "render/renderer.h"
+#include "rhi/rendering.h"
 
 namespace shadel {
 
@@ -59,27 +60,10 @@ void recordThinGBuffer(Renderer& r, ThinGBuffer& g, VkCommandBuffer cmd, uint64_
                      VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, 0,
                      VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT,
                      VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT);
-    VkRenderingAttachmentInfo colors[2]{};
-    RenderTargetView targets[2] = {g.normalTarget, g.flagsTarget};
-    for (int i = 0; i < 2; ++i) {
-        colors[i].sType = VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO;
-        colors[i].imageView = vkView(gpu, targets[i]);
-        colors[i].imageLayout = VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL;
-        colors[i].loadOp = VK_ATTACHMENT_LOAD_OP_CLEAR; // flags 0: sky
-        colors[i].storeOp = VK_ATTACHMENT_STORE_OP_STORE;
-    }
-    VkRenderingAttachmentInfo depth{VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO};
-    depth.imageView = vkView(gpu, r.depthTarget);
-    depth.imageLayout = VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL;
-    depth.loadOp = VK_ATTACHMENT_LOAD_OP_LOAD;
-    depth.storeOp = VK_ATTACHMENT_STORE_OP_STORE;
-    VkRenderingInfo ri{VK_STRUCTURE_TYPE_RENDERING_INFO};
-    ri.renderArea = {{0, 0}, {r.internalWidth, r.internalHeight}};
-    ri.layerCount = 1;
-    ri.colorAttachmentCount = 2;
-    ri.pColorAttachments = colors;
-    ri.pDepthAttachment = &depth;
-    vkCmdBeginRendering(cmd, &ri);
+    // Cleared to 0: flags 0 is sky.
+    beginRendering(cmd, r.internalWidth, r.internalHeight,
+                   {{vkView(gpu, g.normalTarget), true}, {vkView(gpu, g.flagsTarget), true}},
+                   {vkView(gpu, r.depthTarget)});
     bind(gpu, cmd, g.pipeline);
     pushConstants(gpu, cmd, RasterPush{frame, 0});
     drawCameraList(r, cmd, DRAW_LIST_OPAQUE);
