@@ -199,7 +199,8 @@ int main(int argc, char** argv) {
     render->add_option("--shuffle-draws", ro.shuffleDrawsSeed,
                        "SEED: draw the transparent instances in a random order (order "
                        "independence tests)");
-    std::string lightCulling = "tiled", blockers = "on";
+    std::string lightCulling = "tiled", blockers = "on", spectra = "off", sunShadows = "pcf",
+                spotShadows = "on";
     render
         ->add_option("--light-culling", lightCulling,
                      "tiled | none: per-tile (forward) and per-chunk (shadel) light lists")
@@ -207,6 +208,20 @@ int main(int argc, char** argv) {
     render
         ->add_option("--blockers", blockers,
                      "on | off: light blockers and portals stop the lights that list them")
+        ->capture_default_str();
+    render
+        ->add_option("--spectra", spectra,
+                     "on | off | single: forward shading per 16x16 tile by permutations "
+                     "compiled with only the features the tile needs (single: one "
+                     "all-features permutation; off: the raster forward pass)")
+        ->capture_default_str();
+    render
+        ->add_option("--sun-shadows", sunShadows,
+                     "pcf | pcss: the sun's shadow filter (pcss: variable penumbra)")
+        ->capture_default_str();
+    render
+        ->add_option("--spot-shadows", spotShadows,
+                     "on | off: shadow maps (one atlas) for the spots that cast shadows")
         ->capture_default_str();
     render->add_option("--trace", ro.trace,
                        "FILE.json: Chrome trace events (CPU frontend and GPU passes per frame; "
@@ -272,6 +287,12 @@ int main(int argc, char** argv) {
         ->add_option("--light-culling", benchLightCulling,
                      "tiled | none | compare: compare also renders forward and decoupled "
                      "without culling and reports tiled / none frame-time ratios")
+        ->capture_default_str();
+    std::string benchSpectra = "off";
+    bench
+        ->add_option("--spectra", benchSpectra,
+                     "off | on | single | compare: compare also renders forward with --spectra "
+                     "on and single and reports on / single and on / off frame-time ratios")
         ->capture_default_str();
     bench
         ->add_option("--reuse-refresh", bo.reuseRefreshPeriod,
@@ -418,6 +439,12 @@ int main(int argc, char** argv) {
             ro.reuse = reuse == "on";
             ro.lightCulling = parseLightCulling(lightCulling);
             ro.lightBlockers = parseOnOff("--blockers", blockers);
+            ro.spectra = parseSpectra(spectra);
+            if (sunShadows != "pcf" && sunShadows != "pcss")
+                throw InputError(
+                    format("--sun-shadows %s: expected pcf or pcss", sunShadows.c_str()));
+            ro.sunSoftShadows = sunShadows == "pcss";
+            ro.spotShadows = parseOnOff("--spot-shadows", spotShadows);
             ro.gi = parseGi(gi);
             if (giSnap != "on" && giSnap != "off")
                 throw InputError(format("--gi-snap %s: expected on or off", giSnap.c_str()));
@@ -451,6 +478,11 @@ int main(int argc, char** argv) {
             bo.cameraPath = parseCameraPath(benchCameraPath);
             bo.compareLightCulling = benchLightCulling == "compare";
             if (!bo.compareLightCulling) bo.lightCulling = parseLightCulling(benchLightCulling);
+            bo.compareSpectra = benchSpectra == "compare";
+            if (!bo.compareSpectra && parseSpectra(benchSpectra) != Spectra::Off)
+                throw InputError(format("bench --spectra %s: expected off or compare (the "
+                                        "decoupled runs have no spectra)",
+                                        benchSpectra.c_str()));
             runBench(g.gpu, bo);
             return 0;
         }

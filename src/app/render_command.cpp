@@ -50,8 +50,10 @@ Visualize parseVisualize(const std::string& text) {
     if (text == "light-count") return Visualize::LightCount;
     if (text == "blockers") return Visualize::Blockers;
     if (text == "gi") return Visualize::Gi;
+    if (text == "spectra") return Visualize::Spectra;
     throw InputError(format("--visualize %s: expected none, marking, mips, chunks, sheet, "
-                            "layer:radiance, layer:material, light-count, blockers or gi",
+                            "layer:radiance, layer:material, light-count, blockers, gi or "
+                            "spectra",
                             text.c_str()));
 }
 
@@ -59,6 +61,13 @@ LightCulling parseLightCulling(const std::string& text) {
     if (text == "tiled") return LightCulling::Tiled;
     if (text == "none") return LightCulling::None;
     throw InputError(format("--light-culling %s: expected tiled or none", text.c_str()));
+}
+
+Spectra parseSpectra(const std::string& text) {
+    if (text == "off") return Spectra::Off;
+    if (text == "on") return Spectra::On;
+    if (text == "single") return Spectra::Single;
+    throw InputError(format("--spectra %s: expected on, off or single", text.c_str()));
 }
 
 bool parseOnOff(const char* flag, const std::string& text) {
@@ -252,6 +261,9 @@ RenderRun runRender(Gpu& gpu, const RenderOptions& o) {
     settings.shuffleSeed = o.shuffleDrawsSeed.value_or(0);
     settings.lightCulling = o.lightCulling;
     settings.lightBlockers = o.lightBlockers;
+    settings.spectra = o.spectra;
+    settings.sunSoftShadows = o.sunSoftShadows;
+    settings.spotShadows = o.spotShadows;
     requireCount("--gi-iterations", o.giIterations, 0, 64);
     if (o.visualize == Visualize::Gi && o.gi == GiMode::Off)
         throw InputError("--visualize gi: shows the indirect light of --gi lpv; GI is off");
@@ -354,6 +366,8 @@ RenderRun runRender(Gpu& gpu, const RenderOptions& o) {
     s["transparent_draws"] = run.frames.back().transparentDraws;
     s["transparent_draws_decoupled"] = run.frames.back().transparentDecoupledDraws;
     lightCullingStats(renderer, gpuScene, s);
+    featureSpectraStats(renderer, s);
+    spotShadowStats(renderer, s);
     s["density_mode"] = autoDensity ? "auto" : "explicit";
     if (autoDensity)
         s["view_density"] = {{"budget_scale", viewDensity.budgetScale},

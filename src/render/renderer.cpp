@@ -40,7 +40,8 @@ static void createTargets(Renderer& r) {
     hdr.width = r.internalWidth;
     hdr.height = r.internalHeight;
     hdr.usage = VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT | VK_IMAGE_USAGE_SAMPLED_BIT;
-    if (usesVisibilityBuffer(r.settings)) hdr.usage |= VK_IMAGE_USAGE_STORAGE_BIT; // resolve
+    if (usesVisibilityBuffer(r.settings) || usesTileShading(r)) // compute resolve / shading
+        hdr.usage |= VK_IMAGE_USAGE_STORAGE_BIT;
     r.hdr = need(createTexture(gpu, hdr), "the scene colour target");
     r.hdrTarget = createRenderTargetView(gpu, r.hdr);
     r.hdrRead = createReadView(gpu, r.hdr);
@@ -85,6 +86,17 @@ void initRenderer(Renderer& r, Gpu& gpu, const RenderSettings& settings, const G
     r.settings = settings;
     if (settings.width == 0 || settings.height == 0 || settings.ssaa == 0)
         throw InputError("--size and --ssaa must be positive");
+    if (settings.spectra != Spectra::Off && settings.mode != RenderMode::Forward)
+        throw InputError("--spectra on|single: forward mode only (the shadel path's chunks do "
+                         "not run per-spectrum permutations yet)");
+    if (settings.spectra != Spectra::Off && settings.lightCulling != LightCulling::Tiled)
+        throw InputError("--spectra on|single needs --light-culling tiled (the tile pass "
+                         "records each tile's features)");
+    if (settings.spectra != Spectra::Off && settings.occlusion)
+        throw InputError("--spectra on|single needs --occlusion off (tile shading reads the "
+                         "visibility buffer, which the phase-2 prepass does not write)");
+    if (settings.visualize == Visualize::Spectra && settings.spectra == Spectra::Off)
+        throw InputError("--visualize spectra needs --spectra on or single");
     if (settings.occlusion && usesVisibilityBuffer(settings))
         throw InputError("--occlusion on needs --marking raster (the phase-2 prepass writes "
                          "depth only, not the visibility buffer)");
@@ -116,9 +128,12 @@ void initRenderer(Renderer& r, Gpu& gpu, const RenderSettings& settings, const G
     initShaderMessages(gpu, r.messages);
     initFrameRecorder(gpu, r.recorder, settings.timing);
     if (settings.mode == RenderMode::Decoupled) r.decoupled = createDecoupled(r, scene);
-    if (usesVisibilityBuffer(settings)) r.visibility = createVisibility(r);
+    // Tile shading (--spectra on|single, forward) reads the visibility buffer too.
+    if (usesVisibilityBuffer(settings) || usesTileShading(r)) r.visibility = createVisibility(r);
     r.oit = createOit(r, scene);
     r.lightCulling = createLightCulling(r, scene);
+    r.spotShadows = createSpotShadows(r, scene);
+    if (usesTileShading(r)) r.spectra = createFeatureSpectra(r);
     if (settings.gi == GiMode::Lpv) r.gi = createGi(r, scene);
     r.culling = createCulling(r, scene);
 }
@@ -127,6 +142,8 @@ void destroyRenderer(Renderer& r) {
     if (!r.gpu) return;
     Gpu& gpu = *r.gpu;
     vkDeviceWaitIdle(gpu.device.device);
+    destroyFeatureSpectra(r, r.spectra);
+    destroySpotShadows(r, r.spotShadows);
     destroyLightCulling(r, r.lightCulling);
     if (r.gi) destroyGi(r, r.gi);
     r.captures = {}; // its sources refer to what is destroyed below
@@ -244,8 +261,7 @@ FrameResult renderFrame(Renderer& r, const GpuScene& scene, const CameraView& ca
     gpu::FrameConstants constants = makeFrameConstants(r, scene, camera);
     updateLights(r, scene, constants);
     constants.lighting = prepareLightCulling(
-        r, scene, r.settings.animateLights ? r.lightsLastFrame : scene.lightInfo,
-        constants.viewProj);
+        r, scene, r.settings.animateLights ? r.lightsLastFrame : scene.lightInfo, constants);
     if (r.gi) prepareGiFrame(r, scene, camera, constants);
     if (r.decoupled) prepareDecoupledFrame(r, scene, camera, constants);
     prepareTransparentDraws(r, scene, camera);
@@ -259,6 +275,9 @@ FrameResult renderFrame(Renderer& r, const GpuScene& scene, const CameraView& ca
     pass(rec, "instanceCull",
          [&](VkCommandBuffer cmd) { recordInstanceCull(r, cmd, frame, scene); });
     pass(rec, "shadowMap", [&](VkCommandBuffer cmd) { recordShadowMap(r, cmd, frame); });
+    if (spotShadowMapsThisFrame(r)) // shadow-casting spots, one atlas (render/lighting)
+        pass(rec, "spotShadowMaps",
+             [&](VkCommandBuffer cmd) { recordSpotShadowMaps(r, cmd, frame); });
     if (r.gi) { // light propagation volumes (render/gi): RSMs, injection, propagation
         pass(rec, "giReflectiveShadowMaps",
              [&](VkCommandBuffer cmd) { recordGiReflectiveShadowMaps(r, cmd, frame); });
@@ -273,7 +292,9 @@ FrameResult renderFrame(Renderer& r, const GpuScene& scene, const CameraView& ca
     if (lightTilesThisFrame(r))
         pass(rec, "lightCulling", [&](VkCommandBuffer cmd) { recordLightCulling(r, cmd, frame); });
     if (r.settings.occlusion) recordOcclusionPasses(r, rec, frame, scene);
-    if (r.settings.mode == RenderMode::Forward) {
+    if (r.spectra) { // forward, per-tile permutations (render/lighting/feature_spectra.h)
+        pass(rec, "tileShading", [&](VkCommandBuffer cmd) { recordTileShading(r, cmd, frame); });
+    } else if (r.settings.mode == RenderMode::Forward) {
         pass(rec, "forwardShading",
              [&](VkCommandBuffer cmd) { recordForwardShading(r, cmd, frame); });
     } else {
@@ -299,6 +320,7 @@ FrameResult renderFrame(Renderer& r, const GpuScene& scene, const CameraView& ca
         uint32_t(transparentDrawOrder(r).size()) + result.transparentDecoupledDraws;
     if (r.decoupled) finishDecoupledFrame(r);
     readLightCullingStats(r);
+    readFeatureSpectraStats(r);
     finishCullingFrame(r);
     r.framesRendered++;
     size_t bytes = size_t(r.settings.width) * r.settings.height * 4;

@@ -10,7 +10,9 @@
 #include "render/debug/capture.h"
 #include "render/gi/lpv.h"
 #include "render/gpu_scene.h"
+#include "render/lighting/feature_spectra.h"
 #include "render/lighting/light_culling.h"
+#include "render/lighting/spot_shadows.h"
 #include "render/shadel/visibility.h"
 #include "rhi/frame.h"
 #include "rhi/pipeline.h"
@@ -36,6 +38,7 @@ enum class Visualize : uint32_t {
     LightCount = VISUALIZE_LIGHT_COUNT, // lights per tile (forward) or chunk (shadel)
     Blockers = VISUALIZE_BLOCKERS,      // tiles / chunks with per-pixel blocker checks
     Gi = 6,                             // --visualize gi: the LPV's indirect light only
+    Spectra = VISUALIZE_SPECTRA,        // each tile's shading mode (--spectra on|single)
 };
 
 // --light-culling: per-tile (forward) and per-chunk (shadel) light lists, or every light for
@@ -85,7 +88,10 @@ struct RenderSettings {
     std::vector<GiBlocker> giBlockers; // GI light blockers (axial occlusion in propagation)
     bool lod = false;                  // GPU LOD selection by projected error (render/culling)
     float lodErrorPixels = 0.5f;       // the coarsest LOD whose error projects below this is drawn
-    bool occlusion = false; // two-phase hierarchical-Z occlusion culling (render/culling)
+    bool occlusion = false;         // two-phase hierarchical-Z occlusion culling (render/culling)
+    Spectra spectra = Spectra::Off; // forward: per-tile shading permutations (render/lighting)
+    bool sunSoftShadows = false;    // --sun-shadows pcss: variable penumbra (render/lighting)
+    bool spotShadows = true;        // --spot-shadows: shadow maps of shadow-casting spots
 };
 
 struct FrameResult {
@@ -148,6 +154,8 @@ struct Renderer {
     VisibilityStatePtr visibility;     // decoupled with --marking visibility
     OitStatePtr oit;                   // scenes with blended materials (render/oit)
     LightCullingStatePtr lightCulling; // light lists (render/lighting/light_culling.h)
+    SpectraStatePtr spectra;           // --spectra on|single (render/lighting/feature_spectra.h)
+    SpotShadowStatePtr spotShadows;    // shadow-casting spots (render/lighting/spot_shadows.h)
     GiStatePtr gi;                     // --gi lpv
     CullingStatePtr culling;           // LODs, occlusion, per-view counts (render/culling)
     CaptureRegistry captures;          // --capture: named resources of the frame (render/debug)

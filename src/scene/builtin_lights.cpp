@@ -1,6 +1,9 @@
 #include "scene/builtin_lights.h"
 
+#include <algorithm>
 #include <cmath>
+#include <utility>
+#include <vector>
 
 #include <glm/gtc/matrix_transform.hpp>
 
@@ -258,6 +261,24 @@ Scene makeLightsScene(Scene scene) {
     night.znear = 0.1f;
     night.zfar = 400.0f;
     scene.cameras.insert(scene.cameras.begin(), night);
+    // Shadowed spots: the 16 spots nearest the night camera, in front of it, cast shadows
+    // (one shadow atlas, render/lighting/spot_shadows.h); every other one has a soft (PCSS)
+    // shadow from a 0.4 m wide lamp head, the rest PCF.
+    std::vector<std::pair<float, size_t>> spots;
+    for (size_t i = 0; i < scene.lights.size(); ++i) {
+        const Light& l = scene.lights[i];
+        glm::vec3 to = l.position - night.position;
+        if ((l.type == LightType::Spot || l.type == LightType::SquareSpot) &&
+            glm::dot(to, night.forward) > 2.0f)
+            spots.push_back({glm::length(to), i});
+    }
+    std::sort(spots.begin(), spots.end());
+    for (size_t k = 0; k < spots.size() && k < 16; ++k) {
+        Light& l = scene.lights[spots[k].second];
+        l.castsShadow = true;
+        l.softShadow = k % 2 == 0;
+        l.lightSize = 0.4f;
+    }
     return scene;
 }
 
