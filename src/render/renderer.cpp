@@ -95,6 +95,9 @@ void initRenderer(Renderer& r, Gpu& gpu, const RenderSettings& settings, const G
     if (settings.spectra != Spectra::Off && settings.occlusion)
         throw InputError("--spectra on|single needs --occlusion off (tile shading reads the "
                          "visibility buffer, which the phase-2 prepass does not write)");
+    if (settings.spectra != Spectra::Off && settings.inspectX >= 0)
+        throw InputError("--inspect needs --spectra off (the prints come from the raster "
+                         "forward pass)");
     if (settings.visualize == Visualize::Spectra && settings.spectra == Spectra::Off)
         throw InputError("--visualize spectra needs --spectra on or single");
     if (settings.occlusion && usesVisibilityBuffer(settings))

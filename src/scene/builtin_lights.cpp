@@ -261,23 +261,25 @@ Scene makeLightsScene(Scene scene) {
     night.znear = 0.1f;
     night.zfar = 400.0f;
     scene.cameras.insert(scene.cameras.begin(), night);
-    // Shadowed spots: the 16 spots nearest the night camera, in front of it, cast shadows
-    // (one shadow atlas, render/lighting/spot_shadows.h); every other one has a soft (PCSS)
-    // shadow from a 0.4 m wide lamp head, the rest PCF.
-    std::vector<std::pair<float, size_t>> spots;
-    for (size_t i = 0; i < scene.lights.size(); ++i) {
-        const Light& l = scene.lights[i];
-        glm::vec3 to = l.position - night.position;
-        if ((l.type == LightType::Spot || l.type == LightType::SquareSpot) &&
-            glm::dot(to, night.forward) > 2.0f)
-            spots.push_back({glm::length(to), i});
-    }
-    std::sort(spots.begin(), spots.end());
-    for (size_t k = 0; k < spots.size() && k < 16; ++k) {
-        Light& l = scene.lights[spots[k].second];
+    // Shadowed spots (render/lighting/spot_shadows.h: one atlas): 16 lamps down the avenue in
+    // front of the night camera, each over a post it throws a shadow of onto the street; every
+    // other one round or square, soft (PCSS, a 0.4 m lamp head) or hard (PCF).
+    uint32_t postMaterial = addMaterial(scene, "shadow post", {0.5f, 0.5f, 0.55f}, 0.6f);
+    for (int i = 0; i < 16; ++i) {
+        float x = -47.0f + 2.0f * float(i);
+        float z = (i % 2 == 0 ? -2.5f : 2.5f) + rng.uniform(-0.5f, 0.5f);
+        addBox(scene, name("shadow post", i), {0.3f, 2.2f, 0.3f}, {x + 1.2f, 0.0f, z},
+               postMaterial);
+        Light l = light(i % 4 < 2 ? LightType::Spot : LightType::SquareSpot,
+                        name("shadowed spot", i), {x, 5.0f, z}, warmOrCool(rng), 40.0f, 10.0f);
+        l.direction = glm::normalize(glm::vec3(0.45f, -1.0f, 0.0f));
+        l.axis = glm::vec3(0, 0, 1);
+        l.innerConeAngle = 0.35f;
+        l.outerConeAngle = 0.6f;
         l.castsShadow = true;
-        l.softShadow = k % 2 == 0;
+        l.softShadow = i % 2 == 0;
         l.lightSize = 0.4f;
+        scene.lights.push_back(l);
     }
     return scene;
 }
