@@ -33,6 +33,13 @@ struct SpotShadowState {
     std::vector<glm::uvec4> rects; // atlas texels: x, y, size, 1 if placed
     uint32_t placed = 0;
     uint64_t atlasTexelsUsed = 0;
+    // The maps are drawn again only when what they see may have changed: the spots (this
+    // frame's views differ from the last drawn) or the caster list, which the camera's
+    // shadow-caster culling chooses (the camera moved).
+    std::vector<gpu::GpuSpotShadow> drawnViews;
+    glm::mat4 drawnCamera{0.0f};
+    bool redraw = true;
+    uint32_t redraws = 0;
 };
 
 void SpotShadowStateDeleter::operator()(SpotShadowState* state) const {
@@ -147,15 +154,25 @@ void prepareShadows(Renderer& r, const std::vector<gpu::GpuLight>& lights,
     Gpu& gpu = *r.gpu;
     SpotShadowState& s = *r.spotShadows;
     auto* out = static_cast<gpu::GpuSpotShadow*>(mapped(gpu, s.shadows));
+    std::vector<gpu::GpuSpotShadow> views(s.lightOf.size());
     for (size_t i = 0; i < s.lightOf.size(); ++i)
-        out[i] = s.lightOf[i] < lights.size() ? spotView(lights[s.lightOf[i]], s.rects[i])
-                                              : gpu::GpuSpotShadow{};
+        views[i] = s.lightOf[i] < lights.size() ? spotView(lights[s.lightOf[i]], s.rects[i])
+                                                : gpu::GpuSpotShadow{};
+    s.redraw = s.drawnViews.size() != views.size() || constants.viewProj != s.drawnCamera ||
+               std::memcmp(views.data(), s.drawnViews.data(),
+                           views.size() * sizeof(gpu::GpuSpotShadow)) != 0;
+    if (s.redraw) {
+        s.drawnViews = views;
+        s.drawnCamera = constants.viewProj;
+        s.redraws++;
+    }
+    std::memcpy(out, views.data(), views.size() * sizeof(gpu::GpuSpotShadow));
     f.spotShadows = address(gpu, s.shadows);
     f.spotShadowAtlas = slot(gpu, s.read).value;
 }
 
 bool spotShadowMapsThisFrame(const Renderer& r) {
-    return r.spotShadows != nullptr;
+    return r.spotShadows != nullptr && r.spotShadows->redraw;
 }
 
 void recordSpotShadowMaps(Renderer& r, VkCommandBuffer cmd, uint64_t frame) {
@@ -217,6 +234,7 @@ void spotShadowStats(const Renderer& r, nlohmann::json& stats) {
     const SpotShadowState& s = *r.spotShadows;
     stats["spot_shadow_maps"] = s.placed;
     stats["spot_shadow_maps_unplaced"] = uint32_t(s.rects.size()) - s.placed;
+    stats["spot_shadow_atlas_draws"] = s.redraws; // frames that drew the maps
     stats["spot_shadow_atlas_fill"] =
         double(s.atlasTexelsUsed) / (double(kAtlasSize) * double(kAtlasSize));
 }

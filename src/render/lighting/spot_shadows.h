@@ -32,6 +32,8 @@ void destroySpotShadows(Renderer& r, SpotShadowStatePtr& state);
 // and the sun's soft-shadow constants.
 void prepareShadows(Renderer& r, const std::vector<gpu::GpuLight>& lights,
                     const gpu::FrameConstants& constants, gpu::LightingFrame& f);
+// Whether the maps are drawn this frame: the first frame, or the spots or the camera (whose
+// culling chooses the caster list) changed since they were last drawn.
 bool spotShadowMapsThisFrame(const Renderer& r);
 // "spotShadowMaps": the atlas cleared, then each spot's view into its rectangle.
 void recordSpotShadowMaps(Renderer& r, VkCommandBuffer cmd, uint64_t frame);
