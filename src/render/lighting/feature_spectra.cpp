@@ -144,7 +144,10 @@ void recordSpectraReset(Renderer& r, VkCommandBuffer cmd) {
     vkCmdUpdateBuffer(cmd, vkBuffer(gpu, s.dispatch), 0, args.size() * 4, args.data());
     vkCmdFillBuffer(cmd, vkBuffer(gpu, s.superfluous), 0, VK_WHOLE_SIZE, 0);
     vkCmdFillBuffer(cmd, vkBuffer(gpu, s.featureTiles), 0, VK_WHOLE_SIZE, 0);
-    // The caller's barrier (transfer -> compute) covers these.
+    // Before the tile pass's atomics (vkCmdUpdateBuffer counts as a transfer: ALL_TRANSFER).
+    memoryBarrier(cmd, VK_PIPELINE_STAGE_2_ALL_TRANSFER_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT,
+                  VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
+                  VK_ACCESS_2_SHADER_STORAGE_READ_BIT | VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT);
 }
 
 void recordTileShading(Renderer& r, VkCommandBuffer cmd, uint64_t frame) {
