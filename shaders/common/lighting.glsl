@@ -18,6 +18,7 @@ layout(buffer_reference, scalar) readonly buffer LightBlockerBuffer { GpuLightBl
 layout(buffer_reference, scalar) readonly buffer LightPortalBuffer { GpuLightPortal p[]; };
 layout(buffer_reference, scalar) readonly buffer LightListBuffer { uvec2 e[]; };
 layout(buffer_reference, scalar) buffer LightingCountersRef { LightingCounters c; };
+layout(buffer_reference, scalar) readonly buffer SpotShadowBuffer { GpuSpotShadow s[]; };
 
 #define LIGHT_LIST_ALL 0u
 #define LIGHT_LIST_BUFFER 1u
@@ -25,6 +26,14 @@ layout(buffer_reference, scalar) buffer LightingCountersRef { LightingCounters c
 #define LIGHT_TILE_MAX_LIGHTS 1024u // lights a tile's list can hold (shared memory while culling)
 #define LIGHT_CHUNK_MAX_LIGHTS 512u // entries of a shadel chunk's list (shared memory)
 #define LIGHT_INVALID 0xFFFFFFFFu   // an entry culling removed in place
+
+// Feature spectra (seed 001, render/lighting/feature_spectra.h): the SPECTRUM_* features this
+// pipeline compiles in. Every feature by default; a tile-shading permutation sets fewer, and
+// the branches of the features it lacks are dead code the compiler removes (fewer registers).
+// Only tiles that need none of the missing features are shaded by such a permutation, so the
+// result is the same.
+layout(constant_id = SPECTRUM_FEATURES_CONSTANT_ID) const uint kSpectrumFeatures = SPECTRUM_ALL;
+#define SPECTRUM_HAS(features) ((kSpectrumFeatures & (features)) != 0u)
 
 uint gLightListMode = LIGHT_LIST_ALL;
 uint64_t gLightListAddress = 0ul;
@@ -156,6 +165,8 @@ float sunShadow(FrameConstants f, vec3 worldPos, vec3 n) {
     return lit / 9.0;
 }
 
+#include "lighting/shadows.glsl"
+
 float rangeAttenuation(float distance, float range) {
     float invSquare = 1.0 / max(distance * distance, 1e-4);
     if (range <= 0.0) return invSquare;
@@ -173,6 +184,7 @@ bool blockerStops(GpuLightBlocker b, LightPortalBuffer portals, vec3 p, vec3 lig
     vec3 hit = p + (lightPos - p) * (dp / (dp - dl)) - b.center;
     vec2 uv = vec2(dot(hit, b.axisU), dot(hit, b.axisV));
     if (abs(uv.x) > b.halfU || abs(uv.y) > b.halfV) return false;
+    if (!SPECTRUM_HAS(SPECTRUM_PORTALS)) return true;
     for (uint k = 0u; k < b.portalCount; ++k) {
         GpuLightPortal portal = portals.p[b.firstPortal + k];
         if (all(greaterThanEqual(uv, portal.minUv)) && all(lessThanEqual(uv, portal.maxUv)))
@@ -200,12 +212,12 @@ bool lightBlockedAt(FrameConstants f, GpuLight light, uint mask, vec3 p) {
 
 // Cone factor of round and square spots (1 inside the inner cone, 0 outside the outer).
 float spotFactor(GpuLight light, vec3 dirToLight) {
-    if (light.type == LIGHT_SPOT) {
+    if (SPECTRUM_HAS(SPECTRUM_SPOT) && light.type == LIGHT_SPOT) {
         float cd = dot(light.direction, -dirToLight);
         float s = clamp(cd * light.spotScale + light.spotOffset, 0.0, 1.0);
         return s * s;
     }
-    if (light.type == LIGHT_SPOT_SQUARE) {
+    if (SPECTRUM_HAS(SPECTRUM_SQUARE_SPOT) && light.type == LIGHT_SPOT_SQUARE) {
         float z = dot(light.direction, -dirToLight);
         if (z <= 0.0) return 0.0;
         vec3 up = cross(light.direction, light.axis);
@@ -262,10 +274,13 @@ vec3 tubeLight(GpuLight light, MaterialSample m, vec3 n, vec3 v, vec3 p) {
 
 // One light of the buffer at surface point p (not counting blockers).
 vec3 evaluateLight(GpuLight light, MaterialSample m, vec3 n, vec3 v, vec3 p) {
-    if ((light.flags & LIGHT_FLAG_CLIP_PLANE) != 0u && dot(light.clipPlane.xyz, p) + light.clipPlane.w < 0.0)
+    if (SPECTRUM_HAS(SPECTRUM_CLIP_PLANES) && (light.flags & LIGHT_FLAG_CLIP_PLANE) != 0u &&
+        dot(light.clipPlane.xyz, p) + light.clipPlane.w < 0.0)
         return vec3(0.0);
     if (light.type == LIGHT_DIRECTIONAL) return brdf(m, n, v, -light.direction, light.color);
-    if (light.type == LIGHT_TUBE) return tubeLight(light, m, n, v, p);
+    if (light.type == LIGHT_TUBE)
+        return SPECTRUM_HAS(SPECTRUM_TUBE) ? tubeLight(light, m, n, v, p) : vec3(0.0);
+    if (!SPECTRUM_HAS(SPECTRUM_OMNI | SPECTRUM_SPOT | SPECTRUM_SQUARE_SPOT)) return vec3(0.0);
     vec3 toLight = light.position - p;
     float dist = length(toLight);
     vec3 dir = toLight / max(dist, 1e-4);
@@ -308,8 +323,21 @@ vec3 shadeSurface(FrameConstants f, MaterialSample m, vec3 worldPos, vec3 geomet
     color += ambientLit * gRtOcclusion;
 
     vec3 l = -f.sunDirection;
-    if (dot(f.sunColor, f.sunColor) > 0.0)
-        color += brdf(m, n, v, l, f.sunColor * (gRtSun ? gRtSunVisibility : sunShadow(f, worldPos, geometricNormal)));
+    LightingFrame lf;
+    bool haveLighting = f.lighting != 0ul;
+    if (haveLighting) lf = LightingFrameRef(f.lighting).l;
+    if (dot(f.sunColor, f.sunColor) > 0.0) {
+        float shadow = 1.0;
+        if (gRtSun) // ray-traced sun visibility (render/raytracing), in place of the shadow map
+            shadow = gRtSunVisibility;
+        else if (SPECTRUM_HAS(SPECTRUM_SOFT_SHADOWS) && haveLighting && lf.sunSoftShadows != 0u)
+            shadow = sunShadowSoft(f, lf, worldPos, geometricNormal);
+        else if (SPECTRUM_HAS(SPECTRUM_SHADOWS))
+            shadow = sunShadow(f, worldPos, geometricNormal);
+        color += brdf(m, n, v, l, f.sunColor * shadow);
+    }
+    bool spotShadows = SPECTRUM_HAS(SPECTRUM_SPOT_SHADOWS) && haveLighting &&
+                       lf.spotShadowAtlas != NO_TEXTURE;
 
     LightBuffer lights = LightBuffer(f.lights);
     vec3 direct = vec3(0.0);
@@ -318,10 +346,16 @@ vec3 shadeSurface(FrameConstants f, MaterialSample m, vec3 worldPos, vec3 geomet
         uvec2 entry = lightListEntry(f, i);
         if (entry.x == LIGHT_INVALID) continue;
         GpuLight light = lights.l[entry.x];
-        if (lightBlockedAt(f, light, entry.y, worldPos)) continue;
-        direct += evaluateLight(light, m, n, v, worldPos);
+        if (SPECTRUM_HAS(SPECTRUM_BLOCKERS) && lightBlockedAt(f, light, entry.y, worldPos))
+            continue;
+        vec3 c = evaluateLight(light, m, n, v, worldPos);
+        if (spotShadows && light.shadowIndex != LIGHT_NO_SHADOW && any(notEqual(c, vec3(0.0))))
+            c *= spotShadow(lf, light, worldPos, geometricNormal);
+        direct += c;
     }
     // Darks subtract light; they never make a surface emit negative light.
+    // Without darks the sum is not negative and the clamp changes nothing.
+    if (!SPECTRUM_HAS(SPECTRUM_DARK)) return color + direct * m.occlusion;
     return color + max(direct * m.occlusion, -color);
 }
 

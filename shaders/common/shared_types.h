@@ -47,11 +47,32 @@ using uint = uint32_t;
 #define LIGHT_TUBE 4u        // a segment of 2 * halfLength along axis (representative point)
 #define LIGHT_KIND_COUNT 5u
 // GpuLight::flags
-#define LIGHT_FLAG_DARK 1u       // a negative light: subtracts its radiance (colour is negated)
-#define LIGHT_FLAG_CLIP_PLANE 2u // lights only where dot(clipPlane, vec4(p, 1)) >= 0
+#define LIGHT_FLAG_DARK 1u          // a negative light: subtracts its radiance (colour is negated)
+#define LIGHT_FLAG_CLIP_PLANE 2u    // lights only where dot(clipPlane, vec4(p, 1)) >= 0
+#define LIGHT_FLAG_SOFT_SHADOW 4u   // shadow-mapped spot: variable penumbra (PCSS) instead of PCF
+#define LIGHT_NO_SHADOW 0xFFFFFFFFu // GpuLight::shadowIndex of a light without a shadow map
+#define LIGHT_MAX_SPOT_SHADOWS 16u  // shadow-casting spots with a map in the atlas (the first)
 // Light blockers (render/lighting): a light lists up to this many blockers.
 #define LIGHT_MAX_BLOCKERS_PER_LIGHT 32u
 #define LIGHT_TILE_SIZE 16u // pixels per side of a forward light culling tile
+// Feature spectra (seed 001, render/lighting/feature_spectra.h): the lighting features a tile
+// needs, recorded by the tile pass; each shading permutation compiles in only its set
+// (specialization constant SPECTRUM_FEATURES_CONSTANT_ID of shaders/common/lighting.glsl).
+#define SPECTRUM_OMNI 0x1u           // point lights
+#define SPECTRUM_SPOT 0x2u           // round-cone spots
+#define SPECTRUM_SQUARE_SPOT 0x4u    // square-cone spots
+#define SPECTRUM_TUBE 0x8u           // tube lights (representative point)
+#define SPECTRUM_DARK 0x10u          // negative lights (the clamp that keeps the sum >= 0)
+#define SPECTRUM_CLIP_PLANES 0x20u   // a light's clip plane crosses the tile
+#define SPECTRUM_BLOCKERS 0x40u      // (light, blocker) pairs tested per pixel
+#define SPECTRUM_PORTALS 0x80u       // ... of blockers with portals
+#define SPECTRUM_SHADOWS 0x100u      // the sun's shadow map (PCF)
+#define SPECTRUM_SPOT_SHADOWS 0x200u // spot shadow maps in the atlas (PCF)
+#define SPECTRUM_SOFT_SHADOWS 0x400u // variable penumbra (PCSS): the sun's or a spot's
+#define SPECTRUM_FEATURE_COUNT 11u
+#define SPECTRUM_ALL 0x7FFu
+#define SPECTRUM_MAX_MODES 16u
+#define SPECTRUM_FEATURES_CONSTANT_ID 140
 
 #define NO_TEXTURE 0xFFFFFFFFu
 
@@ -75,6 +96,7 @@ using uint = uint32_t;
 #define VISUALIZE_GI 6u             // --visualize gi: the LPV indirect light only
 #define VISUALIZE_RT_AO 7u          // --visualize rt-ao: the ray-traced ambient occlusion only
 #define VISUALIZE_TILES 20u         // --visualize tiles: the 8x8 tile classes (render/tiles)
+#define VISUALIZE_SPECTRA 18u       // --visualize spectra: each tile's shading permutation
 
 // One vertex of the unified geometry buffer (matches shadel::Vertex).
 struct GpuVertex {
@@ -149,12 +171,12 @@ struct GpuLight {
     float spotOffset;  // round: -cos(outer) * spotScale; square: tan(outer) * spotScale
     uint flags;        // LIGHT_FLAG_*
     float halfLength;  // tube: half the segment's length
-    float radius;      // tube: the tube's radius (widens the specular lobe)
+    float radius;      // tube: the tube's radius (widens the specular lobe); spot: emitter width
     vec3 axis;         // tube: the segment's direction; square spot: the cone's "right" axis
     uint blockerFirst; // into LightingFrame::lightBlockers
     vec4 clipPlane;    // LIGHT_FLAG_CLIP_PLANE: world-space plane, lit side positive
     uint blockerCount; // blockers this light lists (<= LIGHT_MAX_BLOCKERS_PER_LIGHT)
-    uint pad0;
+    uint shadowIndex;  // into LightingFrame::spotShadows; LIGHT_NO_SHADOW without a shadow map
     uint pad1;
     uint pad2;
 };
@@ -210,6 +232,36 @@ struct LightingFrame {
     uint64_t frustumLights; // uint light indices
     uint frustumLightCount;
     uint pad0;
+    uint64_t spectra; // SpectraFrame with --spectra on|single, else 0
+    // Shadows (render/lighting/spot_shadows.h): spot shadow maps share one atlas.
+    uint64_t spotShadows;   // GpuSpotShadow[], GpuLight::shadowIndex indexes it
+    uint spotShadowAtlas;   // bindless slot of the atlas (depth), NO_TEXTURE without one
+    uint sunSoftShadows;    // 1: the sun's shadow is PCSS (variable penumbra), 0: PCF
+    float sunPenumbraScale; // penumbra width per metre from occluder to receiver (tan of the
+                            // sun's angular radius)
+    float sunDepthRange;    // metres from the sun shadow map's depth 0 to 1 (orthographic)
+};
+
+// A spot light's shadow map: its rectangle of the atlas and its perspective view.
+struct GpuSpotShadow {
+    mat4 viewProj;    // world -> the spot's clip space (depth 0 near .. 1 far)
+    vec4 atlasRect;   // the map's rectangle in atlas UV: offset xy, size zw
+    float nearPlane;  // of the perspective (metres)
+    float farPlane;   // the light's range
+    float lightSize;  // PCSS: the emitter's width (metres)
+    float texelAngle; // 2 tan(half the field of view) / resolution: a texel's width per metre
+};
+
+// Feature spectra (render/lighting/feature_spectra.h): the tile pass bins every tile into the
+// first mode (cheapest first) whose features cover what the tile needs.
+struct SpectraFrame {
+    uint64_t dispatch;     // VkDispatchIndirectCommand per mode: x = tiles binned to it
+    uint64_t tileBins;     // uint tile indices: mode m's list starts at m * binCapacity
+    uint64_t superfluous;  // uint per (mode, feature bit): binned tiles that did not need it
+    uint64_t featureTiles; // uint per feature bit: tiles that needed it; then per feature set
+    uint modeCount;
+    uint binCapacity; // tiles (each mode's list can hold every tile)
+    uint modeFeatures[SPECTRUM_MAX_MODES];
 };
 
 struct DrawIndexedCommand { // VkDrawIndexedIndirectCommand

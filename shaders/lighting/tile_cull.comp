@@ -8,6 +8,7 @@
 // the same order as shading without culling.
 #define LIGHT_CULL_ORDERED_APPEND
 #include "lighting/light_cull.glsl"
+#include "lighting/spectra.glsl"
 
 layout(local_size_x = 16, local_size_y = 16) in;
 layout(push_constant, scalar) uniform Push {
@@ -20,6 +21,7 @@ shared uint sDepthMin, sDepthMax;
 shared uvec2 sList[LIGHT_TILE_MAX_LIGHTS];
 shared bool sAnyPerPixel;
 shared uint sKept, sPoolBase;
+shared uint sFeatures; // SPECTRUM_* the tile's list needs (feature spectra)
 
 void main() {
     FrameConstants f = FrameConstantsRef(pc.frame).f;
@@ -32,6 +34,7 @@ void main() {
         sAppendCount = 0u;
         sAnyPerPixel = false;
         sKept = 0u;
+        sFeatures = 0u;
     }
     barrier();
     // Depth bounds of the tile's covered pixels (reversed Z: 0 is the far plane, the sky).
@@ -46,7 +49,10 @@ void main() {
     }
     barrier();
     if (sDepthMax == 0u) { // nothing but sky
-        if (tid == 0u) LightListBuffer(lf.tileRanges).e[tile] = uvec2(0u);
+        if (tid == 0u) {
+            LightListBuffer(lf.tileRanges).e[tile] = uvec2(0u);
+            binTileSpectrum(lf, tile, 0u); // sky: nothing to light
+        }
         return;
     }
     // The tile's frustum between its depth bounds: 8 world-space corners.
@@ -135,6 +141,7 @@ void main() {
     barrier();
     LightListBuffer outList = LightListBuffer(lf.tileLights + uint64_t(sPoolBase) * 8ul);
     uint room = sKept;
+    uint features = 0u;
     for (uint base = 0u; base < candidates; base += THREADS) {
         uint i = base + tid;
         uvec2 entry = i < candidates ? sList[i] : uvec2(LIGHT_INVALID);
@@ -144,8 +151,11 @@ void main() {
             outList.e[slot] = entry;
             if (entry.y != 0u) sAnyPerPixel = true;
             atomicOr(UintBuffer(lf.visibleLights).v[entry.x >> 5], 1u << (entry.x & 31u));
+            if (lf.spectra != 0ul) features |= entryFeatures(lf, lights.l[entry.x], entry.y, corners);
         }
     }
+    if (features != 0u) atomicOr(sFeatures, features);
     barrier();
     if (tid == 0u && sAnyPerPixel) atomicAdd(counters.c.perPixelBlockerTiles, 1u);
+    if (tid == 0u) binTileSpectrum(lf, tile, sFeatures | frameFeatures(f, lf));
 }

@@ -140,6 +140,28 @@ nlohmann::json runBench(Gpu& gpu, const BenchOptions& b) {
         }
     }
 
+    if (b.compareSpectra) {
+        // Forward again, tile-shaded: by spectra, and by one all-features permutation.
+        for (Spectra sp : {Spectra::On, Spectra::Single}) {
+            const char* name = sp == Spectra::On ? "forward_spectra" : "forward_spectra_single";
+            std::fprintf(stderr, "bench: forward, --spectra %s\n",
+                         sp == Spectra::On ? "on" : "single");
+            o.mode = RenderMode::Forward;
+            o.reuse = false;
+            o.lightCulling = b.lightCulling;
+            o.spectra = sp;
+            out["modes"][name] = runRender(gpu, o).stats;
+        }
+        o.spectra = Spectra::Off;
+        double on = out["modes"]["forward_spectra"]["frame_ms"]["median"];
+        double single = out["modes"]["forward_spectra_single"]["frame_ms"]["median"];
+        out["ratios"]["spectra_forward"] = single > 0 ? on / single : 0.0;
+        out["ratios"]["spectra_forward_vs_raster"] = fwd > 0 ? on / fwd : 0.0;
+        std::printf("spectra (forward): on %.3f ms, single %.3f ms, raster %.3f ms; on / single "
+                    "%.3f, on / raster %.3f\n",
+                    on, single, fwd, single > 0 ? on / single : 0.0, fwd > 0 ? on / fwd : 0.0);
+    }
+
     std::printf("shadel bench: %s at %ux%u on %s, %u frames, %s camera, medians (timing: %s)\n",
                 b.scene.c_str(), b.width, b.height, gpu.device.name.c_str(), b.frames,
                 pathNames[int(b.cameraPath)], forward["timing"].get<std::string>().c_str());

@@ -54,6 +54,9 @@ struct RenderOptions {
     bool particleHalfRes = true;                                 // --particle-resolution half|full
     LightCulling lightCulling = LightCulling::Tiled;             // --light-culling tiled|none
     bool lightBlockers = true;                                   // --blockers on|off
+    Spectra spectra = Spectra::Off;                  // --spectra on|off|single
+    bool sunSoftShadows = false;                     // --sun-shadows pcf|pcss
+    bool spotShadows = true;                         // --spot-shadows on|off
     CameraPath cameraPath = CameraPath::Static;
     GiMode gi = GiMode::Off;   // --gi lpv|off
     uint32_t giIterations = 8; // --gi-iterations
@@ -102,6 +105,7 @@ void parseInspect(const std::string& text, int32_t& x, int32_t& y);
 OitMode parseOit(const std::string& text);
 ParticleLighting parseParticleLighting(const std::string& text);
 LightCulling parseLightCulling(const std::string& text);
+Spectra parseSpectra(const std::string& text);
 bool parseOnOff(const char* flag, const std::string& text); // "on" / "off", else InputError
 GiMode parseGi(const std::string& text);                    // --gi lpv|off
 // The bake cache folder when --cache-dir is not given (see defaultBakeCacheDir()).
@@ -136,6 +140,9 @@ struct BenchOptions {
     // --particle-lighting-compare: forward only, particle lighting atlas vs pixel vs vertex
     // (ratios.particle_lighting_atlas_over_pixel; app/bench_command.cpp).
     bool compareParticleLighting = false;
+    // --spectra compare: forward also with --spectra on and single; ratios.spectra_forward =
+    // on / single median frame time (the seed's spectra against one all-features shader).
+    bool compareSpectra = false;
     std::string plot; // --plot FILE.png: per-pass bar chart (app/bench_plot.h)
 };
 nlohmann::json runBench(Gpu& gpu, const BenchOptions& options);

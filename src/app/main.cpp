@@ -221,7 +221,8 @@ int main(int argc, char** argv) {
         ->add_option("--particle-atlas-size", ro.particleAtlasSize,
                      "texels per side of the particle lightmap atlas (128..8192)")
         ->capture_default_str();
-    std::string lightCulling = "tiled", blockers = "on";
+    std::string lightCulling = "tiled", blockers = "on", spectra = "off", sunShadows = "pcf",
+                spotShadows = "on";
     render
         ->add_option("--light-culling", lightCulling,
                      "tiled | none: per-tile (forward) and per-chunk (shadel) light lists")
@@ -229,6 +230,20 @@ int main(int argc, char** argv) {
     render
         ->add_option("--blockers", blockers,
                      "on | off: light blockers and portals stop the lights that list them")
+        ->capture_default_str();
+    render
+        ->add_option("--spectra", spectra,
+                     "on | off | single: forward shading per 16x16 tile by permutations "
+                     "compiled with only the features the tile needs (single: one "
+                     "all-features permutation; off: the raster forward pass)")
+        ->capture_default_str();
+    render
+        ->add_option("--sun-shadows", sunShadows,
+                     "pcf | pcss: the sun's shadow filter (pcss: variable penumbra)")
+        ->capture_default_str();
+    render
+        ->add_option("--spot-shadows", spotShadows,
+                     "on | off: shadow maps (one atlas) for the spots that cast shadows")
         ->capture_default_str();
     render->add_option("--trace", ro.trace,
                        "FILE.json: Chrome trace events (CPU frontend and GPU passes per frame; "
@@ -332,6 +347,12 @@ int main(int argc, char** argv) {
         ->add_option("--light-culling", benchLightCulling,
                      "tiled | none | compare: compare also renders forward and decoupled "
                      "without culling and reports tiled / none frame-time ratios")
+        ->capture_default_str();
+    std::string benchSpectra = "off";
+    bench
+        ->add_option("--spectra", benchSpectra,
+                     "off | on | single | compare: compare also renders forward with --spectra "
+                     "on and single and reports on / single and on / off frame-time ratios")
         ->capture_default_str();
     bench
         ->add_option("--reuse-refresh", bo.reuseRefreshPeriod,
@@ -484,6 +505,12 @@ int main(int argc, char** argv) {
                 throw InputError(format("--particle-resolution %s: expected half or full",
                                         particleResolution.c_str()));
             ro.particleHalfRes = particleResolution == "half";
+            ro.spectra = parseSpectra(spectra);
+            if (sunShadows != "pcf" && sunShadows != "pcss")
+                throw InputError(
+                    format("--sun-shadows %s: expected pcf or pcss", sunShadows.c_str()));
+            ro.sunSoftShadows = sunShadows == "pcss";
+            ro.spotShadows = parseOnOff("--spot-shadows", spotShadows);
             ro.gi = parseGi(gi);
             if (giSnap != "on" && giSnap != "off")
                 throw InputError(format("--gi-snap %s: expected on or off", giSnap.c_str()));
@@ -526,6 +553,11 @@ int main(int argc, char** argv) {
             bo.cameraPath = parseCameraPath(benchCameraPath);
             bo.compareLightCulling = benchLightCulling == "compare";
             if (!bo.compareLightCulling) bo.lightCulling = parseLightCulling(benchLightCulling);
+            bo.compareSpectra = benchSpectra == "compare";
+            if (!bo.compareSpectra && parseSpectra(benchSpectra) != Spectra::Off)
+                throw InputError(format("bench --spectra %s: expected off or compare (the "
+                                        "decoupled runs have no spectra)",
+                                        benchSpectra.c_str()));
             runBench(g.gpu, bo);
             return 0;
         }

@@ -55,9 +55,10 @@ Visualize parseVisualize(const std::string& text) {
     if (text == "rt-ao") return Visualize::RtAo;
     if (text == "particle-atlas") return Visualize::ParticleAtlas;
     if (text == "tiles") return Visualize::Tiles;
+    if (text == "spectra") return Visualize::Spectra;
     throw InputError(format("--visualize %s: expected none, marking, mips, chunks, sheet, "
                             "layer:radiance, layer:material, light-count, blockers, gi, rt-ao, "
-                            "particle-atlas or tiles",
+                            "particle-atlas, tiles or spectra",
                             text.c_str()));
 }
 
@@ -65,6 +66,13 @@ LightCulling parseLightCulling(const std::string& text) {
     if (text == "tiled") return LightCulling::Tiled;
     if (text == "none") return LightCulling::None;
     throw InputError(format("--light-culling %s: expected tiled or none", text.c_str()));
+}
+
+Spectra parseSpectra(const std::string& text) {
+    if (text == "off") return Spectra::Off;
+    if (text == "on") return Spectra::On;
+    if (text == "single") return Spectra::Single;
+    throw InputError(format("--spectra %s: expected on, off or single", text.c_str()));
 }
 
 bool parseOnOff(const char* flag, const std::string& text) {
@@ -284,6 +292,9 @@ RenderRun runRender(Gpu& gpu, const RenderOptions& o) {
     settings.particleAtlasSize = o.particleAtlasSize;
     settings.particleHalfRes = o.particleHalfRes;
     settings.lightBlockers = o.lightBlockers;
+    settings.spectra = o.spectra;
+    settings.sunSoftShadows = o.sunSoftShadows;
+    settings.spotShadows = o.spotShadows;
     requireCount("--gi-iterations", o.giIterations, 0, 64);
     if (o.visualize == Visualize::Gi && o.gi == GiMode::Off)
         throw InputError("--visualize gi: shows the indirect light of --gi lpv; GI is off");
@@ -404,6 +415,8 @@ RenderRun runRender(Gpu& gpu, const RenderOptions& o) {
     s["transparent_draws_decoupled"] = run.frames.back().transparentDecoupledDraws;
     lightCullingStats(renderer, gpuScene, s);
     if (renderer.particles) particleStats(renderer, s);
+    featureSpectraStats(renderer, s);
+    spotShadowStats(renderer, s);
     s["density_mode"] = autoDensity ? "auto" : "explicit";
     if (autoDensity)
         s["view_density"] = {{"budget_scale", viewDensity.budgetScale},

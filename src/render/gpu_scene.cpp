@@ -29,7 +29,9 @@ gpu::GpuLight gpuLight(const Light& l, std::vector<uint32_t>& blockerLists) {
     g.direction = glm::normalize(l.direction);
     g.range = l.range;
     g.color = l.color * l.intensity * (l.dark ? -1.0f : 1.0f);
-    g.flags = (l.dark ? LIGHT_FLAG_DARK : 0u) | (l.hasClipPlane ? LIGHT_FLAG_CLIP_PLANE : 0u);
+    g.flags = (l.dark ? LIGHT_FLAG_DARK : 0u) | (l.hasClipPlane ? LIGHT_FLAG_CLIP_PLANE : 0u) |
+              (l.softShadow ? LIGHT_FLAG_SOFT_SHADOW : 0u);
+    g.shadowIndex = LIGHT_NO_SHADOW; // given by uploadScene to shadow-casting spots
     g.clipPlane = l.clipPlane;
     if (l.type == LightType::SquareSpot) {
         // On the tangent of the angle off the axis, per side of the square.
@@ -53,7 +55,8 @@ gpu::GpuLight gpuLight(const Light& l, std::vector<uint32_t>& blockerLists) {
     }
     g.axis = axis;
     g.halfLength = l.type == LightType::Tube ? 0.5f * l.tubeLength : 0.0f;
-    g.radius = l.tubeRadius;
+    // Tubes: the tube's radius; spots: the emitter's width (soft shadows' penumbra).
+    g.radius = l.type == LightType::Tube ? l.tubeRadius : l.lightSize;
     g.blockerFirst = uint32_t(blockerLists.size());
     g.blockerCount = uint32_t(std::min<size_t>(l.blockers.size(), LIGHT_MAX_BLOCKERS_PER_LIGHT));
     blockerLists.insert(blockerLists.end(), l.blockers.begin(),
@@ -250,6 +253,7 @@ void uploadScene(Gpu& gpu, const Scene& scene, GpuScene& out, const std::vector<
     std::vector<gpu::GpuLight> lights;
     std::vector<uint32_t> lightBlockers;
     bool haveSun = false;
+    uint32_t spotShadows = 0;
     for (const Light& l : scene.lights) {
         if (l.type == LightType::Directional && !haveSun) {
             haveSun = true;
@@ -259,6 +263,10 @@ void uploadScene(Gpu& gpu, const Scene& scene, GpuScene& out, const std::vector<
             continue;
         }
         lights.push_back(gpuLight(l, lightBlockers));
+        // Spot shadow maps (render/lighting/spot_shadows.h), in light order, up to the atlas's.
+        bool spot = l.type == LightType::Spot || l.type == LightType::SquareSpot;
+        if (l.castsShadow && spot && spotShadows < LIGHT_MAX_SPOT_SHADOWS)
+            lights.back().shadowIndex = spotShadows++;
         out.lightCastsShadow.push_back(l.castsShadow ? 1 : 0);
     }
     std::vector<gpu::GpuLightBlocker> blockers;

@@ -43,7 +43,8 @@ static void createTargets(Renderer& r) {
     hdr.width = r.internalWidth;
     hdr.height = r.internalHeight;
     hdr.usage = VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT | VK_IMAGE_USAGE_SAMPLED_BIT;
-    if (usesVisibilityBuffer(r.settings) || r.settings.screenSpace) // resolve, screen space
+    // compute resolve, screen space, tile shading
+    if (usesVisibilityBuffer(r.settings) || r.settings.screenSpace || usesTileShading(r))
         hdr.usage |= VK_IMAGE_USAGE_STORAGE_BIT;
     r.hdr = need(createTexture(gpu, hdr), "the scene colour target");
     r.hdrTarget = createRenderTargetView(gpu, r.hdr);
@@ -70,9 +71,10 @@ static void createTargets(Renderer& r) {
 // --capture names of the targets every frame has (render/debug/capture.h).
 static void registerTargetCaptures(Renderer& r) {
     Gpu& gpu = *r.gpu;
-    VkImageLayout hdrLayout = usesVisibilityBuffer(r.settings) || r.settings.screenSpace
+    // After tonemap (which reads a target that allows storage in GENERAL layout).
+    VkImageLayout hdrLayout = (desc(gpu, r.hdr).usage & VK_IMAGE_USAGE_STORAGE_BIT)
                                   ? VK_IMAGE_LAYOUT_GENERAL
-                                  : VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL; // after tonemap
+                                  : VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL;
     registerTextureCapture(
         r.captures, gpu, "hdr", "scene colour before tonemapping (EXR)", CaptureKind::Hdr,
         [&r] { return r.hdr; }, hdrLayout);
@@ -89,6 +91,26 @@ void initRenderer(Renderer& r, Gpu& gpu, const RenderSettings& settings, const G
     r.settings = settings;
     if (settings.width == 0 || settings.height == 0 || settings.ssaa == 0)
         throw InputError("--size and --ssaa must be positive");
+    if (settings.spectra != Spectra::Off && settings.mode != RenderMode::Forward)
+        throw InputError("--spectra on|single: forward mode only (the shadel path's chunks do "
+                         "not run per-spectrum permutations yet)");
+    if (settings.spectra != Spectra::Off && settings.lightCulling != LightCulling::Tiled)
+        throw InputError("--spectra on|single needs --light-culling tiled (the tile pass "
+                         "records each tile's features)");
+    if (settings.spectra != Spectra::Off && settings.occlusion)
+        throw InputError("--spectra on|single needs --occlusion off (tile shading reads the "
+                         "visibility buffer, which the phase-2 prepass does not write)");
+    if (settings.spectra != Spectra::Off && settings.rt.enabled())
+        throw InputError("--spectra on|single with --rt-*: tile shading does not read the "
+                         "ray-traced terms yet; use --spectra off");
+    if (settings.spectra != Spectra::Off && settings.screenSpace)
+        throw InputError("--spectra on|single with --screen-space on: the thin G-buffer needs "
+                         "the depth prepass the tile path replaces; use one of them");
+    if (settings.spectra != Spectra::Off && settings.inspectX >= 0)
+        throw InputError("--inspect needs --spectra off (the prints come from the raster "
+                         "forward pass)");
+    if (settings.visualize == Visualize::Spectra && settings.spectra == Spectra::Off)
+        throw InputError("--visualize spectra needs --spectra on or single");
     if (settings.occlusion && usesVisibilityBuffer(settings))
         throw InputError("--occlusion on needs --marking raster (the phase-2 prepass writes "
                          "depth only, not the visibility buffer)");
@@ -120,10 +142,13 @@ void initRenderer(Renderer& r, Gpu& gpu, const RenderSettings& settings, const G
     initShaderMessages(gpu, r.messages);
     initFrameRecorder(gpu, r.recorder, settings.timing);
     if (settings.mode == RenderMode::Decoupled) r.decoupled = createDecoupled(r, scene);
-    if (usesVisibilityBuffer(settings)) r.visibility = createVisibility(r);
+    // Tile shading (--spectra on|single, forward) reads the visibility buffer too.
+    if (usesVisibilityBuffer(settings) || usesTileShading(r)) r.visibility = createVisibility(r);
     r.oit = createOit(r, scene);
     r.particles = createParticles(r, scene);
     r.lightCulling = createLightCulling(r, scene);
+    r.spotShadows = createSpotShadows(r, scene);
+    if (usesTileShading(r)) r.spectra = createFeatureSpectra(r);
     if (settings.gi == GiMode::Lpv) r.gi = createGi(r, scene);
     r.culling = createCulling(r, scene);
     r.debugLines = createDebugLines(r);
@@ -136,6 +161,8 @@ void destroyRenderer(Renderer& r) {
     Gpu& gpu = *r.gpu;
     vkDeviceWaitIdle(gpu.device.device);
     destroyRayTracing(r, r.rt);
+    destroyFeatureSpectra(r, r.spectra);
+    destroySpotShadows(r, r.spotShadows);
     destroyLightCulling(r, r.lightCulling);
     destroyDebugLines(r, r.debugLines);
     destroyScreenSpace(r);
@@ -264,8 +291,7 @@ FrameResult renderFrame(Renderer& r, const GpuScene& scene, const CameraView& ca
         r.restreamedMaterials = restreamedMaterials(*r.streaming);
     }
     constants.lighting = prepareLightCulling(
-        r, scene, r.settings.animateLights ? r.lightsLastFrame : scene.lightInfo,
-        constants.viewProj);
+        r, scene, r.settings.animateLights ? r.lightsLastFrame : scene.lightInfo, constants);
     if (r.gi) prepareGiFrame(r, scene, camera, constants);
     if (r.decoupled) prepareDecoupledFrame(r, scene, camera, constants);
     prepareTransparentDraws(r, scene, camera);
@@ -288,6 +314,9 @@ FrameResult renderFrame(Renderer& r, const GpuScene& scene, const CameraView& ca
          [&](VkCommandBuffer cmd) { recordInstanceCull(r, cmd, frame, scene); });
     pass(rec, "shadowMap", [&](VkCommandBuffer cmd) { recordShadowMap(r, cmd, frame); });
     if (r.rt) pass(rec, "rtBuildTlas", [&](VkCommandBuffer cmd) { recordTlasBuild(r, cmd); });
+    if (spotShadowMapsThisFrame(r)) // shadow-casting spots, one atlas (render/lighting)
+        pass(rec, "spotShadowMaps",
+             [&](VkCommandBuffer cmd) { recordSpotShadowMaps(r, cmd, frame); });
     if (r.gi) { // light propagation volumes (render/gi): RSMs, injection, propagation
         pass(rec, "giReflectiveShadowMaps",
              [&](VkCommandBuffer cmd) { recordGiReflectiveShadowMaps(r, cmd, frame); });
@@ -303,10 +332,12 @@ FrameResult renderFrame(Renderer& r, const GpuScene& scene, const CameraView& ca
         pass(rec, "lightCulling", [&](VkCommandBuffer cmd) { recordLightCulling(r, cmd, frame); });
     if (r.settings.occlusion) recordOcclusionPasses(r, rec, frame, scene);
     recordThinGBufferPass(r, rec, frame); // --screen-space on (render/screenspace)
-    if (r.settings.mode == RenderMode::Forward) {
-        if (r.rt) // sun visibility, AO, indirect light per pixel (render/raytracing)
-            pass(rec, "rtPixelTerms",
-                 [&](VkCommandBuffer cmd) { recordRayTracedPixels(r, cmd, frame); });
+    if (r.rt && r.settings.mode == RenderMode::Forward) // sun visibility, AO, GI per pixel
+        pass(rec, "rtPixelTerms",
+             [&](VkCommandBuffer cmd) { recordRayTracedPixels(r, cmd, frame); });
+    if (r.spectra) { // forward, per-tile permutations (render/lighting/feature_spectra.h)
+        pass(rec, "tileShading", [&](VkCommandBuffer cmd) { recordTileShading(r, cmd, frame); });
+    } else if (r.settings.mode == RenderMode::Forward) {
         pass(rec, "forwardShading",
              [&](VkCommandBuffer cmd) { recordForwardShading(r, cmd, frame); });
     } else {
@@ -339,6 +370,7 @@ FrameResult renderFrame(Renderer& r, const GpuScene& scene, const CameraView& ca
         uint32_t(transparentDrawOrder(r).size()) + result.transparentDecoupledDraws;
     if (r.decoupled) finishDecoupledFrame(r);
     readLightCullingStats(r);
+    readFeatureSpectraStats(r);
     finishCullingFrame(r);
     if (r.rt) finishRayTracingFrame(r);
     finishScreenSpaceFrame(r);

@@ -12,9 +12,11 @@
 #include "render/distance_fields/distance_fields.h"
 #include "render/gi/lpv.h"
 #include "render/gpu_scene.h"
+#include "render/lighting/feature_spectra.h"
 #include "render/lighting/light_culling.h"
 #include "render/raytracing/ray_tracing.h"
 #include "render/raytracing/rt_settings.h"
+#include "render/lighting/spot_shadows.h"
 #include "render/shadel/visibility.h"
 #include "rhi/frame.h"
 #include "rhi/pipeline.h"
@@ -43,6 +45,7 @@ enum class Visualize : uint32_t {
     RtAo = VISUALIZE_RT_AO,             // --visualize rt-ao: the ray-traced AO only (--rt-ao on)
     ParticleAtlas = 24,                 // --visualize particle-atlas (render/particles)
     Tiles = VISUALIZE_TILES,            // --visualize tiles: 8x8 tile classes (render/tiles)
+    Spectra = VISUALIZE_SPECTRA,        // each tile's shading mode (--spectra on|single)
 };
 // --particle-lighting: lit particle sprites read the atlas, or are lit per pixel / per vertex.
 enum class ParticleLighting : uint32_t { Atlas = 0, Pixel = 1, Vertex = 2 };
@@ -109,6 +112,9 @@ struct RenderSettings {
     // whether they run per classified 8x8 tile (render/tiles) or over every tile.
     bool screenSpace = false;
     bool tileClassification = true;
+    Spectra spectra = Spectra::Off; // forward: per-tile shading permutations (render/lighting)
+    bool sunSoftShadows = false;    // --sun-shadows pcss: variable penumbra (render/lighting)
+    bool spotShadows = true;        // --spot-shadows: shadow maps of shadow-casting spots
 };
 
 struct FrameResult {
@@ -194,6 +200,9 @@ struct Renderer {
     // Texture streaming (render/streaming), owned by the caller; null: textures loaded whole.
     TextureStreaming* streaming = nullptr;
     std::vector<uint8_t> restreamedMaterials; // per material: a texture of it changed this frame
+    SpectraStatePtr spectra;           // --spectra on|single (render/lighting/feature_spectra.h)
+    SpotShadowStatePtr spotShadows;    // shadow-casting spots (render/lighting/spot_shadows.h)
+    GiStatePtr gi;                     // --gi lpv
     std::chrono::steady_clock::time_point createdAt = std::chrono::steady_clock::now();
 };
 

@@ -1,6 +1,9 @@
 #include "scene/builtin_lights.h"
 
+#include <algorithm>
 #include <cmath>
+#include <utility>
+#include <vector>
 
 #include <glm/gtc/matrix_transform.hpp>
 
@@ -258,6 +261,26 @@ Scene makeLightsScene(Scene scene) {
     night.znear = 0.1f;
     night.zfar = 400.0f;
     scene.cameras.insert(scene.cameras.begin(), night);
+    // Shadowed spots (render/lighting/spot_shadows.h: one atlas): 16 lamps down the avenue in
+    // front of the night camera, each over a post it throws a shadow of onto the street; every
+    // other one round or square, soft (PCSS, a 0.4 m lamp head) or hard (PCF).
+    uint32_t postMaterial = addMaterial(scene, "shadow post", {0.5f, 0.5f, 0.55f}, 0.6f);
+    for (int i = 0; i < 16; ++i) {
+        float x = -47.0f + 2.0f * float(i);
+        float z = (i % 2 == 0 ? -2.5f : 2.5f) + rng.uniform(-0.5f, 0.5f);
+        addBox(scene, name("shadow post", i), {0.3f, 2.2f, 0.3f}, {x + 1.2f, 0.0f, z},
+               postMaterial);
+        Light l = light(i % 4 < 2 ? LightType::Spot : LightType::SquareSpot,
+                        name("shadowed spot", i), {x, 5.0f, z}, warmOrCool(rng), 40.0f, 10.0f);
+        l.direction = glm::normalize(glm::vec3(0.45f, -1.0f, 0.0f));
+        l.axis = glm::vec3(0, 0, 1);
+        l.innerConeAngle = 0.35f;
+        l.outerConeAngle = 0.6f;
+        l.castsShadow = true;
+        l.softShadow = i % 2 == 0;
+        l.lightSize = 0.4f;
+        scene.lights.push_back(l);
+    }
     return scene;
 }
 

@@ -153,6 +153,8 @@ struct Light {
     float innerConeAngle = 0.0f;
     float outerConeAngle = 0.7853982f;
     bool castsShadow = false;
+    bool softShadow = false;   // shadow-casting spots: variable penumbra (PCSS) instead of PCF
+    float lightSize = 0.1f;    // the emitter's width (metres): PCSS penumbra size
     bool dark = false;         // a negative light: subtracts what it would add
     glm::vec3 axis{1, 0, 0};   // tube: the segment; square spot: the cone's "right" axis
     float tubeLength = 0.0f;   // tube: the segment's length

@@ -80,7 +80,9 @@ void destroyLightCulling(Renderer& r, LightCullingStatePtr& state) {
 }
 
 uint64_t prepareLightCulling(Renderer& r, const GpuScene& scene,
-                             const std::vector<gpu::GpuLight>& lights, const glm::mat4& viewProj) {
+                             const std::vector<gpu::GpuLight>& lights,
+                             const gpu::FrameConstants& constants) {
+    const glm::mat4& viewProj = constants.viewProj;
     Gpu& gpu = *r.gpu;
     LightCullingState& s = *r.lightCulling;
     gpu::LightingFrame f{};
@@ -115,6 +117,13 @@ uint64_t prepareLightCulling(Renderer& r, const GpuScene& scene,
     f.tiled = s.tiledThisFrame ? 1u : 0u;
     f.poolCapacity = s.poolCapacity;
     f.blockerCount = scene.blockerCount;
+    // Tile shading needs every tile's features and bin, whatever the light count.
+    if (r.spectra && r.settings.lightCulling == LightCulling::Tiled) {
+        s.tiledThisFrame = true;
+        f.tiled = 1u;
+    }
+    f.spectra = prepareFeatureSpectra(r, s.tilesX, s.tilesY);
+    prepareShadows(r, lights, constants, f);
     std::memcpy(mapped(gpu, s.frame), &f, sizeof(f));
     return address(gpu, s.frame);
 }
@@ -124,6 +133,7 @@ void recordLightCulling(Renderer& r, VkCommandBuffer cmd, uint64_t frame) {
     LightCullingState& s = *r.lightCulling;
     vkCmdFillBuffer(cmd, vkBuffer(gpu, s.counters), 0, VK_WHOLE_SIZE, 0);
     vkCmdFillBuffer(cmd, vkBuffer(gpu, s.visibleLights), 0, VK_WHOLE_SIZE, 0);
+    recordSpectraReset(r, cmd);
     memoryBarrier(cmd, VK_PIPELINE_STAGE_2_CLEAR_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT,
                   VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
                   VK_ACCESS_2_SHADER_STORAGE_READ_BIT | VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT);

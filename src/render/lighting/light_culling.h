@@ -31,8 +31,10 @@ void destroyLightCulling(Renderer& r, LightCullingStatePtr& state);
 // This frame's LightingFrame (host-visible), with the lights that meet the camera frustum
 // (`lights`: this frame's, `viewProj`: the camera's); returns its address for
 // FrameConstants::lighting.
+// Also this frame's shadow constants (render/lighting/spot_shadows.h).
 uint64_t prepareLightCulling(Renderer& r, const GpuScene& scene,
-                             const std::vector<gpu::GpuLight>& lights, const glm::mat4& viewProj);
+                             const std::vector<gpu::GpuLight>& lights,
+                             const gpu::FrameConstants& constants);
 // Whether this frame builds tile lists: --light-culling tiled and enough lights in view (or
 // blockers to classify); otherwise shading loops over the lights directly.
 bool lightTilesThisFrame(const Renderer& r);

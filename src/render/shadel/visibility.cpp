@@ -89,6 +89,14 @@ void destroyVisibility(Renderer& r, VisibilityStatePtr& state) {
     state.reset();
 }
 
+uint32_t visibilityBufferSlot(Renderer& r) {
+    return slot(*r.gpu, r.visibility->idsRead).value;
+}
+
+uint32_t visibilityHdrWriteSlot(Renderer& r) {
+    return slot(*r.gpu, r.visibility->hdrWrite).value;
+}
+
 void recordVisibilityPrepass(Renderer& r, VkCommandBuffer cmd, uint64_t frame) {
     Gpu& gpu = *r.gpu;
     VisibilityState& v = *r.visibility;

@@ -23,6 +23,11 @@ using VisibilityStatePtr = std::unique_ptr<VisibilityState, VisibilityStateDelet
 VisibilityStatePtr createVisibility(Renderer& r);
 void destroyVisibility(Renderer& r, VisibilityStatePtr& state);
 
+// Bindless slots of the visibility buffer (sampled) and of the HDR target (storage), for the
+// compute passes that read the one and write the other (also render/lighting's tile shading).
+uint32_t visibilityBufferSlot(Renderer& r);
+uint32_t visibilityHdrWriteSlot(Renderer& r);
+
 // "visibilityPrepass": reversed-Z depth + instance/triangle IDs of opaque and decoupled lists.
 void recordVisibilityPrepass(Renderer& r, VkCommandBuffer cmd, uint64_t frame);
 // "markingCompute": occupancy bits from the visibility buffer (after shadelClear).

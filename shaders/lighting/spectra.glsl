@@ -1,0 +1,73 @@
+// Feature spectra (seed 001): the tile pass records which lighting features a tile needs and
+// bins the tile into the cheapest shading permutation ("mode") whose features cover them; the
+// tile shading pass (tile_shade.comp) then runs each mode's permutation over its bin through
+// an indirect dispatch. See render/lighting/feature_spectra.h.
+#ifndef SHADEL_SPECTRA_GLSL
+#define SHADEL_SPECTRA_GLSL
+#include "common/lighting.glsl"
+
+layout(buffer_reference, scalar) readonly buffer SpectraFrameRef { SpectraFrame s; };
+
+// The features one (light, blocker mask) entry of a tile's list asks for. `corners`: the
+// tile's volume (a clip plane that leaves all of it lit needs no per-pixel test).
+uint entryFeatures(LightingFrame lf, GpuLight light, uint blockerMask, vec3 corners[8]) {
+    uint features = 0u;
+    if (light.type == LIGHT_POINT) features |= SPECTRUM_OMNI;
+    if (light.type == LIGHT_SPOT) features |= SPECTRUM_SPOT;
+    if (light.type == LIGHT_SPOT_SQUARE) features |= SPECTRUM_SQUARE_SPOT;
+    if (light.type == LIGHT_TUBE) features |= SPECTRUM_TUBE;
+    if ((light.flags & LIGHT_FLAG_DARK) != 0u) features |= SPECTRUM_DARK;
+    if ((light.flags & LIGHT_FLAG_CLIP_PLANE) != 0u) {
+        bool allLit = true;
+        for (int i = 0; i < 8; ++i)
+            allLit = allLit && dot(light.clipPlane.xyz, corners[i]) + light.clipPlane.w >= 0.0;
+        if (!allLit) features |= SPECTRUM_CLIP_PLANES;
+    }
+    if (light.shadowIndex != LIGHT_NO_SHADOW && lf.spotShadowAtlas != NO_TEXTURE) {
+        features |= SPECTRUM_SPOT_SHADOWS;
+        if ((light.flags & LIGHT_FLAG_SOFT_SHADOW) != 0u) features |= SPECTRUM_SOFT_SHADOWS;
+    }
+    if (blockerMask != 0u && lf.blockersOn != 0u) {
+        features |= SPECTRUM_BLOCKERS;
+        LightBlockerBuffer blockers = LightBlockerBuffer(lf.blockers);
+        UintBuffer list = UintBuffer(lf.lightBlockers);
+        uint n = min(light.blockerCount, LIGHT_MAX_BLOCKERS_PER_LIGHT);
+        for (uint k = 0u; k < n; ++k)
+            if ((blockerMask & (1u << k)) != 0u &&
+                blockers.b[list.v[light.blockerFirst + k]].portalCount != 0u)
+                features |= SPECTRUM_PORTALS;
+    }
+    return features;
+}
+
+// Features every covered pixel of the frame needs (not per light): the sun's shadow map.
+uint frameFeatures(FrameConstants f, LightingFrame lf) {
+    bool sunShadow = f.sunShadowSlot != NO_TEXTURE && dot(f.sunColor, f.sunColor) > 0.0;
+    if (!sunShadow) return 0u;
+    return lf.sunSoftShadows != 0u ? SPECTRUM_SHADOWS | SPECTRUM_SOFT_SHADOWS : SPECTRUM_SHADOWS;
+}
+
+// The first mode (they are ordered cheapest first; the last has every feature) covering
+// `features`; appends the tile to its bin and counts the features it compiles in needlessly.
+void binTileSpectrum(LightingFrame lf, uint tile, uint features) {
+    if (lf.spectra == 0ul) return;
+    SpectraFrame sf = SpectraFrameRef(lf.spectra).s;
+    uint mode = sf.modeCount - 1u;
+    for (uint m = 0u; m < sf.modeCount; ++m)
+        if ((features & ~sf.modeFeatures[m]) == 0u) {
+            mode = m;
+            break;
+        }
+    // x of the mode's VkDispatchIndirectCommand.
+    uint slot = atomicAdd(UintBuffer(sf.dispatch).v[mode * 3u], 1u);
+    UintBuffer(sf.tileBins).v[mode * sf.binCapacity + slot] = tile;
+    uint superfluous = sf.modeFeatures[mode] & ~features;
+    for (uint bit = 0u; bit < SPECTRUM_FEATURE_COUNT; ++bit) {
+        if ((superfluous & (1u << bit)) != 0u)
+            atomicAdd(UintBuffer(sf.superfluous).v[mode * SPECTRUM_FEATURE_COUNT + bit], 1u);
+        if ((features & (1u << bit)) != 0u) atomicAdd(UintBuffer(sf.featureTiles).v[bit], 1u);
+    }
+    // Then a histogram of the exact feature sets (what the modes are chosen from).
+    atomicAdd(UintBuffer(sf.featureTiles).v[SPECTRUM_FEATURE_COUNT + features], 1u);
+}
+#endif

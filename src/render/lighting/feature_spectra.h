@@ -1,0 +1,55 @@
+#pragma once
+// Feature spectra (seed 001, "Lighting Compute Optimization"): a shader with every lighting
+// feature compiled in pays for all of them everywhere (registers, occupancy, code). The tile
+// pass (shaders/lighting/tile_cull.comp) records the features each 16x16 tile needs (light
+// kinds, darks, clip planes, per-pixel blockers, portals, shadows) and bins the tile into the
+// first of a few shading modes, cheapest first, whose features cover them; each mode is a
+// permutation of the tile shading compute (shaders/lighting/tile_shade.comp) compiled with only
+// its features (a specialization constant), run over its bin by an indirect dispatch.
+//
+// Forward mode only. The forward path shades in a raster pass, where a permutation cannot be
+// chosen per screen tile without drawing the scene once per mode; so with --spectra on|single
+// the forward frame becomes deferred-style per tile: the visibility prepass (instance,
+// triangle per pixel, render/shadel/visibility.h) replaces the depth prepass, and the tile
+// shading rebuilds each pixel's surface from it exactly as the raster varyings and
+// derivatives give it, then runs the same evaluateMaterial + shadeSurface.
+//   --spectra on:     the modes of kSpectrumModes, each tile in the cheapest covering one;
+//   --spectra single: the same pass with one all-features mode (the baseline the seed's
+//                     spectra are measured against);
+//   --spectra off:    the raster forward shading (the default).
+#include <memory>
+
+#include <nlohmann/json.hpp>
+
+#include "rhi/vk.h"
+
+namespace shadel {
+
+struct Renderer;
+
+enum class Spectra { Off, On, Single };
+
+struct SpectraState;
+struct SpectraStateDeleter {
+    void operator()(SpectraState* state) const;
+};
+using SpectraStatePtr = std::unique_ptr<SpectraState, SpectraStateDeleter>;
+
+// Whether the frame shades forward tiles by spectra (forward mode, --spectra on|single).
+bool usesTileShading(const Renderer& r);
+
+// After the light culling state and the visibility buffer exist: the mode permutations.
+SpectraStatePtr createFeatureSpectra(Renderer& r);
+void destroyFeatureSpectra(Renderer& r, SpectraStatePtr& state);
+
+// This frame's SpectraFrame address (LightingFrame::spectra), 0 without spectra.
+uint64_t prepareFeatureSpectra(Renderer& r, uint32_t tilesX, uint32_t tilesY);
+// Empties the bins before the tile pass fills them (recorded with the light culling clears).
+void recordSpectraReset(Renderer& r, VkCommandBuffer cmd);
+// "tileShading": every mode's permutation over its bin (indirect), into the HDR target.
+void recordTileShading(Renderer& r, VkCommandBuffer cmd, uint64_t frame);
+// After the frame: tiles per spectrum, superfluous features, tiles per feature.
+void readFeatureSpectraStats(Renderer& r);
+void featureSpectraStats(const Renderer& r, nlohmann::json& stats);
+
+} // namespace shadel

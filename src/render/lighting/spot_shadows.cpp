@@ -1,0 +1,242 @@
+#include "render/lighting/spot_shadows.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+
+#include <glm/gtc/matrix_transform.hpp>
+
+#include "core/block_allocator.h"
+#include "core/error.h"
+#include "render/forward/forward_passes.h"
+#include "render/renderer.h"
+
+namespace shadel {
+
+namespace {
+constexpr uint32_t kAtlasSize = 4096;
+constexpr uint32_t kSoftMapSize = 1024; // PCSS spots: wide kernels want the resolution
+constexpr uint32_t kMapSize = 512;
+constexpr float kNearPlane = 0.05f;
+// The sun's PCSS: penumbra width per metre between occluder and receiver, tan(1.5 degrees) (the
+// real sun's 0.27 would stay under a texel of the 2048^2 map over a town).
+constexpr float kSunPenumbraScale = 0.0262f;
+} // namespace
+
+struct SpotShadowState {
+    TextureHandle atlas;
+    DepthTargetView target;
+    TextureReadView read;
+    BufferHandle shadows; // gpu::GpuSpotShadow[] (upload)
+    Pipeline pass;
+    std::vector<uint32_t> lightOf; // light index per shadow index
+    std::vector<glm::uvec4> rects; // atlas texels: x, y, size, 1 if placed
+    uint32_t placed = 0;
+    uint64_t atlasTexelsUsed = 0;
+    // The maps are drawn again only when what they see may have changed: the spots (this
+    // frame's views differ from the last drawn) or the caster list, which the camera's
+    // shadow-caster culling chooses (the camera moved).
+    std::vector<gpu::GpuSpotShadow> drawnViews;
+    glm::mat4 drawnCamera{0.0f};
+    bool redraw = true;
+    uint32_t redraws = 0;
+};
+
+void SpotShadowStateDeleter::operator()(SpotShadowState* state) const {
+    delete state;
+}
+
+SpotShadowStatePtr createSpotShadows(Renderer& r, const GpuScene& scene) {
+    if (!r.settings.spotShadows) return nullptr;
+    std::vector<uint32_t> lightOf;
+    for (uint32_t i = 0; i < scene.lightInfo.size(); ++i) {
+        uint32_t index = scene.lightInfo[i].shadowIndex;
+        if (index == LIGHT_NO_SHADOW) continue;
+        if (lightOf.size() <= index) lightOf.resize(index + 1, ~0u);
+        lightOf[index] = i;
+    }
+    if (lightOf.empty()) return nullptr;
+    Gpu& gpu = *r.gpu;
+    SpotShadowStatePtr s(new SpotShadowState);
+    s->lightOf = lightOf;
+    // Place every map at once, largest first (the allocator's batched insert).
+    std::vector<Extent<2>> extents;
+    for (uint32_t light : lightOf) {
+        bool soft = (scene.lightInfo[light].flags & LIGHT_FLAG_SOFT_SHADOW) != 0u;
+        uint32_t size = soft ? kSoftMapSize : kMapSize;
+        extents.push_back({size, size});
+    }
+    BlockAllocator<2> allocator({kAtlasSize, kAtlasSize});
+    auto placements = allocator.insertBatch(extents);
+    for (size_t i = 0; i < placements.size(); ++i) {
+        const auto& p = placements[i];
+        s->rects.push_back(p ? glm::uvec4(p->origin[0], p->origin[1], p->extent[0], 1u)
+                             : glm::uvec4(0u));
+        s->placed += p ? 1u : 0u;
+    }
+    s->atlasTexelsUsed = allocator.usedVolume();
+
+    TextureDesc atlas;
+    atlas.name = "spotShadowAtlas";
+    atlas.format = VK_FORMAT_D32_SFLOAT;
+    atlas.width = atlas.height = kAtlasSize;
+    atlas.usage = VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT | VK_IMAGE_USAGE_SAMPLED_BIT;
+    s->atlas = createTexture(gpu, atlas);
+    s->shadows = createBuffer(
+        gpu, {"spotShadows", lightOf.size() * sizeof(gpu::GpuSpotShadow), 0, MemoryKind::Upload});
+    if (!s->atlas || !s->shadows) throw DeviceError("out of GPU memory for the spot shadow atlas");
+    s->target = createDepthTargetView(gpu, s->atlas);
+    s->read = createReadView(gpu, s->atlas);
+
+    GraphicsPipelineDesc pass;
+    pass.name = "spotShadowMaps";
+    pass.vertexShader = "lighting_spot_shadow.vert.spv";
+    pass.fragmentShader = "forward_depth.frag.spv";
+    pass.depthFormat = VK_FORMAT_D32_SFLOAT;
+    pass.depthCompare = VK_COMPARE_OP_LESS_OR_EQUAL;
+    pass.cullMode = VK_CULL_MODE_NONE;
+    pass.depthClamp = true;
+    pass.depthBias = true;
+    s->pass = createGraphicsPipeline(gpu, pass);
+    return s;
+}
+
+void destroySpotShadows(Renderer& r, SpotShadowStatePtr& state) {
+    if (!state) return;
+    Gpu& gpu = *r.gpu;
+    destroy(gpu, state->pass);
+    destroy(gpu, state->target);
+    destroy(gpu, state->read);
+    destroy(gpu, state->atlas);
+    destroy(gpu, state->shadows);
+    state.reset();
+}
+
+// The spot's perspective view: its outer cone (round) or pyramid (square) fills the map.
+static gpu::GpuSpotShadow spotView(const gpu::GpuLight& l, glm::uvec4 rect) {
+    gpu::GpuSpotShadow s{};
+    float tanHalf;
+    if (l.type == LIGHT_SPOT_SQUARE) {
+        // spotOffset / spotScale = tan(outer) per side; the pyramid's corners need sqrt(2) more
+        // only for a round frustum, and this one is square like the cone.
+        tanHalf = l.spotOffset / std::max(l.spotScale, 1e-6f);
+    } else {
+        float cosOuter = std::clamp(-l.spotOffset / std::max(l.spotScale, 1e-6f), 0.05f, 0.9999f);
+        tanHalf = std::tan(std::acos(cosOuter));
+    }
+    tanHalf = std::clamp(tanHalf, 0.01f, std::tan(glm::radians(85.0f)));
+    glm::vec3 dir = glm::normalize(l.direction);
+    glm::vec3 up = l.type == LIGHT_SPOT_SQUARE ? glm::cross(l.axis, dir)
+                   : std::abs(dir.y) > 0.99f   ? glm::vec3(1, 0, 0)
+                                               : glm::vec3(0, 1, 0);
+    float range = l.range > 0.0f ? l.range : 200.0f;
+    glm::mat4 view = glm::lookAt(l.position, l.position + dir, up);
+    glm::mat4 proj = glm::perspectiveRH_ZO(2.0f * std::atan(tanHalf), 1.0f, kNearPlane, range);
+    s.viewProj = proj * view;
+    s.atlasRect = glm::vec4(glm::vec2(rect.x, rect.y), glm::vec2(rect.z)) / float(kAtlasSize);
+    s.nearPlane = rect.w ? kNearPlane : -1.0f; // < 0: no map (the atlas was full)
+    s.farPlane = range;
+    s.lightSize = l.radius;
+    s.texelAngle = 2.0f * tanHalf / float(std::max(rect.z, 1u));
+    return s;
+}
+
+void prepareShadows(Renderer& r, const std::vector<gpu::GpuLight>& lights,
+                    const gpu::FrameConstants& constants, gpu::LightingFrame& f) {
+    f.sunSoftShadows = r.settings.sunSoftShadows ? 1u : 0u;
+    f.sunPenumbraScale = kSunPenumbraScale;
+    glm::mat4 inv = glm::inverse(constants.sunViewProj);
+    glm::vec4 a = inv * glm::vec4(0, 0, 0, 1), b = inv * glm::vec4(0, 0, 1, 1);
+    f.sunDepthRange = glm::length(glm::vec3(b) / b.w - glm::vec3(a) / a.w);
+    f.spotShadowAtlas = NO_TEXTURE;
+    f.spotShadows = 0;
+    if (!r.spotShadows) return;
+    Gpu& gpu = *r.gpu;
+    SpotShadowState& s = *r.spotShadows;
+    auto* out = static_cast<gpu::GpuSpotShadow*>(mapped(gpu, s.shadows));
+    std::vector<gpu::GpuSpotShadow> views(s.lightOf.size());
+    for (size_t i = 0; i < s.lightOf.size(); ++i)
+        views[i] = s.lightOf[i] < lights.size() ? spotView(lights[s.lightOf[i]], s.rects[i])
+                                                : gpu::GpuSpotShadow{};
+    s.redraw = s.drawnViews.size() != views.size() || constants.viewProj != s.drawnCamera ||
+               std::memcmp(views.data(), s.drawnViews.data(),
+                           views.size() * sizeof(gpu::GpuSpotShadow)) != 0;
+    if (s.redraw) {
+        s.drawnViews = views;
+        s.drawnCamera = constants.viewProj;
+        s.redraws++;
+    }
+    std::memcpy(out, views.data(), views.size() * sizeof(gpu::GpuSpotShadow));
+    f.spotShadows = address(gpu, s.shadows);
+    f.spotShadowAtlas = slot(gpu, s.read).value;
+}
+
+bool spotShadowMapsThisFrame(const Renderer& r) {
+    return r.spotShadows != nullptr && r.spotShadows->redraw;
+}
+
+void recordSpotShadowMaps(Renderer& r, VkCommandBuffer cmd, uint64_t frame) {
+    Gpu& gpu = *r.gpu;
+    SpotShadowState& s = *r.spotShadows;
+    VkImage image = vkImage(gpu, s.atlas);
+    imageBarrier(
+        cmd, image, VK_IMAGE_ASPECT_DEPTH_BIT, VK_IMAGE_LAYOUT_UNDEFINED,
+        VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL,
+        VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT | VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, 0,
+        VK_PIPELINE_STAGE_2_EARLY_FRAGMENT_TESTS_BIT | VK_PIPELINE_STAGE_2_LATE_FRAGMENT_TESTS_BIT,
+        VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT |
+            VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_READ_BIT);
+    VkRenderingAttachmentInfo depth{VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO};
+    depth.imageView = vkView(gpu, s.target);
+    depth.imageLayout = VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL;
+    depth.loadOp = VK_ATTACHMENT_LOAD_OP_CLEAR;
+    depth.storeOp = VK_ATTACHMENT_STORE_OP_STORE;
+    depth.clearValue.depthStencil = {1.0f, 0};
+    VkRenderingInfo ri{VK_STRUCTURE_TYPE_RENDERING_INFO};
+    ri.renderArea = {{0, 0}, {kAtlasSize, kAtlasSize}};
+    ri.layerCount = 1;
+    ri.pDepthAttachment = &depth;
+    vkCmdBeginRendering(cmd, &ri);
+    bind(gpu, cmd, s.pass);
+    vkCmdSetDepthBias(cmd, 1.25f, 0.0f, 1.75f);
+    vkCmdBindIndexBuffer(cmd, vkBuffer(gpu, r.sceneIndices), 0, VK_INDEX_TYPE_UINT32);
+    for (uint32_t i = 0; i < s.rects.size(); ++i) {
+        glm::uvec4 rect = s.rects[i];
+        if (!rect.w) continue;
+        VkViewport vp{float(rect.x), float(rect.y), float(rect.z), float(rect.z), 0, 1};
+        VkRect2D scissor{{int32_t(rect.x), int32_t(rect.y)}, {rect.z, rect.z}};
+        vkCmdSetViewport(cmd, 0, 1, &vp);
+        vkCmdSetScissor(cmd, 0, 1, &scissor);
+        pushConstants(gpu, cmd, RasterPush{frame, 2u + i});
+        // The sun's shadow list: its volume is fitted to the whole scene, so it holds the opaque
+        // casters a spot inside the scene sees (the GPU clips the rest), as for the GI's RSMs.
+        vkCmdDrawIndexedIndirectCount(
+            cmd, vkBuffer(gpu, r.shadowDraws),
+            VkDeviceSize(DRAW_LIST_OPAQUE) * r.maxDraws * sizeof(gpu::DrawIndexedCommand),
+            vkBuffer(gpu, r.drawCounts), (DRAW_LIST_COUNT + DRAW_LIST_OPAQUE) * 4, r.maxDraws,
+            sizeof(gpu::DrawIndexedCommand));
+    }
+    vkCmdEndRendering(cmd);
+    imageBarrier(cmd, image, VK_IMAGE_ASPECT_DEPTH_BIT, VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL,
+                 VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL,
+                 VK_PIPELINE_STAGE_2_LATE_FRAGMENT_TESTS_BIT,
+                 VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT,
+                 VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT | VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
+                 VK_ACCESS_2_SHADER_SAMPLED_READ_BIT);
+}
+
+void spotShadowStats(const Renderer& r, nlohmann::json& stats) {
+    stats["sun_shadows"] = r.settings.sunSoftShadows ? "pcss" : "pcf";
+    if (!r.spotShadows) {
+        stats["spot_shadow_maps"] = 0;
+        return;
+    }
+    const SpotShadowState& s = *r.spotShadows;
+    stats["spot_shadow_maps"] = s.placed;
+    stats["spot_shadow_maps_unplaced"] = uint32_t(s.rects.size()) - s.placed;
+    stats["spot_shadow_atlas_draws"] = s.redraws; // frames that drew the maps
+    stats["spot_shadow_atlas_fill"] =
+        double(s.atlasTexelsUsed) / (double(kAtlasSize) * double(kAtlasSize));
+}
+
+} // namespace shadel
