@@ -54,9 +54,9 @@ struct RenderOptions {
     bool particleHalfRes = true;                                 // --particle-resolution half|full
     LightCulling lightCulling = LightCulling::Tiled;             // --light-culling tiled|none
     bool lightBlockers = true;                                   // --blockers on|off
-    Spectra spectra = Spectra::Off;                  // --spectra on|off|single
-    bool sunSoftShadows = false;                     // --sun-shadows pcf|pcss
-    bool spotShadows = true;                         // --spot-shadows on|off
+    Spectra spectra = Spectra::Off;                              // --spectra on|off|single
+    bool sunSoftShadows = false;                                 // --sun-shadows pcf|pcss
+    bool spotShadows = true;                                     // --spot-shadows on|off
     CameraPath cameraPath = CameraPath::Static;
     GiMode gi = GiMode::Off;   // --gi lpv|off
     uint32_t giIterations = 8; // --gi-iterations

@@ -299,7 +299,8 @@ void uploadScene(Gpu& gpu, const Scene& scene, GpuScene& out, const std::vector<
     if (baked)
         out.shadelUvs = uploadArray(gpu, "scene.shadelUvs", shadelUvs.data(),
                                     shadelUvs.size() * sizeof(glm::vec2));
-    out.indices = uploadArray(gpu, "scene.indices", indices.data(), indices.size() * 4, indexUsage | rtInput);
+    out.indices =
+        uploadArray(gpu, "scene.indices", indices.data(), indices.size() * 4, indexUsage | rtInput);
     out.meshes = uploadArray(gpu, "scene.meshes", out.meshInfo.data(),
                              out.meshInfo.size() * sizeof(gpu::GpuMesh));
     out.meshLods = uploadArray(gpu, "scene.meshLods", out.lodInfo.data(),

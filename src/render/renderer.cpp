@@ -331,7 +331,7 @@ FrameResult renderFrame(Renderer& r, const GpuScene& scene, const CameraView& ca
     if (lightTilesThisFrame(r))
         pass(rec, "lightCulling", [&](VkCommandBuffer cmd) { recordLightCulling(r, cmd, frame); });
     if (r.settings.occlusion) recordOcclusionPasses(r, rec, frame, scene);
-    recordThinGBufferPass(r, rec, frame); // --screen-space on (render/screenspace)
+    recordThinGBufferPass(r, rec, frame);               // --screen-space on (render/screenspace)
     if (r.rt && r.settings.mode == RenderMode::Forward) // sun visibility, AO, GI per pixel
         pass(rec, "rtPixelTerms",
              [&](VkCommandBuffer cmd) { recordRayTracedPixels(r, cmd, frame); });
@@ -350,7 +350,7 @@ FrameResult renderFrame(Renderer& r, const GpuScene& scene, const CameraView& ca
     recordScreenSpacePasses(r, rec, frame);  // sky, SSR, SSS over classified tiles
     recordTransparencyPasses(r, rec, frame); // blended materials, after every opaque surface
     if (r.debugLines) recordDebugLinePasses(r, rec, frame, scene, constants.lightCount);
-    recordParticleAtlasView(r, rec, frame);  // --visualize particle-atlas
+    recordParticleAtlasView(r, rec, frame); // --visualize particle-atlas
     pass(rec, "tonemap", [&](VkCommandBuffer cmd) { recordTonemap(r, cmd, frame); });
     if (r.decoupled) recordDecoupledPostPasses(r, rec, frame);
     endFrame(rec);

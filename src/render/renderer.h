@@ -14,9 +14,9 @@
 #include "render/gpu_scene.h"
 #include "render/lighting/feature_spectra.h"
 #include "render/lighting/light_culling.h"
+#include "render/lighting/spot_shadows.h"
 #include "render/raytracing/ray_tracing.h"
 #include "render/raytracing/rt_settings.h"
-#include "render/lighting/spot_shadows.h"
 #include "render/shadel/visibility.h"
 #include "rhi/frame.h"
 #include "rhi/pipeline.h"
@@ -200,9 +200,8 @@ struct Renderer {
     // Texture streaming (render/streaming), owned by the caller; null: textures loaded whole.
     TextureStreaming* streaming = nullptr;
     std::vector<uint8_t> restreamedMaterials; // per material: a texture of it changed this frame
-    SpectraStatePtr spectra;           // --spectra on|single (render/lighting/feature_spectra.h)
-    SpotShadowStatePtr spotShadows;    // shadow-casting spots (render/lighting/spot_shadows.h)
-    GiStatePtr gi;                     // --gi lpv
+    SpectraStatePtr spectra;        // --spectra on|single (render/lighting/feature_spectra.h)
+    SpotShadowStatePtr spotShadows; // shadow-casting spots (render/lighting/spot_shadows.h)
     std::chrono::steady_clock::time_point createdAt = std::chrono::steady_clock::now();
 };
 
