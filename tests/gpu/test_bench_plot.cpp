@@ -55,7 +55,10 @@ TEST(BenchPlot, BenchWritesThePlot) {
     ASSERT_TRUE(std::filesystem::exists(path));
     EXPECT_GT(std::filesystem::file_size(path), 1000u);
     PlotImage img = plotBench(result);
-    for (int m = 0; m < 3; ++m) EXPECT_GT(pixelsOf(img, kPlotModeColours[m]), 100u) << m;
+    // Every mode has its bar. Bar areas follow the measured times (BarAreasFollowThePassTimes),
+    // and one cold frame's times vary by 100x (pipeline compiles, a warm shader cache for one
+    // mode and not another), so no fixed area is asserted here.
+    for (int m = 0; m < 3; ++m) EXPECT_GT(pixelsOf(img, kPlotModeColours[m]), 0u) << m;
     EXPECT_EQ(validationErrors(), 0u);
     std::filesystem::remove(path);
 }
