@@ -308,7 +308,7 @@ struct FrameConstants {
     uint64_t gi;         // GiFrame (render/gi, shaders/gi/gi_types.h), 0 when GI is off
     uint64_t culling;    // CullingFrame (render/culling): LODs, occlusion, per-view counts
     uint64_t debugLines; // GpuDebugLines (render/debug/debug_lines.h), 0 when --debug-lines is off
-    uint64_t rt;        // RtFrame (render/raytracing, shaders/raytracing/rt_types.h), 0 when off
+    uint64_t rt;         // RtFrame (render/raytracing, shaders/raytracing/rt_types.h), 0 when off
     // uint per bindless sampled slot: the finest MIP shading wanted of a 32768^2 texture there,
     // atomically min-reduced (render/streaming, shaders/streaming/feedback.glsl); 0 = off.
     uint64_t textureFeedback;
