@@ -5,6 +5,12 @@
 #include "debug/inspect.glsl"
 #include "raytracing/rt_apply.glsl"
 
+// The prepass laid the depth down and this pass tests against it (equal) without writing it, so
+// the test can run before shading. Declared because this shader has side effects (the texture
+// streaming feedback's atomics, --inspect prints): without it lavapipe tests depth after shading
+// and shades every occluded fragment too (builtin:default 1280x720: 390 -> 200 ms).
+layout(early_fragment_tests) in;
+
 layout(push_constant, scalar) uniform Push {
     uint64_t frame;
     uint shadowView;
