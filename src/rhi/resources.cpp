@@ -222,7 +222,7 @@ VkImageView vkView(const Gpu& gpu, RenderTargetView v) {
 VkImageView vkView(const Gpu& gpu, DepthTargetView v) {
     return gpu.depthViews[v.index].view;
 }
-VkImageView vkView(const Gpu& gpu, TextureReadView v) {
+VkImageView sampledImageView(const Gpu& gpu, TextureReadView v) {
     return gpu.readViews[v.index].view;
 }
 TextureHandle textureOf(const Gpu& gpu, RenderTargetView v) {

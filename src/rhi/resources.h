@@ -80,7 +80,10 @@ VkImage vkImage(const Gpu& gpu, TextureHandle texture);
 const TextureDesc& desc(const Gpu& gpu, TextureHandle texture);
 VkImageView vkView(const Gpu& gpu, RenderTargetView view);
 VkImageView vkView(const Gpu& gpu, DepthTargetView view);
-VkImageView vkView(const Gpu& gpu, TextureReadView view); // to rebind a streamed slot
+// The image view behind a sampled view, only to point another bindless slot at it (texture
+// streaming rebinds a texture's slot as it moves between cache layers). Not `vkView`: that
+// overload set is for attachments, and a sampled view is not one (tests/compile_fail).
+VkImageView sampledImageView(const Gpu& gpu, TextureReadView view);
 TextureHandle textureOf(const Gpu& gpu, RenderTargetView view);
 TextureHandle textureOf(const Gpu& gpu, DepthTargetView view);
 TextureHandle textureOf(const Gpu& gpu, TextureReadView view);

@@ -304,7 +304,7 @@ static void uploadWhole(TextureStreaming& s,
 }
 
 static VkImageView viewFor(const TextureStreaming& s, const CacheImage& c, uint32_t texture) {
-    return vkView(*s.gpu, s.pack.textures[texture].srgb ? c.srgb : c.linear);
+    return sampledImageView(*s.gpu, s.pack.textures[texture].srgb ? c.srgb : c.linear);
 }
 
 TextureStreamingPtr createTextureStreaming(Gpu& gpu, const Scene& scene,
