@@ -39,9 +39,14 @@ nlohmann::json runParticleLightingBench(Gpu& gpu, const BenchOptions& b, RenderO
         out["modes"][name] = runRender(gpu, o).stats;
     }
     double atlasLight = passMs(out["modes"]["atlas"], "particleAtlasLighting");
-    double atlasSprites = passMs(out["modes"]["atlas"], "particleSprites");
-    double pixelSprites = passMs(out["modes"]["pixel"], "particleSprites");
-    double vertexSprites = passMs(out["modes"]["vertex"], "particleSprites");
+    // The sprite pass is particleSpritesHalf at --particle-resolution half (the default).
+    auto sprites = [&](const char* mode) {
+        return passMs(out["modes"][mode], "particleSprites") +
+               passMs(out["modes"][mode], "particleSpritesHalf");
+    };
+    double atlasSprites = sprites("atlas");
+    double pixelSprites = sprites("pixel");
+    double vertexSprites = sprites("vertex");
     double atlasLighting = atlasLight + atlasSprites - vertexSprites;
     double pixelLighting = pixelSprites - vertexSprites;
     out["particle_ms"] = {
