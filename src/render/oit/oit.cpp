@@ -83,6 +83,18 @@ std::vector<uint32_t> shuffledOrder(uint32_t n, uint64_t seed) {
     return order;
 }
 
+TextureHandle createWboitTarget(Gpu& gpu, const char* name, uint32_t width, uint32_t height) {
+    TextureDesc t;
+    t.name = name;
+    t.format = VK_FORMAT_R16G16B16A16_SFLOAT;
+    t.width = width;
+    t.height = height;
+    t.usage = VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT | VK_IMAGE_USAGE_SAMPLED_BIT;
+    TextureHandle h = createTexture(gpu, t);
+    if (!h) throw DeviceError(format("out of GPU memory for the %s target", name));
+    return h;
+}
+
 std::vector<VkPipelineColorBlendAttachmentState> wboitAttachmentBlends() {
     // Seed: "MRT0: (1)S + (1)D; MRT1: (0)S + (1-S)D for colour, (1)S + (1)D for alpha".
     return {blendState(VK_BLEND_FACTOR_ONE, VK_BLEND_FACTOR_ONE, VK_BLEND_FACTOR_ONE,
@@ -107,19 +119,9 @@ OitStatePtr createOit(Renderer& r, const GpuScene& scene) {
         o.instanceMesh.push_back(scene.instanceInfo[i].mesh);
     Gpu& gpu = *r.gpu;
 
-    auto target = [&](const char* name) {
-        TextureDesc t;
-        t.name = name;
-        t.format = VK_FORMAT_R16G16B16A16_SFLOAT;
-        t.width = r.internalWidth;
-        t.height = r.internalHeight;
-        t.usage = VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT | VK_IMAGE_USAGE_SAMPLED_BIT;
-        TextureHandle h = createTexture(gpu, t);
-        if (!h) throw DeviceError(format("out of GPU memory for the %s target", name));
-        return h;
-    };
-    o.accum = target("oit.accumulation");
-    o.reveal = target("oit.revealageAdditiveness");
+    o.accum = createWboitTarget(gpu, "oit.accumulation", r.internalWidth, r.internalHeight);
+    o.reveal =
+        createWboitTarget(gpu, "oit.revealageAdditiveness", r.internalWidth, r.internalHeight);
     o.accumTarget = createRenderTargetView(gpu, o.accum);
     o.revealTarget = createRenderTargetView(gpu, o.reveal);
     o.accumRead = createReadView(gpu, o.accum);

@@ -37,6 +37,8 @@ void recordTransparencyPasses(Renderer& r, FrameRecorder& rec, uint64_t frame);
 // accumulate into them.
 void beginWboitTargets(Renderer& r, VkCommandBuffer cmd, bool clear);
 std::vector<VkPipelineColorBlendAttachmentState> wboitAttachmentBlends();
+// One WBOIT target (RGBA16F, attachment + sampled): accumulation or revealage/additiveness.
+TextureHandle createWboitTarget(Gpu& gpu, const char* name, uint32_t width, uint32_t height);
 
 // Deterministic permutation of [0, n) for --shuffle-draws (splitmix64 Fisher-Yates, identical on
 // every standard library).

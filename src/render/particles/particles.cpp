@@ -151,19 +151,10 @@ ParticleStatePtr createParticles(Renderer& r, const GpuScene& scene) {
     if (r.settings.particleHalfRes) {
         s.halfWidth = (r.internalWidth + 1) / 2;
         s.halfHeight = (r.internalHeight + 1) / 2;
-        auto target = [&](const char* name) {
-            TextureDesc t;
-            t.name = name;
-            t.format = VK_FORMAT_R16G16B16A16_SFLOAT;
-            t.width = s.halfWidth;
-            t.height = s.halfHeight;
-            t.usage = VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT | VK_IMAGE_USAGE_SAMPLED_BIT;
-            TextureHandle h = createTexture(gpu, t);
-            if (!h) throw DeviceError(format("out of GPU memory for the %s target", name));
-            return h;
-        };
-        s.accumHalf = target("particles.accumulationHalf");
-        s.revealHalf = target("particles.revealageAdditivenessHalf");
+        s.accumHalf =
+            createWboitTarget(gpu, "particles.accumulationHalf", s.halfWidth, s.halfHeight);
+        s.revealHalf = createWboitTarget(gpu, "particles.revealageAdditivenessHalf", s.halfWidth,
+                                         s.halfHeight);
         s.accumHalfTarget = createRenderTargetView(gpu, s.accumHalf);
         s.revealHalfTarget = createRenderTargetView(gpu, s.revealHalf);
         s.accumHalfRead = createReadView(gpu, s.accumHalf);
