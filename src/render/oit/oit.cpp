@@ -7,6 +7,7 @@
 #include "render/forward/forward_passes.h"
 #include "render/particles/particles.h"
 #include "render/shadel/decoupled.h"
+#include "rhi/rendering.h"
 
 namespace shadel {
 
@@ -352,18 +353,7 @@ void recordTransparencyPasses(Renderer& r, FrameRecorder& rec, uint64_t frame) {
                 VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT,
                 VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT, VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT,
                 VK_ACCESS_2_SHADER_SAMPLED_READ_BIT);
-        VkRenderingAttachmentInfo color{VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO};
-        color.imageView = vkView(gpu, r.hdrTarget);
-        color.imageLayout = VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL;
-        color.loadOp = VK_ATTACHMENT_LOAD_OP_LOAD;
-        color.storeOp = VK_ATTACHMENT_STORE_OP_STORE;
-        VkRenderingInfo ri{VK_STRUCTURE_TYPE_RENDERING_INFO};
-        ri.renderArea = {{0, 0}, {r.internalWidth, r.internalHeight}};
-        ri.layerCount = 1;
-        ri.colorAttachmentCount = 1;
-        ri.pColorAttachments = &color;
-        vkCmdBeginRendering(cmd, &ri);
-        setViewport(cmd, r.internalWidth, r.internalHeight);
+        beginRendering(cmd, r.internalWidth, r.internalHeight, {{vkView(gpu, r.hdrTarget)}});
         bind(gpu, cmd, o.composite);
         struct {
             uint64_t frame;
