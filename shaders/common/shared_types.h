@@ -401,8 +401,13 @@ struct GpuShadelObject {
     // Frames a carried-over chunk may go unshaded: fewer where the camera's motion, seen from
     // the object, turns the view direction faster (view-dependent terms drift).
     uint refreshPeriod;
+    uint firstRect; // index of its firstMip rect in ShadelFrame::rects (levels follow in order)
     uint idMapOffset[SHADEL_MAX_MIPS]; // in 16-bit units into ShadelFrame::idMaps
     uvec4 rect[SHADEL_MAX_MIPS];       // x, y, w, h in blocks of the virtual sheet
+    // Level windows: a fine level's rect holds only the part of the level the view needs (last
+    // frame's marks plus a margin), placed at this origin in level blocks (x | y << 16); a
+    // coarse level's window is the whole level (origin 0).
+    uint window[SHADEL_MAX_MIPS];
 };
 
 // 3-D debug lines (render/debug/debug_lines.h, shaders/debug/debug_lines.glsl): shaders append
@@ -430,7 +435,7 @@ struct GpuDebugLines {
 
 // sizeof(GpuShadelObject) in the scalar layout: shaders address one object in place
 // (ShadelObjectRef); static_assert'ed on the C++ side.
-#define GPU_SHADEL_OBJECT_BYTES (28u + 20u * SHADEL_MAX_MIPS)
+#define GPU_SHADEL_OBJECT_BYTES (32u + 24u * SHADEL_MAX_MIPS)
 
 // One rectangle of the sheet in use this frame (the clear and allocation passes walk these).
 struct GpuShadelRect {
@@ -467,7 +472,9 @@ struct GpuShadelCounters {
     uint magnifiedPixels;     // sampled reconstructed pixels whose MIP-0 shadel spans > 1 pixel
     uint reconstructedPixels; // sampled (even x and y) pixels the reconstruction drew
     uint chunksPerMip[SHADEL_MAX_MIPS]; // allocated chunks by MIP level
-    uint pad1;
+    // Sampled reconstructed pixels read from a coarser level than they wanted because that
+    // level's window (last frame's marks + margin) did not hold them yet.
+    uint windowFallbackPixels;
     uvec4 fillDispatch;  // x, y, z, marked blocks in the list: indirect args of the queue fill
     uvec4 shadeDispatch; // x, y, z, queue length: indirect args of the shading pass
     uvec4 copyDispatch;  // x, y, z, queue length: indirect args of the carry-over pass
@@ -495,6 +502,10 @@ struct ShadelFrame {
     uint64_t prevOccupancy;                // last frame's occupancy masks
     uint64_t prevOffsetMap;                // last frame's offset map
     uint64_t changedLights; // vec4 (centre, radius) of what lights that changed reach
+    // uvec4 per rect: the level blocks this frame's samples wanted, in window or not
+    // {0xFFFF - min x, 0xFFFF - min y, max x + 1, max y + 1} (atomicMax; 0 = none), read back
+    // to place next frame's windows.
+    uint64_t levelWants;
     uint changedLightCount;
     uint frameNumber; // frames rendered by this renderer (refresh phase)
     uint reuse;       // 0: reshade everything (--reuse off)

@@ -9,6 +9,7 @@
 void inspectShadels(FrameConstants f, ShadelFrame s, ShadelObjectRef o, Reconstruction r,
                     vec2 shadelUv, vec2 texelDx, vec2 texelDy) {
     ShadelLevels l = shadelLevels(o, texelDx, texelDy, s.shadingBias, s.trilinearBand);
+    fitLevelsToWindows(o, shadelUv, l); // the levels the reconstruction read
     shaderPrintF4(f, PRINT_SHADEL_LOD, vec4(r.lod, float(l.mip0), float(l.mip1), l.blend));
     ivec2 t0;
     vec2 w;

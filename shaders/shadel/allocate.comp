@@ -17,9 +17,18 @@ void main() {
     uint t = gl_GlobalInvocationID.x;
     if (t >= s.rectBlockCount) return;
     GpuShadelRect rect;
-    uint block = rectBlock(s, t, rect);
+    uint rectIndex;
+    uint block = rectBlock(s, t, rect, rectIndex);
     uint64_t mask = Uint64Buffer(s.occupancy).v[block];
     if (mask == 0ul) return;
+    // Level windows: the level block this is, into the rect's wanted box (read back).
+    uvec2 inRect = uvec2(block % s.sheetBlocks, block / s.sheetBlocks) - rect.rect.xy;
+    uvec2 levelBlock = inRect + windowOrigin(shadelObject(s, rect.object), rect.mip) / SHADEL_BLOCK;
+    Uvec4Buffer wants = Uvec4Buffer(s.levelWants);
+    atomicMax(wants.v[rectIndex].x, 0xFFFFu - levelBlock.x);
+    atomicMax(wants.v[rectIndex].y, 0xFFFFu - levelBlock.y);
+    atomicMax(wants.v[rectIndex].z, levelBlock.x + 1u);
+    atomicMax(wants.v[rectIndex].w, levelBlock.y + 1u);
     uint n = bitCount(uint(mask)) + bitCount(uint(mask >> 32));
     ShadelCountersRef counters = ShadelCountersRef(s.counters);
     atomicAdd(counters.c.chunksRequested, n);

@@ -43,12 +43,34 @@ void markLevel(ShadelFrame s, ShadelObjectRef o, uint mip, vec2 uv) {
     if (b.x / SHADEL_CHUNK != a.x / SHADEL_CHUNK && b.y / SHADEL_CHUNK != a.y / SHADEL_CHUNK) markChunk(s, b);
 }
 
+// A level the sample wanted but whose window did not hold it: grow the level's wanted box
+// (read back; next frame's window covers it). Most such samples find the box already grown.
+void wantLevel(ShadelFrame s, ShadelObjectRef o, uint mip, vec2 uv) {
+    ivec2 t0;
+    vec2 w;
+    bilinearFootprint(o, mip, uv, t0, w);
+    uvec2 lo = levelTexel(o, mip, t0) / SHADEL_BLOCK, hi = levelTexel(o, mip, t0 + ivec2(1)) / SHADEL_BLOCK;
+    uvec4 box = uvec4(0xFFFFu - lo, hi + 1u);
+    Uvec4Buffer wants = Uvec4Buffer(s.levelWants);
+    uint at = o.v.firstRect + (mip - o.v.firstMip);
+    uvec4 known = wants.v[at];
+    if (all(lessThanEqual(box, known))) return;
+    atomicMax(wants.v[at].x, box.x);
+    atomicMax(wants.v[at].y, box.y);
+    atomicMax(wants.v[at].z, box.z);
+    atomicMax(wants.v[at].w, box.w);
+}
+
 // texelDx/Dy: screen derivatives of the sample's MIP-0 shadel coordinate (shadelUv * mip0Size).
 void markSample(ShadelFrame s, ShadelObjectRef o, vec2 shadelUv, vec2 texelDx, vec2 texelDy) {
-    ShadelLevels l = shadelLevels(o, texelDx, texelDy, s.shadingBias, s.trilinearBand);
+    ShadelLevels wanted = shadelLevels(o, texelDx, texelDy, s.shadingBias, s.trilinearBand);
     ShadelAniso a = shadelAniso(texelDx, texelDy);
     for (uint i = 0u; i < a.taps; ++i) { // the same taps reconstruction reads
         vec2 uv = shadelTapUv(o.v.mip0Size, shadelUv, a, i);
+        ShadelLevels l = wanted;
+        uint unheld = fitLevelsToWindows(o, uv, l);
+        for (uint k = wanted.mip0; (unheld >> k) != 0u; ++k)
+            if (((unheld >> k) & 1u) != 0u) wantLevel(s, o, k, uv);
         markLevel(s, o, l.mip0, uv);
         if (l.two) markLevel(s, o, l.mip1, uv);
     }

@@ -75,6 +75,8 @@ void resolveQuad(FrameConstants f, ShadelFrame s, ivec2 origin, inout uvec4 coun
                                                  reconstructionLayer(f, s));
             counts += uvec4(r.magnified ? 1u : 0u, r.sampled ? 1u : 0u, r.missing != 0u ? 1u : 0u,
                             r.overflowed != 0u ? 1u : 0u);
+            if (r.sampled && r.windowFallback) // rare: only where a window lags the view
+                atomicAdd(ShadelCountersRef(s.counters).c.windowFallbackPixels, 1u);
             vec3 c = r.color;
             bool inspect = inspecting(f, uvec2(pixel));
             if (inspect) {

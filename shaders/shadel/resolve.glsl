@@ -65,8 +65,9 @@ struct Reconstruction {
     uint missing;    // taps that found no marked chunk
     uint overflowed; // taps whose chunk got no storage
     uint64_t mask0;  // occupancy of the first tap's block (marking view)
-    float lod;
+    float lod;       // of the first tap, after fitting to the level windows
     uint mip0;
+    bool windowFallback; // a level the sample wanted was outside its window: read coarser
     bool sampled;   // a pixel of the statistics sample (one of every 2x2)
     bool magnified; // ... whose MIP-0 shadel is larger than the pixel
 };
@@ -76,20 +77,25 @@ struct Reconstruction {
 // layerSlot: the storage layer to read (the radiance layer, or another for --visualize layer:X).
 Reconstruction reconstructSample(ShadelFrame s, ShadelObjectRef o, vec2 shadelUv, vec2 texelDx,
                                  vec2 texelDy, ivec2 pixel, uint layerSlot) {
-    ShadelLevels l = shadelLevels(o, texelDx, texelDy, s.shadingBias, s.trilinearBand);
+    ShadelLevels wanted = shadelLevels(o, texelDx, texelDy, s.shadingBias, s.trilinearBand);
     Reconstruction r;
-    r.mip0 = l.mip0;
-    r.lod = float(l.mip0) + l.blend;
     r.missing = 0u;
     r.overflowed = 0u;
     r.mask0 = 0ul;
+    r.windowFallback = false;
     uint64_t mask1, tapMask;
     ShadelAniso a = shadelAniso(texelDx, texelDy);
     r.color = vec3(0.0);
-    for (uint i = 0u; i < a.taps; ++i) { // the same taps marking marked
+    for (uint i = 0u; i < a.taps; ++i) { // the same taps and levels marking marked
         vec2 uv = shadelTapUv(o.v.mip0Size, shadelUv, a, i);
+        ShadelLevels l = wanted;
+        r.windowFallback = r.windowFallback || fitLevelsToWindows(o, uv, l) != 0u;
         vec3 c = sampleLevel(s, o, l.mip0, uv, layerSlot, r.missing, r.overflowed, tapMask);
-        if (i == 0u) r.mask0 = tapMask;
+        if (i == 0u) {
+            r.mask0 = tapMask;
+            r.mip0 = l.mip0;
+            r.lod = float(l.mip0) + l.blend;
+        }
         if (l.two) c = mix(c, sampleLevel(s, o, l.mip1, uv, layerSlot, r.missing, r.overflowed, mask1), l.blend);
         r.color += c;
     }
@@ -113,6 +119,7 @@ uint reconstructionLayer(FrameConstants f, ShadelFrame s) {
 void countReconstruction(ShadelFrame s, Reconstruction r) {
     ShadelCountersRef counters = ShadelCountersRef(s.counters);
     if (r.magnified) atomicAdd(counters.c.magnifiedPixels, 1u);
+    if (r.sampled && r.windowFallback) atomicAdd(counters.c.windowFallbackPixels, 1u);
     if (r.sampled) atomicAdd(counters.c.reconstructedPixels, 1u);
     if (r.missing != 0u) atomicAdd(counters.c.reconstructionMisses, 1u);
     if (r.overflowed != 0u) atomicAdd(counters.c.overflowSamples, 1u);

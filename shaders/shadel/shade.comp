@@ -62,8 +62,8 @@ bool chunkTouchesChangedLight(FrameConstants f, ShadelFrame s, ShadelObjectRef o
     if (gl_LocalInvocationIndex == 0u) chunkNearChangedLight = false;
     barrier();
     uvec2 size = levelSize(o, work.mip);
-    uvec2 shadel = uvec2(work.chunk & 0xFFFFu, work.chunk >> 16) * SHADEL_CHUNK +
-                   gl_LocalInvocationID.xy - o.v.rect[work.mip].xy * SHADEL_BLOCK;
+    uvec2 shadel = levelShadel(o, work.mip, uvec2(work.chunk & 0xFFFFu, work.chunk >> 16) *
+                                                SHADEL_CHUNK + gl_LocalInvocationID.xy);
     uint tri = all(lessThan(shadel, size))
                    ? triangleId(s, o.v.idMapOffset[work.mip] + shadel.y * size.x + shadel.x)
                    : 0xFFFFu;
@@ -185,7 +185,7 @@ void main() {
 
     uvec2 sheetShadel = uvec2(work.chunk & 0xFFFFu, work.chunk >> 16) * SHADEL_CHUNK + local;
     uvec2 size = levelSize(o, work.mip);
-    uvec2 shadel = sheetShadel - o.v.rect[work.mip].xy * SHADEL_BLOCK;
+    uvec2 shadel = levelShadel(o, work.mip, sheetShadel);
     // Shadels outside the level or in a gutter no filter reads have nothing to shade; they stay
     // in the workgroup until chunk light culling (barriers) is done.
     bool shading = all(lessThan(shadel, size));

@@ -95,12 +95,60 @@ void bilinearFootprint(ShadelObjectRef o, uint mip, vec2 uv, out ivec2 texel0, o
     weight = t - vec2(texel0);
 }
 
-// Sheet shadel coordinate of an object's level texel (clamped to the object's level rect so
-// border taps never leave the object).
+// Origin of the level's window (the part of the level its rect holds), in level texels.
+uvec2 windowOrigin(ShadelObjectRef o, uint mip) {
+    uint w = o.v.window[mip];
+    return uvec2(w & 0xFFFFu, w >> 16) * SHADEL_BLOCK;
+}
+
+// The level texel a tap reads: clamped to the level, so border taps never leave the object.
+uvec2 levelTexel(ShadelObjectRef o, uint mip, ivec2 texel) {
+    return uvec2(clamp(texel, ivec2(0), ivec2(levelSize(o, mip)) - 1));
+}
+
+// Whether the level's window holds the whole 2x2 footprint at `uv` (a coarse level's window is
+// the level, so it always does).
+bool windowHolds(ShadelObjectRef o, uint mip, vec2 uv) {
+    ivec2 t0;
+    vec2 w;
+    bilinearFootprint(o, mip, uv, t0, w);
+    uvec2 lo = levelTexel(o, mip, t0), hi = levelTexel(o, mip, t0 + ivec2(1));
+    uvec2 origin = windowOrigin(o, mip);
+    return all(greaterThanEqual(lo, origin)) &&
+           all(lessThan(hi, origin + o.v.rect[mip].zw * SHADEL_BLOCK));
+}
+
+// Level windows: a sample whose footprint a level's window does not hold reads the next
+// coarser level instead (the coarsest is always whole, so one is found); a second level of a
+// blend that does not hold it is dropped. Marking and reconstruction both call this, so they
+// agree. Returns the levels that were wanted but not held (bit per MIP): marking records them
+// so next frame's windows grow there.
+uint fitLevelsToWindows(ShadelObjectRef o, vec2 uv, inout ShadelLevels l) {
+    uint unheld = 0u;
+    while (l.mip0 + 1u < o.v.mipCount && !windowHolds(o, l.mip0, uv)) {
+        unheld |= 1u << l.mip0;
+        l.mip0++;
+        l.mip1 = l.mip0;
+        l.two = false;
+        l.blend = 0.0;
+    }
+    if (l.two && !windowHolds(o, l.mip1, uv)) {
+        unheld |= 1u << l.mip1;
+        l.two = false;
+        l.blend = 0.0;
+    }
+    return unheld;
+}
+
+// Sheet shadel coordinate of an object's level texel (clamped to the level; the level's window
+// must hold it: fitLevelsToWindows).
 uvec2 sheetShadel(ShadelObjectRef o, uint mip, ivec2 texel) {
-    uvec2 size = levelSize(o, mip);
-    uvec2 t = uvec2(clamp(texel, ivec2(0), ivec2(size) - 1));
-    return o.v.rect[mip].xy * SHADEL_BLOCK + t;
+    return o.v.rect[mip].xy * SHADEL_BLOCK + levelTexel(o, mip, texel) - windowOrigin(o, mip);
+}
+
+// The level texel of a sheet shadel of the object's level `mip` (the inverse of sheetShadel).
+uvec2 levelShadel(ShadelObjectRef o, uint mip, uvec2 sheet) {
+    return sheet - o.v.rect[mip].xy * SHADEL_BLOCK + windowOrigin(o, mip);
 }
 
 uint blockIndex(ShadelFrame s, uvec2 sheetShadel) {

@@ -42,6 +42,7 @@ struct RenderOptions {
     float forwardBelowPixels = 8.0f;
     uint32_t allocationCounters = SHADEL_COUNTERS;
     bool sheetAllMips = false;
+    bool levelWindows = true;
     bool capacityControl = true;
     bool reuse = true;
     uint32_t reuseRefreshPeriod = 8;

@@ -182,6 +182,12 @@ int main(int argc, char** argv) {
         ->add_option("--capacity-control", capacityControl,
                      "decoupled: on | off: raise the shading bias when storage runs short")
         ->capture_default_str();
+    std::string levelWindows = "on";
+    render
+        ->add_option("--level-windows", levelWindows,
+                     "decoupled: on | off: a fine level's sheet rect holds only the part of the "
+                     "level last frame's samples wanted, plus a margin (off: whole levels)")
+        ->capture_default_str();
     std::string reuse = "on";
     render
         ->add_option("--reuse", reuse,
@@ -494,6 +500,10 @@ int main(int argc, char** argv) {
                 throw InputError(
                     format("--capacity-control %s: expected on or off", capacityControl.c_str()));
             ro.capacityControl = capacityControl == "on";
+            if (levelWindows != "on" && levelWindows != "off")
+                throw InputError(
+                    format("--level-windows %s: expected on or off", levelWindows.c_str()));
+            ro.levelWindows = levelWindows == "on";
             if (reuse != "on" && reuse != "off")
                 throw InputError(format("--reuse %s: expected on or off", reuse.c_str()));
             ro.reuse = reuse == "on";

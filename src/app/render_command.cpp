@@ -277,6 +277,7 @@ RenderRun runRender(Gpu& gpu, const RenderOptions& o) {
     settings.forwardBelowPixels = o.forwardBelowPixels;
     settings.allocationCounters = o.allocationCounters;
     settings.sheetAllMips = o.sheetAllMips;
+    settings.levelWindows = o.levelWindows;
     settings.capacityControl = o.capacityControl;
     settings.reuse = o.reuse;
     settings.reuseRefreshPeriod = o.reuseRefreshPeriod;

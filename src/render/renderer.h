@@ -78,6 +78,7 @@ struct RenderSettings {
     float forwardBelowPixels = 8; // decoupled: objects smaller on screen drawn forward (0 = never)
     uint32_t allocationCounters = SHADEL_COUNTERS; // decoupled: hashed counters used (tests)
     bool sheetAllMips = false;   // decoupled: rects at every MIP (the old policy, for comparison)
+    bool levelWindows = true;    // decoupled: fine levels' rects hold only what the view wanted
     bool capacityControl = true; // decoupled: steer the shading bias from storage use
     bool reuse = true;           // decoupled: carry unchanged shadels over from last frame
     uint32_t reuseRefreshPeriod = 8; // decoupled: reshade every carried chunk this often

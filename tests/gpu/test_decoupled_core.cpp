@@ -241,3 +241,65 @@ TEST(DecoupledCore, MaterialLayerIsVisibleAndDiffersFromRadiance) {
     EXPECT_EQ(stat(material, "reconstruction_misses"), 0u);
     EXPECT_LT(psnr(material.frames[0].rgba, radiance.frames[0].rgba), 30.0);
 }
+
+// Level windows (issue 19): once last frame's marks are known, a fine level's rect holds only
+// the blocks the view wanted plus a margin, and a level nothing wanted holds none. The sheet
+// then needs far fewer blocks, with the same image and no misses.
+TEST(DecoupledCore, LevelWindowsAtLeastHalveTheSheet) {
+    // The issue's size for the town; the many-object city at a small size (its ~4000 objects,
+    // most seen at a few coarse levels, are what the windows empty).
+    struct Case {
+        const char* scene;
+        uint32_t width, height;
+    };
+    for (Case c : {Case{"builtin:default", 1280, 720}, Case{"builtin:many", 320, 180}}) {
+        const char* scene = c.scene;
+        RenderOptions o = decoupled(scene, c.width, c.height);
+        o.frames = 3; // frame 0 places whole levels (no feedback yet), frame 1 the windows
+        o.levelWindows = false;
+        RenderRun whole = renderChecked(o);
+        o.levelWindows = true;
+        RenderRun windows = renderChecked(o);
+        uint64_t wholeBlocks = stat(whole, "sheet_blocks_allocated");
+        uint64_t windowBlocks = stat(windows, "sheet_blocks_allocated");
+        double p = psnr(windows.frames.back().rgba, whole.frames.back().rgba);
+        std::printf("[ figures ] %s %ux%u, frame 3: sheet blocks %llu with level windows, %llu "
+                    "whole (%.3fx), %llu touched; PSNR %.2f dB\n",
+                    scene, c.width, c.height, (unsigned long long)windowBlocks,
+                    (unsigned long long)wholeBlocks, double(windowBlocks) / double(wholeBlocks),
+                    (unsigned long long)stat(windows, "sheet_blocks_touched"), p);
+        EXPECT_EQ(stat(windows, "sheet_blocks_whole_levels"), wholeBlocks);
+        EXPECT_LE(2 * windowBlocks, wholeBlocks) << scene;
+        EXPECT_GE(windowBlocks, stat(windows, "sheet_blocks_touched")) << scene;
+        EXPECT_EQ(stat(windows, "reconstruction_misses"), 0u);
+        EXPECT_EQ(stat(windows, "level_window_moves"), 0u); // a still view settles at once
+        EXPECT_EQ(windows.stats["window_fallback_pixel_fraction"].get<double>(), 0.0);
+        EXPECT_GE(p, 50.0) << scene;
+        // The first frame has no feedback: whole levels, the same image.
+        EXPECT_GE(psnr(windows.frames[0].rgba, whole.frames[0].rgba), 90.0);
+    }
+}
+
+// On a moving camera the windows follow the marks: a sample the window does not hold yet reads
+// a coarser level for a frame (never a hole), and every frame stays close to whole levels.
+TEST(DecoupledCore, LevelWindowsFollowAnOrbitWithoutHoles) {
+    RenderOptions o = decoupled("builtin:default", 320, 180);
+    o.frames = 12;
+    o.cameraPath = CameraPath::Orbit;
+    o.levelWindows = false;
+    RenderRun whole = renderChecked(o);
+    o.levelWindows = true;
+    RenderRun windows = renderChecked(o);
+    double worst = 1e9;
+    for (size_t i = 0; i < windows.frames.size(); ++i)
+        worst = std::min(worst, psnr(windows.frames[i].rgba, whole.frames[i].rgba));
+    double fallback = windows.stats["window_fallback_pixel_fraction"].get<double>();
+    std::printf("[ figures ] default 320x180 orbit, 12 frames: sheet blocks %llu vs %llu whole, "
+                "worst frame %.2f dB, last frame's window fallbacks %.4f of pixels\n",
+                (unsigned long long)stat(windows, "sheet_blocks_allocated"),
+                (unsigned long long)stat(whole, "sheet_blocks_allocated"), worst, fallback);
+    EXPECT_EQ(stat(windows, "reconstruction_misses"), 0u);
+    EXPECT_LT(stat(windows, "sheet_blocks_allocated"), stat(whole, "sheet_blocks_allocated"));
+    EXPECT_LT(fallback, 0.05);
+    EXPECT_GE(worst, 40.0);
+}

@@ -42,6 +42,18 @@ struct ObjectSlot {
     uint32_t mipCount = 0;
     std::array<BlockId, SHADEL_MAX_MIPS> ids{};
     std::array<glm::uvec4, SHADEL_MAX_MIPS> rects{};
+    // Level windows: where each level's rect sits in the level (origin in level blocks; the
+    // rect's z, w are its size), and the level blocks last frame's samples wanted there
+    // (min x, min y, max x + 1, max y + 1; empty when min >= max), valid for the frame
+    // numbered wantedFor - 1 (one frame of readback latency; 0: no feedback yet).
+    std::array<glm::uvec2, SHADEL_MAX_MIPS> windowOrigin{};
+    std::array<glm::uvec4, SHADEL_MAX_MIPS> wanted{};
+    std::array<uint64_t, SHADEL_MAX_MIPS> wantedFor{};
+};
+
+// The part of a level a rect holds, in level blocks.
+struct LevelWindow {
+    glm::uvec2 origin{0}, size{0};
 };
 
 struct FrameCounters {
@@ -51,8 +63,10 @@ struct FrameCounters {
     uint32_t objectsSmallForward = 0;
     uint32_t objectsSheetLimited = 0;
     uint64_t rectBlocks = 0;
-    float shadingBias = 0.0f;     // the bias this frame was shaded with
-    uint32_t objectsReusable = 0; // objects with any level whose shadels may be carried over
+    uint64_t wholeLevelBlocks = 0; // what the same levels would take whole (no windows)
+    uint32_t windowMoves = 0;      // level rects placed again because their window changed
+    float shadingBias = 0.0f;      // the bias this frame was shaded with
+    uint32_t objectsReusable = 0;  // objects with any level whose shadels may be carried over
     std::array<uint32_t, SHADEL_MAX_MIPS> firstMipHistogram{};
 };
 
@@ -79,6 +93,9 @@ struct DecoupledState {
     std::vector<uint64_t> seenFrame;    // per instance: frameNumber + 1 when the GPU saw it
     std::vector<gpu::GpuShadelRect> rects;
     uint32_t rectBlockCount = 0;
+    bool levelWindows = true;      // --level-windows
+    uint64_t wholeLevelBlocks = 0; // this frame's levels, whole
+    uint32_t windowMoves = 0;
     uint32_t capacityChunks = 0;
     uint32_t objectsDecoupled = 0, objectsForward = 0, objectsSmallForward = 0;
     uint32_t objectsSheetLimited = 0; // finer levels wanted but no sheet room: clamped
@@ -87,6 +104,7 @@ struct DecoupledState {
     BufferHandle frameInfo;    // gpu::ShadelFrame (upload)
     BufferHandle objectBuffer; // GpuShadelObject[] (upload)
     BufferHandle rectBuffer;   // GpuShadelRect[] (upload)
+    BufferHandle levelWants;   // uvec4 per rect: the level blocks samples wanted (readback)
     // Two frames of occupancy and offset map (this frame's at parity, last frame's at the other),
     // so a chunk finds where its shadels were last frame.
     std::array<BufferHandle, 2> occupancy; // uint64 per block
@@ -191,8 +209,12 @@ DecoupledStatePtr createDecoupled(Renderer& r, const GpuScene& scene) {
     d.grid.build(scene.instanceInfo);
     d.visitedFrame.assign(scene.instanceCount, 0);
     d.seenFrame.assign(scene.instanceCount, 0);
-    d.rectBuffer = upload("shadel.rects", std::max<size_t>(scene.instanceCount, 1) *
-                                              SHADEL_MAX_MIPS * sizeof(gpu::GpuShadelRect));
+    size_t maxRects = std::max<size_t>(scene.instanceCount, 1) * SHADEL_MAX_MIPS;
+    d.rectBuffer = upload("shadel.rects", maxRects * sizeof(gpu::GpuShadelRect));
+    d.levelWants =
+        need(createBuffer(gpu, {"shadel.levelWants", maxRects * 16, 0, MemoryKind::Readback}),
+             "level wants");
+    d.levelWindows = rs.levelWindows && !rs.sheetAllMips;
     d.occupancy = {device("shadel.chunkOccupancy.frame0", blocks * 8),
                    device("shadel.chunkOccupancy.frame1", blocks * 8)};
     d.offsetMap = {device("shadel.offsetMap.frame0", blocks * 4),
@@ -270,7 +292,7 @@ void destroyDecoupled(Renderer& r, DecoupledStatePtr& state) {
           &d.shade, &d.sheetView, &d.mark, &d.markTransparent, &d.reconstruct})
         destroy(gpu, *p);
     destroyShadeStorage(gpu, d.storage);
-    for (BufferHandle b : {d.frameInfo, d.changedLights, d.objectBuffer, d.rectBuffer,
+    for (BufferHandle b : {d.frameInfo, d.changedLights, d.objectBuffer, d.rectBuffer, d.levelWants,
                            d.occupancy[0], d.occupancy[1], d.offsetMap[0], d.offsetMap[1],
                            d.allocId, d.counters, d.markedBlocks, d.queue, d.copyQueue})
         destroy(gpu, b);
@@ -296,17 +318,125 @@ static void freeObject(Gpu& gpu, DecoupledState& d, ObjectSlot& o) {
     o.allocated = false;
 }
 
+static glm::uvec2 levelBlocks(const ShadelMeshInfo& mesh, uint32_t k) {
+    uint32_t w = std::max(1u, mesh.mip0Size.x >> k), h = std::max(1u, mesh.mip0Size.y >> k);
+    return {(w + SHADEL_BLOCK - 1) / SHADEL_BLOCK, (h + SHADEL_BLOCK - 1) / SHADEL_BLOCK};
+}
+
+// Level windows. The finest levels of a large object are mostly unread: of builtin:default's
+// 7814 rect blocks at 1280x720, 796 hold a marked chunk (the rest is occluded, off screen or
+// seen at a coarser MIP, which only the GPU's marks can tell). So a fine level's rect holds
+// only a window of the level: the blocks last frame's samples wanted there (marked, or wanted
+// but read coarser because the window did not hold them: marking.glsl wantLevel), plus a
+// margin for the view's motion; a level nothing wanted holds no blocks at all (most levels of
+// builtin:many's 4000 small objects). A sample outside the window reads the next coarser level
+// for a frame (counted: window_fallback_pixel_fraction), never a hole. The coarsest level and
+// levels with no feedback yet (just placed) are held whole.
+
+static LevelWindow wholeLevel(const ShadelMeshInfo& mesh, uint32_t k) {
+    return {glm::uvec2(0), levelBlocks(mesh, k)};
+}
+
+static LevelWindow currentWindow(const ObjectSlot& o, uint32_t k) {
+    return {o.windowOrigin[k], {o.rects[k].z, o.rects[k].w}};
+}
+
+// The window the level should hold this frame: the wanted blocks, grown on each side by one
+// block and a quarter of their extent (the view's motion over a frame), within the level.
+// The level blocks last frame wanted at level k or at its neighbours k - 1 and k + 1 (scaled
+// to level k): a surface moving across a LOD boundary then finds the next level already
+// there. {lo, hi} in level k blocks, lo >= hi when nothing was wanted.
+static std::pair<glm::uvec2, glm::uvec2> wantedBlocks(const DecoupledState& d, const ObjectSlot& o,
+                                                      const ShadelMeshInfo& mesh, uint32_t k) {
+    glm::uvec2 lo{~0u}, hi{0u};
+    auto add = [&](uint32_t level, auto toK) {
+        if (level >= mesh.mipCount || o.wantedFor[level] != d.frameNumber + 1) return;
+        const glm::uvec4& w = o.wanted[level];
+        if (w.x >= w.z || w.y >= w.w) return;
+        auto [a, b] = toK(glm::uvec2(w.x, w.y), glm::uvec2(w.z, w.w));
+        lo = glm::min(lo, a);
+        hi = glm::max(hi, b);
+    };
+    add(k, [](glm::uvec2 a, glm::uvec2 b) { return std::pair{a, b}; });
+    if (k > 0)
+        add(k - 1, [](glm::uvec2 a, glm::uvec2 b) { return std::pair{a / 2u, (b + 1u) / 2u}; });
+    add(k + 1, [](glm::uvec2 a, glm::uvec2 b) { return std::pair{a * 2u, b * 2u}; });
+    glm::uvec2 size = levelBlocks(mesh, k);
+    return {glm::min(lo, size), glm::min(hi, size)};
+}
+
+static LevelWindow targetWindow(const DecoupledState& d, const ObjectSlot& o,
+                                const ShadelMeshInfo& mesh, uint32_t k) {
+    LevelWindow whole = wholeLevel(mesh, k);
+    if (!d.levelWindows || k + 1 >= mesh.mipCount || o.wantedFor[k] != d.frameNumber + 1)
+        return whole;
+    auto [lo, hi] = wantedBlocks(d, o, mesh, k);
+    // Nothing wanted (occluded, or seen only at other levels): an empty window; samples read
+    // coarser and their wants bring the level back next frame.
+    if (lo.x >= hi.x || lo.y >= hi.y) return {};
+    glm::uvec2 margin = 1u + (hi - lo) / 4u;
+    lo -= glm::min(lo, margin);
+    hi = glm::min(hi + margin, whole.size);
+    return {lo, hi - lo};
+}
+
+// Hysteresis: the level keeps its window (and its place, so its shadels can be carried over)
+// while the window holds the wanted blocks with one block to spare and is at most twice the
+// target's area; a view hovering at an edge does not move the rect every frame.
+static bool keepWindow(const DecoupledState& d, const ObjectSlot& o, const ShadelMeshInfo& mesh,
+                       uint32_t k, LevelWindow target) {
+    LevelWindow now = currentWindow(o, k);
+    if (now.origin == target.origin && now.size == target.size) return true;
+    LevelWindow whole = wholeLevel(mesh, k);
+    if (target.size == whole.size) return false; // whole again (no feedback, or windows off)
+    if (target.size.x * target.size.y == 0) return false; // nothing wanted: give it back
+    auto [lo, hi] = wantedBlocks(d, o, mesh, k);
+    if (lo.x < hi.x && lo.y < hi.y) {
+        lo -= glm::min(lo, glm::uvec2(1u));
+        hi = glm::min(hi + 1u, whole.size);
+        if (glm::any(glm::lessThan(lo, now.origin)) ||
+            glm::any(glm::greaterThan(hi, now.origin + now.size)))
+            return false;
+    }
+    return uint64_t(now.size.x) * now.size.y <= 2 * uint64_t(target.size.x) * target.size.y;
+}
+
+static void setLevelRect(Gpu& gpu, DecoupledState& d, ObjectSlot& o, uint32_t object, uint32_t k,
+                         const Placement<2>& placed, LevelWindow window) {
+    o.ids[k] = placed.id;
+    o.levelSince[k] = d.frameNumber;
+    o.windowOrigin[k] = window.origin;
+    o.rects[k] = {d.regions[k].x0 + placed.origin[0], placed.origin[1], window.size.x,
+                  window.size.y};
+    writeAllocId(gpu, d, o.rects[k], ((object + 1) << 4) | k);
+}
+
 static bool allocateLevel(Gpu& gpu, DecoupledState& d, ObjectSlot& o, uint32_t object,
                           const ShadelMeshInfo& mesh, uint32_t k) {
-    uint32_t w = std::max(1u, mesh.mip0Size.x >> k), h = std::max(1u, mesh.mip0Size.y >> k);
-    Extent<2> blocks{(w + SHADEL_BLOCK - 1) / SHADEL_BLOCK, (h + SHADEL_BLOCK - 1) / SHADEL_BLOCK};
-    auto placed = d.regions[k].allocator->insert(blocks);
+    LevelWindow window = targetWindow(d, o, mesh, k);
+    auto placed = d.regions[k].allocator->insert(Extent<2>{window.size.x, window.size.y});
     if (!placed) return false;
-    o.ids[k] = placed->id;
-    o.levelSince[k] = d.frameNumber;
-    o.rects[k] = {d.regions[k].x0 + placed->origin[0], placed->origin[1], blocks[0], blocks[1]};
-    writeAllocId(gpu, d, o.rects[k], ((object + 1) << 4) | k);
+    setLevelRect(gpu, d, o, object, k, *placed, window);
     return true;
+}
+
+// A level whose window changed is placed again (the new rect first, so a full sheet keeps the
+// old window rather than losing the level).
+static void updateLevelWindow(Gpu& gpu, DecoupledState& d, ObjectSlot& o, uint32_t object,
+                              const ShadelMeshInfo& mesh, uint32_t k) {
+    LevelWindow target = targetWindow(d, o, mesh, k);
+    if (keepWindow(d, o, mesh, k, target)) return;
+    std::optional<Placement<2>> placed;
+    if (target.size.x * target.size.y != 0) {
+        placed = d.regions[k].allocator->insert(Extent<2>{target.size.x, target.size.y});
+        if (!placed) return;
+    }
+    freeLevel(gpu, d, o, k);
+    d.windowMoves++;
+    if (placed) return setLevelRect(gpu, d, o, object, k, *placed, target);
+    o.levelSince[k] = d.frameNumber; // empty: no rect, no blocks
+    o.windowOrigin[k] = glm::uvec2(0);
+    o.rects[k] = {d.regions[k].x0, 0, 0, 0};
 }
 
 // Coarse CPU allocation (seed: "CPU side max space estimator"): a potentially visible object
@@ -330,6 +460,8 @@ static bool updateObjectRects(Gpu& gpu, DecoupledState& d, ObjectSlot& o, uint32
         o.allocated = false;
         return false;
     }
+    for (uint32_t k = o.firstMip; k < o.mipCount; ++k)
+        if (o.levelSince[k] < d.frameNumber) updateLevelWindow(gpu, d, o, object, mesh, k);
     return true;
 }
 
@@ -430,6 +562,8 @@ void prepareDecoupledFrame(Renderer& r, const GpuScene& scene, const CameraView&
     d.shadingBias = d.baseShadingBias + (d.capacityControl ? d.controller.bias : 0.0f);
     d.rects.clear();
     d.rectBlockCount = 0;
+    d.wholeLevelBlocks = 0;
+    d.windowMoves = 0;
     d.objectsDecoupled = d.objectsForward = d.objectsSmallForward = d.objectsSheetLimited = 0;
     d.firstMipHistogram.fill(0);
     d.objectsReusable = 0;
@@ -537,11 +671,15 @@ void prepareDecoupledFrame(Renderer& r, const GpuScene& scene, const CameraView&
         g.mipCount = mesh.mipCount;
         g.firstMip = o.firstMip;
         g.flags |= SHADEL_OBJECT_DECOUPLED;
+        g.firstRect = uint32_t(d.rects.size());
         for (uint32_t k = o.firstMip; k < mesh.mipCount; ++k) {
             g.idMapOffset[k] = mesh.idMapOffset[k];
             g.rect[k] = o.rects[k];
+            g.window[k] = o.windowOrigin[k].x | (o.windowOrigin[k].y << 16);
             d.rects.push_back({o.rects[k], i, k, d.rectBlockCount, 0});
             d.rectBlockCount += o.rects[k].z * o.rects[k].w;
+            glm::uvec2 whole = levelBlocks(mesh, k);
+            d.wholeLevelBlocks += uint64_t(whole.x) * whole.y;
         }
     }
     d.lastCameraPosition = camera.position;
@@ -580,6 +718,7 @@ void prepareDecoupledFrame(Renderer& r, const GpuScene& scene, const CameraView&
     }
     s.storageReadSlot = s.layerReadSlot[SHADEL_LAYER_RADIANCE];
     s.changedLights = address(gpu, d.changedLights);
+    s.levelWants = address(gpu, d.levelWants);
     s.changedLightCount = d.changedLightsOverflow ? 0u : uint32_t(r.changedLightVolumes.size());
     s.frameNumber = uint32_t(d.frameNumber);
     s.reuse = d.reuse ? 1u : 0u;
@@ -616,6 +755,8 @@ void recordDecoupledPasses(Renderer& r, FrameRecorder& rec, uint64_t frame, cons
 
     pass(rec, "shadelClear", [&](VkCommandBuffer cmd) {
         vkCmdFillBuffer(cmd, vkBuffer(gpu, d.counters), 0, VK_WHOLE_SIZE, 0);
+        if (!d.rects.empty())
+            vkCmdFillBuffer(cmd, vkBuffer(gpu, d.levelWants), 0, d.rects.size() * 16, 0);
         if (rectGroups) {
             bind(gpu, cmd, d.clear);
             pushConstants(gpu, cmd, FramePush{frame});
@@ -653,6 +794,11 @@ void recordDecoupledPasses(Renderer& r, FrameRecorder& rec, uint64_t frame, cons
             vkCmdDispatch(cmd, rectGroups, 1, 1);
         }
         computeToCompute(cmd);
+        // The level wants (marking and this pass) are read back after the frame.
+        memoryBarrier(
+            cmd, VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT | VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
+            VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT, VK_PIPELINE_STAGE_2_HOST_BIT,
+            VK_ACCESS_2_HOST_READ_BIT);
     });
 
     pass(rec, "workQueues", [&](VkCommandBuffer cmd) {
@@ -753,6 +899,18 @@ void finishDecoupledFrame(Renderer& r) {
     f.objectsSheetLimited = d.objectsSheetLimited;
     f.firstMipHistogram = d.firstMipHistogram;
     f.rectBlocks = d.rectBlockCount;
+    f.wholeLevelBlocks = d.wholeLevelBlocks;
+    f.windowMoves = d.windowMoves;
+    // Level windows: what this frame's samples wanted of each level places next frame's windows.
+    const auto* wants = static_cast<const glm::uvec4*>(mapped(*r.gpu, d.levelWants));
+    for (size_t i = 0; i < d.rects.size(); ++i) {
+        const gpu::GpuShadelRect& rect = d.rects[i];
+        ObjectSlot& o = d.objects[rect.object];
+        glm::uvec4 w = wants[i];
+        o.wanted[rect.mip] = w.z == 0 ? glm::uvec4(0) // nothing wanted
+                                      : glm::uvec4(0xFFFFu - w.x, 0xFFFFu - w.y, w.z, w.w);
+        o.wantedFor[rect.mip] = d.frameNumber + 2; // next frame's number + 1 (0: none yet)
+    }
     f.shadingBias = d.shadingBias;
     f.objectsReusable = d.objectsReusable;
     d.history.push_back(f);
@@ -837,6 +995,13 @@ void decoupledStats(const Renderer& r, nlohmann::json& s) {
     s["objects_by_first_mip"] = firstMips;
     s["sheet_blocks_allocated"] = last.rectBlocks; // rect blocks of every level in use
     s["sheet_blocks_touched"] = last.counters.markedBlocks;
+    s["level_windows"] = d.levelWindows;
+    s["sheet_blocks_whole_levels"] = last.wholeLevelBlocks; // the same levels without windows
+    s["level_window_moves"] = last.windowMoves;
+    s["window_fallback_pixel_fraction"] =
+        last.counters.reconstructedPixels
+            ? double(last.counters.windowFallbackPixels) / double(last.counters.reconstructedPixels)
+            : 0.0;
     s["sheet_shadels"] = uint64_t(d.sheetBlocks) * SHADEL_BLOCK;
     // The seed's measure (~1.5 bits per shadel): the 64-bit occupancy mask + 32-bit offset of
     // every block in use, over the shadels its marked chunks hold.
