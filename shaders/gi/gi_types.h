@@ -17,16 +17,19 @@ namespace shadel::gpu {
 // Per cell of the injection buffer: 12 ints of radiance SH (R, G, B x 4) + 4 of geometry SH.
 #define GI_INJECT_INTS 16u
 
-#define GI_MAX_BLOCKERS 64u
+#define GI_MAX_BLOCKERS 64u // a macro-cell's blocker list is one 64-bit mask
+#define GI_MACRO 4u         // cells per side of a macro-cell (the apply's blocker culling)
+#define GI_MACRO_GRID (GI_GRID / GI_MACRO)
 
-// A light blocker for GI: a rectangle light does not propagate through (render/gi/lpv.h).
+// A light blocker for GI: a rectangle light does not propagate through (render/gi/lpv.h), with
+// portals (holes light passes through, as in direct lighting).
 struct GpuGiBlocker {
     vec3 center;
     float halfU;
     vec3 axisU; // unit
     float halfV;
-    vec3 axisV; // unit, orthogonal to axisU
-    float pad;
+    vec3 axisV;   // unit, orthogonal to axisU
+    uint portals; // first | count << 16 into GiFrame::portals
 };
 
 // One cascade as the apply reads it.
@@ -35,6 +38,9 @@ struct GiCascade {
     float cellSize;    // metres per cell
     uint64_t radiance; // vec4[3] per cell: propagated radiant intensity, SH (R, G, B)
     uint64_t geometry; // vec4 per cell: blocking potential, SH (geometry volume)
+    // uint64 per macro-cell (GI_MACRO^3 cells): bit k = blocker k can cut a segment that starts
+    // in the macro-cell and ends within one cell of it (the apply's and injection's taps).
+    uint64_t blockerCells;
 };
 
 struct GiFrame {
@@ -44,6 +50,9 @@ struct GiFrame {
     uint blockerCount; // light blockers: the apply drops trilinear taps behind one
     uint pad0;
     uint64_t blockers; // GpuGiBlocker[blockerCount]
+    uint64_t portals;  // vec4 per portal: min u, min v, max u, max v (metres from the centre)
+    uint blockerCells; // 1: test only a macro-cell's blockers (0: all, for comparison)
+    uint pad1;
 };
 
 #ifdef __cplusplus

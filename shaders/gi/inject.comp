@@ -34,7 +34,7 @@ bool cellOf(GiFrame g, GiCascade c, vec3 p, out uint index) {
     if (any(lessThan(cell, ivec3(0))) || any(greaterThanEqual(cell, ivec3(int(GI_GRID)))))
         return false;
     // A point whose cell centre lies behind a blocker would put its light on the other side.
-    if (g.blockerCount > 0u && giSegmentBlocked(g.blockers, g.blockerCount, p,
+    if (g.blockerCount > 0u && giSegmentBlocked(g.blockers, g.portals, giBlockersNear(g, c, p), p,
                                                 c.origin + (vec3(cell) + 0.5) * c.cellSize))
         return false;
     index = (uint(cell.z) * GI_GRID + uint(cell.y)) * GI_GRID + uint(cell.x);

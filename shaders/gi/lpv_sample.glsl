@@ -19,14 +19,16 @@ vec3 giCascadeIrradiance(GiFrame g, GiCascade c, vec3 p, vec3 n) {
     vec4 lobe = shCosineLobe(-n);
     vec3 sum = vec3(0.0);
     float kept = 0.0;
+    // Blockers culled per macro-cell (the seed's 4x4x4): most cells test none.
+    uint64_t near = g.blockerCount > 0u ? giBlockersNear(g, c, p) : 0ul;
     for (int k = 0; k < 8; ++k) {
         ivec3 o = ivec3(k & 1, (k >> 1) & 1, (k >> 2) & 1);
         ivec3 cell = clamp(i0 + o, ivec3(0), ivec3(int(GI_GRID) - 1));
         vec3 w3 = mix(1.0 - t, t, vec3(o));
         float w = w3.x * w3.y * w3.z;
         // A tap whose cell centre is behind a blocker holds light from the blocker's other side.
-        if (g.blockerCount > 0u && giSegmentBlocked(g.blockers, g.blockerCount, p,
-                                                    c.origin + (vec3(cell) + 0.5) * c.cellSize))
+        if (near != 0ul && giSegmentBlocked(g.blockers, g.portals, near, p,
+                                            c.origin + (vec3(cell) + 0.5) * c.cellSize))
             continue;
         kept += w;
         uint index = (uint(cell.z) * GI_GRID + uint(cell.y)) * GI_GRID + uint(cell.x);

@@ -8,6 +8,7 @@
 #extension GL_EXT_control_flow_attributes : require
 #include "gi/gi_types.h"
 #include "gi/sh.glsl"
+#include "gi/blockers.glsl"
 
 layout(local_size_x = 4, local_size_y = 4, local_size_z = 4) in;
 
@@ -22,27 +23,24 @@ layout(push_constant, scalar) uniform Push {
     uint64_t geometry; // vec4 per cell: blocking potential
     uint64_t axial;    // vec4 per cell: blocker coverage of its -x, -y, -z faces (xyz)
     uint64_t blockers; // GpuGiBlocker[blockerCount] (mode 0)
+    uint64_t portals;  // vec4 per portal (mode 0)
+    uint64_t cells;    // uint64 blocker mask per macro-cell, 0 = test every blocker (mode 0)
     vec3 origin;       // the cascade's min corner and cell size (mode 0)
     float cellSize;
     uint blockerCount;
     uint mode;
 } pc;
 
-layout(buffer_reference, scalar) readonly buffer GiBlockerBuffer { GpuGiBlocker b[]; };
-
-// Whether the segment a -> b crosses blocker k.
-bool segmentHitsBlocker(GpuGiBlocker k, vec3 a, vec3 b) {
-    vec3 n = cross(k.axisU, k.axisV);
-    float da = dot(a - k.center, n), db = dot(b - k.center, n);
-    if ((da > 0.0) == (db > 0.0)) return false;
-    vec3 p = mix(a, b, da / (da - db)) - k.center;
-    return abs(dot(p, k.axisU)) <= k.halfU && abs(dot(p, k.axisV)) <= k.halfV;
-}
-
 // Axial occlusion of the face between cell - e_axis and cell: the fraction of four rays
 // between the two cells (spread over the face) that a blocker stops.
 float faceCoverage(ivec3 cell, int axis) {
-    GiBlockerBuffer blockers = GiBlockerBuffer(pc.blockers);
+    // The rays stay within one cell of this one: its macro-cell's blockers are all that can
+    // cut them.
+    uvec3 m = uvec3(cell) / GI_MACRO;
+    uint64_t near = pc.cells == 0ul ? giAllBlockers(pc.blockerCount)
+                                    : GiBlockerCells(pc.cells).m[(m.z * GI_MACRO_GRID + m.y) *
+                                                                     GI_MACRO_GRID + m.x];
+    if (near == 0ul) return 0.0;
     vec3 b = pc.origin + (vec3(cell) + 0.5) * pc.cellSize;
     vec3 e = vec3(0.0);
     e[axis] = pc.cellSize;
@@ -52,11 +50,8 @@ float faceCoverage(ivec3 cell, int axis) {
     float blocked = 0.0;
     for (int r = 0; r < 4; ++r) {
         vec3 offset = ((r & 1) == 0 ? -u : u) + ((r & 2) == 0 ? -v : v);
-        for (uint k = 0u; k < pc.blockerCount; ++k)
-            if (segmentHitsBlocker(blockers.b[k], b - e + offset, b + offset)) {
-                blocked += 0.25;
-                break;
-            }
+        if (giSegmentBlocked(pc.blockers, pc.portals, near, b - e + offset, b + offset))
+            blocked += 0.25;
     }
     return blocked;
 }

@@ -59,9 +59,10 @@ struct RenderOptions {
     bool sunSoftShadows = false;                                 // --sun-shadows pcf|pcss
     bool spotShadows = true;                                     // --spot-shadows on|off
     CameraPath cameraPath = CameraPath::Static;
-    GiMode gi = GiMode::Off;   // --gi lpv|off
-    uint32_t giIterations = 8; // --gi-iterations
-    bool giSnap = true;        // --gi-snap on|off (off: debug, cascades slide with the camera)
+    GiMode gi = GiMode::Off;    // --gi lpv|off
+    uint32_t giIterations = 8;  // --gi-iterations
+    bool giBlockerCells = true; // --gi-blocker-cells on|off (off: every tap tests every blocker)
+    bool giSnap = true;         // --gi-snap on|off (off: debug, cascades slide with the camera)
     std::vector<GiBlocker> giBlockers; // GI light blockers (no flag yet: scenes will carry them)
     double shadelBudget = 64e6;        // MIP-0 shadels the bake may use for the whole scene
     bool printPasses = false;

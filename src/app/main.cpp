@@ -255,7 +255,7 @@ int main(int argc, char** argv) {
                        "FILE.json: Chrome trace events (CPU frontend and GPU passes per frame; "
                        "chrome://tracing, Perfetto)");
     render->add_flag("--passes", ro.printPasses, "print the per-pass timing table");
-    std::string gi = "off", giSnap = "on";
+    std::string gi = "off", giSnap = "on", giBlockerCells = "on";
     render
         ->add_option("--gi", gi,
                      "lpv | off: light propagation volume GI (sun + shadow-casting spot RSMs, "
@@ -267,6 +267,11 @@ int main(int argc, char** argv) {
         ->add_option("--gi-snap", giSnap,
                      "GI: on | off: snap the cascades to their cell size (off only to measure "
                      "swimming)")
+        ->capture_default_str();
+    render
+        ->add_option("--gi-blocker-cells", giBlockerCells,
+                     "GI: on | off: each tap tests only the light blockers of its 4^3 "
+                     "macro-cell (off: every blocker, for comparison)")
         ->capture_default_str();
     // World scale (render/culling): instance count of builtin:many, LODs, occlusion culling.
     std::string lod = "off", occlusion = "off";
@@ -525,6 +530,10 @@ int main(int argc, char** argv) {
             if (giSnap != "on" && giSnap != "off")
                 throw InputError(format("--gi-snap %s: expected on or off", giSnap.c_str()));
             ro.giSnap = giSnap == "on";
+            if (giBlockerCells != "on" && giBlockerCells != "off")
+                throw InputError(
+                    format("--gi-blocker-cells %s: expected on or off", giBlockerCells.c_str()));
+            ro.giBlockerCells = giBlockerCells == "on";
             if (*instancesFlag && ro.instances == 0)
                 throw InputError("--instances 0: expected 1..1000000");
             ro.lod = parseOnOff("--lod", lod);

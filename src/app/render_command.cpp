@@ -15,7 +15,9 @@
 #include "bake/bake_cache.h"
 #include "core/error.h"
 #include "core/log.h"
+#include "gi/gi_types.h"
 #include "render/debug/inspect.h"
+#include "render/gi/lpv.h"
 #include "render/particles/particles.h"
 #include "render/screenspace/screen_space.h"
 #include "render/shadel/decoupled.h"
@@ -302,7 +304,20 @@ RenderRun runRender(Gpu& gpu, const RenderOptions& o) {
     settings.gi = o.gi;
     settings.giIterations = o.giIterations;
     settings.giSnap = o.giSnap;
+    settings.giBlockerCells = o.giBlockerCells;
+    // GI stops at the scene's light blockers too (and passes their portals), as direct light.
     settings.giBlockers = o.giBlockers;
+    if (o.lightBlockers && o.gi != GiMode::Off) {
+        std::vector<GiBlocker> fromScene = giBlockersOf(scene);
+        size_t room = GI_MAX_BLOCKERS > settings.giBlockers.size()
+                          ? GI_MAX_BLOCKERS - settings.giBlockers.size()
+                          : 0;
+        if (fromScene.size() > room)
+            SHADEL_WARN("GI: the scene has %zu light blockers; GI uses the first %zu (at most %u)",
+                        fromScene.size(), room, GI_MAX_BLOCKERS);
+        fromScene.resize(std::min(fromScene.size(), room));
+        settings.giBlockers.insert(settings.giBlockers.end(), fromScene.begin(), fromScene.end());
+    }
     settings.lod = o.lod;
     settings.occlusion = o.occlusion;
     settings.debugLines = o.debugLines;

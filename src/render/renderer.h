@@ -93,6 +93,7 @@ struct RenderSettings {
         true;                // --blockers: light blockers and portals stop the lights listing them
     GiMode gi = GiMode::Off; // --gi (off by default: see render/gi/lpv.h for its cost)
     uint32_t giIterations = 8;         // --gi-iterations: LPV propagation steps
+    bool giBlockerCells = true;        // GI taps test only their 4^3 macro-cell's blockers
     bool giSnap = true;                // --gi-snap off: cascades slide with the camera (debug)
     float giIntensity = 1.0f;          // scale of the indirect term
     std::vector<GiBlocker> giBlockers; // GI light blockers (axial occlusion in propagation)

@@ -43,6 +43,28 @@ double floorRedOverGreen(const RenderRun& run) {
     return r / std::max(g, 1.0);
 }
 
+// GI-only red light (red above green) over columns [x0, x1) of the first frame.
+double redLight(const RenderRun& run, uint32_t x0, uint32_t x1) {
+    double sum = 0;
+    for (uint32_t y = 0; y < kH; ++y)
+        for (uint32_t x = x0; x < x1; ++x) {
+            const uint8_t* p = &run.frames[0].rgba[(y * kW + x) * 4];
+            sum += std::max(0, int(p[0]) - int(p[1]));
+        }
+    return sum;
+}
+
+// The blocker of BlockerStopsPropagationIntoTheRoomBeyondIt: across the room and far beyond,
+// 0.7 m in front of the red wall.
+GiBlocker wallAcrossTheRoom() {
+    GiBlocker wall;
+    wall.center = glm::vec3(-1.3f, 1.6f, 0.0f);
+    wall.axisU = glm::vec3(0, 0, 1);
+    wall.axisV = glm::vec3(0, 1, 0);
+    wall.halfSize = glm::vec2(20.0f, 20.0f);
+    return wall;
+}
+
 } // namespace
 
 // The floor by the front half of the red wall gets no direct light (the spot lights the wall's
@@ -150,32 +172,77 @@ TEST(Gi, BlockerStopsPropagationIntoTheRoomBeyondIt) {
     o.visualize = Visualize::Gi;
     o.exposure = 16.0f; // the light beyond is dim: lift it well above 8-bit quantisation
     RenderRun open = renderChecked(o);
-    GiBlocker wall;
-    wall.center = glm::vec3(-1.3f, 1.6f, 0.0f);
-    wall.axisU = glm::vec3(0, 0, 1);
-    wall.axisV = glm::vec3(0, 1, 0);
     // Larger than the room: light must not go round it either (through cells outside the
     // room, whose walls the spot's RSM does not see, so they do not occlude).
-    wall.halfSize = glm::vec2(20.0f, 20.0f);
+    GiBlocker wall = wallAcrossTheRoom();
     o.giBlockers = {wall};
     RenderRun blocked = renderChecked(o);
     EXPECT_EQ(blocked.stats["gi"]["blockers"].get<uint32_t>(), 1u);
     // Columns from 64 on see the room at x > -1.0 (back wall, floor, block, green wall). The red
     // wall's light is counted as red above green: the spot also grazes the white top of the
     // ceiling by the opening, on the room's side of the blocker, and that light may enter.
-    auto light = [](const RenderRun& run, uint32_t x0, uint32_t x1) {
-        double sum = 0;
-        for (uint32_t y = 0; y < kH; ++y)
-            for (uint32_t x = x0; x < x1; ++x) {
-                const uint8_t* p = &run.frames[0].rgba[(y * kW + x) * 4];
-                sum += std::max(0, int(p[0]) - int(p[1]));
-            }
-        return sum;
-    };
-    double beyondOpen = light(open, 64, kW), beyondBlocked = light(blocked, 64, kW);
+    double beyondOpen = redLight(open, 64, kW), beyondBlocked = redLight(blocked, 64, kW);
     std::printf("GI-only red light beyond the blocker: %.0f without, %.0f with (%.1f%%)\n",
                 beyondOpen, beyondBlocked, 100.0 * beyondBlocked / beyondOpen);
     EXPECT_GT(beyondOpen, 0.0);
     EXPECT_LE(beyondBlocked, 0.1 * beyondOpen);
-    EXPECT_GE(light(blocked, 0, 24), 0.5 * light(open, 0, 24)) << "the red wall's side";
+    EXPECT_GE(redLight(blocked, 0, 24), 0.5 * redLight(open, 0, 24)) << "the red wall's side";
+}
+
+// Portals are holes in blockers (seed 001), in GI as in direct light: the wall across the room
+// with a portal as large as the room's cross-section lets the red wall's light into the room
+// again (the part of the wall outside the room still blocks).
+TEST(Gi, PortalInABlockerLetsTheLightThrough) {
+    RenderOptions o = cornell(GiMode::Lpv);
+    o.visualize = Visualize::Gi;
+    o.exposure = 16.0f;
+    RenderRun open = renderChecked(o);
+    GiBlocker wall = wallAcrossTheRoom();
+    o.giBlockers = {wall};
+    RenderRun blocked = renderChecked(o);
+    // The room's interior: z in [-2, 2], y in [0.1, 3.1] (u along z, v along y from y = 1.6).
+    wall.portals = {glm::vec4(-2.0f, -1.5f, 2.0f, 1.5f)};
+    o.giBlockers = {wall};
+    RenderRun portal = renderChecked(o);
+    EXPECT_EQ(portal.stats["gi"]["portals"].get<uint32_t>(), 1u);
+    double beyondOpen = redLight(open, 64, kW), beyondBlocked = redLight(blocked, 64, kW),
+           beyondPortal = redLight(portal, 64, kW);
+    std::printf("[ figures ] GI-only red light beyond the wall: open %.0f, blocked %.0f, with a "
+                "room-sized portal %.0f (%.1f%% of open)\n",
+                beyondOpen, beyondBlocked, beyondPortal, 100.0 * beyondPortal / beyondOpen);
+    EXPECT_GE(beyondPortal, 0.7 * beyondOpen);
+    EXPECT_GE(beyondPortal, 3.0 * beyondBlocked);
+}
+
+// Macro-cell culling (seed 001: blockers culled against 4x4x4 macro-cells) only skips blockers
+// that cannot cut a tap: the image is the one of testing every blocker, while a macro-cell
+// tests a fraction of them.
+TEST(Gi, MacroCellBlockerCullingChangesNothing) {
+    RenderOptions o = cornell(GiMode::Lpv);
+    o.visualize = Visualize::Gi;
+    o.exposure = 16.0f;
+    GiBlocker wall = wallAcrossTheRoom();
+    wall.halfSize = glm::vec2(1.8f, 1.4f); // inside the room: light goes round it
+    wall.portals = {glm::vec4(-0.5f, -1.4f, 0.5f, 0.6f)};
+    o.giBlockers = {wall};
+    // Small blockers elsewhere in the volumes (outside the room), which most cells skip.
+    for (int i = 0; i < 12; ++i) {
+        GiBlocker b;
+        b.center = glm::vec3(-10.0f + 2.0f * float(i), 1.0f, 8.0f + float(i % 3));
+        b.axisU = glm::vec3(1, 0, 0);
+        b.axisV = glm::vec3(0, 1, 0);
+        b.halfSize = glm::vec2(0.5f, 0.5f);
+        o.giBlockers.push_back(b);
+    }
+    RenderRun culled = renderChecked(o);
+    o.giBlockerCells = false;
+    RenderRun all = renderChecked(o);
+    double perCell = culled.stats["gi"]["blockers_per_macro_cell"].get<double>();
+    double p = psnr(culled.frames[0].rgba, all.frames[0].rgba);
+    std::printf("[ figures ] cornell GI, 13 blockers: %.3f tested per macro-cell; culled vs all "
+                "%.2f dB\n",
+                perCell, p);
+    EXPECT_GE(p, 60.0);
+    EXPECT_LT(perCell, 1.0);
+    EXPECT_GT(perCell, 0.0);
 }

@@ -9,6 +9,7 @@
 #include "core/log.h"
 #include "gi/gi_types.h"
 #include "render/renderer.h"
+#include "scene/scene.h"
 
 namespace shadel {
 
@@ -36,7 +37,7 @@ struct InjectPush { // shaders/gi/inject.comp
 };
 
 struct PropagatePush { // shaders/gi/propagate.comp
-    uint64_t inject, source, target, accum, geometry, axial, blockers;
+    uint64_t inject, source, target, accum, geometry, axial, blockers, portals, cells;
     glm::vec3 origin;
     float cellSize;
     uint32_t blockerCount;
@@ -56,11 +57,12 @@ struct Rsm {
 };
 
 struct CascadeBuffers {
-    BufferHandle inject;   // int[GI_INJECT_INTS] per cell
-    BufferHandle light[2]; // ping-pong propagation steps, vec4[3] per cell
-    BufferHandle accum;    // vec4[3] per cell (the apply reads it)
-    BufferHandle geometry; // vec4 per cell
-    BufferHandle axial;    // vec4 per cell: blocker coverage of its -x, -y, -z faces
+    BufferHandle inject;       // int[GI_INJECT_INTS] per cell
+    BufferHandle light[2];     // ping-pong propagation steps, vec4[3] per cell
+    BufferHandle accum;        // vec4[3] per cell (the apply reads it)
+    BufferHandle geometry;     // vec4 per cell
+    BufferHandle axial;        // vec4 per cell: blocker coverage of its -x, -y, -z faces
+    BufferHandle blockerCells; // uint64 blocker mask per macro-cell (host-visible)
 };
 
 } // namespace
@@ -70,7 +72,11 @@ struct GiState {
     CascadeBuffers cascades[GI_CASCADES];
     BufferHandle frame;    // host-visible GiFrame
     BufferHandle blockers; // GpuGiBlocker[], when there are any
+    BufferHandle portals;  // vec4[] (min u, min v, max u, max v), when there are any
     uint32_t blockerCount = 0;
+    std::vector<GiBlocker> blockerList;
+    uint64_t blockerCellPairs = 0; // (macro-cell, blocker) pairs of the cascades in use
+    uint64_t cascadePairs[GI_CASCADES] = {};
     gpu::GiFrame constants{};
     float baseCellSize = 1.0f;
     Pipeline rsmPass, inject, propagate;
@@ -167,14 +173,37 @@ GiStatePtr createGi(Renderer& r, const GpuScene& scene) {
             format("%zu GI light blockers: at most %u", blockers.size(), GI_MAX_BLOCKERS));
     if (!blockers.empty()) {
         std::vector<gpu::GpuGiBlocker> packed;
-        for (const GiBlocker& b : blockers)
+        std::vector<glm::vec4> portals;
+        for (const GiBlocker& b : blockers) {
+            uint32_t count = uint32_t(std::min<size_t>(b.portals.size(), 0xFFFF));
+            if (portals.size() + count > 0xFFFF)
+                throw InputError("GI light blockers: more than 65535 portals in all");
             packed.push_back({b.center, b.halfSize.x, glm::normalize(b.axisU), b.halfSize.y,
-                              glm::normalize(b.axisV), 0.0f});
+                              glm::normalize(b.axisV), uint32_t(portals.size()) | (count << 16)});
+            portals.insert(portals.end(), b.portals.begin(), b.portals.begin() + count);
+        }
         gi->blockers = createBuffer(
             gpu, {"gi.blockers", packed.size() * sizeof(packed[0]), 0, MemoryKind::Upload});
         if (!gi->blockers) throw DeviceError("out of GPU memory for the GI blockers");
         std::memcpy(mapped(gpu, gi->blockers), packed.data(), packed.size() * sizeof(packed[0]));
+        if (!portals.empty()) {
+            gi->portals =
+                createBuffer(gpu, {"gi.blockerPortals", portals.size() * sizeof(glm::vec4), 0,
+                                   MemoryKind::Upload});
+            if (!gi->portals) throw DeviceError("out of GPU memory for the GI blocker portals");
+            std::memcpy(mapped(gpu, gi->portals), portals.data(),
+                        portals.size() * sizeof(glm::vec4));
+        }
         gi->blockerCount = uint32_t(packed.size());
+        gi->blockerList = blockers;
+        for (uint32_t c = 0; c < GI_CASCADES; ++c) {
+            gi->cascades[c].blockerCells =
+                createBuffer(gpu, {"gi.cascade" + std::to_string(c) + ".blockerCells",
+                                   VkDeviceSize(GI_MACRO_GRID * GI_MACRO_GRID * GI_MACRO_GRID) * 8,
+                                   0, MemoryKind::Upload});
+            if (!gi->cascades[c].blockerCells)
+                throw DeviceError("out of GPU memory for the GI blocker cells");
+        }
     }
 
     // Cascade 0's cells: a room-sized scene fits in cascade 0 (8 steps carry light a quarter of
@@ -214,14 +243,59 @@ void destroyGi(Renderer& r, GiStatePtr& state) {
         destroy(gpu, rsm.depth);
     }
     for (CascadeBuffers& b : state->cascades)
-        for (BufferHandle h : {b.inject, b.light[0], b.light[1], b.accum, b.geometry, b.axial})
-            destroy(gpu, h);
+        for (BufferHandle h :
+             {b.inject, b.light[0], b.light[1], b.accum, b.geometry, b.axial, b.blockerCells})
+            if (h) destroy(gpu, h);
     destroy(gpu, state->frame);
     if (state->blockers) destroy(gpu, state->blockers);
+    if (state->portals) destroy(gpu, state->portals);
     destroy(gpu, state->rsmPass);
     destroy(gpu, state->inject);
     destroy(gpu, state->propagate);
     state.reset();
+}
+
+std::vector<GiBlocker> giBlockersOf(const Scene& scene) {
+    std::vector<GiBlocker> out;
+    for (const LightBlocker& b : scene.blockers) {
+        GiBlocker g{b.center, b.axisU, b.axisV, b.halfSize, {}};
+        for (const LightBlocker::Portal& p : b.portals)
+            g.portals.push_back({p.min.x, p.min.y, p.max.x, p.max.y});
+        out.push_back(std::move(g));
+    }
+    return out;
+}
+
+// Whether blocker b can cut a segment inside the box [lo, hi]: its plane crosses the box and
+// its rectangle's bounds meet it (conservative: portals are not subtracted).
+static bool blockerMeetsBox(const GiBlocker& b, glm::vec3 lo, glm::vec3 hi) {
+    glm::vec3 u = glm::normalize(b.axisU), v = glm::normalize(b.axisV);
+    glm::vec3 n = glm::cross(u, v);
+    glm::vec3 centre = 0.5f * (lo + hi), half = 0.5f * (hi - lo);
+    if (std::abs(glm::dot(centre - b.center, n)) > glm::dot(half, glm::abs(n))) return false;
+    glm::vec3 reach = glm::abs(u) * b.halfSize.x + glm::abs(v) * b.halfSize.y;
+    return glm::all(glm::lessThanEqual(b.center - reach, hi)) &&
+           glm::all(glm::greaterThanEqual(b.center + reach, lo));
+}
+
+// Macro-cell culling of the blockers (seed 001: "blockers culled against 4x4x4 macro-cells"):
+// per macro-cell of a cascade at its origin, the blockers a tap segment starting there can
+// cross. Segments end within one cell (and a half, the apply's offset along the normal).
+static uint64_t fillBlockerCells(const GiState& gi, glm::vec3 origin, float cell, uint64_t* cells) {
+    uint64_t pairs = 0;
+    float macro = cell * float(GI_MACRO);
+    for (uint32_t z = 0; z < GI_MACRO_GRID; ++z)
+        for (uint32_t y = 0; y < GI_MACRO_GRID; ++y)
+            for (uint32_t x = 0; x < GI_MACRO_GRID; ++x) {
+                glm::vec3 lo = origin + glm::vec3(x, y, z) * macro - 1.5f * cell;
+                glm::vec3 hi = origin + glm::vec3(x + 1, y + 1, z + 1) * macro + 1.5f * cell;
+                uint64_t mask = 0;
+                for (uint32_t k = 0; k < gi.blockerList.size(); ++k)
+                    if (blockerMeetsBox(gi.blockerList[k], lo, hi)) mask |= 1ull << k;
+                cells[(z * GI_MACRO_GRID + y) * GI_MACRO_GRID + x] = mask;
+                pairs += uint64_t(__builtin_popcountll(mask));
+            }
+    return pairs;
 }
 
 void prepareGiFrame(Renderer& r, const GpuScene& scene, const CameraView& camera,
@@ -250,6 +324,8 @@ void prepareGiFrame(Renderer& r, const GpuScene& scene, const CameraView& camera
     g.intensity = r.settings.giIntensity;
     g.blockerCount = gi.blockerCount;
     g.blockers = gi.blockers ? address(*r.gpu, gi.blockers) : 0;
+    g.portals = gi.portals ? address(*r.gpu, gi.portals) : 0;
+    g.blockerCells = r.settings.giBlockerCells ? 1u : 0u;
     glm::vec3 wanted[GI_CASCADES];
     uint32_t moved = 0;
     bool allValid = true;
@@ -288,7 +364,17 @@ void prepareGiFrame(Renderer& r, const GpuScene& scene, const CameraView& camera
         gc.cellSize = gi.baseCellSize * float(1u << c);
         gc.radiance = address(*r.gpu, gi.cascades[c].accum);
         gc.geometry = address(*r.gpu, gi.cascades[c].geometry);
+        if (gi.cascades[c].blockerCells) {
+            // Recomputed where the cascade's light is (its origin moves only when updated).
+            if (gi.dirtyMask & (1u << c)) {
+                auto* cells = static_cast<uint64_t*>(mapped(*r.gpu, gi.cascades[c].blockerCells));
+                gi.cascadePairs[c] = fillBlockerCells(gi, gc.origin, gc.cellSize, cells);
+            }
+            gc.blockerCells = address(*r.gpu, gi.cascades[c].blockerCells);
+        }
     }
+    gi.blockerCellPairs = 0;
+    for (uint64_t pairs : gi.cascadePairs) gi.blockerCellPairs += pairs;
     std::memcpy(mapped(*r.gpu, gi.frame), &g, sizeof(g));
     for (Rsm& rsm : gi.rsms)
         if (rsm.light == 0xFFFFFFFFu) {
@@ -410,6 +496,10 @@ void recordGiInjection(Renderer& r, VkCommandBuffer cmd) {
         push.geometry = address(gpu, b.geometry);
         push.axial = address(gpu, b.axial);
         push.blockers = gi.blockers ? address(gpu, gi.blockers) : 0;
+        push.portals = gi.portals ? address(gpu, gi.portals) : 0;
+        push.cells = gi.cascades[c].blockerCells && r.settings.giBlockerCells
+                         ? address(gpu, gi.cascades[c].blockerCells)
+                         : 0;
         push.origin = gi.constants.cascades[c].origin;
         push.cellSize = gi.constants.cascades[c].cellSize;
         push.blockerCount = gi.blockerCount;
@@ -470,6 +560,17 @@ void giStats(const Renderer& r, nlohmann::json& stats) {
                    {"iterations", r.settings.giIterations},
                    {"snap", r.settings.giSnap},
                    {"blockers", gi.blockerCount},
+                   {"portals",
+                    [&] {
+                        size_t n = 0;
+                        for (const GiBlocker& b : gi.blockerList) n += b.portals.size();
+                        return n;
+                    }()},
+                   {"blocker_cells", r.settings.giBlockerCells},
+                   // Blockers a macro-cell's taps test, on average (all blockers without culling).
+                   {"blockers_per_macro_cell",
+                    double(gi.blockerCellPairs) /
+                        double(GI_CASCADES * GI_MACRO_GRID * GI_MACRO_GRID * GI_MACRO_GRID)},
                    {"reflective_shadow_maps", gi.rsms.size()},
                    {"rsm_renders", gi.rsmRenders},
                    // Injections + propagations of one cascade over the run (a cascade is

@@ -23,14 +23,20 @@ struct GiState;
 
 // A light blocker (seed 001) as GI uses it: a rectangle (say a wall's mid-plane) that light does
 // not propagate through, stored per cascade as axial occlusion (how much of each cell face it
-// covers along x, y, z). The same fields as the lighting branch's Scene::LightBlocker (issue 10,
-// without its portals yet): when both land, GI should read the scene's blockers instead.
+// covers along x, y, z), with portals (holes light passes through). The scene's light blockers
+// (Scene::LightBlocker, direct lighting's) become these (giBlockersOf), so GI and direct light
+// stop at the same walls and pass the same doorways.
 struct GiBlocker {
     glm::vec3 center{0.0f};
-    glm::vec3 axisU{1, 0, 0}; // unit, in the plane
-    glm::vec3 axisV{0, 1, 0}; // unit, in the plane, orthogonal to axisU
-    glm::vec2 halfSize{1.0f}; // along axisU, axisV
+    glm::vec3 axisU{1, 0, 0};       // unit, in the plane
+    glm::vec3 axisV{0, 1, 0};       // unit, in the plane, orthogonal to axisU
+    glm::vec2 halfSize{1.0f};       // along axisU, axisV
+    std::vector<glm::vec4> portals; // min u, min v, max u, max v: metres along axisU, axisV
 };
+
+struct Scene;
+// The scene's light blockers as GI blockers (the same rectangles and portals).
+std::vector<GiBlocker> giBlockersOf(const Scene& scene);
 
 struct GiStateDeleter {
     void operator()(GiState* state) const;
