@@ -182,6 +182,74 @@ std::vector<glm::vec2> placeCharts(const ChartedMesh& charted, const Layout& lay
     return uv;
 }
 
+// Meshes of at most this many charts that cover less than kGoodUtilisation of their rect are
+// charted again with each of these first-growth cones (degrees) and the best layout is kept.
+// Variants are only tried on rects of at most kGrowthVariantShadels (packing and ID maps cost
+// in proportion to the rect), which keeps the added bake time a small fraction.
+constexpr size_t kGrowthVariantCharts = 32;
+constexpr double kGrowthVariantShadels = 512.0 * 512.0;
+constexpr double kGoodUtilisation = 0.7;
+constexpr float kGrowthVariantDegrees[] = {90.0f, 110.0f};
+
+// The MIP-0 layout of a charted mesh: rect, shadel UVs, ID map and the density they use.
+struct Mip0 {
+    uint32_t width = 0, height = 0;
+    double density = 0;
+    std::vector<glm::vec2> uv;
+    std::vector<uint16_t> level0;
+    IdMapStats stats;
+    bool padded = false; // the packed charts were smaller than minResolution
+    double utilisation() const { return double(stats.coveredShadels) / (double(width) * height); }
+};
+
+// Finds a density whose packed rect fits [min, max] resolution and lets every triangle own a
+// MIP-0 shadel. Charting is scale-free, so only packing and rasterization repeat. With
+// `fixedDensity` a layout that would need another density is given up (width 0) instead.
+Mip0 placeMip0(const Mesh& mesh, const ChartedMesh& charted, double density, uint32_t gutter,
+               uint32_t minResolution, uint32_t maxResolution, bool fixedDensity = false) {
+    IdMapOptions options;
+    options.floodPasses = std::max(2u, gutter + 1);
+    options.forceOwnership = true;
+    int growthsToMinimum = 0;
+    std::vector<std::vector<uint32_t>> triangles = chartTriangles(charted);
+    for (int attempt = 0;; ++attempt) {
+        Layout layout = layoutCharts(charted, triangles, density, gutter);
+        uint32_t packedSide = std::max(layout.pack.width, layout.pack.height);
+        if (fixedDensity && (packedSide > maxResolution || packedSide * 1.2 < minResolution))
+            return {};
+        if (packedSide > maxResolution) {
+            if (attempt > 40 || density < 1e-9)
+                throw InputError(format("mesh '%s': %zu charts do not fit %ux%u shadels",
+                                        mesh.name.c_str(), charted.charts.size(), maxResolution,
+                                        maxResolution));
+            density *= 0.97 * double(maxResolution) / packedSide;
+            continue;
+        }
+        if (growthsToMinimum < 8 && packedSide * 1.2 < minResolution && charted.surfaceArea > 0) {
+            // Tiny object: spend the minimum rect on detail instead of empty space. Gutters do
+            // not scale with density, so this takes a few steps.
+            ++growthsToMinimum;
+            density *= std::max(1.1, 0.9 * double(minResolution) / packedSide);
+            continue;
+        }
+        Mip0 m;
+        m.width = std::max(layout.pack.width, minResolution);
+        m.height = std::max(layout.pack.height, minResolution);
+        m.padded = m.width != layout.pack.width || m.height != layout.pack.height;
+        m.uv = placeCharts(charted, layout, density, m.width, m.height);
+        m.level0 = buildIdMap(m.uv, charted.indices, m.width, m.height, options, &m.stats);
+        bool canGrow = std::max(m.width, m.height) < maxResolution && attempt < 40;
+        if (m.stats.unownedTriangles > 0 && canGrow) {
+            if (fixedDensity) return {};
+            // Triangles smaller than a shadel crowd each other out: raise the density.
+            density *= 1.4;
+            continue;
+        }
+        m.density = density;
+        return m;
+    }
+}
+
 } // namespace
 
 uint32_t bakedMipCount(uint32_t width, uint32_t height) {
@@ -202,9 +270,40 @@ BakedMesh bakeMesh(const Mesh& mesh, const BakeSettings& settings) {
     uint32_t maxResolution = std::max(minResolution, settings.maxResolution / kChunk * kChunk);
     uint32_t gutter = settings.gutterShadels;
 
-    ChartedMesh charted = buildCharts(mesh, {settings.chartConeDegrees});
+    ChartedMesh charted = buildCharts(mesh, {settings.chartConeDegrees}); // validates indices
     BakedMesh out;
     out.triangleCount = mesh.triangleCount();
+    if (out.triangleCount == 0) {
+        out.width = out.height = minResolution;
+        out.shadelsPerMetre = settings.shadelsPerMetre;
+        for (uint32_t k = 0; k < bakedMipCount(out.width, out.height); ++k)
+            out.idMaps.emplace_back(size_t(out.width >> k) * (out.height >> k), kEmptyShadel);
+        out.bakeSeconds = secondsSince(start);
+        return out;
+    }
+
+    Mip0 mip0 =
+        placeMip0(mesh, charted, settings.shadelsPerMetre, gutter, minResolution, maxResolution);
+    // Charting by normal cones is chaotic on smooth closed meshes: which cone packs best (a torus
+    // comes out as crescents whose hollows the packer cannot fill, and a wider cone makes fewer,
+    // differently curved ones) is only known after packing. A mesh of few charts that packs poorly
+    // is cheap to chart again with wider first-growth cones; the layout covering most of its rect
+    // is kept (every variant passes the same stretch and density checks).
+    // Only at the requested density and unpadded: where triangles smaller than a shadel or a
+    // tiny object made the density grow, or the rect is padded to minResolution, chart shapes are
+    // not what wastes the rect.
+    if (charted.charts.size() <= kGrowthVariantCharts && mip0.utilisation() < kGoodUtilisation &&
+        mip0.density == double(settings.shadelsPerMetre) && !mip0.padded &&
+        double(mip0.width) * mip0.height <= kGrowthVariantShadels) {
+        for (float wide : kGrowthVariantDegrees) {
+            ChartedMesh variant = buildCharts(mesh, {settings.chartConeDegrees, wide});
+            Mip0 placed =
+                placeMip0(mesh, variant, mip0.density, gutter, minResolution, maxResolution, true);
+            if (placed.width > 0 && placed.utilisation() > mip0.utilisation() &&
+                placed.stats.unownedTriangles <= mip0.stats.unownedTriangles)
+                charted = std::move(variant), mip0 = std::move(placed);
+        }
+    }
     out.degenerateTriangles = charted.degenerateTriangles;
     out.surfaceArea = charted.surfaceArea;
     out.chartCount = uint32_t(charted.charts.size());
@@ -216,67 +315,22 @@ BakedMesh bakeMesh(const Mesh& mesh, const BakeSettings& settings) {
     }
     if (stretchArea > 0) out.meanStretch = float(stretchSum / stretchArea);
     out.vertexRemap = std::move(charted.vertexRemap);
-    out.indices = charted.indices;
-
-    IdMapOptions options;
-    options.floodPasses = std::max(2u, gutter + 1);
-    if (out.triangleCount == 0) {
-        out.width = out.height = minResolution;
-        out.shadelsPerMetre = settings.shadelsPerMetre;
-        for (uint32_t k = 0; k < bakedMipCount(out.width, out.height); ++k)
-            out.idMaps.emplace_back(size_t(out.width >> k) * (out.height >> k), kEmptyShadel);
-        out.bakeSeconds = secondsSince(start);
-        return out;
-    }
-
-    // Find a density whose packed rect fits [min, max] resolution and lets every triangle own a
-    // MIP-0 shadel. Charting is scale-free, so only packing and rasterization repeat.
-    double density = settings.shadelsPerMetre;
-    int growthsToMinimum = 0;
-    IdMapStats stats0;
-    std::vector<std::vector<uint32_t>> triangles = chartTriangles(charted);
-    for (int attempt = 0;; ++attempt) {
-        Layout layout = layoutCharts(charted, triangles, density, gutter);
-        uint32_t packedSide = std::max(layout.pack.width, layout.pack.height);
-        if (packedSide > maxResolution) {
-            if (attempt > 40 || density < 1e-9)
-                throw InputError(format("mesh '%s': %u charts do not fit %ux%u shadels",
-                                        mesh.name.c_str(), out.chartCount, maxResolution,
-                                        maxResolution));
-            density *= 0.97 * double(maxResolution) / packedSide;
-            continue;
-        }
-        if (growthsToMinimum < 8 && packedSide * 1.2 < minResolution && charted.surfaceArea > 0) {
-            // Tiny object: spend the minimum rect on detail instead of empty space. Gutters do
-            // not scale with density, so this takes a few steps.
-            ++growthsToMinimum;
-            density *= std::max(1.1, 0.9 * double(minResolution) / packedSide);
-            continue;
-        }
-        uint32_t width = std::max(layout.pack.width, minResolution);
-        uint32_t height = std::max(layout.pack.height, minResolution);
-        std::vector<glm::vec2> uv = placeCharts(charted, layout, density, width, height);
-        options.forceOwnership = true;
-        std::vector<uint16_t> level0 = buildIdMap(uv, out.indices, width, height, options, &stats0);
-        bool canGrow = std::max(width, height) < maxResolution && attempt < 40;
-        if (stats0.unownedTriangles > 0 && canGrow) {
-            // Triangles smaller than a shadel crowd each other out: raise the density.
-            density *= 1.4;
-            continue;
-        }
-        out.width = width, out.height = height;
-        out.shadelUv = std::move(uv);
-        out.idMaps.push_back(std::move(level0));
-        break;
-    }
+    out.indices = std::move(charted.indices);
+    out.width = mip0.width, out.height = mip0.height;
+    out.shadelUv = std::move(mip0.uv);
+    out.idMaps.push_back(std::move(mip0.level0));
+    double density = mip0.density;
+    const IdMapStats& stats0 = mip0.stats;
     out.shadelsPerMetre = float(density);
     out.forcedTriangles = stats0.forcedTriangles;
     out.unownedTriangles = stats0.unownedTriangles;
-    out.utilisation = float(double(stats0.coveredShadels) / (double(out.width) * out.height));
+    out.utilisation = float(mip0.utilisation());
     if (out.unownedTriangles > 0)
         SHADEL_WARN("mesh '%s': %u triangles own no shadel even at %ux%u", mesh.name.c_str(),
                     out.unownedTriangles, out.width, out.height);
 
+    IdMapOptions options;
+    options.floodPasses = std::max(2u, gutter + 1);
     options.forceOwnership = false; // coarse levels cannot hold every triangle, nor need to
     uint32_t mips = bakedMipCount(out.width, out.height);
     for (uint32_t k = 1; k < mips; ++k)

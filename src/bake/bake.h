@@ -12,6 +12,10 @@
 // meshes whose triangles are too small for each to own a shadel at MIP 0; lowered only to fit
 // maxResolution. BakedMesh::shadelsPerMetre is the density actually used.
 //
+// Chart variants. A mesh of few charts whose layout covers little of its rect (at the requested
+// density, not padded, rect <= 512^2) is charted again with wider first-growth cones (charting.h)
+// and the layout covering the most of its rect is kept: deterministic, and never worse.
+//
 // MIP levels. ID maps exist for levels k = 0 .. mipCount-1 with mipCount = 1 + floor(log2(
 // min(width, height) / 8)): the coarsest level is the first where a side is one chunk (8).
 // Coarser levels would still occupy one chunk and one block, so they save no storage; the

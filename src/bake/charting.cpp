@@ -302,7 +302,9 @@ public:
         : mesh_(mesh), maxChartDensityDeviation_(maxChartDensityDeviation) {
         double cone = double(settings.coneDegrees);
         narrowGrowth_ = std::min(cone + kConformalExtraConeDegrees, kMaxGrowthConeDegrees);
-        wideGrowth_ = std::min(cone + kWideConformalExtraConeDegrees, kMaxGrowthConeDegrees);
+        wideGrowth_ = settings.wideGrowthDegrees > 0
+                          ? double(settings.wideGrowthDegrees)
+                          : std::min(cone + kWideConformalExtraConeDegrees, kMaxGrowthConeDegrees);
         // Merging only absorbs slivers left between charts; across creases (box edges) it would
         // make folded nets that pack worse than their faces, so it keeps the planar bound.
         mergeLimit_ = glm::radians(std::min(cone + 5.0, 75.0));

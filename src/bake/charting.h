@@ -53,6 +53,10 @@ struct ChartingSettings {
     // Planar charts keep every normal within coneDegrees + 10 of the projection axis, so their
     // stretch is at most 1 / cos(coneDegrees + 10); conformal charts meet a tighter stretch bound.
     float coneDegrees = 40.0f;
+    // Normal cone of the first (wide) growth, degrees; 0 = coneDegrees + 35, at most 75. Wider
+    // cones make fewer, more curved charts (the stretch and density checks still decide what is
+    // kept): bake.cpp tries a few when a mesh of few charts packs poorly.
+    float wideGrowthDegrees = 0.0f;
 };
 
 // Throws InputError if an index is out of range.
