@@ -168,6 +168,8 @@ void destroyRenderer(Renderer& r) {
     destroyScreenSpace(r);
     if (r.distanceFields) destroyDistanceFields(r, *r.distanceFields);
     r.distanceFields.reset();
+    if (r.stencilEffects) destroyStencilEffects(r, *r.stencilEffects);
+    r.stencilEffects.reset();
     if (r.gi) destroyGi(r, r.gi);
     r.captures = {}; // its sources refer to what is destroyed below
     if (r.visibility) destroyVisibility(r, r.visibility);
@@ -348,6 +350,7 @@ FrameResult renderFrame(Renderer& r, const GpuScene& scene, const CameraView& ca
     }
     recordParticlePasses(r, rec, frame);     // GPU particles: simulation, atlas lighting
     recordScreenSpacePasses(r, rec, frame);  // sky, SSR, SSS over classified tiles
+    recordStencilEffects(r, rec, frame);     // water composite, character outline (stencil)
     recordTransparencyPasses(r, rec, frame); // blended materials, after every opaque surface
     if (r.debugLines) recordDebugLinePasses(r, rec, frame, scene, constants.lightCount);
     recordParticleAtlasView(r, rec, frame); // --visualize particle-atlas

@@ -18,6 +18,7 @@
 #include "render/raytracing/ray_tracing.h"
 #include "render/raytracing/rt_settings.h"
 #include "render/shadel/visibility.h"
+#include "render/stencil/stencil_effects.h"
 #include "rhi/frame.h"
 #include "rhi/pipeline.h"
 #include "rhi/shader_messages.h"
@@ -186,17 +187,18 @@ struct Renderer {
     std::vector<gpu::GpuLight> lightsLastFrame;
     std::vector<glm::vec4> changedLightVolumes;
     uint64_t framesRendered = 0;
-    VisibilityStatePtr visibility;        // decoupled with --marking visibility
-    OitStatePtr oit;                      // scenes with blended materials (render/oit)
-    ParticleStatePtr particles;           // scenes with particle emitters (render/particles)
-    LightCullingStatePtr lightCulling;    // light lists (render/lighting/light_culling.h)
-    GiStatePtr gi;                        // --gi lpv
-    DebugLinesStatePtr debugLines;        // --debug-lines (render/debug/debug_lines.h)
-    CullingStatePtr culling;              // LODs, occlusion, per-view counts (render/culling)
-    RayTracingStatePtr rt;                // BLASes, TLAS, traced terms (--rt-*, render/raytracing)
-    CaptureRegistry captures;             // --capture: named resources of the frame (render/debug)
-    ScreenSpaceStatePtr screenSpace;      // --screen-space on (render/screenspace, render/tiles)
-    DistanceFieldStatePtr distanceFields; // --distance-fields on (render/distance_fields)
+    VisibilityStatePtr visibility;         // decoupled with --marking visibility
+    OitStatePtr oit;                       // scenes with blended materials (render/oit)
+    ParticleStatePtr particles;            // scenes with particle emitters (render/particles)
+    LightCullingStatePtr lightCulling;     // light lists (render/lighting/light_culling.h)
+    GiStatePtr gi;                         // --gi lpv
+    DebugLinesStatePtr debugLines;         // --debug-lines (render/debug/debug_lines.h)
+    CullingStatePtr culling;               // LODs, occlusion, per-view counts (render/culling)
+    RayTracingStatePtr rt;                 // BLASes, TLAS, traced terms (--rt-*, render/raytracing)
+    CaptureRegistry captures;              // --capture: named resources of the frame (render/debug)
+    ScreenSpaceStatePtr screenSpace;       // --screen-space on (render/screenspace, render/tiles)
+    DistanceFieldStatePtr distanceFields;  // --distance-fields on (render/distance_fields)
+    StencilEffectsStatePtr stencilEffects; // --stencil-effects on|fullscreen (render/stencil)
     // Texture streaming (render/streaming), owned by the caller; null: textures loaded whole.
     TextureStreaming* streaming = nullptr;
     std::vector<uint8_t> restreamedMaterials; // per material: a texture of it changed this frame
