@@ -74,6 +74,7 @@ struct RenderOptions {
     bool screenSpace = false;       // --screen-space: sky, SSR, SSS (render/screenspace)
     bool tileClassification = true; // --tile-classification: per-tile dispatch (render/tiles)
     bool distanceFields = false;    // --distance-fields: DF shadows + AO (render/distance_fields)
+    float dfShadowStart = 40.0f;    // --df-shadow-start: metres beyond which the DF shadows apply
     // --stencil-effects on|fullscreen: water composite + character outline (render/stencil)
     StencilEffects stencilEffects = StencilEffects::Off;
     // Texture streaming (render/streaming): --texture-budget MiB (0 = none: every texture

@@ -300,6 +300,11 @@ int main(int argc, char** argv) {
                      "(needs --screen-space on)")
         ->capture_default_str();
     render
+        ->add_option("--df-shadow-start", ro.dfShadowStart,
+                     "metres: with --distance-fields on, the sun's shadow comes from the fields "
+                     "beyond this distance from the camera (0: everywhere), the shadow map nearer")
+        ->capture_default_str();
+    render
         ->add_option("--stencil-effects", stencilEffects,
                      "off | on | fullscreen: water composite and character outline with "
                      "occlusion tint, culled by the stencil test (fullscreen: every pixel, "

@@ -320,6 +320,11 @@ RenderRun runRender(Gpu& gpu, const RenderOptions& o) {
         throw InputError("--stencil-effects: composites the screen-space reflections; add "
                          "--screen-space on");
     settings.tileClassification = o.tileClassification;
+    settings.distanceFieldLighting = o.distanceFields;
+    if (std::string e = checkFiniteInRange("--df-shadow-start", o.dfShadowStart, {0.0, 1e6});
+        !e.empty())
+        throw InputError(e);
+    settings.dfShadowStart = o.dfShadowStart;
     settings.timing = o.timing ? *o.timing : defaultTimingMode(gpu);
     Renderer renderer;
     RenderRun run;

@@ -113,6 +113,11 @@ struct RenderSettings {
     // whether they run per classified 8x8 tile (render/tiles) or over every tile.
     bool screenSpace = false;
     bool tileClassification = true;
+    // --distance-fields on: forward and shadel shading compiled with the DF far shadows + AO
+    // (render/distance_fields); the sun's shadow map gives way to the fields beyond this many
+    // metres from the camera (0: everywhere).
+    bool distanceFieldLighting = false;
+    float dfShadowStart = 40.0f;
     Spectra spectra = Spectra::Off; // forward: per-tile shading permutations (render/lighting)
     bool sunSoftShadows = false;    // --sun-shadows pcss: variable penumbra (render/lighting)
     bool spotShadows = true;        // --spot-shadows: shadow maps of shadow-casting spots

@@ -77,8 +77,9 @@ TEST(StencilEffects, OutlineShowsACharacterBehindAWall) {
             6)
             continue;
         ++changed;
-        if (a[i] > 200 && a[i + 2] < 120 && a[i] > a[i + 2] + 100) ++outline; // orange
-        if (a[i + 2] > b[i + 2] + 10) ++tinted;                               // bluer
+        // The outline is bright and warm (tonemapped to a pale yellow), the tint cold.
+        if (a[i] > 220 && a[i + 1] > 200 && a[i + 2] + 40 < a[i]) ++outline;
+        if (a[i + 2] > a[i] + 40 && a[i + 2] > b[i + 2] + 10) ++tinted;
     }
     std::printf("behind the stands 320x180: %llu pixels changed, %llu outline, %llu tinted\n",
                 (unsigned long long)changed, (unsigned long long)outline,

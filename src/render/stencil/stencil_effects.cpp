@@ -1,6 +1,8 @@
 #include "render/stencil/stencil_effects.h"
 
+#include <algorithm>
 #include <bit>
+#include <cmath>
 
 #include "core/error.h"
 #include "core/log.h"
@@ -27,6 +29,7 @@ struct MarkDraw {
     uint32_t indexCount, firstIndex;
     int32_t vertexOffset;
     uint32_t instance;
+    glm::vec3 worldMin, worldMax;
 };
 
 struct StencilEffectsState {
@@ -87,7 +90,9 @@ void viewportAndScissor(VkCommandBuffer cmd, uint32_t w, uint32_t h) {
     vkCmdSetScissor(cmd, 0, 1, &scissor);
 }
 
-void beginDepthStencil(Renderer& r, StencilEffectsState& s, VkCommandBuffer cmd, bool mark) {
+void beginDepthStencil(Renderer& r, StencilEffectsState& s, VkCommandBuffer cmd, bool mark,
+                       VkRect2D area = {}) {
+    if (mark || area.extent.width == 0) area = {{0, 0}, {r.internalWidth, r.internalHeight}};
     VkRenderingAttachmentInfo ds{VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO};
     ds.imageView = s.depthStencilView;
     ds.imageLayout = VK_IMAGE_LAYOUT_DEPTH_STENCIL_ATTACHMENT_OPTIMAL;
@@ -100,7 +105,7 @@ void beginDepthStencil(Renderer& r, StencilEffectsState& s, VkCommandBuffer cmd,
     mask.loadOp = VK_ATTACHMENT_LOAD_OP_CLEAR;
     mask.storeOp = VK_ATTACHMENT_STORE_OP_STORE;
     VkRenderingInfo ri{VK_STRUCTURE_TYPE_RENDERING_INFO};
-    ri.renderArea = {{0, 0}, {r.internalWidth, r.internalHeight}};
+    ri.renderArea = area;
     ri.layerCount = 1;
     ri.colorAttachmentCount = mark ? 1 : 0;
     ri.pColorAttachments = &mask;
@@ -108,6 +113,7 @@ void beginDepthStencil(Renderer& r, StencilEffectsState& s, VkCommandBuffer cmd,
     ri.pStencilAttachment = &ds;
     vkCmdBeginRendering(cmd, &ri);
     viewportAndScissor(cmd, r.internalWidth, r.internalHeight);
+    vkCmdSetScissor(cmd, 0, 1, &area);
 }
 
 void drawMarks(Renderer& r, VkCommandBuffer cmd, const Pipeline& p,
@@ -117,6 +123,34 @@ void drawMarks(Renderer& r, VkCommandBuffer cmd, const Pipeline& p,
     pushConstants(*r.gpu, cmd, RasterPush{frame, 0});
     for (const MarkDraw& d : draws)
         vkCmdDrawIndexed(cmd, d.indexCount, 1, d.firstIndex, d.vertexOffset, d.instance);
+}
+
+// The pixels the instances' world boxes can cover, grown by `margin` (a coarse stand-in for
+// hierarchical stencil: lavapipe tests the stencil per pixel, so a full-screen triangle over a
+// few stencil pixels still costs a test per pixel; the rect keeps the test near them). The whole
+// target when a box reaches behind the camera.
+VkRect2D screenRect(const Renderer& r, const std::vector<MarkDraw>& draws,
+                    const glm::mat4& viewProj, int margin) {
+    int w = int(r.internalWidth), h = int(r.internalHeight);
+    VkRect2D whole{{0, 0}, {uint32_t(w), uint32_t(h)}};
+    glm::vec2 lo(1e9f), hi(-1e9f);
+    for (const MarkDraw& d : draws)
+        for (int c = 0; c < 8; ++c) {
+            glm::vec3 p((c & 1) ? d.worldMax.x : d.worldMin.x,
+                        (c & 2) ? d.worldMax.y : d.worldMin.y,
+                        (c & 4) ? d.worldMax.z : d.worldMin.z);
+            glm::vec4 clip = viewProj * glm::vec4(p, 1.0f);
+            if (clip.w <= 1e-4f) return whole;
+            glm::vec2 px = (glm::vec2(clip) / clip.w * 0.5f + 0.5f) * glm::vec2(w, h);
+            lo = glm::min(lo, px);
+            hi = glm::max(hi, px);
+        }
+    int x0 = std::clamp(int(std::floor(lo.x)) - margin, 0, w);
+    int y0 = std::clamp(int(std::floor(lo.y)) - margin, 0, h);
+    int x1 = std::clamp(int(std::ceil(hi.x)) + margin, 0, w);
+    int y1 = std::clamp(int(std::ceil(hi.y)) + margin, 0, h);
+    if (x1 <= x0 || y1 <= y0) return {{0, 0}, {0, 0}};
+    return {{x0, y0}, {uint32_t(x1 - x0), uint32_t(y1 - y0)}};
 }
 
 gpu::ScreenSpacePush effectPush(Renderer& r, const StencilEffectsState& s, uint64_t frame) {
@@ -136,7 +170,8 @@ StencilEffectsStatePtr createStencilEffects(Renderer& r, const Scene& scene,
     for (uint32_t i = 0; i < gpuScene.instanceInfo.size(); ++i) {
         const gpu::GpuInstance& inst = gpuScene.instanceInfo[i];
         const gpu::GpuMesh& mesh = gpuScene.meshInfo[inst.mesh];
-        MarkDraw d{mesh.indexCount, mesh.firstIndex, mesh.vertexOffset, i};
+        MarkDraw d{mesh.indexCount, mesh.firstIndex, mesh.vertexOffset, i,
+                   inst.worldMin,   inst.worldMax};
         uint32_t cls = (gpuScene.materialInfo[inst.material].flags >> MATERIAL_CLASS_SHIFT) &
                        MATERIAL_CLASS_MASK;
         if (cls == uint32_t(SurfaceClass::Water)) s->waterDraws.push_back(d);
@@ -244,7 +279,8 @@ uint32_t characterMaskSlot(const Renderer& r, const StencilEffectsState& s) {
     return slot(*r.gpu, s.maskRead).value;
 }
 
-void recordStencilEffects(Renderer& r, FrameRecorder& rec, uint64_t frame) {
+void recordStencilEffects(Renderer& r, FrameRecorder& rec, uint64_t frame,
+                          const glm::mat4& viewProj) {
     if (!r.stencilEffects || !r.screenSpace) return;
     StencilEffectsState& s = *r.stencilEffects;
     Gpu& gpu = *r.gpu;
@@ -293,12 +329,18 @@ void recordStencilEffects(Renderer& r, FrameRecorder& rec, uint64_t frame) {
                      VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT,
                      VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT, kFragment, kStorageReadWrite);
     });
-    auto effect = [&](const char* name, const Pipeline& p, bool last) {
+    auto effect = [&](const char* name, const Pipeline& p, const std::vector<MarkDraw>& draws,
+                      int margin, bool last) {
+        // Stencil-culled: only the rect the marked instances can cover (the full-screen version
+        // covers the whole target, as its name says).
+        bool culled = s.mode == StencilEffects::On;
+        VkRect2D area = culled ? screenRect(r, draws, viewProj, margin) : VkRect2D{};
         pass(rec, name, [&](VkCommandBuffer cmd) {
-            beginDepthStencil(r, s, cmd, false);
+            bool empty = culled && area.extent.width == 0;
+            beginDepthStencil(r, s, cmd, false, empty ? VkRect2D{{0, 0}, {1, 1}} : area);
             bind(gpu, cmd, p);
             pushConstants(gpu, cmd, push);
-            vkCmdDraw(cmd, 3, 1, 0, 0);
+            if (!empty) vkCmdDraw(cmd, 3, 1, 0, 0);
             vkCmdEndRendering(cmd);
             if (!last)
                 memoryBarrier(cmd, kFragment, VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT, kFragment,
@@ -312,8 +354,10 @@ void recordStencilEffects(Renderer& r, FrameRecorder& rec, uint64_t frame) {
         });
     };
     bool full = s.mode == StencilEffects::FullScreen;
-    effect(full ? "waterCompositeFullScreen" : "waterComposite", s.water, false);
-    effect(full ? "characterOutlineFullScreen" : "characterOutline", s.outline, true);
+    int outlineRadius = std::max(1, int(r.internalHeight) / 360); // character_outline.frag
+    effect(full ? "waterCompositeFullScreen" : "waterComposite", s.water, s.waterDraws, 1, false);
+    effect(full ? "characterOutlineFullScreen" : "characterOutline", s.outline, s.characterDraws,
+           outlineRadius + 1, true);
 }
 
 } // namespace shadel

@@ -10,6 +10,8 @@
 // stencil test, branching per pixel: the same image, the baseline of `bench --stencil-compare`.
 #include <memory>
 
+#include <glm/glm.hpp>
+
 #include "rhi/frame.h"
 
 namespace shadel {
@@ -32,7 +34,9 @@ StencilEffectsStatePtr createStencilEffects(Renderer& r, const Scene& scene,
 void destroyStencilEffects(Renderer& r, StencilEffectsState& s);
 // After the screen-space passes, before transparency: stencilMark, waterComposite,
 // characterOutline.
-void recordStencilEffects(Renderer& r, FrameRecorder& rec, uint64_t frame);
+// `viewProj`: the camera's, for the screen rect the effects' instances can cover.
+void recordStencilEffects(Renderer& r, FrameRecorder& rec, uint64_t frame,
+                          const glm::mat4& viewProj);
 // For the screen-space push constants: the character mask's sampled slot.
 uint32_t characterMaskSlot(const Renderer& r, const StencilEffectsState& s);
 
