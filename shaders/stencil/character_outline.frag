@@ -24,11 +24,14 @@ void main() {
     float centre = maskAt(p);
     if (centre == 0.0) return; // only the full-screen version gets here
     int radius = max(1, int(pc.height) / 360); // 2 pixels at 720 lines
+    // Eight taps on the circle of the radius (axes and diagonals) rather than the whole disc:
+    // at 720 lines 8 fetches instead of 13 for an outline that differs only at thin features.
+    int diagonal = max(1, int(float(radius) * 0.7071 + 0.5));
+    const ivec2 dirs[8] = ivec2[8](ivec2(1, 0), ivec2(-1, 0), ivec2(0, 1), ivec2(0, -1),
+                                   ivec2(1, 1), ivec2(-1, 1), ivec2(1, -1), ivec2(-1, -1));
     bool edge = false;
-    for (int dy = -radius; dy <= radius; ++dy)
-        for (int dx = -radius; dx <= radius; ++dx)
-            if (dx * dx + dy * dy <= radius * radius && maskAt(p + ivec2(dx, dy)) == 0.0)
-                edge = true;
+    for (int k = 0; k < 8; ++k)
+        edge = edge || maskAt(p + dirs[k] * (k < 4 ? radius : diagonal)) == 0.0;
     vec4 color = imageLoad(gImagesRgba16f[pc.hdrSlot], p);
     if (edge)
         color.rgb = kOutlineColor;
