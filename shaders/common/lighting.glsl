@@ -12,6 +12,7 @@
 #define SHADEL_LIGHTING_GLSL
 #include "common/material.glsl"
 #include "gi/lpv_sample.glsl"
+#include "distance_fields/distance_fields.glsl"
 
 layout(buffer_reference, scalar) readonly buffer LightingFrameRef { LightingFrame l; };
 layout(buffer_reference, scalar) readonly buffer LightBlockerBuffer { GpuLightBlocker b[]; };
@@ -34,6 +35,11 @@ layout(buffer_reference, scalar) readonly buffer SpotShadowBuffer { GpuSpotShado
 // result is the same.
 layout(constant_id = SPECTRUM_FEATURES_CONSTANT_ID) const uint kSpectrumFeatures = SPECTRUM_ALL;
 #define SPECTRUM_HAS(features) ((kSpectrumFeatures & (features)) != 0u)
+
+// Distance-field far shadows and AO (render/distance_fields): compiled in only by the pipelines
+// that set the constant (forward and shadel shading with --distance-fields on), so other scenes
+// and passes do not carry the tracing code.
+layout(constant_id = DISTANCE_FIELD_LIGHTING_CONSTANT_ID) const uint kDistanceFieldLighting = 0u;
 
 uint gLightListMode = LIGHT_LIST_ALL;
 uint64_t gLightListAddress = 0ul;
@@ -320,6 +326,13 @@ vec3 shadeSurface(FrameConstants f, MaterialSample m, vec3 worldPos, vec3 geomet
         vec3 mirrored = mix(f.ambientColor * 0.5, f.ambientColor + f.skyColor, r.y * 0.5 + 0.5);
         ambientLit = ambientLit * (1.0 - fc) + fc * mirrored * m.occlusion;
     }
+    // Distance fields: AO on the ambient; the sun's visibility in the far field.
+    bool dfLighting = kDistanceFieldLighting != 0u && f.distanceFields != 0ul;
+    DistanceFieldFrame df;
+    if (dfLighting) {
+        df = DistanceFieldFrameRef(f.distanceFields).d;
+        ambientLit *= dfAmbientOcclusion(df, worldPos + geometricNormal * 0.02, geometricNormal);
+    }
     color += ambientLit * gRtOcclusion;
 
     vec3 l = -f.sunDirection;
@@ -334,6 +347,19 @@ vec3 shadeSurface(FrameConstants f, MaterialSample m, vec3 worldPos, vec3 geomet
             shadow = sunShadowSoft(f, lf, worldPos, geometricNormal);
         else if (SPECTRUM_HAS(SPECTRUM_SHADOWS))
             shadow = sunShadow(f, worldPos, geometricNormal);
+        if (dfLighting && !gRtSun) {
+            // Beyond the shadow map's range, with a band of a tenth of it where both blend.
+            float dist = length(worldPos - f.cameraPosition);
+            float far = f.dfShadowStart <= 0.0
+                            ? 1.0
+                            : clamp((dist - f.dfShadowStart) / (0.1 * f.dfShadowStart), 0.0, 1.0);
+            if (far > 0.0) {
+                float traced = dot(geometricNormal, l) > 0.0
+                                   ? dfSoftShadow(df, worldPos + (geometricNormal + l) * 0.04, l, 400.0)
+                                   : 0.0;
+                shadow = mix(shadow, traced, far);
+            }
+        }
         color += brdf(m, n, v, l, f.sunColor * shadow);
     }
     bool spotShadows = SPECTRUM_HAS(SPECTRUM_SPOT_SHADOWS) && haveLighting &&

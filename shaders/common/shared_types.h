@@ -73,6 +73,9 @@ using uint = uint32_t;
 #define SPECTRUM_ALL 0x7FFu
 #define SPECTRUM_MAX_MODES 16u
 #define SPECTRUM_FEATURES_CONSTANT_ID 140
+// Specialization constant of shaders/common/lighting.glsl: 1 compiles the distance-field far
+// shadows and AO in (render/distance_fields; forward and shadel shading with --distance-fields).
+#define DISTANCE_FIELD_LIGHTING_CONSTANT_ID 142
 
 #define NO_TEXTURE 0xFFFFFFFFu
 
@@ -312,6 +315,12 @@ struct FrameConstants {
     // uint per bindless sampled slot: the finest MIP shading wanted of a 32768^2 texture there,
     // atomically min-reduced (render/streaming, shaders/streaming/feedback.glsl); 0 = off.
     uint64_t textureFeedback;
+    // Distance-field lighting (render/distance_fields, --distance-fields on): the
+    // DistanceFieldFrame (0: off); the sun's shadow comes from the fields beyond dfShadowStart
+    // metres from the camera (the far field), from the shadow map nearer; DF AO on the ambient.
+    uint64_t distanceFields;
+    float dfShadowStart;
+    uint dfPad;
 };
 
 // ---- GPU-driven world (render/culling) ------------------------------------------------------

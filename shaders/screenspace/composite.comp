@@ -26,8 +26,12 @@ void main() {
     vec3 view = -viewDirectionAt(f, vec2(p) + 0.5);
     float f0 = (g.flags & PIXEL_WATER) != 0u ? 0.02 : 0.04;
     float fresnel = f0 + (1.0 - f0) * pow(1.0 - clamp(dot(g.normal, view), 0.0, 1.0), 5.0);
-    color.rgb += reflection.rgb * reflection.a * fresnel;
-    if (pc.distanceFields != 0ul) // distance-field ambient occlusion (render/distance_fields)
+    // With the stencil-culled effects, the water composite (shaders/stencil) reflects the water.
+    if (pc.stencilEffects == 0u || (g.flags & PIXEL_WATER) == 0u)
+        color.rgb += reflection.rgb * reflection.a * fresnel;
+    // Distance-field AO: the lighting applies it to the ambient (shaders/common/lighting.glsl)
+    // when the frame's shading has the fields; else here, on the whole colour.
+    if (pc.distanceFields != 0ul && f.distanceFields == 0ul)
         color.rgb *= mix(1.0, imageLoad(gImagesRgba8[pc.dfSlot], p).b, DF_AO_STRENGTH);
     imageStore(gImagesRgba16f[pc.hdrSlot], p, color);
 }

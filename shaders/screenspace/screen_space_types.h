@@ -31,6 +31,10 @@ struct ScreenSpacePush {
     uint pyramid[DEPTH_PYRAMID_LEVELS]; // storage R32UI: closest depth per level
     uint64_t distanceFields;            // DistanceFieldFrame (render/distance_fields), 0 when off
     uint dfSlot; // storage RGBA8: DF sun visibility, shadow-map visibility, DF AO
+    // Stencil-culled effects (render/stencil): 1 when the water composite owns the water's
+    // reflection (the screen-space composite then leaves it out), and the character mask.
+    uint stencilEffects;
+    uint characterMaskSlot; // sampled R8 (shaders/stencil/stencil_bits.h)
 };
 
 #ifdef __cplusplus

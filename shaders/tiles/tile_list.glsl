@@ -13,8 +13,12 @@ layout(buffer_reference, scalar) buffer TileBuffer {
 uint packTile(uvec2 tile) { return tile.x | (tile.y << 16); }
 uvec2 unpackTile(uint packed) { return uvec2(packed & 0xffffu, packed >> 16); }
 
+// Compute stages only (the screen-space helpers are included by fragment shaders too:
+// render/stencil; they define SCREEN_SPACE_FRAGMENT).
+#ifndef SCREEN_SPACE_FRAGMENT
 uvec2 currentTile(uint64_t tiles, uint listOffset) {
     if (listOffset == 0xffffffffu) return gl_WorkGroupID.xy;
     return unpackTile(TileBuffer(tiles).entries[listOffset + gl_WorkGroupID.x]);
 }
+#endif
 #endif

@@ -73,6 +73,50 @@ nlohmann::json runParticleLightingBench(Gpu& gpu, const BenchOptions& b, RenderO
     return out;
 }
 
+// --stencil-compare: the same forward frames with --screen-space on and the stencil effects,
+// stencil-culled and full-screen (the same shaders on every pixel, branching per pixel). The
+// ratio of each effect pass is culled / full-screen; the marks (stencilMark) are reported apart.
+nlohmann::json runStencilBench(Gpu& gpu, const BenchOptions& b, RenderOptions o) {
+    nlohmann::json out;
+    out["scene"] = b.scene;
+    out["device"] = gpu.device.name;
+    out["frames"] = b.frames;
+    o.mode = RenderMode::Forward;
+    o.screenSpace = true;
+    for (auto [name, mode] : {std::pair{"stencil", StencilEffects::On},
+                              std::pair{"fullscreen", StencilEffects::FullScreen}}) {
+        std::fprintf(stderr, "bench: stencil effects %s, %u frames at %ux%u\n", name, b.frames,
+                     b.width, b.height);
+        o.stencilEffects = mode;
+        out["modes"][name] = runRender(gpu, o).stats;
+    }
+    const nlohmann::json& culled = out["modes"]["stencil"];
+    const nlohmann::json& full = out["modes"]["fullscreen"];
+    double outline = passMs(culled, "characterOutline");
+    double outlineFull = passMs(full, "characterOutlineFullScreen");
+    double water = passMs(culled, "waterComposite");
+    double waterFull = passMs(full, "waterCompositeFullScreen");
+    out["stencil_ms"] = {{"character_outline", outline},
+                         {"character_outline_fullscreen", outlineFull},
+                         {"water_composite", water},
+                         {"water_composite_fullscreen", waterFull},
+                         {"stencil_mark", passMs(culled, "stencilMark")}};
+    out["ratios"]["stencil_outline"] = outlineFull > 0 ? outline / outlineFull : 0.0;
+    out["ratios"]["stencil_water"] = waterFull > 0 ? water / waterFull : 0.0;
+    std::printf("shadel bench --stencil-compare: %s at %ux%u on %s, %u frames, medians (timing: "
+                "%s)\n",
+                b.scene.c_str(), b.width, b.height, gpu.device.name.c_str(), b.frames,
+                culled["timing"].get<std::string>().c_str());
+    std::printf("  characterOutline  stencil %.3f ms / full-screen %.3f ms = %.3f\n", outline,
+                outlineFull, out["ratios"]["stencil_outline"].get<double>());
+    std::printf("  waterComposite    stencil %.3f ms / full-screen %.3f ms = %.3f\n", water,
+                waterFull, out["ratios"]["stencil_water"].get<double>());
+    std::printf("  stencilMark (depth-stencil copy + marks) %.3f ms\n",
+                out["stencil_ms"]["stencil_mark"].get<double>());
+    if (!b.json.empty()) writeOutputFile(b.json, out.dump(2) + "\n");
+    return out;
+}
+
 } // namespace
 
 // Renders the same scene over the same camera path forward, decoupled with reuse off and
@@ -98,6 +142,7 @@ nlohmann::json runBench(Gpu& gpu, const BenchOptions& b) {
     o.lightCulling = b.lightCulling;
     o.progress = false;
     if (b.compareParticleLighting) return runParticleLightingBench(gpu, b, o);
+    if (b.compareStencil) return runStencilBench(gpu, b, o);
 
     struct Mode {
         const char* name;

@@ -76,6 +76,9 @@ struct RenderOptions {
     bool screenSpace = false;       // --screen-space: sky, SSR, SSS (render/screenspace)
     bool tileClassification = true; // --tile-classification: per-tile dispatch (render/tiles)
     bool distanceFields = false;    // --distance-fields: DF shadows + AO (render/distance_fields)
+    float dfShadowStart = 40.0f;    // --df-shadow-start: metres beyond which the DF shadows apply
+    // --stencil-effects on|fullscreen: water composite + character outline (render/stencil)
+    StencilEffects stencilEffects = StencilEffects::Off;
     // Texture streaming (render/streaming): --texture-budget MiB (0 = none: every texture
     // resident), --streaming, and builtin:textures' texture side (0 = 2048).
     double textureBudgetMiB = 0.0;
@@ -145,6 +148,9 @@ struct BenchOptions {
     // --spectra compare: forward also with --spectra on and single; ratios.spectra_forward =
     // on / single median frame time (the seed's spectra against one all-features shader).
     bool compareSpectra = false;
+    // --stencil-compare: forward with --screen-space on and the stencil effects, stencil-culled
+    // and full-screen; ratios.stencil_outline|stencil_water = culled / full-screen pass time.
+    bool compareStencil = false;
     std::string plot; // --plot FILE.png: per-pass bar chart (app/bench_plot.h)
 };
 nlohmann::json runBench(Gpu& gpu, const BenchOptions& options);

@@ -295,7 +295,8 @@ int main(int argc, char** argv) {
     RtFlags rtFlags; // ray tracing (render/raytracing)
     addRayTracingFlags(*render, rtFlags);
     // Seed 004's screen-space passes and tile classification (render/screenspace, tiles).
-    std::string screenSpace = "off", tileClassification = "on", distanceFields = "off";
+    std::string screenSpace = "off", tileClassification = "on", distanceFields = "off",
+                stencilEffects = "off";
     render
         ->add_option("--screen-space", screenSpace,
                      "on | off: thin G-buffer, sky, screen-space reflections and skin SSS")
@@ -308,6 +309,17 @@ int main(int argc, char** argv) {
         ->add_option("--distance-fields", distanceFields,
                      "on | off: mesh distance fields in a 3-D atlas: soft sun shadows and AO "
                      "(needs --screen-space on)")
+        ->capture_default_str();
+    render
+        ->add_option("--df-shadow-start", ro.dfShadowStart,
+                     "metres: with --distance-fields on, the sun's shadow comes from the fields "
+                     "beyond this distance from the camera (0: everywhere), the shadow map nearer")
+        ->capture_default_str();
+    render
+        ->add_option("--stencil-effects", stencilEffects,
+                     "off | on | fullscreen: water composite and character outline with "
+                     "occlusion tint, culled by the stencil test (fullscreen: every pixel, "
+                     "the baseline; needs --screen-space on)")
         ->capture_default_str();
     // Texture streaming (render/streaming).
     render
@@ -351,6 +363,9 @@ int main(int argc, char** argv) {
         ->capture_default_str();
     bench->add_flag("--animate-lights", bo.animateLights, "move point and spot lights");
     std::string benchLightCulling = "tiled";
+    bench->add_flag("--stencil-compare", bo.compareStencil,
+                    "forward with --screen-space on: the stencil-culled water composite and "
+                    "character outline against their full-screen versions");
     bench->add_flag("--particle-lighting-compare", bo.compareParticleLighting,
                     "instead of the three modes: forward with --particle-lighting atlas, pixel "
                     "and vertex, and the particle lighting cost of atlas over pixel");
@@ -543,6 +558,12 @@ int main(int argc, char** argv) {
             ro.screenSpace = parseOnOff("--screen-space", screenSpace);
             ro.tileClassification = parseOnOff("--tile-classification", tileClassification);
             ro.distanceFields = parseOnOff("--distance-fields", distanceFields);
+            if (stencilEffects != "off" && stencilEffects != "on" && stencilEffects != "fullscreen")
+                throw InputError(format("--stencil-effects %s: expected off, on or fullscreen",
+                                        stencilEffects.c_str()));
+            ro.stencilEffects = stencilEffects == "on"           ? StencilEffects::On
+                                : stencilEffects == "fullscreen" ? StencilEffects::FullScreen
+                                                                 : StencilEffects::Off;
             if (streaming != "layered" && streaming != "sparse")
                 throw InputError(
                     format("--streaming %s: expected layered or sparse", streaming.c_str()));

@@ -332,7 +332,15 @@ RenderRun runRender(Gpu& gpu, const RenderOptions& o) {
     if (o.distanceFields && !o.screenSpace)
         throw InputError(
             "--distance-fields on: runs on the screen-space tiles; add --screen-space on");
+    if (o.stencilEffects != StencilEffects::Off && !o.screenSpace)
+        throw InputError("--stencil-effects: composites the screen-space reflections; add "
+                         "--screen-space on");
     settings.tileClassification = o.tileClassification;
+    settings.distanceFieldLighting = o.distanceFields;
+    if (std::string e = checkFiniteInRange("--df-shadow-start", o.dfShadowStart, {0.0, 1e6});
+        !e.empty())
+        throw InputError(e);
+    settings.dfShadowStart = o.dfShadowStart;
     settings.timing = o.timing ? *o.timing : defaultTimingMode(gpu);
     Renderer renderer;
     RenderRun run;
@@ -341,6 +349,9 @@ RenderRun runRender(Gpu& gpu, const RenderOptions& o) {
         if (o.distanceFields)
             renderer.distanceFields = createDistanceFields(
                 renderer, scene, gpuScene, o.cacheDir.empty() ? defaultCacheDir() : o.cacheDir);
+        if (o.stencilEffects != StencilEffects::Off)
+            renderer.stencilEffects =
+                createStencilEffects(renderer, scene, gpuScene, o.stencilEffects);
         renderer.streaming = streaming.get();
         if (listCaptures) {
             std::printf("%s", captureListing(renderer.captures).c_str());

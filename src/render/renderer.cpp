@@ -168,6 +168,8 @@ void destroyRenderer(Renderer& r) {
     destroyScreenSpace(r);
     if (r.distanceFields) destroyDistanceFields(r, *r.distanceFields);
     r.distanceFields.reset();
+    if (r.stencilEffects) destroyStencilEffects(r, *r.stencilEffects);
+    r.stencilEffects.reset();
     if (r.gi) destroyGi(r, r.gi);
     r.captures = {}; // its sources refer to what is destroyed below
     if (r.visibility) destroyVisibility(r, r.visibility);
@@ -293,6 +295,10 @@ FrameResult renderFrame(Renderer& r, const GpuScene& scene, const CameraView& ca
     constants.lighting = prepareLightCulling(
         r, scene, r.settings.animateLights ? r.lightsLastFrame : scene.lightInfo, constants);
     if (r.gi) prepareGiFrame(r, scene, camera, constants);
+    if (r.distanceFields && r.settings.distanceFieldLighting) { // render/distance_fields
+        constants.distanceFields = distanceFieldFrameAddress(r, *r.distanceFields);
+        constants.dfShadowStart = r.settings.dfShadowStart;
+    }
     if (r.decoupled) prepareDecoupledFrame(r, scene, camera, constants);
     prepareTransparentDraws(r, scene, camera);
     prepareParticleFrame(r);
@@ -346,8 +352,9 @@ FrameResult renderFrame(Renderer& r, const GpuScene& scene, const CameraView& ca
                  [&](VkCommandBuffer cmd) { recordRayTracedShadels(r, cmd, frame); });
         recordDecoupledPasses(r, rec, frame, scene);
     }
-    recordParticlePasses(r, rec, frame);     // GPU particles: simulation, atlas lighting
-    recordScreenSpacePasses(r, rec, frame);  // sky, SSR, SSS over classified tiles
+    recordParticlePasses(r, rec, frame);    // GPU particles: simulation, atlas lighting
+    recordScreenSpacePasses(r, rec, frame); // sky, SSR, SSS over classified tiles
+    recordStencilEffects(r, rec, frame, constants.viewProj); // water, character outline
     recordTransparencyPasses(r, rec, frame); // blended materials, after every opaque surface
     if (r.debugLines) recordDebugLinePasses(r, rec, frame, scene, constants.lightCount);
     recordParticleAtlasView(r, rec, frame); // --visualize particle-atlas

@@ -18,6 +18,7 @@
 #include "render/raytracing/ray_tracing.h"
 #include "render/raytracing/rt_settings.h"
 #include "render/shadel/visibility.h"
+#include "render/stencil/stencil_effects.h"
 #include "rhi/frame.h"
 #include "rhi/pipeline.h"
 #include "rhi/shader_messages.h"
@@ -114,6 +115,11 @@ struct RenderSettings {
     // whether they run per classified 8x8 tile (render/tiles) or over every tile.
     bool screenSpace = false;
     bool tileClassification = true;
+    // --distance-fields on: forward and shadel shading compiled with the DF far shadows + AO
+    // (render/distance_fields); the sun's shadow map gives way to the fields beyond this many
+    // metres from the camera (0: everywhere).
+    bool distanceFieldLighting = false;
+    float dfShadowStart = 40.0f;
     Spectra spectra = Spectra::Off; // forward: per-tile shading permutations (render/lighting)
     bool sunSoftShadows = false;    // --sun-shadows pcss: variable penumbra (render/lighting)
     bool spotShadows = true;        // --spot-shadows: shadow maps of shadow-casting spots
@@ -188,17 +194,18 @@ struct Renderer {
     std::vector<gpu::GpuLight> lightsLastFrame;
     std::vector<glm::vec4> changedLightVolumes;
     uint64_t framesRendered = 0;
-    VisibilityStatePtr visibility;        // decoupled with --marking visibility
-    OitStatePtr oit;                      // scenes with blended materials (render/oit)
-    ParticleStatePtr particles;           // scenes with particle emitters (render/particles)
-    LightCullingStatePtr lightCulling;    // light lists (render/lighting/light_culling.h)
-    GiStatePtr gi;                        // --gi lpv
-    DebugLinesStatePtr debugLines;        // --debug-lines (render/debug/debug_lines.h)
-    CullingStatePtr culling;              // LODs, occlusion, per-view counts (render/culling)
-    RayTracingStatePtr rt;                // BLASes, TLAS, traced terms (--rt-*, render/raytracing)
-    CaptureRegistry captures;             // --capture: named resources of the frame (render/debug)
-    ScreenSpaceStatePtr screenSpace;      // --screen-space on (render/screenspace, render/tiles)
-    DistanceFieldStatePtr distanceFields; // --distance-fields on (render/distance_fields)
+    VisibilityStatePtr visibility;         // decoupled with --marking visibility
+    OitStatePtr oit;                       // scenes with blended materials (render/oit)
+    ParticleStatePtr particles;            // scenes with particle emitters (render/particles)
+    LightCullingStatePtr lightCulling;     // light lists (render/lighting/light_culling.h)
+    GiStatePtr gi;                         // --gi lpv
+    DebugLinesStatePtr debugLines;         // --debug-lines (render/debug/debug_lines.h)
+    CullingStatePtr culling;               // LODs, occlusion, per-view counts (render/culling)
+    RayTracingStatePtr rt;                 // BLASes, TLAS, traced terms (--rt-*, render/raytracing)
+    CaptureRegistry captures;              // --capture: named resources of the frame (render/debug)
+    ScreenSpaceStatePtr screenSpace;       // --screen-space on (render/screenspace, render/tiles)
+    DistanceFieldStatePtr distanceFields;  // --distance-fields on (render/distance_fields)
+    StencilEffectsStatePtr stencilEffects; // --stencil-effects on|fullscreen (render/stencil)
     // Texture streaming (render/streaming), owned by the caller; null: textures loaded whole.
     TextureStreaming* streaming = nullptr;
     std::vector<uint8_t> restreamedMaterials; // per material: a texture of it changed this frame

@@ -102,6 +102,8 @@ Pipeline createGraphicsPipeline(Gpu& gpu, const GraphicsPipelineDesc& desc) {
     depth.depthTestEnable = desc.depthTest;
     depth.depthWriteEnable = desc.depthWrite;
     depth.depthCompareOp = desc.depthCompare;
+    depth.stencilTestEnable = desc.stencilTest;
+    depth.front = depth.back = desc.stencil;
     std::vector<VkPipelineColorBlendAttachmentState> blends(desc.colorFormats.size());
     for (auto& b : blends) {
         b.colorWriteMask = 0xF;
@@ -139,6 +141,9 @@ Pipeline createGraphicsPipeline(Gpu& gpu, const GraphicsPipelineDesc& desc) {
     rendering.colorAttachmentCount = uint32_t(desc.colorFormats.size());
     rendering.pColorAttachmentFormats = desc.colorFormats.data();
     rendering.depthAttachmentFormat = desc.depthFormat;
+    if (desc.depthFormat == VK_FORMAT_D32_SFLOAT_S8_UINT ||
+        desc.depthFormat == VK_FORMAT_D24_UNORM_S8_UINT)
+        rendering.stencilAttachmentFormat = desc.depthFormat;
 
     VkGraphicsPipelineCreateInfo ci{VK_STRUCTURE_TYPE_GRAPHICS_PIPELINE_CREATE_INFO};
     ci.pNext = &rendering;

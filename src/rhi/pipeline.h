@@ -29,6 +29,10 @@ struct GraphicsPipelineDesc {
     // with their separate colour and alpha blending).
     std::vector<VkPipelineColorBlendAttachmentState> attachmentBlends;
     std::vector<std::pair<uint32_t, uint32_t>> specialization; // constant id, value
+    // Stencil, for a depthFormat with a stencil aspect (which then is the stencil format too):
+    // the test and ops of both faces, with a static reference.
+    bool stencilTest = false;
+    VkStencilOpState stencil{};
 };
 
 struct Pipeline {

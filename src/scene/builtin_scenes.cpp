@@ -754,6 +754,7 @@ Scene makeArena() {
         b.place(n + " head", b.mesh(makeSphere(n + " head", 0.2f, skin, 24, 12)),
                 at + glm::vec3(0, 1.97f, 0));
     }
+    for (Instance& inst : scene.instances) inst.character = inst.name.rfind("fighter", 0) == 0;
     // Foliage around the arena, stands behind it, buildings far beyond.
     uint32_t bush = b.mesh(makeSphere("bush", 1.2f, leaves, 20, 10));
     for (int i = 0; i < 12; ++i) {

@@ -134,6 +134,7 @@ struct Instance {
     std::string name;
     uint32_t mesh = 0;
     glm::mat4 transform{1.0f}; // object to world
+    bool character = false;    // outlined, and tinted where hidden (--stencil-effects)
 };
 
 // Point is the omni light; Spot has a round cone, SquareSpot a square one (a pyramid whose

@@ -52,6 +52,8 @@ void createForwardPipelines(Renderer& r) {
     opaque.depthCompare = VK_COMPARE_OP_EQUAL; // the prepass resolved visibility
     opaque.cullMode = VK_CULL_MODE_NONE;
     opaque.specialization = shaderPrintSpecialization(r.settings.inspectX >= 0);
+    if (r.settings.distanceFieldLighting)
+        opaque.specialization.push_back({DISTANCE_FIELD_LIGHTING_CONSTANT_ID, 1u});
     r.forwardOpaque = createGraphicsPipeline(gpu, opaque);
 }
 

@@ -87,6 +87,10 @@ gpu::ScreenSpacePush makePush(Renderer& r, const ScreenSpaceState& s, uint64_t f
         p.distanceFields = distanceFieldFrameAddress(r, *r.distanceFields);
         p.dfSlot = distanceFieldOutputSlot(r, *r.distanceFields);
     }
+    if (r.stencilEffects) {
+        p.stencilEffects = 1;
+        p.characterMaskSlot = characterMaskSlot(r, *r.stencilEffects);
+    }
     return p;
 }
 
@@ -258,6 +262,10 @@ void recordScreenSpacePasses(Renderer& r, FrameRecorder& rec, uint64_t frame) {
                      VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_READ_BIT |
                          VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT);
     });
+}
+
+gpu::ScreenSpacePush screenSpacePush(Renderer& r, uint64_t frame) {
+    return makePush(r, *r.screenSpace, frame);
 }
 
 void finishScreenSpaceFrame(Renderer& r) {

@@ -8,6 +8,7 @@
 #include <nlohmann/json.hpp>
 
 #include "rhi/frame.h"
+#include "screenspace/screen_space_types.h"
 
 namespace shadel {
 
@@ -21,6 +22,8 @@ void recordThinGBufferPass(Renderer& r, FrameRecorder& rec, uint64_t frame);
 void recordScreenSpacePasses(Renderer& r, FrameRecorder& rec, uint64_t frame);
 // After the frame: the tile class counts; into the stats as "tile_classes".
 void finishScreenSpaceFrame(Renderer& r);
+// The push constants of the screen-space passes, for passes outside them (render/stencil).
+gpu::ScreenSpacePush screenSpacePush(Renderer& r, uint64_t frame);
 void screenSpaceStats(const Renderer& r, nlohmann::json& stats);
 
 } // namespace shadel

@@ -258,7 +258,10 @@ DecoupledStatePtr createDecoupled(Renderer& r, const GpuScene& scene) {
     d.dispatchSetup =
         createComputePipeline(gpu, "shadelDispatchSetup", "shadel_dispatch_setup.comp.spv");
     d.carryOver = createComputePipeline(gpu, "shadelCarryOver", "shadel_carry_over.comp.spv");
-    d.shade = createComputePipeline(gpu, "shadelShade", "shadel_shade.comp.spv");
+    std::vector<std::pair<uint32_t, uint32_t>> shadeConstants;
+    if (r.settings.distanceFieldLighting) // render/distance_fields: far shadows + AO per shadel
+        shadeConstants.push_back({DISTANCE_FIELD_LIGHTING_CONSTANT_ID, 1u});
+    d.shade = createComputePipeline(gpu, "shadelShade", "shadel_shade.comp.spv", shadeConstants);
     d.sheetView = createComputePipeline(gpu, "shadelSheetView", "shadel_sheet_view.comp.spv");
     GraphicsPipelineDesc mark;
     mark.name = "shadelMark";
