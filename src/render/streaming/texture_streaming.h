@@ -64,6 +64,9 @@ void prepareTextureStreaming(TextureStreaming& s, const CameraView& camera, floa
 // Per scene material: 1 when a texture it samples changed residency in this frame's prepare
 // (shading stored in earlier frames is stale: the decoupled path must not carry it over).
 const std::vector<uint8_t>& restreamedMaterials(const TextureStreaming& s);
+// --streaming sparse: the semaphore this frame's page binds signal (the frame's first submission
+// waits on it), then forgotten; null when nothing was bound.
+VkSemaphore takeTextureStreamingWait(TextureStreaming& s);
 void recordTextureStreaming(TextureStreaming& s, VkCommandBuffer cmd);
 void finishTextureStreamingFrame(TextureStreaming& s);
 
