@@ -22,14 +22,14 @@
 namespace shadel {
 
 struct SparseTexture {
-    uint32_t size = 0;                  // level 0 side (power of two)
-    uint32_t tailFirst = 0;             // first level of the MIP tail (always bound)
-    std::vector<uint32_t> levelPages;   // per level below tailFirst: pages (sparse blocks) it takes
-    uint32_t resident = 0;              // finest whole level (the sampled view's base)
+    uint32_t size = 0;                // level 0 side (power of two)
+    uint32_t tailFirst = 0;           // first level of the MIP tail (always bound)
+    std::vector<uint32_t> levelPages; // per level below tailFirst: pages (sparse blocks) it takes
+    uint32_t resident = 0;            // finest whole level (the sampled view's base)
     std::vector<std::vector<uint32_t>> pages; // per level below tailFirst: pool pages bound
-    bool pending = false;               // a level load in flight
-    uint64_t changedFrame = ~0ull;      // a level came or went this frame: cannot yield now
-    float wanted = 0.0f;                // merged priority: the side it wants
+    bool pending = false;                     // a level load in flight
+    uint64_t changedFrame = ~0ull;            // a level came or went this frame: cannot yield now
+    float wanted = 0.0f;                      // merged priority: the side it wants
     uint32_t failedLoads = 0;
 };
 
@@ -69,7 +69,9 @@ uint32_t residentPages(const SparseResidency& r);
 
 // Starts a frame: levels that change in it (commits, evictions) cannot change again until the
 // next, so one frame's binds never bind and unbind the same range.
-inline void beginSparseFrame(SparseResidency& r) { r.frame++; }
+inline void beginSparseFrame(SparseResidency& r) {
+    r.frame++;
+}
 
 // This frame's loads by priority (pages reserved, textures marked pending) and the evictions that
 // made room (applied at once: the texture's resident level is already coarser).

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 
+#include "core/assert.h"
 #include "core/error.h"
 #include "core/log.h"
 #include "rhi/gpu.h"
@@ -62,9 +63,9 @@ std::string sparseUnsupportedReason(const Gpu& gpu) {
                         "sparseResidencyImage2D and a sparse-binding queue)";
     for (bool srgb : {false, true}) {
         uint32_t n = 0;
-        vkGetPhysicalDeviceSparseImageFormatProperties(
-            d.physical, formatOf(srgb), VK_IMAGE_TYPE_2D, VK_SAMPLE_COUNT_1_BIT, kUsage,
-            VK_IMAGE_TILING_OPTIMAL, &n, nullptr);
+        vkGetPhysicalDeviceSparseImageFormatProperties(d.physical, formatOf(srgb), VK_IMAGE_TYPE_2D,
+                                                       VK_SAMPLE_COUNT_1_BIT, kUsage,
+                                                       VK_IMAGE_TILING_OPTIMAL, &n, nullptr);
         if (n == 0)
             return d.name + " cannot make sparse-resident " +
                    (srgb ? "R8G8B8A8_SRGB" : "R8G8B8A8_UNORM") + " images";
@@ -111,28 +112,38 @@ void createSparseTextures(Gpu& gpu, const std::vector<uint32_t>& sizes,
         SparseLayout layout = sparseLayout(device, img.image);
         const VkSparseImageMemoryRequirements& c = layout.color;
         if (out.granularity.width == 0) out.granularity = c.formatProperties.imageGranularity;
-        if (c.imageMipTailFirstLod >= img.levels)
-            throw DeviceError(format("sparse texture image %zu has no MIP tail", i));
+        // The device's packed tail (none on lavapipe: every level is paged, down to 1x1).
+        img.deviceTailFirst = std::min(c.imageMipTailFirstLod, img.levels);
         SparseTexture t;
         t.size = sizes[i];
-        t.tailFirst = c.imageMipTailFirstLod;
-        for (uint32_t l = 0; l < t.tailFirst; ++l) {
-            uint32_t side = sizes[i] >> l;
-            t.levelPages.push_back(blocksAcross(side, out.granularity.width) *
-                                   blocksAcross(side, out.granularity.height));
-        }
+        // Always resident: the device's tail, and before it the levels smaller than a page
+        // (each would take a whole page; paging them saves nothing worth a load).
+        t.tailFirst = 0;
+        while (t.tailFirst < img.deviceTailFirst &&
+               (sizes[i] >> t.tailFirst) >= out.granularity.width &&
+               (sizes[i] >> t.tailFirst) >= out.granularity.height)
+            t.tailFirst++;
+        auto pagesOf = [&](uint32_t l) {
+            uint32_t side = std::max(sizes[i] >> l, 1u);
+            return blocksAcross(side, out.granularity.width) *
+                   blocksAcross(side, out.granularity.height);
+        };
+        for (uint32_t l = 0; l < t.tailFirst; ++l) t.levelPages.push_back(pagesOf(l));
+        for (uint32_t l = t.tailFirst; l < img.deviceTailFirst; ++l)
+            out.tailBytes += uint64_t(pagesOf(l)) * out.pageBytes;
         book.push_back(std::move(t));
-        out.tailBytes += alignUp(c.imageMipTailSize, out.pageBytes);
+        if (img.deviceTailFirst < img.levels)
+            out.tailBytes += alignUp(c.imageMipTailSize, out.pageBytes);
         for (const auto& m : layout.metadata)
             out.tailBytes += alignUp(m.imageMipTailSize, out.pageBytes);
         layouts.push_back(std::move(layout));
     }
     if (addressSpace > gpu.device.properties.limits.sparseAddressSpaceSize)
-        throw InputError(format("--streaming sparse: the %zu textures need %.0f MiB of sparse "
-                                "address space, the device has %.0f MiB",
-                                sizes.size(), double(addressSpace) / 1048576.0,
-                                double(gpu.device.properties.limits.sparseAddressSpaceSize) /
-                                    1048576.0));
+        throw InputError(
+            format("--streaming sparse: the %zu textures need %.0f MiB of sparse "
+                   "address space, the device has %.0f MiB",
+                   sizes.size(), double(addressSpace) / 1048576.0,
+                   double(gpu.device.properties.limits.sparseAddressSpaceSize) / 1048576.0));
     if (out.tailBytes > budgetBytes)
         throw InputError(format("--texture-budget %.2f: below the %.2f MiB the %zu textures' "
                                 "sparse MIP tails need",
@@ -159,19 +170,41 @@ void createSparseTextures(Gpu& gpu, const std::vector<uint32_t>& sizes,
         ai.memoryTypeIndex = out.memoryType;
         VkDeviceMemory m = VK_NULL_HANDLE;
         if (vkAllocateMemory(device, &ai, nullptr, &m) != VK_SUCCESS)
-            throw DeviceError(format("out of GPU memory for %s (%.1f MiB)", name,
-                                     double(bytes) / 1048576.0));
+            throw DeviceError(
+                format("out of GPU memory for %s (%.1f MiB)", name, double(bytes) / 1048576.0));
         setName(gpu.device, m, VK_OBJECT_TYPE_DEVICE_MEMORY, name);
         return m;
     };
     out.tailMemory = allocate(out.tailBytes, "streaming.sparse.tails");
     if (out.poolBytes) out.poolMemory = allocate(out.poolBytes, "streaming.sparse.pagePool");
 
-    // Every tail bound once, opaquely (the tail's layout is the device's business).
+    // Every tail bound once: the device's opaquely (its layout is the device's business), the
+    // sub-page levels before it block by block.
     std::vector<std::vector<VkSparseMemoryBind>> tailBinds(out.images.size());
+    std::vector<std::vector<VkSparseImageMemoryBind>> levelBinds(out.images.size());
     std::vector<VkSparseImageOpaqueMemoryBindInfo> opaque;
+    std::vector<VkSparseImageMemoryBindInfo> blocks;
     uint64_t offset = 0;
     for (size_t i = 0; i < out.images.size(); ++i) {
+        for (uint32_t l = out.residency.textures[i].tailFirst; l < out.images[i].deviceTailFirst;
+             ++l) {
+            uint32_t side = std::max(sizes[i] >> l, 1u);
+            uint32_t gw = out.granularity.width, gh = out.granularity.height;
+            for (uint32_t by = 0; by < blocksAcross(side, gh); ++by)
+                for (uint32_t bx = 0; bx < blocksAcross(side, gw); ++bx) {
+                    VkSparseImageMemoryBind b{};
+                    b.subresource = {VK_IMAGE_ASPECT_COLOR_BIT, l, 0};
+                    b.offset = {int32_t(bx * gw), int32_t(by * gh), 0};
+                    b.extent = {std::min(gw, side - bx * gw), std::min(gh, side - by * gh), 1};
+                    b.memory = out.tailMemory;
+                    b.memoryOffset = offset;
+                    offset += out.pageBytes;
+                    levelBinds[i].push_back(b);
+                }
+        }
+        if (!levelBinds[i].empty())
+            blocks.push_back(
+                {out.images[i].image, uint32_t(levelBinds[i].size()), levelBinds[i].data()});
         auto bindTail = [&](const VkSparseImageMemoryRequirements& r, VkSparseMemoryBindFlags f) {
             VkSparseMemoryBind b{};
             b.resourceOffset = r.imageMipTailOffset;
@@ -182,13 +215,18 @@ void createSparseTextures(Gpu& gpu, const std::vector<uint32_t>& sizes,
             tailBinds[i].push_back(b);
             offset += alignUp(r.imageMipTailSize, out.pageBytes);
         };
-        bindTail(layouts[i].color, 0);
+        if (out.images[i].deviceTailFirst < out.images[i].levels) bindTail(layouts[i].color, 0);
         for (const auto& m : layouts[i].metadata) bindTail(m, VK_SPARSE_MEMORY_BIND_METADATA_BIT);
-        opaque.push_back({out.images[i].image, uint32_t(tailBinds[i].size()), tailBinds[i].data()});
+        if (!tailBinds[i].empty())
+            opaque.push_back(
+                {out.images[i].image, uint32_t(tailBinds[i].size()), tailBinds[i].data()});
     }
+    SHADEL_ASSERT(offset <= out.tailBytes);
     VkBindSparseInfo bi{VK_STRUCTURE_TYPE_BIND_SPARSE_INFO};
     bi.imageOpaqueBindCount = uint32_t(opaque.size());
     bi.pImageOpaqueBinds = opaque.data();
+    bi.imageBindCount = uint32_t(blocks.size());
+    bi.pImageBinds = blocks.data();
     VkFenceCreateInfo fci{VK_STRUCTURE_TYPE_FENCE_CREATE_INFO};
     VkFence fence = VK_NULL_HANDLE;
     VK_CHECK(vkCreateFence(device, &fci, nullptr, &fence));
@@ -244,8 +282,7 @@ VkSemaphore submitSparseBinds(SparseTextures& s, const std::vector<const SparseL
     if (binds.empty() && unbinds.empty()) return VK_NULL_HANDLE;
     // Per image, its blocks of the level in row-major order, each to its page (or to nothing).
     std::vector<std::vector<VkSparseImageMemoryBind>> perImage(s.images.size());
-    auto level = [&](int32_t texture, uint32_t lvl, const std::vector<uint32_t>& pages,
-                     bool bind) {
+    auto level = [&](int32_t texture, uint32_t lvl, const std::vector<uint32_t>& pages, bool bind) {
         uint32_t side = s.residency.textures[texture].size >> lvl;
         uint32_t gw = s.granularity.width, gh = s.granularity.height;
         uint32_t across = blocksAcross(side, gw), k = 0;
@@ -266,8 +303,7 @@ VkSemaphore submitSparseBinds(SparseTextures& s, const std::vector<const SparseL
     std::vector<VkSparseImageMemoryBindInfo> infos;
     for (size_t i = 0; i < perImage.size(); ++i)
         if (!perImage[i].empty())
-            infos.push_back(
-                {s.images[i].image, uint32_t(perImage[i].size()), perImage[i].data()});
+            infos.push_back({s.images[i].image, uint32_t(perImage[i].size()), perImage[i].data()});
     VkBindSparseInfo bi{VK_STRUCTURE_TYPE_BIND_SPARSE_INFO};
     bi.imageBindCount = uint32_t(infos.size());
     bi.pImageBinds = infos.data();

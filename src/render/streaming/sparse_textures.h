@@ -1,9 +1,10 @@
 #pragma once
 // The GPU side of sparse residency (--streaming sparse): one sparse-resident image per texture
-// (its whole MIP chain as address space, nothing bound), its MIP tail bound opaquely at creation
-// from one tail allocation, and a fixed pool of pages (sparse blocks, 64 KiB for RGBA8) that
-// level loads bind into and evictions unbind from, with vkQueueBindSparse. The bookkeeping of
-// who holds which page is sparse_residency.h.
+// (its whole MIP chain as address space), its MIP tail bound at creation from one tail
+// allocation (the device's packed tail opaquely; before it, the levels smaller than a page, which
+// a device without a packed tail such as lavapipe pages like any other), and a fixed pool of pages
+// (sparse blocks, 64 KiB for RGBA8) that level loads bind into and evictions unbind from, with
+// vkQueueBindSparse. The bookkeeping of who holds which page is sparse_residency.h.
 //
 // Binds are queued before the frame and signal a semaphore the frame's first submission waits on
 // (binds are not ordered against command buffers otherwise). Unbinds are safe then too: the
@@ -24,6 +25,7 @@ struct SparseImage {
     VkImage image = VK_NULL_HANDLE;
     std::vector<VkImageView> views; // per base level 0..tailFirst: that level and coarser
     uint32_t levels = 0;
+    uint32_t deviceTailFirst = 0; // the device's packed MIP tail (== levels: it has none)
 };
 
 struct SparseTextures {
@@ -34,7 +36,7 @@ struct SparseTextures {
     uint32_t memoryType = 0;
     VkDeviceMemory tailMemory = VK_NULL_HANDLE, poolMemory = VK_NULL_HANDLE;
     uint64_t tailBytes = 0, poolBytes = 0; // what is allocated: all the textures ever use
-    VkSemaphore bound = VK_NULL_HANDLE;   // signalled by this frame's binds
+    VkSemaphore bound = VK_NULL_HANDLE;    // signalled by this frame's binds
     SparseResidency residency;
     uint64_t pageBinds = 0, pageUnbinds = 0;
 };

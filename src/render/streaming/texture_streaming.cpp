@@ -161,7 +161,7 @@ struct TextureStreaming {
     std::vector<BindlessSlot> logical;          // per texture, persistent
     std::vector<uint32_t> logicalSlots;
     uint64_t imageBytes = 0; // what the cache images take (budget-checked)
-    bool sparseMode = false;  // --streaming sparse with a budget: `sparse` instead of tails+slots
+    bool sparseMode = false; // --streaming sparse with a budget: `sparse` instead of tails+slots
     SparseTextures sparse;
     VkSemaphore bindWait = VK_NULL_HANDLE; // this frame's sparse binds, for the frame to wait on
 
@@ -428,7 +428,7 @@ TextureStreamingPtr createTextureStreaming(Gpu& gpu, const Scene& scene,
         s.logicalSlots.push_back(s.logical.back().value);
     }
     SHADEL_INFO("texture streaming: %zu textures, %s, %.1f MiB of cache images", n,
-                s.resident       ? "all resident (no budget)"
+                s.resident     ? "all resident (no budget)"
                 : s.sparseMode ? "sparse residency"
                                : "layered cache",
                 double(s.imageBytes) / 1048576.0);
@@ -745,8 +745,8 @@ void textureStreamingStats(const TextureStreaming& s, nlohmann::json& stats) {
         sp["page_texels"] = {s.sparse.granularity.width, s.sparse.granularity.height};
         sp["pool_pages"] = res.poolPages;
         sp["pool_bytes"] = s.sparse.poolBytes;
-        sp["pages_resident"] = residentPages(res);  // bound to whole resident levels now
-        sp["pages_used_peak"] = s.sparsePagesPeak;   // resident or reserved for loads in flight
+        sp["pages_resident"] = residentPages(res); // bound to whole resident levels now
+        sp["pages_used_peak"] = s.sparsePagesPeak; // resident or reserved for loads in flight
         sp["pages_resident_per_frame"] = s.sparsePagesPerFrame;
         sp["page_binds"] = s.sparse.pageBinds;
         sp["page_unbinds"] = s.sparse.pageUnbinds;
