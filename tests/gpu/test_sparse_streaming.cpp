@@ -62,8 +62,10 @@ void expectConsistent(const SparseResidency& r, const std::vector<SparseLevelLoa
     for (const SparseLevelLoad& l : inFlight) {
         const SparseTexture& t = r.textures[l.texture];
         EXPECT_TRUE(t.pending);
-        EXPECT_EQ(l.level + 1, t.resident);
-        EXPECT_EQ(l.pages.size(), t.levelPages[l.level]);
+        EXPECT_EQ(l.level + l.levels, t.resident);
+        size_t pages = 0;
+        for (uint32_t k = l.level; k < t.resident; ++k) pages += t.levelPages[k];
+        EXPECT_EQ(l.pages.size(), pages);
         for (uint32_t p : l.pages) owners[p]++;
         pending++;
     }

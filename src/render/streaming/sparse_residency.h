@@ -5,12 +5,13 @@
 //
 // The same cache logic as the layered path (texture_cache.h) with pages instead of slots: each
 // texture wants a side (the merged CPU + GPU priority); its target level is the coarsest whose
-// side holds that. Levels come in one at a time, finest-resident minus one, as a load whose pages
-// are taken from the pool when it is planned; when the pool is short, textures holding more than
-// they want, then much lower priorities, give back their finest level (pairwise, by priority, with
-// the layered path's swap ratio). Every texture's MIP tail (levels from tailFirst on, as the device
-// packs them) is bound once at creation and never paged. The pool's size is fixed from the budget,
-// so bound memory never exceeds it by construction.
+// side holds that. The levels from there to the resident one come in as one load (fewer when the
+// pool cannot make room for all), whose pages are taken from the pool when it is planned; when the
+// pool is short, textures holding more than they want, then much lower priorities, give back their
+// finest level (pairwise, by priority, with the layered path's swap ratio). Every texture's MIP
+// tail (levels from tailFirst on, as the device packs them, and the levels smaller than a page) is
+// bound once at creation and never paged. The pool's size is fixed from the budget, so bound memory
+// never exceeds it by construction.
 //
 // Shaders never see a level that is not whole: a texture is sampled through a view starting at
 // its resident level, which moves only when a level's every page is bound and copied.
@@ -33,11 +34,12 @@ struct SparseTexture {
     uint32_t failedLoads = 0;
 };
 
-// A level load: `pages` (pool indices, one per block of the level in row-major block order) are
-// reserved for `level` of `texture` until the load lands (commit: bind + copy) or fails.
+// A load of levels [level, level + levels) (down to the texture's resident level): `pages` (pool
+// indices: per level from the finest, one per block in row-major block order) are reserved until
+// the load lands (commit: bind + copy) or fails.
 struct SparseLevelLoad {
     int32_t texture = -1;
-    uint32_t level = 0;
+    uint32_t level = 0, levels = 1;
     std::vector<uint32_t> pages;
 };
 

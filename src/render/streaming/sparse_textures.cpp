@@ -299,7 +299,15 @@ VkSemaphore submitSparseBinds(SparseTextures& s, const std::vector<const SparseL
         (bind ? s.pageBinds : s.pageUnbinds) += k;
     };
     for (const SparseEviction& e : unbinds) level(e.texture, e.level, e.pages, false);
-    for (const SparseLevelLoad* l : binds) level(l->texture, l->level, l->pages, true);
+    for (const SparseLevelLoad* l : binds) {
+        size_t k = 0;
+        for (uint32_t lvl = l->level; lvl < l->level + l->levels; ++lvl) {
+            uint32_t n = s.residency.textures[l->texture].levelPages[lvl];
+            level(l->texture, lvl,
+                  std::vector<uint32_t>(l->pages.begin() + k, l->pages.begin() + k + n), true);
+            k += n;
+        }
+    }
     std::vector<VkSparseImageMemoryBindInfo> infos;
     for (size_t i = 0; i < perImage.size(); ++i)
         if (!perImage[i].empty())

@@ -98,8 +98,8 @@ uint64_t levelBytesFrom(const PackedTexture& t, uint32_t firstLevel, uint32_t en
     return bytes;
 }
 
-// A load of an exchange's levels (layered) or of one level (sparse) from the file into the
-// staging ring.
+// A load of an exchange's levels (layered) or of the levels down to a target (sparse) from the file
+// into the staging ring.
 struct LoadJob {
     CacheExchange exchange;  // exchange.texture: the texture read (both modes)
     SparseLevelLoad sparse;  // sparse: the level and the pages it is bound to
@@ -467,7 +467,7 @@ static void prepareSparseFrame(TextureStreaming& s) {
         std::unique_ptr<LoadJob> job = std::move(s.jobs.front());
         s.jobs.pop_front();
         if (state == 2) {
-            SHADEL_WARN("texture streaming: texture %d level %u load failed (%s); it stays at "
+            SHADEL_WARN("texture streaming: texture %d levels %u.. load failed (%s); it stays at "
                         "its level",
                         job->sparse.texture, job->sparse.level, job->error.c_str());
             abandonSparseLoad(res, job->sparse);
@@ -490,7 +490,7 @@ static void prepareSparseFrame(TextureStreaming& s) {
     size_t started = 0;
     for (SparseLevelLoad& load : planned) {
         const PackedTexture& t = s.pack.textures[load.texture];
-        uint64_t bytes = t.levels[load.level].bytes, offset = 0;
+        uint64_t bytes = levelBytesFrom(t, load.level, load.level + load.levels), offset = 0;
         if (!s.ring.allocate(bytes, offset)) {
             abandonSparseLoad(res, load);
             res.textures[load.texture].failedLoads--; // not the load's fault: retried later
@@ -499,7 +499,7 @@ static void prepareSparseFrame(TextureStreaming& s) {
         auto job = std::make_unique<LoadJob>();
         job->exchange.texture = load.texture;
         job->firstLevel = load.level;
-        job->endLevel = load.level + 1;
+        job->endLevel = load.level + load.levels;
         job->sparse = std::move(load);
         job->stagingOffset = offset;
         job->bytes = bytes;
@@ -628,9 +628,10 @@ void recordTextureStreaming(TextureStreaming& s, VkCommandBuffer cmd) {
             VkImage image = s.sparse.images[l.texture].image;
             imageBarrier(cmd, image, VK_IMAGE_ASPECT_COLOR_BIT, VK_IMAGE_LAYOUT_UNDEFINED,
                          VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, VK_PIPELINE_STAGE_2_NONE, 0,
-                         VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT, l.level, 1);
+                         VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT, l.level,
+                         l.levels);
             std::vector<VkBufferImageCopy> regions;
-            appendLevelRegions(s.pack.textures[l.texture], l.level, l.level + 1, l.level,
+            appendLevelRegions(s.pack.textures[l.texture], l.level, l.level + l.levels, l.level,
                                job->stagingOffset, regions);
             vkCmdCopyBufferToImage(cmd, vkBuffer(gpu, s.staging), image,
                                    VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, uint32_t(regions.size()),
@@ -638,7 +639,7 @@ void recordTextureStreaming(TextureStreaming& s, VkCommandBuffer cmd) {
             imageBarrier(cmd, image, VK_IMAGE_ASPECT_COLOR_BIT,
                          VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, ro, VK_PIPELINE_STAGE_2_COPY_BIT,
                          VK_ACCESS_2_TRANSFER_WRITE_BIT, shaders,
-                         VK_ACCESS_2_SHADER_SAMPLED_READ_BIT, l.level, 1);
+                         VK_ACCESS_2_SHADER_SAMPLED_READ_BIT, l.level, l.levels);
         }
         return;
     }
