@@ -138,7 +138,7 @@ TEST(TextureStreamingSparsePolicy, PagesAreOwnedOnceAndLevelsStayWholeUnderRando
         inFlight = still;
         std::vector<SparseLevelLoad> planned;
         std::vector<SparseEviction> evicted;
-        planSparseLoads(r, limits, planned, evicted);
+        planSparseLoads(r, limits, ~0ull, planned, evicted);
         EXPECT_LE(r.pending, limits.pendingTotal);
         for (const SparseEviction& e : evicted) {
             // A level that changed this frame never goes in the same frame (one bind batch
@@ -168,7 +168,7 @@ TEST(TextureStreamingSparsePolicy, HighPrioritiesGetTheirLevelsAndLowOnesYield) 
             beginSparseFrame(r);
             std::vector<SparseLevelLoad> planned;
             std::vector<SparseEviction> evicted;
-            planSparseLoads(r, {}, planned, evicted);
+            planSparseLoads(r, {}, ~0ull, planned, evicted);
             for (const SparseLevelLoad& l : planned) commitSparseLoad(r, l); // land at once
             expectConsistent(r, {});
         }
@@ -198,6 +198,33 @@ TEST(TextureStreamingSparsePolicy, HighPrioritiesGetTheirLevelsAndLowOnesYield) 
     EXPECT_EQ(r.textures[1].resident, 1u);
     EXPECT_EQ(r.textures[0].resident, 3u);
     EXPECT_EQ(usedPages(r), 26u);
+}
+
+TEST(TextureStreamingSparsePolicy, LoadsTakeEveryLevelToTheTargetButNoMoreThanTheStagingHolds) {
+    SparseResidency r = makeSparseResidency({pagedTexture(512)}, 100);
+    r.textures[0].wanted = 512.0f;
+    std::vector<SparseLevelLoad> planned;
+    std::vector<SparseEviction> evicted;
+    beginSparseFrame(r);
+    planSparseLoads(r, {}, 5, planned, evicted); // levels 0..2 need 21 pages: 1..2 fit
+    ASSERT_EQ(planned.size(), 1u);
+    EXPECT_EQ(planned[0].level, 1u);
+    EXPECT_EQ(planned[0].levels, 2u);
+    EXPECT_EQ(planned[0].pages.size(), 5u);
+    commitSparseLoad(r, planned[0]);
+    planned.clear();
+    beginSparseFrame(r);
+    planSparseLoads(r, {}, 15, planned, evicted); // level 0 alone is 16 pages
+    EXPECT_TRUE(planned.empty());
+    beginSparseFrame(r);
+    planSparseLoads(r, {}, ~0ull, planned, evicted);
+    ASSERT_EQ(planned.size(), 1u);
+    EXPECT_EQ(planned[0].level, 0u);
+    EXPECT_EQ(planned[0].levels, 1u);
+    commitSparseLoad(r, planned[0]);
+    EXPECT_EQ(r.textures[0].resident, 0u);
+    EXPECT_EQ(residentPages(r), 21u);
+    EXPECT_TRUE(evicted.empty());
 }
 
 // The checks at test scale with pages instead of slots: the walk never exceeds the

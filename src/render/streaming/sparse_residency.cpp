@@ -85,7 +85,7 @@ static bool makeRoom(SparseResidency& r, int32_t requester, float wanted, uint64
     return true;
 }
 
-void planSparseLoads(SparseResidency& r, const TextureCacheLimits& limits,
+void planSparseLoads(SparseResidency& r, const TextureCacheLimits& limits, uint64_t maxLoadPages,
                      std::vector<SparseLevelLoad>& loads, std::vector<SparseEviction>& evictions) {
     std::vector<int32_t> order(r.textures.size());
     std::iota(order.begin(), order.end(), 0);
@@ -102,7 +102,8 @@ void planSparseLoads(SparseResidency& r, const TextureCacheLimits& limits,
         for (uint32_t first = sparseTargetLevel(tex); first < tex.resident; ++first) {
             uint64_t need = 0;
             for (uint32_t l = first; l < tex.resident; ++l) need += tex.levelPages[l];
-            if (need > r.poolPages || !makeRoom(r, c, tex.wanted, need, limits, evictions))
+            if (need > r.poolPages || need > maxLoadPages ||
+                !makeRoom(r, c, tex.wanted, need, limits, evictions))
                 continue;
             SparseLevelLoad load{c, first, tex.resident - first, {}};
             for (uint64_t i = 0; i < need; ++i) {

@@ -76,8 +76,9 @@ inline void beginSparseFrame(SparseResidency& r) {
 }
 
 // This frame's loads by priority (pages reserved, textures marked pending) and the evictions that
-// made room (applied at once: the texture's resident level is already coarser).
-void planSparseLoads(SparseResidency& r, const TextureCacheLimits& limits,
+// made room (applied at once: the texture's resident level is already coarser). No load takes
+// more than maxLoadPages (what the staging ring can hold).
+void planSparseLoads(SparseResidency& r, const TextureCacheLimits& limits, uint64_t maxLoadPages,
                      std::vector<SparseLevelLoad>& loads, std::vector<SparseEviction>& evictions);
 // A landed load: its level becomes resident. A failed one: its pages go back.
 void commitSparseLoad(SparseResidency& r, const SparseLevelLoad& load);

@@ -102,7 +102,7 @@ uint64_t levelBytesFrom(const PackedTexture& t, uint32_t firstLevel, uint32_t en
 // into the staging ring.
 struct LoadJob {
     CacheExchange exchange;  // exchange.texture: the texture read (both modes)
-    SparseLevelLoad sparse;  // sparse: the level and the pages it is bound to
+    SparseLevelLoad sparse;  // sparse: the levels and the pages they are bound to
     uint32_t firstLevel = 0; // layered: the pack level that becomes the slot's mip 0
     uint32_t endLevel = 0;   // pack levels [firstLevel, endLevel) are read
     uint64_t stagingOffset = 0, bytes = 0;
@@ -484,7 +484,10 @@ static void prepareSparseFrame(TextureStreaming& s) {
 
     std::vector<SparseLevelLoad> planned;
     std::vector<SparseEviction> evictions;
-    planSparseLoads(res, s.settings.limits, planned, evictions);
+    // Loads land in the staging ring: none larger than its free space (pages hold as many bytes
+    // as the file's RGBA8 tiles), so a load is rarely planned (and room made) for nothing.
+    uint64_t ringFree = s.ring.capacity - s.ring.used();
+    planSparseLoads(res, s.settings.limits, ringFree / s.sparse.pageBytes, planned, evictions);
     for (const SparseEviction& e : evictions) rebind(e.texture);
     s.sparseEvictions += evictions.size();
     size_t started = 0;
