@@ -276,6 +276,25 @@ TEST(TextureStreamingSparse, WalkMatchesResidentDecoupled) {
     EXPECT_GE(last, 35.0);
 }
 
+// A pool too small for what the walk wants (512^2 textures, 20 pages): textures that hold more
+// than they want give their finest level back, whose pages are unbound and bound elsewhere in
+// later frames, with the validation layer watching.
+TEST(TextureStreamingSparse, ATightPoolEvictsAndUnbindsLevels) {
+    RenderOptions o = sparseGallery(RenderMode::Forward, 10, 29.25);
+    o.galleryTextureSize = 512;
+    o.width = 320, o.height = 180;
+    RenderRun run = renderChecked(o);
+    const auto& st = run.stats["texture_streaming"];
+    const auto& sp = st["sparse"];
+    EXPECT_EQ(sp["pool_pages"].get<uint32_t>(), 20u);
+    EXPECT_GT(sp["level_evictions"].get<uint64_t>(), 0u);
+    EXPECT_GT(sp["page_unbinds"].get<uint64_t>(), 0u);
+    EXPECT_GT(sp["page_binds"].get<uint64_t>(), sp["pages_resident"].get<uint64_t>());
+    EXPECT_LE(sp["pages_used_peak"].get<uint32_t>(), 20u);
+    EXPECT_EQ(st["loads_failed"].get<uint64_t>(), 0u);
+    EXPECT_LE(run.stats["texture_memory_peak_bytes"].get<uint64_t>(), uint64_t(29.25 * 1048576.0));
+}
+
 TEST(TextureStreamingSparse, UnsupportedDeviceOrTooSmallBudgetExitWith2) {
     const std::string gallery = "render --size 16x16 --scene builtin:textures "
                                 "--gallery-texture-size 256 --streaming sparse ";
