@@ -18,6 +18,11 @@
 //
 // Without a budget every texture is loaded whole at start from the same file (the "everything
 // resident" reference for quality and timing).
+//
+// --streaming sparse (sparse_textures.h, sparse_residency.h): the same priorities, loads and
+// staging ring, but one sparse-resident image per texture whose MIP levels are paged in and out
+// of a fixed page pool instead of slots; the slot's view is rebound to start at the resident
+// level, and prepare queues the page binds the frame waits on (takeTextureStreamingWait).
 #include <memory>
 #include <string>
 #include <vector>
