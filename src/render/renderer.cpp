@@ -291,6 +291,8 @@ FrameResult renderFrame(Renderer& r, const GpuScene& scene, const CameraView& ca
     if (r.streaming) {
         prepareTextureStreaming(*r.streaming, camera, float(r.internalHeight), constants);
         r.restreamedMaterials = restreamedMaterials(*r.streaming);
+        if (VkSemaphore bound = takeTextureStreamingWait(*r.streaming)) // sparse page binds
+            r.recorder.waitOnce.push_back(bound);
     }
     constants.lighting = prepareLightCulling(
         r, scene, r.settings.animateLights ? r.lightsLastFrame : scene.lightInfo, constants);

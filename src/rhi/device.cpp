@@ -395,6 +395,16 @@ void createDevice(Device& device, const DeviceDesc& desc) {
     // Geometry capability.
     enable.core.features.geometryShader = f.core.features.geometryShader;
     device.optional.primitiveId = f.core.features.geometryShader == VK_TRUE;
+    // Sparse residency (texture streaming, --streaming sparse). SHADEL_DISABLE_SPARSE=1 leaves
+    // it off, as on a device without it (tests of that error path).
+    const char* noSparse = std::getenv("SHADEL_DISABLE_SPARSE");
+    if ((!noSparse || std::strcmp(noSparse, "1") != 0) && f.core.features.sparseBinding &&
+        f.core.features.sparseResidencyImage2D &&
+        (families[device.queueFamily].queueFlags & VK_QUEUE_SPARSE_BINDING_BIT)) {
+        enable.core.features.sparseBinding = VK_TRUE;
+        enable.core.features.sparseResidencyImage2D = VK_TRUE;
+        device.optional.sparseResidency = true;
+    }
 
     auto exts = deviceExtensions(device.physical);
     std::vector<const char*> deviceExts;
@@ -518,9 +528,10 @@ std::string describeDevice(const Device& device) {
            "bufferDeviceAddress shaderInt64 shaderBufferInt64Atomics fragmentStoresAndAtomics "
            "multiDrawIndirect drawIndirectCount timestamps: all present\n";
     out +=
-        format("optional: meshShader=%s rayQuery=%s computeDerivatives=%s\n",
+        format("optional: meshShader=%s rayQuery=%s computeDerivatives=%s sparseResidency=%s\n",
                device.optional.meshShader ? "yes" : "no", device.optional.rayQuery ? "yes" : "no",
-               device.optional.computeDerivatives ? "yes" : "no");
+               device.optional.computeDerivatives ? "yes" : "no",
+               device.optional.sparseResidency ? "yes" : "no");
     out += format("limits:   maxImageDimension2D=%u maxComputeWorkGroupInvocations=%u "
                   "maxPushConstantsSize=%u maxDescriptorSetUpdateAfterBindSampledImages=%u "
                   "timestampPeriod=%.3fns\n",

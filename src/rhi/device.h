@@ -23,6 +23,8 @@ struct DeviceFeatures { // optional features, used when present
     bool rayQuery = false;
     bool computeDerivatives = false;
     bool primitiveId = false; // fragment gl_PrimitiveID (geometryShader feature)
+    // sparseBinding + sparseResidencyImage2D, on a queue with sparse binding (--streaming sparse)
+    bool sparseResidency = false;
 };
 
 struct Device {

@@ -57,6 +57,16 @@ static void submitAndWait(FrameRecorder& r) {
     VkSubmitInfo2 si{VK_STRUCTURE_TYPE_SUBMIT_INFO_2};
     si.commandBufferInfoCount = 1;
     si.pCommandBufferInfos = &cbi;
+    std::vector<VkSemaphoreSubmitInfo> waits;
+    for (VkSemaphore sem : r.waitOnce) {
+        VkSemaphoreSubmitInfo w{VK_STRUCTURE_TYPE_SEMAPHORE_SUBMIT_INFO};
+        w.semaphore = sem;
+        w.stageMask = VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT;
+        waits.push_back(w);
+    }
+    r.waitOnce.clear();
+    si.waitSemaphoreInfoCount = uint32_t(waits.size());
+    si.pWaitSemaphoreInfos = waits.data();
     VK_CHECK(vkResetFences(r.gpu->device.device, 1, &r.fence));
     VK_CHECK(vkQueueSubmit2(r.gpu->device.queue, 1, &si, r.fence));
     auto waitStart = std::chrono::steady_clock::now();

@@ -36,6 +36,9 @@ struct FrameRecorder {
     double frameMs = 0.0;           // wall clock from beginFrame to the GPU finishing
     double gpuWaitMs = 0.0;         // of which the CPU waited on fences
     std::chrono::steady_clock::time_point frameStart;
+    // Binary semaphores the frame's next submission waits on (at every stage), then forgets:
+    // work queued before the frame that the frame depends on (sparse binds, render/streaming).
+    std::vector<VkSemaphore> waitOnce;
 };
 
 void initFrameRecorder(Gpu& gpu, FrameRecorder& recorder, TimingMode mode);

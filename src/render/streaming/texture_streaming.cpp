@@ -14,6 +14,7 @@
 #include "bake/texture_pack.h"
 #include "core/error.h"
 #include "core/log.h"
+#include "render/streaming/sparse_textures.h"
 #include "render/streaming/texture_priority.h"
 #include "rhi/bindless.h"
 #include "rhi/gpu.h"
@@ -64,11 +65,13 @@ void destroyCacheImage(Gpu& gpu, CacheImage& c) {
     c = {};
 }
 
-// The copy regions of consecutive pack levels [firstLevel, end) of `level` sides, tiles as the
-// file stores them, at bufferOffset in a buffer, into mips 0.. of an image.
-void appendLevelRegions(const PackedTexture& t, uint32_t firstLevel, VkDeviceSize bufferOffset,
+// The copy regions of consecutive pack levels [firstLevel, endLevel), tiles as the file stores
+// them, at bufferOffset in a buffer, into mips firstMip.. of an image (0 for a layered slot, whose
+// mip 0 is the level it holds; firstLevel for a sparse image, which holds every level).
+void appendLevelRegions(const PackedTexture& t, uint32_t firstLevel, uint32_t endLevel,
+                        uint32_t firstMip, VkDeviceSize bufferOffset,
                         std::vector<VkBufferImageCopy>& regions) {
-    for (uint32_t l = firstLevel; l < t.levels.size(); ++l) {
+    for (uint32_t l = firstLevel; l < endLevel; ++l) {
         uint32_t side = t.levels[l].size;
         uint32_t tile = std::min(side, kTexturePackTile);
         VkDeviceSize o = bufferOffset;
@@ -78,7 +81,7 @@ void appendLevelRegions(const PackedTexture& t, uint32_t firstLevel, VkDeviceSiz
                 r.bufferOffset = o;
                 r.bufferRowLength = tile;
                 r.bufferImageHeight = tile;
-                r.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, l - firstLevel, 0, 1};
+                r.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, l - firstLevel + firstMip, 0, 1};
                 r.imageOffset = {int32_t(tx), int32_t(ty), 0};
                 r.imageExtent = {tile, tile, 1};
                 regions.push_back(r);
@@ -88,16 +91,20 @@ void appendLevelRegions(const PackedTexture& t, uint32_t firstLevel, VkDeviceSiz
     }
 }
 
-uint64_t levelBytesFrom(const PackedTexture& t, uint32_t firstLevel) {
+uint64_t levelBytesFrom(const PackedTexture& t, uint32_t firstLevel, uint32_t endLevel = ~0u) {
     uint64_t bytes = 0;
-    for (uint32_t l = firstLevel; l < t.levels.size(); ++l) bytes += t.levels[l].bytes;
+    endLevel = std::min<uint32_t>(endLevel, uint32_t(t.levels.size()));
+    for (uint32_t l = firstLevel; l < endLevel; ++l) bytes += t.levels[l].bytes;
     return bytes;
 }
 
-// A load of an exchange's levels from the file into the staging ring.
+// A load of an exchange's levels (layered) or of the levels down to a target (sparse) from the file
+// into the staging ring.
 struct LoadJob {
-    CacheExchange exchange;
-    uint32_t firstLevel = 0; // the pack level that becomes the slot's mip 0
+    CacheExchange exchange;  // exchange.texture: the texture read (both modes)
+    SparseLevelLoad sparse;  // sparse: the levels and the pages they are bound to
+    uint32_t firstLevel = 0; // layered: the pack level that becomes the slot's mip 0
+    uint32_t endLevel = 0;   // pack levels [firstLevel, endLevel) are read
     uint64_t stagingOffset = 0, bytes = 0;
     std::atomic<int> state{0}; // 0 queued, 1 loaded, 2 failed
     std::string error;
@@ -154,6 +161,9 @@ struct TextureStreaming {
     std::vector<BindlessSlot> logical;          // per texture, persistent
     std::vector<uint32_t> logicalSlots;
     uint64_t imageBytes = 0; // what the cache images take (budget-checked)
+    bool sparseMode = false; // --streaming sparse with a budget: `sparse` instead of tails+slots
+    SparseTextures sparse;
+    VkSemaphore bindWait = VK_NULL_HANDLE; // this frame's sparse binds, for the frame to wait on
 
     // Priorities.
     std::vector<TextureUse> uses;
@@ -179,6 +189,9 @@ struct TextureStreaming {
     uint64_t exchangesStarted = 0, exchangesCommitted = 0, loadsFailed = 0, bytesLoaded = 0;
     std::vector<uint64_t> residentPerFrame, exchangesPerFrame;
     std::vector<uint32_t> pendingPerFrame;
+    std::vector<uint32_t> sparsePagesPerFrame; // resident pages after each frame
+    uint32_t sparsePagesPeak = 0;              // used pages (resident + reserved), peak
+    uint64_t sparseEvictions = 0;
     double prepareMsTotal = 0.0;
 };
 
@@ -196,7 +209,7 @@ static void workerLoop(TextureStreaming* s) {
         const PackedTexture& t = s->pack.textures[job->exchange.texture];
         uint64_t o = job->stagingOffset;
         bool ok = true;
-        for (uint32_t l = job->firstLevel; l < t.levels.size() && ok; ++l) {
+        for (uint32_t l = job->firstLevel; l < job->endLevel && ok; ++l) {
             ok = readPackedLevel(s->fd, t.levels[l], base + o, &job->error);
             o += t.levels[l].bytes;
         }
@@ -218,6 +231,7 @@ void TextureStreamingDeleter::operator()(TextureStreaming* s) const {
     for (CacheImage& c : s->tails) destroyCacheImage(gpu, c);
     for (auto& layer : s->slots)
         for (CacheImage& c : layer) destroyCacheImage(gpu, c);
+    destroySparseTextures(s->sparse);
     destroy(gpu, s->feedback);
     destroy(gpu, s->staging);
     if (s->fd >= 0) ::close(s->fd);
@@ -244,11 +258,16 @@ static uint64_t deviceImageBytes(Gpu& gpu, uint32_t size) {
     return (req.memoryRequirements.size + align - 1) / align * align;
 }
 
-// Uploads pack levels [firstLevel, end) of each listed texture into its image, synchronously
-// (creation only: the tails, or every texture whole without a budget), a few at a time.
+// Uploads pack levels [firstLevel, end) of each listed texture into its image from mip firstMip
+// on (0: a cache image; firstLevel: a sparse image's tail), synchronously (creation only: the
+// tails, or every texture whole without a budget), a few at a time.
+struct InitialUpload {
+    VkImage image = VK_NULL_HANDLE;
+    uint32_t firstMip = 0;
+};
 static void uploadWhole(TextureStreaming& s,
                         const std::vector<std::pair<uint32_t, uint32_t>>& items,
-                        const std::vector<CacheImage>& images) {
+                        const std::vector<InitialUpload>& images) {
     Gpu& gpu = *s.gpu;
     const uint64_t batchLimit = 256ull << 20;
     size_t i = 0;
@@ -280,14 +299,15 @@ static void uploadWhole(TextureStreaming& s,
         }
         immediateSubmit(gpu, [&](VkCommandBuffer cmd) {
             for (size_t k = i; k < end; ++k) {
-                const CacheImage& img = images[k];
-                VkImage image = vkImage(gpu, img.image);
+                VkImage image = images[k].image;
+                uint32_t mip = images[k].firstMip;
                 imageBarrier(cmd, image, VK_IMAGE_ASPECT_COLOR_BIT, VK_IMAGE_LAYOUT_UNDEFINED,
                              VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, VK_PIPELINE_STAGE_2_NONE, 0,
-                             VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT);
+                             VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT, mip);
+                const PackedTexture& t = s.pack.textures[items[k].first];
                 std::vector<VkBufferImageCopy> regions;
-                appendLevelRegions(s.pack.textures[items[k].first], items[k].second, offsets[k - i],
-                                   regions);
+                appendLevelRegions(t, items[k].second, uint32_t(t.levels.size()), mip,
+                                   offsets[k - i], regions);
                 vkCmdCopyBufferToImage(cmd, vkBuffer(gpu, staging), image,
                                        VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL,
                                        uint32_t(regions.size()), regions.data());
@@ -295,7 +315,7 @@ static void uploadWhole(TextureStreaming& s,
                              VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL,
                              VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, VK_PIPELINE_STAGE_2_COPY_BIT,
                              VK_ACCESS_2_TRANSFER_WRITE_BIT, VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT,
-                             VK_ACCESS_2_SHADER_SAMPLED_READ_BIT);
+                             VK_ACCESS_2_SHADER_SAMPLED_READ_BIT, mip);
             }
         });
         destroy(gpu, staging);
@@ -310,8 +330,10 @@ static VkImageView viewFor(const TextureStreaming& s, const CacheImage& c, uint3
 TextureStreamingPtr createTextureStreaming(Gpu& gpu, const Scene& scene,
                                            const TextureStreamingSettings& settings,
                                            const std::string& cacheDir) {
-    if (settings.mode == StreamingMode::Sparse)
-        throw InputError("--streaming sparse: not built yet (only layered)");
+    if (settings.mode == StreamingMode::Sparse) {
+        std::string why = sparseUnsupportedReason(gpu);
+        if (!why.empty()) throw InputError("--streaming sparse: " + why);
+    }
     TextureStreamingPtr sp(new TextureStreaming);
     TextureStreaming& s = *sp;
     s.gpu = &gpu;
@@ -325,17 +347,33 @@ TextureStreamingPtr createTextureStreaming(Gpu& gpu, const Scene& scene,
     std::vector<uint32_t> sizes;
     for (const PackedTexture& t : s.pack.textures) sizes.push_back(t.size);
 
-    // Images: the tails (or, resident, every texture whole).
+    uint64_t budget = uint64_t(settings.budgetMiB * 1048576.0);
+    s.sparseMode = !s.resident && settings.mode == StreamingMode::Sparse;
+
+    // Images: the tails (or, resident, every texture whole; or the sparse images, tails bound).
     std::vector<std::pair<uint32_t, uint32_t>> items;
-    for (uint32_t i = 0; i < n; ++i) {
-        uint32_t side = s.resident ? sizes[i] : std::min(sizes[i], kTailSize);
-        s.tails.push_back(makeCacheImage(
-            gpu, format("streaming.%s.%u", s.resident ? "texture" : "tail", i), side));
-        items.push_back({i, log2u(sizes[i]) - log2u(side)});
-        s.imageBytes += deviceImageBytes(gpu, side);
+    std::vector<InitialUpload> targets;
+    if (s.sparseMode) {
+        std::vector<bool> srgb;
+        for (const PackedTexture& t : s.pack.textures) srgb.push_back(t.srgb);
+        createSparseTextures(gpu, sizes, srgb, budget, s.sparse);
+        for (uint32_t i = 0; i < n; ++i) {
+            uint32_t tailFirst = s.sparse.residency.textures[i].tailFirst;
+            items.push_back({i, tailFirst});
+            targets.push_back({s.sparse.images[i].image, tailFirst});
+        }
+        s.imageBytes = s.sparse.tailBytes + s.sparse.poolBytes; // allocated once, never grown
+    } else {
+        for (uint32_t i = 0; i < n; ++i) {
+            uint32_t side = s.resident ? sizes[i] : std::min(sizes[i], kTailSize);
+            s.tails.push_back(makeCacheImage(
+                gpu, format("streaming.%s.%u", s.resident ? "texture" : "tail", i), side));
+            items.push_back({i, log2u(sizes[i]) - log2u(side)});
+            targets.push_back({vkImage(gpu, s.tails.back().image), 0});
+            s.imageBytes += deviceImageBytes(gpu, side);
+        }
     }
-    if (!s.resident) {
-        uint64_t budget = uint64_t(settings.budgetMiB * 1048576.0);
+    if (!s.resident && !s.sparseMode) {
         s.cache = makeTextureCache(sizes, budget,
                                    [&](uint32_t side) { return deviceImageBytes(gpu, side); });
         for (size_t k = 0; k < s.cache.layers.size(); ++k) {
@@ -356,6 +394,8 @@ TextureStreamingPtr createTextureStreaming(Gpu& gpu, const Scene& scene,
                                  0, VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT,
                                  VK_ACCESS_2_SHADER_SAMPLED_READ_BIT);
         });
+    }
+    if (!s.resident) {
         s.feedback =
             createBuffer(gpu, {"streaming.feedback", kBindlessSampledCapacity * sizeof(uint32_t),
                                VK_BUFFER_USAGE_TRANSFER_DST_BIT, MemoryKind::Readback});
@@ -379,14 +419,18 @@ TextureStreamingPtr createTextureStreaming(Gpu& gpu, const Scene& scene,
         s.gpuSeenFrame.assign(n, 0);
         s.worker = std::thread(workerLoop, &s);
     }
-    uploadWhole(s, items, s.tails);
+    uploadWhole(s, items, targets);
     for (uint32_t i = 0; i < n; ++i) {
-        s.logical.push_back(allocateBindless(gpu, BindlessKind::Sampled, viewFor(s, s.tails[i], i),
+        VkImageView view =
+            s.sparseMode ? sparseResidentView(s.sparse, i) : viewFor(s, s.tails[i], i);
+        s.logical.push_back(allocateBindless(gpu, BindlessKind::Sampled, view,
                                              VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL));
         s.logicalSlots.push_back(s.logical.back().value);
     }
     SHADEL_INFO("texture streaming: %zu textures, %s, %.1f MiB of cache images", n,
-                s.resident ? "all resident (no budget)" : "layered cache",
+                s.resident     ? "all resident (no budget)"
+                : s.sparseMode ? "sparse residency"
+                               : "layered cache",
                 double(s.imageBytes) / 1048576.0);
     return sp;
 }
@@ -397,6 +441,87 @@ const std::vector<uint32_t>& streamedTextureSlots(const TextureStreaming& s) {
 
 const std::vector<uint8_t>& restreamedMaterials(const TextureStreaming& s) {
     return s.restreamed;
+}
+
+static void markRestreamed(TextureStreaming& s, int32_t texture) {
+    if (texture >= 0)
+        for (uint32_t m : s.materialsOf[texture]) s.restreamed[m] = 1;
+}
+
+// Sparse residency's frame (priorities already merged): landed level loads bound (their copies
+// are the pass's), new loads planned with the evictions that make room, all binds queued for the
+// frame to wait on; every texture whose level changed sampled through its new view.
+static void prepareSparseFrame(TextureStreaming& s) {
+    Gpu& gpu = *s.gpu;
+    SparseResidency& res = s.sparse.residency;
+    beginSparseFrame(res);
+    std::vector<const SparseLevelLoad*> binds;
+    auto rebind = [&](int32_t t) {
+        updateBindless(gpu, BindlessKind::Sampled, s.logical[t], sparseResidentView(s.sparse, t),
+                       VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL);
+        markRestreamed(s, t);
+    };
+    while (!s.jobs.empty()) {
+        int state = s.jobs.front()->state.load(std::memory_order_acquire);
+        if (state == 0) break;
+        std::unique_ptr<LoadJob> job = std::move(s.jobs.front());
+        s.jobs.pop_front();
+        if (state == 2) {
+            SHADEL_WARN("texture streaming: texture %d levels %u.. load failed (%s); it stays at "
+                        "its level",
+                        job->sparse.texture, job->sparse.level, job->error.c_str());
+            abandonSparseLoad(res, job->sparse);
+            s.loadsFailed++;
+        } else {
+            commitSparseLoad(res, job->sparse);
+            binds.push_back(&job->sparse);
+            rebind(job->sparse.texture);
+            s.exchangesCommitted++;
+            s.bytesLoaded += job->bytes;
+        }
+        s.landed.push_back(std::move(job)); // copied by the pass; staging freed in order
+    }
+
+    std::vector<SparseLevelLoad> planned;
+    std::vector<SparseEviction> evictions;
+    // Loads land in the staging ring: none larger than its free space (pages hold as many bytes
+    // as the file's RGBA8 tiles), so a load is rarely planned (and room made) for nothing.
+    uint64_t ringFree = s.ring.capacity - s.ring.used();
+    planSparseLoads(res, s.settings.limits, ringFree / s.sparse.pageBytes, planned, evictions);
+    for (const SparseEviction& e : evictions) rebind(e.texture);
+    s.sparseEvictions += evictions.size();
+    size_t started = 0;
+    for (SparseLevelLoad& load : planned) {
+        const PackedTexture& t = s.pack.textures[load.texture];
+        uint64_t bytes = levelBytesFrom(t, load.level, load.level + load.levels), offset = 0;
+        if (!s.ring.allocate(bytes, offset)) {
+            abandonSparseLoad(res, load);
+            res.textures[load.texture].failedLoads--; // not the load's fault: retried later
+            continue;
+        }
+        auto job = std::make_unique<LoadJob>();
+        job->exchange.texture = load.texture;
+        job->firstLevel = load.level;
+        job->endLevel = load.level + load.levels;
+        job->sparse = std::move(load);
+        job->stagingOffset = offset;
+        job->bytes = bytes;
+        {
+            std::lock_guard<std::mutex> lock(s.mutex);
+            s.queue.push_back(job.get());
+        }
+        s.jobs.push_back(std::move(job));
+        ++started;
+    }
+    if (started) s.wake.notify_one();
+    s.exchangesStarted += started;
+    s.bindWait = submitSparseBinds(s.sparse, binds, evictions);
+}
+
+VkSemaphore takeTextureStreamingWait(TextureStreaming& s) {
+    VkSemaphore sem = s.bindWait;
+    s.bindWait = VK_NULL_HANDLE;
+    return sem;
 }
 
 void prepareTextureStreaming(TextureStreaming& s, const CameraView& camera, float viewportHeight,
@@ -416,11 +541,19 @@ void prepareTextureStreaming(TextureStreaming& s, const CameraView& camera, floa
         }
     }
     std::vector<float> cpu = cpuWantedSizes(s.uses, n, camera, viewportHeight);
-    for (size_t t = 0; t < n; ++t)
-        s.cache.textures[t].wanted = mergedWanted(cpu[t], s.gpuWanted[t], s.settings.cpuCap);
+    for (size_t t = 0; t < n; ++t) {
+        float wanted = mergedWanted(cpu[t], s.gpuWanted[t], s.settings.cpuCap);
+        (s.sparseMode ? s.sparse.residency.textures[t].wanted : s.cache.textures[t].wanted) =
+            wanted;
+    }
+    std::fill(s.restreamed.begin(), s.restreamed.end(), 0);
+    constants.textureFeedback = address(gpu, s.feedback);
+    if (s.sparseMode) {
+        prepareSparseFrame(s);
+        return;
+    }
 
     // Landed loads, in queue order: commit (ownership, bindless) and leave the copies to the pass.
-    std::fill(s.restreamed.begin(), s.restreamed.end(), 0);
     while (!s.jobs.empty()) {
         int state = s.jobs.front()->state.load(std::memory_order_acquire);
         if (state == 0) break;
@@ -468,6 +601,7 @@ void prepareTextureStreaming(TextureStreaming& s, const CameraView& camera, floa
         auto job = std::make_unique<LoadJob>();
         job->exchange = e;
         job->firstLevel = first;
+        job->endLevel = uint32_t(t.levels.size());
         job->stagingOffset = offset;
         job->bytes = bytes;
         {
@@ -479,7 +613,6 @@ void prepareTextureStreaming(TextureStreaming& s, const CameraView& camera, floa
     }
     if (started) s.wake.notify_one();
     s.exchangesStarted += started;
-    constants.textureFeedback = address(gpu, s.feedback);
 }
 
 void recordTextureStreaming(TextureStreaming& s, VkCommandBuffer cmd) {
@@ -491,6 +624,28 @@ void recordTextureStreaming(TextureStreaming& s, VkCommandBuffer cmd) {
                   VK_ACCESS_2_SHADER_STORAGE_READ_BIT | VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT);
     const VkImageLayout ro = VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL;
     const VkPipelineStageFlags2 shaders = VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT;
+    if (s.sparseMode) { // each landed level into its freshly bound pages (the frame waited on them)
+        for (const auto& job : s.landed) {
+            if (job->state.load(std::memory_order_acquire) != 1) continue;
+            const SparseLevelLoad& l = job->sparse;
+            VkImage image = s.sparse.images[l.texture].image;
+            imageBarrier(cmd, image, VK_IMAGE_ASPECT_COLOR_BIT, VK_IMAGE_LAYOUT_UNDEFINED,
+                         VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, VK_PIPELINE_STAGE_2_NONE, 0,
+                         VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT, l.level,
+                         l.levels);
+            std::vector<VkBufferImageCopy> regions;
+            appendLevelRegions(s.pack.textures[l.texture], l.level, l.level + l.levels, l.level,
+                               job->stagingOffset, regions);
+            vkCmdCopyBufferToImage(cmd, vkBuffer(gpu, s.staging), image,
+                                   VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, uint32_t(regions.size()),
+                                   regions.data());
+            imageBarrier(cmd, image, VK_IMAGE_ASPECT_COLOR_BIT,
+                         VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, ro, VK_PIPELINE_STAGE_2_COPY_BIT,
+                         VK_ACCESS_2_TRANSFER_WRITE_BIT, shaders,
+                         VK_ACCESS_2_SHADER_SAMPLED_READ_BIT, l.level, l.levels);
+        }
+        return;
+    }
     for (const auto& job : s.landed) {
         if (job->state.load(std::memory_order_acquire) != 1) continue; // failed: nothing landed
         const CacheExchange& e = job->exchange;
@@ -536,7 +691,7 @@ void recordTextureStreaming(TextureStreaming& s, VkCommandBuffer cmd) {
                          VK_ACCESS_2_TRANSFER_WRITE_BIT);
         }
         std::vector<VkBufferImageCopy> regions;
-        appendLevelRegions(t, job->firstLevel, job->stagingOffset, regions);
+        appendLevelRegions(t, job->firstLevel, job->endLevel, 0, job->stagingOffset, regions);
         vkCmdCopyBufferToImage(cmd, vkBuffer(gpu, s.staging), up,
                                VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, uint32_t(regions.size()),
                                regions.data());
@@ -553,8 +708,15 @@ void finishTextureStreamingFrame(TextureStreaming& s) {
     for (const auto& job : s.landed) copied += job->state.load(std::memory_order_acquire) == 1;
     s.exchangesPerFrame.push_back(copied);
     s.landed.clear();
-    s.residentPerFrame.push_back(residentBytes(s.cache));
-    s.pendingPerFrame.push_back(s.cache.pending);
+    if (s.sparseMode) {
+        uint32_t pages = residentPages(s.sparse.residency);
+        s.sparsePagesPerFrame.push_back(pages);
+        s.sparsePagesPeak = std::max(s.sparsePagesPeak, usedPages(s.sparse.residency));
+        s.residentPerFrame.push_back(s.sparse.tailBytes + uint64_t(pages) * s.sparse.pageBytes);
+    } else {
+        s.residentPerFrame.push_back(residentBytes(s.cache));
+    }
+    s.pendingPerFrame.push_back(s.sparseMode ? s.sparse.residency.pending : s.cache.pending);
     s.frame++;
 }
 
@@ -565,13 +727,43 @@ uint64_t textureMemoryPeakBytes(const TextureStreaming& s) {
 void textureStreamingStats(const TextureStreaming& s, nlohmann::json& stats) {
     stats["texture_memory_peak_bytes"] = textureMemoryPeakBytes(s);
     nlohmann::json j;
-    j["mode"] = s.resident ? "resident" : "layered";
+    j["mode"] = s.resident ? "resident" : s.sparseMode ? "sparse" : "layered";
     j["textures"] = s.pack.textures.size();
     j["file"] = s.pack.path;
     j["file_bytes"] = s.pack.fileSize;
     j["budget_bytes"] = s.resident ? 0 : uint64_t(s.settings.budgetMiB * 1048576.0);
     j["cache_image_bytes"] = s.imageBytes;
-    if (!s.resident) {
+    if (s.sparseMode) {
+        const SparseResidency& res = s.sparse.residency;
+        j["tail_bytes"] = s.sparse.tailBytes;
+        j["staging_ring_bytes"] = s.ring.capacity;
+        j["exchanges_started"] = s.exchangesStarted; // level loads
+        j["exchanges_committed"] = s.exchangesCommitted;
+        j["loads_failed"] = s.loadsFailed;
+        j["bytes_loaded"] = s.bytesLoaded;
+        j["resident_bytes_per_frame"] = s.residentPerFrame;
+        j["pending_per_frame"] = s.pendingPerFrame;
+        j["exchanges_per_frame"] = s.exchangesPerFrame;
+        nlohmann::json sp;
+        sp["page_bytes"] = s.sparse.pageBytes;
+        sp["page_texels"] = {s.sparse.granularity.width, s.sparse.granularity.height};
+        sp["pool_pages"] = res.poolPages;
+        sp["pool_bytes"] = s.sparse.poolBytes;
+        sp["pages_resident"] = residentPages(res); // bound to whole resident levels now
+        sp["pages_used_peak"] = s.sparsePagesPeak; // resident or reserved for loads in flight
+        sp["pages_resident_per_frame"] = s.sparsePagesPerFrame;
+        sp["page_binds"] = s.sparse.pageBinds;
+        sp["page_unbinds"] = s.sparse.pageUnbinds;
+        sp["level_evictions"] = s.sparseEvictions;
+        j["sparse"] = sp;
+        nlohmann::json sizes = nlohmann::json::array(), levels = nlohmann::json::array();
+        for (const SparseTexture& t : res.textures) {
+            sizes.push_back(t.size >> t.resident);
+            levels.push_back(t.resident);
+        }
+        j["resident_sizes"] = sizes;
+        j["resident_levels"] = levels;
+    } else if (!s.resident) {
         nlohmann::json layers = nlohmann::json::array();
         for (const CacheLayer& l : s.cache.layers) {
             uint32_t used = 0;

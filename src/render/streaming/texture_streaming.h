@@ -18,6 +18,11 @@
 //
 // Without a budget every texture is loaded whole at start from the same file (the "everything
 // resident" reference for quality and timing).
+//
+// --streaming sparse (sparse_textures.h, sparse_residency.h): the same priorities, loads and
+// staging ring, but one sparse-resident image per texture whose MIP levels are paged in and out
+// of a fixed page pool instead of slots; the slot's view is rebound to start at the resident
+// level, and prepare queues the page binds the frame waits on (takeTextureStreamingWait).
 #include <memory>
 #include <string>
 #include <vector>
@@ -64,6 +69,9 @@ void prepareTextureStreaming(TextureStreaming& s, const CameraView& camera, floa
 // Per scene material: 1 when a texture it samples changed residency in this frame's prepare
 // (shading stored in earlier frames is stale: the decoupled path must not carry it over).
 const std::vector<uint8_t>& restreamedMaterials(const TextureStreaming& s);
+// --streaming sparse: the semaphore this frame's page binds signal (the frame's first submission
+// waits on it), then forgotten; null when nothing was bound.
+VkSemaphore takeTextureStreamingWait(TextureStreaming& s);
 void recordTextureStreaming(TextureStreaming& s, VkCommandBuffer cmd);
 void finishTextureStreamingFrame(TextureStreaming& s);
 
