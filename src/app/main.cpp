@@ -99,6 +99,12 @@ int main(int argc, char** argv) {
         ->add_option("--time", timeSeconds,
                      "SECONDS: pose glTF animations (node TRS, morph weights, skins) at this time")
         ->check(finiteInRange(kTimeRange));
+    double timeStep = 0.0;
+    render
+        ->add_option("--time-step", timeStep,
+                     "SECONDS: animated playback over --frames: frame i posed at --time (default "
+                     "0) + i * SECONDS (node TRS, morph weights, skins)")
+        ->check(finiteInRange(kTimeStepRange));
     render
         ->add_option("--fov", ro.cameraOverrides.fovDegrees,
                      "vertical field of view in degrees (default: the camera's)")
@@ -486,6 +492,10 @@ int main(int argc, char** argv) {
             ro.shadelsPerMetre = parseDensity(density);
             ro.cameraPath = parseCameraPath(cameraPath);
             if (timeSeconds >= 0.0) ro.time = timeSeconds;
+            if (timeStep != 0.0) {
+                ro.timeStep = timeStep;
+                if (!ro.time) ro.time = 0.0;
+            }
             if (!from.empty())
                 ro.cameraOverrides.from = parseVec3("--from", from, kCoordinateRange);
             if (!lookAt.empty())

@@ -177,6 +177,7 @@ void uploadScene(Gpu& gpu, const Scene& scene, GpuScene& out, const std::vector<
     std::vector<uint32_t> indices;
     out.meshInfo.clear();
     out.lodInfo.clear();
+    out.vertexSource.clear();
     for (size_t mi = 0; mi < scene.meshes.size(); ++mi) {
         const Mesh& mesh = scene.meshes[mi];
         gpu::GpuMesh g{};
@@ -192,6 +193,7 @@ void uploadScene(Gpu& gpu, const Scene& scene, GpuScene& out, const std::vector<
                 geometry.vertices.push_back({src.position, src.normal, src.tangent, src.uv0});
             }
             geometry.shadelUvs = b->shadelUv;
+            geometry.sources = b->vertexRemap;
             geometry.indices = b->indices;
             geometry.keepTriangleOrder = true; // the triangle-ID maps index LOD 0's triangles
             g.shadelMesh = uint32_t(mi);
@@ -201,8 +203,9 @@ void uploadScene(Gpu& gpu, const Scene& scene, GpuScene& out, const std::vector<
             geometry.indices = mesh.indices;
         }
         // LOD 0 and its simplified levels, all in the unified buffers (render/culling).
-        gpu::GpuMeshLods lods = appendMeshWithLods(std::move(geometry), vertices,
-                                                   baked ? &shadelUvs : nullptr, indices);
+        gpu::GpuMeshLods lods =
+            appendMeshWithLods(std::move(geometry), vertices, baked ? &shadelUvs : nullptr, indices,
+                               &out.vertexSource);
         g.firstIndex = lods.lod[0].firstIndex;
         g.indexCount = lods.lod[0].indexCount;
         out.meshInfo.push_back(g);

@@ -200,6 +200,9 @@ struct Renderer {
     // Texture streaming (render/streaming), owned by the caller; null: textures loaded whole.
     TextureStreaming* streaming = nullptr;
     std::vector<uint8_t> restreamedMaterials; // per material: a texture of it changed this frame
+    // Per instance: animated playback (render/animation) moved or deformed it before this frame;
+    // empty without playback. Decoupled reuse reshades these; spot shadow maps are redrawn.
+    std::vector<uint8_t> reposedInstances;
     SpectraStatePtr spectra;        // --spectra on|single (render/lighting/feature_spectra.h)
     SpotShadowStatePtr spotShadows; // shadow-casting spots (render/lighting/spot_shadows.h)
     std::chrono::steady_clock::time_point createdAt = std::chrono::steady_clock::now();
