@@ -334,6 +334,8 @@ RenderRun runRender(Gpu& gpu, const RenderOptions& o) {
             renderer.distanceFields = createDistanceFields(
                 renderer, scene, gpuScene, o.cacheDir.empty() ? defaultCacheDir() : o.cacheDir);
         renderer.streaming = streaming.get();
+        if (o.gpuSkinning) renderer.skinning = createSkinning(renderer, scene, gpuScene);
+        renderer.pointsLines = createPointsLines(renderer, scene);
         if (listCaptures) {
             std::printf("%s", captureListing(renderer.captures).c_str());
             run.listedCaptures = true;
@@ -348,8 +350,12 @@ RenderRun runRender(Gpu& gpu, const RenderOptions& o) {
             Camera onPath = cameraOnPath(camera, o.cameraPath, i, o.frames, bounds);
             CameraView view =
                 makeCameraView(onPath, o.width * o.ssaa, o.height * o.ssaa, jitter * float(o.ssaa));
-            if (playback && i > 0)
-                poseFrame(gpu, *playback, i, gpuScene, renderer.reposedInstances);
+            if (playback && i > 0) {
+                poseFrame(gpu, *playback, i, gpuScene, renderer.reposedInstances,
+                          renderer.skinning != nullptr);
+                if (renderer.skinning)
+                    setSkinPoses(renderer, *renderer.skinning, playback->drawn.skinPoses);
+            }
             run.frames.push_back(renderFrame(renderer, gpuScene, view));
             if (o.progress && o.frames > 1 && tty)
                 std::fprintf(stderr, "\rrender: frame %u/%u (%.1f ms)", i + 1, o.frames,
@@ -459,6 +465,11 @@ RenderRun runRender(Gpu& gpu, const RenderOptions& o) {
                           {"instances_reposed", playback->instancesReposed},
                           {"meshes_reposed", playback->meshesReposed},
                           {"vertices_written", playback->verticesWritten}};
+    s["points_lines_vertices"] =
+        renderer.pointsLines ? pointsLinesVertexCount(*renderer.pointsLines) : 0u;
+    s["skinning"] = {
+        {"mode", renderer.skinning ? "gpu" : "cpu"},
+        {"gpu_vertices", renderer.skinning ? skinnedVertexCount(*renderer.skinning) : 0u}};
     if (renderer.gi) giStats(renderer, s);
     if (renderer.rt) rayTracingStats(renderer, s);
     if (renderer.screenSpace) screenSpaceStats(renderer, s);

@@ -85,7 +85,13 @@ static void setMaterialExtensions(gpu::GpuMaterial& g, const Material& m, SlotOf
     g.specularFactor = m.specularFactor;
     g.sheenColorFactor = m.sheenColorFactor;
     g.sheenRoughnessFactor = m.sheenRoughnessFactor;
+    g.specularTexture = textureSlot(m.specularTexture);
+    g.specularColorTexture = textureSlot(m.specularColorTexture);
+    g.sheenColorTexture = textureSlot(m.sheenColorTexture);
+    g.sheenRoughnessTexture = textureSlot(m.sheenRoughnessTexture);
 }
+static_assert(kTextureSlotCount == TEXTURE_SLOT_COUNT && 3 * TEXTURE_SLOT_COUNT == 36,
+              "scene.h TextureSlot and shared_types.h TEXTURE_SLOT_* agree");
 
 void uploadScene(Gpu& gpu, const Scene& scene, GpuScene& out, const std::vector<BakedMesh>* baked,
                  const std::vector<uint32_t>* streamedTextureSlots) {

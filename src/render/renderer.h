@@ -15,9 +15,11 @@
 #include "render/lighting/feature_spectra.h"
 #include "render/lighting/light_culling.h"
 #include "render/lighting/spot_shadows.h"
+#include "render/points_lines/points_lines.h"
 #include "render/raytracing/ray_tracing.h"
 #include "render/raytracing/rt_settings.h"
 #include "render/shadel/visibility.h"
+#include "render/skinning/skinning.h"
 #include "rhi/frame.h"
 #include "rhi/pipeline.h"
 #include "rhi/shader_messages.h"
@@ -197,6 +199,8 @@ struct Renderer {
     CaptureRegistry captures;             // --capture: named resources of the frame (render/debug)
     ScreenSpaceStatePtr screenSpace;      // --screen-space on (render/screenspace, render/tiles)
     DistanceFieldStatePtr distanceFields; // --distance-fields on (render/distance_fields)
+    PointsLinesStatePtr pointsLines;      // glTF points and lines, forward (render/points_lines)
+    SkinningStatePtr skinning;            // skinned meshes skinned on the GPU (render/skinning)
     // Texture streaming (render/streaming), owned by the caller; null: textures loaded whole.
     TextureStreaming* streaming = nullptr;
     std::vector<uint8_t> restreamedMaterials; // per material: a texture of it changed this frame

@@ -118,3 +118,35 @@ TEST(GltfFeaturesPlayback, BadTimeStepExitsWith2NamingTheFlag) {
     EXPECT_EQ(runShadel("render --size 16x16 --scene builtin:default --time-step 0.1", err), 2);
     EXPECT_NE(err.find("--time-step"), std::string::npos) << err;
 }
+
+TEST(GltfFeaturesPlayback, GpuSkinningMatchesTheCpuSkinnedPose) {
+    // One pose: the compute pass (render/skinning) against the importer's CPU skinning.
+    RenderOptions cpu = skinOptions(RenderMode::Forward);
+    cpu.time = 1.0;
+    cpu.gpuSkinning = false;
+    RenderRun cpuRun = renderChecked(cpu);
+    EXPECT_EQ(cpuRun.stats["skinning"]["mode"], "cpu");
+    RenderOptions gpu = cpu;
+    gpu.gpuSkinning = true;
+    RenderRun gpuRun = renderChecked(gpu);
+    EXPECT_EQ(gpuRun.stats["skinning"]["mode"], "gpu");
+    EXPECT_GT(gpuRun.stats["skinning"]["gpu_vertices"].get<uint32_t>(), 0u);
+    bool skinningPass = false;
+    for (const auto& p : gpuRun.stats["passes"]) skinningPass |= p["name"] == "skinning";
+    EXPECT_TRUE(skinningPass);
+    double single = psnr(gpuRun.frames[0].rgba, cpuRun.frames[0].rgba);
+    // Playback: the vertex buffer keeps the first frame's pose and only the joint matrices
+    // change, so the last frame matches the CPU pose only if the compute pass skinned it.
+    RenderOptions play = skinOptions(RenderMode::Forward);
+    play.frames = 3;
+    play.time = 0.2;
+    play.timeStep = 0.4; // frame 2 at 1.0 s
+    RenderRun playRun = renderChecked(play);
+    EXPECT_EQ(playRun.stats["animation"]["vertices_written"].get<uint64_t>(), 0u);
+    double played = psnr(playRun.frames[2].rgba, cpuRun.frames[0].rgba);
+    std::printf("simple_skin at 1.0 s, GPU vs CPU skinning: single render %.1f dB, playback frame "
+                "2 %.1f dB\n",
+                single, played);
+    EXPECT_GE(single, 50.0);
+    EXPECT_GE(played, 50.0);
+}

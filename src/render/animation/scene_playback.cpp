@@ -26,7 +26,7 @@ static bool sameVertices(const Mesh& a, const Mesh& b) {
 }
 
 void poseFrame(Gpu& gpu, ScenePlayback& p, uint32_t frame, GpuScene& gpuScene,
-               std::vector<uint8_t>& reposed) {
+               std::vector<uint8_t>& reposed, bool gpuSkinned) {
     reposed.assign(gpuScene.instanceCount, 0);
     SceneFileOptions options = p.options;
     options.time = p.startTime + double(frame) * p.step;
@@ -63,19 +63,21 @@ void poseFrame(Gpu& gpu, ScenePlayback& p, uint32_t frame, GpuScene& gpuScene,
         if (sameVertices(now, drawn.meshes[m])) continue;
         meshMoved[m] = 1;
         p.meshesReposed++;
-        uint32_t first = uint32_t(gpuScene.meshInfo[m].vertexOffset);
-        uint32_t end = m + 1 < gpuScene.meshInfo.size()
-                           ? uint32_t(gpuScene.meshInfo[m + 1].vertexOffset)
-                           : uint32_t(gpuScene.vertexSource.size());
-        std::vector<gpu::GpuVertex> vertices(end - first);
-        for (uint32_t v = first; v < end; ++v) {
-            const Vertex& src = now.vertices[gpuScene.vertexSource[v]];
-            vertices[v - first] = {src.position, src.normal, src.tangent, src.uv0};
+        if (!(gpuSkinned && now.skin)) { // else the skinning pass deforms it from the joints
+            uint32_t first = uint32_t(gpuScene.meshInfo[m].vertexOffset);
+            uint32_t end = m + 1 < gpuScene.meshInfo.size()
+                               ? uint32_t(gpuScene.meshInfo[m + 1].vertexOffset)
+                               : uint32_t(gpuScene.vertexSource.size());
+            std::vector<gpu::GpuVertex> vertices(end - first);
+            for (uint32_t v = first; v < end; ++v) {
+                const Vertex& src = now.vertices[gpuScene.vertexSource[v]];
+                vertices[v - first] = {src.position, src.normal, src.tangent, src.uv0};
+            }
+            uploadBuffer(gpu, gpuScene.vertices, vertices.data(),
+                         vertices.size() * sizeof(gpu::GpuVertex),
+                         VkDeviceSize(first) * sizeof(gpu::GpuVertex));
+            p.verticesWritten += vertices.size();
         }
-        uploadBuffer(gpu, gpuScene.vertices, vertices.data(),
-                     vertices.size() * sizeof(gpu::GpuVertex),
-                     VkDeviceSize(first) * sizeof(gpu::GpuVertex));
-        p.verticesWritten += vertices.size();
         gpu::GpuMesh& g = gpuScene.meshInfo[m];
         g.boundsMin = now.bounds.min;
         g.boundsMax = now.bounds.max;
@@ -108,6 +110,7 @@ void poseFrame(Gpu& gpu, ScenePlayback& p, uint32_t frame, GpuScene& gpuScene,
         gpuScene.bounds.extend(
             Aabb{gpuScene.instanceInfo[i].worldMin, gpuScene.instanceInfo[i].worldMax});
     }
+    drawn.skinPoses = std::move(posed.skinPoses);
     if (anyReposed) // one copy: the GPU is idle between frames
         uploadBuffer(gpu, gpuScene.instances, gpuScene.instanceInfo.data(),
                      gpuScene.instanceInfo.size() * sizeof(gpu::GpuInstance));

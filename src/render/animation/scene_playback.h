@@ -36,7 +36,9 @@ ScenePlayback startPlayback(const std::string& spec, const SceneFileOptions& opt
 // `gpuScene` (between frames: the GPU is idle). `reposed` gets one byte per instance: 1 when
 // its transform or its mesh's vertices changed. Throws InputError when the posed file no longer
 // matches the drawn scene's structure.
+// With `gpuSkinned`, meshes carrying GPU skinning input (Mesh::skin) are not written: the
+// skinning pass (render/skinning) deforms them from `drawn.skinPoses`, which the caller hands it.
 void poseFrame(Gpu& gpu, ScenePlayback& playback, uint32_t frame, GpuScene& gpuScene,
-               std::vector<uint8_t>& reposed);
+               std::vector<uint8_t>& reposed, bool gpuSkinned = false);
 
 } // namespace shadel

@@ -143,7 +143,7 @@ static void registerDecoupledCaptures(Renderer& r, DecoupledState& d) {
 
 DecoupledStatePtr createDecoupled(Renderer& r, const GpuScene& scene) {
     Gpu& gpu = *r.gpu;
-    if (scene.shadelMeshes.empty())
+    if (scene.shadelMeshes.size() != scene.meshInfo.size()) // (a points-only file has none)
         throw InputError(
             "--mode decoupled needs a baked scene (internal: uploadScene without bake)");
     DecoupledStatePtr state(new DecoupledState());
