@@ -124,8 +124,16 @@ MaterialSample evaluateMaterial(GpuMaterial m, SurfaceInput s) {
     if ((m.flags & MATERIAL_DOUBLE_SIDED) != 0u && !s.frontFacing) n = -n;
     o.normal = applyNormalMap(m, TEXTURE_SLOT_NORMAL, m.normalTexture, m.normalScale, s, n, o.roughness);
 
-    o.specularF0 = min(m.dielectricF0Scalar * m.specularColorFactor, vec3(1.0));
-    o.specularF90 = m.specularFactor;
+    // KHR_materials_specular: strength in the specular texture's A, the F0 tint in the colour
+    // texture's RGB (sRGB), both multiplying their factors.
+    float specularStrength = 1.0;
+    vec3 specularTint = m.specularColorFactor;
+    if (m.specularTexture != NO_TEXTURE)
+        specularStrength = sampleMaterialTexture(m, TEXTURE_SLOT_SPECULAR, m.specularTexture, s).a;
+    if (m.specularColorTexture != NO_TEXTURE)
+        specularTint *= sampleMaterialTexture(m, TEXTURE_SLOT_SPECULAR_COLOR, m.specularColorTexture, s).rgb;
+    o.specularF0 = min(m.dielectricF0Scalar * specularTint, vec3(1.0)) * specularStrength;
+    o.specularF90 = m.specularFactor * specularStrength;
     o.clearcoat = m.clearcoatFactor;
     o.clearcoatRoughness = m.clearcoatRoughnessFactor;
     o.clearcoatNormal = n; // the coat follows the geometry, not the base layer's normal map
@@ -139,8 +147,18 @@ MaterialSample evaluateMaterial(GpuMaterial m, SurfaceInput s) {
         o.clearcoatNormal = applyNormalMap(m, TEXTURE_SLOT_CLEARCOAT_NORMAL, m.clearcoatNormalTexture,
                                            m.clearcoatNormalScale, s, n, o.clearcoatRoughness);
     }
+    // KHR_materials_sheen: colour in the colour texture's RGB (sRGB), roughness in the
+    // roughness texture's A, both multiplying their factors.
     o.sheenColor = m.sheenColorFactor;
-    o.sheenRoughness = max(m.sheenRoughnessFactor, 0.07);
+    float sheenRoughness = m.sheenRoughnessFactor;
+    if (any(greaterThan(o.sheenColor, vec3(0.0)))) {
+        if (m.sheenColorTexture != NO_TEXTURE)
+            o.sheenColor *= sampleMaterialTexture(m, TEXTURE_SLOT_SHEEN_COLOR, m.sheenColorTexture, s).rgb;
+        if (m.sheenRoughnessTexture != NO_TEXTURE)
+            sheenRoughness *= sampleMaterialTexture(m, TEXTURE_SLOT_SHEEN_ROUGHNESS,
+                                                    m.sheenRoughnessTexture, s).a;
+    }
+    o.sheenRoughness = max(sheenRoughness, 0.07);
     o.unlit = (m.flags & MATERIAL_UNLIT) != 0u;
     return o;
 }

@@ -35,6 +35,11 @@ using uint = uint32_t;
 #define TEXTURE_SLOT_CLEARCOAT 5u
 #define TEXTURE_SLOT_CLEARCOAT_ROUGHNESS 6u
 #define TEXTURE_SLOT_CLEARCOAT_NORMAL 7u
+#define TEXTURE_SLOT_SPECULAR 8u        // KHR_materials_specular: A = strength
+#define TEXTURE_SLOT_SPECULAR_COLOR 9u  // RGB = F0 tint
+#define TEXTURE_SLOT_SHEEN_COLOR 10u    // KHR_materials_sheen: RGB
+#define TEXTURE_SLOT_SHEEN_ROUGHNESS 11u // A
+#define TEXTURE_SLOT_COUNT 12u
 
 #define PROCEDURAL_NONE 0u
 #define PROCEDURAL_TEXEL_CHECKER 1u
@@ -149,7 +154,7 @@ struct GpuMaterial {
     // weighted blended OIT composites both without sorting (render/oit).
     float additiveness;
     // glTF material extensions (scene.h Material; shaders/common/material.glsl).
-    vec2 uvTransform[24]; // per texture slot (TEXTURE_SLOT_*): columns c0, c1, translation c2
+    vec2 uvTransform[36]; // 3 x TEXTURE_SLOT_COUNT: per texture slot (TEXTURE_SLOT_*): columns c0, c1, translation c2
     uint clampMask;       // bit per texture slot: clamp-to-edge sampler
     uint clearcoatTexture;
     uint clearcoatRoughnessTexture;
@@ -162,6 +167,10 @@ struct GpuMaterial {
     float specularFactor;     // dielectric F90
     vec3 sheenColorFactor;    // 0: no sheen
     float sheenRoughnessFactor;
+    uint specularTexture; // bindless slots of the factors' textures, NO_TEXTURE when absent
+    uint specularColorTexture;
+    uint sheenColorTexture;
+    uint sheenRoughnessTexture;
 };
 
 struct GpuLight {

@@ -112,6 +112,14 @@ void validateRenderOptions(const RenderOptions& o) {
         if (std::string problem = checkFiniteInRange("--time", *o.time, kTimeRange);
             !problem.empty())
             throw InputError(problem);
+    if (o.timeStep) {
+        if (std::string problem = checkFiniteInRange("--time-step", *o.timeStep, kTimeStepRange);
+            !problem.empty())
+            throw InputError(problem);
+        if (o.scene.rfind("builtin:", 0) == 0)
+            throw InputError(format("--time-step %g: plays glTF animations; %s has none",
+                                    *o.timeStep, o.scene.c_str()));
+    }
     const CameraOverrides& c = o.cameraOverrides;
     if (c.fovDegrees != 0.0f)
         if (std::string problem = checkFiniteInRange("--fov", c.fovDegrees, kFovRange);

@@ -29,6 +29,7 @@ constexpr FloatRange kShadelBudgetRange{0, 1e12, true}; // MIP-0 shadels
 constexpr FloatRange kForwardBelowRange{0, 1e12};       // pixels; 0 = never
 constexpr FloatRange kFovRange{0, 179, true};           // degrees, vertical
 constexpr FloatRange kTimeRange{0, 1e6};                // seconds (--time)
+constexpr FloatRange kTimeStepRange{0, 3600, true};     // seconds per frame (--time-step)
 constexpr FloatRange kCoordinateRange{-1e9, 1e9};       // world units (--from, --look-at)
 constexpr FloatRange kTextureBudgetRange{0, 1e6, true}; // MiB (--texture-budget)
 

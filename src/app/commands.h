@@ -22,6 +22,9 @@ struct RenderOptions {
     std::string camera;
     CameraOverrides cameraOverrides; // --from, --look-at, --fov
     std::optional<double> time;      // --time: glTF animations posed at this time (seconds)
+    // --time-step: animated playback, frame i posed at time (or 0) + i * timeStep (seconds)
+    std::optional<double> timeStep;
+    bool gpuSkinning = true; // --skinning gpu|cpu (render/skinning)
     bool jitter = false;
     uint32_t ssaa = 1;
     Visualize visualize = Visualize::None;

@@ -99,6 +99,16 @@ int main(int argc, char** argv) {
         ->add_option("--time", timeSeconds,
                      "SECONDS: pose glTF animations (node TRS, morph weights, skins) at this time")
         ->check(finiteInRange(kTimeRange));
+    double timeStep = 0.0;
+    std::string skinning = "gpu";
+    render->add_option("--skinning", skinning,
+                       "gpu|cpu: skinned glTF meshes skinned by a compute pass before every view "
+                       "(default) or by the importer on the CPU");
+    render
+        ->add_option("--time-step", timeStep,
+                     "SECONDS: animated playback over --frames: frame i posed at --time (default "
+                     "0) + i * SECONDS (node TRS, morph weights, skins)")
+        ->check(finiteInRange(kTimeStepRange));
     render
         ->add_option("--fov", ro.cameraOverrides.fovDegrees,
                      "vertical field of view in degrees (default: the camera's)")
@@ -512,6 +522,13 @@ int main(int argc, char** argv) {
             ro.shadelsPerMetre = parseDensity(density);
             ro.cameraPath = parseCameraPath(cameraPath);
             if (timeSeconds >= 0.0) ro.time = timeSeconds;
+            if (skinning != "gpu" && skinning != "cpu")
+                throw InputError(format("--skinning %s: expected gpu or cpu", skinning.c_str()));
+            ro.gpuSkinning = skinning == "gpu";
+            if (timeStep != 0.0) {
+                ro.timeStep = timeStep;
+                if (!ro.time) ro.time = 0.0;
+            }
             if (!from.empty())
                 ro.cameraOverrides.from = parseVec3("--from", from, kCoordinateRange);
             if (!lookAt.empty())

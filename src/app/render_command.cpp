@@ -16,6 +16,7 @@
 #include "core/error.h"
 #include "core/log.h"
 #include "gi/gi_types.h"
+#include "render/animation/scene_playback.h"
 #include "render/debug/inspect.h"
 #include "render/gi/lpv.h"
 #include "render/particles/particles.h"
@@ -202,6 +203,8 @@ RenderRun runRender(Gpu& gpu, const RenderOptions& o) {
             runViews(camera, o.cameraPath, o.frames, bounds, o.width * o.ssaa, o.height * o.ssaa);
         ViewDensityOptions vo;
         vo.budget = o.shadelBudget;
+        // Playback rewrites each mesh's posed vertices one to one: meshes stay whole.
+        vo.chunks = !o.timeStep;
         viewDensity = viewDrivenDensity(scene, views, vo);
         scene = std::move(viewDensity.scene);
         viewDensity.scene = Scene{};
@@ -254,6 +257,11 @@ RenderRun runRender(Gpu& gpu, const RenderOptions& o) {
     }
     uploadScene(gpu, scene, gpuScene, o.mode == RenderMode::Decoupled ? &baked : nullptr,
                 streaming ? &streamedTextureSlots(*streaming) : nullptr);
+    // --time-step: the file posed again before every frame after the first (render/animation).
+    std::optional<ScenePlayback> playback;
+    if (o.timeStep)
+        playback = startPlayback(o.scene, {o.allowExternalFiles, o.time}, o.time.value_or(0.0),
+                                 *o.timeStep, scene);
 
     RenderSettings settings;
     settings.width = o.width;
@@ -353,6 +361,8 @@ RenderRun runRender(Gpu& gpu, const RenderOptions& o) {
             renderer.stencilEffects =
                 createStencilEffects(renderer, scene, gpuScene, o.stencilEffects);
         renderer.streaming = streaming.get();
+        if (o.gpuSkinning) renderer.skinning = createSkinning(renderer, scene, gpuScene);
+        renderer.pointsLines = createPointsLines(renderer, scene);
         if (listCaptures) {
             std::printf("%s", captureListing(renderer.captures).c_str());
             run.listedCaptures = true;
@@ -367,6 +377,12 @@ RenderRun runRender(Gpu& gpu, const RenderOptions& o) {
             Camera onPath = cameraOnPath(camera, o.cameraPath, i, o.frames, bounds);
             CameraView view =
                 makeCameraView(onPath, o.width * o.ssaa, o.height * o.ssaa, jitter * float(o.ssaa));
+            if (playback && i > 0) {
+                poseFrame(gpu, *playback, i, gpuScene, renderer.reposedInstances,
+                          renderer.skinning != nullptr);
+                if (renderer.skinning)
+                    setSkinPoses(renderer, *renderer.skinning, playback->drawn.skinPoses);
+            }
             run.frames.push_back(renderFrame(renderer, gpuScene, view));
             if (o.progress && o.frames > 1 && tty)
                 std::fprintf(stderr, "\rrender: frame %u/%u (%.1f ms)", i + 1, o.frames,
@@ -470,6 +486,17 @@ RenderRun runRender(Gpu& gpu, const RenderOptions& o) {
         s["mip0_shadels"] = mip0;
         s["id_map_bytes"] = gpuScene.idMapBytes;
     }
+    if (playback)
+        s["animation"] = {{"time_start", playback->startTime},
+                          {"time_step", playback->step},
+                          {"instances_reposed", playback->instancesReposed},
+                          {"meshes_reposed", playback->meshesReposed},
+                          {"vertices_written", playback->verticesWritten}};
+    s["points_lines_vertices"] =
+        renderer.pointsLines ? pointsLinesVertexCount(*renderer.pointsLines) : 0u;
+    s["skinning"] = {
+        {"mode", renderer.skinning ? "gpu" : "cpu"},
+        {"gpu_vertices", renderer.skinning ? skinnedVertexCount(*renderer.skinning) : 0u}};
     if (renderer.gi) giStats(renderer, s);
     if (renderer.rt) rayTracingStats(renderer, s);
     if (renderer.screenSpace) screenSpaceStats(renderer, s);

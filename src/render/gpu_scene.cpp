@@ -85,7 +85,13 @@ static void setMaterialExtensions(gpu::GpuMaterial& g, const Material& m, SlotOf
     g.specularFactor = m.specularFactor;
     g.sheenColorFactor = m.sheenColorFactor;
     g.sheenRoughnessFactor = m.sheenRoughnessFactor;
+    g.specularTexture = textureSlot(m.specularTexture);
+    g.specularColorTexture = textureSlot(m.specularColorTexture);
+    g.sheenColorTexture = textureSlot(m.sheenColorTexture);
+    g.sheenRoughnessTexture = textureSlot(m.sheenRoughnessTexture);
 }
+static_assert(kTextureSlotCount == TEXTURE_SLOT_COUNT && 3 * TEXTURE_SLOT_COUNT == 36,
+              "scene.h TextureSlot and shared_types.h TEXTURE_SLOT_* agree");
 
 void uploadScene(Gpu& gpu, const Scene& scene, GpuScene& out, const std::vector<BakedMesh>* baked,
                  const std::vector<uint32_t>* streamedTextureSlots) {
@@ -177,6 +183,7 @@ void uploadScene(Gpu& gpu, const Scene& scene, GpuScene& out, const std::vector<
     std::vector<uint32_t> indices;
     out.meshInfo.clear();
     out.lodInfo.clear();
+    out.vertexSource.clear();
     for (size_t mi = 0; mi < scene.meshes.size(); ++mi) {
         const Mesh& mesh = scene.meshes[mi];
         gpu::GpuMesh g{};
@@ -192,6 +199,7 @@ void uploadScene(Gpu& gpu, const Scene& scene, GpuScene& out, const std::vector<
                 geometry.vertices.push_back({src.position, src.normal, src.tangent, src.uv0});
             }
             geometry.shadelUvs = b->shadelUv;
+            geometry.sources = b->vertexRemap;
             geometry.indices = b->indices;
             geometry.keepTriangleOrder = true; // the triangle-ID maps index LOD 0's triangles
             g.shadelMesh = uint32_t(mi);
@@ -201,8 +209,9 @@ void uploadScene(Gpu& gpu, const Scene& scene, GpuScene& out, const std::vector<
             geometry.indices = mesh.indices;
         }
         // LOD 0 and its simplified levels, all in the unified buffers (render/culling).
-        gpu::GpuMeshLods lods = appendMeshWithLods(std::move(geometry), vertices,
-                                                   baked ? &shadelUvs : nullptr, indices);
+        gpu::GpuMeshLods lods =
+            appendMeshWithLods(std::move(geometry), vertices, baked ? &shadelUvs : nullptr, indices,
+                               &out.vertexSource);
         g.firstIndex = lods.lod[0].firstIndex;
         g.indexCount = lods.lod[0].indexCount;
         out.meshInfo.push_back(g);

@@ -37,7 +37,10 @@ struct GpuScene {
     std::vector<TextureHandle> textures;
     std::vector<TextureReadView> textureViews;
     std::vector<gpu::GpuMesh> meshInfo;
-    std::vector<gpu::GpuMeshLods> lodInfo;    // what `meshLods` holds
+    std::vector<gpu::GpuMeshLods> lodInfo; // what `meshLods` holds
+    // Per vertex of `vertices`: the index into its Scene mesh's vertices it was made from (baked
+    // seams and fetch order reorder them); animated playback rewrites vertices through it.
+    std::vector<uint32_t> vertexSource;
     std::vector<ShadelMeshInfo> shadelMeshes; // per mesh, when baked
     BufferHandle idMaps;                      // every mesh's triangle-ID maps, all MIPs
     std::vector<gpu::GpuInstance> instanceInfo;

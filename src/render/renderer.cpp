@@ -170,6 +170,10 @@ void destroyRenderer(Renderer& r) {
     r.distanceFields.reset();
     if (r.stencilEffects) destroyStencilEffects(r, *r.stencilEffects);
     r.stencilEffects.reset();
+    if (r.skinning) destroySkinning(r, *r.skinning);
+    r.skinning.reset();
+    if (r.pointsLines) destroyPointsLines(r, *r.pointsLines);
+    r.pointsLines.reset();
     if (r.gi) destroyGi(r, r.gi);
     r.captures = {}; // its sources refer to what is destroyed below
     if (r.visibility) destroyVisibility(r, r.visibility);
@@ -285,6 +289,7 @@ FrameResult renderFrame(Renderer& r, const GpuScene& scene, const CameraView& ca
     r.sceneIndices = scene.indices;
     r.skyColor = scene.skyColor;
     gpu::FrameConstants constants = makeFrameConstants(r, scene, camera);
+    if (r.skinning) constants.vertices = skinnedVerticesAddress(r, *r.skinning); // every view
     updateLights(r, scene, constants);
     // Before beginFrame (streaming rebinds texture slots in the set this frame uses) and before
     // the decoupled frontend (which must not carry over shading of re-streamed textures).
@@ -318,6 +323,8 @@ FrameResult renderFrame(Renderer& r, const GpuScene& scene, const CameraView& ca
     if (r.streaming) // landed texture loads copied in, the feedback buffer cleared
         pass(rec, "textureStreaming",
              [&](VkCommandBuffer cmd) { recordTextureStreaming(*r.streaming, cmd); });
+    if (r.skinning) // skinned vertices for every view below (render/skinning)
+        pass(rec, "skinning", [&](VkCommandBuffer cmd) { recordSkinning(r, cmd); });
     pass(rec, "instanceCull",
          [&](VkCommandBuffer cmd) { recordInstanceCull(r, cmd, frame, scene); });
     pass(rec, "shadowMap", [&](VkCommandBuffer cmd) { recordShadowMap(r, cmd, frame); });
@@ -357,6 +364,7 @@ FrameResult renderFrame(Renderer& r, const GpuScene& scene, const CameraView& ca
     recordParticlePasses(r, rec, frame);    // GPU particles: simulation, atlas lighting
     recordScreenSpacePasses(r, rec, frame); // sky, SSR, SSS over classified tiles
     recordStencilEffects(r, rec, frame, constants.viewProj); // water, character outline
+    recordPointsLines(r, rec, frame); // glTF points and lines, forward in both modes
     recordTransparencyPasses(r, rec, frame); // blended materials, after every opaque surface
     if (r.debugLines) recordDebugLinePasses(r, rec, frame, scene, constants.lightCount);
     recordParticleAtlasView(r, rec, frame); // --visualize particle-atlas

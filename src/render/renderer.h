@@ -15,10 +15,12 @@
 #include "render/lighting/feature_spectra.h"
 #include "render/lighting/light_culling.h"
 #include "render/lighting/spot_shadows.h"
+#include "render/points_lines/points_lines.h"
 #include "render/raytracing/ray_tracing.h"
 #include "render/raytracing/rt_settings.h"
 #include "render/shadel/visibility.h"
 #include "render/stencil/stencil_effects.h"
+#include "render/skinning/skinning.h"
 #include "rhi/frame.h"
 #include "rhi/pipeline.h"
 #include "rhi/shader_messages.h"
@@ -206,9 +208,14 @@ struct Renderer {
     ScreenSpaceStatePtr screenSpace;       // --screen-space on (render/screenspace, render/tiles)
     DistanceFieldStatePtr distanceFields;  // --distance-fields on (render/distance_fields)
     StencilEffectsStatePtr stencilEffects; // --stencil-effects on|fullscreen (render/stencil)
+    PointsLinesStatePtr pointsLines;      // glTF points and lines, forward (render/points_lines)
+    SkinningStatePtr skinning;            // skinned meshes skinned on the GPU (render/skinning)
     // Texture streaming (render/streaming), owned by the caller; null: textures loaded whole.
     TextureStreaming* streaming = nullptr;
     std::vector<uint8_t> restreamedMaterials; // per material: a texture of it changed this frame
+    // Per instance: animated playback (render/animation) moved or deformed it before this frame;
+    // empty without playback. Decoupled reuse reshades these; spot shadow maps are redrawn.
+    std::vector<uint8_t> reposedInstances;
     SpectraStatePtr spectra;        // --spectra on|single (render/lighting/feature_spectra.h)
     SpotShadowStatePtr spotShadows; // shadow-casting spots (render/lighting/spot_shadows.h)
     std::chrono::steady_clock::time_point createdAt = std::chrono::steady_clock::now();

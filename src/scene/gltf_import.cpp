@@ -850,9 +850,10 @@ public:
         for (size_t i = 0; i < model_.materials.size(); ++i)
             scene_.materials.push_back(convertMaterial(int(i)));
         meshParts_.resize(model_.meshes.size());
+        pointLineParts_.resize(model_.meshes.size());
         meshConverted_.assign(model_.meshes.size(), false);
         traverseNodes();
-        if (scene_.triangleCount() == 0) {
+        if (scene_.triangleCount() == 0 && scene_.pointLines.empty()) {
             std::string why = "no triangles to render";
             if (skippedPrimitives_ > 0)
                 why += format(" (%u primitive(s) skipped: %s)", skippedPrimitives_,
@@ -876,6 +877,7 @@ private:
     const std::string& input_;
     Scene& scene_;
     std::vector<std::vector<uint32_t>> meshParts_;
+    std::vector<std::vector<PointLineSet>> pointLineParts_; // per glTF mesh, object space
     std::vector<bool> meshConverted_;
     std::map<uint32_t, uint32_t> mirroredMesh_;        // mesh -> copy with reversed winding
     std::map<std::pair<int, bool>, int32_t> textures_; // (image, sRGB) -> scene texture
@@ -1205,6 +1207,13 @@ private:
         const std::vector<double>& weights = nodeWeights.empty() ? gm.weights : nodeWeights;
         for (size_t p = 0; p < gm.primitives.size(); ++p) {
             std::string where = format("mesh %d primitive %zu", meshIndex, p);
+            if (isPointsOrLines(gm.primitives[p])) { // drawn forward (render/points_lines)
+                PointLineSet set = convertPointsOrLines(gm.primitives[p], where, weights);
+                set.name =
+                    (gm.name.empty() ? format("mesh%d", meshIndex) : gm.name) + format("/%zu", p);
+                if (!set.vertices.empty()) pointLineParts_[size_t(meshIndex)].push_back(set);
+                continue;
+            }
             std::optional<Mesh> mesh = convertPrimitive(gm.primitives[p], where, weights);
             if (!mesh) continue;
             mesh->name = (gm.name.empty() ? format("mesh%d", meshIndex) : gm.name) +
@@ -1214,6 +1223,72 @@ private:
                 scene_.meshes.push_back(std::move(part));
             }
         }
+    }
+
+    static bool isPointsOrLines(const tinygltf::Primitive& prim) {
+        return prim.mode == TINYGLTF_MODE_POINTS || prim.mode == TINYGLTF_MODE_LINE ||
+               prim.mode == TINYGLTF_MODE_LINE_LOOP || prim.mode == TINYGLTF_MODE_LINE_STRIP;
+    }
+
+    // Points: one per vertex (or per index); lines, strips and loops: a list of segments.
+    // Positions (with morph targets), COLOR_0 and the material; no normals (drawn unlit).
+    PointLineSet convertPointsOrLines(const tinygltf::Primitive& prim, const std::string& where,
+                                      const std::vector<double>& weights) {
+        auto it = prim.attributes.find("POSITION");
+        if (it == prim.attributes.end()) error(where + " has no POSITION attribute");
+        std::vector<float> positions = readFloats(it->second, 3, "POSITION");
+        size_t vertexCount = positions.size() / 3;
+        Mesh points; // positions through the same morph code as triangles
+        points.vertices.resize(vertexCount);
+        for (size_t v = 0; v < vertexCount; ++v) {
+            glm::vec3 p = glm::make_vec3(&positions[v * 3]);
+            if (!finite3(p))
+                error(format("accessor %d (POSITION) element %zu is not finite", it->second, v));
+            points.vertices[v].position = p;
+        }
+        std::vector<float> noNormals;
+        applyMorphTargets(prim, weights, vertexCount, points, noNormals);
+        std::vector<glm::vec4> colors;
+        if (auto c = prim.attributes.find("COLOR_0"); c != prim.attributes.end()) {
+            int components = model_.accessors[size_t(c->second)].type == TINYGLTF_TYPE_VEC3 ? 3 : 4;
+            std::vector<float> data = readFloats(c->second, components, "COLOR_0");
+            if (data.size() / size_t(components) != vertexCount)
+                error(format("%s: COLOR_0 has %zu elements but POSITION has %zu", where.c_str(),
+                             data.size() / size_t(components), vertexCount));
+            for (size_t v = 0; v < vertexCount; ++v)
+                colors.push_back(glm::vec4(
+                    data[v * size_t(components)], data[v * size_t(components) + 1],
+                    data[v * size_t(components) + 2], components == 4 ? data[v * 4 + 3] : 1.0f));
+        }
+        std::vector<uint32_t> idx;
+        if (prim.indices >= 0) {
+            idx = readIndices(prim.indices);
+            for (uint32_t i : idx)
+                if (i >= vertexCount)
+                    error(format("accessor %d index %u out of range (vertex count %zu)",
+                                 prim.indices, i, vertexCount));
+        } else {
+            idx.resize(vertexCount);
+            for (size_t i = 0; i < vertexCount; ++i) idx[i] = uint32_t(i);
+        }
+        std::vector<uint32_t> order; // vertices drawn, pairs for lines
+        if (prim.mode == TINYGLTF_MODE_POINTS || prim.mode == TINYGLTF_MODE_LINE) {
+            order = idx;
+            if (prim.mode == TINYGLTF_MODE_LINE) order.resize(order.size() / 2 * 2);
+        } else {
+            for (size_t i = 0; i + 1 < idx.size(); ++i)
+                order.push_back(idx[i]), order.push_back(idx[i + 1]);
+            if (prim.mode == TINYGLTF_MODE_LINE_LOOP && idx.size() > 2)
+                order.push_back(idx.back()), order.push_back(idx.front());
+        }
+        PointLineSet set;
+        set.lines = prim.mode != TINYGLTF_MODE_POINTS;
+        set.material = prim.material >= 0 ? uint32_t(prim.material) : defaultMaterial();
+        for (uint32_t i : order) {
+            set.vertices.push_back(points.vertices[i]);
+            if (!colors.empty()) set.colors.push_back(colors[i]);
+        }
+        return set;
     }
 
     std::optional<Mesh> convertPrimitive(const tinygltf::Primitive& prim, const std::string& where,
@@ -1384,6 +1459,11 @@ private:
                 inst.transform = world;
                 scene_.instances.push_back(std::move(inst));
             }
+            for (const PointLineSet& set : pointLineParts_[size_t(node.mesh)]) {
+                scene_.pointLines.push_back(set);
+                scene_.pointLines.back().name = nodeName + " " + set.name;
+                scene_.pointLines.back().transform = world;
+            }
         }
         glm::vec3 position = glm::vec3(world * glm::vec4(0, 0, 0, 1));
         glm::mat3 basis(world);
@@ -1493,6 +1573,7 @@ private:
         }
         const tinygltf::Mesh& gm = model_.meshes[size_t(node.mesh)];
         const std::vector<double>& weights = node.weights.empty() ? gm.weights : node.weights;
+        const uint32_t poseIndex = uint32_t(scene_.skinPoses.size()); // this node's joints
         for (size_t p = 0; p < gm.primitives.size(); ++p) {
             const tinygltf::Primitive& prim = gm.primitives[p];
             std::string where =
@@ -1507,6 +1588,12 @@ private:
                 size_t count = mesh->vertices.size();
                 if (ji.size() != count * 4 || wi.size() != count * 4)
                     error(where + ": JOINTS_0/WEIGHTS_0 do not match POSITION");
+                // The unskinned vertices and influences, for GPU skinning (render/skinning).
+                auto skinData = std::make_shared<MeshSkin>();
+                skinData->skin = poseIndex;
+                skinData->bindVertices = mesh->vertices;
+                skinData->joints.resize(count);
+                skinData->weights.resize(count);
                 for (size_t v = 0; v < count; ++v) {
                     glm::mat4 m(0.0f);
                     for (int k = 0; k < 4; ++k) {
@@ -1515,6 +1602,8 @@ private:
                             error(format("%s: vertex %zu joint %g out of range (%zu joints)",
                                          where.c_str(), v, jf, joints.size()));
                         m += joints[size_t(jf)] * wi[v * 4 + size_t(k)];
+                        skinData->joints[v][k] = uint32_t(jf);
+                        skinData->weights[v][k] = wi[v * 4 + size_t(k)];
                     }
                     Vertex& vert = mesh->vertices[v];
                     vert.position = glm::vec3(m * glm::vec4(vert.position, 1.0f));
@@ -1528,10 +1617,15 @@ private:
                 }
                 sanitizeNormalsAndTangents(*mesh);
                 computeBounds(*mesh);
+                mesh->skin = std::move(skinData);
+                if (scene_.skinPoses.size() == poseIndex) scene_.skinPoses.push_back({joints});
             }
             mesh->name = (gm.name.empty() ? format("mesh%d", node.mesh) : gm.name) +
                          format(" (skinned, node %d)", index);
             std::vector<Mesh> parts = splitMesh(std::move(*mesh));
+            // Parts renumber the vertices: only a whole mesh keeps its GPU skinning input.
+            if (parts.size() > 1)
+                for (Mesh& part : parts) part.skin.reset();
             for (size_t k = 0; k < parts.size(); ++k) {
                 Instance inst;
                 inst.name = nodeName + (parts.size() > 1 ? format("#%zu", k) : std::string());

@@ -180,22 +180,35 @@ void applyMaterialExtensions(const tinygltf::Material& gm, int index, Material& 
         out.specularFactor = std::clamp(number(*sp, "specularFactor", 1.0f), 0.0f, 1.0f);
         out.specularColorFactor =
             glm::max(vec3Of(*sp, "specularColorFactor", glm::vec3(1.0f)), glm::vec3(0.0f));
-        for (const char* key : {"specularTexture", "specularColorTexture"})
-            if (textureInfoOf(*sp, key).index >= 0)
-                t.warn(format("material %d: KHR_materials_specular %s is not applied (its "
-                              "factor is)",
-                              index, key));
+        // Strength in A (linear), F0 tint in RGB (sRGB).
+        if (ValueTextureInfo info = textureInfoOf(*sp, "specularTexture"); info.index >= 0) {
+            out.specularTexture = t.resolve(info.index, info.texCoord, false, "specular");
+            setSlot(out, TextureSlot::Specular, out.specularTexture, info.index, info.transform, t);
+        }
+        if (ValueTextureInfo info = textureInfoOf(*sp, "specularColorTexture"); info.index >= 0) {
+            out.specularColorTexture =
+                t.resolve(info.index, info.texCoord, true, "specular colour");
+            setSlot(out, TextureSlot::SpecularColor, out.specularColorTexture, info.index,
+                    info.transform, t);
+        }
     }
     if (const tinygltf::Value* sh = extension(gm.extensions, "KHR_materials_sheen")) {
         out.sheenColorFactor = glm::clamp(vec3Of(*sh, "sheenColorFactor", glm::vec3(0.0f)),
                                           glm::vec3(0.0f), glm::vec3(1.0f));
         out.sheenRoughnessFactor =
             std::clamp(number(*sh, "sheenRoughnessFactor", 0.0f), 0.0f, 1.0f);
-        for (const char* key : {"sheenColorTexture", "sheenRoughnessTexture"})
-            if (textureInfoOf(*sh, key).index >= 0)
-                t.warn(format("material %d: KHR_materials_sheen %s is not applied (its factor "
-                              "is)",
-                              index, key));
+        // Colour in RGB (sRGB), roughness in A (linear).
+        if (ValueTextureInfo info = textureInfoOf(*sh, "sheenColorTexture"); info.index >= 0) {
+            out.sheenColorTexture = t.resolve(info.index, info.texCoord, true, "sheen colour");
+            setSlot(out, TextureSlot::SheenColor, out.sheenColorTexture, info.index, info.transform,
+                    t);
+        }
+        if (ValueTextureInfo info = textureInfoOf(*sh, "sheenRoughnessTexture"); info.index >= 0) {
+            out.sheenRoughnessTexture =
+                t.resolve(info.index, info.texCoord, false, "sheen roughness");
+            setSlot(out, TextureSlot::SheenRoughness, out.sheenRoughnessTexture, info.index,
+                    info.transform, t);
+        }
     }
 }
 

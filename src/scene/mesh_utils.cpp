@@ -202,8 +202,19 @@ std::string sceneInvariantViolation(const Scene& scene) {
         const Material& mat = scene.materials[i];
         if (!textureOk(mat.baseColorTexture) || !textureOk(mat.metallicRoughnessTexture) ||
             !textureOk(mat.normalTexture) || !textureOk(mat.emissiveTexture) ||
-            !textureOk(mat.occlusionTexture))
+            !textureOk(mat.occlusionTexture) || !textureOk(mat.specularTexture) ||
+            !textureOk(mat.specularColorTexture) || !textureOk(mat.sheenColorTexture) ||
+            !textureOk(mat.sheenRoughnessTexture))
             return "material " + std::to_string(i) + ": texture index out of range";
+    }
+    for (const PointLineSet& set : scene.pointLines) {
+        std::string where = "points/lines '" + set.name + "'";
+        if (set.material >= scene.materials.size()) return where + ": material index";
+        if (set.lines && set.vertices.size() % 2 != 0) return where + ": odd line vertex count";
+        if (!set.colors.empty() && set.colors.size() != set.vertices.size())
+            return where + ": colour count";
+        for (const Vertex& v : set.vertices)
+            if (!isFinite(v.position)) return where + ": position not finite";
     }
     for (size_t i = 0; i < scene.textures.size(); ++i) {
         const Texture& tex = scene.textures[i];

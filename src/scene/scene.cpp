@@ -17,6 +17,9 @@ Aabb Scene::worldBounds() const {
     Aabb out;
     for (const Instance& inst : instances)
         out.extend(transformAabb(meshes[inst.mesh].bounds, inst.transform));
+    for (const PointLineSet& set : pointLines) // glTF points and lines
+        for (const Vertex& v : set.vertices)
+            out.extend(glm::vec3(set.transform * glm::vec4(v.position, 1.0f)));
     return out;
 }
 

@@ -2,6 +2,7 @@
 // The scene model: plain data, no GPU objects. Importers (glTF, built-in scenes) fill it;
 // the baker and the renderers read it.
 #include <cstdint>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -30,6 +31,21 @@ struct Vertex {
     glm::vec2 uv0;     // material UVs (may overlap / tile: never used for shadel space)
 };
 
+// What GPU skinning (render/skinning) needs of a skinned mesh, parallel to Mesh::vertices: the
+// vertices before skinning (morph targets applied) and four joints and weights each; joints
+// index Scene::skinPoses[skin].joints.
+struct MeshSkin {
+    uint32_t skin = 0;
+    std::vector<Vertex> bindVertices;
+    std::vector<glm::uvec4> joints;
+    std::vector<glm::vec4> weights;
+};
+
+// A skinned node's joint matrices at the scene's time: world(joint) x inverseBind (glTF).
+struct SkinPose {
+    std::vector<glm::mat4> joints;
+};
+
 // One glTF primitive = one mesh here: one material, triangles only.
 struct Mesh {
     std::string name;
@@ -37,7 +53,20 @@ struct Mesh {
     std::vector<uint32_t> indices; // triangle list
     uint32_t material = 0;
     Aabb bounds;
+    // Skinned meshes: vertices hold the CPU-skinned pose; `skin` lets the GPU skin them instead.
+    std::shared_ptr<const MeshSkin> skin;
     uint32_t triangleCount() const { return uint32_t(indices.size() / 3); }
+};
+
+// A glTF points or lines primitive of one node (drawn forward only, in both modes:
+// render/points_lines). Lines are a list of segments (strips and loops unrolled).
+struct PointLineSet {
+    std::string name;
+    bool lines = false;            // false: one point per vertex; true: vertex pairs
+    std::vector<Vertex> vertices;  // object space
+    std::vector<glm::vec4> colors; // COLOR_0 per vertex, or empty (white)
+    uint32_t material = 0;
+    glm::mat4 transform{1.0f}; // object to world
 };
 
 enum class AlphaMode : uint32_t { Opaque = 0, Mask = 1, Blend = 2 };
@@ -66,6 +95,10 @@ enum class TextureSlot : uint32_t {
     Clearcoat,          // KHR_materials_clearcoat: R = coat weight
     ClearcoatRoughness, // G = coat roughness
     ClearcoatNormal,
+    Specular,       // KHR_materials_specular: A = specular strength
+    SpecularColor,  // RGB = dielectric F0 tint
+    SheenColor,     // KHR_materials_sheen: RGB = sheen colour
+    SheenRoughness, // A = sheen roughness
     Count
 };
 constexpr uint32_t kTextureSlotCount = uint32_t(TextureSlot::Count);
@@ -112,6 +145,10 @@ struct Material {
     glm::vec3 specularColorFactor{1.0f}; // tints dielectric F0
     glm::vec3 sheenColorFactor{0.0f};    // KHR_materials_sheen (0: no sheen)
     float sheenRoughnessFactor = 0.0f;
+    int32_t specularTexture = kNoTexture; // the factors' textures (TextureSlot::Specular...)
+    int32_t specularColorTexture = kNoTexture;
+    int32_t sheenColorTexture = kNoTexture;
+    int32_t sheenRoughnessTexture = kNoTexture;
     SurfaceClass surfaceClass = SurfaceClass::DefaultLit;
 };
 
@@ -204,6 +241,8 @@ struct Scene {
     std::vector<LightBlocker> blockers;
     std::vector<Camera> cameras;           // the first is the default
     std::vector<ParticleEmitter> emitters; // GPU particles (render/particles)
+    std::vector<SkinPose> skinPoses;       // per skinned node (MeshSkin::skin)
+    std::vector<PointLineSet> pointLines;  // glTF points and lines primitives
     glm::vec3 skyColor{0.55f, 0.7f, 0.95f};
     glm::vec3 ambientColor{0.08f, 0.09f, 0.11f};
 

@@ -121,7 +121,6 @@ def bad_files():
     d["scenes"][0]["nodes"] = [0, 1]; out["shared_child_node.gltf"] = d
     d = copy.deepcopy(q); d["scenes"][0]["nodes"] = [0, 0]; out["duplicate_root_node.gltf"] = d
 
-    d = copy.deepcopy(q); d["meshes"][0]["primitives"][0]["mode"] = 0; out["no_triangles_points.gltf"] = d
     d = copy.deepcopy(q); del d["nodes"][0]["mesh"]; out["no_triangles_no_mesh.gltf"] = d
     d = copy.deepcopy(q); d["meshes"][0]["primitives"][0]["mode"] = 9; out["bad_mode.gltf"] = d
     d = copy.deepcopy(q); del d["meshes"][0]["primitives"][0]["attributes"]["POSITION"]
@@ -210,6 +209,9 @@ def good_files():
         {"attributes": {"POSITION": 0}, "mode": 1},
     ]
     out["strip_fan_lines.gltf"] = d
+
+    # Points only (mode 0): no triangles, drawn forward as points (render/points_lines).
+    d = copy.deepcopy(q); d["meshes"][0]["primitives"][0]["mode"] = 0; out["points_only.gltf"] = d
 
     # Mirrored instance: scale -1 in X must reverse the winding of its mesh copy.
     d = copy.deepcopy(q)

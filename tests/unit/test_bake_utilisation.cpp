@@ -3,7 +3,8 @@
 // without UVs, cover >= 60% of their MIP-0 shadel rects. A missing model fails (the package is a
 // build dependency, scripts/setup.sh). Models left out are the deliberately broken ones, which
 // the importer rejects (tests/unit/test_gltf_import.cpp): non-finite positions, indices out of
-// range, missing buffers, schema errors, no scene, Draco, points/lines only.
+// range, missing buffers, schema errors, no scene, Draco; and the points/lines-only ones, which
+// load but have no surface to bake (their points and lines are drawn forward).
 #include <gtest/gtest.h>
 
 #include <chrono>

@@ -135,7 +135,6 @@ const BadFile kOurBadFiles[] = {
     {"no_asset.gltf", "missing 'asset'"},
     {"no_position.gltf", "has no POSITION"},
     {"no_triangles_no_mesh.gltf", "no triangles"},
-    {"no_triangles_points.gltf", "no triangles to render (1 primitive(s) skipped: points/lines)"},
     {"required_unsupported_extension.gltf",
      "required extension EXT_made_up_geometry is not supported"},
     {"root_not_object.gltf", "root must be an object"},
@@ -194,7 +193,6 @@ const BadFile kAssimpBadFiles[] = {
     {"glTF2/draco/2CylinderEngine.gltf", "required extension KHR_draco_mesh_compression"},
     {"glTF2/BoxTextured-glTF-techniqueWebGL/BoxTextured.gltf",
      "required extension KHR_technique_webgl is not supported"},
-    {"glTF2/glTF-Asset-Generator/Mesh_PrimitiveMode/Mesh_PrimitiveMode_00.gltf", "points/lines"},
     {"glTF/BoxTextured-glTF/BoxTextured.gltf", "glTF version '1.0' is not supported"},
     {"glTF/BoxTextured-glTF-Binary/BoxTextured.glb", "binary glTF version 1 is not supported"},
     {"glTF/CesiumMilkTruck/CesiumMilkTruck.gltf", "glTF version 1 is not supported"},
@@ -314,11 +312,39 @@ TEST(GltfImport, CamerasAndPunctualLightsInWorldSpace) {
     EXPECT_NEAR(glm::distance(bounds.max, glm::vec3(12, 0, 2)), 0.0f, 1e-5f);
 }
 
-TEST(GltfImport, StripsAndFansBecomeTrianglesLinesAreSkipped) {
+TEST(GltfImport, StripsAndFansBecomeTrianglesLinesBecomeSegments) {
     Scene scene = loadScene(kData + "/gltf/strip_fan_lines.gltf");
     EXPECT_EQ(scene.meshes.size(), 2u);
     EXPECT_EQ(scene.triangleCount(), 4u);
     EXPECT_EQ(sceneInvariantViolation(scene), "");
+    // The LINES primitive (4 vertices, non-indexed): two segments, drawn forward.
+    ASSERT_EQ(scene.pointLines.size(), 1u);
+    EXPECT_TRUE(scene.pointLines[0].lines);
+    EXPECT_EQ(scene.pointLines[0].vertices.size(), 4u);
+}
+
+// Points and lines are drawn (forward only, render/points_lines): a file with nothing else is a
+// renderable scene, no longer "no triangles to render".
+TEST(GltfImport, PointsOnlyFilesLoad) {
+    Scene points = loadScene(kData + "/gltf/points_only.gltf");
+    EXPECT_EQ(points.triangleCount(), 0u);
+    ASSERT_EQ(points.pointLines.size(), 1u);
+    EXPECT_FALSE(points.pointLines[0].lines);
+    EXPECT_FALSE(points.pointLines[0].vertices.empty());
+    EXPECT_TRUE(points.worldBounds().valid()); // framing sees them
+    REQUIRE_ASSIMP_MODELS();
+    // glTF-Asset-Generator's points, lines, line loop and line strip (modes 0-3).
+    for (int mode = 0; mode < 4; ++mode) {
+        std::string file = kAssimp +
+                           "/glTF-Asset-Generator/Mesh_PrimitiveMode/Mesh_PrimitiveMode_0" +
+                           std::to_string(mode) + ".gltf";
+        Scene scene = loadScene(file);
+        ASSERT_EQ(scene.pointLines.size(), 1u) << file;
+        EXPECT_EQ(scene.pointLines[0].lines, mode != 0) << file;
+        if (mode != 0) {
+            EXPECT_EQ(scene.pointLines[0].vertices.size() % 2, 0u) << file;
+        }
+    }
 }
 
 TEST(GltfImport, MirroredInstanceKeepsFrontFacesFront) {

@@ -69,7 +69,8 @@ float surfaceDeviation(const std::vector<gpu::GpuVertex>& vertices,
 
 gpu::GpuMeshLods appendMeshWithLods(MeshGeometry mesh, std::vector<gpu::GpuVertex>& vertices,
                                     std::vector<glm::vec2>* shadelUvs,
-                                    std::vector<uint32_t>& indices) {
+                                    std::vector<uint32_t>& indices,
+                                    std::vector<uint32_t>* vertexSources) {
     size_t vertexCount = mesh.vertices.size();
     const float* positions = vertexCount ? &mesh.vertices[0].position.x : nullptr;
     constexpr size_t stride = sizeof(gpu::GpuVertex);
@@ -115,6 +116,13 @@ gpu::GpuMeshLods appendMeshWithLods(MeshGeometry mesh, std::vector<gpu::GpuVerte
         if (!mesh.shadelUvs.empty())
             meshopt_remapVertexBuffer(shadelUvs->data() + vertexOffset, mesh.shadelUvs.data(),
                                       vertexCount, sizeof(glm::vec2), remap.data());
+    }
+    if (vertexSources) {
+        vertexSources->resize(vertexOffset + kept, 0u);
+        for (size_t v = 0; v < vertexCount; ++v)
+            if (remap[v] != ~0u)
+                (*vertexSources)[vertexOffset + remap[v]] =
+                    mesh.sources.empty() ? uint32_t(v) : mesh.sources[v];
     }
 
     gpu::GpuMeshLods out{};

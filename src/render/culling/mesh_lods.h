@@ -13,16 +13,21 @@ namespace shadel {
 struct MeshGeometry {
     std::vector<gpu::GpuVertex> vertices;
     std::vector<glm::vec2> shadelUvs; // parallel to vertices, or empty
-    std::vector<uint32_t> indices;    // LOD 0, mesh-local
+    // Parallel to vertices, or empty (= 0, 1, 2...): what each vertex came from, carried through
+    // the fetch reordering into `vertexSources` (animated playback rewrites posed vertices).
+    std::vector<uint32_t> sources;
+    std::vector<uint32_t> indices; // LOD 0, mesh-local
     // LOD 0's triangle order is meaningful (triangle-ID maps index it): do not reorder it.
     bool keepTriangleOrder = false;
 };
 
 // Appends the mesh (vertices, shadel UVs when `shadelUvs` is given, every LOD's indices) to the
 // unified arrays. The returned levels' firstIndex are absolute; all share the mesh's
-// vertexOffset (the vertex count before the call).
+// vertexOffset (the vertex count before the call). With `vertexSources`, each appended vertex's
+// `sources` entry is appended in the same order.
 gpu::GpuMeshLods appendMeshWithLods(MeshGeometry mesh, std::vector<gpu::GpuVertex>& vertices,
                                     std::vector<glm::vec2>* shadelUvs,
-                                    std::vector<uint32_t>& indices);
+                                    std::vector<uint32_t>& indices,
+                                    std::vector<uint32_t>* vertexSources = nullptr);
 
 } // namespace shadel

@@ -160,7 +160,9 @@ void prepareShadows(Renderer& r, const std::vector<gpu::GpuLight>& lights,
                                                 : gpu::GpuSpotShadow{};
     s.redraw = s.drawnViews.size() != views.size() || constants.viewProj != s.drawnCamera ||
                std::memcmp(views.data(), s.drawnViews.data(),
-                           views.size() * sizeof(gpu::GpuSpotShadow)) != 0;
+                           views.size() * sizeof(gpu::GpuSpotShadow)) != 0 ||
+               std::find(r.reposedInstances.begin(), r.reposedInstances.end(), 1) !=
+                   r.reposedInstances.end(); // animated casters (render/animation)
     if (s.redraw) {
         s.drawnViews = views;
         s.drawnCamera = constants.viewProj;

@@ -161,7 +161,7 @@ static void registerDecoupledCaptures(Renderer& r, DecoupledState& d) {
 
 DecoupledStatePtr createDecoupled(Renderer& r, const GpuScene& scene) {
     Gpu& gpu = *r.gpu;
-    if (scene.shadelMeshes.empty())
+    if (scene.shadelMeshes.size() != scene.meshInfo.size()) // (a points-only file has none)
         throw InputError(
             "--mode decoupled needs a baked scene (internal: uploadScene without bake)");
     DecoupledStatePtr state(new DecoupledState());
@@ -592,6 +592,10 @@ void prepareDecoupledFrame(Renderer& r, const GpuScene& scene, const CameraView&
         d.visit.insert(d.visit.end(), seen->begin(), seen->end());
         for (uint32_t i : *seen) d.seenFrame[i] = d.frameNumber + 1;
     } else {
+        // Animated playback moved instances (render/animation): the grid follows their bounds.
+        if (std::find(r.reposedInstances.begin(), r.reposedInstances.end(), 1) !=
+            r.reposedInstances.end())
+            d.grid.build(scene.instanceInfo);
         d.grid.query(frustumBox, d.visit);
     }
     d.visit.insert(d.visit.end(), d.touched.begin(), d.touched.end());
@@ -647,7 +651,8 @@ void prepareDecoupledFrame(Renderer& r, const GpuScene& scene, const CameraView&
         // Preserved layers: a level's shadels may be carried over when last frame marked and
         // stored them at the same place (the object was decoupled and the level's rect is
         // older than this frame) and nothing the shading reads has changed. Instances and
-        // materials are static in this renderer; lights that moved invalidate what they reach.
+        // materials are static unless animated playback reposes them; lights that moved
+        // invalidate what they reach.
         // View-dependent terms (specular) drift with the camera: the shading pass reshades
         // every chunk at least once per refresh period.
         // A light that changed and reaches the object: its chunks check their own shadels
@@ -659,8 +664,10 @@ void prepareDecoupledFrame(Renderer& r, const GpuScene& scene, const CameraView&
         // Texture streaming changed what a texture of its material holds: reshade it.
         bool restreamed = inst.material < r.restreamedMaterials.size() &&
                           r.restreamedMaterials[inst.material] != 0;
+        // Animated playback posed it anew (moved or deformed): its shadels are shaded again.
+        bool reposed = i < r.reposedInstances.size() && r.reposedInstances[i] != 0;
         bool inputsUnchanged =
-            d.reuse && wasDecoupled && reach != LightReach::Everything && !restreamed;
+            d.reuse && wasDecoupled && reach != LightReach::Everything && !restreamed && !reposed;
         for (uint32_t k = o.firstMip; k < mesh.mipCount && inputsUnchanged; ++k)
             if (o.levelSince[k] < d.frameNumber) g.reuseLevels |= 1u << k;
         bool known = inst.material < scene.materialInfo.size();

@@ -31,9 +31,11 @@ std::vector<TextureUse> textureUses(const Scene& scene) {
         float scale = std::cbrt(std::abs(glm::determinant(glm::mat3(inst.transform))));
         float uvPerMetre = scale > 0.0f ? meshUvPerMetre[inst.mesh] / scale : 0.0f;
         if (!(uvPerMetre > 0.0f)) continue;
-        for (int32_t t : {mat.baseColorTexture, mat.metallicRoughnessTexture, mat.normalTexture,
-                          mat.emissiveTexture, mat.occlusionTexture, mat.clearcoatTexture,
-                          mat.clearcoatRoughnessTexture, mat.clearcoatNormalTexture}) {
+        for (int32_t t :
+             {mat.baseColorTexture, mat.metallicRoughnessTexture, mat.normalTexture,
+              mat.emissiveTexture, mat.occlusionTexture, mat.clearcoatTexture,
+              mat.clearcoatRoughnessTexture, mat.clearcoatNormalTexture, mat.specularTexture,
+              mat.specularColorTexture, mat.sheenColorTexture, mat.sheenRoughnessTexture}) {
             if (t < 0 || size_t(t) >= scene.textures.size()) continue;
             uses.push_back(
                 {uint32_t(t), world.center(), 0.5f * glm::length(world.extent()), uvPerMetre});

@@ -409,9 +409,11 @@ TextureStreamingPtr createTextureStreaming(Gpu& gpu, const Scene& scene,
         s.materialsOf.resize(n);
         for (uint32_t m = 0; m < scene.materials.size(); ++m) {
             const Material& mat = scene.materials[m];
-            for (int32_t t : {mat.baseColorTexture, mat.metallicRoughnessTexture, mat.normalTexture,
-                              mat.emissiveTexture, mat.occlusionTexture, mat.clearcoatTexture,
-                              mat.clearcoatRoughnessTexture, mat.clearcoatNormalTexture})
+            for (int32_t t :
+                 {mat.baseColorTexture, mat.metallicRoughnessTexture, mat.normalTexture,
+                  mat.emissiveTexture, mat.occlusionTexture, mat.clearcoatTexture,
+                  mat.clearcoatRoughnessTexture, mat.clearcoatNormalTexture, mat.specularTexture,
+                  mat.specularColorTexture, mat.sheenColorTexture, mat.sheenRoughnessTexture})
                 if (t >= 0 && size_t(t) < n) s.materialsOf[t].push_back(m);
         }
         s.restreamed.assign(scene.materials.size(), 0);

@@ -1,0 +1,119 @@
+#include "render/animation/scene_playback.h"
+
+#include <cstring>
+
+#include "core/error.h"
+#include "core/log.h"
+#include "scene/load.h"
+
+namespace shadel {
+
+ScenePlayback startPlayback(const std::string& spec, const SceneFileOptions& options,
+                            double startTime, double step, Scene drawn) {
+    ScenePlayback p;
+    p.spec = spec;
+    p.options = options;
+    p.startTime = startTime;
+    p.step = step;
+    p.drawn = std::move(drawn);
+    return p;
+}
+
+static bool sameVertices(const Mesh& a, const Mesh& b) {
+    return a.vertices.size() == b.vertices.size() &&
+           std::memcmp(a.vertices.data(), b.vertices.data(), a.vertices.size() * sizeof(Vertex)) ==
+               0;
+}
+
+void poseFrame(Gpu& gpu, ScenePlayback& p, uint32_t frame, GpuScene& gpuScene,
+               std::vector<uint8_t>& reposed, bool gpuSkinned) {
+    reposed.assign(gpuScene.instanceCount, 0);
+    SceneFileOptions options = p.options;
+    options.time = p.startTime + double(frame) * p.step;
+    // The first frame's import already gave the file's warnings; they would repeat each frame.
+    LogLevel level = logLevel();
+    if (level < LogLevel::Error) setLogLevel(LogLevel::Error);
+    Scene posed;
+    try {
+        posed = loadScene(p.spec, options);
+    } catch (...) {
+        setLogLevel(level);
+        throw;
+    }
+    setLogLevel(level);
+    Scene& drawn = p.drawn;
+    if (posed.meshes.size() != drawn.meshes.size() ||
+        posed.instances.size() != drawn.instances.size() ||
+        drawn.instances.size() != gpuScene.instanceCount)
+        throw InputError(format("%s: at %.4f s the animated scene has %zu meshes / %zu "
+                                "instances, not the %zu / %zu of the first frame",
+                                p.spec.c_str(), *options.time, posed.meshes.size(),
+                                posed.instances.size(), drawn.meshes.size(),
+                                drawn.instances.size()));
+
+    // Vertices of the meshes that deformed (morph targets, skins), through the upload's
+    // vertex order (baked seams duplicate vertices; the fetch order permutes them).
+    std::vector<uint8_t> meshMoved(drawn.meshes.size(), 0);
+    for (size_t m = 0; m < drawn.meshes.size(); ++m) {
+        Mesh& now = posed.meshes[m];
+        if (now.vertices.size() != drawn.meshes[m].vertices.size() ||
+            now.indices != drawn.meshes[m].indices)
+            throw InputError(format("%s: mesh %zu (%s) changes topology over the animation",
+                                    p.spec.c_str(), m, now.name.c_str()));
+        if (sameVertices(now, drawn.meshes[m])) continue;
+        meshMoved[m] = 1;
+        p.meshesReposed++;
+        if (!(gpuSkinned && now.skin)) { // else the skinning pass deforms it from the joints
+            uint32_t first = uint32_t(gpuScene.meshInfo[m].vertexOffset);
+            uint32_t end = m + 1 < gpuScene.meshInfo.size()
+                               ? uint32_t(gpuScene.meshInfo[m + 1].vertexOffset)
+                               : uint32_t(gpuScene.vertexSource.size());
+            std::vector<gpu::GpuVertex> vertices(end - first);
+            for (uint32_t v = first; v < end; ++v) {
+                const Vertex& src = now.vertices[gpuScene.vertexSource[v]];
+                vertices[v - first] = {src.position, src.normal, src.tangent, src.uv0};
+            }
+            uploadBuffer(gpu, gpuScene.vertices, vertices.data(),
+                         vertices.size() * sizeof(gpu::GpuVertex),
+                         VkDeviceSize(first) * sizeof(gpu::GpuVertex));
+            p.verticesWritten += vertices.size();
+        }
+        gpu::GpuMesh& g = gpuScene.meshInfo[m];
+        g.boundsMin = now.bounds.min;
+        g.boundsMax = now.bounds.max;
+        uploadBuffer(gpu, gpuScene.meshes, &g, sizeof(g), m * sizeof(gpu::GpuMesh));
+        drawn.meshes[m] = std::move(now);
+    }
+
+    // Instances whose transform or mesh moved; the scene bounds (the sun's shadow fit) follow.
+    gpuScene.bounds = Aabb{};
+    bool anyReposed = false;
+    for (size_t i = 0; i < drawn.instances.size(); ++i) {
+        Instance& inst = drawn.instances[i];
+        const Instance& now = posed.instances[i];
+        if (now.mesh != inst.mesh)
+            throw InputError(format("%s: instance %zu (%s) changes mesh over the animation",
+                                    p.spec.c_str(), i, now.name.c_str()));
+        bool moved = now.transform != inst.transform;
+        if (moved || meshMoved[inst.mesh]) {
+            inst.transform = now.transform;
+            gpu::GpuInstance& g = gpuScene.instanceInfo[i];
+            g.model = inst.transform;
+            g.normalMatrix = glm::transpose(glm::inverse(inst.transform));
+            Aabb world = transformAabb(drawn.meshes[inst.mesh].bounds, inst.transform);
+            g.worldMin = world.min;
+            g.worldMax = world.max;
+            reposed[i] = 1;
+            anyReposed = true;
+            p.instancesReposed++;
+        }
+        gpuScene.bounds.extend(
+            Aabb{gpuScene.instanceInfo[i].worldMin, gpuScene.instanceInfo[i].worldMax});
+    }
+    drawn.skinPoses = std::move(posed.skinPoses);
+    if (anyReposed) // one copy: the GPU is idle between frames
+        uploadBuffer(gpu, gpuScene.instances, gpuScene.instanceInfo.data(),
+                     gpuScene.instanceInfo.size() * sizeof(gpu::GpuInstance));
+}
+
+} // namespace shadel

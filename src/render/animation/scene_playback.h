@@ -1,0 +1,44 @@
+#pragma once
+// Animated playback of a glTF scene over a run's frames (`--time-step SECONDS`): frame i shows
+// the file's animations posed at T0 + i * step (T0 = `--time`, default 0). Each frame the file
+// is posed again on the CPU (scene/gltf_animation: node TRS, morph weights, skins) and only what
+// moved is written to the GPU scene: instance transforms and bounds, and the vertices of meshes
+// whose posed vertices changed. Topology never changes, so a decoupled object keeps its charts,
+// shadel UVs and triangle-ID maps (baked from the T0 pose); its marking, shading and
+// reconstruction read the deformed vertices, and `reposed` tells the reuse logic
+// (render/shadel) not to carry its shadels over.
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "render/gpu_scene.h"
+#include "scene/gltf_import.h"
+#include "scene/scene.h"
+
+namespace shadel {
+
+struct ScenePlayback {
+    std::string spec;         // the glTF file
+    SceneFileOptions options; // its import options (time replaced per frame)
+    double startTime = 0.0;   // T0 (seconds)
+    double step = 0.0;        // seconds per frame
+    Scene drawn;              // the pose the GPU scene holds (instances, meshes)
+    // Totals over the run (stats).
+    uint64_t instancesReposed = 0, meshesReposed = 0, verticesWritten = 0;
+};
+
+// `drawn` is the scene uploaded for the first frame (posed at T0, meshes not split into chunks:
+// their vertices map one to one onto the file's).
+ScenePlayback startPlayback(const std::string& spec, const SceneFileOptions& options,
+                            double startTime, double step, Scene drawn);
+
+// Poses the file at T0 + frame * step and writes what changed since the drawn pose into
+// `gpuScene` (between frames: the GPU is idle). `reposed` gets one byte per instance: 1 when
+// its transform or its mesh's vertices changed. Throws InputError when the posed file no longer
+// matches the drawn scene's structure.
+// With `gpuSkinned`, meshes carrying GPU skinning input (Mesh::skin) are not written: the
+// skinning pass (render/skinning) deforms them from `drawn.skinPoses`, which the caller hands it.
+void poseFrame(Gpu& gpu, ScenePlayback& playback, uint32_t frame, GpuScene& gpuScene,
+               std::vector<uint8_t>& reposed, bool gpuSkinned = false);
+
+} // namespace shadel
