@@ -304,10 +304,11 @@ vec3 shadeSurface(FrameConstants f, MaterialSample m, vec3 worldPos, vec3 geomet
     vec3 color = m.emissive;
     // Indirect diffuse light from the light propagation volume (0 when GI is off).
     vec3 indirect = giIrradiance(f.gi, worldPos, n) * m.baseColor * (1.0 - m.metallic) *
-                    m.occlusion / PI;
+                    m.occlusion * m.ambientOcclusion / PI;
     if (f.visualize == VISUALIZE_GI) return indirect;
     if (f.visualize == VISUALIZE_RT_AO) return vec3(gRtOcclusion);
-    color += indirect + gRtIndirect * m.baseColor * (1.0 - m.metallic) * m.occlusion;
+    color += indirect + gRtIndirect * m.baseColor * (1.0 - m.metallic) * m.occlusion *
+                            m.ambientOcclusion;
     // Ambient: a hemisphere term so shadowed sides are not black.
     float up = n.y * 0.5 + 0.5;
     vec3 ambient = mix(f.ambientColor * 0.5, f.ambientColor + f.skyColor * 0.15, up);
@@ -320,7 +321,7 @@ vec3 shadeSurface(FrameConstants f, MaterialSample m, vec3 worldPos, vec3 geomet
         vec3 mirrored = mix(f.ambientColor * 0.5, f.ambientColor + f.skyColor, r.y * 0.5 + 0.5);
         ambientLit = ambientLit * (1.0 - fc) + fc * mirrored * m.occlusion;
     }
-    color += ambientLit * gRtOcclusion;
+    color += ambientLit * gRtOcclusion * m.ambientOcclusion; // AO decals: ambient only
 
     vec3 l = -f.sunDirection;
     LightingFrame lf;

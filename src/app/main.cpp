@@ -241,6 +241,12 @@ int main(int argc, char** argv) {
         ->add_option("--sun-shadows", sunShadows,
                      "pcf | pcss: the sun's shadow filter (pcss: variable penumbra)")
         ->capture_default_str();
+    std::string decals = "on";
+    render
+        ->add_option("--decals", decals,
+                     "on | off: the scene's projected box decals (base colour, normal, "
+                     "roughness, ambient occlusion)")
+        ->capture_default_str();
     render
         ->add_option("--spot-shadows", spotShadows,
                      "on | off: shadow maps (one atlas) for the spots that cast shadows")
@@ -511,6 +517,7 @@ int main(int argc, char** argv) {
                     format("--sun-shadows %s: expected pcf or pcss", sunShadows.c_str()));
             ro.sunSoftShadows = sunShadows == "pcss";
             ro.spotShadows = parseOnOff("--spot-shadows", spotShadows);
+            ro.decals = parseOnOff("--decals", decals);
             ro.gi = parseGi(gi);
             if (giSnap != "on" && giSnap != "off")
                 throw InputError(format("--gi-snap %s: expected on or off", giSnap.c_str()));

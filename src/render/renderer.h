@@ -9,6 +9,7 @@
 #include "render/culling/culling.h"
 #include "render/debug/capture.h"
 #include "render/debug/debug_lines.h"
+#include "render/decals/decals.h"
 #include "render/distance_fields/distance_fields.h"
 #include "render/gi/lpv.h"
 #include "render/gpu_scene.h"
@@ -115,6 +116,7 @@ struct RenderSettings {
     Spectra spectra = Spectra::Off; // forward: per-tile shading permutations (render/lighting)
     bool sunSoftShadows = false;    // --sun-shadows pcss: variable penumbra (render/lighting)
     bool spotShadows = true;        // --spot-shadows: shadow maps of shadow-casting spots
+    bool decals = true;             // --decals: the scene's projected box decals (render/decals)
 };
 
 struct FrameResult {
@@ -202,6 +204,7 @@ struct Renderer {
     std::vector<uint8_t> restreamedMaterials; // per material: a texture of it changed this frame
     SpectraStatePtr spectra;        // --spectra on|single (render/lighting/feature_spectra.h)
     SpotShadowStatePtr spotShadows; // shadow-casting spots (render/lighting/spot_shadows.h)
+    DecalStatePtr decals;           // --decals on, scenes with decals (render/decals/decals.h)
     std::chrono::steady_clock::time_point createdAt = std::chrono::steady_clock::now();
 };
 
