@@ -67,12 +67,12 @@ Scene makeDecalsScene() {
     const uint32_t rough = DECAL_KIND(DECAL_STAGE_ROUGHNESS);
     const uint32_t ao = DECAL_KIND(DECAL_STAGE_AMBIENT_OCCLUSION);
     // Graffiti on the wall, two splats overlapping (the second drawn over the first).
-    Decal red = decal({-0.6f, 1.9f, -2.35f}, front, right, {2.4f, 2.4f, 0.8f}, base,
-                      DecalPattern::Splat);
+    Decal red =
+        decal({-0.6f, 1.9f, -2.35f}, front, right, {2.4f, 2.4f, 0.8f}, base, DecalPattern::Splat);
     red.color = {0.85f, 0.15f, 0.1f, 0.9f};
     scene.decals.push_back(red);
-    Decal blue = decal({0.5f, 1.5f, -2.35f}, front, right, {2.0f, 2.0f, 0.8f}, base,
-                       DecalPattern::Splat);
+    Decal blue =
+        decal({0.5f, 1.5f, -2.35f}, front, right, {2.0f, 2.0f, 0.8f}, base, DecalPattern::Splat);
     blue.color = {0.1f, 0.3f, 0.85f, 0.85f};
     scene.decals.push_back(blue);
     // A riveted plate over the graffiti's right edge: bumps (normal) and darker rivets.
@@ -82,25 +82,25 @@ Scene makeDecalsScene() {
     plate.normalStrength = 4.0f;
     scene.decals.push_back(plate);
     // Rivets on the crate's front face (projected along +z, the ground beside it fades out).
-    Decal crateRivets = decal({-1.8f, 0.6f, 0.8f}, front, right, {1.2f, 1.2f, 0.6f}, normal,
-                              DecalPattern::Rivets);
+    Decal crateRivets =
+        decal({-1.8f, 0.6f, 0.8f}, front, right, {1.2f, 1.2f, 0.6f}, normal, DecalPattern::Rivets);
     crateRivets.normalStrength = 5.0f;
     scene.decals.push_back(crateRivets);
     // Road stripes on the ground, a puddle over them (roughness only).
-    Decal stripes = decal({0.3f, 0.0f, 1.6f}, up, right, {3.2f, 1.6f, 0.6f}, base,
-                          DecalPattern::Stripes);
+    Decal stripes =
+        decal({-0.1f, 0.0f, 1.6f}, up, right, {3.2f, 1.6f, 0.6f}, base, DecalPattern::Stripes);
     stripes.color = {0.95f, 0.8f, 0.1f, 0.9f};
     scene.decals.push_back(stripes);
-    Decal puddle = decal({0.0f, 0.0f, 1.9f}, up, right, {2.2f, 1.6f, 0.6f}, rough,
-                         DecalPattern::Puddle);
+    Decal puddle =
+        decal({0.0f, 0.0f, 1.9f}, up, right, {2.2f, 1.6f, 0.6f}, rough, DecalPattern::Puddle);
     puddle.roughness = 0.08f;
     scene.decals.push_back(puddle);
     // Contact shadows: ambient occlusion only, under the figure and the crate.
     Decal figureShadow = decal(kFigure, up, right, {1.6f, 1.6f, 0.6f}, ao, DecalPattern::Blob);
     figureShadow.occlusion = 0.85f;
     scene.decals.push_back(figureShadow);
-    Decal crateShadow = decal({-1.8f, 0.0f, 0.2f}, up, right, {2.4f, 2.4f, 0.6f}, ao,
-                              DecalPattern::Blob);
+    Decal crateShadow =
+        decal({-1.8f, 0.0f, 0.2f}, up, right, {2.4f, 2.4f, 0.6f}, ao, DecalPattern::Blob);
     crateShadow.occlusion = 0.6f;
     scene.decals.push_back(crateShadow);
 

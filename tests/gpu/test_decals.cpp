@@ -136,8 +136,8 @@ TEST(Decals, AmbientOcclusionDecalDarkensOnlyTheAmbientLight) {
     Scene scene = loadScene("builtin:decals", {});
     CameraView view = makeCameraView(findCamera(scene, ""), kW, kH);
     // Beside the figure's base (on the ground, inside the contact shadow).
-    glm::ivec2 pixel = projectPixel(decalsSceneContactShadowCentre() + glm::vec3(0.0f, 0.0f, 0.4f),
-                                    view);
+    glm::ivec2 pixel =
+        projectPixel(decalsSceneContactShadowCentre() + glm::vec3(0.0f, 0.0f, 0.4f), view);
     auto on = inspect(true, pixel);
     auto off = inspect(false, pixel);
     ASSERT_TRUE(on.count(PRINT_AMBIENT) && off.count(PRINT_AMBIENT)) << "nothing inspected";

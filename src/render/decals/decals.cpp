@@ -49,10 +49,10 @@ gpu::GpuDecal gpuDecal(const Decal& decal) {
     gpu::GpuDecal g{};
     glm::vec3 z = glm::normalize(decal.axisZ);
     glm::vec3 x = decal.axisX - z * glm::dot(z, decal.axisX);
-    x = glm::length(x) > 1e-6f ? glm::normalize(x)
-                               : glm::normalize(glm::cross(z, std::abs(z.y) < 0.9f
-                                                                  ? glm::vec3(0, 1, 0)
-                                                                  : glm::vec3(1, 0, 0)));
+    x = glm::length(x) > 1e-6f
+            ? glm::normalize(x)
+            : glm::normalize(
+                  glm::cross(z, std::abs(z.y) < 0.9f ? glm::vec3(0, 1, 0) : glm::vec3(1, 0, 0)));
     glm::vec3 y = glm::cross(z, x);
     glm::vec3 size = glm::max(decal.size, glm::vec3(1e-4f));
     const glm::vec3 axes[3] = {x, y, z};
@@ -95,11 +95,11 @@ DecalStatePtr createDecals(Renderer& r, const GpuScene& scene) {
         return b;
     };
     size_t count = s->cpuDecals.size();
-    s->decals = need(createBuffer(
-        gpu, {"decals.boxes", count * sizeof(gpu::GpuDecal), 0, MemoryKind::Upload}));
+    s->decals = need(
+        createBuffer(gpu, {"decals.boxes", count * sizeof(gpu::GpuDecal), 0, MemoryKind::Upload}));
     std::memcpy(mapped(gpu, s->decals), s->cpuDecals.data(), count * sizeof(gpu::GpuDecal));
-    s->frame = need(
-        createBuffer(gpu, {"decals.frame", sizeof(gpu::DecalFrame), 0, MemoryKind::Upload}));
+    s->frame =
+        need(createBuffer(gpu, {"decals.frame", sizeof(gpu::DecalFrame), 0, MemoryKind::Upload}));
     s->frustumDecals =
         need(createBuffer(gpu, {"decals.frustumDecals", count * 4, 0, MemoryKind::Upload}));
     const uint64_t rangeBytes = 8ull * DECAL_STAGES;
@@ -109,8 +109,8 @@ DecalStatePtr createDecals(Renderer& r, const GpuScene& scene) {
     s->entries = need(createBuffer(gpu, {"decals.entries", uint64_t(s->poolCapacity) * 4}));
     s->counters = need(createBuffer(
         gpu, {"decals.counters", sizeof(gpu::DecalCounters), 0, MemoryKind::Readback}));
-    s->visible = need(createBuffer(
-        gpu, {"decals.visible", ((count + 31) / 32) * 4, 0, MemoryKind::Readback}));
+    s->visible = need(
+        createBuffer(gpu, {"decals.visible", ((count + 31) / 32) * 4, 0, MemoryKind::Readback}));
     s->tileCull = createComputePipeline(gpu, "decalTileCull", "decals_tile_cull.comp.spv");
     if (r.decoupled)
         s->chunkCull = createComputePipeline(gpu, "decalChunkCull", "decals_chunk_cull.comp.spv");
@@ -201,11 +201,10 @@ void recordDecalCulling(Renderer& r, FrameRecorder& rec, uint64_t frame) {
             pushConstants(gpu, cmd, ChunkPush{frame});
             vkCmdDispatchIndirect(cmd, vkBuffer(gpu, queue.counters), queue.dispatchOffset);
         }
-        memoryBarrier(cmd, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
-                      VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT,
-                      VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT |
-                          VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
-                      VK_ACCESS_2_SHADER_STORAGE_READ_BIT);
+        memoryBarrier(
+            cmd, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT,
+            VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT | VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
+            VK_ACCESS_2_SHADER_STORAGE_READ_BIT);
     });
 }
 
