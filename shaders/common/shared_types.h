@@ -327,7 +327,14 @@ struct GpuLod {
     uint firstIndex;
     uint indexCount;
     float error; // object-space deviation from LOD 0 (meshoptimizer's error, in scene units)
-    uint pad;
+    // The proxy (shadow) index set of this level (seed 003's "main and proxy index sets"): the
+    // same triangles over position-only deduplicated vertices (meshopt_generateShadowIndexBuffer),
+    // so a depth-only view fetches each position once instead of once per normal/UV/chart seam.
+    uint proxyFirstIndex; // indexCount indices, the same vertexOffset
+    uint uniqueVertices;      // distinct vertices the main set references
+    uint proxyUniqueVertices; // ... and the proxy set
+    uint pad0;
+    uint pad1;
 };
 
 struct GpuMeshLods {
@@ -345,6 +352,7 @@ struct GpuCullStats {
     uint frustumVisible[CULL_VIEWS]; // passed the frustum (and, for shadows, the caster) test
     uint occlusionCulled;            // camera: frustum-visible but behind the depth pyramid
     uint drawnLastFrameVisible;      // camera: drawn in phase 1 (visible last frame)
+    uint verticesDrawn[CULL_VIEWS];  // distinct vertices of the index sets drawn, summed
 };
 
 struct CullingFrame {
@@ -360,7 +368,7 @@ struct CullingFrame {
     uint hizLevels;
     uvec2 hizSize;   // level 0 = the depth target's size
     float sceneMinY; // the lowest point of the scene: shadows end there
-    uint pad0;
+    uint proxyShadows; // 1: shadow views draw each LOD's proxy index set
 };
 
 // Shader -> CPU message channel (shader asserts and prints). Written with atomics, read after the

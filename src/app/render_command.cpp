@@ -296,6 +296,7 @@ RenderRun runRender(Gpu& gpu, const RenderOptions& o) {
     settings.sunSoftShadows = o.sunSoftShadows;
     settings.spotShadows = o.spotShadows;
     settings.decals = o.decals;
+    settings.proxyShadows = o.proxyShadows;
     requireCount("--gi-iterations", o.giIterations, 0, 64);
     if (o.visualize == Visualize::Gi && o.gi == GiMode::Off)
         throw InputError("--visualize gi: shows the indirect light of --gi lpv; GI is off");

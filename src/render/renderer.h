@@ -116,6 +116,7 @@ struct RenderSettings {
     Spectra spectra = Spectra::Off; // forward: per-tile shading permutations (render/lighting)
     bool sunSoftShadows = false;    // --sun-shadows pcss: variable penumbra (render/lighting)
     bool spotShadows = true;        // --spot-shadows: shadow maps of shadow-casting spots
+    bool proxyShadows = true; // --proxy-shadows: shadow views draw proxy index sets (render/culling)
     bool decals = true;             // --decals: the scene's projected box decals (render/decals)
 };
 
