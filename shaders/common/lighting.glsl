@@ -310,10 +310,11 @@ vec3 shadeSurface(FrameConstants f, MaterialSample m, vec3 worldPos, vec3 geomet
     vec3 color = m.emissive;
     // Indirect diffuse light from the light propagation volume (0 when GI is off).
     vec3 indirect = giIrradiance(f.gi, worldPos, n) * m.baseColor * (1.0 - m.metallic) *
-                    m.occlusion / PI;
+                    m.occlusion * m.ambientOcclusion / PI;
     if (f.visualize == VISUALIZE_GI) return indirect;
     if (f.visualize == VISUALIZE_RT_AO) return vec3(gRtOcclusion);
-    color += indirect + gRtIndirect * m.baseColor * (1.0 - m.metallic) * m.occlusion;
+    color += indirect + gRtIndirect * m.baseColor * (1.0 - m.metallic) * m.occlusion *
+                            m.ambientOcclusion;
     // Ambient: a hemisphere term so shadowed sides are not black.
     float up = n.y * 0.5 + 0.5;
     vec3 ambient = mix(f.ambientColor * 0.5, f.ambientColor + f.skyColor * 0.15, up);
@@ -333,7 +334,7 @@ vec3 shadeSurface(FrameConstants f, MaterialSample m, vec3 worldPos, vec3 geomet
         df = DistanceFieldFrameRef(f.distanceFields).d;
         ambientLit *= dfAmbientOcclusion(df, worldPos + geometricNormal * 0.02, geometricNormal);
     }
-    color += ambientLit * gRtOcclusion;
+    color += ambientLit * gRtOcclusion * m.ambientOcclusion; // AO decals: ambient only
 
     vec3 l = -f.sunDirection;
     LightingFrame lf;

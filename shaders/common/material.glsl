@@ -22,7 +22,8 @@ struct MaterialSample {
     vec3 normal; // world, with normal map applied
     float metallic;
     float roughness;
-    float occlusion;
+    float occlusion;        // the material's occlusion texture: ambient and lights
+    float ambientOcclusion; // AO decals (render/decals): ambient and indirect light only
     vec3 emissive;
     // glTF material extensions (defaults: plain metal/rough).
     vec3 specularF0;          // dielectric F0: ior and KHR_materials_specular (0.04 by default)
@@ -35,6 +36,8 @@ struct MaterialSample {
     bool unlit;               // KHR_materials_unlit: the output is baseColor
 };
 
+
+#include "decals/decals.glsl"
 
 // One-texel checker: the seed's `IntTexCoord.x % 2` shader. It is a point function of the
 // texel coordinate and has no filtered form, so any path that point-samples it aliases.
@@ -160,6 +163,8 @@ MaterialSample evaluateMaterial(GpuMaterial m, SurfaceInput s) {
     }
     o.sheenRoughness = max(sheenRoughness, 0.07);
     o.unlit = (m.flags & MATERIAL_UNLIT) != 0u;
+    o.ambientOcclusion = 1.0;
+    applyDecals(o, s.position, n); // the caller's decal list, if it chose one (decals.glsl)
     return o;
 }
 #endif

@@ -330,6 +330,7 @@ struct FrameConstants {
     uint64_t distanceFields;
     float dfShadowStart;
     uint dfPad;
+    uint64_t decals; // DecalFrame (render/decals), 0 when the frame has no decals
 };
 
 // ---- GPU-driven world (render/culling) ------------------------------------------------------
@@ -344,7 +345,14 @@ struct GpuLod {
     uint firstIndex;
     uint indexCount;
     float error; // object-space deviation from LOD 0 (meshoptimizer's error, in scene units)
-    uint pad;
+    // The proxy (shadow) index set of this level (seed 003's "main and proxy index sets"): the
+    // same triangles over position-only deduplicated vertices (meshopt_generateShadowIndexBuffer),
+    // so a depth-only view fetches each position once instead of once per normal/UV/chart seam.
+    uint proxyFirstIndex; // indexCount indices, the same vertexOffset
+    uint uniqueVertices;      // distinct vertices the main set references
+    uint proxyUniqueVertices; // ... and the proxy set
+    uint pad0;
+    uint pad1;
 };
 
 struct GpuMeshLods {
@@ -362,6 +370,7 @@ struct GpuCullStats {
     uint frustumVisible[CULL_VIEWS]; // passed the frustum (and, for shadows, the caster) test
     uint occlusionCulled;            // camera: frustum-visible but behind the depth pyramid
     uint drawnLastFrameVisible;      // camera: drawn in phase 1 (visible last frame)
+    uint verticesDrawn[CULL_VIEWS];  // distinct vertices of the index sets drawn, summed
 };
 
 struct CullingFrame {
@@ -377,7 +386,7 @@ struct CullingFrame {
     uint hizLevels;
     uvec2 hizSize;   // level 0 = the depth target's size
     float sceneMinY; // the lowest point of the scene: shadows end there
-    uint pad0;
+    uint proxyShadows; // 1: shadow views draw each LOD's proxy index set
 };
 
 // Shader -> CPU message channel (shader asserts and prints). Written with atomics, read after the
@@ -535,6 +544,62 @@ struct ShadelFrame {
     float trilinearBand;  // width of the LOD interval blended between two MIPs (1 = trilinear)
     uint materialSamples; // material evaluations per shadel above MIP 0 (1 or 4)
     uint regionStart[SHADEL_MAX_MIPS]; // first block column of each MIP's region
+};
+
+// ---- Projected box decals (render/decals, shaders/decals) -----------------------------------
+// Decal stages, applied in this order to the material before lighting (seed 004's decal render
+// stages; the AO-only kind is seed 001's character shadow). A decal may take part in several.
+#define DECAL_STAGE_BASE_COLOR 0u
+#define DECAL_STAGE_NORMAL 1u
+#define DECAL_STAGE_ROUGHNESS 2u
+#define DECAL_STAGE_AMBIENT_OCCLUSION 3u // darkens ambient / indirect light only
+#define DECAL_STAGES 4u
+#define DECAL_KIND(stage) (1u << (stage))
+// Procedural masks in the decal's [0,1]^2 projection (shaders/decals/decals.glsl).
+#define DECAL_PATTERN_SPLAT 0u   // a soft-edged ring and disc (graffiti)
+#define DECAL_PATTERN_STRIPES 1u // diagonal stripes (road marking)
+#define DECAL_PATTERN_RIVETS 2u  // a grid of round bumps (height for the normal stage)
+#define DECAL_PATTERN_PUDDLE 3u  // a wobbly blob (wet patch: low roughness)
+#define DECAL_PATTERN_BLOB 4u    // radial falloff (contact shadow under a character)
+#define DECAL_TILE_MAX 256u      // decals one tile's / chunk's list holds
+
+struct GpuDecal {
+    mat4 worldToBox; // world -> box space [-0.5, 0.5]^3; the box's z projects (faces the surface)
+    vec3 center;     // world-space box: centre, unit axes, half sizes (culling, normal stage)
+    uint kinds;      // DECAL_KIND(stage) bits
+    vec3 axisX;
+    uint pattern; // DECAL_PATTERN_*
+    vec3 axisY;
+    float normalStrength; // normal stage: height gradient scale
+    vec3 axisZ;
+    float roughness; // roughness stage: the target perceptual roughness
+    vec3 halfSize;
+    float occlusion; // AO stage: ambient kept at the mask's centre is 1 - occlusion
+    vec4 color;      // base colour stage: rgb, a = opacity
+};
+
+// What decal culling shares with shading (FrameConstants::decals).
+struct DecalFrame {
+    uint64_t decals;        // GpuDecal[]
+    uint64_t frustumDecals; // uint decal indices meeting the camera frustum, in decal order
+    uint64_t tileRanges;    // uvec2 (first entry, count) per (tile * DECAL_STAGES + stage)
+    uint64_t chunkRanges;   // the same per (shading work index * DECAL_STAGES + stage)
+    uint64_t entries;       // the pool of uint decal indices both lists take room in
+    uint64_t counters;      // DecalCounters
+    uint64_t visibleDecals; // uint bit set: decals in at least one list
+    uint frustumDecalCount;
+    uint poolCapacity;
+    uint tilesX;
+    uint tilesY;
+    uint chunkCapacity; // work indices chunkRanges holds
+    uint pad0;
+};
+
+struct DecalCounters {
+    uint tilePairs;      // (decal, tile) pairs in the forward lists
+    uint chunkPairs;     // (decal, chunk) pairs in the shadel chunk lists
+    uint poolEntries;    // entries asked of the pool (every stage)
+    uint listsOverflowed; // tiles or chunks whose lists did not fit (decals dropped)
 };
 
 #ifdef __cplusplus

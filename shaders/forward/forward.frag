@@ -37,6 +37,8 @@ void main() {
     s.uvDx = dFdx(inUv);
     s.uvDy = dFdy(inUv);
     s.frontFacing = gl_FrontFacing;
+    // Decals land on opaque surfaces: the list of this pixel's tile (render/decals).
+    if ((mat.flags & MATERIAL_ALPHA_BLEND) == 0u) useTileDecalList(f, gl_FragCoord.xy);
     MaterialSample m = evaluateMaterial(mat, s);
     if ((mat.flags & MATERIAL_ALPHA_MASK) != 0u && m.alpha < mat.alphaCutoff) discard;
     // Opaque pixels lie on the prepass depth the tile's bounds came from; blended ones need not.

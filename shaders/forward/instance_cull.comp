@@ -50,7 +50,7 @@ void main() {
     uint id = gl_GlobalInvocationID.x;
     uint view = pc.shadowView != 0u ? CULL_VIEW_SHADOW : CULL_VIEW_CAMERA;
     bool inFrustum = false, drawn = false, hidden = false, drawnBefore = false;
-    uint triangles = 0u;
+    uint triangles = 0u, vertices = 0u;
     if (id < f.instanceCount) {
         GpuInstance inst = InstanceBuffer(f.instances).i[id];
         inFrustum = true;
@@ -89,6 +89,12 @@ void main() {
                 cmd.indexCount = lod.indexCount;
                 cmd.instanceCount = 1u;
                 cmd.firstIndex = lod.firstIndex;
+                // Shadow views draw the proxy set (positions only), except alpha-tested casters,
+                // whose depth needs their UVs.
+                bool proxy = pc.shadowView != 0u && c.proxyShadows != 0u &&
+                             (MaterialBuffer(f.materials).m[inst.material].flags & MATERIAL_ALPHA_MASK) == 0u;
+                if (proxy) cmd.firstIndex = lod.proxyFirstIndex;
+                vertices = proxy ? lod.proxyUniqueVertices : lod.uniqueVertices;
                 cmd.vertexOffset = mesh.vertexOffset;
                 cmd.firstInstance = id;
                 DrawBuffer(pc.draws).d[list * pc.maxDraws + slot] = cmd;
@@ -104,6 +110,7 @@ void main() {
     CullStatsRef stats = CullStatsRef(c.stats);
     uint nDrawn = subgroupAdd(drawn ? 1u : 0u);
     uint nTriangles = subgroupAdd(triangles);
+    uint nVertices = subgroupAdd(vertices);
     // Phase 2 sees every frustum-visible instance again: count those once, in phase 2 / single.
     uint nFrustum = subgroupAdd(inFrustum && pc.phase != PHASE_LAST_VISIBLE ? 1u : 0u);
     uint nHidden = subgroupAdd(hidden && !drawnBefore ? 1u : 0u);
@@ -111,6 +118,7 @@ void main() {
     if (subgroupElect()) {
         if (nDrawn != 0u) atomicAdd(stats.s.instancesDrawn[view], nDrawn);
         if (nTriangles != 0u) atomicAdd(stats.s.trianglesDrawn[view], nTriangles);
+        if (nVertices != 0u) atomicAdd(stats.s.verticesDrawn[view], nVertices);
         if (nFrustum != 0u) atomicAdd(stats.s.frustumVisible[view], nFrustum);
         if (nHidden != 0u) atomicAdd(stats.s.occlusionCulled, nHidden);
         if (nBefore != 0u) atomicAdd(stats.s.drawnLastFrameVisible, nBefore);

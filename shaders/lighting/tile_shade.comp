@@ -57,6 +57,7 @@ void main() {
         s.uvDx = visInterpolate(bary.dx, a.uv0, b.uv0, c.uv0);
         s.uvDy = visInterpolate(bary.dy, a.uv0, b.uv0, c.uv0);
         s.frontFacing = tri.frontFacing;
+        useTileDecalList(f, vec2(pixel) + 0.5); // decals (render/decals)
         MaterialSample m = evaluateMaterial(mat, s);
         useTileLightList(f, vec2(pixel) + 0.5);
         vec3 shaded = visualizeLighting(f, shadeSurface(f, m, s.position, s.normal));

@@ -32,6 +32,7 @@ vec3 forwardShade(FrameConstants f) {
     si.uvDx = dFdx(inUv);
     si.uvDy = dFdy(inUv);
     si.frontFacing = gl_FrontFacing;
+    useTileDecalList(f, gl_FragCoord.xy); // decals, as forward shading applies them
     MaterialSample m = evaluateMaterial(mat, si);
     vec3 color = shadeSurface(f, m, inPosition, si.normal);
     if (inspecting(f, uvec2(gl_FragCoord.xy)))

@@ -88,6 +88,7 @@ void resolveQuad(FrameConstants f, ShadelFrame s, ivec2 origin, inout uvec4 coun
                 inspectShadels(f, s, o, r, v.shadelUv, v.texelDx, v.texelDy);
             }
             if (r.missing + r.overflowed != 0u || inspect) {
+                useTileDecalList(f, vec2(pixel) + 0.5); // decals, as forward shading applies them
                 vec3 forward = forwardShade(f, inst, q.tri, v.bary, vis, inspect);
                 if (r.missing + r.overflowed != 0u) c = forward;
             }

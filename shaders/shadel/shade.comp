@@ -234,6 +234,10 @@ void main() {
     si.frontFacing = dot(geometricNormal, f.cameraPosition - si.position) >= 0.0;
     GpuMaterial mat = MaterialBuffer(f.materials).m[inst.material];
     useRayTracedShadelTerms(f, work.object, shadelCenterUv(shadel, size)); // --rt-* (RT cache)
+    // Decals: this chunk's lists (render/decals), applied inside evaluateMaterial, so each
+    // shadel takes them once and every pixel reading it reuses them. Opaque surfaces only, as
+    // in forward shading.
+    if ((mat.flags & MATERIAL_ALPHA_BLEND) == 0u) useChunkDecalList(f, workIndex);
     // The shadel's whole footprint, not its centre (prefilter.glsl; --material-samples caps it).
     vec4 material;
     vec3 color = prefilteredShade(f, mat, si, shadelCenterUv(shadel, size), vec2(1.0) / vec2(size),

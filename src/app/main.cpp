@@ -257,6 +257,16 @@ int main(int argc, char** argv) {
         ->add_option("--sun-shadows", sunShadows,
                      "pcf | pcss: the sun's shadow filter (pcss: variable penumbra)")
         ->capture_default_str();
+    std::string decals = "on", proxyShadows = "on";
+    render
+        ->add_option("--proxy-shadows", proxyShadows,
+                     "on | off: shadow views draw each mesh's proxy index set (positions only)")
+        ->capture_default_str();
+    render
+        ->add_option("--decals", decals,
+                     "on | off: the scene's projected box decals (base colour, normal, "
+                     "roughness, ambient occlusion)")
+        ->capture_default_str();
     render
         ->add_option("--spot-shadows", spotShadows,
                      "on | off: shadow maps (one atlas) for the spots that cast shadows")
@@ -558,6 +568,8 @@ int main(int argc, char** argv) {
                     format("--sun-shadows %s: expected pcf or pcss", sunShadows.c_str()));
             ro.sunSoftShadows = sunShadows == "pcss";
             ro.spotShadows = parseOnOff("--spot-shadows", spotShadows);
+            ro.decals = parseOnOff("--decals", decals);
+            ro.proxyShadows = parseOnOff("--proxy-shadows", proxyShadows);
             ro.gi = parseGi(gi);
             if (giSnap != "on" && giSnap != "off")
                 throw InputError(format("--gi-snap %s: expected on or off", giSnap.c_str()));

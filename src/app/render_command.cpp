@@ -306,6 +306,8 @@ RenderRun runRender(Gpu& gpu, const RenderOptions& o) {
     settings.spectra = o.spectra;
     settings.sunSoftShadows = o.sunSoftShadows;
     settings.spotShadows = o.spotShadows;
+    settings.decals = o.decals;
+    settings.proxyShadows = o.proxyShadows;
     requireCount("--gi-iterations", o.giIterations, 0, 64);
     if (o.visualize == Visualize::Gi && o.gi == GiMode::Off)
         throw InputError("--visualize gi: shows the indirect light of --gi lpv; GI is off");
@@ -460,6 +462,7 @@ RenderRun runRender(Gpu& gpu, const RenderOptions& o) {
     if (renderer.particles) particleStats(renderer, s);
     featureSpectraStats(renderer, s);
     spotShadowStats(renderer, s);
+    decalStats(renderer, s);
     s["density_mode"] = autoDensity ? "auto" : "explicit";
     if (autoDensity)
         s["view_density"] = {{"budget_scale", viewDensity.budgetScale},

@@ -295,6 +295,7 @@ void uploadScene(Gpu& gpu, const Scene& scene, GpuScene& out, const std::vector<
     }
     out.skyColor = scene.skyColor;
     out.emitters = scene.emitters;
+    out.decals = scene.decals;
     out.ambientColor = scene.ambientColor;
 
     VkBufferUsageFlags indexUsage = VK_BUFFER_USAGE_INDEX_BUFFER_BIT;

@@ -48,6 +48,7 @@ struct GpuScene {
     std::vector<uint8_t> lightCastsShadow;      // per lightInfo entry (GI light views)
     std::vector<gpu::GpuMaterial> materialInfo; // what `materials` holds
     std::vector<ParticleEmitter> emitters;      // the scene's, simulated by render/particles
+    std::vector<Decal> decals;                  // the scene's, culled and applied by render/decals
     uint32_t instanceCount = 0;
     uint32_t lightCount = 0;
     Aabb bounds;

@@ -151,6 +151,7 @@ void initRenderer(Renderer& r, Gpu& gpu, const RenderSettings& settings, const G
     if (usesTileShading(r)) r.spectra = createFeatureSpectra(r);
     if (settings.gi == GiMode::Lpv) r.gi = createGi(r, scene);
     r.culling = createCulling(r, scene);
+    r.decals = createDecals(r, scene); // after the decoupled state (its queue's capacity)
     r.debugLines = createDebugLines(r);
     if (settings.rt.enabled()) r.rt = createRayTracing(r, scene);
     createScreenSpace(r);
@@ -163,6 +164,7 @@ void destroyRenderer(Renderer& r) {
     destroyRayTracing(r, r.rt);
     destroyFeatureSpectra(r, r.spectra);
     destroySpotShadows(r, r.spotShadows);
+    destroyDecals(r, r.decals);
     destroyLightCulling(r, r.lightCulling);
     destroyDebugLines(r, r.debugLines);
     destroyScreenSpace(r);
@@ -310,6 +312,7 @@ FrameResult renderFrame(Renderer& r, const GpuScene& scene, const CameraView& ca
     prepareTransparentDraws(r, scene, camera);
     prepareParticleFrame(r);
     prepareCullingFrame(r, scene, constants);
+    constants.decals = prepareDecalFrame(r, constants);
     constants.debugLines = debugLinesAddress(r);
     if (r.rt) prepareRayTracingFrame(r, scene, camera, constants);
     std::memcpy(mapped(gpu, r.frameConstants), &constants, sizeof(constants));
@@ -350,6 +353,8 @@ FrameResult renderFrame(Renderer& r, const GpuScene& scene, const CameraView& ca
     if (r.rt && r.settings.mode == RenderMode::Forward) // sun visibility, AO, GI per pixel
         pass(rec, "rtPixelTerms",
              [&](VkCommandBuffer cmd) { recordRayTracedPixels(r, cmd, frame); });
+    if (r.settings.mode == RenderMode::Forward) // decal lists per tile (render/decals)
+        recordDecalCulling(r, rec, frame);       // (decoupled: in recordDecoupledPasses)
     if (r.spectra) { // forward, per-tile permutations (render/lighting/feature_spectra.h)
         pass(rec, "tileShading", [&](VkCommandBuffer cmd) { recordTileShading(r, cmd, frame); });
     } else if (r.settings.mode == RenderMode::Forward) {
@@ -388,6 +393,7 @@ FrameResult renderFrame(Renderer& r, const GpuScene& scene, const CameraView& ca
     if (r.decoupled) finishDecoupledFrame(r);
     readLightCullingStats(r);
     readFeatureSpectraStats(r);
+    readDecalStats(r);
     finishCullingFrame(r);
     if (r.rt) finishRayTracingFrame(r);
     finishScreenSpaceFrame(r);

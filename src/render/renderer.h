@@ -9,6 +9,7 @@
 #include "render/culling/culling.h"
 #include "render/debug/capture.h"
 #include "render/debug/debug_lines.h"
+#include "render/decals/decals.h"
 #include "render/distance_fields/distance_fields.h"
 #include "render/gi/lpv.h"
 #include "render/gpu_scene.h"
@@ -125,6 +126,8 @@ struct RenderSettings {
     Spectra spectra = Spectra::Off; // forward: per-tile shading permutations (render/lighting)
     bool sunSoftShadows = false;    // --sun-shadows pcss: variable penumbra (render/lighting)
     bool spotShadows = true;        // --spot-shadows: shadow maps of shadow-casting spots
+    bool proxyShadows = true; // --proxy-shadows: shadow views draw proxy index sets (render/culling)
+    bool decals = true;             // --decals: the scene's projected box decals (render/decals)
 };
 
 struct FrameResult {
@@ -218,6 +221,7 @@ struct Renderer {
     std::vector<uint8_t> reposedInstances;
     SpectraStatePtr spectra;        // --spectra on|single (render/lighting/feature_spectra.h)
     SpotShadowStatePtr spotShadows; // shadow-casting spots (render/lighting/spot_shadows.h)
+    DecalStatePtr decals;           // --decals on, scenes with decals (render/decals/decals.h)
     std::chrono::steady_clock::time_point createdAt = std::chrono::steady_clock::now();
 };
 

@@ -11,6 +11,7 @@
 #include "core/error.h"
 #include "core/log.h"
 #include "scene/builtin_gallery.h"
+#include "scene/builtin_decals.h"
 #include "scene/builtin_lights.h"
 #include "scene/mesh_utils.h"
 
@@ -789,6 +790,7 @@ const std::vector<std::pair<std::string, std::function<Scene()>>>& registry() {
         {"blockers", makeBlockersScene},
         {"cornell", makeCornell},
         {"arena", makeArena},
+        {"decals", makeDecalsScene},
         {"textures", [] { return makeTextureGallery(); }},
     };
     return scenes;

@@ -8,6 +8,7 @@
 
 #include <glm/glm.hpp>
 
+#include "scene/decal.h"
 #include "scene/particle_emitter.h"
 
 namespace shadel {
@@ -243,6 +244,7 @@ struct Scene {
     std::vector<ParticleEmitter> emitters; // GPU particles (render/particles)
     std::vector<SkinPose> skinPoses;       // per skinned node (MeshSkin::skin)
     std::vector<PointLineSet> pointLines;  // glTF points and lines primitives
+    std::vector<Decal> decals;             // projected box decals (render/decals)
     glm::vec3 skyColor{0.55f, 0.7f, 0.95f};
     glm::vec3 ambientColor{0.08f, 0.09f, 0.11f};
 

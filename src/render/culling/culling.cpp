@@ -112,6 +112,8 @@ void prepareCullingFrame(Renderer& r, const GpuScene& scene, gpu::FrameConstants
     // P[1][1] = cot(fov / 2): a length l at distance d spans l * P[1][1] * height / 2 / d pixels.
     f.lodScale = std::abs(constants.proj[1][1]) * 0.5f * float(r.internalHeight); // y is flipped
     f.occlusion = r.settings.occlusion ? 1u : 0u;
+    // Not with GI: the reflective shadow maps draw the shadow list and need every normal.
+    f.proxyShadows = r.settings.proxyShadows && !r.gi ? 1u : 0u;
     f.sceneMinY = scene.bounds.valid() ? scene.bounds.min.y : -1e30f;
     if (!c.levelSize.empty()) {
         f.hizLevels = uint32_t(c.levelSize.size());
@@ -235,6 +237,7 @@ void cullingStats(const Renderer& r, nlohmann::json& s) {
                             {"frustum_visible", st.frustumVisible[v]},
                             {"instances_drawn", st.instancesDrawn[v]},
                             {"triangles_drawn", st.trianglesDrawn[v]},
+                            {"vertices_drawn", st.verticesDrawn[v]},
                             {"culled_fraction",
                              c.instances ? 1.0 - double(st.instancesDrawn[v]) / c.instances : 0.0}};
         if (v == CULL_VIEW_CAMERA) {
@@ -248,6 +251,7 @@ void cullingStats(const Renderer& r, nlohmann::json& s) {
     s["culling"] = {
         {"lod", r.settings.lod ? "on" : "off"},
         {"occlusion", r.settings.occlusion ? "on" : "off"},
+        {"proxy_shadows", r.settings.proxyShadows && !r.gi ? "on" : "off"},
         {"views", {{"camera", view(CULL_VIEW_CAMERA)}, {"shadow", view(CULL_VIEW_SHADOW)}}}};
 }
 

@@ -133,6 +133,25 @@ gpu::GpuMeshLods appendMeshWithLods(MeshGeometry mesh, std::vector<gpu::GpuVerte
         out.lod[k].error = errors[k];
         for (uint32_t i : levels[k]) indices.push_back(remap[i]);
     }
+    // Proxy index sets: each level again over the first vertex of every distinct position.
+    const gpu::GpuVertex* mine = vertices.data() + vertexOffset;
+    auto distinct = [&](const uint32_t* first, size_t count) {
+        std::vector<uint8_t> seen(kept, 0);
+        uint32_t n = 0;
+        for (size_t i = 0; i < count; ++i) n += seen[first[i]]++ == 0 ? 1u : 0u;
+        return n;
+    };
+    for (size_t k = 0; k < levels.size(); ++k) {
+        std::vector<uint32_t> proxy(out.lod[k].indexCount);
+        if (!proxy.empty())
+            meshopt_generateShadowIndexBuffer(proxy.data(), indices.data() + out.lod[k].firstIndex,
+                                              proxy.size(), mine, kept, sizeof(glm::vec3),
+                                              sizeof(gpu::GpuVertex));
+        out.lod[k].uniqueVertices = distinct(indices.data() + out.lod[k].firstIndex, proxy.size());
+        out.lod[k].proxyUniqueVertices = distinct(proxy.data(), proxy.size());
+        out.lod[k].proxyFirstIndex = uint32_t(indices.size());
+        indices.insert(indices.end(), proxy.begin(), proxy.end());
+    }
     return out;
 }
 

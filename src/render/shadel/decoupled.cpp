@@ -1,3 +1,4 @@
+#include "render/decals/decals.h"
 #include "render/shadel/decoupled.h"
 
 #include <algorithm>
@@ -758,6 +759,11 @@ void computeToCompute(VkCommandBuffer cmd) {
 }
 } // namespace
 
+ShadelShadingQueue shadelShadingQueue(const Renderer& r) {
+    const DecoupledState& d = *r.decoupled;
+    return {d.counters, offsetof(gpu::GpuShadelCounters, shadeDispatch), d.capacityChunks};
+}
+
 void recordDecoupledPasses(Renderer& r, FrameRecorder& rec, uint64_t frame, const GpuScene&) {
     Gpu& gpu = *r.gpu;
     DecoupledState& d = *r.decoupled;
@@ -839,6 +845,8 @@ void recordDecoupledPasses(Renderer& r, FrameRecorder& rec, uint64_t frame, cons
         vkCmdDispatchIndirect(cmd, vkBuffer(gpu, d.counters),
                               offsetof(gpu::GpuShadelCounters, copyDispatch));
     });
+
+    recordDecalCulling(r, rec, frame); // the decal lists of screen tiles and queued chunks
 
     pass(rec, "shadelShading", [&](VkCommandBuffer cmd) {
         bind(gpu, cmd, d.shade);

@@ -29,6 +29,15 @@ void recordDecoupledPostPasses(Renderer& r, FrameRecorder& rec, uint64_t frame);
 bool drawnDecoupled(const Renderer& r, uint32_t instance);
 // Reads back the frame's counters (after the GPU finished).
 void finishDecoupledFrame(Renderer& r);
+// The shading queue, for passes that run once per queued chunk before shading (render/decals):
+// the buffer holding its indirect dispatch arguments (GpuShadelCounters::shadeDispatch, the same
+// workgroup layout as shading) and the entries it can hold.
+struct ShadelShadingQueue {
+    BufferHandle counters;
+    VkDeviceSize dispatchOffset = 0;
+    uint32_t capacity = 0;
+};
+ShadelShadingQueue shadelShadingQueue(const Renderer& r);
 // Adds the decoupled fields of DESIGN §5 (medians over the frames rendered so far).
 void decoupledStats(const Renderer& r, nlohmann::json& stats);
 

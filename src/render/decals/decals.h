@@ -1,0 +1,47 @@
+#pragma once
+// Projected box decals (seed 004's decal stages, seed 001's AO-only character shadow): base
+// colour, normal, roughness and ambient-occlusion decals applied to the material before
+// lighting, in the material code both paths share (shaders/decals/decals.glsl).
+//
+// One culling pass builds every stage's list at once (seed 004: "build the decal lists with a
+// single frustum cull, then copy each decal that passes into the relevant list"): the CPU keeps
+// the decals meeting the camera frustum, then one compute pass gives each 16x16 screen tile
+// (forward shading, and the shadel path's forward fallbacks) and, in decoupled mode, each chunk
+// of the shading queue its lists, one per stage, in decal order. Shadel shading applies its
+// chunk's lists, so a decal is evaluated once per shadel and reused with the shadel.
+#include <cstdint>
+#include <memory>
+
+#include <nlohmann/json_fwd.hpp>
+
+#include "common/shared_types.h"
+#include "rhi/frame.h"
+#include "scene/decal.h"
+
+namespace shadel {
+
+struct Renderer;
+struct GpuScene;
+
+struct DecalState;
+struct DecalStateDeleter {
+    void operator()(DecalState* state) const;
+};
+using DecalStatePtr = std::unique_ptr<DecalState, DecalStateDeleter>;
+
+// Null when --decals off or the scene has none (then nothing is culled or applied).
+DecalStatePtr createDecals(Renderer& r, const GpuScene& scene);
+void destroyDecals(Renderer& r, DecalStatePtr& state);
+// The decal as the GPU sees it (box transform, orthonormal axes).
+gpu::GpuDecal gpuDecal(const Decal& decal);
+// This frame's DecalFrame (the decals meeting the camera frustum); its address for
+// FrameConstants::decals, 0 without decals.
+uint64_t prepareDecalFrame(Renderer& r, const gpu::FrameConstants& constants);
+// The "decalCulling" pass: every tile's lists, then (decoupled) every queued chunk's. Forward:
+// after the depth prepass, before shading; decoupled: after the work queues, before shading.
+void recordDecalCulling(Renderer& r, FrameRecorder& rec, uint64_t frame);
+// After the frame: the counters (decals_visible, decal_tile_pairs, ...).
+void readDecalStats(Renderer& r);
+void decalStats(const Renderer& r, nlohmann::json& stats);
+
+} // namespace shadel
