@@ -450,6 +450,18 @@ static void markRestreamed(TextureStreaming& s, int32_t texture) {
         for (uint32_t m : s.materialsOf[texture]) s.restreamed[m] = 1;
 }
 
+// Hands a load to the worker thread: its bytes land at `offset` in the staging ring.
+static void startLoad(TextureStreaming& s, std::unique_ptr<LoadJob> job, uint64_t offset,
+                      uint64_t bytes) {
+    job->stagingOffset = offset;
+    job->bytes = bytes;
+    {
+        std::lock_guard<std::mutex> lock(s.mutex);
+        s.queue.push_back(job.get());
+    }
+    s.jobs.push_back(std::move(job));
+}
+
 // Sparse residency's frame (priorities already merged): landed level loads bound (their copies
 // are the pass's), new loads planned with the evictions that make room, all binds queued for the
 // frame to wait on; every texture whose level changed sampled through its new view.
@@ -506,13 +518,7 @@ static void prepareSparseFrame(TextureStreaming& s) {
         job->firstLevel = load.level;
         job->endLevel = load.level + load.levels;
         job->sparse = std::move(load);
-        job->stagingOffset = offset;
-        job->bytes = bytes;
-        {
-            std::lock_guard<std::mutex> lock(s.mutex);
-            s.queue.push_back(job.get());
-        }
-        s.jobs.push_back(std::move(job));
+        startLoad(s, std::move(job), offset, bytes);
         ++started;
     }
     if (started) s.wake.notify_one();
@@ -604,13 +610,7 @@ void prepareTextureStreaming(TextureStreaming& s, const CameraView& camera, floa
         job->exchange = e;
         job->firstLevel = first;
         job->endLevel = uint32_t(t.levels.size());
-        job->stagingOffset = offset;
-        job->bytes = bytes;
-        {
-            std::lock_guard<std::mutex> lock(s.mutex);
-            s.queue.push_back(job.get());
-        }
-        s.jobs.push_back(std::move(job));
+        startLoad(s, std::move(job), offset, bytes);
         ++started;
     }
     if (started) s.wake.notify_one();
