@@ -35,9 +35,9 @@ using uint = uint32_t;
 #define TEXTURE_SLOT_CLEARCOAT 5u
 #define TEXTURE_SLOT_CLEARCOAT_ROUGHNESS 6u
 #define TEXTURE_SLOT_CLEARCOAT_NORMAL 7u
-#define TEXTURE_SLOT_SPECULAR 8u        // KHR_materials_specular: A = strength
-#define TEXTURE_SLOT_SPECULAR_COLOR 9u  // RGB = F0 tint
-#define TEXTURE_SLOT_SHEEN_COLOR 10u    // KHR_materials_sheen: RGB
+#define TEXTURE_SLOT_SPECULAR 8u         // KHR_materials_specular: A = strength
+#define TEXTURE_SLOT_SPECULAR_COLOR 9u   // RGB = F0 tint
+#define TEXTURE_SLOT_SHEEN_COLOR 10u     // KHR_materials_sheen: RGB
 #define TEXTURE_SLOT_SHEEN_ROUGHNESS 11u // A
 #define TEXTURE_SLOT_COUNT 12u
 
@@ -154,7 +154,8 @@ struct GpuMaterial {
     // weighted blended OIT composites both without sorting (render/oit).
     float additiveness;
     // glTF material extensions (scene.h Material; shaders/common/material.glsl).
-    vec2 uvTransform[36]; // 3 x TEXTURE_SLOT_COUNT: per texture slot (TEXTURE_SLOT_*): columns c0, c1, translation c2
+    vec2 uvTransform[36]; // 3 x TEXTURE_SLOT_COUNT: per texture slot (TEXTURE_SLOT_*): columns c0,
+                          // c1, translation c2
     uint clampMask;       // bit per texture slot: clamp-to-edge sampler
     uint clearcoatTexture;
     uint clearcoatRoughnessTexture;
@@ -348,7 +349,7 @@ struct GpuLod {
     // The proxy (shadow) index set of this level (seed 003's "main and proxy index sets"): the
     // same triangles over position-only deduplicated vertices (meshopt_generateShadowIndexBuffer),
     // so a depth-only view fetches each position once instead of once per normal/UV/chart seam.
-    uint proxyFirstIndex; // indexCount indices, the same vertexOffset
+    uint proxyFirstIndex;     // indexCount indices, the same vertexOffset
     uint uniqueVertices;      // distinct vertices the main set references
     uint proxyUniqueVertices; // ... and the proxy set
     uint pad0;
@@ -384,8 +385,8 @@ struct CullingFrame {
     float lodScale;       // pixels per unit of error at distance 1 (viewport height / 2 * P[1][1])
     uint occlusion;       // 1: two-phase hierarchical-Z culling of the camera view
     uint hizLevels;
-    uvec2 hizSize;   // level 0 = the depth target's size
-    float sceneMinY; // the lowest point of the scene: shadows end there
+    uvec2 hizSize;     // level 0 = the depth target's size
+    float sceneMinY;   // the lowest point of the scene: shadows end there
     uint proxyShadows; // 1: shadow views draw each LOD's proxy index set
 };
 
@@ -596,9 +597,9 @@ struct DecalFrame {
 };
 
 struct DecalCounters {
-    uint tilePairs;      // (decal, tile) pairs in the forward lists
-    uint chunkPairs;     // (decal, chunk) pairs in the shadel chunk lists
-    uint poolEntries;    // entries asked of the pool (every stage)
+    uint tilePairs;       // (decal, tile) pairs in the forward lists
+    uint chunkPairs;      // (decal, chunk) pairs in the shadel chunk lists
+    uint poolEntries;     // entries asked of the pool (every stage)
     uint listsOverflowed; // tiles or chunks whose lists did not fit (decals dropped)
 };
 

@@ -62,7 +62,7 @@ struct RenderOptions {
     bool sunSoftShadows = false;                                 // --sun-shadows pcf|pcss
     bool spotShadows = true;                                     // --spot-shadows on|off
     bool decals = true;                                          // --decals on|off
-    bool proxyShadows = true; // --proxy-shadows on|off
+    bool proxyShadows = true;                                    // --proxy-shadows on|off
     CameraPath cameraPath = CameraPath::Static;
     GiMode gi = GiMode::Off;    // --gi lpv|off
     uint32_t giIterations = 8;  // --gi-iterations

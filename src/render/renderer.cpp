@@ -354,7 +354,7 @@ FrameResult renderFrame(Renderer& r, const GpuScene& scene, const CameraView& ca
         pass(rec, "rtPixelTerms",
              [&](VkCommandBuffer cmd) { recordRayTracedPixels(r, cmd, frame); });
     if (r.settings.mode == RenderMode::Forward) // decal lists per tile (render/decals)
-        recordDecalCulling(r, rec, frame);       // (decoupled: in recordDecoupledPasses)
+        recordDecalCulling(r, rec, frame);      // (decoupled: in recordDecoupledPasses)
     if (r.spectra) { // forward, per-tile permutations (render/lighting/feature_spectra.h)
         pass(rec, "tileShading", [&](VkCommandBuffer cmd) { recordTileShading(r, cmd, frame); });
     } else if (r.settings.mode == RenderMode::Forward) {
@@ -369,7 +369,7 @@ FrameResult renderFrame(Renderer& r, const GpuScene& scene, const CameraView& ca
     recordParticlePasses(r, rec, frame);    // GPU particles: simulation, atlas lighting
     recordScreenSpacePasses(r, rec, frame); // sky, SSR, SSS over classified tiles
     recordStencilEffects(r, rec, frame, constants.viewProj); // water, character outline
-    recordPointsLines(r, rec, frame); // glTF points and lines, forward in both modes
+    recordPointsLines(r, rec, frame);        // glTF points and lines, forward in both modes
     recordTransparencyPasses(r, rec, frame); // blended materials, after every opaque surface
     if (r.debugLines) recordDebugLinePasses(r, rec, frame, scene, constants.lightCount);
     recordParticleAtlasView(r, rec, frame); // --visualize particle-atlas

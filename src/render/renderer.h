@@ -20,8 +20,8 @@
 #include "render/raytracing/ray_tracing.h"
 #include "render/raytracing/rt_settings.h"
 #include "render/shadel/visibility.h"
-#include "render/stencil/stencil_effects.h"
 #include "render/skinning/skinning.h"
+#include "render/stencil/stencil_effects.h"
 #include "rhi/frame.h"
 #include "rhi/pipeline.h"
 #include "rhi/shader_messages.h"
@@ -126,8 +126,9 @@ struct RenderSettings {
     Spectra spectra = Spectra::Off; // forward: per-tile shading permutations (render/lighting)
     bool sunSoftShadows = false;    // --sun-shadows pcss: variable penumbra (render/lighting)
     bool spotShadows = true;        // --spot-shadows: shadow maps of shadow-casting spots
-    bool proxyShadows = true; // --proxy-shadows: shadow views draw proxy index sets (render/culling)
-    bool decals = true;             // --decals: the scene's projected box decals (render/decals)
+    bool proxyShadows =
+        true;           // --proxy-shadows: shadow views draw proxy index sets (render/culling)
+    bool decals = true; // --decals: the scene's projected box decals (render/decals)
 };
 
 struct FrameResult {
@@ -211,8 +212,8 @@ struct Renderer {
     ScreenSpaceStatePtr screenSpace;       // --screen-space on (render/screenspace, render/tiles)
     DistanceFieldStatePtr distanceFields;  // --distance-fields on (render/distance_fields)
     StencilEffectsStatePtr stencilEffects; // --stencil-effects on|fullscreen (render/stencil)
-    PointsLinesStatePtr pointsLines;      // glTF points and lines, forward (render/points_lines)
-    SkinningStatePtr skinning;            // skinned meshes skinned on the GPU (render/skinning)
+    PointsLinesStatePtr pointsLines;       // glTF points and lines, forward (render/points_lines)
+    SkinningStatePtr skinning;             // skinned meshes skinned on the GPU (render/skinning)
     // Texture streaming (render/streaming), owned by the caller; null: textures loaded whole.
     TextureStreaming* streaming = nullptr;
     std::vector<uint8_t> restreamedMaterials; // per material: a texture of it changed this frame

@@ -10,8 +10,8 @@
 
 #include "core/error.h"
 #include "core/log.h"
-#include "scene/builtin_gallery.h"
 #include "scene/builtin_decals.h"
+#include "scene/builtin_gallery.h"
 #include "scene/builtin_lights.h"
 #include "scene/mesh_utils.h"
 

@@ -1,5 +1,5 @@
-#include "render/decals/decals.h"
 #include "render/shadel/decoupled.h"
+#include "render/decals/decals.h"
 
 #include <algorithm>
 #include <cstring>
