@@ -394,14 +394,13 @@ static bool keepWindow(const DecoupledState& d, const ObjectSlot& o, const Shade
     LevelWindow whole = wholeLevel(mesh, k);
     if (target.size == whole.size) return false; // whole again (no feedback, or windows off)
     if (target.size.x * target.size.y == 0) return false; // nothing wanted: give it back
+    // A non-empty target means something was wanted: it must stay inside with a block to spare.
     auto [lo, hi] = wantedBlocks(d, o, mesh, k);
-    if (lo.x < hi.x && lo.y < hi.y) {
-        lo -= glm::min(lo, glm::uvec2(1u));
-        hi = glm::min(hi + 1u, whole.size);
-        if (glm::any(glm::lessThan(lo, now.origin)) ||
-            glm::any(glm::greaterThan(hi, now.origin + now.size)))
-            return false;
-    }
+    lo -= glm::min(lo, glm::uvec2(1u));
+    hi = glm::min(hi + 1u, whole.size);
+    if (glm::any(glm::lessThan(lo, now.origin)) ||
+        glm::any(glm::greaterThan(hi, now.origin + now.size)))
+        return false;
     return uint64_t(now.size.x) * now.size.y <= 2 * uint64_t(target.size.x) * target.size.y;
 }
 
@@ -921,7 +920,7 @@ void finishDecoupledFrame(Renderer& r) {
     f.windowMoves = d.windowMoves;
     // Level windows: what this frame's samples wanted of each level places next frame's windows.
     const auto* wants = static_cast<const glm::uvec4*>(mapped(*r.gpu, d.levelWants));
-    for (size_t i = 0; i < d.rects.size(); ++i) {
+    for (size_t i = 0; d.levelWindows && i < d.rects.size(); ++i) { // off: nothing reads them
         const gpu::GpuShadelRect& rect = d.rects[i];
         ObjectSlot& o = d.objects[rect.object];
         glm::uvec4 w = wants[i];
