@@ -138,6 +138,7 @@ nlohmann::json runBench(Gpu& gpu, const BenchOptions& b) {
     o.cameraPath = b.cameraPath;
     o.animateLights = b.animateLights;
     o.reuseRefreshPeriod = b.reuseRefreshPeriod;
+    o.marking = b.marking;
     o.cacheLimitBytes = b.cacheLimitBytes;
     o.lightCulling = b.lightCulling;
     o.progress = false;
