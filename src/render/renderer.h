@@ -65,7 +65,7 @@ struct RenderSettings {
     uint32_t ssaa = 1; // N x N supersampling (forward reference)
     RenderMode mode = RenderMode::Forward;
     // Decoupled only. Visibility is the default (Auto): on lavapipe at 1280x720 (builtin:default,
-    // orbit, 6 frames) visibility prepass + compute marking + resolve cost 31 + 29 + 65 ms where
+    // orbit, 6 frames) visibility prepass + compute marking + resolve cost 33 + 29 + 72 ms where
     // depth prepass + raster marking + reconstruction cost 23 + 37 + 105 ms. (An earlier build
     // measured the opposite; lavapipe and the shaders changed since.)
     MarkingMode marking = MarkingMode::Auto;
