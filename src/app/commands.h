@@ -144,6 +144,7 @@ struct BenchOptions {
     uint32_t reuseRefreshPeriod = 8;
     uint64_t cacheLimitBytes = 4ull << 30;
     MarkingMode marking = MarkingMode::Auto; // decoupled and reuse modes
+    float shadingBias = 0.0f;                // decoupled and reuse modes
     LightCulling lightCulling = LightCulling::Tiled;
     // --light-culling compare: forward and decoupled rendered again with no culling, and
     // ratios.light_culling_forward|decoupled = tiled / none median frame time.

@@ -395,6 +395,11 @@ int main(int argc, char** argv) {
                      "tiled | none | compare: compare also renders forward and decoupled "
                      "without culling and reports tiled / none frame-time ratios")
         ->capture_default_str();
+    bench
+        ->add_option("--shading-bias", bo.shadingBias,
+                     "decoupled modes: fractional MIP bias (+ = fewer shadels)")
+        ->capture_default_str()
+        ->check(finiteInRange(kShadingBiasRange));
     std::string benchMarking = "auto";
     bench->add_option("--marking", benchMarking, "decoupled modes: auto | raster | visibility")
         ->capture_default_str();
