@@ -138,6 +138,8 @@ nlohmann::json runBench(Gpu& gpu, const BenchOptions& b) {
     o.cameraPath = b.cameraPath;
     o.animateLights = b.animateLights;
     o.reuseRefreshPeriod = b.reuseRefreshPeriod;
+    o.marking = b.marking;
+    o.shadingBias = b.shadingBias;
     o.cacheLimitBytes = b.cacheLimitBytes;
     o.lightCulling = b.lightCulling;
     o.progress = false;
@@ -159,6 +161,7 @@ nlohmann::json runBench(Gpu& gpu, const BenchOptions& b) {
     out["frames"] = b.frames;
     out["camera_path"] = pathNames[int(b.cameraPath)];
     out["animate_lights"] = b.animateLights;
+    out["shading_bias"] = b.shadingBias;
     for (const Mode& m : modes) {
         std::fprintf(stderr, "bench: %s, %u frames at %ux%u (%s camera)\n", m.name, b.frames,
                      b.width, b.height, pathNames[int(b.cameraPath)]);

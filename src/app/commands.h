@@ -16,7 +16,7 @@ struct RenderOptions {
     std::string scene = "builtin:default";
     bool allowExternalFiles = false; // glTF URIs may leave the model's folder
     RenderMode mode = RenderMode::Forward;
-    MarkingMode marking = MarkingMode::Raster; // decoupled: --marking raster|visibility
+    MarkingMode marking = MarkingMode::Auto; // decoupled: --marking auto|raster|visibility
     uint32_t width = 1280, height = 720;
     uint32_t frames = 1;
     std::string camera;
@@ -143,6 +143,8 @@ struct BenchOptions {
     bool animateLights = false;
     uint32_t reuseRefreshPeriod = 8;
     uint64_t cacheLimitBytes = 4ull << 30;
+    MarkingMode marking = MarkingMode::Auto; // decoupled and reuse modes
+    float shadingBias = 0.0f;                // decoupled and reuse modes
     LightCulling lightCulling = LightCulling::Tiled;
     // --light-culling compare: forward and decoupled rendered again with no culling, and
     // ratios.light_culling_forward|decoupled = tiled / none median frame time.

@@ -124,10 +124,11 @@ int main(int argc, char** argv) {
                      "(ray-traced AO only, with --rt-ao on) | particle-atlas | tiles (the 8x8 "
                      "tile classes, with --screen-space on)")
         ->capture_default_str();
-    std::string marking = "raster";
+    std::string marking = "auto";
     render
         ->add_option("--marking", marking,
-                     "decoupled: raster (marking + reconstruction as raster passes) | visibility "
+                     "decoupled: auto (visibility unless --occlusion or --screen-space needs "
+                     "raster) | raster (marking + reconstruction as raster passes) | visibility "
                      "(visibility buffer, compute marking + resolve)")
         ->capture_default_str();
     render->add_option("--out", ro.out, "FILE.png (last frame) or DIR/ (every frame)");
@@ -394,6 +395,14 @@ int main(int argc, char** argv) {
                      "tiled | none | compare: compare also renders forward and decoupled "
                      "without culling and reports tiled / none frame-time ratios")
         ->capture_default_str();
+    bench
+        ->add_option("--shading-bias", bo.shadingBias,
+                     "decoupled modes: fractional MIP bias (+ = fewer shadels)")
+        ->capture_default_str()
+        ->check(finiteInRange(kShadingBiasRange));
+    std::string benchMarking = "auto";
+    bench->add_option("--marking", benchMarking, "decoupled modes: auto | raster | visibility")
+        ->capture_default_str();
     std::string benchSpectra = "off";
     bench
         ->add_option("--spectra", benchSpectra,
@@ -433,7 +442,7 @@ int main(int argc, char** argv) {
     view->add_option("--camera", vo.camera, "camera name (default: the scene's first)");
     view->add_option("--mode", vo.mode, "forward | decoupled (switchable in the window)")
         ->capture_default_str();
-    view->add_option("--marking", vo.marking, "decoupled: raster | visibility")
+    view->add_option("--marking", vo.marking, "decoupled: auto | raster | visibility")
         ->capture_default_str();
     view->add_option("--size", viewSize, "WIDTHxHEIGHT of the window")->capture_default_str();
     view->add_option("--frames", vo.frames, "quit after N frames (0: when the window closes)")
@@ -620,6 +629,7 @@ int main(int argc, char** argv) {
             bo.timing = parseTiming(benchTiming);
             bo.shadelsPerMetre = parseDensity(benchDensity);
             bo.cameraPath = parseCameraPath(benchCameraPath);
+            bo.marking = parseMarking(benchMarking);
             bo.compareLightCulling = benchLightCulling == "compare";
             if (!bo.compareLightCulling) bo.lightCulling = parseLightCulling(benchLightCulling);
             bo.compareSpectra = benchSpectra == "compare";

@@ -91,9 +91,10 @@ GiMode parseGi(const std::string& text) {
 }
 
 MarkingMode parseMarking(const std::string& text) {
+    if (text == "auto") return MarkingMode::Auto;
     if (text == "raster") return MarkingMode::Raster;
     if (text == "visibility") return MarkingMode::Visibility;
-    throw InputError(format("--marking %s: expected raster or visibility", text.c_str()));
+    throw InputError(format("--marking %s: expected auto, raster or visibility", text.c_str()));
 }
 
 void parseInspect(const std::string& text, int32_t& x, int32_t& y) {
@@ -416,7 +417,7 @@ RenderRun runRender(Gpu& gpu, const RenderOptions& o) {
     s["camera"] = camera.name;
     s["mode"] = modeName(o.mode);
     if (o.mode == RenderMode::Decoupled)
-        s["marking"] = o.marking == MarkingMode::Raster ? "raster" : "visibility";
+        s["marking"] = renderer.settings.marking == MarkingMode::Raster ? "raster" : "visibility";
     s["width"] = o.width;
     s["height"] = o.height;
     s["ssaa"] = o.ssaa;

@@ -86,7 +86,15 @@ static void registerTargetCaptures(Renderer& r) {
         [&r] { return r.shadowMap; }, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL);
 }
 
-void initRenderer(Renderer& r, Gpu& gpu, const RenderSettings& settings, const GpuScene& scene) {
+// --marking auto: visibility, unless a feature that needs the raster prepass is on.
+static RenderSettings resolveMarking(RenderSettings s) {
+    if (s.marking == MarkingMode::Auto)
+        s.marking = s.occlusion || s.screenSpace ? MarkingMode::Raster : MarkingMode::Visibility;
+    return s;
+}
+
+void initRenderer(Renderer& r, Gpu& gpu, const RenderSettings& requested, const GpuScene& scene) {
+    const RenderSettings settings = resolveMarking(requested);
     r.gpu = &gpu;
     r.settings = settings;
     if (settings.width == 0 || settings.height == 0 || settings.ssaa == 0)

@@ -30,8 +30,10 @@ namespace shadel {
 
 enum class RenderMode { Forward, Decoupled };
 // Decoupled marking + reconstruction: raster passes over the objects, or compute passes over
-// the pixels of a visibility buffer (render/shadel/visibility.h).
-enum class MarkingMode { Raster, Visibility };
+// the pixels of a visibility buffer (render/shadel/visibility.h). Auto (the default) is
+// visibility, the faster one, unless a feature that needs the raster path is on (--occlusion on,
+// --screen-space on); initRenderer resolves it, so a renderer's settings never hold Auto.
+enum class MarkingMode { Auto, Raster, Visibility };
 // Transparency: weighted blended OIT, or the CPU-sorted back-to-front reference (tests).
 enum class OitMode { Wboit, Sorted };
 // Global illumination: none, or light propagation volumes (render/gi/lpv.h).
@@ -62,10 +64,11 @@ struct RenderSettings {
     uint32_t width = 1280, height = 720;
     uint32_t ssaa = 1; // N x N supersampling (forward reference)
     RenderMode mode = RenderMode::Forward;
-    // Decoupled only. Raster is the default: on lavapipe at 1280x720 (builtin:default, 3 runs
-    // of 5 frames) the compute marking was slower than the raster one (75 vs 40 ms median) and
-    // the resolve cost what reconstruction costs (176 vs 169 ms): frame 548 vs 506 ms.
-    MarkingMode marking = MarkingMode::Raster;
+    // Decoupled only. Visibility is the default (Auto): on lavapipe at 1280x720 (builtin:default,
+    // orbit, 6 frames) visibility prepass + compute marking + resolve cost 33 + 29 + 72 ms where
+    // depth prepass + raster marking + reconstruction cost 23 + 37 + 105 ms. (An earlier build
+    // measured the opposite; lavapipe and the shaders changed since.)
+    MarkingMode marking = MarkingMode::Auto;
     Visualize visualize = Visualize::None;
     float exposure = 1.0f;
     uint32_t shadowMapSize = 2048;

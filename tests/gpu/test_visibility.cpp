@@ -107,3 +107,21 @@ TEST(Visibility, DebugViewsMatchRasterMode) {
         EXPECT_GE(p, 30.0) << "view " << uint32_t(v);
     }
 }
+
+// --marking auto (the default) takes the visibility buffer, and the raster path where a feature
+// needs its depth-only prepass (occlusion culling's phase 2, the screen-space thin G-buffer);
+// the stats say which ran. Transparent surfaces are still shaded in shadel space with it (their
+// layers behind the visibility buffer's nearest surface are marked by raster).
+TEST(Visibility, AutoMarkingPicksVisibilityUnlessAFeatureNeedsRaster) {
+    RenderOptions o = decoupled("builtin:smooth", MarkingMode::Auto, 64, 36);
+    RenderRun automatic = renderChecked(o);
+    EXPECT_EQ(automatic.stats["marking"], "visibility");
+    EXPECT_TRUE(has(passNames(automatic), "resolveCompute"));
+    o.occlusion = true;
+    EXPECT_EQ(renderChecked(o).stats["marking"], "raster");
+    o.occlusion = false;
+    o.screenSpace = true;
+    RenderRun screenSpace = renderChecked(o);
+    EXPECT_EQ(screenSpace.stats["marking"], "raster");
+    EXPECT_TRUE(has(passNames(screenSpace), "reconstruction"));
+}

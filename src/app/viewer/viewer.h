@@ -12,7 +12,7 @@ struct ViewOptions {
     std::string scene = "builtin:default";
     std::string camera;
     std::string mode = "forward";
-    std::string marking = "raster";
+    std::string marking = "auto";
     uint32_t width = 1280, height = 720;
     uint32_t frames = 0;    // 0 = until the window closes
     std::string screenshot; // PNG of the window's last frame (with --frames) or on request

@@ -12,6 +12,7 @@
 #include "render/culling/instance_grid.h"
 #include "render/debug/inspect.h"
 #include "render/forward/forward_passes.h"
+#include "render/oit/oit.h"
 #include "render/renderer.h"
 #include "render/shadel/capacity_control.h"
 #include "render/shadel/shade_storage.h"
@@ -612,12 +613,11 @@ void prepareDecoupledFrame(Renderer& r, const GpuScene& scene, const CameraView&
         g = gpu::GpuShadelObject{};
         glm::vec3 margin = (inst.worldMax - inst.worldMin) * d.frustumMargin;
         // Transparent surfaces are shaded in shadel space too and reconstructed into the WBOIT
-        // targets (render/oit); the sorted reference and the visibility-buffer marking (which
-        // sees only the nearest surface) keep them forward.
+        // targets (render/oit); the sorted reference keeps them forward. (The visibility buffer
+        // sees only the nearest surface: with it, they are marked by the raster pass below.)
         bool blended = inst.material < scene.materialInfo.size() &&
                        (scene.materialInfo[inst.material].flags & MATERIAL_ALPHA_BLEND) != 0u;
-        bool transparentForward = blended && (r.settings.oit != OitMode::Wboit ||
-                                              r.settings.marking == MarkingMode::Visibility);
+        bool transparentForward = blended && r.settings.oit != OitMode::Wboit;
         // Hidden by occlusion last frame: its rects go back (it returns forward for a frame).
         bool wanted = mesh.mipCount > 0 && !transparentForward &&
                       (!seen || d.seenFrame[i] == d.frameNumber + 1) &&
@@ -785,12 +785,23 @@ void recordDecoupledPasses(Renderer& r, FrameRecorder& rec, uint64_t frame, cons
     });
 
     pass(rec, r.visibility ? "markingCompute" : "marking", [&](VkCommandBuffer cmd) {
-        // --marking visibility: a compute pass over the visibility buffer's pixels.
-        if (r.visibility) return recordMarkingCompute(r, cmd, frame);
+        // --marking visibility: a compute pass over the visibility buffer's pixels; the
+        // transparent layers behind its nearest surface are marked by raster below.
+        if (r.visibility) {
+            recordMarkingCompute(r, cmd, frame);
+            if (decoupledTransparentDraws(r) == 0) return;
+            memoryBarrier(
+                cmd, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
+                VK_ACCESS_2_SHADER_STORAGE_READ_BIT | VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT,
+                VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT,
+                VK_ACCESS_2_SHADER_STORAGE_READ_BIT | VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT);
+        }
         beginSceneDepthPass(r, cmd, false); // against the prepass depth
-        bind(gpu, cmd, d.mark);
-        pushConstants(gpu, cmd, RasterPush{frame, 0});
-        drawCameraList(r, cmd, DRAW_LIST_DECOUPLED);
+        if (!r.visibility) {
+            bind(gpu, cmd, d.mark);
+            pushConstants(gpu, cmd, RasterPush{frame, 0});
+            drawCameraList(r, cmd, DRAW_LIST_DECOUPLED);
+        }
         // Transparent surfaces: tested against the opaque depth only, never against each
         // other (nothing here writes depth), so every layer marks what it will read.
         bind(gpu, cmd, d.markTransparent);
