@@ -110,8 +110,8 @@ TEST(Visibility, DebugViewsMatchRasterMode) {
 
 // --marking auto (the default) takes the visibility buffer, and the raster path where a feature
 // needs its depth-only prepass (occlusion culling's phase 2, the screen-space thin G-buffer);
-// the stats say which ran. Transparent surfaces are still shaded in shadel space with it (their
-// layers behind the visibility buffer's nearest surface are marked by raster).
+// the stats say which ran. (Transparency with either path:
+// Oit.DecoupledTransparencyMatchesForward.)
 TEST(Visibility, AutoMarkingPicksVisibilityUnlessAFeatureNeedsRaster) {
     RenderOptions o = decoupled("builtin:smooth", MarkingMode::Auto, 64, 36);
     RenderRun automatic = renderChecked(o);
