@@ -152,8 +152,9 @@ struct BenchOptions {
     // --particle-lighting-compare: forward only, particle lighting atlas vs pixel vs vertex
     // (ratios.particle_lighting_atlas_over_pixel; app/bench_command.cpp).
     bool compareParticleLighting = false;
-    // --spectra compare: forward also with --spectra on and single; ratios.spectra_forward =
-    // on / single median frame time (the seed's spectra against one all-features shader).
+    // --spectra compare: forward and decoupled (reuse off) also with --spectra on and single;
+    // ratios.spectra_forward|spectra_decoupled = on / single median frame time (the seed's
+    // spectra against one all-features shader).
     bool compareSpectra = false;
     // --stencil-compare: forward with --screen-space on and the stencil effects, stencil-culled
     // and full-screen; ratios.stencil_outline|stencil_water = culled / full-screen pass time.

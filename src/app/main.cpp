@@ -406,7 +406,7 @@ int main(int argc, char** argv) {
     std::string benchSpectra = "off";
     bench
         ->add_option("--spectra", benchSpectra,
-                     "off | on | single | compare: compare also renders forward with --spectra "
+                     "off | compare: compare also renders forward and decoupled with --spectra "
                      "on and single and reports on / single and on / off frame-time ratios")
         ->capture_default_str();
     bench

@@ -68,10 +68,10 @@ struct SpectraState {
     Pipeline classify, setup;      // chunks: the classify permutation, the dispatch sizes
     BufferHandle frame;            // gpu::SpectraFrame (upload)
     // Per mode: tiles, a VkDispatchIndirectCommand (x counts); chunks, a uvec4 (w counts).
-    BufferHandle dispatch;         // (read back for stats)
-    BufferHandle tileBins;         // modes x tiles (or chunks of the shading queue)
-    BufferHandle superfluous;      // modes x features (readback)
-    BufferHandle featureTiles;     // features (readback)
+    BufferHandle dispatch;     // (read back for stats)
+    BufferHandle tileBins;     // modes x tiles (or chunks of the shading queue)
+    BufferHandle superfluous;  // modes x features (readback)
+    BufferHandle featureTiles; // features (readback)
     uint32_t tiles = 0;
     // Last frame's counts.
     std::vector<uint32_t> binned, lastSuperfluous, lastFeatureTiles;
@@ -127,7 +127,8 @@ SpectraStatePtr createFeatureSpectra(Renderer& r) {
     if (s->chunks) {
         // Permutations of the shadel shading itself (shade.comp), with its other constants.
         std::vector<std::pair<uint32_t, uint32_t>> base;
-        if (r.settings.distanceFieldLighting) base.push_back({DISTANCE_FIELD_LIGHTING_CONSTANT_ID, 1u});
+        if (r.settings.distanceFieldLighting)
+            base.push_back({DISTANCE_FIELD_LIGHTING_CONSTANT_ID, 1u});
         auto constants = base;
         constants.push_back({CHUNK_SPECTRA_PHASE_CONSTANT_ID, 1u});
         s->classify = createComputePipeline(gpu, "shadelChunkSpectra.classify",
