@@ -61,6 +61,7 @@ struct RenderOptions {
     Spectra spectra = Spectra::Off;                              // --spectra on|off|single
     bool sunSoftShadows = false;                                 // --sun-shadows pcf|pcss
     bool spotShadows = true;                                     // --spot-shadows on|off
+    uint32_t sunCascades = 1;                                    // --sun-cascades 1..4
     bool decals = true;                                          // --decals on|off
     bool proxyShadows = true;                                    // --proxy-shadows on|off
     CameraPath cameraPath = CameraPath::Static;

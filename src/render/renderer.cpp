@@ -154,6 +154,7 @@ void initRenderer(Renderer& r, Gpu& gpu, const RenderSettings& requested, const 
     r.particles = createParticles(r, scene);
     r.lightCulling = createLightCulling(r, scene);
     r.spotShadows = createSpotShadows(r, scene);
+    r.sunCascades = createSunCascades(r, scene);
     if (usesTileShading(r) || usesChunkSpectra(r)) r.spectra = createFeatureSpectra(r);
     if (settings.gi == GiMode::Lpv) r.gi = createGi(r, scene);
     r.culling = createCulling(r, scene);
@@ -170,6 +171,7 @@ void destroyRenderer(Renderer& r) {
     destroyRayTracing(r, r.rt);
     destroyFeatureSpectra(r, r.spectra);
     destroySpotShadows(r, r.spotShadows);
+    destroySunCascades(r, r.sunCascades);
     destroyDecals(r, r.decals);
     destroyLightCulling(r, r.lightCulling);
     destroyDebugLines(r, r.debugLines);
@@ -337,6 +339,8 @@ FrameResult renderFrame(Renderer& r, const GpuScene& scene, const CameraView& ca
     pass(rec, "instanceCull",
          [&](VkCommandBuffer cmd) { recordInstanceCull(r, cmd, frame, scene); });
     pass(rec, "shadowMap", [&](VkCommandBuffer cmd) { recordShadowMap(r, cmd, frame); });
+    if (r.sunCascades) // --sun-cascades 2..4 (render/lighting/sun_cascades.h)
+        pass(rec, "sunCascades", [&](VkCommandBuffer cmd) { recordSunCascades(r, cmd, frame); });
     if (r.rt) pass(rec, "rtBuildTlas", [&](VkCommandBuffer cmd) { recordTlasBuild(r, cmd); });
     if (spotShadowMapsThisFrame(r)) // shadow-casting spots, one atlas (render/lighting)
         pass(rec, "spotShadowMaps",
