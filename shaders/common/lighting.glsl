@@ -152,9 +152,14 @@ vec3 brdf(MaterialSample m, vec3 n, vec3 v, vec3 l, vec3 radiance) {
     return color * radiance;
 }
 
-// 3x3 PCF on the sun's shadow map (reversed-Z is not used for the orthographic shadow map).
+#include "lighting/shadows.glsl"
+
+// 3x3 PCF on the sun's shadow map (reversed-Z is not used for the orthographic shadow map):
+// the cascade holding the point (--sun-cascades 2..4), else the one map fitted to the scene.
 float sunShadow(FrameConstants f, vec3 worldPos, vec3 n) {
     if (f.sunShadowSlot == NO_TEXTURE) return 1.0;
+    float cascaded;
+    if (sunCascadeShadow(f, worldPos, n, false, cascaded)) return cascaded;
     // Normal offset scaled by the texel size keeps acne away on grazing surfaces.
     vec3 p = worldPos + n * f.shadowTexelSize * 1.5;
     vec4 clip = f.sunViewProj * vec4(p, 1.0);
@@ -170,8 +175,6 @@ float sunShadow(FrameConstants f, vec3 worldPos, vec3 n) {
                            vec3(uv + vec2(x, y) * texel, depth));
     return lit / 9.0;
 }
-
-#include "lighting/shadows.glsl"
 
 float rangeAttenuation(float distance, float range) {
     float invSquare = 1.0 / max(distance * distance, 1e-4);

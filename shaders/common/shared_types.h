@@ -78,6 +78,8 @@ using uint = uint32_t;
 #define SPECTRUM_ALL 0x7FFu
 #define SPECTRUM_MAX_MODES 16u
 #define SPECTRUM_FEATURES_CONSTANT_ID 140
+#define SPECTRUM_MODE_CONSTANT_ID 141        // the mode (bin) a tile / chunk shading permutation runs
+#define CHUNK_SPECTRA_PHASE_CONSTANT_ID 143 // shadel shading: off, classify or shade (chunk_spectra.glsl)
 // Specialization constant of shaders/common/lighting.glsl: 1 compiles the distance-field far
 // shadows and AO in (render/distance_fields; forward and shadel shading with --distance-fields).
 #define DISTANCE_FIELD_LIGHTING_CONSTANT_ID 142
@@ -253,6 +255,28 @@ struct LightingFrame {
     float sunPenumbraScale; // penumbra width per metre from occluder to receiver (tan of the
                             // sun's angular radius)
     float sunDepthRange;    // metres from the sun shadow map's depth 0 to 1 (orthographic)
+    // Feature spectra of the shadel path (decoupled, --spectra on|single): a SpectraFrame whose
+    // bins hold work-queue indices of shading chunks (dispatch: uvec4 per mode, w = count).
+    uint64_t chunkSpectra;
+    // The sun's cascaded shadow maps (render/lighting/sun_cascades.h): GpuSunCascades, 0 with
+    // --sun-cascades 1 (the one map fitted to the scene, FrameConstants::sunViewProj).
+    uint64_t sunCascades;
+};
+
+#define SUN_MAX_CASCADES 4u
+// The sun's cascades: slices of the camera's view depth, each an orthographic map (a rectangle
+// of one atlas) fitted to its slice's bounding sphere and snapped to its texels.
+struct GpuSunCascades {
+    mat4 viewProj[SUN_MAX_CASCADES]; // world -> the cascade's clip space (depth 0..1)
+    vec4 atlasRect[SUN_MAX_CASCADES]; // UV offset xy, size zw
+    vec4 splitFar;       // view depth (metres along cameraForward) where cascade i ends
+    vec4 texelWorld;     // a texel's width in metres, per cascade
+    vec3 cameraForward;  // unit: view depth = dot(p - cameraPosition, cameraForward)
+    uint count;
+    uint atlasSlot;      // bindless slot of the atlas (depth)
+    float depthRange;    // metres from depth 0 to 1 (the same for every cascade)
+    uint pad0;
+    uint pad1;
 };
 
 // A spot light's shadow map: its rectangle of the atlas and its perspective view.

@@ -57,9 +57,55 @@ vec2 shadowBlockerSearch(ShadowRegion r, vec2 uv, float depth, float radiusTexel
     return vec2(count > 0.0 ? sum / count : depth, count);
 }
 
+layout(buffer_reference, scalar) readonly buffer SunCascadesRef { GpuSunCascades c; };
+
+// The sun's PCSS in an orthographic map region: texelWorld metres per texel, depth linear over
+// depthRange metres.
+float sunPcss(LightingFrame lf, ShadowRegion r, vec2 uv, float depth, float texelWorld,
+              float depthRange) {
+    // Occluders up to 8 m above the receiver can darken it: search the penumbra they cast.
+    float search = clamp(lf.sunPenumbraScale * 8.0 / texelWorld, 1.0, 16.0);
+    vec2 blockers = shadowBlockerSearch(r, uv, depth, search);
+    if (blockers.y == 0.0) return 1.0; // nothing nearer the sun around: fully lit
+    float penumbra = (depth - blockers.x) * depthRange * lf.sunPenumbraScale;
+    return pcfDisk(r, uv, depth, clamp(penumbra / texelWorld, 1.0, 24.0));
+}
+
+// Cascaded sun shadows (render/lighting/sun_cascades.h): the first cascade whose view-depth
+// slice holds the point filters its rectangle of the atlas, PCF (3x3) or PCSS, with a normal
+// offset and depth bias of its own texel size. False (and `lit` unset) without cascades, or
+// beyond the last one: the caller uses the map fitted to the whole scene.
+bool sunCascadeShadow(FrameConstants f, vec3 worldPos, vec3 n, bool soft, out float lit) {
+    lit = 1.0;
+    if (f.lighting == 0ul) return false;
+    LightingFrame lf = LightingFrameRef(f.lighting).l;
+    if (lf.sunCascades == 0ul) return false;
+    GpuSunCascades c = SunCascadesRef(lf.sunCascades).c;
+    float viewDepth = dot(worldPos - f.cameraPosition, c.cameraForward);
+    uint i = 0u;
+    while (i < c.count && viewDepth > c.splitFar[i]) ++i;
+    if (i >= c.count) return false;
+    float texelWorld = c.texelWorld[i];
+    vec3 p = worldPos + n * texelWorld * 1.5;
+    vec3 ndc = (c.viewProj[i] * vec4(p, 1.0)).xyz; // orthographic: w = 1
+    if (any(greaterThan(abs(ndc.xy), vec2(1.0))) || ndc.z > 1.0) return false;
+    ShadowRegion r;
+    r.slot = c.atlasSlot;
+    r.texel = 1.0 / vec2(textureSize(gTextures[r.slot], 0));
+    r.lo = c.atlasRect[i].xy + r.texel * 0.5;
+    r.hi = c.atlasRect[i].xy + c.atlasRect[i].zw - r.texel * 0.5;
+    vec2 uv = c.atlasRect[i].xy + (ndc.xy * 0.5 + 0.5) * c.atlasRect[i].zw;
+    // Two texels of depth bias, in the cascade's depth units.
+    float depth = ndc.z - 2.0 * texelWorld / c.depthRange;
+    lit = soft ? sunPcss(lf, r, uv, depth, texelWorld, c.depthRange) : pcf3x3(r, uv, depth);
+    return true;
+}
+
 // The sun: orthographic, depth linear over lf.sunDepthRange metres.
 float sunShadowSoft(FrameConstants f, LightingFrame lf, vec3 worldPos, vec3 n) {
     if (f.sunShadowSlot == NO_TEXTURE) return 1.0;
+    float cascaded;
+    if (sunCascadeShadow(f, worldPos, n, true, cascaded)) return cascaded;
     vec3 p = worldPos + n * f.shadowTexelSize * 1.5;
     vec4 clip = f.sunViewProj * vec4(p, 1.0);
     vec3 ndc = clip.xyz / clip.w;

@@ -48,26 +48,53 @@ uint frameFeatures(FrameConstants f, LightingFrame lf) {
 }
 
 // The first mode (they are ordered cheapest first; the last has every feature) covering
-// `features`; appends the tile to its bin and counts the features it compiles in needlessly.
-void binTileSpectrum(LightingFrame lf, uint tile, uint features) {
-    if (lf.spectra == 0ul) return;
-    SpectraFrame sf = SpectraFrameRef(lf.spectra).s;
-    uint mode = sf.modeCount - 1u;
+// `features`.
+uint spectrumModeOf(SpectraFrame sf, uint features) {
     for (uint m = 0u; m < sf.modeCount; ++m)
-        if ((features & ~sf.modeFeatures[m]) == 0u) {
-            mode = m;
-            break;
-        }
-    // x of the mode's VkDispatchIndirectCommand.
-    uint slot = atomicAdd(UintBuffer(sf.dispatch).v[mode * 3u], 1u);
-    UintBuffer(sf.tileBins).v[mode * sf.binCapacity + slot] = tile;
+        if ((features & ~sf.modeFeatures[m]) == 0u) return m;
+    return sf.modeCount - 1u;
+}
+
+// Counts the features a binned tile (or chunk) compiles in needlessly, the features it needs,
+// and a histogram of the exact feature sets (what the modes are chosen from).
+void countSpectrumFeatures(SpectraFrame sf, uint mode, uint features) {
     uint superfluous = sf.modeFeatures[mode] & ~features;
     for (uint bit = 0u; bit < SPECTRUM_FEATURE_COUNT; ++bit) {
         if ((superfluous & (1u << bit)) != 0u)
             atomicAdd(UintBuffer(sf.superfluous).v[mode * SPECTRUM_FEATURE_COUNT + bit], 1u);
         if ((features & (1u << bit)) != 0u) atomicAdd(UintBuffer(sf.featureTiles).v[bit], 1u);
     }
-    // Then a histogram of the exact feature sets (what the modes are chosen from).
     atomicAdd(UintBuffer(sf.featureTiles).v[SPECTRUM_FEATURE_COUNT + features], 1u);
+}
+
+// Appends the tile to the bin of the first mode covering `features`.
+void binTileSpectrum(LightingFrame lf, uint tile, uint features) {
+    if (lf.spectra == 0ul) return;
+    SpectraFrame sf = SpectraFrameRef(lf.spectra).s;
+    uint mode = spectrumModeOf(sf, features);
+    // x of the mode's VkDispatchIndirectCommand.
+    uint slot = atomicAdd(UintBuffer(sf.dispatch).v[mode * 3u], 1u);
+    UintBuffer(sf.tileBins).v[mode * sf.binCapacity + slot] = tile;
+    countSpectrumFeatures(sf, mode, features);
+}
+
+// The shadel path: appends a shading chunk (its work-queue index) to its mode's bin. The
+// dispatch entry of a mode is a uvec4 whose w counts the chunks; chunk_spectra_setup.comp turns
+// the counts into 2-D dispatch sizes (as the shading queue's, dispatch_setup.comp).
+void binChunkSpectrum(LightingFrame lf, uint workIndex, uint features) {
+    if (lf.chunkSpectra == 0ul) return;
+    SpectraFrame sf = SpectraFrameRef(lf.chunkSpectra).s;
+    uint mode = spectrumModeOf(sf, features);
+    uint slot = atomicAdd(UintBuffer(sf.dispatch).v[mode * 4u + 3u], 1u);
+    UintBuffer(sf.tileBins).v[mode * sf.binCapacity + slot] = workIndex;
+    countSpectrumFeatures(sf, mode, features);
+}
+
+// A mode's colour in --visualize spectra.
+vec3 spectrumColor(uint mode) {
+    const vec3 palette[8] = vec3[8](vec3(0.15, 0.35, 1.0), vec3(0.1, 0.85, 0.3), vec3(1.0, 0.85, 0.1),
+                                    vec3(1.0, 0.45, 0.05), vec3(0.85, 0.1, 0.9), vec3(0.1, 0.9, 0.9),
+                                    vec3(0.6, 0.3, 0.1), vec3(1.0, 0.1, 0.1));
+    return palette[mode % 8u] * (mode >= 8u ? 0.5 : 1.0);
 }
 #endif

@@ -15,20 +15,13 @@
 layout(local_size_x = 16, local_size_y = 16) in;
 
 // This pipeline's mode: where its tile list starts, and its colour in --visualize spectra.
-layout(constant_id = 141) const uint kSpectrumMode = 0u;
+layout(constant_id = SPECTRUM_MODE_CONSTANT_ID) const uint kSpectrumMode = 0u;
 
 layout(push_constant, scalar) uniform Push {
     uint64_t frame;
     uint visibilitySlot;
     uint hdrSlot;
 } pc;
-
-vec3 spectrumColor(uint mode) {
-    const vec3 palette[8] = vec3[8](vec3(0.15, 0.35, 1.0), vec3(0.1, 0.85, 0.3), vec3(1.0, 0.85, 0.1),
-                                    vec3(1.0, 0.45, 0.05), vec3(0.85, 0.1, 0.9), vec3(0.1, 0.9, 0.9),
-                                    vec3(0.6, 0.3, 0.1), vec3(1.0, 0.1, 0.1));
-    return palette[mode % 8u] * (mode >= 8u ? 0.5 : 1.0);
-}
 
 void main() {
     FrameConstants f = FrameConstantsRef(pc.frame).f;

@@ -9,6 +9,7 @@
 #include "common/lighting.glsl"
 #include "lighting/light_cull.glsl"
 #include "lighting/light_debug.glsl"
+#include "lighting/chunk_spectra.glsl"
 #include "common/shadel_bary.h"
 #include "shadel/prefilter.glsl"
 #define DEBUG_LINES_WORKGROUP_BOX
@@ -147,7 +148,7 @@ void cullChunkLights(FrameConstants f, bool shading, vec3 p) {
         sLightList[i] = mask == LIGHT_INVALID ? uvec2(LIGHT_INVALID, 0u) : uvec2(sLightList[i].x, mask);
     }
     barrier();
-    if (tid == 0u) {
+    if (tid == 0u && kChunkSpectraPhase != CHUNK_SPECTRA_SHADE) { // counted once per chunk
         uint kept = 0u;
         bool perPixel = false;
         for (uint i = 0u; i < count; ++i) {
@@ -164,11 +165,13 @@ void cullChunkLights(FrameConstants f, bool shading, vec3 p) {
     }
 }
 
+#include "lighting/chunk_spectra_classify.glsl" // --spectra: binning chunks by features
+
 void main() {
     FrameConstants f = FrameConstantsRef(pc.frame).f;
     gTextureFeedback = f.textureFeedback; // texture streaming: the MIPs the shadels want
     ShadelFrame s = ShadelFrameRef(f.shadel).s;
-    uint workIndex = gl_WorkGroupID.y * 32768u + gl_WorkGroupID.x;
+    uint workIndex = chunkSpectraWorkIndex(f, gl_WorkGroupID.y * 32768u + gl_WorkGroupID.x);
     if (workIndex >= ShadelCountersRef(s.counters).c.shadeDispatch.w) return;
     GpuShadelWork work = ShadelWorkBuffer(s.queue).w[workIndex];
     ShadelObjectRef o = shadelObject(s, work.object);
@@ -176,7 +179,11 @@ void main() {
     ivec2 outTexel = storageTexel(s, work.slot, local);
     // Chunks of objects a changed light reaches come here even when reusable (the fill pass
     // cannot tell which of their shadels the light reaches): carry over those it does not.
-    int carrySlot = (o.v.flags & SHADEL_OBJECT_NEAR_CHANGED_LIGHT) != 0u ? carrySource(s, o, work) : -1;
+    // (With spectra the classify phase decided: a binned chunk is shaded.)
+    int carrySlot = kChunkSpectraPhase != CHUNK_SPECTRA_SHADE &&
+                            (o.v.flags & SHADEL_OBJECT_NEAR_CHANGED_LIGHT) != 0u
+                        ? carrySource(s, o, work)
+                        : -1;
     if (carrySlot >= 0 && chunkTouchesChangedLight(f, s, o, work)) carrySlot = -1;
     if (carrySlot >= 0) {
         carryOver(s, uint(carrySlot), outTexel);
@@ -221,6 +228,10 @@ void main() {
     si.uvDy = uvDy;
     if (f.lighting != 0ul && LightingFrameRef(f.lighting).l.tiled != 0u)
         cullChunkLights(f, shading, si.position);
+    if (kChunkSpectraPhase == CHUNK_SPECTRA_CLASSIFY) {
+        classifyChunkSpectrum(f, workIndex);
+        return;
+    }
     // --debug-lines chunks: this chunk's world box, coloured by MIP (uniform over the workgroup).
     if (debugLinesOn(f, DEBUG_LINES_CHUNKS))
         debugWorkgroupBox(f, shading, si.position, debugLevelColour(work.mip));
@@ -244,6 +255,6 @@ void main() {
                                   uvs.v[i0], uvs.v[i1], uvs.v[i2], v0.uv0, v1.uv0, v2.uv0,
                                   s.materialSamples, uvec3(shadel, work.object * 16u + work.mip),
                                   material);
-    color = visualizeLighting(f, color);
+    color = visualizeChunkSpectrum(f, visualizeLighting(f, color));
     storeLayers(s, outTexel, vec4(color, 1.0), material);
 }

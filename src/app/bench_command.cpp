@@ -213,6 +213,29 @@ nlohmann::json runBench(Gpu& gpu, const BenchOptions& b) {
         std::printf("spectra (forward): on %.3f ms, single %.3f ms, raster %.3f ms; on / single "
                     "%.3f, on / raster %.3f\n",
                     on, single, fwd, single > 0 ? on / single : 0.0, fwd > 0 ? on / fwd : 0.0);
+
+        // Decoupled (reuse off): chunks binned by spectra, and by one all-features permutation
+        // (the same classify + bin passes), against the plain shading pass of --spectra off.
+        for (Spectra sp : {Spectra::On, Spectra::Single}) {
+            const char* name = sp == Spectra::On ? "decoupled_spectra" : "decoupled_spectra_single";
+            std::fprintf(stderr, "bench: decoupled, --spectra %s\n",
+                         sp == Spectra::On ? "on" : "single");
+            o.mode = RenderMode::Decoupled;
+            o.reuse = false;
+            o.lightCulling = b.lightCulling;
+            o.spectra = sp;
+            out["modes"][name] = runRender(gpu, o).stats;
+        }
+        o.spectra = Spectra::Off;
+        double don = out["modes"]["decoupled_spectra"]["frame_ms"]["median"];
+        double dsingle = out["modes"]["decoupled_spectra_single"]["frame_ms"]["median"];
+        double doff = out["modes"]["decoupled"]["frame_ms"]["median"];
+        out["ratios"]["spectra_decoupled"] = dsingle > 0 ? don / dsingle : 0.0;
+        out["ratios"]["spectra_decoupled_vs_off"] = doff > 0 ? don / doff : 0.0;
+        std::printf("spectra (decoupled): on %.3f ms, single %.3f ms, off %.3f ms; on / single "
+                    "%.3f, on / off %.3f\n",
+                    don, dsingle, doff, dsingle > 0 ? don / dsingle : 0.0,
+                    doff > 0 ? don / doff : 0.0);
     }
 
     std::printf("shadel bench: %s at %ux%u on %s, %u frames, %s camera, medians (timing: %s)\n",

@@ -61,6 +61,7 @@ struct RenderOptions {
     Spectra spectra = Spectra::Off;                              // --spectra on|off|single
     bool sunSoftShadows = false;                                 // --sun-shadows pcf|pcss
     bool spotShadows = true;                                     // --spot-shadows on|off
+    uint32_t sunCascades = 1;                                    // --sun-cascades 1..4
     bool decals = true;                                          // --decals on|off
     bool proxyShadows = true;                                    // --proxy-shadows on|off
     CameraPath cameraPath = CameraPath::Static;
@@ -152,8 +153,9 @@ struct BenchOptions {
     // --particle-lighting-compare: forward only, particle lighting atlas vs pixel vs vertex
     // (ratios.particle_lighting_atlas_over_pixel; app/bench_command.cpp).
     bool compareParticleLighting = false;
-    // --spectra compare: forward also with --spectra on and single; ratios.spectra_forward =
-    // on / single median frame time (the seed's spectra against one all-features shader).
+    // --spectra compare: forward and decoupled (reuse off) also with --spectra on and single;
+    // ratios.spectra_forward|spectra_decoupled = on / single median frame time (the seed's
+    // spectra against one all-features shader).
     bool compareSpectra = false;
     // --stencil-compare: forward with --screen-space on and the stencil effects, stencil-culled
     // and full-screen; ratios.stencil_outline|stencil_water = culled / full-screen pass time.

@@ -268,6 +268,12 @@ int main(int argc, char** argv) {
                      "on | off: the scene's projected box decals (base colour, normal, "
                      "roughness, ambient occlusion)")
         ->capture_default_str();
+    std::string sunCascades = "1";
+    render
+        ->add_option("--sun-cascades", sunCascades,
+                     "1..4: the sun's shadow as N cascaded maps over the view depth (1: one map "
+                     "fitted to the scene)")
+        ->capture_default_str();
     render
         ->add_option("--spot-shadows", spotShadows,
                      "on | off: shadow maps (one atlas) for the spots that cast shadows")
@@ -406,7 +412,7 @@ int main(int argc, char** argv) {
     std::string benchSpectra = "off";
     bench
         ->add_option("--spectra", benchSpectra,
-                     "off | on | single | compare: compare also renders forward with --spectra "
+                     "off | compare: compare also renders forward and decoupled with --spectra "
                      "on and single and reports on / single and on / off frame-time ratios")
         ->capture_default_str();
     bench
@@ -577,6 +583,10 @@ int main(int argc, char** argv) {
                     format("--sun-shadows %s: expected pcf or pcss", sunShadows.c_str()));
             ro.sunSoftShadows = sunShadows == "pcss";
             ro.spotShadows = parseOnOff("--spot-shadows", spotShadows);
+            if (sunCascades.size() != 1 || sunCascades[0] < '1' || sunCascades[0] > '4')
+                throw InputError(
+                    format("--sun-cascades %s: expected 1, 2, 3 or 4", sunCascades.c_str()));
+            ro.sunCascades = uint32_t(sunCascades[0] - '0');
             ro.decals = parseOnOff("--decals", decals);
             ro.proxyShadows = parseOnOff("--proxy-shadows", proxyShadows);
             ro.gi = parseGi(gi);

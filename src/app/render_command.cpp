@@ -307,6 +307,7 @@ RenderRun runRender(Gpu& gpu, const RenderOptions& o) {
     settings.spectra = o.spectra;
     settings.sunSoftShadows = o.sunSoftShadows;
     settings.spotShadows = o.spotShadows;
+    settings.sunCascades = o.sunCascades;
     settings.decals = o.decals;
     settings.proxyShadows = o.proxyShadows;
     requireCount("--gi-iterations", o.giIterations, 0, 64);
@@ -463,6 +464,7 @@ RenderRun runRender(Gpu& gpu, const RenderOptions& o) {
     if (renderer.particles) particleStats(renderer, s);
     featureSpectraStats(renderer, s);
     spotShadowStats(renderer, s);
+    sunCascadeStats(renderer, s);
     decalStats(renderer, s);
     s["density_mode"] = autoDensity ? "auto" : "explicit";
     if (autoDensity)

@@ -99,22 +99,20 @@ void initRenderer(Renderer& r, Gpu& gpu, const RenderSettings& requested, const 
     r.settings = settings;
     if (settings.width == 0 || settings.height == 0 || settings.ssaa == 0)
         throw InputError("--size and --ssaa must be positive");
-    if (settings.spectra != Spectra::Off && settings.mode != RenderMode::Forward)
-        throw InputError("--spectra on|single: forward mode only (the shadel path's chunks do "
-                         "not run per-spectrum permutations yet)");
     if (settings.spectra != Spectra::Off && settings.lightCulling != LightCulling::Tiled)
         throw InputError("--spectra on|single needs --light-culling tiled (the tile pass "
                          "records each tile's features)");
-    if (settings.spectra != Spectra::Off && settings.occlusion)
+    bool tileSpectra = settings.spectra != Spectra::Off && settings.mode == RenderMode::Forward;
+    if (tileSpectra && settings.occlusion)
         throw InputError("--spectra on|single needs --occlusion off (tile shading reads the "
                          "visibility buffer, which the phase-2 prepass does not write)");
-    if (settings.spectra != Spectra::Off && settings.rt.enabled())
+    if (tileSpectra && settings.rt.enabled())
         throw InputError("--spectra on|single with --rt-*: tile shading does not read the "
                          "ray-traced terms yet; use --spectra off");
-    if (settings.spectra != Spectra::Off && settings.screenSpace)
+    if (tileSpectra && settings.screenSpace)
         throw InputError("--spectra on|single with --screen-space on: the thin G-buffer needs "
                          "the depth prepass the tile path replaces; use one of them");
-    if (settings.spectra != Spectra::Off && settings.inspectX >= 0)
+    if (tileSpectra && settings.inspectX >= 0)
         throw InputError("--inspect needs --spectra off (the prints come from the raster "
                          "forward pass)");
     if (settings.visualize == Visualize::Spectra && settings.spectra == Spectra::Off)
@@ -156,7 +154,8 @@ void initRenderer(Renderer& r, Gpu& gpu, const RenderSettings& requested, const 
     r.particles = createParticles(r, scene);
     r.lightCulling = createLightCulling(r, scene);
     r.spotShadows = createSpotShadows(r, scene);
-    if (usesTileShading(r)) r.spectra = createFeatureSpectra(r);
+    r.sunCascades = createSunCascades(r, scene);
+    if (usesTileShading(r) || usesChunkSpectra(r)) r.spectra = createFeatureSpectra(r);
     if (settings.gi == GiMode::Lpv) r.gi = createGi(r, scene);
     r.culling = createCulling(r, scene);
     r.decals = createDecals(r, scene); // after the decoupled state (its queue's capacity)
@@ -172,6 +171,7 @@ void destroyRenderer(Renderer& r) {
     destroyRayTracing(r, r.rt);
     destroyFeatureSpectra(r, r.spectra);
     destroySpotShadows(r, r.spotShadows);
+    destroySunCascades(r, r.sunCascades);
     destroyDecals(r, r.decals);
     destroyLightCulling(r, r.lightCulling);
     destroyDebugLines(r, r.debugLines);
@@ -339,6 +339,8 @@ FrameResult renderFrame(Renderer& r, const GpuScene& scene, const CameraView& ca
     pass(rec, "instanceCull",
          [&](VkCommandBuffer cmd) { recordInstanceCull(r, cmd, frame, scene); });
     pass(rec, "shadowMap", [&](VkCommandBuffer cmd) { recordShadowMap(r, cmd, frame); });
+    if (r.sunCascades) // --sun-cascades 2..4 (render/lighting/sun_cascades.h)
+        pass(rec, "sunCascades", [&](VkCommandBuffer cmd) { recordSunCascades(r, cmd, frame); });
     if (r.rt) pass(rec, "rtBuildTlas", [&](VkCommandBuffer cmd) { recordTlasBuild(r, cmd); });
     if (spotShadowMapsThisFrame(r)) // shadow-casting spots, one atlas (render/lighting)
         pass(rec, "spotShadowMaps",
@@ -363,7 +365,7 @@ FrameResult renderFrame(Renderer& r, const GpuScene& scene, const CameraView& ca
              [&](VkCommandBuffer cmd) { recordRayTracedPixels(r, cmd, frame); });
     if (r.settings.mode == RenderMode::Forward) // decal lists per tile (render/decals)
         recordDecalCulling(r, rec, frame);      // (decoupled: in recordDecoupledPasses)
-    if (r.spectra) { // forward, per-tile permutations (render/lighting/feature_spectra.h)
+    if (usesTileShading(r)) { // forward, per-tile permutations (render/lighting/feature_spectra.h)
         pass(rec, "tileShading", [&](VkCommandBuffer cmd) { recordTileShading(r, cmd, frame); });
     } else if (r.settings.mode == RenderMode::Forward) {
         pass(rec, "forwardShading",

@@ -16,6 +16,7 @@
 #include "render/lighting/feature_spectra.h"
 #include "render/lighting/light_culling.h"
 #include "render/lighting/spot_shadows.h"
+#include "render/lighting/sun_cascades.h"
 #include "render/points_lines/points_lines.h"
 #include "render/raytracing/ray_tracing.h"
 #include "render/raytracing/rt_settings.h"
@@ -129,6 +130,7 @@ struct RenderSettings {
     Spectra spectra = Spectra::Off; // forward: per-tile shading permutations (render/lighting)
     bool sunSoftShadows = false;    // --sun-shadows pcss: variable penumbra (render/lighting)
     bool spotShadows = true;        // --spot-shadows: shadow maps of shadow-casting spots
+    uint32_t sunCascades = 1;       // --sun-cascades: 1 = one map fitted to the scene
     bool proxyShadows =
         true;           // --proxy-shadows: shadow views draw proxy index sets (render/culling)
     bool decals = true; // --decals: the scene's projected box decals (render/decals)
@@ -225,6 +227,7 @@ struct Renderer {
     std::vector<uint8_t> reposedInstances;
     SpectraStatePtr spectra;        // --spectra on|single (render/lighting/feature_spectra.h)
     SpotShadowStatePtr spotShadows; // shadow-casting spots (render/lighting/spot_shadows.h)
+    SunCascadeStatePtr sunCascades; // --sun-cascades 2..4 (render/lighting/sun_cascades.h)
     DecalStatePtr decals;           // --decals on, scenes with decals (render/decals/decals.h)
     std::chrono::steady_clock::time_point createdAt = std::chrono::steady_clock::now();
 };

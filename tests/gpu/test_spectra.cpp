@@ -76,6 +76,39 @@ TEST(Spectra, PermutationsMatchTheAllFeaturesShaders) {
               one["spectra_superfluous_total"].get<uint64_t>() / 2);
 }
 
+// The shadel path ("the same for chunk queues"): queued chunks are binned by the features of
+// their culled light lists and each bin is shaded by its permutation of the shadel shading.
+TEST(Spectra, ShadelChunkPermutationsMatchTheAllFeaturesShading) {
+    auto decoupled = [](Spectra spectra) {
+        RenderOptions o = spectraOptions(spectra);
+        o.mode = RenderMode::Decoupled;
+        return renderChecked(o);
+    };
+    RenderRun off = decoupled(Spectra::Off);
+    RenderRun on = decoupled(Spectra::On);
+    RenderRun single = decoupled(Spectra::Single);
+    EXPECT_GE(psnr(off.frames[0].rgba, on.frames[0].rgba), 50.0);
+    EXPECT_GE(psnr(single.frames[0].rgba, on.frames[0].rgba), 50.0);
+    const auto& s = on.stats;
+    ASSERT_EQ(s["spectra_unit"], "chunks");
+    // Every shaded chunk is binned once, and the chunks spread over several spectra.
+    uint64_t chunks = s["chunks_shaded"].get<uint64_t>();
+    ASSERT_GT(chunks, 100u);
+    EXPECT_EQ(sumValues(s["spectra"]), chunks) << s["spectra"].dump();
+    int used = 0;
+    for (const auto& [name, value] : s["spectra"].items()) used += value.get<uint64_t>() > 0;
+    EXPECT_GE(used, 3) << s["spectra"].dump();
+    EXPECT_LT(s["spectra"]["all"].get<uint64_t>(), chunks) << s["spectra"].dump();
+    EXPECT_EQ(s["tile_features"]["blockers"].get<uint64_t>(),
+              s["per_pixel_blocker_chunks"].get<uint64_t>())
+        << "a chunk needs the blocker feature exactly when it has per-pixel blocker pairs";
+    // Chunk culling is counted once, not once per phase.
+    EXPECT_EQ(s["light_chunk_pairs"], off.stats["light_chunk_pairs"]);
+    EXPECT_EQ(single.stats["spectra"]["all"].get<uint64_t>(), chunks);
+    EXPECT_LT(s["spectra_superfluous_total"].get<uint64_t>(),
+              single.stats["spectra_superfluous_total"].get<uint64_t>() / 2);
+}
+
 TEST(Spectra, VisualizeSpectraColoursTilesByMode) {
     RenderOptions o = spectraOptions(Spectra::On);
     o.visualize = Visualize::Spectra;
@@ -99,8 +132,8 @@ TEST(Spectra, BadSpectraFlagsAreOneLineErrors) {
     EXPECT_EQ(parseSpectra("single"), Spectra::Single);
     EXPECT_EQ(parseVisualize("spectra"), Visualize::Spectra);
     std::string err = (std::filesystem::temp_directory_path() / "shadel-spectra-err.txt").string();
-    for (const char* args : {"--spectra maybe", "--spectra on --mode decoupled",
-                             "--spectra on --light-culling none", "--visualize spectra"}) {
+    for (const char* args :
+         {"--spectra maybe", "--spectra on --light-culling none", "--visualize spectra"}) {
         std::string cmd = std::string("timeout 120 ") + SHADEL_BINARY +
                           " render --scene builtin:blockers --size 32x32 " + args +
                           " >/dev/null 2>" + err;

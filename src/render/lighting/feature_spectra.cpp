@@ -7,6 +7,7 @@
 
 #include "core/error.h"
 #include "render/renderer.h"
+#include "render/shadel/decoupled.h"
 
 namespace shadel {
 
@@ -61,13 +62,16 @@ struct TileShadePush {
 } // namespace
 
 struct SpectraState {
+    bool chunks = false;           // the shadel path's chunk queue (else forward screen tiles)
     std::vector<uint32_t> modes;   // feature sets, cheapest first
     std::vector<Pipeline> shading; // one permutation per mode
+    Pipeline classify, setup;      // chunks: the classify permutation, the dispatch sizes
     BufferHandle frame;            // gpu::SpectraFrame (upload)
-    BufferHandle dispatch;         // VkDispatchIndirectCommand per mode (read back for stats)
-    BufferHandle tileBins;         // modes x tiles
-    BufferHandle superfluous;      // modes x features (readback)
-    BufferHandle featureTiles;     // features (readback)
+    // Per mode: tiles, a VkDispatchIndirectCommand (x counts); chunks, a uvec4 (w counts).
+    BufferHandle dispatch;     // (read back for stats)
+    BufferHandle tileBins;     // modes x tiles (or chunks of the shading queue)
+    BufferHandle superfluous;  // modes x features (readback)
+    BufferHandle featureTiles; // features (readback)
     uint32_t tiles = 0;
     // Last frame's counts.
     std::vector<uint32_t> binned, lastSuperfluous, lastFeatureTiles;
@@ -81,6 +85,16 @@ bool usesTileShading(const Renderer& r) {
     return r.settings.mode == RenderMode::Forward && r.settings.spectra != Spectra::Off;
 }
 
+bool usesChunkSpectra(const Renderer& r) {
+    return r.settings.mode == RenderMode::Decoupled && r.settings.spectra != Spectra::Off;
+}
+
+namespace {
+uint32_t dispatchStride(const SpectraState& s) {
+    return s.chunks ? 16u : 12u;
+}
+} // namespace
+
 SpectraStatePtr createFeatureSpectra(Renderer& r) {
     Gpu& gpu = *r.gpu;
     SpectraStatePtr s(new SpectraState);
@@ -90,8 +104,10 @@ SpectraStatePtr createFeatureSpectra(Renderer& r) {
         s->modes.assign(std::begin(kSpectrumModes), std::end(kSpectrumModes));
     static_assert(std::size(kSpectrumModes) <= SPECTRUM_MAX_MODES);
     uint32_t modes = uint32_t(s->modes.size());
-    s->tiles = ((r.internalWidth + LIGHT_TILE_SIZE - 1) / LIGHT_TILE_SIZE) *
-               ((r.internalHeight + LIGHT_TILE_SIZE - 1) / LIGHT_TILE_SIZE);
+    s->chunks = usesChunkSpectra(r);
+    s->tiles = s->chunks ? shadelShadingQueue(r).capacity
+                         : ((r.internalWidth + LIGHT_TILE_SIZE - 1) / LIGHT_TILE_SIZE) *
+                               ((r.internalHeight + LIGHT_TILE_SIZE - 1) / LIGHT_TILE_SIZE);
     auto need = [](BufferHandle b) {
         if (!b) throw DeviceError("out of GPU memory for the feature spectra buffers");
         return b;
@@ -99,7 +115,7 @@ SpectraStatePtr createFeatureSpectra(Renderer& r) {
     s->frame = need(
         createBuffer(gpu, {"spectra.frame", sizeof(gpu::SpectraFrame), 0, MemoryKind::Upload}));
     s->dispatch =
-        need(createBuffer(gpu, {"spectra.dispatch", uint64_t(modes) * 12,
+        need(createBuffer(gpu, {"spectra.dispatch", uint64_t(modes) * dispatchStride(*s),
                                 VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT, MemoryKind::Readback}));
     s->tileBins = need(createBuffer(gpu, {"spectra.tileBins", uint64_t(modes) * s->tiles * 4}));
     s->superfluous =
@@ -108,10 +124,31 @@ SpectraStatePtr createFeatureSpectra(Renderer& r) {
     s->featureTiles = need(
         createBuffer(gpu, {"spectra.featureTiles", (SPECTRUM_FEATURE_COUNT + SPECTRUM_ALL + 1) * 4,
                            0, MemoryKind::Readback}));
+    if (s->chunks) {
+        // Permutations of the shadel shading itself (shade.comp), with its other constants.
+        std::vector<std::pair<uint32_t, uint32_t>> base;
+        if (r.settings.distanceFieldLighting)
+            base.push_back({DISTANCE_FIELD_LIGHTING_CONSTANT_ID, 1u});
+        auto constants = base;
+        constants.push_back({CHUNK_SPECTRA_PHASE_CONSTANT_ID, 1u});
+        s->classify = createComputePipeline(gpu, "shadelChunkSpectra.classify",
+                                            "shadel_shade.comp.spv", constants);
+        s->setup = createComputePipeline(gpu, "shadelChunkSpectra.setup",
+                                         "lighting_chunk_spectra_setup.comp.spv");
+        for (uint32_t m = 0; m < modes; ++m) {
+            constants = base;
+            constants.push_back({CHUNK_SPECTRA_PHASE_CONSTANT_ID, 2u});
+            constants.push_back({SPECTRUM_FEATURES_CONSTANT_ID, s->modes[m]});
+            constants.push_back({SPECTRUM_MODE_CONSTANT_ID, m});
+            s->shading.push_back(createComputePipeline(
+                gpu, "shadelShading." + modeName(s->modes[m]), "shadel_shade.comp.spv", constants));
+        }
+        return s;
+    }
     for (uint32_t m = 0; m < modes; ++m)
         s->shading.push_back(createComputePipeline(
             gpu, "tileShading." + modeName(s->modes[m]), "lighting_tile_shade.comp.spv",
-            {{SPECTRUM_FEATURES_CONSTANT_ID, s->modes[m]}, {141u, m}}));
+            {{SPECTRUM_FEATURES_CONSTANT_ID, s->modes[m]}, {SPECTRUM_MODE_CONSTANT_ID, m}}));
     return s;
 }
 
@@ -119,6 +156,10 @@ void destroyFeatureSpectra(Renderer& r, SpectraStatePtr& state) {
     if (!state) return;
     Gpu& gpu = *r.gpu;
     for (Pipeline& p : state->shading) destroy(gpu, p);
+    if (state->chunks) {
+        destroy(gpu, state->classify);
+        destroy(gpu, state->setup);
+    }
     for (BufferHandle b :
          {state->frame, state->dispatch, state->tileBins, state->superfluous, state->featureTiles})
         destroy(gpu, b);
@@ -135,7 +176,7 @@ uint64_t prepareFeatureSpectra(Renderer& r, uint32_t tilesX, uint32_t tilesY) {
     f.superfluous = address(gpu, s.superfluous);
     f.featureTiles = address(gpu, s.featureTiles);
     f.modeCount = uint32_t(s.modes.size());
-    f.binCapacity = tilesX * tilesY;
+    f.binCapacity = s.chunks ? s.tiles : tilesX * tilesY;
     for (size_t m = 0; m < s.modes.size(); ++m) f.modeFeatures[m] = s.modes[m];
     std::memcpy(mapped(gpu, s.frame), &f, sizeof(f));
     return address(gpu, s.frame);
@@ -146,7 +187,11 @@ void recordSpectraReset(Renderer& r, VkCommandBuffer cmd) {
     Gpu& gpu = *r.gpu;
     SpectraState& s = *r.spectra;
     std::vector<uint32_t> args;
-    for (size_t m = 0; m < s.modes.size(); ++m) args.insert(args.end(), {0u, 1u, 1u});
+    for (size_t m = 0; m < s.modes.size(); ++m)
+        if (s.chunks)
+            args.insert(args.end(), {0u, 0u, 1u, 0u}); // sized by the setup after classifying
+        else
+            args.insert(args.end(), {0u, 1u, 1u});
     vkCmdUpdateBuffer(cmd, vkBuffer(gpu, s.dispatch), 0, args.size() * 4, args.data());
     vkCmdFillBuffer(cmd, vkBuffer(gpu, s.superfluous), 0, VK_WHOLE_SIZE, 0);
     vkCmdFillBuffer(cmd, vkBuffer(gpu, s.featureTiles), 0, VK_WHOLE_SIZE, 0);
@@ -180,6 +225,41 @@ void recordTileShading(Renderer& r, VkCommandBuffer cmd, uint64_t frame) {
                  VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT | VK_ACCESS_2_COLOR_ATTACHMENT_READ_BIT);
 }
 
+namespace {
+struct ChunkSpectraSetupPush {
+    uint64_t spectraFrame;
+};
+} // namespace
+
+void recordChunkSpectraClassify(Renderer& r, VkCommandBuffer cmd, uint64_t frame) {
+    Gpu& gpu = *r.gpu;
+    SpectraState& s = *r.spectra;
+    ShadelShadingQueue queue = shadelShadingQueue(r);
+    bind(gpu, cmd, s.classify);
+    pushConstants(gpu, cmd, frame);
+    vkCmdDispatchIndirect(cmd, vkBuffer(gpu, queue.counters), queue.dispatchOffset);
+    memoryBarrier(cmd, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT,
+                  VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
+                  VK_ACCESS_2_SHADER_STORAGE_READ_BIT | VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT);
+    bind(gpu, cmd, s.setup);
+    pushConstants(gpu, cmd, ChunkSpectraSetupPush{address(gpu, s.frame)});
+    vkCmdDispatch(cmd, 1, 1, 1);
+    // The bins and their dispatch sizes, for the per-spectrum shading.
+    memoryBarrier(cmd, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT,
+                  VK_PIPELINE_STAGE_2_DRAW_INDIRECT_BIT | VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
+                  VK_ACCESS_2_INDIRECT_COMMAND_READ_BIT | VK_ACCESS_2_SHADER_STORAGE_READ_BIT);
+}
+
+void recordChunkSpectraShading(Renderer& r, VkCommandBuffer cmd, uint64_t frame) {
+    Gpu& gpu = *r.gpu;
+    SpectraState& s = *r.spectra;
+    for (size_t m = 0; m < s.modes.size(); ++m) {
+        bind(gpu, cmd, s.shading[m]);
+        pushConstants(gpu, cmd, frame);
+        vkCmdDispatchIndirect(cmd, vkBuffer(gpu, s.dispatch), VkDeviceSize(m) * 16);
+    }
+}
+
 void readFeatureSpectraStats(Renderer& r) {
     if (!r.spectra) return;
     Gpu& gpu = *r.gpu;
@@ -187,7 +267,7 @@ void readFeatureSpectraStats(Renderer& r) {
     size_t modes = s.modes.size();
     const uint32_t* args = static_cast<const uint32_t*>(mapped(gpu, s.dispatch));
     s.binned.resize(modes);
-    for (size_t m = 0; m < modes; ++m) s.binned[m] = args[m * 3];
+    for (size_t m = 0; m < modes; ++m) s.binned[m] = s.chunks ? args[m * 4 + 3] : args[m * 3];
     const uint32_t* sup = static_cast<const uint32_t*>(mapped(gpu, s.superfluous));
     s.lastSuperfluous.assign(sup, sup + modes * SPECTRUM_FEATURE_COUNT);
     const uint32_t* ft = static_cast<const uint32_t*>(mapped(gpu, s.featureTiles));
@@ -200,6 +280,7 @@ void featureSpectraStats(const Renderer& r, nlohmann::json& stats) {
                                                                     : "off";
     if (!r.spectra || r.spectra->binned.empty()) return;
     const SpectraState& s = *r.spectra;
+    stats["spectra_unit"] = s.chunks ? "chunks" : "tiles"; // what "spectra" counts
     nlohmann::json spectra = nlohmann::json::object(), superfluous = nlohmann::json::object(),
                    features = nlohmann::json::object();
     uint64_t superfluousTotal = 0;

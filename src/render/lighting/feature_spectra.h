@@ -17,6 +17,13 @@
 //   --spectra single: the same pass with one all-features mode (the baseline the seed's
 //                     spectra are measured against);
 //   --spectra off:    the raster forward shading (the default).
+//
+// Decoupled mode ("the same for chunk queues"): shading is per 8x8-shadel chunk of the shading
+// queue, culled against the chunk's world box (shaders/shadel/shade.comp). With --spectra
+// on|single a classify permutation of the shadel shading runs over the queue first (carry-over
+// decision, chunk light culling, the chunk's features, append to its mode's bin), then each
+// mode's permutation of the same shader shades its bin by indirect dispatch
+// (shaders/lighting/chunk_spectra.glsl). Stats "spectra" then count chunks, not tiles.
 #include <memory>
 
 #include <nlohmann/json.hpp>
@@ -37,17 +44,26 @@ using SpectraStatePtr = std::unique_ptr<SpectraState, SpectraStateDeleter>;
 
 // Whether the frame shades forward tiles by spectra (forward mode, --spectra on|single).
 bool usesTileShading(const Renderer& r);
+// Whether shadel chunks are shaded by spectra (decoupled mode, --spectra on|single).
+bool usesChunkSpectra(const Renderer& r);
 
-// After the light culling state and the visibility buffer exist: the mode permutations.
+// After the light culling state and the visibility buffer (forward) or the decoupled state
+// (its shading queue) exist: the mode permutations.
 SpectraStatePtr createFeatureSpectra(Renderer& r);
 void destroyFeatureSpectra(Renderer& r, SpectraStatePtr& state);
 
-// This frame's SpectraFrame address (LightingFrame::spectra), 0 without spectra.
+// This frame's SpectraFrame address (LightingFrame::spectra, or ::chunkSpectra when
+// usesChunkSpectra), 0 without spectra.
 uint64_t prepareFeatureSpectra(Renderer& r, uint32_t tilesX, uint32_t tilesY);
 // Empties the bins before the tile pass fills them (recorded with the light culling clears).
 void recordSpectraReset(Renderer& r, VkCommandBuffer cmd);
 // "tileShading": every mode's permutation over its bin (indirect), into the HDR target.
 void recordTileShading(Renderer& r, VkCommandBuffer cmd, uint64_t frame);
+// "shadelChunkSpectra" (decoupled, before shadelShading): the classify permutation over the
+// shading queue, then the bins' dispatch sizes.
+void recordChunkSpectraClassify(Renderer& r, VkCommandBuffer cmd, uint64_t frame);
+// Inside "shadelShading": every mode's shadel shading permutation over its bin (indirect).
+void recordChunkSpectraShading(Renderer& r, VkCommandBuffer cmd, uint64_t frame);
 // After the frame: tiles per spectrum, superfluous features, tiles per feature.
 void readFeatureSpectraStats(Renderer& r);
 void featureSpectraStats(const Renderer& r, nlohmann::json& stats);

@@ -122,7 +122,8 @@ uint64_t prepareLightCulling(Renderer& r, const GpuScene& scene,
         s.tiledThisFrame = true;
         f.tiled = 1u;
     }
-    f.spectra = prepareFeatureSpectra(r, s.tilesX, s.tilesY);
+    (usesChunkSpectra(r) ? f.chunkSpectra : f.spectra) =
+        prepareFeatureSpectra(r, s.tilesX, s.tilesY);
     prepareShadows(r, lights, constants, f);
     std::memcpy(mapped(gpu, s.frame), &f, sizeof(f));
     return address(gpu, s.frame);

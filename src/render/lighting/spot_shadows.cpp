@@ -148,6 +148,7 @@ void prepareShadows(Renderer& r, const std::vector<gpu::GpuLight>& lights,
     glm::mat4 inv = glm::inverse(constants.sunViewProj);
     glm::vec4 a = inv * glm::vec4(0, 0, 0, 1), b = inv * glm::vec4(0, 0, 1, 1);
     f.sunDepthRange = glm::length(glm::vec3(b) / b.w - glm::vec3(a) / a.w);
+    f.sunCascades = prepareSunCascades(r, constants); // 0 with --sun-cascades 1
     f.spotShadowAtlas = NO_TEXTURE;
     f.spotShadows = 0;
     if (!r.spotShadows) return;

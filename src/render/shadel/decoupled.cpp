@@ -858,11 +858,19 @@ void recordDecoupledPasses(Renderer& r, FrameRecorder& rec, uint64_t frame, cons
 
     recordDecalCulling(r, rec, frame); // the decal lists of screen tiles and queued chunks
 
+    if (usesChunkSpectra(r)) // --spectra: chunks binned by the lighting features they need
+        pass(rec, "shadelChunkSpectra",
+             [&](VkCommandBuffer cmd) { recordChunkSpectraClassify(r, cmd, frame); });
+
     pass(rec, "shadelShading", [&](VkCommandBuffer cmd) {
-        bind(gpu, cmd, d.shade);
-        pushConstants(gpu, cmd, FramePush{frame});
-        vkCmdDispatchIndirect(cmd, vkBuffer(gpu, d.counters),
-                              offsetof(gpu::GpuShadelCounters, shadeDispatch));
+        if (usesChunkSpectra(r)) { // one permutation per spectrum (render/lighting)
+            recordChunkSpectraShading(r, cmd, frame);
+        } else {
+            bind(gpu, cmd, d.shade);
+            pushConstants(gpu, cmd, FramePush{frame});
+            vkCmdDispatchIndirect(cmd, vkBuffer(gpu, d.counters),
+                                  offsetof(gpu::GpuShadelCounters, shadeDispatch));
+        }
         memoryBarrier(cmd, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
                       VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT, VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT,
                       VK_ACCESS_2_SHADER_SAMPLED_READ_BIT);

@@ -1,0 +1,20 @@
+#version 460
+// Feature spectra of the shadel path: each mode's chunk count (the classify phase's appends)
+// becomes its 2-D indirect dispatch size, x kept under every device's maxComputeWorkGroupCount[0]
+// as for the shading queue (shaders/shadel/dispatch_setup.comp).
+#include "common/bindless.glsl"
+
+layout(local_size_x = SPECTRUM_MAX_MODES) in;
+layout(buffer_reference, scalar) readonly buffer SetupSpectraFrameRef { SpectraFrame s; };
+layout(push_constant, scalar) uniform Push { uint64_t spectraFrame; } pc;
+
+void main() {
+    SpectraFrame sf = SetupSpectraFrameRef(pc.spectraFrame).s;
+    uint mode = gl_LocalInvocationIndex;
+    if (mode >= sf.modeCount) return;
+    UintBuffer args = UintBuffer(sf.dispatch);
+    uint n = args.v[mode * 4u + 3u];
+    args.v[mode * 4u] = min(n, 32768u);
+    args.v[mode * 4u + 1u] = n == 0u ? 0u : (n + 32767u) / 32768u;
+    args.v[mode * 4u + 2u] = 1u;
+}

@@ -1,0 +1,239 @@
+#include "render/lighting/sun_cascades.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+
+#include <glm/gtc/matrix_transform.hpp>
+
+#include "core/error.h"
+#include "render/forward/forward_passes.h"
+#include "render/renderer.h"
+
+namespace shadel {
+
+namespace {
+// Cascades start this close to the camera (nearer points belong to the first).
+constexpr float kFirstSplitNear = 0.5f;
+// The practical split scheme: this much logarithmic, the rest uniform.
+constexpr float kLogWeight = 0.75f;
+// Metres added in front of and behind the scene along the light, so casters are never clipped.
+constexpr float kDepthPadding = 1.0f;
+} // namespace
+
+struct SunCascadeState {
+    uint32_t count = 0;
+    uint32_t mapSize = 0; // texels per side of one cascade
+    uint32_t columns = 1; // of the atlas
+    Aabb sceneBounds;
+    TextureHandle atlas;
+    DepthTargetView target;
+    TextureReadView read;
+    BufferHandle cascades; // gpu::GpuSunCascades (upload)
+    Pipeline pass;
+    gpu::GpuSunCascades last{};
+    float wholeSceneTexel = 0.0f;
+};
+
+void SunCascadeStateDeleter::operator()(SunCascadeState* state) const {
+    delete state;
+}
+
+SunCascadeStatePtr createSunCascades(Renderer& r, const GpuScene& scene) {
+    if (r.settings.sunCascades <= 1 || !scene.sunCastsShadow) return nullptr;
+    Gpu& gpu = *r.gpu;
+    SunCascadeStatePtr s(new SunCascadeState);
+    s->count = std::min(r.settings.sunCascades, SUN_MAX_CASCADES);
+    // Half the whole-scene map's resolution per cascade: four cascades fill an atlas of the
+    // whole-scene map's size, and each still covers far less ground per texel.
+    s->mapSize = std::max(r.settings.shadowMapSize / 2, 256u);
+    s->columns = std::min(s->count, 2u);
+    s->sceneBounds = scene.bounds.valid() ? scene.bounds : Aabb{glm::vec3(-1), glm::vec3(1)};
+    TextureDesc atlas;
+    atlas.name = "sunCascadeAtlas";
+    atlas.format = VK_FORMAT_D32_SFLOAT;
+    atlas.width = s->mapSize * s->columns;
+    atlas.height = s->mapSize * ((s->count + s->columns - 1) / s->columns);
+    atlas.usage = VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT | VK_IMAGE_USAGE_SAMPLED_BIT;
+    s->atlas = createTexture(gpu, atlas);
+    s->cascades =
+        createBuffer(gpu, {"sunCascades", sizeof(gpu::GpuSunCascades), 0, MemoryKind::Upload});
+    if (!s->atlas || !s->cascades) throw DeviceError("out of GPU memory for the sun's cascades");
+    s->target = createDepthTargetView(gpu, s->atlas);
+    s->read = createReadView(gpu, s->atlas);
+
+    GraphicsPipelineDesc pass;
+    pass.name = "sunCascades";
+    pass.vertexShader = "lighting_sun_cascade.vert.spv";
+    pass.fragmentShader = "forward_depth.frag.spv";
+    pass.depthFormat = VK_FORMAT_D32_SFLOAT;
+    pass.depthCompare = VK_COMPARE_OP_LESS_OR_EQUAL;
+    pass.cullMode = VK_CULL_MODE_NONE;
+    pass.depthClamp = true;
+    pass.depthBias = true;
+    s->pass = createGraphicsPipeline(gpu, pass);
+    return s;
+}
+
+void destroySunCascades(Renderer& r, SunCascadeStatePtr& state) {
+    if (!state) return;
+    Gpu& gpu = *r.gpu;
+    destroy(gpu, state->pass);
+    destroy(gpu, state->target);
+    destroy(gpu, state->read);
+    destroy(gpu, state->atlas);
+    destroy(gpu, state->cascades);
+    state.reset();
+}
+
+uint64_t prepareSunCascades(Renderer& r, const gpu::FrameConstants& constants) {
+    if (!r.sunCascades) return 0;
+    Gpu& gpu = *r.gpu;
+    SunCascadeState& s = *r.sunCascades;
+    s.wholeSceneTexel = constants.shadowTexelSize;
+    gpu::GpuSunCascades c{};
+    c.count = s.count;
+    c.atlasSlot = slot(gpu, s.read).value;
+
+    // The camera's basis and its frustum's half-extents per metre of view depth.
+    glm::mat4 invView = glm::inverse(constants.view);
+    glm::vec3 eye = constants.cameraPosition;
+    glm::vec3 right = glm::normalize(glm::vec3(invView[0]));
+    glm::vec3 up = glm::normalize(glm::vec3(invView[1]));
+    glm::vec3 forward = -glm::normalize(glm::vec3(invView[2]));
+    float tanX = 1.0f / std::max(std::abs(constants.proj[0][0]), 1e-6f);
+    float tanY = 1.0f / std::max(std::abs(constants.proj[1][1]), 1e-6f);
+    c.cameraForward = forward;
+
+    // The slices end where the scene does: its farthest corner's view depth.
+    const Aabb& b = s.sceneBounds;
+    glm::vec3 sceneCorners[8];
+    float far = 0.0f;
+    for (int i = 0; i < 8; ++i) {
+        sceneCorners[i] = glm::vec3(i & 1 ? b.max.x : b.min.x, i & 2 ? b.max.y : b.min.y,
+                                    i & 4 ? b.max.z : b.min.z);
+        far = std::max(far, glm::dot(sceneCorners[i] - eye, forward));
+    }
+    far = std::max(far, kFirstSplitNear * 4.0f);
+
+    // A fixed light basis (rotation only): texel snapping in it is stable under camera motion.
+    glm::vec3 dir = glm::normalize(constants.sunDirection);
+    glm::vec3 lightUp = std::abs(dir.y) > 0.99f ? glm::vec3(1, 0, 0) : glm::vec3(0, 1, 0);
+    glm::mat4 lightView = glm::lookAt(glm::vec3(0.0f), dir, lightUp);
+    float sceneZMin = 1e30f, sceneZMax = -1e30f;
+    for (const glm::vec3& p : sceneCorners) {
+        float z = (lightView * glm::vec4(p, 1.0f)).z;
+        sceneZMin = std::min(sceneZMin, z), sceneZMax = std::max(sceneZMax, z);
+    }
+
+    float sliceNear = 0.0f;
+    for (uint32_t i = 0; i < s.count; ++i) {
+        float t = float(i + 1) / float(s.count);
+        float logSplit = kFirstSplitNear * std::pow(far / kFirstSplitNear, t);
+        float uniformSplit = kFirstSplitNear + (far - kFirstSplitNear) * t;
+        float sliceFar = kLogWeight * logSplit + (1.0f - kLogWeight) * uniformSplit;
+        // The slice's bounding sphere: centroid of its corners, radius to the farthest.
+        glm::vec3 corners[8];
+        glm::vec3 center(0.0f);
+        for (int k = 0; k < 8; ++k) {
+            float d = k & 4 ? sliceFar : sliceNear;
+            corners[k] = eye + forward * d + right * (k & 1 ? d * tanX : -d * tanX) +
+                         up * (k & 2 ? d * tanY : -d * tanY);
+            center += corners[k] * 0.125f;
+        }
+        float radius = 0.0f;
+        for (const glm::vec3& p : corners) radius = std::max(radius, glm::length(p - center));
+        radius = std::ceil(radius * 16.0f) / 16.0f; // constant for a camera of fixed field of view
+        float texel = 2.0f * radius / float(s.mapSize);
+        glm::vec3 lc = glm::vec3(lightView * glm::vec4(center, 1.0f));
+        lc.x = std::floor(lc.x / texel) * texel;
+        lc.y = std::floor(lc.y / texel) * texel;
+        // Depth: the whole scene along the light (and the slice, for cameras outside it), so a
+        // caster between the sun and the slice is never clipped.
+        float zMin = sceneZMin, zMax = sceneZMax;
+        for (const glm::vec3& p : corners) {
+            float z = (lightView * glm::vec4(p, 1.0f)).z;
+            zMin = std::min(zMin, z), zMax = std::max(zMax, z);
+        }
+        float nearPlane = -zMax - kDepthPadding, farPlane = -zMin + kDepthPadding;
+        glm::mat4 proj = glm::orthoRH_ZO(lc.x - radius, lc.x + radius, lc.y - radius, lc.y + radius,
+                                         nearPlane, farPlane);
+        c.viewProj[i] = proj * lightView;
+        float column = float(i % s.columns), row = float(i / s.columns);
+        float rows = float((s.count + s.columns - 1) / s.columns);
+        c.atlasRect[i] =
+            glm::vec4(column / float(s.columns), row / rows, 1.0f / float(s.columns), 1.0f / rows);
+        c.splitFar[i] = sliceFar;
+        c.texelWorld[i] = texel;
+        c.depthRange = std::max(c.depthRange, farPlane - nearPlane);
+        sliceNear = sliceFar;
+    }
+    s.last = c;
+    std::memcpy(mapped(gpu, s.cascades), &c, sizeof(c));
+    return address(gpu, s.cascades);
+}
+
+void recordSunCascades(Renderer& r, VkCommandBuffer cmd, uint64_t frame) {
+    Gpu& gpu = *r.gpu;
+    SunCascadeState& s = *r.sunCascades;
+    VkImage image = vkImage(gpu, s.atlas);
+    const TextureDesc& d = desc(gpu, s.atlas);
+    imageBarrier(
+        cmd, image, VK_IMAGE_ASPECT_DEPTH_BIT, VK_IMAGE_LAYOUT_UNDEFINED,
+        VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL,
+        VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT | VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, 0,
+        VK_PIPELINE_STAGE_2_EARLY_FRAGMENT_TESTS_BIT | VK_PIPELINE_STAGE_2_LATE_FRAGMENT_TESTS_BIT,
+        VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT |
+            VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_READ_BIT);
+    VkRenderingAttachmentInfo depth{VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO};
+    depth.imageView = vkView(gpu, s.target);
+    depth.imageLayout = VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL;
+    depth.loadOp = VK_ATTACHMENT_LOAD_OP_CLEAR;
+    depth.storeOp = VK_ATTACHMENT_STORE_OP_STORE;
+    depth.clearValue.depthStencil = {1.0f, 0};
+    VkRenderingInfo ri{VK_STRUCTURE_TYPE_RENDERING_INFO};
+    ri.renderArea = {{0, 0}, {d.width, d.height}};
+    ri.layerCount = 1;
+    ri.pDepthAttachment = &depth;
+    vkCmdBeginRendering(cmd, &ri);
+    bind(gpu, cmd, s.pass);
+    vkCmdSetDepthBias(cmd, 1.25f, 0.0f, 1.75f);
+    vkCmdBindIndexBuffer(cmd, vkBuffer(gpu, r.sceneIndices), 0, VK_INDEX_TYPE_UINT32);
+    for (uint32_t i = 0; i < s.count; ++i) {
+        uint32_t x = (i % s.columns) * s.mapSize, y = (i / s.columns) * s.mapSize;
+        VkViewport vp{float(x), float(y), float(s.mapSize), float(s.mapSize), 0, 1};
+        VkRect2D scissor{{int32_t(x), int32_t(y)}, {s.mapSize, s.mapSize}};
+        vkCmdSetViewport(cmd, 0, 1, &vp);
+        vkCmdSetScissor(cmd, 0, 1, &scissor);
+        pushConstants(gpu, cmd, RasterPush{frame, i});
+        // The sun view's culled casters (see the header: they cover every cascade).
+        vkCmdDrawIndexedIndirectCount(
+            cmd, vkBuffer(gpu, r.shadowDraws),
+            VkDeviceSize(DRAW_LIST_OPAQUE) * r.maxDraws * sizeof(gpu::DrawIndexedCommand),
+            vkBuffer(gpu, r.drawCounts), (DRAW_LIST_COUNT + DRAW_LIST_OPAQUE) * 4, r.maxDraws,
+            sizeof(gpu::DrawIndexedCommand));
+    }
+    vkCmdEndRendering(cmd);
+    imageBarrier(cmd, image, VK_IMAGE_ASPECT_DEPTH_BIT, VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL,
+                 VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL,
+                 VK_PIPELINE_STAGE_2_LATE_FRAGMENT_TESTS_BIT,
+                 VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT,
+                 VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT | VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
+                 VK_ACCESS_2_SHADER_SAMPLED_READ_BIT);
+}
+
+void sunCascadeStats(const Renderer& r, nlohmann::json& stats) {
+    stats["sun_cascades"] = r.sunCascades ? r.sunCascades->count : 1u;
+    if (!r.sunCascades) return;
+    const SunCascadeState& s = *r.sunCascades;
+    nlohmann::json splits = nlohmann::json::array(), texels = nlohmann::json::array();
+    for (uint32_t i = 0; i < s.count; ++i) {
+        splits.push_back(s.last.splitFar[i]);
+        texels.push_back(s.last.texelWorld[i]);
+    }
+    stats["sun_cascade_splits_m"] = splits;          // view depth where each cascade ends
+    stats["sun_cascade_texel_m"] = texels;           // a texel's width per cascade
+    stats["sun_shadow_texel_m"] = s.wholeSceneTexel; // the whole-scene map's
+}
+
+} // namespace shadel
