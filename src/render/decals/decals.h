@@ -6,9 +6,15 @@
 // One culling pass builds every stage's list at once (seed 004: "build the decal lists with a
 // single frustum cull, then copy each decal that passes into the relevant list"): the CPU keeps
 // the decals meeting the camera frustum, then one compute pass gives each 16x16 screen tile
-// (forward shading, and the shadel path's forward fallbacks) and, in decoupled mode, each chunk
-// of the shading queue its lists, one per stage, in decal order. Shadel shading applies its
-// chunk's lists, so a decal is evaluated once per shadel and reused with the shadel.
+// (forward shading, and the shadel path's forward fallbacks) its lists, one per stage, in decal
+// order, and, in decoupled mode, each instance the decals meeting its world bounds. Shadel
+// shading refines its object's list against its chunk's box in shared memory (as it culls
+// lights, shaders/shadel/shade.comp) and applies it, so a decal is evaluated once per shadel and
+// reused with the shadel; chunks of objects no decal meets skip decal culling.
+//
+// Why not a per-chunk pass: it rebuilt every queued chunk's 64 shadel positions (ID map,
+// indices, vertices) only to bound the chunk, which shading does again right after; on
+// builtin:decals at 1280x720 it cost more than half of shadelShading itself.
 #include <cstdint>
 #include <memory>
 
@@ -37,7 +43,7 @@ gpu::GpuDecal gpuDecal(const Decal& decal);
 // This frame's DecalFrame (the decals meeting the camera frustum); its address for
 // FrameConstants::decals, 0 without decals.
 uint64_t prepareDecalFrame(Renderer& r, const gpu::FrameConstants& constants);
-// The "decalCulling" pass: every tile's lists, then (decoupled) every queued chunk's. Forward:
+// The "decalCulling" pass: every tile's lists, then (decoupled) every instance's. Forward:
 // after the depth prepass, before shading; decoupled: after the work queues, before shading.
 void recordDecalCulling(Renderer& r, FrameRecorder& rec, uint64_t frame);
 // After the frame: the counters (decals_visible, decal_tile_pairs, ...).
