@@ -1,9 +1,9 @@
 #version 460
 // Decal culling, coarse per-object half (render/decals): one invocation per instance, every
 // decal meeting the camera frustum tested against the instance's world bounds, in decal order,
-// into the instance's list. Shadel shading refines the list per chunk against the box of the
-// points it shades (shadel/shade.comp, cullChunkDecals), so chunks of objects no decal touches
-// skip decal culling altogether and the others test only the few decals their object meets.
+// into the instance's list. Shadel shading narrows the list to each shadel's point
+// (decals/decals.glsl, useShadelDecalList), so shadels of objects no decal meets test nothing
+// and the others test only the few decals their object meets.
 #include "decals/decal_cull.glsl"
 
 layout(local_size_x = 64) in;

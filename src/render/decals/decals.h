@@ -8,13 +8,15 @@
 // the decals meeting the camera frustum, then one compute pass gives each 16x16 screen tile
 // (forward shading, and the shadel path's forward fallbacks) its lists, one per stage, in decal
 // order, and, in decoupled mode, each instance the decals meeting its world bounds. Shadel
-// shading refines its object's list against its chunk's box in shared memory (as it culls
-// lights, shaders/shadel/shade.comp) and applies it, so a decal is evaluated once per shadel and
-// reused with the shadel; chunks of objects no decal meets skip decal culling.
+// shading narrows its object's list to each shadel's point (per-stage bit masks in registers,
+// shaders/decals/decals.glsl useShadelDecalList) and applies it, so a decal is evaluated once
+// per shadel and reused with the shadel; shadels of objects no decal meets test nothing.
 //
-// Why not a per-chunk pass: it rebuilt every queued chunk's 64 shadel positions (ID map,
-// indices, vertices) only to bound the chunk, which shading does again right after; on
-// builtin:decals at 1280x720 it cost more than half of shadelShading itself.
+// Why not a list per queued chunk: the pass doing it rebuilt every chunk's 64 shadel positions
+// (ID map, indices, vertices) and reduced them to a box with shared atomics and barriers, only
+// for shading to rebuild the same positions right after; at 1280x720 on builtin:decals it cost
+// about two thirds of shadelShading itself. Every prefilter sample evaluates the material at the
+// shadel's one point, so the per-shadel test is exact and costs a few box tests per shadel.
 #include <cstdint>
 #include <memory>
 
