@@ -587,6 +587,7 @@ struct ShadelFrame {
 #define DECAL_PATTERN_PUDDLE 3u  // a wobbly blob (wet patch: low roughness)
 #define DECAL_PATTERN_BLOB 4u    // radial falloff (contact shadow under a character)
 #define DECAL_TILE_MAX 256u      // decals one tile's / chunk's list holds
+#define DECAL_OBJECT_ALL 0xFFFFFFFFu // an object list that did not fit: every frustum decal
 
 struct GpuDecal {
     mat4 worldToBox; // world -> box space [-0.5, 0.5]^3; the box's z projects (faces the surface)
@@ -608,7 +609,10 @@ struct DecalFrame {
     uint64_t decals;        // GpuDecal[]
     uint64_t frustumDecals; // uint decal indices meeting the camera frustum, in decal order
     uint64_t tileRanges;    // uvec2 (first entry, count) per (tile * DECAL_STAGES + stage)
-    uint64_t chunkRanges;   // the same per (shading work index * DECAL_STAGES + stage)
+    uint64_t objectRanges;  // uvec2 (first entry, count) per instance: the decals its world
+                            // bounds meet, in decal order (count DECAL_OBJECT_ALL: the list did
+                            // not fit, take every frustum decal); shadel shading narrows them
+                            // to each shadel's point
     uint64_t entries;       // the pool of uint decal indices both lists take room in
     uint64_t counters;      // DecalCounters
     uint64_t visibleDecals; // uint bit set: decals in at least one list
@@ -616,15 +620,16 @@ struct DecalFrame {
     uint poolCapacity;
     uint tilesX;
     uint tilesY;
-    uint chunkCapacity; // work indices chunkRanges holds
+    uint instanceCount; // instances objectRanges holds (0 in forward mode)
     uint pad0;
 };
 
 struct DecalCounters {
     uint tilePairs;       // (decal, tile) pairs in the forward lists
-    uint chunkPairs;      // (decal, chunk) pairs in the shadel chunk lists
+    uint shadelPairs;     // (decal, shadel) pairs the shadel path's shading kept
     uint poolEntries;     // entries asked of the pool (every stage)
     uint listsOverflowed; // tiles or chunks whose lists did not fit (decals dropped)
+    uint objectPairs;     // (decal, instance) pairs of the coarse per-object lists
 };
 
 #ifdef __cplusplus

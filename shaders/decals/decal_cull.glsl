@@ -1,25 +1,11 @@
-// Decal culling shared by the screen-tile and the shadel-chunk workgroups of the one decal
-// culling pass (render/decals/decals.h): a decal's box against a convex volume, an ordered
-// append (lists keep the decals' order, so overlapping decals combine the same way in every
-// tile and chunk), and writing one list per decal stage into the shared pool.
+// Decal culling of the screen-tile workgroups of the decal culling pass
+// (render/decals/decals.h): a decal's box against a convex volume, an ordered append (lists keep
+// the decals' order, so overlapping decals combine the same way in every tile), and writing one
+// list per decal stage into the shared pool.
 #ifndef SHADEL_DECAL_CULL_GLSL
 #define SHADEL_DECAL_CULL_GLSL
 #extension GL_KHR_shader_subgroup_ballot : require
 #include "common/material.glsl" // which includes decals/decals.glsl
-
-// The decal's box meets the axis-aligned box [lo, hi]: separating axes of both boxes' faces
-// (conservative: the edge-cross axes are not tested, so a few near misses are kept).
-bool decalMeetsBox(GpuDecal d, vec3 lo, vec3 hi) {
-    vec3 axes[3] = vec3[3](d.axisX, d.axisY, d.axisZ);
-    vec3 reach = abs(axes[0]) * d.halfSize.x + abs(axes[1]) * d.halfSize.y + abs(axes[2]) * d.halfSize.z;
-    if (any(greaterThan(d.center - reach, hi)) || any(lessThan(d.center + reach, lo))) return false;
-    vec3 c = (lo + hi) * 0.5, e = (hi - lo) * 0.5;
-    for (int a = 0; a < 3; ++a) {
-        float boxReach = dot(abs(axes[a]), e);
-        if (abs(dot(axes[a], c - d.center)) > d.halfSize[a] + boxReach) return false;
-    }
-    return true;
-}
 
 // The decal's box is not wholly outside any of the planes (inside: dot(n, x) + w >= 0).
 bool decalInsidePlanes(GpuDecal d, vec4 planes[6]) {
@@ -54,16 +40,18 @@ void decalOrderedAppend(bool keep, uint decal) {
     barrier();
 }
 
-// Every decal meeting the volume `meets` tests, 'threads' at a time, into sDecalList.
-#define DECAL_CULL_LOOP(df, threads, meets)                                                       \
+// Every decal of the index list at `list` (`count` entries, in decal order) meeting the volume
+// `meets` tests, 'threads' at a time, into sDecalList.
+#define DECAL_CULL_LIST_LOOP(df, list, count, threads, meets)                                     \
     {                                                                                             \
         DecalBuffer decalsIn = DecalBuffer(df.decals);                                            \
-        UintBuffer frustumDecals = UintBuffer(df.frustumDecals);                                  \
-        for (uint base = 0u; base < df.frustumDecalCount; base += threads) {                      \
+        UintBuffer listIn = UintBuffer(list);                                                     \
+        uint listCount = (count);                                                                 \
+        for (uint base = 0u; base < listCount; base += threads) {                                 \
             uint i = base + gl_LocalInvocationIndex;                                              \
-            uint index = i < df.frustumDecalCount ? frustumDecals.v[i] : 0u;                      \
+            uint index = i < listCount ? listIn.v[i] : 0u;                                        \
             bool keep = false;                                                                    \
-            if (i < df.frustumDecalCount) {                                                       \
+            if (i < listCount) {                                                                  \
                 GpuDecal d = decalsIn.d[index];                                                   \
                 keep = meets;                                                                     \
             }                                                                                     \
@@ -71,9 +59,13 @@ void decalOrderedAppend(bool keep, uint decal) {
         }                                                                                         \
     }
 
-// The lists of one tile or chunk (`ranges` + `index`), one per stage, from sDecalList; `tile`:
-// count the pairs as tile pairs, else chunk pairs. Call in uniform control flow after the loop.
-void writeDecalLists(DecalFrame df, uint64_t ranges, uint index, bool tile, uint threads) {
+// Every decal meeting the camera frustum that `meets`.
+#define DECAL_CULL_LOOP(df, threads, meets)                                                       \
+    DECAL_CULL_LIST_LOOP(df, df.frustumDecals, df.frustumDecalCount, threads, meets)
+
+// The lists of one tile (`ranges` + `index`), one per stage, from sDecalList. Call in uniform
+// control flow after the loop.
+void writeDecalLists(DecalFrame df, uint64_t ranges, uint index, uint threads) {
     uint tid = gl_LocalInvocationIndex;
     uint count = min(sDecalCount, DECAL_TILE_MAX);
     DecalBuffer decals = DecalBuffer(df.decals);
@@ -94,8 +86,7 @@ void writeDecalLists(DecalFrame df, uint64_t ranges, uint index, bool tile, uint
         DecalRangeBuffer(ranges).r[index * DECAL_STAGES + st] = uvec2(first, fits ? n : 0u);
     }
     if (tid == 0u) {
-        if (tile) atomicAdd(counters.c.tilePairs, count);
-        else atomicAdd(counters.c.chunkPairs, count);
+        atomicAdd(counters.c.tilePairs, count);
         if (sDecalCount > DECAL_TILE_MAX) atomicAdd(counters.c.listsOverflowed, 1u);
     }
     for (uint i = tid; i < count; i += threads)

@@ -69,5 +69,5 @@ void main() {
     for (int i = 1; i < 8; ++i) boxMin = min(boxMin, corners[i]), boxMax = max(boxMax, corners[i]);
 
     DECAL_CULL_LOOP(df, 256u, decalInsidePlanes(d, planes) && decalMeetsBox(d, boxMin, boxMax))
-    writeDecalLists(df, df.tileRanges, tile, true, 256u);
+    writeDecalLists(df, df.tileRanges, tile, 256u);
 }

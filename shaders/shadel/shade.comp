@@ -4,6 +4,7 @@
 // with clamped barycentrics (and the barycentrics one shadel right and down, for derivatives),
 // then runs the same material and lighting code as the forward path.
 #include "shadel/shadel.glsl"
+#extension GL_KHR_shader_subgroup_arithmetic : require
 #define SHADEL_LIGHT_LIST_SHARED
 #define LIGHT_CULL_ORDERED_APPEND
 #include "common/lighting.glsl"
@@ -167,6 +168,26 @@ void cullChunkLights(FrameConstants f, bool shading, vec3 p) {
 
 #include "lighting/chunk_spectra_classify.glsl" // --spectra: binning chunks by features
 
+// The decal stats of this shadel's list (useShadelDecalList): (decal, shadel) pairs, and the
+// decals kept marked visible, one atomic per subgroup. Any control flow.
+void countShadelDecals(FrameConstants f, uint object, uint pairs) {
+    uint kept = 0u;
+    for (uint st = 0u; st < DECAL_STAGES; ++st) kept |= gDecalShadelList ? gDecalStageMask[st] : 0u;
+    pairs = subgroupAdd(pairs);
+    kept = subgroupOr(kept);
+    if (!subgroupElect() || pairs == 0u) return;
+    DecalFrame df = DecalFrameRef(f.decals).d;
+    atomicAdd(DecalCountersRef(df.counters).c.shadelPairs, pairs);
+    uvec2 range = DecalRangeBuffer(df.objectRanges).r[object];
+    uint64_t list = df.entries + uint64_t(range.x) * 4ul;
+    if (range.y == DECAL_OBJECT_ALL) list = df.frustumDecals, range.y = df.frustumDecalCount;
+    for (uint i = 0u; i < range.y; ++i) {
+        if (i < 32u && ((kept >> i) & 1u) == 0u) continue; // entries past 32 are always kept
+        uint decal = UintBuffer(list).v[i];
+        atomicOr(UintBuffer(df.visibleDecals).v[decal >> 5], 1u << (decal & 31u));
+    }
+}
+
 void main() {
     FrameConstants f = FrameConstantsRef(pc.frame).f;
     gTextureFeedback = f.textureFeedback; // texture streaming: the MIPs the shadels want
@@ -245,10 +266,13 @@ void main() {
     si.frontFacing = dot(geometricNormal, f.cameraPosition - si.position) >= 0.0;
     GpuMaterial mat = MaterialBuffer(f.materials).m[inst.material];
     useRayTracedShadelTerms(f, work.object, shadelCenterUv(shadel, size)); // --rt-* (RT cache)
-    // Decals: this chunk's lists (render/decals), applied inside evaluateMaterial, so each
-    // shadel takes them once and every pixel reading it reuses them. Opaque surfaces only, as
-    // in forward shading.
-    if ((mat.flags & MATERIAL_ALPHA_BLEND) == 0u) useChunkDecalList(f, workIndex);
+    // Decals: the object's list (render/decals) narrowed to this shadel's point, applied inside
+    // evaluateMaterial, so each shadel takes them once and every pixel reading it reuses them.
+    // Opaque surfaces only, as in forward shading.
+    uint decalPairs = (mat.flags & MATERIAL_ALPHA_BLEND) == 0u
+                          ? useShadelDecalList(f, work.object, si.position)
+                          : 0u;
+    if (f.decals != 0ul) countShadelDecals(f, work.object, decalPairs);
     // The shadel's whole footprint, not its centre (prefilter.glsl; --material-samples caps it).
     vec4 material;
     vec3 color = prefilteredShade(f, mat, si, shadelCenterUv(shadel, size), vec2(1.0) / vec2(size),

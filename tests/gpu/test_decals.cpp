@@ -163,8 +163,9 @@ TEST(Decals, AmbientOcclusionDecalDarkensOnlyTheAmbientLight) {
             << "the pixel darkens by the ambient it lost, nothing else";
 }
 
-// The shadel path applies decals per shadel from its chunk lists: the image matches forward
-// shading, nothing is missed, and the chunk lists are what put the decals there.
+// The shadel path applies decals per shadel from its object's list narrowed to the shadel: the
+// image matches forward shading, nothing is missed, and those lists are what put the decals
+// there; the per-object pass keeps only the decals meeting an object (not every pair).
 TEST(Decals, DecoupledMatchesForward) {
     RenderRun forward = renderChecked(decalOptions(RenderMode::Forward, true));
     RenderRun forwardOff = renderChecked(decalOptions(RenderMode::Forward, false));
@@ -172,14 +173,22 @@ TEST(Decals, DecoupledMatchesForward) {
     double p = psnr(decoupled.frames[0].rgba, forward.frames[0].rgba);
     double pOff = psnr(decoupled.frames[0].rgba, forwardOff.frames[0].rgba);
     std::printf("[ figures ] builtin:decals %ux%u: decoupled vs forward %.2f dB, misses %u, "
-                "decal chunk pairs %u, tile pairs %u; decoupled vs forward without decals "
+                "decal shadel pairs %u, tile pairs %u; decoupled vs forward without decals "
                 "%.2f dB\n",
                 kW, kH, p, decoupled.stats["reconstruction_misses"].get<uint32_t>(),
-                decoupled.stats["decal_chunk_pairs"].get<uint32_t>(),
+                decoupled.stats["decal_shadel_pairs"].get<uint32_t>(),
                 decoupled.stats["decal_tile_pairs"].get<uint32_t>(), pOff);
     EXPECT_GE(p, 35.0);
     EXPECT_EQ(decoupled.stats["reconstruction_misses"].get<uint32_t>(), 0u);
-    EXPECT_GT(decoupled.stats["decal_chunk_pairs"].get<uint32_t>(), 0u);
+    EXPECT_GT(decoupled.stats["decal_shadel_pairs"].get<uint32_t>(), 0u);
+    const uint32_t objectPairs = decoupled.stats["decal_object_pairs"].get<uint32_t>();
+    const uint32_t allPairs = decoupled.stats["decals_in_frustum"].get<uint32_t>() *
+                              decoupled.stats["objects_decoupled"].get<uint32_t>();
+    std::printf("[ figures ] (decal, object) pairs %u of %u\n", objectPairs, allPairs);
+    EXPECT_GT(objectPairs, 0u);
+    EXPECT_LT(objectPairs, allPairs) << "the per-object pass must cull";
+    EXPECT_EQ(decoupled.stats["decals_visible"].get<uint32_t>(),
+              decoupled.stats["decals"].get<uint32_t>());
     EXPECT_LT(pOff, p - 10.0) << "the shadel path must show the decals as forward does";
 }
 

@@ -9,22 +9,21 @@
 
 #include "render/camera.h"
 #include "render/renderer.h"
-#include "render/shadel/decoupled.h"
 
 namespace shadel {
 
 struct DecalState {
-    Pipeline tileCull, chunkCull;
+    Pipeline tileCull, objectCull;
     BufferHandle decals;        // gpu::GpuDecal[]
     BufferHandle frame;         // gpu::DecalFrame (upload)
     BufferHandle frustumDecals; // uint decal indices (upload), the CPU's frustum cull
     BufferHandle tileRanges;    // uvec2 per (tile, stage)
-    BufferHandle chunkRanges;   // uvec2 per (shading work index, stage)
+    BufferHandle objectRanges;  // uvec2 per instance (decoupled)
     BufferHandle entries;       // the pool of decal indices
     BufferHandle counters;      // gpu::DecalCounters (readback)
     BufferHandle visible;       // uint bit set (readback)
     std::vector<gpu::GpuDecal> cpuDecals;
-    uint32_t tilesX = 0, tilesY = 0, chunkCapacity = 0, poolCapacity = 0;
+    uint32_t tilesX = 0, tilesY = 0, instanceCount = 0, poolCapacity = 0;
     uint32_t frustumCount = 0;
     // Last frame's counts (read after the GPU finished).
     gpu::DecalCounters last{};
@@ -40,7 +39,7 @@ struct TilePush {
     uint64_t frame;
     uint32_t depthSlot;
 };
-struct ChunkPush {
+struct ObjectPush {
     uint64_t frame;
 };
 } // namespace
@@ -85,11 +84,13 @@ DecalStatePtr createDecals(Renderer& r, const GpuScene& scene) {
     s->tilesX = (r.internalWidth + LIGHT_TILE_SIZE - 1) / LIGHT_TILE_SIZE;
     s->tilesY = (r.internalHeight + LIGHT_TILE_SIZE - 1) / LIGHT_TILE_SIZE;
     uint32_t tiles = s->tilesX * s->tilesY;
-    s->chunkCapacity = r.decoupled ? shadelShadingQueue(r).capacity : 0u;
-    // One pool for every list: 16 entries per tile or chunk on average (at least 64 K, at most
-    // 4 M = 16 MiB); a frame that needs more drops the lists that do not fit and counts them.
+    // Decoupled: a coarse list per instance, refined per chunk by shadel shading.
+    s->instanceCount = r.decoupled ? scene.instanceCount : 0u;
+    // One pool for every list: 16 entries per tile or instance on average (at least 64 K, at
+    // most 4 M = 16 MiB); a frame that needs more drops the tile lists that do not fit and
+    // counts them (an object list that does not fit stands for every frustum decal).
     s->poolCapacity = uint32_t(
-        std::clamp<uint64_t>(uint64_t(tiles + s->chunkCapacity) * 16u, 1u << 16, 1u << 22));
+        std::clamp<uint64_t>(uint64_t(tiles + s->instanceCount) * 16u, 1u << 16, 1u << 22));
     auto need = [](BufferHandle b) {
         if (!b) throw DeviceError("out of GPU memory for the decal buffers");
         return b;
@@ -104,8 +105,8 @@ DecalStatePtr createDecals(Renderer& r, const GpuScene& scene) {
         need(createBuffer(gpu, {"decals.frustumDecals", count * 4, 0, MemoryKind::Upload}));
     const uint64_t rangeBytes = 8ull * DECAL_STAGES;
     s->tileRanges = need(createBuffer(gpu, {"decals.tileRanges", tiles * rangeBytes}));
-    s->chunkRanges = need(createBuffer(
-        gpu, {"decals.chunkRanges", std::max<uint64_t>(s->chunkCapacity, 1) * rangeBytes}));
+    s->objectRanges = need(
+        createBuffer(gpu, {"decals.objectRanges", std::max<uint64_t>(s->instanceCount, 1) * 8ull}));
     s->entries = need(createBuffer(gpu, {"decals.entries", uint64_t(s->poolCapacity) * 4}));
     s->counters = need(createBuffer(
         gpu, {"decals.counters", sizeof(gpu::DecalCounters), 0, MemoryKind::Readback}));
@@ -113,7 +114,8 @@ DecalStatePtr createDecals(Renderer& r, const GpuScene& scene) {
         createBuffer(gpu, {"decals.visible", ((count + 31) / 32) * 4, 0, MemoryKind::Readback}));
     s->tileCull = createComputePipeline(gpu, "decalTileCull", "decals_tile_cull.comp.spv");
     if (r.decoupled)
-        s->chunkCull = createComputePipeline(gpu, "decalChunkCull", "decals_chunk_cull.comp.spv");
+        s->objectCull =
+            createComputePipeline(gpu, "decalObjectCull", "decals_object_cull.comp.spv");
     return s;
 }
 
@@ -121,9 +123,9 @@ void destroyDecals(Renderer& r, DecalStatePtr& state) {
     if (!state) return;
     Gpu& gpu = *r.gpu;
     destroy(gpu, state->tileCull);
-    if (state->chunkCull.pipeline) destroy(gpu, state->chunkCull);
+    if (state->objectCull.pipeline) destroy(gpu, state->objectCull);
     for (BufferHandle b : {state->decals, state->frame, state->frustumDecals, state->tileRanges,
-                           state->chunkRanges, state->entries, state->counters, state->visible})
+                           state->objectRanges, state->entries, state->counters, state->visible})
         destroy(gpu, b);
     state.reset();
 }
@@ -152,7 +154,7 @@ uint64_t prepareDecalFrame(Renderer& r, const gpu::FrameConstants& constants) {
     f.decals = address(gpu, s.decals);
     f.frustumDecals = address(gpu, s.frustumDecals);
     f.tileRanges = address(gpu, s.tileRanges);
-    f.chunkRanges = address(gpu, s.chunkRanges);
+    f.objectRanges = address(gpu, s.objectRanges);
     f.entries = address(gpu, s.entries);
     f.counters = address(gpu, s.counters);
     f.visibleDecals = address(gpu, s.visible);
@@ -160,7 +162,7 @@ uint64_t prepareDecalFrame(Renderer& r, const gpu::FrameConstants& constants) {
     f.poolCapacity = s.poolCapacity;
     f.tilesX = s.tilesX;
     f.tilesY = s.tilesY;
-    f.chunkCapacity = s.chunkCapacity;
+    f.instanceCount = s.instanceCount;
     std::memcpy(mapped(gpu, s.frame), &f, sizeof(f));
     return address(gpu, s.frame);
 }
@@ -194,12 +196,12 @@ void recordDecalCulling(Renderer& r, FrameRecorder& rec, uint64_t frame) {
                          VK_PIPELINE_STAGE_2_LATE_FRAGMENT_TESTS_BIT,
                      VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_READ_BIT |
                          VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT);
-        // Chunks: one workgroup per entry of the shading queue, as shading dispatches them.
-        if (r.decoupled) {
-            ShadelShadingQueue queue = shadelShadingQueue(r);
-            bind(gpu, cmd, s.chunkCull);
-            pushConstants(gpu, cmd, ChunkPush{frame});
-            vkCmdDispatchIndirect(cmd, vkBuffer(gpu, queue.counters), queue.dispatchOffset);
+        // Decoupled: one invocation per instance, its coarse list. Shadel shading refines it
+        // per chunk in the workgroup, from the positions it rebuilds anyway (decals.h).
+        if (r.decoupled && s.instanceCount > 0) {
+            bind(gpu, cmd, s.objectCull);
+            pushConstants(gpu, cmd, ObjectPush{frame});
+            vkCmdDispatch(cmd, (s.instanceCount + 63) / 64, 1, 1);
         }
         memoryBarrier(
             cmd, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT,
@@ -225,7 +227,8 @@ void decalStats(const Renderer& r, nlohmann::json& stats) {
     stats["decals_in_frustum"] = s ? s->frustumCount : 0u;
     stats["decals_visible"] = s ? s->visibleCount : 0u;
     stats["decal_tile_pairs"] = s ? s->last.tilePairs : 0u;
-    stats["decal_chunk_pairs"] = s ? s->last.chunkPairs : 0u;
+    stats["decal_shadel_pairs"] = s ? s->last.shadelPairs : 0u;
+    stats["decal_object_pairs"] = s ? s->last.objectPairs : 0u;
     stats["decal_list_entries"] = s ? s->last.poolEntries : 0u;
     stats["decal_lists_overflowed"] = s ? s->last.listsOverflowed : 0u;
 }
