@@ -2,6 +2,7 @@
 
 #include <cstring>
 #include <ctime>
+#include <limits>
 
 #include <glm/gtc/matrix_transform.hpp>
 
@@ -135,13 +136,7 @@ void initRenderer(Renderer& r, Gpu& gpu, const RenderSettings& requested, const 
     r.pixels =
         createBuffer(gpu, {"pixels.readback", VkDeviceSize(settings.width) * settings.height * 4, 0,
                            MemoryKind::Readback});
-    if (settings.animateLights)
-        r.animatedLights =
-            createBuffer(gpu, {"lights.animated",
-                               std::max<size_t>(scene.lightInfo.size(), 1) * sizeof(gpu::GpuLight),
-                               0, MemoryKind::Upload});
-    if (!r.draws || !r.shadowDraws || !r.drawCounts || !r.frameConstants || !r.pixels ||
-        (settings.animateLights && !r.animatedLights))
+    if (!r.draws || !r.shadowDraws || !r.drawCounts || !r.frameConstants || !r.pixels)
         throw DeviceError("out of GPU memory for the renderer's frame buffers");
     createForwardPipelines(r);
     createTonemapPipeline(r);
@@ -197,7 +192,8 @@ void destroyRenderer(Renderer& r) {
     destroy(gpu, r.tonemap);
     for (BufferHandle b : {r.draws, r.shadowDraws, r.drawCounts, r.frameConstants, r.pixels})
         destroy(gpu, b);
-    if (r.animatedLights) destroy(gpu, r.animatedLights);
+    if (r.liveLights) destroy(gpu, r.liveLights);
+    destroySceneEdits(r);
     destroy(gpu, r.hdrTarget);
     destroy(gpu, r.hdrRead);
     destroy(gpu, r.depthTarget);
@@ -209,11 +205,11 @@ void destroyRenderer(Renderer& r) {
 }
 
 // The sun's orthographic shadow volume, fitted to the scene bounds.
-static glm::mat4 sunViewProj(const GpuScene& scene, float& texelWorldSize, uint32_t mapSize) {
+static glm::mat4 sunViewProj(const GpuScene& scene, glm::vec3 dir, float& texelWorldSize,
+                             uint32_t mapSize) {
     Aabb b = scene.bounds.valid() ? scene.bounds : Aabb{glm::vec3(-1), glm::vec3(1)};
     glm::vec3 center = b.center();
     float radius = std::max(glm::length(b.extent()) * 0.5f, 1e-3f);
-    glm::vec3 dir = glm::normalize(scene.sunDirection);
     glm::vec3 up = std::abs(dir.y) > 0.99f ? glm::vec3(1, 0, 0) : glm::vec3(0, 1, 0);
     glm::mat4 view = glm::lookAt(center - dir * radius * 2.0f, center, up);
     glm::mat4 proj =
@@ -231,15 +227,16 @@ static gpu::FrameConstants makeFrameConstants(Renderer& r, const GpuScene& scene
     f.viewProj = camera.proj * camera.view;
     f.invViewProj = glm::inverse(f.viewProj);
     float texel = 0.0f;
-    f.sunViewProj = sunViewProj(scene, texel, r.settings.shadowMapSize);
+    SunEdit sun = currentSun(r, scene); // as loaded, or edited (render/scene_edits.h)
+    f.sunViewProj = sunViewProj(scene, sun.direction, texel, r.settings.shadowMapSize);
     auto planes = frustumPlanes(f.viewProj);
     auto shadowPlanes = frustumPlanes(f.sunViewProj);
     shadowPlanes[4] = glm::vec4(0, 0, 0, 1); // depth clamp keeps casters in front of the near plane
     for (int i = 0; i < 6; ++i) f.frustumPlanes[i] = planes[i], f.shadowPlanes[i] = shadowPlanes[i];
     f.cameraPosition = camera.position;
     f.exposure = r.settings.exposure;
-    f.sunDirection = glm::normalize(scene.sunDirection);
-    f.sunColor = scene.sunColor;
+    f.sunDirection = sun.direction;
+    f.sunColor = sun.color;
     f.sunShadowSlot = scene.sunCastsShadow ? slot(gpu, r.shadowRead).value : NO_TEXTURE;
     f.shadowTexelSize = texel;
     f.skyColor = scene.skyColor;
@@ -264,17 +261,33 @@ static gpu::FrameConstants makeFrameConstants(Renderer& r, const GpuScene& scene
     return f;
 }
 
-// --animate-lights: this frame's lights into the upload buffer, and what changed since the last
-// frame (the decoupled path reshades what changed lights reach).
+// Live lights (--animate-lights, edits): this frame's lights into the upload buffer, and what
+// changed since the last frame (the decoupled path reshades what changed lights reach). Also
+// binds the edited materials.
 static void updateLights(Renderer& r, const GpuScene& scene, gpu::FrameConstants& constants) {
     r.changedLightVolumes.clear();
-    if (!r.settings.animateLights || scene.lightInfo.empty()) return;
-    std::vector<gpu::GpuLight> lights = animatedLights(scene.lightInfo, r.framesRendered);
-    std::memcpy(mapped(*r.gpu, r.animatedLights), lights.data(),
-                lights.size() * sizeof(gpu::GpuLight));
-    constants.lights = address(*r.gpu, r.animatedLights);
-    if (r.framesRendered > 0)
-        r.changedLightVolumes = changedLightVolumes(r.lightsLastFrame, lights);
+    const std::vector<gpu::GpuLight>& base = applySceneEdits(r, scene, constants);
+    if (r.edits.sunChanged) // the sun reaches everything
+        r.changedLightVolumes.push_back(
+            glm::vec4(0.0f, 0.0f, 0.0f, std::numeric_limits<float>::infinity()));
+    bool live = r.settings.animateLights || !r.edits.lights.empty();
+    if (!live || scene.lightInfo.empty()) return;
+    std::vector<gpu::GpuLight> lights =
+        r.settings.animateLights ? animatedLights(base, r.framesRendered) : base;
+    if (!r.liveLights) {
+        r.liveLights = createBuffer(
+            *r.gpu, {"lights.live", lights.size() * sizeof(gpu::GpuLight), 0, MemoryKind::Upload});
+        if (!r.liveLights) throw DeviceError("out of GPU memory for the live lights");
+    }
+    std::memcpy(mapped(*r.gpu, r.liveLights), lights.data(), lights.size() * sizeof(gpu::GpuLight));
+    constants.lights = address(*r.gpu, r.liveLights);
+    // The first live frame after unedited ones compares against the lights as loaded.
+    const std::vector<gpu::GpuLight>& before =
+        r.lightsLastFrame.empty() ? scene.lightInfo : r.lightsLastFrame;
+    if (r.framesRendered > 0) {
+        std::vector<glm::vec4> changed = changedLightVolumes(before, lights);
+        r.changedLightVolumes.insert(r.changedLightVolumes.end(), changed.begin(), changed.end());
+    }
     r.lightsLastFrame = std::move(lights);
 }
 
@@ -303,14 +316,21 @@ FrameResult renderFrame(Renderer& r, const GpuScene& scene, const CameraView& ca
     updateLights(r, scene, constants);
     // Before beginFrame (streaming rebinds texture slots in the set this frame uses) and before
     // the decoupled frontend (which must not carry over shading of re-streamed textures).
+    r.changedMaterials.clear();
     if (r.streaming) {
         prepareTextureStreaming(*r.streaming, camera, float(r.internalHeight), constants);
-        r.restreamedMaterials = restreamedMaterials(*r.streaming);
+        r.changedMaterials = restreamedMaterials(*r.streaming);
         if (VkSemaphore bound = takeTextureStreamingWait(*r.streaming)) // sparse page binds
             r.recorder.waitOnce.push_back(bound);
     }
+    // Edited materials reshade like re-streamed ones.
+    if (!r.edits.materialsChanged.empty()) {
+        r.changedMaterials.resize(r.edits.materialsChanged.size(), 0);
+        for (size_t i = 0; i < r.edits.materialsChanged.size(); ++i)
+            r.changedMaterials[i] |= r.edits.materialsChanged[i];
+    }
     constants.lighting = prepareLightCulling(
-        r, scene, r.settings.animateLights ? r.lightsLastFrame : scene.lightInfo, constants);
+        r, scene, r.lightsLastFrame.empty() ? scene.lightInfo : r.lightsLastFrame, constants);
     if (r.gi) prepareGiFrame(r, scene, camera, constants);
     if (r.distanceFields && r.settings.distanceFieldLighting) { // render/distance_fields
         constants.distanceFields = distanceFieldFrameAddress(r, *r.distanceFields);
@@ -408,6 +428,7 @@ FrameResult renderFrame(Renderer& r, const GpuScene& scene, const CameraView& ca
     if (r.rt) finishRayTracingFrame(r);
     finishScreenSpaceFrame(r);
     if (r.streaming) finishTextureStreamingFrame(*r.streaming);
+    finishSceneEdits(r);
     r.framesRendered++;
     size_t bytes = size_t(r.settings.width) * r.settings.height * 4;
     result.rgba.resize(bytes);

@@ -20,6 +20,7 @@
 #include "render/points_lines/points_lines.h"
 #include "render/raytracing/ray_tracing.h"
 #include "render/raytracing/rt_settings.h"
+#include "render/scene_edits.h"
 #include "render/shadel/visibility.h"
 #include "render/skinning/skinning.h"
 #include "render/stencil/stencil_effects.h"
@@ -199,9 +200,10 @@ struct Renderer {
     ShaderMessageChannel messages;
     FrameRecorder recorder;
     DecoupledStatePtr decoupled;
-    // Light animation: this frame's lights, last frame's, and the volumes (xyz, radius) of the
-    // lights that changed between them (what the decoupled path must reshade).
-    BufferHandle animatedLights; // host-visible gpu::GpuLight[], when animating
+    // Live lights (--animate-lights, or edited: render/scene_edits.h): this frame's lights (kept
+    // as the next frame's "last"), and the volumes (xyz, radius) of the lights that changed
+    // since the last frame (what the decoupled path must reshade).
+    BufferHandle liveLights; // host-visible gpu::GpuLight[], once lights animate or are edited
     std::vector<gpu::GpuLight> lightsLastFrame;
     std::vector<glm::vec4> changedLightVolumes;
     uint64_t framesRendered = 0;
@@ -221,7 +223,10 @@ struct Renderer {
     SkinningStatePtr skinning;             // skinned meshes skinned on the GPU (render/skinning)
     // Texture streaming (render/streaming), owned by the caller; null: textures loaded whole.
     TextureStreaming* streaming = nullptr;
-    std::vector<uint8_t> restreamedMaterials; // per material: a texture of it changed this frame
+    // Per material: what it shades with changed this frame (streaming changed a texture of it,
+    // or it was edited); the decoupled path reshades its objects.
+    std::vector<uint8_t> changedMaterials;
+    SceneEdits edits; // the viewer's light, sun and material edits (render/scene_edits.h)
     // Per instance: animated playback (render/animation) moved or deformed it before this frame;
     // empty without playback. Decoupled reuse reshades these; spot shadow maps are redrawn.
     std::vector<uint8_t> reposedInstances;

@@ -10,6 +10,7 @@
 #include "app/commands.h"
 #include "app/output_files.h"
 #include "app/viewer/camera_control.h"
+#include "app/viewer/scene_editor.h"
 #include "app/viewer/viewer_ui.h"
 #include "app/viewer/window.h"
 #include "bake/bake.h"
@@ -103,6 +104,7 @@ int runViewer(const ViewOptions& o, DeviceDesc deviceDesc) {
     if (!o.screenshot.empty()) requireCreatableOutput("--screenshot", o.screenshot);
     parseMarking(o.marking);
     ViewerPanel panel;
+    SceneEditor editor; // lights, sun and materials the user edits
     if (o.mode == "decoupled")
         panel.mode = 1;
     else if (o.mode != "forward")
@@ -185,7 +187,7 @@ int runViewer(const ViewOptions& o, DeviceDesc deviceDesc) {
                 if (panel.frameMsHistory.size() > 120) panel.frameMsHistory.pop_front();
                 panel.statLines = statLines(renderer, result);
                 panel.statLines.push_back(reloadStatus);
-                buildUi(ui, panel);
+                buildUi(ui, panel, [&] { buildSceneEditor(editor, renderer, scene.gpu); });
             }
             bool screenshot = !o.screenshot.empty() && (lastFrame || panel.screenshotRequested);
 
@@ -289,6 +291,7 @@ int runViewer(const ViewOptions& o, DeviceDesc deviceDesc) {
                     destroyRenderer(renderer);
                     renderer = Renderer{};
                     initRenderer(renderer, gpu, settingsFor(o, panel, gpu), scene.gpu);
+                    reapplySceneEdits(editor, renderer, scene.gpu);
                 } else {
                     renderer.settings.visualize = settingsFor(o, panel, gpu).visualize;
                 }

@@ -116,7 +116,7 @@ bool uiWantsMouse(const ViewerUi& ui) {
     return ui.enabled && ImGui::GetIO().WantCaptureMouse;
 }
 
-void buildUi(ViewerUi& ui, ViewerPanel& p) {
+void buildUi(ViewerUi& ui, ViewerPanel& p, const std::function<void()>& sections) {
     (void)ui;
     p.modeChanged = p.visualizeChanged = p.cameraModeChanged = p.screenshotRequested = false;
     ImGui_ImplVulkan_NewFrame();
@@ -160,6 +160,7 @@ void buildUi(ViewerUi& ui, ViewerPanel& p) {
         }
     }
     for (const std::string& line : p.statLines) ImGui::TextUnformatted(line.c_str());
+    if (sections) sections();
     p.screenshotRequested = ImGui::Button("capture screenshot");
     ImGui::End();
     ImGui::Render();

@@ -3,6 +3,7 @@
 // swapchain image the frame was copied into and draws the panel over it.
 #include <cstdint>
 #include <deque>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -39,8 +40,9 @@ extern const int kVisualizeCount;
 void initUi(ViewerUi& ui, ViewerWindow& w, Gpu& gpu);
 void destroyUi(ViewerUi& ui, Gpu& gpu);
 bool uiWantsMouse(const ViewerUi& ui);
-// Builds this frame's panel (ImGui NewFrame .. Render).
-void buildUi(ViewerUi& ui, ViewerPanel& panel);
+// Builds this frame's panel (ImGui NewFrame .. Render); `sections` adds more to the window
+// (the scene editor) before the capture button.
+void buildUi(ViewerUi& ui, ViewerPanel& panel, const std::function<void()>& sections = {});
 // Records the overlay into the swapchain image (COLOR_ATTACHMENT_OPTIMAL in, PRESENT_SRC out).
 void recordUi(ViewerUi& ui, VkCommandBuffer cmd, uint32_t image, VkExtent2D extent);
 

@@ -306,9 +306,10 @@ void prepareGiFrame(Renderer& r, const GpuScene& scene, const CameraView& camera
     g = {};
     gi.dirtyMask = 0;
     gi.frames++;
-    // --animate-lights: a spot that moved needs its RSM again, and every cascade its light.
+    // Live lights (animated or edited): a spot that moved needs its RSM again, and every
+    // cascade its light.
     bool lightsMoved = false;
-    if (r.settings.animateLights && !r.lightsLastFrame.empty())
+    if (!r.lightsLastFrame.empty())
         for (Rsm& rsm : gi.rsms) {
             if (rsm.light == 0xFFFFFFFFu || rsm.light >= r.lightsLastFrame.size()) continue;
             const gpu::GpuLight& l = r.lightsLastFrame[rsm.light]; // this frame's lights

@@ -661,9 +661,10 @@ void prepareDecoupledFrame(Renderer& r, const GpuScene& scene, const CameraView&
                                ? LightReach::Everything
                                : reachOf(r.changedLightVolumes, inst.worldMin, inst.worldMax);
         if (reach == LightReach::Bounded) g.flags |= SHADEL_OBJECT_NEAR_CHANGED_LIGHT;
-        // Texture streaming changed what a texture of its material holds: reshade it.
-        bool restreamed = inst.material < r.restreamedMaterials.size() &&
-                          r.restreamedMaterials[inst.material] != 0;
+        // Its material changed (texture streaming changed what a texture of it holds, or it
+        // was edited): reshade it.
+        bool restreamed =
+            inst.material < r.changedMaterials.size() && r.changedMaterials[inst.material] != 0;
         // Animated playback posed it anew (moved or deformed): its shadels are shaded again.
         bool reposed = i < r.reposedInstances.size() && r.reposedInstances[i] != 0;
         bool inputsUnchanged =
