@@ -4,6 +4,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <unistd.h>
 
 #include "app/capture_output.h"
@@ -143,9 +144,14 @@ static const char* modeName(RenderMode m) {
 
 void printPassTable(const nlohmann::json& stats) {
     std::printf("%-24s %10s\n", "pass", "gpu ms");
-    for (const auto& p : stats["passes"])
-        std::printf("%-24s %10.3f\n", p["name"].get<std::string>().c_str(),
+    uint32_t frames = stats.value("frames", 0u);
+    for (const auto& p : stats["passes"]) {
+        uint32_t ran = p.value("frames", frames);
+        std::printf("%-24s %10.3f", p["name"].get<std::string>().c_str(),
                     p["gpu_ms"].get<double>());
+        if (ran < frames) std::printf("  (%u of %u frames)", ran, frames);
+        std::printf("\n");
+    }
     std::printf("%-24s %10.3f  (median frame, wall clock)\n", "frame",
                 stats["frame_ms"]["median"].get<double>());
 }
@@ -304,6 +310,7 @@ RenderRun runRender(Gpu& gpu, const RenderOptions& o) {
     settings.particleAtlasSize = o.particleAtlasSize;
     settings.particleHalfRes = o.particleHalfRes;
     settings.lightBlockers = o.lightBlockers;
+    settings.lightGrid = o.lightGrid;
     settings.spectra = o.spectra;
     settings.sunSoftShadows = o.sunSoftShadows;
     settings.spotShadows = o.spotShadows;
@@ -435,12 +442,25 @@ RenderRun runRender(Gpu& gpu, const RenderOptions& o) {
     s["frame_ms"] = {{"median", median(frameMs)},
                      {"min", *std::min_element(frameMs.begin(), frameMs.end())},
                      {"max", *std::max_element(frameMs.begin(), frameMs.end())}};
+    // Per pass, the median over the frames that ran it, matched by name (and occurrence within
+    // the frame): frames differ in their pass lists (spot shadow maps are drawn only when they
+    // change, the first frame builds what later frames reuse), so the i-th pass of one frame
+    // is not the i-th of another. Listed in order of first appearance.
+    std::vector<std::pair<std::string, int>> passKeys;
+    std::map<std::pair<std::string, int>, std::vector<double>> passMs;
+    for (auto& f : run.frames) {
+        std::map<std::string, int> seen;
+        for (auto& pt : f.passes) {
+            std::pair<std::string, int> key{pt.name, seen[pt.name]++};
+            auto [it, added] = passMs.try_emplace(key);
+            if (added) passKeys.push_back(key);
+            it->second.push_back(pt.gpuMs);
+        }
+    }
     nlohmann::json passes = nlohmann::json::array();
-    for (size_t p = 0; p < run.frames.front().passes.size(); ++p) {
-        std::vector<double> ms;
-        for (auto& f : run.frames)
-            if (p < f.passes.size()) ms.push_back(f.passes[p].gpuMs);
-        passes.push_back({{"name", run.frames.front().passes[p].name}, {"gpu_ms", median(ms)}});
+    for (auto& key : passKeys) {
+        const std::vector<double>& ms = passMs[key];
+        passes.push_back({{"name", key.first}, {"gpu_ms", median(ms)}, {"frames", ms.size()}});
     }
     s["passes"] = passes;
     uint64_t asserts = 0;
