@@ -225,6 +225,35 @@ struct LightingCounters {
     uint chunksOverflowed;
     uint lightsCulledByBlockers; // (light, tile) pairs a blocker removed whole
     uint tileListEntries;        // entries taken from the tile list pool (may exceed it)
+    uint lightGridCandidates;    // lights the shadel chunks tested (taken from the light grid)
+};
+
+// The light grid (render/lighting/light_grid.h): lights bucketed in world space so a shadel
+// chunk tests only the lights near its box, not every light of the scene. Levels of cubic
+// cells, each twice the size of the one below; cells are hashed into buckets per level. A
+// light is listed in every cell its bounding sphere meets, at the levels where that is at
+// most LIGHT_GRID_MAX_SPAN cells per axis, and in the level's "big" list above that. Lights
+// of infinite range are in the global list. A chunk queries the finest level whose cell is at
+// least its box's size (at most 2x2x2 cells): those cells' buckets + the big and global lists
+// hold every light that can meet the box, and the exact test picks from those.
+#define LIGHT_GRID_LEVELS 8u
+#define LIGHT_GRID_BUCKETS 4096u // per level; a power of two
+#define LIGHT_GRID_MAX_SPAN 8
+#define LIGHT_GRID_MASK_LIGHTS 8192u // the chunk's shared bit set of candidates (more: no grid)
+#define LIGHT_GRID_HASH(x, y, z)                                                                   \
+    (((uint(x) * 73856093u) ^ (uint(y) * 19349663u) ^ (uint(z) * 83492791u)) &                     \
+     (LIGHT_GRID_BUCKETS - 1u))
+
+struct GpuLightGrid {
+    vec3 origin;       // world position of cell (0,0,0)'s corner, every level
+    float cellSize;    // level 0's cell edge (metres); level l: cellSize * 2^l
+    uint levels;       // levels built (<= LIGHT_GRID_LEVELS)
+    uint globalFirst;  // entries of the lights of infinite range
+    uint globalCount;
+    uint pad0;
+    uvec2 big[LIGHT_GRID_LEVELS]; // per level: first entry, count of lights too big for its cells
+    uint64_t buckets;  // uvec2 [level * LIGHT_GRID_BUCKETS + bucket]: first entry, count
+    uint64_t entries;  // uint light indices
 };
 
 // What the tiled-lighting passes share with shading (FrameConstants::lighting).
@@ -261,6 +290,8 @@ struct LightingFrame {
     // The sun's cascaded shadow maps (render/lighting/sun_cascades.h): GpuSunCascades, 0 with
     // --sun-cascades 1 (the one map fitted to the scene, FrameConstants::sunViewProj).
     uint64_t sunCascades;
+    // The light grid the shadel chunks' culling queries (GpuLightGrid), 0: test every light.
+    uint64_t lightGrid;
 };
 
 #define SUN_MAX_CASCADES 4u

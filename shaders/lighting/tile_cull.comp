@@ -9,6 +9,7 @@
 #define LIGHT_CULL_ORDERED_APPEND
 #include "lighting/light_cull.glsl"
 #include "lighting/spectra.glsl"
+#extension GL_KHR_shader_subgroup_arithmetic : require
 
 layout(local_size_x = 16, local_size_y = 16) in;
 layout(push_constant, scalar) uniform Push {
@@ -22,6 +23,36 @@ shared uvec2 sList[LIGHT_TILE_MAX_LIGHTS];
 shared bool sAnyPerPixel;
 shared uint sKept, sPoolBase;
 shared uint sFeatures; // SPECTRUM_* the tile's list needs (feature spectra)
+#define LIGHT_GRID_LIST sList
+#define LIGHT_GRID_LIST_MAX LIGHT_TILE_MAX_LIGHTS
+#include "lighting/light_grid.glsl"
+
+// The tile's test of one light: its sphere against the depth-bounded tile frustum's planes and
+// box, its clip plane against the frustum's corners.
+bool tileKeepsLight(GpuLight light, vec4 planes[6], vec3 boxMin, vec3 boxMax, vec3 corners[8]) {
+    vec4 sphere = lightSphere(light);
+    bool keep = true;
+    if (sphere.w >= 0.0) {
+        for (int p = 0; p < 6; ++p)
+            keep = keep && dot(planes[p].xyz, sphere.xyz) + planes[p].w >= -sphere.w;
+        vec3 nearest = clamp(sphere.xyz, boxMin, boxMax);
+        keep = keep && distance(nearest, sphere.xyz) <= sphere.w;
+    }
+    return keep && !clipPlaneCulls(light, corners);
+}
+
+// Whether the CPU's frustum cull kept the light (its list is in light order): grid candidates
+// outside the camera frustum stay out, as the loop over the frustum's lights leaves them.
+bool inFrustumLights(UintBuffer frustumLights, uint count, uint index) {
+    uint lo = 0u, hi = count;
+    while (lo < hi) {
+        uint mid = (lo + hi) / 2u;
+        uint v = frustumLights.v[mid];
+        if (v == index) return true;
+        if (v < index) lo = mid + 1u; else hi = mid;
+    }
+    return false;
+}
 
 void main() {
     FrameConstants f = FrameConstantsRef(pc.frame).f;
@@ -88,26 +119,34 @@ void main() {
     vec3 boxMin = corners[0], boxMax = corners[0];
     for (int i = 1; i < 8; ++i) boxMin = min(boxMin, corners[i]), boxMax = max(boxMax, corners[i]);
 
-    // Lights against the tile, 256 at a time, kept in light order.
+    // Lights against the tile, kept in light order: the frustum's lights near the tile's box
+    // from the light grid (render/lighting/light_grid.h), or, where the grid cannot answer
+    // (no grid, a box larger than its cells), every frustum light, 256 at a time.
     LightBuffer lights = LightBuffer(f.lights);
     UintBuffer frustumLights = UintBuffer(lf.frustumLights);
-    for (uint base = 0u; base < lf.frustumLightCount; base += THREADS) {
-        uint index = base + tid < lf.frustumLightCount ? frustumLights.v[base + tid] : LIGHT_INVALID;
-        bool keep = false;
-        if (index != LIGHT_INVALID) {
-            GpuLight light = lights.l[index];
-            vec4 sphere = lightSphere(light);
-            keep = true;
-            if (sphere.w >= 0.0) {
-                for (int p = 0; p < 6; ++p)
-                    keep = keep && dot(planes[p].xyz, sphere.xyz) + planes[p].w >= -sphere.w;
-                vec3 nearest = clamp(sphere.xyz, boxMin, boxMax);
-                keep = keep && distance(nearest, sphere.xyz) <= sphere.w;
+    LightGridQuery grid;
+    if (lightGridQuery(f, lf.lightGrid, boxMin, boxMax, grid)) {
+        lightGridMaskClear(f.lightCount, THREADS);
+        UintBuffer entries = UintBuffer(grid.g.entries);
+        for (uint source = 0u; source < lightGridSources(grid); ++source) {
+            uvec2 list = lightGridSource(grid, source);
+            for (uint i = tid; i < list.y; i += THREADS) {
+                uint index = entries.v[list.x + i];
+                if (tileKeepsLight(lights.l[index], planes, boxMin, boxMax, corners) &&
+                    inFrustumLights(frustumLights, lf.frustumLightCount, index))
+                    atomicOr(sGridMask[index >> 5], 1u << (index & 31u));
             }
-            keep = keep && !clipPlaneCulls(light, corners);
         }
-        uint slot = orderedAppend(keep);
-        if (slot < LIGHT_TILE_MAX_LIGHTS) sList[slot] = uvec2(index, 0u);
+        barrier();
+        lightGridMaskCompact(f.lightCount, THREADS);
+    } else {
+        for (uint base = 0u; base < lf.frustumLightCount; base += THREADS) {
+            uint index = base + tid < lf.frustumLightCount ? frustumLights.v[base + tid] : LIGHT_INVALID;
+            bool keep = index != LIGHT_INVALID &&
+                        tileKeepsLight(lights.l[index], planes, boxMin, boxMax, corners);
+            uint slot = orderedAppend(keep);
+            if (slot < LIGHT_TILE_MAX_LIGHTS) sList[slot] = uvec2(index, 0u);
+        }
     }
     uint candidates = min(sAppendCount, LIGHT_TILE_MAX_LIGHTS);
     if (tid == 0u && sAppendCount > LIGHT_TILE_MAX_LIGHTS)

@@ -9,6 +9,9 @@
 #define LIGHT_CULL_ORDERED_APPEND
 #include "common/lighting.glsl"
 #include "lighting/light_cull.glsl"
+#define LIGHT_GRID_LIST sLightList
+#define LIGHT_GRID_LIST_MAX LIGHT_CHUNK_MAX_LIGHTS
+#include "lighting/light_grid.glsl"
 #include "lighting/light_debug.glsl"
 #include "lighting/chunk_spectra.glsl"
 #include "common/shadel_bary.h"
@@ -130,18 +133,22 @@ void cullChunkLights(FrameConstants f, bool shading, vec3 p) {
                           (i & 4) != 0 ? boxMax.z : boxMin.z);
     LightBuffer lights = LightBuffer(f.lights);
     const uint threads = SHADEL_CHUNK * SHADEL_CHUNK;
-    for (uint base = 0u; base < f.lightCount; base += threads) {
-        uint index = base + tid;
-        bool keep = false;
-        if (index < f.lightCount) {
-            GpuLight light = lights.l[index];
-            vec4 sphere = lightSphere(light);
-            keep = sphere.w < 0.0 || distance(clamp(sphere.xyz, boxMin, boxMax), sphere.xyz) <= sphere.w;
-            keep = keep && !clipPlaneCulls(light, corners);
+    // The lights near the box from the light grid; without it (or for a box larger than the
+    // grid's cells), every light. The same list either way.
+    bool gridded = gridChunkLights(f, lf.lightGrid, boxMin, boxMax, corners, threads);
+    if (!gridded)
+        for (uint base = 0u; base < f.lightCount; base += threads) {
+            uint index = base + tid;
+            bool keep = false;
+            if (index < f.lightCount) {
+                GpuLight light = lights.l[index];
+                vec4 sphere = lightSphere(light);
+                keep = sphere.w < 0.0 || distance(clamp(sphere.xyz, boxMin, boxMax), sphere.xyz) <= sphere.w;
+                keep = keep && !clipPlaneCulls(light, corners);
+            }
+            uint slot = orderedAppend(keep);
+            if (slot < LIGHT_CHUNK_MAX_LIGHTS) sLightList[slot] = uvec2(index, 0u);
         }
-        uint slot = orderedAppend(keep);
-        if (slot < LIGHT_CHUNK_MAX_LIGHTS) sLightList[slot] = uvec2(index, 0u);
-    }
     uint count = min(sAppendCount, LIGHT_CHUNK_MAX_LIGHTS);
     if (tid == 0u) sLightListCount = count;
     for (uint i = tid; i < count; i += threads) {
@@ -160,6 +167,7 @@ void cullChunkLights(FrameConstants f, bool shading, vec3 p) {
         }
         LightingCountersRef counters = LightingCountersRef(lf.counters);
         atomicAdd(counters.c.lightChunkPairs, kept);
+        atomicAdd(counters.c.lightGridCandidates, gridded ? sGridCandidates : f.lightCount);
         atomicAdd(counters.c.lightsCulledByBlockers, count - kept);
         if (perPixel) atomicAdd(counters.c.perPixelBlockerChunks, 1u);
         if (sAppendCount > LIGHT_CHUNK_MAX_LIGHTS) atomicAdd(counters.c.chunksOverflowed, 1u);

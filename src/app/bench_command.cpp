@@ -139,6 +139,7 @@ nlohmann::json runBench(Gpu& gpu, const BenchOptions& b) {
     o.animateLights = b.animateLights;
     o.reuseRefreshPeriod = b.reuseRefreshPeriod;
     o.marking = b.marking;
+    o.lightGrid = b.lightGrid;
     o.shadingBias = b.shadingBias;
     o.cacheLimitBytes = b.cacheLimitBytes;
     o.lightCulling = b.lightCulling;

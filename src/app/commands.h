@@ -58,6 +58,7 @@ struct RenderOptions {
     bool particleHalfRes = true;                                 // --particle-resolution half|full
     LightCulling lightCulling = LightCulling::Tiled;             // --light-culling tiled|none
     bool lightBlockers = true;                                   // --blockers on|off
+    bool lightGrid = true;                                       // --light-grid on|off
     Spectra spectra = Spectra::Off;                              // --spectra on|off|single
     bool sunSoftShadows = false;                                 // --sun-shadows pcf|pcss
     bool spotShadows = true;                                     // --spot-shadows on|off
@@ -145,6 +146,7 @@ struct BenchOptions {
     uint32_t reuseRefreshPeriod = 8;
     uint64_t cacheLimitBytes = 4ull << 30;
     MarkingMode marking = MarkingMode::Auto; // decoupled and reuse modes
+    bool lightGrid = true;                   // --light-grid on|off
     float shadingBias = 0.0f;                // decoupled and reuse modes
     LightCulling lightCulling = LightCulling::Tiled;
     // --light-culling compare: forward and decoupled rendered again with no culling, and

@@ -239,10 +239,15 @@ int main(int argc, char** argv) {
                      "texels per side of the particle lightmap atlas (128..8192)")
         ->capture_default_str();
     std::string lightCulling = "tiled", blockers = "on", spectra = "off", sunShadows = "pcf",
-                spotShadows = "on";
+                spotShadows = "on", lightGrid = "on";
     render
         ->add_option("--light-culling", lightCulling,
                      "tiled | none: per-tile (forward) and per-chunk (shadel) light lists")
+        ->capture_default_str();
+    render
+        ->add_option("--light-grid", lightGrid,
+                     "on | off: tiles and shadel chunks take their candidate lights from a "
+                     "world-space light grid (off: each tests every light; the same lists)")
         ->capture_default_str();
     render
         ->add_option("--blockers", blockers,
@@ -409,6 +414,12 @@ int main(int argc, char** argv) {
     std::string benchMarking = "auto";
     bench->add_option("--marking", benchMarking, "decoupled modes: auto | raster | visibility")
         ->capture_default_str();
+    std::string benchLightGrid = "on";
+    bench
+        ->add_option(
+            "--light-grid", benchLightGrid,
+            "on | off: tiles and shadel chunks take their candidate lights from the light grid")
+        ->capture_default_str();
     std::string benchSpectra = "off";
     bench
         ->add_option("--spectra", benchSpectra,
@@ -571,6 +582,7 @@ int main(int argc, char** argv) {
             ro.reuse = reuse == "on";
             ro.lightCulling = parseLightCulling(lightCulling);
             ro.lightBlockers = parseOnOff("--blockers", blockers);
+            ro.lightGrid = parseOnOff("--light-grid", lightGrid);
             ro.particleLighting = parseParticleLighting(particleLighting);
             ro.particles = parseOnOff("--particles", particles);
             if (particleResolution != "half" && particleResolution != "full")
@@ -640,6 +652,7 @@ int main(int argc, char** argv) {
             bo.shadelsPerMetre = parseDensity(benchDensity);
             bo.cameraPath = parseCameraPath(benchCameraPath);
             bo.marking = parseMarking(benchMarking);
+            bo.lightGrid = parseOnOff("--light-grid", benchLightGrid);
             bo.compareLightCulling = benchLightCulling == "compare";
             if (!bo.compareLightCulling) bo.lightCulling = parseLightCulling(benchLightCulling);
             bo.compareSpectra = benchSpectra == "compare";

@@ -100,6 +100,7 @@ struct RenderSettings {
     LightCulling lightCulling = LightCulling::Tiled;
     bool lightBlockers =
         true;                // --blockers: light blockers and portals stop the lights listing them
+    bool lightGrid = true; // --light-grid: tiles and chunks take candidates from the light grid
     GiMode gi = GiMode::Off; // --gi (off by default: see render/gi/lpv.h for its cost)
     uint32_t giIterations = 8;         // --gi-iterations: LPV propagation steps
     bool giBlockerCells = true;        // GI taps test only their 4^3 macro-cell's blockers

@@ -5,6 +5,7 @@
 #include <cstring>
 
 #include "render/camera.h"
+#include "render/lighting/light_grid.h"
 #include "render/renderer.h"
 
 namespace shadel {
@@ -22,6 +23,7 @@ struct LightCullingState {
     gpu::LightingCounters last{};
     uint32_t lightsVisible = 0;
     bool tiledThisFrame = false; // see kMinLightsForTiles
+    LightGridBuffer grid;        // the shadel chunks' light grid (decoupled, tiled)
 };
 
 // Below this many lights in the view (and with no blockers to classify), the tile pass costs
@@ -76,6 +78,7 @@ void destroyLightCulling(Renderer& r, LightCullingStatePtr& state) {
     for (BufferHandle b : {state->frame, state->tileRanges, state->tileLights, state->counters,
                            state->visibleLights, state->frustumLights})
         destroy(gpu, b);
+    destroyLightGrid(gpu, state->grid);
     state.reset();
 }
 
@@ -124,6 +127,8 @@ uint64_t prepareLightCulling(Renderer& r, const GpuScene& scene,
     }
     (usesChunkSpectra(r) ? f.chunkSpectra : f.spectra) =
         prepareFeatureSpectra(r, s.tilesX, s.tilesY);
+    // Screen tiles and shadel chunks take their candidate lights from the light grid.
+    f.lightGrid = f.tiled != 0u && r.settings.lightGrid ? updateLightGrid(gpu, s.grid, lights) : 0;
     prepareShadows(r, lights, constants, f);
     std::memcpy(mapped(gpu, s.frame), &f, sizeof(f));
     return address(gpu, s.frame);
@@ -196,6 +201,9 @@ void lightCullingStats(const Renderer& r, const GpuScene& scene, nlohmann::json&
     stats["per_pixel_blocker_tiles"] = s.last.perPixelBlockerTiles;
     stats["light_tiles_overflowed"] = s.last.tilesOverflowed;
     stats["light_chunk_pairs"] = s.last.lightChunkPairs;
+    // Lights the chunks tested to find those pairs (every light per chunk without the grid).
+    stats["light_chunk_candidates"] = s.last.lightGridCandidates;
+    stats["light_grid_entries"] = s.grid.entries;
     stats["per_pixel_blocker_chunks"] = s.last.perPixelBlockerChunks;
     stats["light_chunks_overflowed"] = s.last.chunksOverflowed;
     stats["lights_culled_by_blockers"] = s.last.lightsCulledByBlockers;

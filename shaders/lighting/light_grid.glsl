@@ -1,0 +1,134 @@
+// The light grid query of a shadel chunk's light culling (render/lighting/light_grid.h; the
+// layout is common/shared_types.h GpuLightGrid). The candidates (the global list, the level's
+// big list and the buckets of the at most 2x2x2 cells the box meets) are tested exactly as
+// without the grid, kept ones set in a shared bit set (a light listed in several buckets
+// counts once), and the bit set is compacted in light order, so the list is the one the loop
+// over every light would have built. Needs light_cull.glsl (orderedAppend's shared state) and
+// GL_KHR_shader_subgroup_arithmetic; the includer defines LIGHT_GRID_LIST and
+// LIGHT_GRID_LIST_MAX (the shared list the compaction fills). Call in uniform control flow.
+#ifndef SHADEL_LIGHT_GRID_GLSL
+#define SHADEL_LIGHT_GRID_GLSL
+
+layout(buffer_reference, scalar) readonly buffer LightGridRef { GpuLightGrid g; };
+layout(buffer_reference, scalar) readonly buffer LightGridBuckets { uvec2 b[]; };
+
+shared uint sGridMask[LIGHT_GRID_MASK_LIGHTS / 32u];
+shared uint sGridCandidates;
+
+// orderedAppend for n entries per invocation: each invocation's first slot, in invocation
+// order after those already placed.
+uint orderedAppendCount(uint n) {
+    uint within = subgroupExclusiveAdd(n);
+    uint subgroupTotal = subgroupAdd(n);
+    if (subgroupElect()) sSubgroupCounts[gl_SubgroupID] = subgroupTotal;
+    barrier();
+    uint base = sAppendCount;
+    for (uint s = 0u; s < gl_SubgroupID; ++s) base += sSubgroupCounts[s];
+    uint total = 0u;
+    if (gl_LocalInvocationIndex == 0u)
+        for (uint s = 0u; s < gl_NumSubgroups; ++s) total += sSubgroupCounts[s];
+    barrier();
+    if (gl_LocalInvocationIndex == 0u) sAppendCount += total;
+    barrier();
+    return base + within;
+}
+
+// A box's grid query: its level and cells. Sources: 0 the global list, 1 the level's big
+// list, 2.. the cells (x fastest).
+struct LightGridQuery {
+    GpuLightGrid g;
+    uint level;
+    ivec3 lo;
+    ivec3 cells;
+};
+
+// False when the grid cannot answer: no grid, the box is larger than its coarsest cell, or
+// there are more lights than the bit set holds (the caller then tests every light).
+bool lightGridQuery(FrameConstants f, uint64_t gridAddress, vec3 boxMin, vec3 boxMax,
+                    out LightGridQuery q) {
+    if (gridAddress == 0ul || f.lightCount > LIGHT_GRID_MASK_LIGHTS) return false;
+    q.g = LightGridRef(gridAddress).g;
+    vec3 size = boxMax - boxMin;
+    float extent = max(size.x, max(size.y, size.z));
+    q.level = 0u;
+    float cell = q.g.cellSize;
+    while (q.level < q.g.levels && cell < extent) {
+        cell *= 2.0;
+        q.level++;
+    }
+    if (q.level >= q.g.levels) return false;
+    vec3 a = floor((boxMin - q.g.origin) / cell), b = floor((boxMax - q.g.origin) / cell);
+    const float maxCell = float(1 << 28);
+    if (any(greaterThanEqual(abs(a), vec3(maxCell))) || any(greaterThanEqual(abs(b), vec3(maxCell))))
+        return false;
+    q.lo = ivec3(a);
+    q.cells = ivec3(b) - q.lo + 1;
+    return true;
+}
+
+uint lightGridSources(LightGridQuery q) {
+    return 2u + uint(q.cells.x * q.cells.y * q.cells.z);
+}
+
+// (first entry, count) of one source's light indices in q.g.entries.
+uvec2 lightGridSource(LightGridQuery q, uint source) {
+    if (source == 0u) return uvec2(q.g.globalFirst, q.g.globalCount);
+    if (source == 1u) return q.g.big[q.level];
+    int c = int(source) - 2;
+    ivec3 at = q.lo + ivec3(c % q.cells.x, (c / q.cells.x) % q.cells.y, c / (q.cells.x * q.cells.y));
+    return LightGridBuckets(q.g.buckets).b[q.level * LIGHT_GRID_BUCKETS + LIGHT_GRID_HASH(at.x, at.y, at.z)];
+}
+
+void lightGridMaskClear(uint lightCount, uint threads) {
+    for (uint w = gl_LocalInvocationIndex; w < (lightCount + 31u) / 32u; w += threads) sGridMask[w] = 0u;
+    if (gl_LocalInvocationIndex == 0u) sGridCandidates = 0u;
+    barrier();
+}
+
+// The kept lights of the bit set appended in light order (orderedAppend's sAppendCount) to
+// LIGHT_GRID_LIST (a shared uvec2 array of LIGHT_GRID_LIST_MAX entries the includer names).
+void lightGridMaskCompact(uint lightCount, uint threads) {
+    uint words = (lightCount + 31u) / 32u;
+    uint tid = gl_LocalInvocationIndex;
+    for (uint base = 0u; base < words; base += threads) {
+        uint word = base + tid < words ? sGridMask[base + tid] : 0u;
+        uint slot = orderedAppendCount(bitCount(word));
+        while (word != 0u) {
+            uint bit = uint(findLSB(word));
+            if (slot < LIGHT_GRID_LIST_MAX) LIGHT_GRID_LIST[slot] = uvec2((base + tid) * 32u + bit, 0u);
+            slot++;
+            word &= word - 1u;
+        }
+    }
+}
+
+// A shadel chunk's lights: those whose sphere meets the box and whose clip plane leaves a
+// corner lit, as the loop over every light in shade.comp tests them.
+bool gridChunkLights(FrameConstants f, uint64_t gridAddress, vec3 boxMin, vec3 boxMax,
+                     vec3 corners[8], uint threads) {
+    LightGridQuery q;
+    if (!lightGridQuery(f, gridAddress, boxMin, boxMax, q)) return false;
+    lightGridMaskClear(f.lightCount, threads);
+    LightBuffer lights = LightBuffer(f.lights);
+    UintBuffer entries = UintBuffer(q.g.entries);
+    uint tested = 0u;
+    for (uint source = 0u; source < lightGridSources(q); ++source) {
+        uvec2 list = lightGridSource(q, source);
+        for (uint i = gl_LocalInvocationIndex; i < list.y; i += threads) {
+            uint index = entries.v[list.x + i];
+            GpuLight light = lights.l[index];
+            vec4 sphere = lightSphere(light);
+            bool keep = sphere.w < 0.0 ||
+                        distance(clamp(sphere.xyz, boxMin, boxMax), sphere.xyz) <= sphere.w;
+            keep = keep && !clipPlaneCulls(light, corners);
+            if (keep) atomicOr(sGridMask[index >> 5], 1u << (index & 31u));
+            tested++;
+        }
+    }
+    if (tested != 0u) atomicAdd(sGridCandidates, tested);
+    barrier();
+    lightGridMaskCompact(f.lightCount, threads);
+    return true;
+}
+
+#endif

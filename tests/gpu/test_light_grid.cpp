@@ -1,0 +1,139 @@
+// The light grid (render/lighting/light_grid.h): a shadel chunk's light culling takes its
+// candidates from a world-space grid instead of testing every light. The candidates must hold
+// every light that meets the chunk's box (else a light goes missing from the image), and must
+// be far fewer than all lights (else the grid is pointless); the lists and the image must be
+// the same as without it.
+#include "gpu_test_env.h"
+
+#include <algorithm>
+#include <random>
+#include <set>
+
+#include "render/lighting/light_grid.h"
+
+using namespace shadel;
+using namespace shadel::test;
+
+namespace {
+
+gpu::GpuLight pointLight(glm::vec3 p, float range, uint32_t type = LIGHT_POINT) {
+    gpu::GpuLight l{};
+    l.type = type;
+    l.position = p;
+    l.range = range;
+    l.color = glm::vec3(1.0f);
+    return l;
+}
+
+bool sphereMeetsBox(glm::vec4 s, glm::vec3 lo, glm::vec3 hi) {
+    if (s.w < 0.0f) return true;
+    return glm::distance(glm::clamp(glm::vec3(s), lo, hi), glm::vec3(s)) <= s.w;
+}
+
+} // namespace
+
+TEST(LightGrid, CandidatesHoldEveryLightThatMeetsTheBoxAndFewOthers) {
+    std::mt19937 rng(7);
+    std::uniform_real_distribution<float> pos(-60.0f, 60.0f), height(0.0f, 12.0f),
+        radius(0.3f, 6.0f), unit(0.0f, 1.0f);
+    std::vector<gpu::GpuLight> lights;
+    for (int i = 0; i < 3000; ++i) {
+        float r = unit(rng) < 0.02f ? 40.0f : radius(rng); // a few wide lights
+        uint32_t type = i % 7 == 0 ? LIGHT_TUBE : LIGHT_POINT;
+        gpu::GpuLight l = pointLight({pos(rng), height(rng), pos(rng)}, r, type);
+        l.halfLength = type == LIGHT_TUBE ? 1.5f : 0.0f;
+        lights.push_back(l);
+    }
+    lights.push_back(pointLight({0, 50, 0}, 0.0f)); // infinite range: always a candidate
+    gpu::GpuLight sun{};
+    sun.type = LIGHT_DIRECTIONAL;
+    lights.push_back(sun);
+    LightGridData grid = buildLightGrid(lights);
+    ASSERT_EQ(grid.header.levels, LIGHT_GRID_LEVELS);
+
+    std::uniform_real_distribution<float> boxSize(0.01f, 8.0f);
+    uint64_t candidates = 0, meeting = 0, boxes = 0;
+    for (int b = 0; b < 4000; ++b) {
+        glm::vec3 lo(pos(rng), height(rng), pos(rng));
+        glm::vec3 hi = lo + glm::vec3(boxSize(rng), boxSize(rng), boxSize(rng));
+        auto list = lightGridCandidates(grid, lo, hi);
+        ASSERT_TRUE(list.has_value()) << "boxes of a few metres fit the grid";
+        std::set<uint32_t> in(list->begin(), list->end());
+        for (uint32_t i = 0; i < lights.size(); ++i) {
+            bool meets = sphereMeetsBox(lightBoundingSphere(lights[i]), lo, hi);
+            meeting += meets;
+            if (meets) {
+                ASSERT_TRUE(in.count(i))
+                    << "light " << i << " meets box " << b << " but is no candidate";
+            }
+        }
+        candidates += in.size();
+        boxes++;
+    }
+    // On average a box tests a small multiple of the lights it meets, not all 3002.
+    double perBox = double(candidates) / double(boxes);
+    EXPECT_LT(perBox, 0.1 * double(lights.size())) << perBox << " candidates per box";
+    EXPECT_LT(double(candidates), 8.0 * double(meeting)) << candidates << " vs " << meeting;
+
+    // Boxes on exact cell boundaries (where float rounding could pick the neighbour cell).
+    for (int b = 0; b < 500; ++b) {
+        float cell = grid.header.cellSize * float(1 << (b % 4));
+        glm::vec3 lo = grid.header.origin + cell * glm::vec3(float(b % 50), 1.0f, float(b % 37));
+        glm::vec3 hi = lo + glm::vec3(cell * 0.5f);
+        auto list = lightGridCandidates(grid, lo, hi);
+        ASSERT_TRUE(list.has_value());
+        std::set<uint32_t> in(list->begin(), list->end());
+        for (uint32_t i = 0; i < lights.size(); ++i)
+            if (sphereMeetsBox(lightBoundingSphere(lights[i]), lo, hi)) {
+                ASSERT_TRUE(in.count(i));
+            }
+    }
+    // A box larger than the coarsest cell is not answered (the chunk tests every light).
+    float coarsest = grid.header.cellSize * float(1u << (LIGHT_GRID_LEVELS - 1));
+    EXPECT_FALSE(lightGridCandidates(grid, glm::vec3(0), glm::vec3(coarsest * 1.5f)).has_value());
+}
+
+TEST(LightGrid, NoFiniteLightsGivesAnEmptyGrid) {
+    gpu::GpuLight sun{};
+    sun.type = LIGHT_DIRECTIONAL;
+    LightGridData grid = buildLightGrid({sun});
+    EXPECT_EQ(grid.header.levels, 0u);
+    EXPECT_FALSE(lightGridCandidates(grid, glm::vec3(0), glm::vec3(1)).has_value());
+}
+
+// builtin:lights (2020 lights) in the shadel path: the same chunk lists and image with and
+// without the grid, from far fewer tested lights.
+TEST(LightGrid, ShadelChunkListsAndImageAreTheSameWithAndWithoutTheGrid) {
+    auto run = [](bool grid) {
+        RenderOptions o = renderOptions("builtin:lights", RenderMode::Decoupled, 192, 108);
+        o.lightGrid = grid;
+        return renderChecked(o);
+    };
+    RenderRun on = run(true), off = run(false);
+    EXPECT_GE(psnr(on.frames[0].rgba, off.frames[0].rgba), 99.0);
+    ASSERT_GT(off.stats["light_chunk_pairs"].get<uint64_t>(), 1000u);
+    EXPECT_EQ(on.stats["light_chunk_pairs"], off.stats["light_chunk_pairs"]);
+    EXPECT_EQ(on.stats["light_chunks_overflowed"], off.stats["light_chunks_overflowed"]);
+    EXPECT_EQ(off.stats["light_grid_entries"].get<uint64_t>(), 0u);
+    EXPECT_GT(on.stats["light_grid_entries"].get<uint64_t>(), 2000u);
+    uint64_t testedOn = on.stats["light_chunk_candidates"].get<uint64_t>();
+    uint64_t testedOff = off.stats["light_chunk_candidates"].get<uint64_t>();
+    EXPECT_LT(testedOn * 5, testedOff) << testedOn << " vs " << testedOff;
+    EXPECT_EQ(on.stats["reconstruction_misses"].get<uint64_t>(), 0u);
+}
+
+// Forward: the screen tiles take the frustum's lights near their box from the grid; the same
+// tile lists and image as the loop over every frustum light.
+TEST(LightGrid, ForwardTileListsAndImageAreTheSameWithAndWithoutTheGrid) {
+    auto run = [](bool grid) {
+        RenderOptions o = renderOptions("builtin:lights", RenderMode::Forward, 192, 108);
+        o.lightGrid = grid;
+        return renderChecked(o);
+    };
+    RenderRun on = run(true), off = run(false);
+    EXPECT_GE(psnr(on.frames[0].rgba, off.frames[0].rgba), 99.0);
+    ASSERT_GT(off.stats["light_tile_pairs"].get<uint64_t>(), 1000u);
+    EXPECT_EQ(on.stats["light_tile_pairs"], off.stats["light_tile_pairs"]);
+    EXPECT_EQ(on.stats["lights_visible"], off.stats["lights_visible"]);
+    EXPECT_EQ(on.stats["per_pixel_blocker_tiles"], off.stats["per_pixel_blocker_tiles"]);
+}
