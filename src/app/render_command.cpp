@@ -84,6 +84,18 @@ bool parseOnOff(const char* flag, const std::string& text) {
     throw InputError(format("%s %s: expected on or off", flag, text.c_str()));
 }
 
+ShadowCulling parseShadowCulling(const std::string& text) {
+    if (text == "per-view") return ShadowCulling::PerView;
+    if (text == "whole-scene") return ShadowCulling::WholeScene;
+    throw InputError(format("--shadow-culling %s: expected per-view or whole-scene", text.c_str()));
+}
+
+uint32_t parseSunCascades(const std::string& text) {
+    if (text.size() != 1 || text[0] < '1' || text[0] > '4')
+        throw InputError(format("--sun-cascades %s: expected 1, 2, 3 or 4", text.c_str()));
+    return uint32_t(text[0] - '0');
+}
+
 GiMode parseGi(const std::string& text) {
     if (text == "off") return GiMode::Off;
     if (text == "lpv") return GiMode::Lpv;
@@ -310,6 +322,7 @@ RenderRun runRender(Gpu& gpu, const RenderOptions& o) {
     settings.sunCascades = o.sunCascades;
     settings.decals = o.decals;
     settings.proxyShadows = o.proxyShadows;
+    settings.shadowCulling = o.shadowCulling;
     requireCount("--gi-iterations", o.giIterations, 0, 64);
     if (o.visualize == Visualize::Gi && o.gi == GiMode::Off)
         throw InputError("--visualize gi: shows the indirect light of --gi lpv; GI is off");
@@ -435,12 +448,24 @@ RenderRun runRender(Gpu& gpu, const RenderOptions& o) {
     s["frame_ms"] = {{"median", median(frameMs)},
                      {"min", *std::min_element(frameMs.begin(), frameMs.end())},
                      {"max", *std::max_element(frameMs.begin(), frameMs.end())}};
+    // Per pass of the first frame: the median over the frames that ran it, matched by name and
+    // occurrence (later frames may skip passes, e.g. spotShadowMaps when nothing changed).
     nlohmann::json passes = nlohmann::json::array();
-    for (size_t p = 0; p < run.frames.front().passes.size(); ++p) {
+    const auto& firstPasses = run.frames.front().passes;
+    for (size_t p = 0; p < firstPasses.size(); ++p) {
+        const std::string& name = firstPasses[p].name;
+        size_t occurrence = 0;
+        for (size_t q = 0; q < p; ++q) occurrence += firstPasses[q].name == name;
         std::vector<double> ms;
-        for (auto& f : run.frames)
-            if (p < f.passes.size()) ms.push_back(f.passes[p].gpuMs);
-        passes.push_back({{"name", run.frames.front().passes[p].name}, {"gpu_ms", median(ms)}});
+        for (auto& f : run.frames) {
+            size_t seen = 0;
+            for (const auto& fp : f.passes)
+                if (fp.name == name && seen++ == occurrence) {
+                    ms.push_back(fp.gpuMs);
+                    break;
+                }
+        }
+        passes.push_back({{"name", name}, {"gpu_ms", median(ms)}});
     }
     s["passes"] = passes;
     uint64_t asserts = 0;

@@ -8,6 +8,7 @@
 
 #include "core/block_allocator.h"
 #include "core/error.h"
+#include "render/culling/culling.h"
 #include "render/forward/forward_passes.h"
 #include "render/renderer.h"
 
@@ -174,6 +175,19 @@ void prepareShadows(Renderer& r, const std::vector<gpu::GpuLight>& lights,
     f.spotShadowAtlas = slot(gpu, s.read).value;
 }
 
+bool spotShadowViewProj(const Renderer& r, uint32_t index, glm::mat4& viewProj) {
+    if (!r.spotShadows || index >= r.spotShadows->drawnViews.size()) return false;
+    // drawnViews is this frame's: the maps are redrawn whenever the views change.
+    const gpu::GpuSpotShadow& view = r.spotShadows->drawnViews[index];
+    if (view.nearPlane < 0.0f) return false;
+    viewProj = view.viewProj;
+    return true;
+}
+
+uint32_t spotShadowCount(const Renderer& r) {
+    return r.spotShadows ? uint32_t(r.spotShadows->lightOf.size()) : 0u;
+}
+
 bool spotShadowMapsThisFrame(const Renderer& r) {
     return r.spotShadows != nullptr && r.spotShadows->redraw;
 }
@@ -211,13 +225,7 @@ void recordSpotShadowMaps(Renderer& r, VkCommandBuffer cmd, uint64_t frame) {
         vkCmdSetViewport(cmd, 0, 1, &vp);
         vkCmdSetScissor(cmd, 0, 1, &scissor);
         pushConstants(gpu, cmd, RasterPush{frame, 2u + i});
-        // The sun's shadow list: its volume is fitted to the whole scene, so it holds the opaque
-        // casters a spot inside the scene sees (the GPU clips the rest), as for the GI's RSMs.
-        vkCmdDrawIndexedIndirectCount(
-            cmd, vkBuffer(gpu, r.shadowDraws),
-            VkDeviceSize(DRAW_LIST_OPAQUE) * r.maxDraws * sizeof(gpu::DrawIndexedCommand),
-            vkBuffer(gpu, r.drawCounts), (DRAW_LIST_COUNT + DRAW_LIST_OPAQUE) * 4, r.maxDraws,
-            sizeof(gpu::DrawIndexedCommand));
+        drawShadowViewList(r, cmd, CULL_VIEW_SPOT0 + i);
     }
     vkCmdEndRendering(cmd);
     imageBarrier(cmd, image, VK_IMAGE_ASPECT_DEPTH_BIT, VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL,
