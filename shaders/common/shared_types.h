@@ -78,9 +78,8 @@ using uint = uint32_t;
 #define SPECTRUM_ALL 0x7FFu
 #define SPECTRUM_MAX_MODES 16u
 #define SPECTRUM_FEATURES_CONSTANT_ID 140
-#define SPECTRUM_MODE_CONSTANT_ID 141 // the mode (bin) a tile / chunk shading permutation runs
-#define CHUNK_SPECTRA_PHASE_CONSTANT_ID                                                            \
-    143 // shadel shading: off, classify or shade (chunk_spectra.glsl)
+#define SPECTRUM_MODE_CONSTANT_ID 141        // the mode (bin) a tile / chunk shading permutation runs
+#define CHUNK_SPECTRA_PHASE_CONSTANT_ID 143 // shadel shading: off, classify or shade (chunk_spectra.glsl)
 // Specialization constant of shaders/common/lighting.glsl: 1 compiles the distance-field far
 // shadows and AO in (render/distance_fields; forward and shadel shading with --distance-fields).
 #define DISTANCE_FIELD_LIGHTING_CONSTANT_ID 142
@@ -268,14 +267,14 @@ struct LightingFrame {
 // The sun's cascades: slices of the camera's view depth, each an orthographic map (a rectangle
 // of one atlas) fitted to its slice's bounding sphere and snapped to its texels.
 struct GpuSunCascades {
-    mat4 viewProj[SUN_MAX_CASCADES];  // world -> the cascade's clip space (depth 0..1)
+    mat4 viewProj[SUN_MAX_CASCADES]; // world -> the cascade's clip space (depth 0..1)
     vec4 atlasRect[SUN_MAX_CASCADES]; // UV offset xy, size zw
-    vec4 splitFar;      // view depth (metres along cameraForward) where cascade i ends
-    vec4 texelWorld;    // a texel's width in metres, per cascade
-    vec3 cameraForward; // unit: view depth = dot(p - cameraPosition, cameraForward)
+    vec4 splitFar;       // view depth (metres along cameraForward) where cascade i ends
+    vec4 texelWorld;     // a texel's width in metres, per cascade
+    vec3 cameraForward;  // unit: view depth = dot(p - cameraPosition, cameraForward)
     uint count;
-    uint atlasSlot;   // bindless slot of the atlas (depth)
-    float depthRange; // metres from depth 0 to 1 (the same for every cascade)
+    uint atlasSlot;      // bindless slot of the atlas (depth)
+    float depthRange;    // metres from depth 0 to 1 (the same for every cascade)
     uint pad0;
     uint pad1;
 };
@@ -603,12 +602,12 @@ struct ShadelFrame {
 #define DECAL_STAGES 4u
 #define DECAL_KIND(stage) (1u << (stage))
 // Procedural masks in the decal's [0,1]^2 projection (shaders/decals/decals.glsl).
-#define DECAL_PATTERN_SPLAT 0u       // a soft-edged ring and disc (graffiti)
-#define DECAL_PATTERN_STRIPES 1u     // diagonal stripes (road marking)
-#define DECAL_PATTERN_RIVETS 2u      // a grid of round bumps (height for the normal stage)
-#define DECAL_PATTERN_PUDDLE 3u      // a wobbly blob (wet patch: low roughness)
-#define DECAL_PATTERN_BLOB 4u        // radial falloff (contact shadow under a character)
-#define DECAL_TILE_MAX 256u          // decals one tile's / chunk's list holds
+#define DECAL_PATTERN_SPLAT 0u   // a soft-edged ring and disc (graffiti)
+#define DECAL_PATTERN_STRIPES 1u // diagonal stripes (road marking)
+#define DECAL_PATTERN_RIVETS 2u  // a grid of round bumps (height for the normal stage)
+#define DECAL_PATTERN_PUDDLE 3u  // a wobbly blob (wet patch: low roughness)
+#define DECAL_PATTERN_BLOB 4u    // radial falloff (contact shadow under a character)
+#define DECAL_TILE_MAX 256u      // decals one tile's / chunk's list holds
 #define DECAL_OBJECT_ALL 0xFFFFFFFFu // an object list that did not fit: every frustum decal
 
 struct GpuDecal {

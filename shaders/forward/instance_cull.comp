@@ -21,7 +21,7 @@ layout(push_constant, scalar) uniform Push {
     uint64_t draws;  // camera: DrawIndexedCommand[DRAW_LIST_COUNT * maxDraws]
     uint64_t counts; // camera: uint[DRAW_LIST_COUNT]
     uint maxDraws;
-    uint shadowViews; // 1: the shadow views too (the sun below, the per-view lists of CullingFrame)
+    uint shadowViews; // 1: the shadow views too (the sun's and CullingFrame's per-view lists)
     uint phase;       // CullPhase (render/culling/culling.h): 0 = single pass
     uint pad;
     // Phase 2: uint[1 + instances], count then the ids of every instance visible this frame
@@ -29,8 +29,7 @@ layout(push_constant, scalar) uniform Push {
     uint64_t visibleList;
     uint64_t sunDraws;  // the sun's whole-scene map: DrawIndexedCommand[DRAW_LIST_COUNT * maxDraws]
     uint64_t sunCounts; // uint[DRAW_LIST_COUNT]
-}
-pc;
+} pc;
 
 layout(buffer_reference, scalar) readonly buffer ShadowCullViewBuffer {
     GpuShadowCullView v[];

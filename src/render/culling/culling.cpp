@@ -32,6 +32,7 @@ struct CullingState {
     Pipeline hizBuild;
     gpu::GpuCullStats last{}; // the last finished frame's counts
     uint32_t instances = 0;
+    uint32_t dispatches = 0, lastDispatches = 0; // instance_cull.comp dispatches this / last frame
     // --shadow-culling per-view: one list per cascade and shadow-casting spot.
     BufferHandle shadowViews;      // gpu::GpuShadowCullView[lists] (upload)
     BufferHandle shadowViewDraws;  // DrawIndexedCommand[lists * maxDraws]
@@ -134,6 +135,7 @@ void destroyCulling(Renderer& r, CullingStatePtr& c) {
 void prepareCullingFrame(Renderer& r, const GpuScene& scene, gpu::FrameConstants& constants) {
     Gpu& gpu = *r.gpu;
     CullingState& c = *r.culling;
+    c.dispatches = 0;
     gpu::CullingFrame f{};
     f.meshLods = address(gpu, scene.meshLods);
     f.stats = address(gpu, c.stats);
@@ -193,6 +195,13 @@ void recordCullingReset(Renderer& r, VkCommandBuffer cmd) {
         vkCmdFillBuffer(cmd, vkBuffer(gpu, c.shadowViewCounts), 0, VK_WHOLE_SIZE, 0);
 }
 
+void recordInstanceCullDispatch(Renderer& r, VkCommandBuffer cmd, const InstanceCullPush& push,
+                                uint32_t instances) {
+    pushConstants(*r.gpu, cmd, push);
+    if (instances) vkCmdDispatch(cmd, (instances + 63) / 64, 1, 1);
+    r.culling->dispatches++;
+}
+
 void recordOcclusionPasses(Renderer& r, FrameRecorder& rec, uint64_t frame, const GpuScene& scene) {
     Gpu& gpu = *r.gpu;
     CullingState& c = *r.culling;
@@ -237,8 +246,7 @@ void recordOcclusionPasses(Renderer& r, FrameRecorder& rec, uint64_t frame, cons
             frame,   address(gpu, c.phase2Draws), address(gpu, c.phase2Counts), r.maxDraws, 0,
             CullRest};
         push.visibleList = address(gpu, c.visibleList);
-        pushConstants(gpu, cmd, push);
-        if (scene.instanceCount) vkCmdDispatch(cmd, (scene.instanceCount + 63) / 64, 1, 1);
+        recordInstanceCullDispatch(r, cmd, push, scene.instanceCount);
         memoryBarrier(cmd, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
                       VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT, VK_PIPELINE_STAGE_2_DRAW_INDIRECT_BIT,
                       VK_ACCESS_2_INDIRECT_COMMAND_READ_BIT);
@@ -296,6 +304,7 @@ void drawShadowViewList(Renderer& r, VkCommandBuffer cmd, uint32_t view) {
 void finishCullingFrame(Renderer& r) {
     CullingState& c = *r.culling;
     std::memcpy(&c.last, mapped(*r.gpu, c.stats), sizeof(gpu::GpuCullStats));
+    c.lastDispatches = c.dispatches;
     if (c.visibleList) {
         const uint32_t* list = static_cast<const uint32_t*>(mapped(*r.gpu, c.visibleList));
         uint32_t count = std::min(list[0], c.instances);
@@ -336,6 +345,7 @@ void cullingStats(const Renderer& r, nlohmann::json& s) {
         {"lod", r.settings.lod ? "on" : "off"},
         {"occlusion", r.settings.occlusion ? "on" : "off"},
         {"proxy_shadows", r.settings.proxyShadows && !r.gi ? "on" : "off"},
+        {"dispatches", c.lastDispatches},
         {"shadow_culling",
          r.settings.shadowCulling == ShadowCulling::PerView ? "per-view" : "whole-scene"},
         {"views", {{"camera", view(CULL_VIEW_CAMERA)}, {"shadow", view(CULL_VIEW_SHADOW)}}}};

@@ -60,6 +60,10 @@ void destroyCulling(Renderer& r, CullingStatePtr& state);
 void prepareCullingFrame(Renderer& r, const GpuScene& scene, gpu::FrameConstants& constants);
 // Inside the instanceCull pass, before the dispatches: zero the counts and the phase-2 lists.
 void recordCullingReset(Renderer& r, VkCommandBuffer cmd);
+// One dispatch of instance_cull.comp over every instance (pipeline bound), counted for the stats
+// ("culling": "dispatches").
+void recordInstanceCullDispatch(Renderer& r, VkCommandBuffer cmd, const InstanceCullPush& push,
+                                uint32_t instances);
 // --occlusion on: the three passes above, after the depth prepass.
 void recordOcclusionPasses(Renderer& r, FrameRecorder& rec, uint64_t frame, const GpuScene& scene);
 // Inside a raster pass drawing the camera's list: the phase-2 part of it (nothing without

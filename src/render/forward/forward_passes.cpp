@@ -80,8 +80,7 @@ void recordInstanceCull(Renderer& r, VkCommandBuffer cmd, uint64_t frame, const 
                           r.settings.occlusion ? CullLastVisible : CullSinglePass};
     push.sunDraws = address(gpu, r.shadowDraws);
     push.sunCounts = address(gpu, r.drawCounts) + DRAW_LIST_COUNT * 4;
-    pushConstants(gpu, cmd, push);
-    if (scene.instanceCount) vkCmdDispatch(cmd, (scene.instanceCount + 63) / 64, 1, 1);
+    recordInstanceCullDispatch(r, cmd, push, scene.instanceCount);
     memoryBarrier(cmd, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT,
                   VK_PIPELINE_STAGE_2_DRAW_INDIRECT_BIT, VK_ACCESS_2_INDIRECT_COMMAND_READ_BIT);
 }
