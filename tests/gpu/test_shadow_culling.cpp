@@ -111,6 +111,30 @@ TEST(ShadowCulling, OcclusionAddsOnlyTheCamerasSecondPhase) {
     EXPECT_GE(psnr(occlusion.frames[0].rgba, wholeScene.frames[0].rgba), 60.0);
 }
 
+// A spot's own list does not depend on the camera (without --lod): its map is drawn once while
+// the camera orbits, where the sun's list (whole-scene) follows the camera and redraws it every
+// frame. The last frames agree.
+TEST(ShadowCulling, SpotMapsAreNotRedrawnForCameraMoves) {
+    RenderOptions o = shadowCullingOptions(RenderMode::Forward, ShadowCulling::PerView);
+    o.sunCascades = 1;
+    o.frames = 3;
+    o.cameraPath = CameraPath::Orbit;
+    RenderRun perView = renderChecked(o);
+    o.lod = true;
+    RenderRun perViewLod = renderChecked(o);
+    o.lod = false;
+    o.shadowCulling = ShadowCulling::WholeScene;
+    RenderRun wholeScene = renderChecked(o);
+    EXPECT_EQ(perView.stats["spot_shadow_atlas_draws"], 1);
+    EXPECT_EQ(perViewLod.stats["spot_shadow_atlas_draws"], 3) << "LODs follow the camera";
+    EXPECT_EQ(wholeScene.stats["spot_shadow_atlas_draws"], 3);
+    double p = psnr(perView.frames.back().rgba, wholeScene.frames.back().rgba);
+    std::printf("[ figures ] orbit, last frame: per-view (maps drawn once) vs whole-scene (every "
+                "frame) %.2f dB\n",
+                p);
+    EXPECT_GE(p, 60.0);
+}
+
 TEST(ShadowCulling, SameImageDecoupled) {
     RenderRun perView =
         renderChecked(shadowCullingOptions(RenderMode::Decoupled, ShadowCulling::PerView));

@@ -35,8 +35,8 @@ struct SpotShadowState {
     uint32_t placed = 0;
     uint64_t atlasTexelsUsed = 0;
     // The maps are drawn again only when what they see may have changed: the spots (this
-    // frame's views differ from the last drawn) or the caster list, which the camera's
-    // shadow-caster culling chooses (the camera moved).
+    // frame's views differ from the last drawn) or the caster lists, which follow the camera
+    // when it chooses them (see cameraChoosesCasters).
     std::vector<gpu::GpuSpotShadow> drawnViews;
     glm::mat4 drawnCamera{0.0f};
     bool redraw = true;
@@ -114,6 +114,13 @@ void destroySpotShadows(Renderer& r, SpotShadowStatePtr& state) {
 }
 
 // The spot's perspective view: its outer cone (round) or pyramid (square) fills the map.
+// Whether the camera's moves change what the spot maps draw: with whole-scene culling they
+// draw the sun's list, culled to the casters whose sun shadow reaches the camera's frustum;
+// with per-view culling only the LODs (--lod on, chosen from the camera) do.
+static bool cameraChoosesCasters(const Renderer& r) {
+    return r.settings.shadowCulling == ShadowCulling::WholeScene || r.settings.lod;
+}
+
 static gpu::GpuSpotShadow spotView(const gpu::GpuLight& l, glm::uvec4 rect) {
     gpu::GpuSpotShadow s{};
     float tanHalf;
@@ -160,7 +167,8 @@ void prepareShadows(Renderer& r, const std::vector<gpu::GpuLight>& lights,
     for (size_t i = 0; i < s.lightOf.size(); ++i)
         views[i] = s.lightOf[i] < lights.size() ? spotView(lights[s.lightOf[i]], s.rects[i])
                                                 : gpu::GpuSpotShadow{};
-    s.redraw = s.drawnViews.size() != views.size() || constants.viewProj != s.drawnCamera ||
+    bool cameraMoved = constants.viewProj != s.drawnCamera;
+    s.redraw = s.drawnViews.size() != views.size() || (cameraMoved && cameraChoosesCasters(r)) ||
                std::memcmp(views.data(), s.drawnViews.data(),
                            views.size() * sizeof(gpu::GpuSpotShadow)) != 0 ||
                std::find(r.reposedInstances.begin(), r.reposedInstances.end(), 1) !=

@@ -38,8 +38,8 @@ void prepareShadows(Renderer& r, const std::vector<gpu::GpuLight>& lights,
 bool spotShadowViewProj(const Renderer& r, uint32_t index, glm::mat4& viewProj);
 // Shadow indices (LIGHT_MAX_SPOT_SHADOWS at most used), 0 without spot shadows.
 uint32_t spotShadowCount(const Renderer& r);
-// Whether the maps are drawn this frame: the first frame, or the spots or the camera (whose
-// culling chooses the caster list) changed since they were last drawn.
+// Whether the maps are drawn this frame: the first frame, or the spots changed since they were
+// last drawn, or the camera did while it chooses the casters (whole-scene culling or --lod on).
 bool spotShadowMapsThisFrame(const Renderer& r);
 // "spotShadowMaps": the atlas cleared, then each spot's view into its rectangle.
 void recordSpotShadowMaps(Renderer& r, VkCommandBuffer cmd, uint64_t frame);
