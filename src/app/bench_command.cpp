@@ -103,23 +103,31 @@ nlohmann::json runShadowCullingBench(Gpu& gpu, const BenchOptions& b, RenderOpti
                      b.width, b.height);
         o.shadowCulling = culling;
         RenderRun run = runRender(gpu, o);
-        for (const char* p : shadowPasses) out["shadow_ms"][name][p] = passMs(run.stats, p);
-        // Per frame, every shadow pass it ran (frames without a spot-map redraw count less).
+        // From the frames themselves: the median of a pass over the frames that ran it, and of
+        // each frame's shadow passes together (frames without a spot-map redraw count less).
+        auto median = [](std::vector<double> v) {
+            std::sort(v.begin(), v.end());
+            size_t n = v.size();
+            return n == 0 ? 0.0 : n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+        };
+        auto passMedian = [&](const char* pass) {
+            std::vector<double> ms;
+            for (const FrameResult& f : run.frames)
+                for (const PassTiming& t : f.passes)
+                    if (t.name == pass) ms.push_back(t.gpuMs);
+            return median(ms);
+        };
         std::vector<double> perFrame;
         for (const FrameResult& f : run.frames) {
             double ms = 0.0;
-            for (const PassTiming& fp : f.passes)
-                for (const char* p : shadowPasses) ms += fp.name == p ? fp.gpuMs : 0.0;
+            for (const PassTiming& t : f.passes)
+                for (const char* p : shadowPasses) ms += t.name == p ? t.gpuMs : 0.0;
             perFrame.push_back(ms);
         }
-        std::sort(perFrame.begin(), perFrame.end());
-        size_t n = perFrame.size();
-        double shadowMs = n == 0       ? 0.0
-                          : n % 2 == 1 ? perFrame[n / 2]
-                                       : 0.5 * (perFrame[n / 2 - 1] + perFrame[n / 2]);
+        for (const char* p : shadowPasses) out["shadow_ms"][name][p] = passMedian(p);
+        out["shadow_ms"][name]["total"] = median(perFrame);
+        out["shadow_ms"][name]["instanceCull"] = passMedian("instanceCull");
         nlohmann::json stats = std::move(run.stats);
-        out["shadow_ms"][name]["total"] = shadowMs;
-        out["shadow_ms"][name]["instanceCull"] = passMs(stats, "instanceCull");
         out["modes"][name] = std::move(stats);
     }
     auto ratio = [](double a, double b) { return b > 0 ? a / b : 0.0; };

@@ -448,24 +448,12 @@ RenderRun runRender(Gpu& gpu, const RenderOptions& o) {
     s["frame_ms"] = {{"median", median(frameMs)},
                      {"min", *std::min_element(frameMs.begin(), frameMs.end())},
                      {"max", *std::max_element(frameMs.begin(), frameMs.end())}};
-    // Per pass of the first frame: the median over the frames that ran it, matched by name and
-    // occurrence (later frames may skip passes, e.g. spotShadowMaps when nothing changed).
     nlohmann::json passes = nlohmann::json::array();
-    const auto& firstPasses = run.frames.front().passes;
-    for (size_t p = 0; p < firstPasses.size(); ++p) {
-        const std::string& name = firstPasses[p].name;
-        size_t occurrence = 0;
-        for (size_t q = 0; q < p; ++q) occurrence += firstPasses[q].name == name;
+    for (size_t p = 0; p < run.frames.front().passes.size(); ++p) {
         std::vector<double> ms;
-        for (auto& f : run.frames) {
-            size_t seen = 0;
-            for (const auto& fp : f.passes)
-                if (fp.name == name && seen++ == occurrence) {
-                    ms.push_back(fp.gpuMs);
-                    break;
-                }
-        }
-        passes.push_back({{"name", name}, {"gpu_ms", median(ms)}});
+        for (auto& f : run.frames)
+            if (p < f.passes.size()) ms.push_back(f.passes[p].gpuMs);
+        passes.push_back({{"name", run.frames.front().passes[p].name}, {"gpu_ms", median(ms)}});
     }
     s["passes"] = passes;
     uint64_t asserts = 0;
