@@ -392,8 +392,12 @@ struct FrameConstants {
 // ---- GPU-driven world (render/culling) ------------------------------------------------------
 #define CULL_MAX_LODS 8u
 #define CULL_VIEW_CAMERA 0u
-#define CULL_VIEW_SHADOW 1u
-#define CULL_VIEWS 2u
+#define CULL_VIEW_SHADOW 1u   // the sun's whole-scene map
+#define CULL_VIEW_CASCADE0 2u // sun cascade i is view CULL_VIEW_CASCADE0 + i
+#define CULL_VIEW_SPOT0 (CULL_VIEW_CASCADE0 + SUN_MAX_CASCADES) // spot shadow i: + i
+#define CULL_VIEWS (CULL_VIEW_SPOT0 + LIGHT_MAX_SPOT_SHADOWS)
+#define CULL_SHADOW_VIEW_CASCADE 0u
+#define CULL_SHADOW_VIEW_SPOT 1u
 
 // One level of a mesh's LOD chain: a range of the unified index buffer over the mesh's vertices
 // (the same vertexOffset for every level: simplification only drops vertices).
@@ -443,6 +447,23 @@ struct CullingFrame {
     uvec2 hizSize;     // level 0 = the depth target's size
     float sceneMinY;   // the lowest point of the scene: shadows end there
     uint proxyShadows; // 1: shadow views draw each LOD's proxy index set
+    // --shadow-culling per-view: the cascades' and spots' own lists, filled by the same dispatch
+    // as the camera's and the sun's (0 views with whole-scene: they draw the sun's list).
+    uint64_t shadowViews;      // GpuShadowCullView[shadowViewCount]
+    uint64_t shadowViewDraws;  // DrawIndexedCommand[lists * maxDraws], one list per view
+    uint64_t shadowViewCounts; // uint per list
+    uint shadowViewCount;
+    uint shadowViewPad;
+};
+
+// A cascade's or spot's view for per-view shadow culling. Depth clamp keeps casters in front of
+// the near plane in the map, so only the four sides and the far plane cull.
+struct GpuShadowCullView {
+    vec4 planes[5];
+    uint view; // CULL_VIEW_*: its row of the stats
+    uint list; // its draw list in CullingFrame::shadowViewDraws
+    uint kind; // CULL_SHADOW_VIEW_*: a cascade's casters must also shadow the camera's frustum
+    uint pad;
 };
 
 // Shader -> CPU message channel (shader asserts and prints). Written with atomics, read after the

@@ -1,3 +1,4 @@
+#include <algorithm>
 #include <cstdio>
 #include <fstream>
 
@@ -73,6 +74,99 @@ nlohmann::json runParticleLightingBench(Gpu& gpu, const BenchOptions& b, RenderO
     return out;
 }
 
+// --shadow-culling-compare: the same forward frames with every sun cascade and shadow-casting
+// spot drawing its own GPU-culled casters (per-view) and the sun's whole-scene list
+// (whole-scene). The shadow passes are the sun's map, the cascades and the spot maps (drawn
+// when the spots changed, or the camera while it chooses their casters: whole-scene or --lod
+// on; with a static camera, the first frame only). Each pass's median is over the frames that
+// ran it; "shadow passes" is the median over frames of each frame's shadow passes.
+// instanceCull is reported apart, since per-view culling moves work into it.
+nlohmann::json runShadowCullingBench(Gpu& gpu, const BenchOptions& b, RenderOptions o) {
+    nlohmann::json out;
+    out["scene"] = b.scene;
+    out["device"] = gpu.device.name;
+    out["frames"] = b.frames;
+    out["sun_cascades"] = b.sunCascades;
+    o.mode = RenderMode::Forward;
+    const char* shadowPasses[] = {"shadowMap", "sunCascades", "spotShadowMaps"};
+    // A discarded one-frame run first: the first frame of a process pays for first-touch memory
+    // (the 4096^2 spot atlas) and pipeline creation, which would land on the first mode alone.
+    {
+        RenderOptions warm = o;
+        warm.frames = 1;
+        std::fprintf(stderr, "bench: warm-up frame\n");
+        runRender(gpu, warm);
+    }
+    for (auto [name, culling] : {std::pair{"per_view", ShadowCulling::PerView},
+                                 std::pair{"whole_scene", ShadowCulling::WholeScene}}) {
+        std::fprintf(stderr, "bench: shadow culling %s, %u frames at %ux%u\n", name, b.frames,
+                     b.width, b.height);
+        o.shadowCulling = culling;
+        RenderRun run = runRender(gpu, o);
+        // From the frames themselves: the median of a pass over the frames that ran it, and of
+        // each frame's shadow passes together (frames without a spot-map redraw count less).
+        auto median = [](std::vector<double> v) {
+            std::sort(v.begin(), v.end());
+            size_t n = v.size();
+            return n == 0 ? 0.0 : n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+        };
+        auto passMedian = [&](const char* pass) {
+            std::vector<double> ms;
+            for (const FrameResult& f : run.frames)
+                for (const PassTiming& t : f.passes)
+                    if (t.name == pass) ms.push_back(t.gpuMs);
+            return median(ms);
+        };
+        std::vector<double> perFrame;
+        for (const FrameResult& f : run.frames) {
+            double ms = 0.0;
+            for (const PassTiming& t : f.passes)
+                for (const char* p : shadowPasses) ms += t.name == p ? t.gpuMs : 0.0;
+            perFrame.push_back(ms);
+        }
+        for (const char* p : shadowPasses) out["shadow_ms"][name][p] = passMedian(p);
+        out["shadow_ms"][name]["total"] = median(perFrame);
+        out["shadow_ms"][name]["instanceCull"] = passMedian("instanceCull");
+        nlohmann::json stats = std::move(run.stats);
+        out["modes"][name] = std::move(stats);
+    }
+    auto ratio = [](double a, double b) { return b > 0 ? a / b : 0.0; };
+    const nlohmann::json& pv = out["modes"]["per_view"];
+    const nlohmann::json& ws = out["modes"]["whole_scene"];
+    double framePv = pv["frame_ms"]["median"], frameWs = ws["frame_ms"]["median"];
+    double shadowPv = out["shadow_ms"]["per_view"]["total"];
+    double shadowWs = out["shadow_ms"]["whole_scene"]["total"];
+    double cullPv = out["shadow_ms"]["per_view"]["instanceCull"];
+    double cullWs = out["shadow_ms"]["whole_scene"]["instanceCull"];
+    out["ratios"]["shadow_culling_frame"] = ratio(framePv, frameWs);
+    out["ratios"]["shadow_culling_shadow_passes"] = ratio(shadowPv, shadowWs);
+    out["ratios"]["shadow_culling_instance_cull"] = ratio(cullPv, cullWs);
+    std::printf("shadel bench --shadow-culling-compare: %s at %ux%u on %s, %u frames, "
+                "--sun-cascades %u, medians (timing: %s)\n",
+                b.scene.c_str(), b.width, b.height, gpu.device.name.c_str(), b.frames,
+                b.sunCascades, pv["timing"].get<std::string>().c_str());
+    std::printf("  %-16s %12s %12s %8s\n", "", "per-view", "whole-scene", "ratio");
+    std::printf("  %-16s %9.3f ms %9.3f ms %8.3f\n", "frame", framePv, frameWs,
+                ratio(framePv, frameWs));
+    for (const char* p : shadowPasses) {
+        double a = out["shadow_ms"]["per_view"][p], c = out["shadow_ms"]["whole_scene"][p];
+        std::printf("  %-16s %9.3f ms %9.3f ms %8.3f\n", p, a, c, ratio(a, c));
+    }
+    std::printf("  %-16s %9.3f ms %9.3f ms %8.3f\n", "shadow passes", shadowPv, shadowWs,
+                ratio(shadowPv, shadowWs));
+    std::printf("  %-16s %9.3f ms %9.3f ms %8.3f\n", "instanceCull", cullPv, cullWs,
+                ratio(cullPv, cullWs));
+    // Casters drawn per shadow view (the last frame's counts).
+    for (const auto& [view, row] : pv["culling"]["views"].items()) {
+        if (view == "camera") continue;
+        std::printf("  drawn %-14s %9u    %9u\n", view.c_str(),
+                    row["instances_drawn"].get<uint32_t>(),
+                    ws["culling"]["views"][view]["instances_drawn"].get<uint32_t>());
+    }
+    if (!b.json.empty()) writeOutputFile(b.json, out.dump(2) + "\n");
+    return out;
+}
+
 // --stencil-compare: the same forward frames with --screen-space on and the stencil effects,
 // stencil-culled and full-screen (the same shaders on every pixel, branching per pixel). The
 // ratio of each effect pass is culled / full-screen; the marks (stencilMark) are reported apart.
@@ -144,6 +238,9 @@ nlohmann::json runBench(Gpu& gpu, const BenchOptions& b) {
     o.cacheLimitBytes = b.cacheLimitBytes;
     o.lightCulling = b.lightCulling;
     o.progress = false;
+    o.sunCascades = b.sunCascades;
+    o.instances = b.instances;
+    if (b.compareShadowCulling) return runShadowCullingBench(gpu, b, o);
     if (b.compareParticleLighting) return runParticleLightingBench(gpu, b, o);
     if (b.compareStencil) return runStencilBench(gpu, b, o);
 

@@ -65,6 +65,7 @@ struct RenderOptions {
     uint32_t sunCascades = 1;                                    // --sun-cascades 1..4
     bool decals = true;                                          // --decals on|off
     bool proxyShadows = true;                                    // --proxy-shadows on|off
+    ShadowCulling shadowCulling = ShadowCulling::PerView; // --shadow-culling per-view|whole-scene
     CameraPath cameraPath = CameraPath::Static;
     GiMode gi = GiMode::Off;    // --gi lpv|off
     uint32_t giIterations = 8;  // --gi-iterations
@@ -119,7 +120,10 @@ ParticleLighting parseParticleLighting(const std::string& text);
 LightCulling parseLightCulling(const std::string& text);
 Spectra parseSpectra(const std::string& text);
 bool parseOnOff(const char* flag, const std::string& text); // "on" / "off", else InputError
-GiMode parseGi(const std::string& text);                    // --gi lpv|off
+ShadowCulling parseShadowCulling(const std::string& text);  // per-view|whole-scene
+// "1".."4", else InputError naming --sun-cascades.
+uint32_t parseSunCascades(const std::string& text);
+GiMode parseGi(const std::string& text); // --gi lpv|off
 // The bake cache folder when --cache-dir is not given (see defaultBakeCacheDir()).
 std::string defaultCacheDir();
 
@@ -162,7 +166,12 @@ struct BenchOptions {
     // --stencil-compare: forward with --screen-space on and the stencil effects, stencil-culled
     // and full-screen; ratios.stencil_outline|stencil_water = culled / full-screen pass time.
     bool compareStencil = false;
-    std::string plot; // --plot FILE.png: per-pass bar chart (app/bench_plot.h)
+    // --shadow-culling-compare: forward only, per-view against whole-scene shadow culling
+    // (ratios.shadow_culling_frame|shadow_passes = per-view / whole-scene; app/bench_command.cpp).
+    bool compareShadowCulling = false;
+    uint32_t sunCascades = 1; // --sun-cascades, every mode
+    uint32_t instances = 0;   // --instances (builtin:many), every mode; 0 = the scene's default
+    std::string plot;         // --plot FILE.png: per-pass bar chart (app/bench_plot.h)
 };
 nlohmann::json runBench(Gpu& gpu, const BenchOptions& options);
 

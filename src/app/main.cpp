@@ -279,6 +279,12 @@ int main(int argc, char** argv) {
                      "1..4: the sun's shadow as N cascaded maps over the view depth (1: one map "
                      "fitted to the scene)")
         ->capture_default_str();
+    std::string shadowCulling = "per-view";
+    render
+        ->add_option("--shadow-culling", shadowCulling,
+                     "per-view | whole-scene: each sun cascade and shadow-casting spot draws "
+                     "its own GPU-culled casters, or all draw the sun's whole-scene list")
+        ->capture_default_str();
     render
         ->add_option("--spot-shadows", spotShadows,
                      "on | off: shadow maps (one atlas) for the spots that cast shadows")
@@ -398,6 +404,14 @@ int main(int argc, char** argv) {
     bench->add_flag("--stencil-compare", bo.compareStencil,
                     "forward with --screen-space on: the stencil-culled water composite and "
                     "character outline against their full-screen versions");
+    bench->add_flag("--shadow-culling-compare", bo.compareShadowCulling,
+                    "instead of the three modes: forward with --shadow-culling per-view and "
+                    "whole-scene; frame and shadow-pass medians and their ratios");
+    std::string benchSunCascades = "1";
+    bench->add_option("--sun-cascades", benchSunCascades, "1..4: the sun's cascaded maps")
+        ->capture_default_str();
+    auto* benchInstancesFlag =
+        bench->add_option("--instances", bo.instances, "builtin:many: instances, 1..1000000");
     bench->add_flag("--particle-lighting-compare", bo.compareParticleLighting,
                     "instead of the three modes: forward with --particle-lighting atlas, pixel "
                     "and vertex, and the particle lighting cost of atlas over pixel");
@@ -595,10 +609,8 @@ int main(int argc, char** argv) {
                     format("--sun-shadows %s: expected pcf or pcss", sunShadows.c_str()));
             ro.sunSoftShadows = sunShadows == "pcss";
             ro.spotShadows = parseOnOff("--spot-shadows", spotShadows);
-            if (sunCascades.size() != 1 || sunCascades[0] < '1' || sunCascades[0] > '4')
-                throw InputError(
-                    format("--sun-cascades %s: expected 1, 2, 3 or 4", sunCascades.c_str()));
-            ro.sunCascades = uint32_t(sunCascades[0] - '0');
+            ro.sunCascades = parseSunCascades(sunCascades);
+            ro.shadowCulling = parseShadowCulling(shadowCulling);
             ro.decals = parseOnOff("--decals", decals);
             ro.proxyShadows = parseOnOff("--proxy-shadows", proxyShadows);
             ro.gi = parseGi(gi);
@@ -653,6 +665,9 @@ int main(int argc, char** argv) {
             bo.cameraPath = parseCameraPath(benchCameraPath);
             bo.marking = parseMarking(benchMarking);
             bo.lightGrid = parseOnOff("--light-grid", benchLightGrid);
+            bo.sunCascades = parseSunCascades(benchSunCascades);
+            if (*benchInstancesFlag && bo.instances == 0)
+                throw InputError("--instances 0: expected 1..1000000");
             bo.compareLightCulling = benchLightCulling == "compare";
             if (!bo.compareLightCulling) bo.lightCulling = parseLightCulling(benchLightCulling);
             bo.compareSpectra = benchSpectra == "compare";

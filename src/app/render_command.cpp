@@ -85,6 +85,18 @@ bool parseOnOff(const char* flag, const std::string& text) {
     throw InputError(format("%s %s: expected on or off", flag, text.c_str()));
 }
 
+ShadowCulling parseShadowCulling(const std::string& text) {
+    if (text == "per-view") return ShadowCulling::PerView;
+    if (text == "whole-scene") return ShadowCulling::WholeScene;
+    throw InputError(format("--shadow-culling %s: expected per-view or whole-scene", text.c_str()));
+}
+
+uint32_t parseSunCascades(const std::string& text) {
+    if (text.size() != 1 || text[0] < '1' || text[0] > '4')
+        throw InputError(format("--sun-cascades %s: expected 1, 2, 3 or 4", text.c_str()));
+    return uint32_t(text[0] - '0');
+}
+
 GiMode parseGi(const std::string& text) {
     if (text == "off") return GiMode::Off;
     if (text == "lpv") return GiMode::Lpv;
@@ -317,6 +329,7 @@ RenderRun runRender(Gpu& gpu, const RenderOptions& o) {
     settings.sunCascades = o.sunCascades;
     settings.decals = o.decals;
     settings.proxyShadows = o.proxyShadows;
+    settings.shadowCulling = o.shadowCulling;
     requireCount("--gi-iterations", o.giIterations, 0, 64);
     if (o.visualize == Visualize::Gi && o.gi == GiMode::Off)
         throw InputError("--visualize gi: shows the indirect light of --gi lpv; GI is off");

@@ -62,6 +62,10 @@ enum class ParticleLighting : uint32_t { Atlas = 0, Pixel = 1, Vertex = 2 };
 // every pixel / shadel.
 enum class LightCulling { None, Tiled };
 
+// --shadow-culling: each sun cascade and shadow-casting spot draws its own culled casters, or
+// every one of them draws the sun's whole-scene list (render/culling/culling.h).
+enum class ShadowCulling { PerView, WholeScene };
+
 struct RenderSettings {
     uint32_t width = 1280, height = 720;
     uint32_t ssaa = 1; // N x N supersampling (forward reference)
@@ -136,6 +140,7 @@ struct RenderSettings {
     bool proxyShadows =
         true;           // --proxy-shadows: shadow views draw proxy index sets (render/culling)
     bool decals = true; // --decals: the scene's projected box decals (render/decals)
+    ShadowCulling shadowCulling = ShadowCulling::PerView; // cascades' and spots' caster lists
 };
 
 struct FrameResult {

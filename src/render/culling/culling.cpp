@@ -3,10 +3,14 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <string>
 #include <vector>
 
 #include "core/log.h"
+#include "render/camera.h"
 #include "render/forward/forward_passes.h"
+#include "render/lighting/spot_shadows.h"
+#include "render/lighting/sun_cascades.h"
 #include "render/renderer.h"
 
 namespace shadel {
@@ -28,6 +32,20 @@ struct CullingState {
     Pipeline hizBuild;
     gpu::GpuCullStats last{}; // the last finished frame's counts
     uint32_t instances = 0;
+    uint32_t dispatches = 0, lastDispatches = 0; // instance_cull.comp dispatches this / last frame
+    // --shadow-culling per-view: one list per cascade and shadow-casting spot.
+    BufferHandle shadowViews;      // gpu::GpuShadowCullView[lists] (upload)
+    BufferHandle shadowViewDraws;  // DrawIndexedCommand[lists * maxDraws]
+    BufferHandle shadowViewCounts; // uint[lists]
+    uint32_t cascades = 0, spots = 0;
+    // The list of view CULL_VIEW_CASCADE0 + i (i < cascades) and CULL_VIEW_SPOT0 + i, none
+    // (~0u) with whole-scene culling.
+    uint32_t listOf(uint32_t view) const {
+        if (!shadowViewDraws) return ~0u;
+        if (view >= CULL_VIEW_SPOT0)
+            return view - CULL_VIEW_SPOT0 < spots ? cascades + view - CULL_VIEW_SPOT0 : ~0u;
+        return view - CULL_VIEW_CASCADE0 < cascades ? view - CULL_VIEW_CASCADE0 : ~0u;
+    }
 };
 
 void CullingStateDeleter::operator()(CullingState* state) const {
@@ -55,6 +73,21 @@ CullingStatePtr createCulling(Renderer& r, const GpuScene& scene) {
     c->visibility = createBuffer(gpu, {"culling.visibleLastFrame", perInstance});
     c->drawnLod = createBuffer(gpu, {"culling.drawnLod", perInstance});
     bool ok = c->frame && c->stats && c->visibility && c->drawnLod;
+    c->cascades = sunCascadeCount(r);
+    c->spots = spotShadowCount(r);
+    uint32_t lists = c->cascades + c->spots;
+    if (r.settings.shadowCulling == ShadowCulling::PerView && lists > 0) {
+        c->shadowViews =
+            createBuffer(gpu, {"culling.shadowViews", lists * sizeof(gpu::GpuShadowCullView), 0,
+                               MemoryKind::Upload});
+        c->shadowViewDraws =
+            createBuffer(gpu, {"draws.shadowViews",
+                               VkDeviceSize(lists) * r.maxDraws * sizeof(gpu::DrawIndexedCommand),
+                               VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT});
+        c->shadowViewCounts = createBuffer(
+            gpu, {"draws.shadowViewCounts", lists * 4u, VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT});
+        ok = ok && c->shadowViews && c->shadowViewDraws && c->shadowViewCounts;
+    }
     if (r.settings.occlusion) {
         glm::uvec2 size(r.internalWidth, r.internalHeight);
         uint32_t texels = 0;
@@ -91,8 +124,9 @@ CullingStatePtr createCulling(Renderer& r, const GpuScene& scene) {
 void destroyCulling(Renderer& r, CullingStatePtr& c) {
     if (!c) return;
     Gpu& gpu = *r.gpu;
-    for (BufferHandle b : {c->frame, c->stats, c->visibility, c->drawnLod, c->pyramid,
-                           c->phase2Draws, c->phase2Counts, c->visibleList})
+    for (BufferHandle b :
+         {c->frame, c->stats, c->visibility, c->drawnLod, c->pyramid, c->phase2Draws,
+          c->phase2Counts, c->visibleList, c->shadowViews, c->shadowViewDraws, c->shadowViewCounts})
         if (b) destroy(gpu, b);
     if (c->hizBuild.pipeline) destroy(gpu, c->hizBuild);
     c.reset();
@@ -101,6 +135,7 @@ void destroyCulling(Renderer& r, CullingStatePtr& c) {
 void prepareCullingFrame(Renderer& r, const GpuScene& scene, gpu::FrameConstants& constants) {
     Gpu& gpu = *r.gpu;
     CullingState& c = *r.culling;
+    c.dispatches = 0;
     gpu::CullingFrame f{};
     f.meshLods = address(gpu, scene.meshLods);
     f.stats = address(gpu, c.stats);
@@ -119,6 +154,33 @@ void prepareCullingFrame(Renderer& r, const GpuScene& scene, gpu::FrameConstants
         f.hizLevels = uint32_t(c.levelSize.size());
         f.hizSize = c.levelSize[0];
     }
+    if (c.shadowViewDraws) {
+        // This frame's cascades and spots (prepareShadows ran before): a view per one with a map.
+        std::vector<gpu::GpuShadowCullView> views;
+        auto add = [&](const glm::mat4& viewProj, uint32_t view, uint32_t kind) {
+            gpu::GpuShadowCullView v{};
+            auto planes = frustumPlanes(viewProj);
+            // Sides and far (planes 0-3, 5): depth clamp keeps nearer casters in the map.
+            for (int p = 0; p < 4; ++p) v.planes[p] = planes[p];
+            v.planes[4] = planes[5];
+            v.view = view;
+            v.list = c.listOf(view);
+            v.kind = kind;
+            views.push_back(v);
+        };
+        for (uint32_t i = 0; i < c.cascades; ++i)
+            add(sunCascadeViewProj(r, i), CULL_VIEW_CASCADE0 + i, CULL_SHADOW_VIEW_CASCADE);
+        glm::mat4 viewProj;
+        for (uint32_t i = 0; i < c.spots; ++i)
+            if (spotShadowViewProj(r, i, viewProj))
+                add(viewProj, CULL_VIEW_SPOT0 + i, CULL_SHADOW_VIEW_SPOT);
+        std::memcpy(mapped(gpu, c.shadowViews), views.data(),
+                    views.size() * sizeof(gpu::GpuShadowCullView));
+        f.shadowViews = address(gpu, c.shadowViews);
+        f.shadowViewDraws = address(gpu, c.shadowViewDraws);
+        f.shadowViewCounts = address(gpu, c.shadowViewCounts);
+        f.shadowViewCount = uint32_t(views.size());
+    }
     std::memcpy(mapped(gpu, c.frame), &f, sizeof(f));
     constants.culling = address(gpu, c.frame);
 }
@@ -129,6 +191,15 @@ void recordCullingReset(Renderer& r, VkCommandBuffer cmd) {
     vkCmdFillBuffer(cmd, vkBuffer(gpu, c.stats), 0, VK_WHOLE_SIZE, 0);
     if (c.phase2Counts) vkCmdFillBuffer(cmd, vkBuffer(gpu, c.phase2Counts), 0, VK_WHOLE_SIZE, 0);
     if (c.visibleList) vkCmdFillBuffer(cmd, vkBuffer(gpu, c.visibleList), 0, 4, 0);
+    if (c.shadowViewCounts)
+        vkCmdFillBuffer(cmd, vkBuffer(gpu, c.shadowViewCounts), 0, VK_WHOLE_SIZE, 0);
+}
+
+void recordInstanceCullDispatch(Renderer& r, VkCommandBuffer cmd, const InstanceCullPush& push,
+                                uint32_t instances) {
+    pushConstants(*r.gpu, cmd, push);
+    if (instances) vkCmdDispatch(cmd, (instances + 63) / 64, 1, 1);
+    r.culling->dispatches++;
 }
 
 void recordOcclusionPasses(Renderer& r, FrameRecorder& rec, uint64_t frame, const GpuScene& scene) {
@@ -175,8 +246,7 @@ void recordOcclusionPasses(Renderer& r, FrameRecorder& rec, uint64_t frame, cons
             frame,   address(gpu, c.phase2Draws), address(gpu, c.phase2Counts), r.maxDraws, 0,
             CullRest};
         push.visibleList = address(gpu, c.visibleList);
-        pushConstants(gpu, cmd, push);
-        if (scene.instanceCount) vkCmdDispatch(cmd, (scene.instanceCount + 63) / 64, 1, 1);
+        recordInstanceCullDispatch(r, cmd, push, scene.instanceCount);
         memoryBarrier(cmd, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
                       VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT, VK_PIPELINE_STAGE_2_DRAW_INDIRECT_BIT,
                       VK_ACCESS_2_INDIRECT_COMMAND_READ_BIT);
@@ -213,9 +283,28 @@ void drawPhase2List(Renderer& r, VkCommandBuffer cmd, uint32_t list) {
                                   sizeof(gpu::DrawIndexedCommand));
 }
 
+void drawShadowViewList(Renderer& r, VkCommandBuffer cmd, uint32_t view) {
+    Gpu& gpu = *r.gpu;
+    const CullingState& c = *r.culling;
+    uint32_t list = c.listOf(view);
+    if (list == ~0u) { // whole-scene: the sun's opaque casters
+        vkCmdDrawIndexedIndirectCount(
+            cmd, vkBuffer(gpu, r.shadowDraws),
+            VkDeviceSize(DRAW_LIST_OPAQUE) * r.maxDraws * sizeof(gpu::DrawIndexedCommand),
+            vkBuffer(gpu, r.drawCounts), (DRAW_LIST_COUNT + DRAW_LIST_OPAQUE) * 4, r.maxDraws,
+            sizeof(gpu::DrawIndexedCommand));
+        return;
+    }
+    vkCmdDrawIndexedIndirectCount(cmd, vkBuffer(gpu, c.shadowViewDraws),
+                                  VkDeviceSize(list) * r.maxDraws * sizeof(gpu::DrawIndexedCommand),
+                                  vkBuffer(gpu, c.shadowViewCounts), VkDeviceSize(list) * 4,
+                                  r.maxDraws, sizeof(gpu::DrawIndexedCommand));
+}
+
 void finishCullingFrame(Renderer& r) {
     CullingState& c = *r.culling;
     std::memcpy(&c.last, mapped(*r.gpu, c.stats), sizeof(gpu::GpuCullStats));
+    c.lastDispatches = c.dispatches;
     if (c.visibleList) {
         const uint32_t* list = static_cast<const uint32_t*>(mapped(*r.gpu, c.visibleList));
         uint32_t count = std::min(list[0], c.instances);
@@ -232,7 +321,11 @@ const std::vector<uint32_t>* visibleLastFrame(const Renderer& r) {
 void cullingStats(const Renderer& r, nlohmann::json& s) {
     const CullingState& c = *r.culling;
     const gpu::GpuCullStats& st = c.last;
-    auto view = [&](uint32_t v) {
+    // Whole-scene culling: the cascades and spots draw the sun's list (its counts).
+    auto view = [&](uint32_t drawnView) {
+        uint32_t v = drawnView >= CULL_VIEW_CASCADE0 && c.listOf(drawnView) == ~0u
+                         ? CULL_VIEW_SHADOW
+                         : drawnView;
         nlohmann::json j = {{"instances", c.instances},
                             {"frustum_visible", st.frustumVisible[v]},
                             {"instances_drawn", st.instancesDrawn[v]},
@@ -252,7 +345,17 @@ void cullingStats(const Renderer& r, nlohmann::json& s) {
         {"lod", r.settings.lod ? "on" : "off"},
         {"occlusion", r.settings.occlusion ? "on" : "off"},
         {"proxy_shadows", r.settings.proxyShadows && !r.gi ? "on" : "off"},
+        {"dispatches", c.lastDispatches},
+        {"shadow_culling",
+         r.settings.shadowCulling == ShadowCulling::PerView ? "per-view" : "whole-scene"},
         {"views", {{"camera", view(CULL_VIEW_CAMERA)}, {"shadow", view(CULL_VIEW_SHADOW)}}}};
+    nlohmann::json& views = s["culling"]["views"];
+    for (uint32_t i = 0; i < c.cascades; ++i)
+        views["sun_cascade_" + std::to_string(i)] = view(CULL_VIEW_CASCADE0 + i);
+    glm::mat4 unused;
+    for (uint32_t i = 0; i < c.spots; ++i) // the spots with a map
+        if (spotShadowViewProj(r, i, unused))
+            views["spot_shadow_" + std::to_string(i)] = view(CULL_VIEW_SPOT0 + i);
 }
 
 } // namespace shadel

@@ -70,24 +70,17 @@ void recordInstanceCull(Renderer& r, VkCommandBuffer cmd, uint64_t frame, const 
                   VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
                   VK_ACCESS_2_SHADER_STORAGE_READ_BIT | VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT);
     bind(gpu, cmd, r.instanceCull);
-    uint32_t groups = (scene.instanceCount + 63) / 64;
-    // With occlusion culling the camera's first phase draws only what was visible last frame.
+    // One dispatch for every view: the camera (with occlusion culling, its first phase: what was
+    // visible last frame), the sun's whole-scene map and the per-view cascade and spot lists.
     InstanceCullPush push{frame,
                           address(gpu, r.draws),
                           address(gpu, r.drawCounts),
                           r.maxDraws,
-                          0,
+                          1,
                           r.settings.occlusion ? CullLastVisible : CullSinglePass};
-    pushConstants(gpu, cmd, push);
-    if (groups) vkCmdDispatch(cmd, groups, 1, 1);
-    push = {frame,
-            address(gpu, r.shadowDraws),
-            address(gpu, r.drawCounts) + DRAW_LIST_COUNT * 4,
-            r.maxDraws,
-            1,
-            CullSinglePass};
-    pushConstants(gpu, cmd, push);
-    if (groups) vkCmdDispatch(cmd, groups, 1, 1);
+    push.sunDraws = address(gpu, r.shadowDraws);
+    push.sunCounts = address(gpu, r.drawCounts) + DRAW_LIST_COUNT * 4;
+    recordInstanceCullDispatch(r, cmd, push, scene.instanceCount);
     memoryBarrier(cmd, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT,
                   VK_PIPELINE_STAGE_2_DRAW_INDIRECT_BIT, VK_ACCESS_2_INDIRECT_COMMAND_READ_BIT);
 }

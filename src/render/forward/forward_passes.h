@@ -18,7 +18,8 @@ struct GpuScene;
 void createForwardPipelines(Renderer& r);
 void destroyForwardPipelines(Renderer& r);
 
-// Culls every instance against the camera frustum and the sun's shadow volume on the GPU.
+// Culls every instance on the GPU, in one dispatch, against the camera frustum, the sun's
+// shadow volume and each cascade's and shadow-casting spot's view (render/culling/culling.h).
 void recordInstanceCull(Renderer& r, VkCommandBuffer cmd, uint64_t frame, const GpuScene& scene);
 void recordShadowMap(Renderer& r, VkCommandBuffer cmd, uint64_t frame);
 void recordDepthPrepass(Renderer& r, VkCommandBuffer cmd, uint64_t frame);

@@ -8,6 +8,7 @@
 
 #include "core/block_allocator.h"
 #include "core/error.h"
+#include "render/culling/culling.h"
 #include "render/forward/forward_passes.h"
 #include "render/renderer.h"
 
@@ -34,8 +35,8 @@ struct SpotShadowState {
     uint32_t placed = 0;
     uint64_t atlasTexelsUsed = 0;
     // The maps are drawn again only when what they see may have changed: the spots (this
-    // frame's views differ from the last drawn) or the caster list, which the camera's
-    // shadow-caster culling chooses (the camera moved).
+    // frame's views differ from the last drawn) or the caster lists, which follow the camera
+    // when it chooses them (see cameraChoosesCasters).
     std::vector<gpu::GpuSpotShadow> drawnViews;
     glm::mat4 drawnCamera{0.0f};
     bool redraw = true;
@@ -113,6 +114,13 @@ void destroySpotShadows(Renderer& r, SpotShadowStatePtr& state) {
 }
 
 // The spot's perspective view: its outer cone (round) or pyramid (square) fills the map.
+// Whether the camera's moves change what the spot maps draw: with whole-scene culling they
+// draw the sun's list, culled to the casters whose sun shadow reaches the camera's frustum;
+// with per-view culling only the LODs (--lod on, chosen from the camera) do.
+static bool cameraChoosesCasters(const Renderer& r) {
+    return r.settings.shadowCulling == ShadowCulling::WholeScene || r.settings.lod;
+}
+
 static gpu::GpuSpotShadow spotView(const gpu::GpuLight& l, glm::uvec4 rect) {
     gpu::GpuSpotShadow s{};
     float tanHalf;
@@ -159,7 +167,8 @@ void prepareShadows(Renderer& r, const std::vector<gpu::GpuLight>& lights,
     for (size_t i = 0; i < s.lightOf.size(); ++i)
         views[i] = s.lightOf[i] < lights.size() ? spotView(lights[s.lightOf[i]], s.rects[i])
                                                 : gpu::GpuSpotShadow{};
-    s.redraw = s.drawnViews.size() != views.size() || constants.viewProj != s.drawnCamera ||
+    bool cameraMoved = constants.viewProj != s.drawnCamera;
+    s.redraw = s.drawnViews.size() != views.size() || (cameraMoved && cameraChoosesCasters(r)) ||
                std::memcmp(views.data(), s.drawnViews.data(),
                            views.size() * sizeof(gpu::GpuSpotShadow)) != 0 ||
                std::find(r.reposedInstances.begin(), r.reposedInstances.end(), 1) !=
@@ -172,6 +181,19 @@ void prepareShadows(Renderer& r, const std::vector<gpu::GpuLight>& lights,
     std::memcpy(out, views.data(), views.size() * sizeof(gpu::GpuSpotShadow));
     f.spotShadows = address(gpu, s.shadows);
     f.spotShadowAtlas = slot(gpu, s.read).value;
+}
+
+bool spotShadowViewProj(const Renderer& r, uint32_t index, glm::mat4& viewProj) {
+    if (!r.spotShadows || index >= r.spotShadows->drawnViews.size()) return false;
+    // drawnViews is this frame's: the maps are redrawn whenever the views change.
+    const gpu::GpuSpotShadow& view = r.spotShadows->drawnViews[index];
+    if (view.nearPlane < 0.0f) return false;
+    viewProj = view.viewProj;
+    return true;
+}
+
+uint32_t spotShadowCount(const Renderer& r) {
+    return r.spotShadows ? uint32_t(r.spotShadows->lightOf.size()) : 0u;
 }
 
 bool spotShadowMapsThisFrame(const Renderer& r) {
@@ -211,13 +233,7 @@ void recordSpotShadowMaps(Renderer& r, VkCommandBuffer cmd, uint64_t frame) {
         vkCmdSetViewport(cmd, 0, 1, &vp);
         vkCmdSetScissor(cmd, 0, 1, &scissor);
         pushConstants(gpu, cmd, RasterPush{frame, 2u + i});
-        // The sun's shadow list: its volume is fitted to the whole scene, so it holds the opaque
-        // casters a spot inside the scene sees (the GPU clips the rest), as for the GI's RSMs.
-        vkCmdDrawIndexedIndirectCount(
-            cmd, vkBuffer(gpu, r.shadowDraws),
-            VkDeviceSize(DRAW_LIST_OPAQUE) * r.maxDraws * sizeof(gpu::DrawIndexedCommand),
-            vkBuffer(gpu, r.drawCounts), (DRAW_LIST_COUNT + DRAW_LIST_OPAQUE) * 4, r.maxDraws,
-            sizeof(gpu::DrawIndexedCommand));
+        drawShadowViewList(r, cmd, CULL_VIEW_SPOT0 + i);
     }
     vkCmdEndRendering(cmd);
     imageBarrier(cmd, image, VK_IMAGE_ASPECT_DEPTH_BIT, VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL,

@@ -7,6 +7,7 @@
 #include <glm/gtc/matrix_transform.hpp>
 
 #include "core/error.h"
+#include "render/culling/culling.h"
 #include "render/forward/forward_passes.h"
 #include "render/renderer.h"
 
@@ -173,6 +174,14 @@ uint64_t prepareSunCascades(Renderer& r, const gpu::FrameConstants& constants) {
     return address(gpu, s.cascades);
 }
 
+uint32_t sunCascadeCount(const Renderer& r) {
+    return r.sunCascades ? r.sunCascades->count : 0u;
+}
+
+glm::mat4 sunCascadeViewProj(const Renderer& r, uint32_t cascade) {
+    return r.sunCascades->last.viewProj[cascade];
+}
+
 void recordSunCascades(Renderer& r, VkCommandBuffer cmd, uint64_t frame) {
     Gpu& gpu = *r.gpu;
     SunCascadeState& s = *r.sunCascades;
@@ -206,12 +215,7 @@ void recordSunCascades(Renderer& r, VkCommandBuffer cmd, uint64_t frame) {
         vkCmdSetViewport(cmd, 0, 1, &vp);
         vkCmdSetScissor(cmd, 0, 1, &scissor);
         pushConstants(gpu, cmd, RasterPush{frame, i});
-        // The sun view's culled casters (see the header: they cover every cascade).
-        vkCmdDrawIndexedIndirectCount(
-            cmd, vkBuffer(gpu, r.shadowDraws),
-            VkDeviceSize(DRAW_LIST_OPAQUE) * r.maxDraws * sizeof(gpu::DrawIndexedCommand),
-            vkBuffer(gpu, r.drawCounts), (DRAW_LIST_COUNT + DRAW_LIST_OPAQUE) * 4, r.maxDraws,
-            sizeof(gpu::DrawIndexedCommand));
+        drawShadowViewList(r, cmd, CULL_VIEW_CASCADE0 + i);
     }
     vkCmdEndRendering(cmd);
     imageBarrier(cmd, image, VK_IMAGE_ASPECT_DEPTH_BIT, VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL,

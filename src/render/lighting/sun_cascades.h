@@ -11,9 +11,9 @@
 // filters it with PCF or PCSS; beyond the last slice the whole-scene map still answers.
 // --sun-cascades 1 keeps that one map alone (no cascade state at all).
 //
-// Casters: each cascade draws the sun view's culled opaque list (render/forward instance
-// culling). That list is culled against the whole-scene shadow volume, which contains every
-// cascade's, so it holds every caster of every cascade; the GPU clips the rest per cascade.
+// Casters: each cascade draws its own list, culled on the GPU against its box with the camera's
+// and the sun's lists (render/culling/culling.h); with --shadow-culling whole-scene, the sun
+// view's list (culled against the whole-scene volume, which contains every cascade's).
 #include <memory>
 
 #include <nlohmann/json.hpp>
@@ -38,6 +38,9 @@ void destroySunCascades(Renderer& r, SunCascadeStatePtr& state);
 
 // This frame's cascades for the camera of `constants`: LightingFrame::sunCascades (0 without).
 uint64_t prepareSunCascades(Renderer& r, const gpu::FrameConstants& constants);
+// The cascades' count (0 without) and, after prepareSunCascades, this frame's world -> clip.
+uint32_t sunCascadeCount(const Renderer& r);
+glm::mat4 sunCascadeViewProj(const Renderer& r, uint32_t cascade);
 // "sunCascades": the atlas cleared, then each cascade's view of the casters into its rectangle.
 void recordSunCascades(Renderer& r, VkCommandBuffer cmd, uint64_t frame);
 // sun_cascades, sun_cascade_splits_m, sun_cascade_texel_m, sun_shadow_texel_m.
