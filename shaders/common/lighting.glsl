@@ -4,8 +4,10 @@
 // each optionally limited by a clip plane and stopped by light blockers with portals.
 //
 // Which lights a surface loops over is chosen by the caller before shadeSurface (render/lighting):
-// every light (LIGHT_LIST_ALL), a screen tile's list in memory (forward, useTileLightList) or the
-// workgroup's list in shared memory (shadel chunks; the shader defines SHADEL_LIGHT_LIST_SHARED).
+// every light (LIGHT_LIST_ALL), a screen tile's list in memory (forward, useTileLightList), the
+// light grid's candidates at one point (forward pixels of a frame without screen tiles:
+// decoupled frames, whose shadel chunks cull against the grid themselves) or the workgroup's
+// list in shared memory (shadel chunks; the shader defines SHADEL_LIGHT_LIST_SHARED).
 // A list entry is (light, mask): bit k of the mask asks for the per-pixel test of the light's
 // k-th blocker; culling has already removed lights a blocker hides from the whole tile.
 #ifndef SHADEL_LIGHTING_GLSL
@@ -20,10 +22,14 @@ layout(buffer_reference, scalar) readonly buffer LightPortalBuffer { GpuLightPor
 layout(buffer_reference, scalar) readonly buffer LightListBuffer { uvec2 e[]; };
 layout(buffer_reference, scalar) buffer LightingCountersRef { LightingCounters c; };
 layout(buffer_reference, scalar) readonly buffer SpotShadowBuffer { GpuSpotShadow s[]; };
+layout(buffer_reference, scalar) readonly buffer LightGridRef { GpuLightGrid g; };
+layout(buffer_reference, scalar) readonly buffer LightGridBuckets { uvec2 b[]; };
+layout(buffer_reference, scalar) readonly buffer LightGridEntries { uint v[]; };
 
 #define LIGHT_LIST_ALL 0u
 #define LIGHT_LIST_BUFFER 1u
 #define LIGHT_LIST_SHARED 2u
+#define LIGHT_LIST_GRID 3u
 #define LIGHT_TILE_MAX_LIGHTS 1024u // lights a tile's list can hold (shared memory while culling)
 #define LIGHT_CHUNK_MAX_LIGHTS 512u // entries of a shadel chunk's list (shared memory)
 #define LIGHT_INVALID 0xFFFFFFFFu   // an entry culling removed in place
@@ -44,6 +50,8 @@ layout(constant_id = DISTANCE_FIELD_LIGHTING_CONSTANT_ID) const uint kDistanceFi
 uint gLightListMode = LIGHT_LIST_ALL;
 uint64_t gLightListAddress = 0ul;
 uint gLightListCount = 0u;
+uvec2 gGridLists[3]; // LIGHT_LIST_GRID: global, big and bucket lists (first entry, count)
+uint gGridBlockerMask = 0u;
 
 #ifdef SHADEL_LIGHT_LIST_SHARED
 shared uvec2 sLightList[LIGHT_CHUNK_MAX_LIGHTS];
@@ -63,8 +71,34 @@ void useTileLightList(FrameConstants f, vec2 fragCoord) {
     gLightListCount = range.y;
 }
 
+// A forward pixel at `position`: its tile's list when screen tiles were culled this frame,
+// else the light grid's candidates at the point (the global list, level 0's big list and the
+// bucket of the point's cell: no light is listed twice there), each of whose blockers is
+// tested per pixel. Lights beyond their range add nothing, so the sum is the all-lights sum.
+void useLightListAt(FrameConstants f, vec2 fragCoord, vec3 position) {
+    if (f.lighting == 0ul) return;
+    LightingFrame lf = LightingFrameRef(f.lighting).l;
+    if (lf.screenTiles != 0u) {
+        useTileLightList(f, fragCoord);
+        return;
+    }
+    if (lf.tiled == 0u || lf.lightGrid == 0ul) return;
+    GpuLightGrid g = LightGridRef(lf.lightGrid).g;
+    if (g.levels == 0u) return;
+    vec3 c = floor((position - g.origin) / g.cellSize);
+    if (any(greaterThanEqual(abs(c), vec3(float(1 << 28))))) return;
+    ivec3 cell = ivec3(c);
+    gLightListMode = LIGHT_LIST_GRID;
+    gLightListAddress = g.entries;
+    gGridLists[0] = uvec2(g.globalFirst, g.globalCount);
+    gGridLists[1] = g.big[0];
+    gGridLists[2] = LightGridBuckets(g.buckets).b[LIGHT_GRID_HASH(cell.x, cell.y, cell.z)];
+    gLightListCount = gGridLists[0].y + gGridLists[1].y + gGridLists[2].y;
+    gGridBlockerMask = lf.blockersOn != 0u ? 0xFFFFFFFFu : 0u;
+}
+
 uint lightListLength(FrameConstants f) {
-    if (gLightListMode == LIGHT_LIST_BUFFER) return gLightListCount;
+    if (gLightListMode == LIGHT_LIST_BUFFER || gLightListMode == LIGHT_LIST_GRID) return gLightListCount;
 #ifdef SHADEL_LIGHT_LIST_SHARED
     if (gLightListMode == LIGHT_LIST_SHARED) return min(sLightListCount, LIGHT_CHUNK_MAX_LIGHTS);
 #endif
@@ -73,6 +107,12 @@ uint lightListLength(FrameConstants f) {
 
 uvec2 lightListEntry(FrameConstants f, uint i) {
     if (gLightListMode == LIGHT_LIST_BUFFER) return LightListBuffer(gLightListAddress).e[i];
+    if (gLightListMode == LIGHT_LIST_GRID) {
+        uint list = i < gGridLists[0].y ? 0u : i < gGridLists[0].y + gGridLists[1].y ? 1u : 2u;
+        uint skip = list == 0u ? 0u : list == 1u ? gGridLists[0].y : gGridLists[0].y + gGridLists[1].y;
+        uint light = LightGridEntries(gLightListAddress).v[gGridLists[list].x + i - skip];
+        return uvec2(light, gGridBlockerMask);
+    }
 #ifdef SHADEL_LIGHT_LIST_SHARED
     if (gLightListMode == LIGHT_LIST_SHARED) return sLightList[i];
 #endif

@@ -275,7 +275,7 @@ struct LightingFrame {
     // can reach a screen tile, so the tile pass tests these alone.
     uint64_t frustumLights; // uint light indices
     uint frustumLightCount;
-    uint pad0;
+    uint screenTiles; // 1: the tile pass built the screen tiles' lists this frame
     uint64_t spectra; // SpectraFrame with --spectra on|single, else 0
     // Shadows (render/lighting/spot_shadows.h): spot shadow maps share one atlas.
     uint64_t spotShadows;   // GpuSpotShadow[], GpuLight::shadowIndex indexes it

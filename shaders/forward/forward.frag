@@ -43,7 +43,7 @@ void main() {
     if ((mat.flags & MATERIAL_ALPHA_MASK) != 0u && m.alpha < mat.alphaCutoff) discard;
     // Opaque pixels lie on the prepass depth the tile's bounds came from; blended ones need not.
     if ((mat.flags & MATERIAL_ALPHA_BLEND) == 0u) {
-        useTileLightList(f, gl_FragCoord.xy);
+        useLightListAt(f, gl_FragCoord.xy, inPosition);
         useRayTracedPixelTerms(f, gl_FragCoord.xy); // --rt-*: this pixel's traced terms
     }
     vec3 color = shadeSurface(f, m, inPosition, s.normal);

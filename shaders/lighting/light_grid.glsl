@@ -9,8 +9,6 @@
 #ifndef SHADEL_LIGHT_GRID_GLSL
 #define SHADEL_LIGHT_GRID_GLSL
 
-layout(buffer_reference, scalar) readonly buffer LightGridRef { GpuLightGrid g; };
-layout(buffer_reference, scalar) readonly buffer LightGridBuckets { uvec2 b[]; };
 
 shared uint sGridMask[LIGHT_GRID_MASK_LIGHTS / 32u];
 shared uint sGridCandidates;

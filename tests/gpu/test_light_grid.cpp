@@ -88,6 +88,14 @@ TEST(LightGrid, CandidatesHoldEveryLightThatMeetsTheBoxAndFewOthers) {
                 ASSERT_TRUE(in.count(i));
             }
     }
+    // A point (what a forward pixel of a decoupled frame queries) lists no light twice.
+    for (int b = 0; b < 2000; ++b) {
+        glm::vec3 p(pos(rng), height(rng), pos(rng));
+        auto list = lightGridCandidates(grid, p, p);
+        ASSERT_TRUE(list.has_value());
+        std::set<uint32_t> in(list->begin(), list->end());
+        ASSERT_EQ(in.size(), list->size()) << "a light listed twice at point " << b;
+    }
     // A box larger than the coarsest cell is not answered (the chunk tests every light).
     float coarsest = grid.header.cellSize * float(1u << (LIGHT_GRID_LEVELS - 1));
     EXPECT_FALSE(lightGridCandidates(grid, glm::vec3(0), glm::vec3(coarsest * 1.5f)).has_value());

@@ -76,6 +76,7 @@ LightGridData buildLightGrid(const std::vector<gpu::GpuLight>& lights) {
     // Two passes over the same cells: count per bucket, then fill (entries in light order).
     std::vector<uint32_t> globalLights;
     std::vector<std::vector<uint32_t>> big(g.levels);
+    std::vector<uint32_t> lightBuckets;
     auto visit = [&](auto&& emit) {
         for (uint32_t i = 0; i < lights.size(); ++i) {
             glm::vec4 s = spheres[i];
@@ -90,10 +91,17 @@ LightGridData buildLightGrid(const std::vector<gpu::GpuLight>& lights) {
                     emit(level, UINT32_MAX, i);
                     continue;
                 }
+                // Once per bucket: cells of one light that hash together list it once (a
+                // point's query reads one bucket and must not count a light twice).
+                lightBuckets.clear();
                 for (int z = range.lo.z; z <= range.hi.z; ++z)
                     for (int y = range.lo.y; y <= range.hi.y; ++y)
                         for (int x = range.lo.x; x <= range.hi.x; ++x)
-                            emit(level, bucketOf({x, y, z}), i);
+                            lightBuckets.push_back(bucketOf({x, y, z}));
+                std::sort(lightBuckets.begin(), lightBuckets.end());
+                lightBuckets.erase(std::unique(lightBuckets.begin(), lightBuckets.end()),
+                                   lightBuckets.end());
+                for (uint32_t bucket : lightBuckets) emit(level, bucket, i);
             }
         }
     };
