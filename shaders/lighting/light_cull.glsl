@@ -1,5 +1,6 @@
 // Culling tests shared by the forward tile pass (tile_cull.comp) and the shadel path's chunk
-// culling (shaders/shadel/shade.comp): a light's bounding sphere, its clip plane, and the
+// culling (shaders/shadel/shade.comp): a light's bounding sphere (an area light's: its
+// rectangle's plus its range), its clip plane, an area light's back side, and the
 // "shadow" volume a blocker casts from the light (seed 001) against a convex volume given by
 // its 8 corners (a tile's depth-bounded frustum or a chunk's box). Every test is conservative:
 // what culling removes contributes exactly nothing per pixel, so the image does not change.
@@ -18,11 +19,19 @@
 vec4 lightSphere(GpuLight l) {
     if (l.type == LIGHT_DIRECTIONAL || l.range <= 0.0) return vec4(l.position, -1.0);
     float extra = l.type == LIGHT_TUBE ? l.halfLength : 0.0;
+    if (l.type == LIGHT_AREA) extra = length(vec2(l.halfLength, l.radius)); // corner to centre
     return vec4(l.position, l.range + extra);
 }
 
-// Whether the light's clip plane leaves every corner unlit.
-bool clipPlaneCulls(GpuLight l, vec3 corners[8]) {
+// Whether a plane that bounds where the light shines leaves every corner unlit: its clip
+// plane, or an area light's own plane (it emits toward `direction` only).
+bool lightPlanesCull(GpuLight l, vec3 corners[8]) {
+    if (l.type == LIGHT_AREA) {
+        bool anyFront = false;
+        for (int i = 0; i < 8; ++i)
+            anyFront = anyFront || dot(l.direction, corners[i] - l.position) > 0.0;
+        if (!anyFront) return true;
+    }
     if ((l.flags & LIGHT_FLAG_CLIP_PLANE) == 0u) return false;
     for (int i = 0; i < 8; ++i)
         if (dot(l.clipPlane.xyz, corners[i]) + l.clipPlane.w >= 0.0) return false;

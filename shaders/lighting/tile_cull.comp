@@ -104,7 +104,7 @@ void main() {
                 vec3 nearest = clamp(sphere.xyz, boxMin, boxMax);
                 keep = keep && distance(nearest, sphere.xyz) <= sphere.w;
             }
-            keep = keep && !clipPlaneCulls(light, corners);
+            keep = keep && !lightPlanesCull(light, corners);
         }
         uint slot = orderedAppend(keep);
         if (slot < LIGHT_TILE_MAX_LIGHTS) sList[slot] = uvec2(index, 0u);

@@ -137,7 +137,7 @@ void cullChunkLights(FrameConstants f, bool shading, vec3 p) {
             GpuLight light = lights.l[index];
             vec4 sphere = lightSphere(light);
             keep = sphere.w < 0.0 || distance(clamp(sphere.xyz, boxMin, boxMax), sphere.xyz) <= sphere.w;
-            keep = keep && !clipPlaneCulls(light, corners);
+            keep = keep && !lightPlanesCull(light, corners);
         }
         uint slot = orderedAppend(keep);
         if (slot < LIGHT_CHUNK_MAX_LIGHTS) sLightList[slot] = uvec2(index, 0u);
