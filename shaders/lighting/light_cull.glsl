@@ -1,7 +1,7 @@
 // Culling tests shared by the forward tile pass (tile_cull.comp) and the shadel path's chunk
 // culling (shaders/shadel/shade.comp): a light's bounding sphere (an area light's: its
-// rectangle's plus its range), its clip plane, an area light's back side, and the
-// "shadow" volume a blocker casts from the light (seed 001) against a convex volume given by
+// rectangle's plus its range), a spot's cone, its clip plane, an area light's back side, and
+// the "shadow" volume a blocker casts from the light (seed 001) against a convex volume given by
 // its 8 corners (a tile's depth-bounded frustum or a chunk's box). Every test is conservative:
 // what culling removes contributes exactly nothing per pixel, so the image does not change.
 #ifndef SHADEL_LIGHT_CULL_GLSL
@@ -21,6 +21,27 @@ vec4 lightSphere(GpuLight l) {
     float extra = l.type == LIGHT_TUBE ? l.halfLength : 0.0;
     if (l.type == LIGHT_AREA) extra = length(vec2(l.halfLength, l.radius)); // corner to centre
     return vec4(l.position, l.range + extra);
+}
+
+// Whether a sphere (a tile's or chunk's bounds) lies wholly outside a spot's outer cone (the
+// square cone's circumscribed round one), or behind its apex: the closest point of the cone's
+// surface to the centre is farther than the radius (Wronski's cone test). Gobos are spots.
+bool spotConeMisses(GpuLight l, vec3 centre, float radius) {
+    if (l.type != LIGHT_SPOT && l.type != LIGHT_SPOT_SQUARE) return false;
+    float c, s; // cosine and sine of the cone's half angle
+    if (l.type == LIGHT_SPOT) {
+        c = clamp(-l.spotOffset / l.spotScale, -1.0, 1.0);
+        s = sqrt(1.0 - c * c);
+    } else {
+        float t = max(l.spotOffset / l.spotScale, 0.0) * sqrt(2.0);
+        c = inversesqrt(1.0 + t * t);
+        s = t * c;
+    }
+    if (c <= 0.0) return false; // 90 degrees or wider: no cone to cull by
+    vec3 v = centre - l.position;
+    float along = dot(v, l.direction);
+    float closest = c * sqrt(max(dot(v, v) - along * along, 0.0)) - along * s;
+    return closest > radius || along < -radius;
 }
 
 // Whether a plane that bounds where the light shines leaves every corner unlit: its clip

@@ -1,7 +1,8 @@
 #version 460
 // Tiled light culling (seed 001): one 16x16 workgroup per 16x16-pixel screen tile. The tile's
 // depth bounds come from the prepass depth; every light's sphere is tested against the tile's
-// depth-bounded frustum (and its clip plane against the frustum's corners); then, for lights
+// depth-bounded frustum (its clip plane and an area light's back side against the frustum's
+// corners, a spot's cone against the frustum's bounding sphere); then, for lights
 // with blockers, each blocker's shadow volume from the light: a blocker that covers the whole
 // tile removes the light, one that covers part of it is kept as a (light, blocker) pair for the
 // per-pixel test. Lists keep the lights' order (ordered compaction), so tiled shading sums in
@@ -87,6 +88,8 @@ void main() {
     planes[5] = vec4(-forward, dot(forward, eye) + zMax);
     vec3 boxMin = corners[0], boxMax = corners[0];
     for (int i = 1; i < 8; ++i) boxMin = min(boxMin, corners[i]), boxMax = max(boxMax, corners[i]);
+    float radius = 0.0; // the volume's bounding sphere about `centre` (spot cones)
+    for (int i = 0; i < 8; ++i) radius = max(radius, distance(corners[i], centre));
 
     // Lights against the tile, 256 at a time, kept in light order.
     LightBuffer lights = LightBuffer(f.lights);
@@ -104,7 +107,8 @@ void main() {
                 vec3 nearest = clamp(sphere.xyz, boxMin, boxMax);
                 keep = keep && distance(nearest, sphere.xyz) <= sphere.w;
             }
-            keep = keep && !lightPlanesCull(light, corners);
+            keep = keep && !lightPlanesCull(light, corners) &&
+                   !spotConeMisses(light, centre, radius);
         }
         uint slot = orderedAppend(keep);
         if (slot < LIGHT_TILE_MAX_LIGHTS) sList[slot] = uvec2(index, 0u);

@@ -137,7 +137,8 @@ void cullChunkLights(FrameConstants f, bool shading, vec3 p) {
             GpuLight light = lights.l[index];
             vec4 sphere = lightSphere(light);
             keep = sphere.w < 0.0 || distance(clamp(sphere.xyz, boxMin, boxMax), sphere.xyz) <= sphere.w;
-            keep = keep && !lightPlanesCull(light, corners);
+            keep = keep && !lightPlanesCull(light, corners) &&
+                   !spotConeMisses(light, (boxMin + boxMax) * 0.5, 0.5 * distance(boxMin, boxMax));
         }
         uint slot = orderedAppend(keep);
         if (slot < LIGHT_CHUNK_MAX_LIGHTS) sLightList[slot] = uvec2(index, 0u);
