@@ -14,6 +14,8 @@
 
 #include "app/exr_file.h"
 #include "render/camera.h"
+#include "render/gpu_scene.h"
+#include "render/lighting/light_culling.h"
 #include "scene/builtin_scenes.h"
 
 using namespace shadel;
@@ -214,4 +216,41 @@ TEST(LightTextures, CullingAndSpectraChangeNothing) {
     EXPECT_GT(area, 0u);
     EXPECT_LT(projected, lit * 3 / 4) << "the gobos' cones are culled from tiles they miss";
     EXPECT_LT(area, lit) << "area lights are culled by their range and their back side";
+}
+
+// The scene light -> GpuLight conversion of the two kinds: a spot is a gobo only with a
+// texture, its UV scale fills the outer cone `textureTiling` times and its right axis is made
+// orthogonal to its direction; an area light carries its half extents, and its culling reach is
+// its range plus its half diagonal.
+TEST(LightTextures, GpuLightsOfGobosAndAreaLights) {
+    std::vector<uint32_t> blockerLists;
+    Light spot;
+    spot.type = LightType::Spot;
+    spot.direction = {0, -1, 0};
+    spot.axis = {1, 0.5f, 0};
+    spot.outerConeAngle = 0.5f;
+    spot.textureTiling = 2.0f;
+    gpu::GpuLight plain = gpuLight(spot, blockerLists);
+    EXPECT_EQ(plain.flags & LIGHT_FLAG_PROJECTED, 0u);
+    EXPECT_EQ(plain.textureSlot, NO_TEXTURE);
+    gpu::GpuLight gobo = gpuLight(spot, blockerLists, 7u);
+    EXPECT_NE(gobo.flags & LIGHT_FLAG_PROJECTED, 0u);
+    EXPECT_EQ(gobo.textureSlot, 7u);
+    EXPECT_NEAR(gobo.textureScale, 0.5f * 2.0f / std::tan(0.5f), 1e-5f);
+    EXPECT_NEAR(glm::dot(gobo.axis, gobo.direction), 0.0f, 1e-6f);
+    EXPECT_NEAR(glm::length(gobo.axis), 1.0f, 1e-6f);
+
+    Light area;
+    area.type = LightType::Area;
+    area.direction = {0, 0, 1};
+    area.axis = {1, 0, 0};
+    area.areaSize = {2.4f, 0.6f};
+    area.range = 4.0f;
+    gpu::GpuLight g = gpuLight(area, blockerLists, 3u);
+    EXPECT_EQ(g.type, LIGHT_AREA);
+    EXPECT_EQ(g.textureSlot, 3u);
+    EXPECT_FLOAT_EQ(g.halfLength, 1.2f);
+    EXPECT_FLOAT_EQ(g.radius, 0.3f);
+    EXPECT_EQ(g.flags & LIGHT_FLAG_PROJECTED, 0u);
+    EXPECT_NEAR(lightReach(g), 4.0f + std::hypot(1.2f, 0.3f), 1e-5f);
 }
