@@ -1,6 +1,7 @@
 // Lighting shared by the forward and decoupled paths: GGX specular + Lambert diffuse, the
 // sun with a PCF shadow map, and one buffer of lights of several kinds (seed 001): omni, spot
-// with a round or square cone, tube (representative-point specular), darks (negative lights),
+// with a round or square cone (optionally projecting a texture: gobos), tube
+// (representative-point specular), textured rectangular area lights, darks (negative lights),
 // each optionally limited by a clip plane and stopped by light blockers with portals.
 //
 // Which lights a surface loops over is chosen by the caller before shadeSurface (render/lighting):
@@ -216,6 +217,14 @@ float sunShadow(FrameConstants f, vec3 worldPos, vec3 n) {
     return lit / 9.0;
 }
 
+// The smooth cut-off of a light's range alone (1 for an infinite range).
+float rangeWindow(float distance, float range) {
+    if (range <= 0.0) return 1.0;
+    float r = distance / range;
+    float window = clamp(1.0 - r * r * r * r, 0.0, 1.0);
+    return window * window;
+}
+
 float rangeAttenuation(float distance, float range) {
     float invSquare = 1.0 / max(distance * distance, 1e-4);
     if (range <= 0.0) return invSquare;
@@ -321,6 +330,127 @@ vec3 tubeLight(GpuLight light, MaterialSample m, vec3 n, vec3 v, vec3 p) {
     return color;
 }
 
+// Metres one pixel spans at the point being shaded (set by shadeSurface; 0: the finest MIP).
+// Gobos pick the MIP of their texture from it, so pixels and shadels (which shade the points
+// pixels will show) filter the projected pattern alike.
+float gLightFootprint = 0.0;
+
+// A gobo: what the spot's texture lets through toward p (dirToLight from p, dist to the light).
+// UV from the tangent of the angle off the axis along the spot's right (axis) and up
+// (cross(axis, direction)) vectors, texture rows top first; the MIP from a texel's width at p
+// against the pixel's.
+vec3 goboColor(GpuLight light, vec3 dirToLight, float dist) {
+    vec3 d = -dirToLight;
+    float z = dot(light.direction, d);
+    if (z <= 1e-4) return vec3(0.0);
+    vec3 up = cross(light.axis, light.direction); // upright seen from behind the light
+    vec2 t = vec2(dot(light.axis, d), dot(up, d)) / z;
+    vec2 uv = vec2(0.5 + t.x * light.textureScale, 0.5 - t.y * light.textureScale);
+    float texels = float(textureSize(gTextures[nonuniformEXT(light.textureSlot)], 0).x);
+    float texelMetres = dist / (z * light.textureScale * texels);
+    float lod = log2(max(gLightFootprint / max(texelMetres, 1e-6), 1.0));
+    return sampleTextureLod(light.textureSlot, SAMPLER_LINEAR_REPEAT, uv, lod).rgb;
+}
+
+// An area light's emitted colour (times light.color) at rectangle coordinates s in [-1, 1]^2
+// (right, up), filtered to MIP `lod`; a flat emitter without a texture.
+vec3 areaTexel(GpuLight light, vec2 s, float lod) {
+    if (light.textureSlot == NO_TEXTURE) return vec3(1.0);
+    vec2 uv = vec2(0.5 + 0.5 * s.x, 0.5 - 0.5 * s.y);
+    return sampleTextureLod(light.textureSlot, SAMPLER_LINEAR_CLAMP, uv, lod).rgb;
+}
+
+// Texels across the wider side of an area light's texture (1 without one).
+float areaTexels(GpuLight light) {
+    if (light.textureSlot == NO_TEXTURE) return 1.0;
+    ivec2 size = textureSize(gTextures[nonuniformEXT(light.textureSlot)], 0);
+    return float(max(size.x, size.y));
+}
+
+#define AREA_DIFFUSE_CELLS 4        // per side: the diffuse integral's samples
+#define AREA_FAR_HALF_DIAGONALS 6.0 // beyond this distance: one sample (<= 2% off the 4x4)
+
+// A textured, one-sided rectangular area light (an approximation, not the exact integral):
+// diffuse from AREA_DIFFUSE_CELLS^2 cells of the rectangle (one far away), each a small emitter
+// of its own area at its centre with the texture averaged over it (the MIP whose texel is the
+// cell), so a distant surface sees the texture's mean colour and a near one its layout; specular
+// from one
+// representative point (the rectangle's point closest to where the reflection ray meets its
+// plane), treated as a point light of the rectangle's power there with Karis's normalization for
+// the lobe the rectangle widens, the texture read at a MIP as wide as the lobe's footprint.
+vec3 areaLight(GpuLight light, MaterialSample m, vec3 n, vec3 v, vec3 p) {
+    vec3 emitNormal = light.direction;
+    vec3 right = light.axis, up = cross(light.direction, light.axis);
+    float hw = light.halfLength, hh = light.radius;
+    if (dot(p - light.position, emitNormal) <= 0.0) return vec3(0.0); // behind the emitter
+    float texels = areaTexels(light);
+    vec3 f0 = mix(m.specularF0, m.baseColor, m.metallic);
+    float f90 = mix(m.specularF90, 1.0, m.metallic);
+    float nv = max(dot(n, v), 1e-4);
+
+    // Diffuse: irradiance summed over the cells. Farther than AREA_FAR_HALF_DIAGONALS half
+    // diagonals the cells' terms differ little and one cell, the whole rectangle in its mean
+    // colour, stands for them (the street's signs are mostly seen from there).
+    vec3 fromCentre = p - light.position;
+    bool far = dot(fromCentre, fromCentre) >
+               AREA_FAR_HALF_DIAGONALS * AREA_FAR_HALF_DIAGONALS * (hw * hw + hh * hh);
+    int side = far ? 1 : AREA_DIFFUSE_CELLS;
+    float cells = float(side);
+    float cellArea = 4.0 * hw * hh / (cells * cells);
+    float cellLod = log2(max(texels / cells, 1.0));
+    vec3 irradiance = vec3(0.0);
+    vec3 meanDir = vec3(0.0);
+    for (int j = 0; j < side; ++j)
+        for (int i = 0; i < side; ++i) {
+            vec2 s = (vec2(i, j) + 0.5) / cells * 2.0 - 1.0;
+            vec3 toCell = light.position + right * (s.x * hw) + up * (s.y * hh) - p;
+            float d2 = dot(toCell, toCell);
+            float d = sqrt(d2);
+            vec3 l = toCell / max(d, 1e-5);
+            float cosReceiver = dot(n, l), cosEmitter = -dot(emitNormal, l);
+            if (cosReceiver <= 0.0 || cosEmitter <= 0.0) continue;
+            // A cell closer than its own size adds at most its radiance (no 1/d^2 blow-up).
+            float w = cosReceiver * cosEmitter * cellArea / max(d2, cellArea) *
+                      rangeWindow(d, light.range);
+            irradiance += areaTexel(light, s, cellLod) * w;
+            meanDir += l * w;
+        }
+    vec3 color = vec3(0.0);
+    if (dot(meanDir, meanDir) > 0.0) {
+        vec3 l = normalize(meanDir);
+        vec3 f = f0 + (f90 - f0) * pow(1.0 - max(dot(v, normalize(v + l)), 0.0), 5.0);
+        color += (1.0 - f) * (1.0 - m.metallic) * m.baseColor / PI * irradiance * light.color;
+    }
+
+    // Specular: the representative point.
+    vec3 r = reflect(-v, n);
+    float front = dot(p - light.position, emitNormal);
+    float rn = dot(r, emitNormal);
+    vec3 hit = rn < -1e-4 ? p + r * (front / -rn) : p + r * length(light.position - p);
+    vec3 local = hit - light.position;
+    vec2 st = clamp(vec2(dot(local, right) / hw, dot(local, up) / hh), -1.0, 1.0);
+    vec3 ls = light.position + right * (st.x * hw) + up * (st.y * hh) - p;
+    float distS = length(ls);
+    vec3 dirS = ls / max(distS, 1e-4);
+    float nlS = dot(n, dirS), cosEmitter = -dot(emitNormal, dirS);
+    if (nlS > 0.0 && cosEmitter > 0.0) {
+        float alpha = max(m.roughness * m.roughness, 1e-3);
+        float sourceRadius = sqrt(4.0 * hw * hh / PI); // a disc of the rectangle's area
+        float widened = clamp(alpha + sourceRadius / (2.0 * max(distS, 1e-4)), 0.0, 1.0);
+        float energy = (alpha * alpha) / max(widened * widened, 1e-6);
+        float a2 = alpha * alpha;
+        vec3 h = normalize(v + dirS);
+        vec3 f = f0 + (f90 - f0) * pow(1.0 - max(dot(v, h), 0.0), 5.0);
+        vec3 spec = f * distributionGgx(max(dot(n, h), 0.0), a2) * visibilitySmithGgx(nv, nlS, a2);
+        // The lobe's footprint on the rectangle, in texels: its MIP.
+        float footprint = 2.0 * distS * widened;
+        float lod = log2(max(footprint * texels / (2.0 * max(hw, hh)), 1.0));
+        vec3 intensity = light.color * areaTexel(light, st, lod) * (4.0 * hw * hh) * cosEmitter;
+        color += spec * energy * intensity * rangeAttenuation(distS, light.range) * nlS;
+    }
+    return color;
+}
+
 // One light of the buffer at surface point p (not counting blockers).
 vec3 evaluateLight(GpuLight light, MaterialSample m, vec3 n, vec3 v, vec3 p) {
     if (SPECTRUM_HAS(SPECTRUM_CLIP_PLANES) && (light.flags & LIGHT_FLAG_CLIP_PLANE) != 0u &&
@@ -329,11 +459,16 @@ vec3 evaluateLight(GpuLight light, MaterialSample m, vec3 n, vec3 v, vec3 p) {
     if (light.type == LIGHT_DIRECTIONAL) return brdf(m, n, v, -light.direction, light.color);
     if (light.type == LIGHT_TUBE)
         return SPECTRUM_HAS(SPECTRUM_TUBE) ? tubeLight(light, m, n, v, p) : vec3(0.0);
+    if (light.type == LIGHT_AREA)
+        return SPECTRUM_HAS(SPECTRUM_AREA) ? areaLight(light, m, n, v, p) : vec3(0.0);
     if (!SPECTRUM_HAS(SPECTRUM_OMNI | SPECTRUM_SPOT | SPECTRUM_SQUARE_SPOT)) return vec3(0.0);
     vec3 toLight = light.position - p;
     float dist = length(toLight);
     vec3 dir = toLight / max(dist, 1e-4);
     vec3 radiance = light.color * rangeAttenuation(dist, light.range) * spotFactor(light, dir);
+    if (SPECTRUM_HAS(SPECTRUM_PROJECTED) && (light.flags & LIGHT_FLAG_PROJECTED) != 0u &&
+        any(notEqual(radiance, vec3(0.0))))
+        radiance *= goboColor(light, dir, dist);
     return brdf(m, n, v, dir, radiance);
 }
 
@@ -408,6 +543,8 @@ vec3 shadeSurface(FrameConstants f, MaterialSample m, vec3 worldPos, vec3 geomet
     }
     bool spotShadows = SPECTRUM_HAS(SPECTRUM_SPOT_SHADOWS) && haveLighting &&
                        lf.spotShadowAtlas != NO_TEXTURE;
+    // A pixel's width at this point (the gobos' MIP): view distance times the pixel's angle.
+    gLightFootprint = length(worldPos - f.cameraPosition) * 2.0 / (f.proj[1][1] * f.viewportSize.y);
 
     LightBuffer lights = LightBuffer(f.lights);
     vec3 direct = vec3(0.0);
@@ -460,14 +597,28 @@ vec3 shadeParticle(FrameConstants f, vec3 p, vec3 n, float wrap) {
             continue;
         }
         vec3 at = light.position;
+        vec3 power = light.color;
         if (light.type == LIGHT_TUBE) {
             float t = clamp(dot(p - light.position, light.axis), -light.halfLength, light.halfLength);
             at = light.position + light.axis * t;
         }
+        if (light.type == LIGHT_AREA) {
+            // The rectangle's closest point, as a point light of its power in its mean colour.
+            vec3 up = cross(light.direction, light.axis);
+            vec3 local = p - light.position;
+            if (dot(local, light.direction) <= 0.0) continue; // behind the emitter
+            at = light.position +
+                 light.axis * clamp(dot(local, light.axis), -light.halfLength, light.halfLength) +
+                 up * clamp(dot(local, up), -light.radius, light.radius);
+            power *= areaTexel(light, vec2(0.0), log2(areaTexels(light))) *
+                     (4.0 * light.halfLength * light.radius) *
+                     max(dot(light.direction, normalize(p - at + light.direction * 1e-3)), 0.0);
+        }
         vec3 toLight = at - p;
         float dist = length(toLight);
         vec3 dir = toLight / max(dist, 1e-4);
-        vec3 radiance = light.color * rangeAttenuation(dist, light.range) * spotFactor(light, dir);
+        vec3 radiance = power * rangeAttenuation(dist, light.range) * spotFactor(light, dir);
+        if ((light.flags & LIGHT_FLAG_PROJECTED) != 0u) radiance *= goboColor(light, dir, dist);
         direct += radiance * wrappedNl(n, dir, wrap) / PI;
     }
     return color + max(direct, -color);

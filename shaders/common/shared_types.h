@@ -50,11 +50,15 @@ using uint = uint32_t;
 #define LIGHT_SPOT 2u        // round cone
 #define LIGHT_SPOT_SQUARE 3u // square cone (a pyramid): spotScale/Offset act on tan of the angle
 #define LIGHT_TUBE 4u        // a segment of 2 * halfLength along axis (representative point)
-#define LIGHT_KIND_COUNT 5u
+// A one-sided rectangle emitting its texture toward `direction`: centre `position`, half-extents
+// halfLength along `axis` (right) and radius along cross(direction, axis) (up).
+#define LIGHT_AREA 5u
+#define LIGHT_KIND_COUNT 6u
 // GpuLight::flags
 #define LIGHT_FLAG_DARK 1u          // a negative light: subtracts its radiance (colour is negated)
 #define LIGHT_FLAG_CLIP_PLANE 2u    // lights only where dot(clipPlane, vec4(p, 1)) >= 0
 #define LIGHT_FLAG_SOFT_SHADOW 4u   // shadow-mapped spot: variable penumbra (PCSS) instead of PCF
+#define LIGHT_FLAG_PROJECTED 8u     // spot with a gobo: colour times `texture` at the projected UV
 #define LIGHT_NO_SHADOW 0xFFFFFFFFu // GpuLight::shadowIndex of a light without a shadow map
 #define LIGHT_MAX_SPOT_SHADOWS 16u  // shadow-casting spots with a map in the atlas (the first)
 // Light blockers (render/lighting): a light lists up to this many blockers.
@@ -74,8 +78,10 @@ using uint = uint32_t;
 #define SPECTRUM_SHADOWS 0x100u      // the sun's shadow map (PCF)
 #define SPECTRUM_SPOT_SHADOWS 0x200u // spot shadow maps in the atlas (PCF)
 #define SPECTRUM_SOFT_SHADOWS 0x400u // variable penumbra (PCSS): the sun's or a spot's
-#define SPECTRUM_FEATURE_COUNT 11u
-#define SPECTRUM_ALL 0x7FFu
+#define SPECTRUM_PROJECTED 0x800u    // spots projecting a texture (gobos)
+#define SPECTRUM_AREA 0x1000u        // textured rectangular area lights
+#define SPECTRUM_FEATURE_COUNT 13u
+#define SPECTRUM_ALL 0x1FFFu
 #define SPECTRUM_MAX_MODES 16u
 #define SPECTRUM_FEATURES_CONSTANT_ID 140
 #define SPECTRUM_MODE_CONSTANT_ID 141        // the mode (bin) a tile / chunk shading permutation runs
@@ -185,15 +191,17 @@ struct GpuLight {
     float spotScale;   // round: 1 / max(cos(inner) - cos(outer), 1e-4); square: on tan(angle)
     float spotOffset;  // round: -cos(outer) * spotScale; square: tan(outer) * spotScale
     uint flags;        // LIGHT_FLAG_*
-    float halfLength;  // tube: half the segment's length
-    float radius;      // tube: the tube's radius (widens the specular lobe); spot: emitter width
-    vec3 axis;         // tube: the segment's direction; square spot: the cone's "right" axis
+    float halfLength;  // tube: half the segment's length; area: half the width (along axis)
+    float radius;      // tube: the tube's radius (widens the specular lobe); spot: emitter width;
+                       // area: half the height (along cross(direction, axis))
+    vec3 axis;         // tube: the segment's direction; square spot, gobo, area: "right" axis
     uint blockerFirst; // into LightingFrame::lightBlockers
     vec4 clipPlane;    // LIGHT_FLAG_CLIP_PLANE: world-space plane, lit side positive
     uint blockerCount; // blockers this light lists (<= LIGHT_MAX_BLOCKERS_PER_LIGHT)
     uint shadowIndex;  // into LightingFrame::spotShadows; LIGHT_NO_SHADOW without a shadow map
-    uint pad1;
-    uint pad2;
+    uint textureSlot;   // gobo / area: bindless slot of the projected / emitted texture
+    float textureScale; // gobo: UV per unit of tan(angle off the axis) (0.5 / tan(outer) fills
+                        // the cone); area: 1
 };
 
 // A light blocker (seed 001): an artist-placed rectangle (a wall's mid-plane) that stops the

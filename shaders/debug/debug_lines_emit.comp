@@ -1,6 +1,6 @@
 #version 460
-// --debug-lines lights|blockers: one invocation per light (its range sphere, spot cone or tube
-// segment; with blockers, the shadow frustum of every blocker it lists, from the light through
+// --debug-lines lights|blockers: one invocation per light (its range sphere, spot cone, tube
+// segment or area light's rectangle; with blockers, the shadow frustum of every blocker it lists, from the light through
 // the blocker's corners out to its range), then one per blocker (its rectangle and portals).
 #include "debug/debug_lines.glsl"
 #include "common/lighting.glsl"
@@ -51,6 +51,12 @@ void emitLight(FrameConstants f, GpuLight light) {
                           base + u * r * ((k & 1) != 0 ? 1.0 : -1.0) + v * r * ((k & 2) != 0 ? 1.0 : -1.0),
                           colour);
         }
+        return;
+    }
+    if (light.type == LIGHT_AREA) { // the rectangle and the way it emits
+        vec3 up = cross(light.direction, light.axis);
+        debugRect(f, light.position, light.axis * light.halfLength, up * light.radius, colour);
+        debugLine(f, light.position, light.position + light.direction * min(reach, 1.0), colour);
         return;
     }
     if (light.type == LIGHT_TUBE)

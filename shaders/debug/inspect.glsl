@@ -1,6 +1,6 @@
 // --inspect X,Y: what the shading computed at one pixel, printed term by term through
 // shaderPrint. The terms are shadeSurface's (common/lighting.glsl) taken apart with the same
-// functions (brdf, sunShadow, rangeAttenuation); PRINT_SHADED is shadeSurface's own result, and
+// functions (brdf, sunShadow, evaluateLight); PRINT_SHADED is shadeSurface's own result, and
 // the GPU test checks that the printed terms add up to it, so the two cannot drift apart.
 #ifndef SHADEL_INSPECT_GLSL
 #define SHADEL_INSPECT_GLSL
@@ -40,23 +40,10 @@ void inspectSurface(FrameConstants f, uint instance, uint triangle, MaterialSamp
     }
     LightBuffer lights = LightBuffer(f.lights);
     for (uint i = 0u; i < min(f.lightCount, INSPECT_MAX_LIGHTS); ++i) {
-        GpuLight light = lights.l[i];
-        vec3 radiance = light.color;
-        vec3 dir;
-        if (light.type == LIGHT_DIRECTIONAL) {
-            dir = -light.direction;
-        } else {
-            vec3 toLight = light.position - worldPos;
-            float dist = length(toLight);
-            dir = toLight / max(dist, 1e-4);
-            radiance *= rangeAttenuation(dist, light.range);
-            if (light.type == LIGHT_SPOT) {
-                float cd = dot(light.direction, -dir);
-                float s = clamp(cd * light.spotScale + light.spotOffset, 0.0, 1.0);
-                radiance *= s * s;
-            }
-        }
-        shaderPrintF4(f, PRINT_LIGHT, vec4(brdf(m, n, v, dir, radiance) * m.occlusion, float(i)));
+        // evaluateLight: every kind as shadeSurface sums it (square spots, tubes, gobos, area
+        // lights, clip planes), before blockers and spot shadows.
+        vec3 term = evaluateLight(lights.l[i], m, n, v, worldPos);
+        shaderPrintF4(f, PRINT_LIGHT, vec4(term * m.occlusion, float(i)));
     }
     shaderPrintF3(f, PRINT_SHADED, shaded);
 }

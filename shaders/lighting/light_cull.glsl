@@ -1,6 +1,7 @@
 // Culling tests shared by the forward tile pass (tile_cull.comp) and the shadel path's chunk
-// culling (shaders/shadel/shade.comp): a light's bounding sphere, its clip plane, and the
-// "shadow" volume a blocker casts from the light (seed 001) against a convex volume given by
+// culling (shaders/shadel/shade.comp): a light's bounding sphere (an area light's: its
+// rectangle's plus its range), a spot's cone, its clip plane, an area light's back side, and
+// the "shadow" volume a blocker casts from the light (seed 001) against a convex volume given by
 // its 8 corners (a tile's depth-bounded frustum or a chunk's box). Every test is conservative:
 // what culling removes contributes exactly nothing per pixel, so the image does not change.
 #ifndef SHADEL_LIGHT_CULL_GLSL
@@ -18,15 +19,53 @@
 vec4 lightSphere(GpuLight l) {
     if (l.type == LIGHT_DIRECTIONAL || l.range <= 0.0) return vec4(l.position, -1.0);
     float extra = l.type == LIGHT_TUBE ? l.halfLength : 0.0;
+    if (l.type == LIGHT_AREA) extra = length(vec2(l.halfLength, l.radius)); // corner to centre
     return vec4(l.position, l.range + extra);
 }
 
-// Whether the light's clip plane leaves every corner unlit.
-bool clipPlaneCulls(GpuLight l, vec3 corners[8]) {
+// Whether a sphere (a tile's or chunk's bounds) lies wholly outside a spot's outer cone (the
+// square cone's circumscribed round one), or behind its apex: the closest point of the cone's
+// surface to the centre is farther than the radius (Wronski's cone test). Gobos are spots.
+bool spotConeMisses(GpuLight l, vec3 centre, float radius) {
+    if (l.type != LIGHT_SPOT && l.type != LIGHT_SPOT_SQUARE) return false;
+    float c, s; // cosine and sine of the cone's half angle
+    if (l.type == LIGHT_SPOT) {
+        c = clamp(-l.spotOffset / l.spotScale, -1.0, 1.0);
+        s = sqrt(1.0 - c * c);
+    } else {
+        float t = max(l.spotOffset / l.spotScale, 0.0) * sqrt(2.0);
+        c = inversesqrt(1.0 + t * t);
+        s = t * c;
+    }
+    if (c <= 0.0) return false; // 90 degrees or wider: no cone to cull by
+    vec3 v = centre - l.position;
+    float along = dot(v, l.direction);
+    float closest = c * sqrt(max(dot(v, v) - along * along, 0.0)) - along * s;
+    return closest > radius || along < -radius;
+}
+
+// Whether a plane that bounds where the light shines leaves every corner unlit: its clip
+// plane, or an area light's own plane (it emits toward `direction` only).
+bool lightPlanesCull(GpuLight l, vec3 corners[8]) {
+    if (l.type == LIGHT_AREA) {
+        bool anyFront = false;
+        for (int i = 0; i < 8; ++i)
+            anyFront = anyFront || dot(l.direction, corners[i] - l.position) > 0.0;
+        if (!anyFront) return true;
+    }
     if ((l.flags & LIGHT_FLAG_CLIP_PLANE) == 0u) return false;
     for (int i = 0; i < 8; ++i)
         if (dot(l.clipPlane.xyz, corners[i]) + l.clipPlane.w >= 0.0) return false;
     return true;
+}
+
+// A shadel chunk's test of one light against its world box: the light's sphere meets the box,
+// no bounding plane leaves every corner unlit, and a spot's cone meets the box's sphere.
+bool chunkKeepsLight(GpuLight light, vec3 boxMin, vec3 boxMax, vec3 corners[8]) {
+    vec4 sphere = lightSphere(light);
+    bool keep = sphere.w < 0.0 || distance(clamp(sphere.xyz, boxMin, boxMax), sphere.xyz) <= sphere.w;
+    return keep && !lightPlanesCull(light, corners) &&
+           !spotConeMisses(light, (boxMin + boxMax) * 0.5, 0.5 * distance(boxMin, boxMax));
 }
 
 // The shadow volume of the quad q0..q3 (in order around it) seen from lightPos: four planes

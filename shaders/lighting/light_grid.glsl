@@ -100,8 +100,8 @@ void lightGridMaskCompact(uint lightCount, uint threads) {
     }
 }
 
-// A shadel chunk's lights: those whose sphere meets the box and whose clip plane leaves a
-// corner lit, as the loop over every light in shade.comp tests them.
+// A shadel chunk's lights: those chunkKeepsLight keeps, as the loop over every light in
+// shade.comp tests them.
 bool gridChunkLights(FrameConstants f, uint64_t gridAddress, vec3 boxMin, vec3 boxMax,
                      vec3 corners[8], uint threads) {
     LightGridQuery q;
@@ -114,12 +114,7 @@ bool gridChunkLights(FrameConstants f, uint64_t gridAddress, vec3 boxMin, vec3 b
         uvec2 list = lightGridSource(q, source);
         for (uint i = gl_LocalInvocationIndex; i < list.y; i += threads) {
             uint index = entries.v[list.x + i];
-            GpuLight light = lights.l[index];
-            vec4 sphere = lightSphere(light);
-            bool keep = sphere.w < 0.0 ||
-                        distance(clamp(sphere.xyz, boxMin, boxMax), sphere.xyz) <= sphere.w;
-            keep = keep && !clipPlaneCulls(light, corners);
-            if (keep) atomicOr(sGridMask[index >> 5], 1u << (index & 31u));
+            if (chunkKeepsLight(lights.l[index], boxMin, boxMax, corners)) atomicOr(sGridMask[index >> 5], 1u << (index & 31u));
             tested++;
         }
     }

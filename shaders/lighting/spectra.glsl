@@ -16,6 +16,8 @@ uint entryFeatures(LightingFrame lf, GpuLight light, uint blockerMask, vec3 corn
     if (light.type == LIGHT_SPOT) features |= SPECTRUM_SPOT;
     if (light.type == LIGHT_SPOT_SQUARE) features |= SPECTRUM_SQUARE_SPOT;
     if (light.type == LIGHT_TUBE) features |= SPECTRUM_TUBE;
+    if (light.type == LIGHT_AREA) features |= SPECTRUM_AREA;
+    if ((light.flags & LIGHT_FLAG_PROJECTED) != 0u) features |= SPECTRUM_PROJECTED;
     if ((light.flags & LIGHT_FLAG_DARK) != 0u) features |= SPECTRUM_DARK;
     if ((light.flags & LIGHT_FLAG_CLIP_PLANE) != 0u) {
         bool allLit = true;

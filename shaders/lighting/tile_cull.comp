@@ -1,7 +1,8 @@
 #version 460
 // Tiled light culling (seed 001): one 16x16 workgroup per 16x16-pixel screen tile. The tile's
 // depth bounds come from the prepass depth; every light's sphere is tested against the tile's
-// depth-bounded frustum (and its clip plane against the frustum's corners); then, for lights
+// depth-bounded frustum (its clip plane and an area light's back side against the frustum's
+// corners, a spot's cone against the frustum's bounding sphere); then, for lights
 // with blockers, each blocker's shadow volume from the light: a blocker that covers the whole
 // tile removes the light, one that covers part of it is kept as a (light, blocker) pair for the
 // per-pixel test. Lists keep the lights' order (ordered compaction), so tiled shading sums in
@@ -28,8 +29,10 @@ shared uint sFeatures; // SPECTRUM_* the tile's list needs (feature spectra)
 #include "lighting/light_grid.glsl"
 
 // The tile's test of one light: its sphere against the depth-bounded tile frustum's planes and
-// box, its clip plane against the frustum's corners.
-bool tileKeepsLight(GpuLight light, vec4 planes[6], vec3 boxMin, vec3 boxMax, vec3 corners[8]) {
+// box, its clip plane and (area lights) back side against the frustum's corners, a spot's cone
+// against the frustum's bounding sphere (centre, radius).
+bool tileKeepsLight(GpuLight light, vec4 planes[6], vec3 boxMin, vec3 boxMax, vec3 corners[8],
+                    vec3 centre, float radius) {
     vec4 sphere = lightSphere(light);
     bool keep = true;
     if (sphere.w >= 0.0) {
@@ -38,7 +41,7 @@ bool tileKeepsLight(GpuLight light, vec4 planes[6], vec3 boxMin, vec3 boxMax, ve
         vec3 nearest = clamp(sphere.xyz, boxMin, boxMax);
         keep = keep && distance(nearest, sphere.xyz) <= sphere.w;
     }
-    return keep && !clipPlaneCulls(light, corners);
+    return keep && !lightPlanesCull(light, corners) && !spotConeMisses(light, centre, radius);
 }
 
 // Whether the CPU's frustum cull kept the light (its list is in light order): grid candidates
@@ -118,6 +121,8 @@ void main() {
     planes[5] = vec4(-forward, dot(forward, eye) + zMax);
     vec3 boxMin = corners[0], boxMax = corners[0];
     for (int i = 1; i < 8; ++i) boxMin = min(boxMin, corners[i]), boxMax = max(boxMax, corners[i]);
+    float radius = 0.0; // the volume's bounding sphere about `centre` (spot cones)
+    for (int i = 0; i < 8; ++i) radius = max(radius, distance(corners[i], centre));
 
     // Lights against the tile, kept in light order: the frustum's lights near the tile's box
     // from the light grid (render/lighting/light_grid.h), or, where the grid cannot answer
@@ -132,7 +137,7 @@ void main() {
             uvec2 list = lightGridSource(grid, source);
             for (uint i = tid; i < list.y; i += THREADS) {
                 uint index = entries.v[list.x + i];
-                if (tileKeepsLight(lights.l[index], planes, boxMin, boxMax, corners) &&
+                if (tileKeepsLight(lights.l[index], planes, boxMin, boxMax, corners, centre, radius) &&
                     inFrustumLights(frustumLights, lf.frustumLightCount, index))
                     atomicOr(sGridMask[index >> 5], 1u << (index & 31u));
             }
@@ -143,7 +148,7 @@ void main() {
         for (uint base = 0u; base < lf.frustumLightCount; base += THREADS) {
             uint index = base + tid < lf.frustumLightCount ? frustumLights.v[base + tid] : LIGHT_INVALID;
             bool keep = index != LIGHT_INVALID &&
-                        tileKeepsLight(lights.l[index], planes, boxMin, boxMax, corners);
+                        tileKeepsLight(lights.l[index], planes, boxMin, boxMax, corners, centre, radius);
             uint slot = orderedAppend(keep);
             if (slot < LIGHT_TILE_MAX_LIGHTS) sList[slot] = uvec2(index, 0u);
         }

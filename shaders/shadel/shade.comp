@@ -141,10 +141,7 @@ void cullChunkLights(FrameConstants f, bool shading, vec3 p) {
             uint index = base + tid;
             bool keep = false;
             if (index < f.lightCount) {
-                GpuLight light = lights.l[index];
-                vec4 sphere = lightSphere(light);
-                keep = sphere.w < 0.0 || distance(clamp(sphere.xyz, boxMin, boxMax), sphere.xyz) <= sphere.w;
-                keep = keep && !clipPlaneCulls(light, corners);
+                keep = chunkKeepsLight(lights.l[index], boxMin, boxMax, corners);
             }
             uint slot = orderedAppend(keep);
             if (slot < LIGHT_CHUNK_MAX_LIGHTS) sLightList[slot] = uvec2(index, 0u);

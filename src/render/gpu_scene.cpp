@@ -22,15 +22,17 @@ static uint32_t mipCount(uint32_t w, uint32_t h) {
     return 1 + uint32_t(std::floor(std::log2(double(std::max(w, h)))));
 }
 
-gpu::GpuLight gpuLight(const Light& l, std::vector<uint32_t>& blockerLists) {
+gpu::GpuLight gpuLight(const Light& l, std::vector<uint32_t>& blockerLists, uint32_t textureSlot) {
     gpu::GpuLight g{};
+    bool spot = l.type == LightType::Spot || l.type == LightType::SquareSpot;
+    bool gobo = spot && textureSlot != NO_TEXTURE;
     g.position = l.position;
     g.type = uint32_t(l.type);
     g.direction = glm::normalize(l.direction);
     g.range = l.range;
     g.color = l.color * l.intensity * (l.dark ? -1.0f : 1.0f);
     g.flags = (l.dark ? LIGHT_FLAG_DARK : 0u) | (l.hasClipPlane ? LIGHT_FLAG_CLIP_PLANE : 0u) |
-              (l.softShadow ? LIGHT_FLAG_SOFT_SHADOW : 0u);
+              (l.softShadow ? LIGHT_FLAG_SOFT_SHADOW : 0u) | (gobo ? LIGHT_FLAG_PROJECTED : 0u);
     g.shadowIndex = LIGHT_NO_SHADOW; // given by uploadScene to shadow-casting spots
     g.clipPlane = l.clipPlane;
     if (l.type == LightType::SquareSpot) {
@@ -44,9 +46,10 @@ gpu::GpuLight gpuLight(const Light& l, std::vector<uint32_t>& blockerLists) {
         g.spotScale = 1.0f / std::max(cosInner - cosOuter, 1e-4f);
         g.spotOffset = -cosOuter * g.spotScale;
     }
-    // The square cone's right axis and the tube's segment: orthogonal to the direction for spots.
+    // The square cone's (gobo's, rectangle's) right axis and the tube's segment: orthogonal to
+    // the direction for spots and area lights.
     glm::vec3 axis = glm::length(l.axis) > 0.0f ? glm::normalize(l.axis) : glm::vec3(1, 0, 0);
-    if (l.type == LightType::SquareSpot) {
+    if (l.type == LightType::SquareSpot || gobo || l.type == LightType::Area) {
         axis -= g.direction * glm::dot(axis, g.direction);
         if (glm::length(axis) < 1e-4f)
             axis = glm::cross(g.direction, std::abs(g.direction.y) < 0.9f ? glm::vec3(0, 1, 0)
@@ -57,6 +60,18 @@ gpu::GpuLight gpuLight(const Light& l, std::vector<uint32_t>& blockerLists) {
     g.halfLength = l.type == LightType::Tube ? 0.5f * l.tubeLength : 0.0f;
     // Tubes: the tube's radius; spots: the emitter's width (soft shadows' penumbra).
     g.radius = l.type == LightType::Tube ? l.tubeRadius : l.lightSize;
+    g.textureSlot = gobo || l.type == LightType::Area ? textureSlot : NO_TEXTURE;
+    g.textureScale = 1.0f;
+    if (gobo) {
+        // UV = 0.5 + tan(angle off the axis) * textureScale along right and up: the outer cone
+        // spans the texture `textureTiling` times.
+        float tanOuter = std::tan(std::clamp(l.outerConeAngle, 1e-3f, 1.5f));
+        g.textureScale = 0.5f * std::max(l.textureTiling, 1e-3f) / tanOuter;
+    }
+    if (l.type == LightType::Area) {
+        g.halfLength = 0.5f * std::max(l.areaSize.x, 1e-3f);
+        g.radius = 0.5f * std::max(l.areaSize.y, 1e-3f);
+    }
     g.blockerFirst = uint32_t(blockerLists.size());
     g.blockerCount = uint32_t(std::min<size_t>(l.blockers.size(), LIGHT_MAX_BLOCKERS_PER_LIGHT));
     blockerLists.insert(blockerLists.end(), l.blockers.begin(),
@@ -103,6 +118,8 @@ void uploadScene(Gpu& gpu, const Scene& scene, GpuScene& out, const std::vector<
         if (m.emissiveTexture >= 0 && size_t(m.emissiveTexture) < srgb.size())
             srgb[m.emissiveTexture] = true;
     }
+    for (const Light& l : scene.lights) // gobos and area lights' emission are colour
+        if (l.texture >= 0 && size_t(l.texture) < srgb.size()) srgb[l.texture] = true;
     // Streamed textures (render/streaming) keep their bindless slots there; none load here.
     for (size_t i = 0; !streamedTextureSlots && i < scene.textures.size(); ++i) {
         const Texture& t = scene.textures[i];
@@ -271,7 +288,7 @@ void uploadScene(Gpu& gpu, const Scene& scene, GpuScene& out, const std::vector<
             out.sunCastsShadow = true;
             continue;
         }
-        lights.push_back(gpuLight(l, lightBlockers));
+        lights.push_back(gpuLight(l, lightBlockers, textureSlot(l.texture)));
         // Spot shadow maps (render/lighting/spot_shadows.h), in light order, up to the atlas's.
         bool spot = l.type == LightType::Spot || l.type == LightType::SquareSpot;
         if (l.castsShadow && spot && spotShadows < LIGHT_MAX_SPOT_SHADOWS)

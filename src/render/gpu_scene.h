@@ -70,7 +70,9 @@ void uploadScene(Gpu& gpu, const Scene& scene, GpuScene& out,
                  const std::vector<BakedMesh>* baked = nullptr,
                  const std::vector<uint32_t>* streamedTextureSlots = nullptr);
 // One scene light as the GPU sees it; appends the blockers it lists to `blockerLists`.
-gpu::GpuLight gpuLight(const Light& light, std::vector<uint32_t>& blockerLists);
+// `textureSlot`: the bindless slot of the light's texture (gobo, area emission), or NO_TEXTURE.
+gpu::GpuLight gpuLight(const Light& light, std::vector<uint32_t>& blockerLists,
+                       uint32_t textureSlot = NO_TEXTURE);
 void destroyScene(Gpu& gpu, GpuScene& scene);
 
 } // namespace shadel

@@ -788,6 +788,7 @@ const std::vector<std::pair<std::string, std::function<Scene()>>>& registry() {
         {"particles", makeParticles},
         {"lights", [] { return makeLightsScene(makeDefault()); }},
         {"blockers", makeBlockersScene},
+        {"textured-lights", makeTexturedLightsScene},
         {"cornell", makeCornell},
         {"arena", makeArena},
         {"decals", makeDecalsScene},

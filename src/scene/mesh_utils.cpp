@@ -223,6 +223,9 @@ std::string sceneInvariantViolation(const Scene& scene) {
             tex.rgba8.size() != (tex.procedural.kind != 0 ? 0 : texels))
             return "texture " + std::to_string(i) + ": size";
     }
+    for (const Light& l : scene.lights)
+        if (!textureOk(l.texture) || !(l.areaSize.x > 0.0f && l.areaSize.y > 0.0f))
+            return "light '" + l.name + "': texture index or area size";
     for (size_t i = 0; i < scene.instances.size(); ++i) {
         const Instance& inst = scene.instances[i];
         if (inst.mesh >= scene.meshes.size())

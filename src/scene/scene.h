@@ -177,9 +177,18 @@ struct Instance {
 
 // Point is the omni light; Spot has a round cone, SquareSpot a square one (a pyramid whose
 // half-angles are the cone angles, turned about the direction by `axis`); Tube is a line light
-// of `tubeLength` along `axis` (seed 001's "realistic" tube lights). glTF KHR_lights_punctual
-// gives Directional, Point and Spot.
-enum class LightType : uint32_t { Directional = 0, Point = 1, Spot = 2, SquareSpot = 3, Tube = 4 };
+// of `tubeLength` along `axis` (seed 001's "realistic" tube lights); Area is a one-sided
+// rectangle of `areaSize` (along `axis`, and along cross(direction, axis)) centred at `position`,
+// emitting `texture` (or a flat colour) toward `direction`. A spot with a `texture` projects it
+// (a gobo). glTF KHR_lights_punctual gives Directional, Point and Spot.
+enum class LightType : uint32_t {
+    Directional = 0,
+    Point = 1,
+    Spot = 2,
+    SquareSpot = 3,
+    Tube = 4,
+    Area = 5
+};
 
 struct Light {
     std::string name;
@@ -192,13 +201,18 @@ struct Light {
     float innerConeAngle = 0.0f;
     float outerConeAngle = 0.7853982f;
     bool castsShadow = false;
-    bool softShadow = false;   // shadow-casting spots: variable penumbra (PCSS) instead of PCF
-    float lightSize = 0.1f;    // the emitter's width (metres): PCSS penumbra size
-    bool dark = false;         // a negative light: subtracts what it would add
-    glm::vec3 axis{1, 0, 0};   // tube: the segment; square spot: the cone's "right" axis
-    float tubeLength = 0.0f;   // tube: the segment's length
-    float tubeRadius = 0.0f;   // tube: its radius (softens the highlight)
-    bool hasClipPlane = false; // lights only where dot(clipPlane, (p, 1)) >= 0
+    bool softShadow = false; // shadow-casting spots: variable penumbra (PCSS) instead of PCF
+    float lightSize = 0.1f;  // the emitter's width (metres): PCSS penumbra size
+    bool dark = false;       // a negative light: subtracts what it would add
+    glm::vec3 axis{1, 0, 0}; // tube: the segment; square spot, gobo, area: the "right" axis
+    float tubeLength = 0.0f; // tube: the segment's length
+    float tubeRadius = 0.0f; // tube: its radius (softens the highlight)
+    // Spots: a gobo (projected texture); area lights: the emitted texture (radiance = colour *
+    // intensity * texel). Index into Scene::textures, kNoTexture for none.
+    int32_t texture = kNoTexture;
+    float textureTiling = 1.0f;     // gobo: repeats of the texture across the outer cone
+    glm::vec2 areaSize{1.0f, 1.0f}; // area: width (along axis), height (metres)
+    bool hasClipPlane = false;      // lights only where dot(clipPlane, (p, 1)) >= 0
     glm::vec4 clipPlane{0, 1, 0, 0};
     std::vector<uint32_t> blockers; // indices into Scene::blockers that stop this light
 };

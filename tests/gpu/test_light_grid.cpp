@@ -39,9 +39,10 @@ TEST(LightGrid, CandidatesHoldEveryLightThatMeetsTheBoxAndFewOthers) {
     std::vector<gpu::GpuLight> lights;
     for (int i = 0; i < 3000; ++i) {
         float r = unit(rng) < 0.02f ? 40.0f : radius(rng); // a few wide lights
-        uint32_t type = i % 7 == 0 ? LIGHT_TUBE : LIGHT_POINT;
+        uint32_t type = i % 7 == 0 ? LIGHT_TUBE : i % 11 == 0 ? LIGHT_AREA : LIGHT_POINT;
         gpu::GpuLight l = pointLight({pos(rng), height(rng), pos(rng)}, r, type);
-        l.halfLength = type == LIGHT_TUBE ? 1.5f : 0.0f;
+        l.halfLength = type == LIGHT_TUBE ? 1.5f : type == LIGHT_AREA ? 2.0f : 0.0f;
+        l.radius = type == LIGHT_AREA ? 1.0f : 0.0f; // an area light's half height
         lights.push_back(l);
     }
     lights.push_back(pointLight({0, 50, 0}, 0.0f)); // infinite range: always a candidate

@@ -24,6 +24,8 @@ const char* lightKindName(uint32_t type) {
         return "square spot";
     case LIGHT_TUBE:
         return "tube";
+    case LIGHT_AREA:
+        return "area";
     default:
         return "light";
     }
@@ -98,9 +100,10 @@ void buildSceneEditor(SceneEditor& e, Renderer& r, const GpuScene& scene) {
         e.light = std::clamp(e.light, 0, int(lightCount) - 1);
         ImGui::SliderInt("light", &e.light, 0, int(lightCount) - 1);
         gpu::GpuLight l = currentLight(r, scene, uint32_t(e.light));
-        ImGui::Text("%s%s%s", lightKindName(l.type),
+        ImGui::Text("%s%s%s%s", lightKindName(l.type),
                     l.shadowIndex != LIGHT_NO_SHADOW ? ", shadow map" : "",
-                    (l.flags & LIGHT_FLAG_DARK) ? ", dark" : "");
+                    (l.flags & LIGHT_FLAG_DARK) ? ", dark" : "",
+                    (l.flags & LIGHT_FLAG_PROJECTED) ? ", gobo" : "");
         if (lightSection(l)) {
             editLight(r, scene, uint32_t(e.light), l);
             e.lights[uint32_t(e.light)] = currentLight(r, scene, uint32_t(e.light));

@@ -25,22 +25,29 @@ namespace {
 // here. The seed's gain is GPU occupancy (fewer registers per thread); a CPU rasterizer has no
 // such limit, and a tile's features are uniform across its workgroup, so branches for features
 // it lacks are already skipped at run time.
+// Gobos and textured area lights (a texture read per light, area lights a 4x4 integral) are
+// the costliest kinds and light only a few tiles of builtin:lights: two modes add both, to the
+// punctual lights (builtin:textured-lights: most lit tiles) and to the street's, so tiles
+// without them never carry their code.
 constexpr uint32_t kSpots = SPECTRUM_OMNI | SPECTRUM_SPOT | SPECTRUM_SQUARE_SPOT | SPECTRUM_SHADOWS;
 constexpr uint32_t kStreet = kSpots | SPECTRUM_TUBE | SPECTRUM_DARK | SPECTRUM_CLIP_PLANES;
+constexpr uint32_t kShadowedStreet = kStreet | SPECTRUM_SPOT_SHADOWS | SPECTRUM_SOFT_SHADOWS;
 const uint32_t kSpectrumModes[] = {
-    0u,                              // sky, or only the ambient reaches the tile
-    SPECTRUM_SHADOWS,                // the sun (moon) alone
-    kSpots,                          // punctual lights
-    kSpots | SPECTRUM_TUBE,          // and tubes
-    kStreet,                         // and darks, clip planes
-    kStreet | SPECTRUM_SPOT_SHADOWS, // and shadowed spots (PCF)
-    kStreet | SPECTRUM_SPOT_SHADOWS | SPECTRUM_SOFT_SHADOWS, // and PCSS
-    SPECTRUM_ALL,                                            // blockers and portals too
+    0u,                                          // sky, or only the ambient reaches the tile
+    SPECTRUM_SHADOWS,                            // the sun (moon) alone
+    kSpots,                                      // punctual lights
+    kSpots | SPECTRUM_PROJECTED | SPECTRUM_AREA, // punctual with gobos, textured area lights
+    kSpots | SPECTRUM_TUBE,                      // punctual and tubes
+    kStreet,                                     // and darks, clip planes
+    kStreet | SPECTRUM_SPOT_SHADOWS,             // and shadowed spots (PCF)
+    kShadowedStreet,                             // and PCSS
+    kShadowedStreet | SPECTRUM_PROJECTED | SPECTRUM_AREA, // and gobos, textured area lights
+    SPECTRUM_ALL,                                         // blockers and portals too
 };
 
 const char* const kFeatureNames[SPECTRUM_FEATURE_COUNT] = {
-    "omni",     "spot",    "square_spot", "tube",         "dark",        "clip_planes",
-    "blockers", "portals", "shadows",     "spot_shadows", "soft_shadows"};
+    "omni",    "spot",    "square_spot",  "tube",         "dark",      "clip_planes", "blockers",
+    "portals", "shadows", "spot_shadows", "soft_shadows", "projected", "area"};
 
 std::string modeName(uint32_t features) {
     if (features == 0u) return "nothing_special";

@@ -4,6 +4,8 @@
 #include <cstring>
 #include <limits>
 
+#include "render/lighting/light_culling.h"
+
 namespace shadel {
 
 std::vector<gpu::GpuLight> animatedLights(const std::vector<gpu::GpuLight>& lights,
@@ -30,8 +32,7 @@ std::vector<glm::vec4> changedLightVolumes(const std::vector<gpu::GpuLight>& bef
     for (size_t i = 0; i < after.size(); ++i) {
         if (std::memcmp(&before[i], &after[i], sizeof(gpu::GpuLight)) == 0) continue;
         for (const gpu::GpuLight* l : {&before[i], &after[i]}) {
-            float radius = l->type == LIGHT_DIRECTIONAL || l->range <= 0.0f ? infinite : l->range;
-            volumes.push_back(glm::vec4(l->position, radius));
+            volumes.push_back(glm::vec4(l->position, lightReach(*l)));
         }
     }
     return volumes;

@@ -2,7 +2,9 @@
 
 #include <algorithm>
 #include <bit>
+#include <cmath>
 #include <cstring>
+#include <limits>
 
 #include "render/camera.h"
 #include "render/lighting/light_grid.h"
@@ -83,6 +85,14 @@ void destroyLightCulling(Renderer& r, LightCullingStatePtr& state) {
     state.reset();
 }
 
+float lightReach(const gpu::GpuLight& l) {
+    if (l.type == LIGHT_DIRECTIONAL || l.range <= 0.0f)
+        return std::numeric_limits<float>::infinity();
+    float extra = l.type == LIGHT_TUBE ? l.halfLength : 0.0f;
+    if (l.type == LIGHT_AREA) extra = std::hypot(l.halfLength, l.radius);
+    return l.range + extra;
+}
+
 uint64_t prepareLightCulling(Renderer& r, const GpuScene& scene,
                              const std::vector<gpu::GpuLight>& lights,
                              const gpu::FrameConstants& constants) {
@@ -97,8 +107,7 @@ uint64_t prepareLightCulling(Renderer& r, const GpuScene& scene,
     for (uint32_t i = 0; i < lights.size(); ++i) {
         const gpu::GpuLight& l = lights[i];
         bool in = true;
-        if (l.type != LIGHT_DIRECTIONAL && l.range > 0.0f) {
-            float radius = l.range + (l.type == LIGHT_TUBE ? l.halfLength : 0.0f);
+        if (float radius = lightReach(l); std::isfinite(radius)) {
             for (const glm::vec4& p : planes)
                 in = in && glm::dot(glm::vec3(p), l.position) + p.w >= -radius;
         }

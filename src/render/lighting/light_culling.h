@@ -35,6 +35,10 @@ void destroyLightCulling(Renderer& r, LightCullingStatePtr& state);
 uint64_t prepareLightCulling(Renderer& r, const GpuScene& scene,
                              const std::vector<gpu::GpuLight>& lights,
                              const gpu::FrameConstants& constants);
+// The radius about GpuLight::position within which the light reaches anything: its range,
+// plus a tube's half length or an area light's half diagonal; infinite without a range (and for
+// directional lights). The CPU's side of lightSphere (shaders/lighting/light_cull.glsl).
+float lightReach(const gpu::GpuLight& light);
 // Whether this frame builds tile lists: --light-culling tiled and enough lights in view (or
 // blockers to classify); otherwise shading loops over the lights directly.
 bool lightTilesThisFrame(const Renderer& r);

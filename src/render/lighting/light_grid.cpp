@@ -5,6 +5,7 @@
 #include <cstring>
 
 #include "core/error.h"
+#include "render/lighting/light_culling.h"
 #include "rhi/resources.h"
 
 namespace shadel {
@@ -40,9 +41,8 @@ uint32_t bucketOf(glm::ivec3 cell) {
 } // namespace
 
 glm::vec4 lightBoundingSphere(const gpu::GpuLight& l) {
-    if (l.type == LIGHT_DIRECTIONAL || !(l.range > 0.0f)) return glm::vec4(l.position, -1.0f);
-    float extra = l.type == LIGHT_TUBE ? l.halfLength : 0.0f;
-    return glm::vec4(l.position, l.range + extra);
+    float reach = lightReach(l);
+    return glm::vec4(l.position, std::isfinite(reach) && reach > 0.0f ? reach : -1.0f);
 }
 
 LightGridData buildLightGrid(const std::vector<gpu::GpuLight>& lights) {
