@@ -156,10 +156,10 @@ uint lightBlockerMask(LightingFrame lf, GpuLight light, vec3 corners[8], vec3 bo
 // uniform control flow.
 shared uint sAppendCount;
 shared uint sSubgroupCounts[256];
-uint orderedAppend(bool keep) {
-    uvec4 ballot = subgroupBallot(keep);
-    uint within = subgroupBallotExclusiveBitCount(ballot);
-    if (subgroupElect()) sSubgroupCounts[gl_SubgroupID] = subgroupBallotBitCount(ballot);
+// This subgroup's first slot, given how many items it appends, after those already placed and
+// those of the subgroups before it; sAppendCount then counts the whole workgroup's.
+uint orderedAppendSubgroupBase(uint subgroupItems) {
+    if (subgroupElect()) sSubgroupCounts[gl_SubgroupID] = subgroupItems;
     barrier();
     uint base = sAppendCount;
     for (uint s = 0u; s < gl_SubgroupID; ++s) base += sSubgroupCounts[s];
@@ -169,7 +169,13 @@ uint orderedAppend(bool keep) {
     barrier();
     if (gl_LocalInvocationIndex == 0u) sAppendCount += total;
     barrier();
-    return keep ? base + within : LIGHT_INVALID;
+    return base;
+}
+
+uint orderedAppend(bool keep) {
+    uvec4 ballot = subgroupBallot(keep);
+    uint base = orderedAppendSubgroupBase(subgroupBallotBitCount(ballot));
+    return keep ? base + subgroupBallotExclusiveBitCount(ballot) : LIGHT_INVALID;
 }
 #endif
 

@@ -16,19 +16,7 @@ shared uint sGridCandidates;
 // orderedAppend for n entries per invocation: each invocation's first slot, in invocation
 // order after those already placed.
 uint orderedAppendCount(uint n) {
-    uint within = subgroupExclusiveAdd(n);
-    uint subgroupTotal = subgroupAdd(n);
-    if (subgroupElect()) sSubgroupCounts[gl_SubgroupID] = subgroupTotal;
-    barrier();
-    uint base = sAppendCount;
-    for (uint s = 0u; s < gl_SubgroupID; ++s) base += sSubgroupCounts[s];
-    uint total = 0u;
-    if (gl_LocalInvocationIndex == 0u)
-        for (uint s = 0u; s < gl_NumSubgroups; ++s) total += sSubgroupCounts[s];
-    barrier();
-    if (gl_LocalInvocationIndex == 0u) sAppendCount += total;
-    barrier();
-    return base + within;
+    return orderedAppendSubgroupBase(subgroupAdd(n)) + subgroupExclusiveAdd(n);
 }
 
 // A box's grid query: its level and cells. Sources: 0 the global list, 1 the level's big

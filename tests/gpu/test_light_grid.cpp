@@ -30,6 +30,16 @@ bool sphereMeetsBox(glm::vec4 s, glm::vec3 lo, glm::vec3 hi) {
     return glm::distance(glm::clamp(glm::vec3(s), lo, hi), glm::vec3(s)) <= s.w;
 }
 
+// builtin:lights (2069 lights) with and without the grid; the images must be identical.
+std::pair<RenderRun, RenderRun> renderWithAndWithoutTheGrid(RenderMode mode) {
+    RenderOptions o = renderOptions("builtin:lights", mode, 192, 108);
+    RenderRun on = renderChecked(o);
+    o.lightGrid = false;
+    RenderRun off = renderChecked(o);
+    EXPECT_GE(psnr(on.frames[0].rgba, off.frames[0].rgba), 99.0);
+    return {std::move(on), std::move(off)};
+}
+
 } // namespace
 
 TEST(LightGrid, CandidatesHoldEveryLightThatMeetsTheBoxAndFewOthers) {
@@ -110,16 +120,10 @@ TEST(LightGrid, NoFiniteLightsGivesAnEmptyGrid) {
     EXPECT_FALSE(lightGridCandidates(grid, glm::vec3(0), glm::vec3(1)).has_value());
 }
 
-// builtin:lights (2020 lights) in the shadel path: the same chunk lists and image with and
+// The shadel path: the same chunk lists and image with and
 // without the grid, from far fewer tested lights.
 TEST(LightGrid, ShadelChunkListsAndImageAreTheSameWithAndWithoutTheGrid) {
-    auto run = [](bool grid) {
-        RenderOptions o = renderOptions("builtin:lights", RenderMode::Decoupled, 192, 108);
-        o.lightGrid = grid;
-        return renderChecked(o);
-    };
-    RenderRun on = run(true), off = run(false);
-    EXPECT_GE(psnr(on.frames[0].rgba, off.frames[0].rgba), 99.0);
+    auto [on, off] = renderWithAndWithoutTheGrid(RenderMode::Decoupled);
     ASSERT_GT(off.stats["light_chunk_pairs"].get<uint64_t>(), 1000u);
     EXPECT_EQ(on.stats["light_chunk_pairs"], off.stats["light_chunk_pairs"]);
     EXPECT_EQ(on.stats["light_chunks_overflowed"], off.stats["light_chunks_overflowed"]);
@@ -134,13 +138,7 @@ TEST(LightGrid, ShadelChunkListsAndImageAreTheSameWithAndWithoutTheGrid) {
 // Forward: the screen tiles take the frustum's lights near their box from the grid; the same
 // tile lists and image as the loop over every frustum light.
 TEST(LightGrid, ForwardTileListsAndImageAreTheSameWithAndWithoutTheGrid) {
-    auto run = [](bool grid) {
-        RenderOptions o = renderOptions("builtin:lights", RenderMode::Forward, 192, 108);
-        o.lightGrid = grid;
-        return renderChecked(o);
-    };
-    RenderRun on = run(true), off = run(false);
-    EXPECT_GE(psnr(on.frames[0].rgba, off.frames[0].rgba), 99.0);
+    auto [on, off] = renderWithAndWithoutTheGrid(RenderMode::Forward);
     ASSERT_GT(off.stats["light_tile_pairs"].get<uint64_t>(), 1000u);
     EXPECT_EQ(on.stats["light_tile_pairs"], off.stats["light_tile_pairs"]);
     EXPECT_EQ(on.stats["lights_visible"], off.stats["lights_visible"]);
