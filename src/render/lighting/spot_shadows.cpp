@@ -10,6 +10,7 @@
 #include "core/error.h"
 #include "render/culling/culling.h"
 #include "render/forward/forward_passes.h"
+#include "render/lighting/shadow_atlas.h"
 #include "render/renderer.h"
 
 namespace shadel {
@@ -25,11 +26,8 @@ constexpr float kSunPenumbraScale = 0.0262f;
 } // namespace
 
 struct SpotShadowState {
-    TextureHandle atlas;
-    DepthTargetView target;
-    TextureReadView read;
-    BufferHandle shadows; // gpu::GpuSpotShadow[] (upload)
-    Pipeline pass;
+    ShadowAtlas atlas;
+    BufferHandle shadows;          // gpu::GpuSpotShadow[] (upload)
     std::vector<uint32_t> lightOf; // light index per shadow index
     std::vector<glm::uvec4> rects; // atlas texels: x, y, size, 1 if placed
     uint32_t placed = 0;
@@ -77,38 +75,18 @@ SpotShadowStatePtr createSpotShadows(Renderer& r, const GpuScene& scene) {
     }
     s->atlasTexelsUsed = allocator.usedVolume();
 
-    TextureDesc atlas;
-    atlas.name = "spotShadowAtlas";
-    atlas.format = VK_FORMAT_D32_SFLOAT;
-    atlas.width = atlas.height = kAtlasSize;
-    atlas.usage = VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT | VK_IMAGE_USAGE_SAMPLED_BIT;
-    s->atlas = createTexture(gpu, atlas);
     s->shadows = createBuffer(
         gpu, {"spotShadows", lightOf.size() * sizeof(gpu::GpuSpotShadow), 0, MemoryKind::Upload});
-    if (!s->atlas || !s->shadows) throw DeviceError("out of GPU memory for the spot shadow atlas");
-    s->target = createDepthTargetView(gpu, s->atlas);
-    s->read = createReadView(gpu, s->atlas);
-
-    GraphicsPipelineDesc pass;
-    pass.name = "spotShadowMaps";
-    pass.vertexShader = "lighting_spot_shadow.vert.spv";
-    pass.fragmentShader = "forward_depth.frag.spv";
-    pass.depthFormat = VK_FORMAT_D32_SFLOAT;
-    pass.depthCompare = VK_COMPARE_OP_LESS_OR_EQUAL;
-    pass.cullMode = VK_CULL_MODE_NONE;
-    pass.depthClamp = true;
-    pass.depthBias = true;
-    s->pass = createGraphicsPipeline(gpu, pass);
+    if (!s->shadows) throw DeviceError("out of GPU memory for the spot shadow atlas");
+    s->atlas = createShadowAtlas(gpu, "spotShadow", kAtlasSize, kAtlasSize,
+                                 "lighting_spot_shadow.vert.spv");
     return s;
 }
 
 void destroySpotShadows(Renderer& r, SpotShadowStatePtr& state) {
     if (!state) return;
     Gpu& gpu = *r.gpu;
-    destroy(gpu, state->pass);
-    destroy(gpu, state->target);
-    destroy(gpu, state->read);
-    destroy(gpu, state->atlas);
+    destroyShadowAtlas(gpu, state->atlas);
     destroy(gpu, state->shadows);
     state.reset();
 }
@@ -180,7 +158,7 @@ void prepareShadows(Renderer& r, const std::vector<gpu::GpuLight>& lights,
     }
     std::memcpy(out, views.data(), views.size() * sizeof(gpu::GpuSpotShadow));
     f.spotShadows = address(gpu, s.shadows);
-    f.spotShadowAtlas = slot(gpu, s.read).value;
+    f.spotShadowAtlas = slot(gpu, s.atlas.read).value;
 }
 
 bool spotShadowViewProj(const Renderer& r, uint32_t index, glm::mat4& viewProj) {
@@ -203,45 +181,15 @@ bool spotShadowMapsThisFrame(const Renderer& r) {
 void recordSpotShadowMaps(Renderer& r, VkCommandBuffer cmd, uint64_t frame) {
     Gpu& gpu = *r.gpu;
     SpotShadowState& s = *r.spotShadows;
-    VkImage image = vkImage(gpu, s.atlas);
-    imageBarrier(
-        cmd, image, VK_IMAGE_ASPECT_DEPTH_BIT, VK_IMAGE_LAYOUT_UNDEFINED,
-        VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL,
-        VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT | VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, 0,
-        VK_PIPELINE_STAGE_2_EARLY_FRAGMENT_TESTS_BIT | VK_PIPELINE_STAGE_2_LATE_FRAGMENT_TESTS_BIT,
-        VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT |
-            VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_READ_BIT);
-    VkRenderingAttachmentInfo depth{VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO};
-    depth.imageView = vkView(gpu, s.target);
-    depth.imageLayout = VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL;
-    depth.loadOp = VK_ATTACHMENT_LOAD_OP_CLEAR;
-    depth.storeOp = VK_ATTACHMENT_STORE_OP_STORE;
-    depth.clearValue.depthStencil = {1.0f, 0};
-    VkRenderingInfo ri{VK_STRUCTURE_TYPE_RENDERING_INFO};
-    ri.renderArea = {{0, 0}, {kAtlasSize, kAtlasSize}};
-    ri.layerCount = 1;
-    ri.pDepthAttachment = &depth;
-    vkCmdBeginRendering(cmd, &ri);
-    bind(gpu, cmd, s.pass);
-    vkCmdSetDepthBias(cmd, 1.25f, 0.0f, 1.75f);
-    vkCmdBindIndexBuffer(cmd, vkBuffer(gpu, r.sceneIndices), 0, VK_INDEX_TYPE_UINT32);
+    beginShadowAtlas(gpu, cmd, s.atlas, vkBuffer(gpu, r.sceneIndices));
     for (uint32_t i = 0; i < s.rects.size(); ++i) {
         glm::uvec4 rect = s.rects[i];
         if (!rect.w) continue;
-        VkViewport vp{float(rect.x), float(rect.y), float(rect.z), float(rect.z), 0, 1};
-        VkRect2D scissor{{int32_t(rect.x), int32_t(rect.y)}, {rect.z, rect.z}};
-        vkCmdSetViewport(cmd, 0, 1, &vp);
-        vkCmdSetScissor(cmd, 0, 1, &scissor);
+        setShadowMapViewport(cmd, rect.x, rect.y, rect.z);
         pushConstants(gpu, cmd, RasterPush{frame, 2u + i});
         drawShadowViewList(r, cmd, CULL_VIEW_SPOT0 + i);
     }
-    vkCmdEndRendering(cmd);
-    imageBarrier(cmd, image, VK_IMAGE_ASPECT_DEPTH_BIT, VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL,
-                 VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL,
-                 VK_PIPELINE_STAGE_2_LATE_FRAGMENT_TESTS_BIT,
-                 VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT,
-                 VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT | VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
-                 VK_ACCESS_2_SHADER_SAMPLED_READ_BIT);
+    endShadowAtlas(gpu, cmd, s.atlas);
 }
 
 void spotShadowStats(const Renderer& r, nlohmann::json& stats) {

@@ -9,6 +9,7 @@
 #include "core/error.h"
 #include "render/culling/culling.h"
 #include "render/forward/forward_passes.h"
+#include "render/lighting/shadow_atlas.h"
 #include "render/renderer.h"
 
 namespace shadel {
@@ -27,11 +28,8 @@ struct SunCascadeState {
     uint32_t mapSize = 0; // texels per side of one cascade
     uint32_t columns = 1; // of the atlas
     Aabb sceneBounds;
-    TextureHandle atlas;
-    DepthTargetView target;
-    TextureReadView read;
+    ShadowAtlas atlas;
     BufferHandle cascades; // gpu::GpuSunCascades (upload)
-    Pipeline pass;
     gpu::GpuSunCascades last{};
     float wholeSceneTexel = 0.0f;
 };
@@ -50,39 +48,19 @@ SunCascadeStatePtr createSunCascades(Renderer& r, const GpuScene& scene) {
     s->mapSize = std::max(r.settings.shadowMapSize / 2, 256u);
     s->columns = std::min(s->count, 2u);
     s->sceneBounds = scene.bounds.valid() ? scene.bounds : Aabb{glm::vec3(-1), glm::vec3(1)};
-    TextureDesc atlas;
-    atlas.name = "sunCascadeAtlas";
-    atlas.format = VK_FORMAT_D32_SFLOAT;
-    atlas.width = s->mapSize * s->columns;
-    atlas.height = s->mapSize * ((s->count + s->columns - 1) / s->columns);
-    atlas.usage = VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT | VK_IMAGE_USAGE_SAMPLED_BIT;
-    s->atlas = createTexture(gpu, atlas);
     s->cascades =
         createBuffer(gpu, {"sunCascades", sizeof(gpu::GpuSunCascades), 0, MemoryKind::Upload});
-    if (!s->atlas || !s->cascades) throw DeviceError("out of GPU memory for the sun's cascades");
-    s->target = createDepthTargetView(gpu, s->atlas);
-    s->read = createReadView(gpu, s->atlas);
-
-    GraphicsPipelineDesc pass;
-    pass.name = "sunCascades";
-    pass.vertexShader = "lighting_sun_cascade.vert.spv";
-    pass.fragmentShader = "forward_depth.frag.spv";
-    pass.depthFormat = VK_FORMAT_D32_SFLOAT;
-    pass.depthCompare = VK_COMPARE_OP_LESS_OR_EQUAL;
-    pass.cullMode = VK_CULL_MODE_NONE;
-    pass.depthClamp = true;
-    pass.depthBias = true;
-    s->pass = createGraphicsPipeline(gpu, pass);
+    if (!s->cascades) throw DeviceError("out of GPU memory for the sun's cascades");
+    s->atlas = createShadowAtlas(gpu, "sunCascade", s->mapSize * s->columns,
+                                 s->mapSize * ((s->count + s->columns - 1) / s->columns),
+                                 "lighting_sun_cascade.vert.spv");
     return s;
 }
 
 void destroySunCascades(Renderer& r, SunCascadeStatePtr& state) {
     if (!state) return;
     Gpu& gpu = *r.gpu;
-    destroy(gpu, state->pass);
-    destroy(gpu, state->target);
-    destroy(gpu, state->read);
-    destroy(gpu, state->atlas);
+    destroyShadowAtlas(gpu, state->atlas);
     destroy(gpu, state->cascades);
     state.reset();
 }
@@ -94,7 +72,7 @@ uint64_t prepareSunCascades(Renderer& r, const gpu::FrameConstants& constants) {
     s.wholeSceneTexel = constants.shadowTexelSize;
     gpu::GpuSunCascades c{};
     c.count = s.count;
-    c.atlasSlot = slot(gpu, s.read).value;
+    c.atlasSlot = slot(gpu, s.atlas.read).value;
 
     // The camera's basis and its frustum's half-extents per metre of view depth.
     glm::mat4 invView = glm::inverse(constants.view);
@@ -185,45 +163,14 @@ glm::mat4 sunCascadeViewProj(const Renderer& r, uint32_t cascade) {
 void recordSunCascades(Renderer& r, VkCommandBuffer cmd, uint64_t frame) {
     Gpu& gpu = *r.gpu;
     SunCascadeState& s = *r.sunCascades;
-    VkImage image = vkImage(gpu, s.atlas);
-    const TextureDesc& d = desc(gpu, s.atlas);
-    imageBarrier(
-        cmd, image, VK_IMAGE_ASPECT_DEPTH_BIT, VK_IMAGE_LAYOUT_UNDEFINED,
-        VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL,
-        VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT | VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, 0,
-        VK_PIPELINE_STAGE_2_EARLY_FRAGMENT_TESTS_BIT | VK_PIPELINE_STAGE_2_LATE_FRAGMENT_TESTS_BIT,
-        VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT |
-            VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_READ_BIT);
-    VkRenderingAttachmentInfo depth{VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO};
-    depth.imageView = vkView(gpu, s.target);
-    depth.imageLayout = VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL;
-    depth.loadOp = VK_ATTACHMENT_LOAD_OP_CLEAR;
-    depth.storeOp = VK_ATTACHMENT_STORE_OP_STORE;
-    depth.clearValue.depthStencil = {1.0f, 0};
-    VkRenderingInfo ri{VK_STRUCTURE_TYPE_RENDERING_INFO};
-    ri.renderArea = {{0, 0}, {d.width, d.height}};
-    ri.layerCount = 1;
-    ri.pDepthAttachment = &depth;
-    vkCmdBeginRendering(cmd, &ri);
-    bind(gpu, cmd, s.pass);
-    vkCmdSetDepthBias(cmd, 1.25f, 0.0f, 1.75f);
-    vkCmdBindIndexBuffer(cmd, vkBuffer(gpu, r.sceneIndices), 0, VK_INDEX_TYPE_UINT32);
+    beginShadowAtlas(gpu, cmd, s.atlas, vkBuffer(gpu, r.sceneIndices));
     for (uint32_t i = 0; i < s.count; ++i) {
-        uint32_t x = (i % s.columns) * s.mapSize, y = (i / s.columns) * s.mapSize;
-        VkViewport vp{float(x), float(y), float(s.mapSize), float(s.mapSize), 0, 1};
-        VkRect2D scissor{{int32_t(x), int32_t(y)}, {s.mapSize, s.mapSize}};
-        vkCmdSetViewport(cmd, 0, 1, &vp);
-        vkCmdSetScissor(cmd, 0, 1, &scissor);
+        setShadowMapViewport(cmd, (i % s.columns) * s.mapSize, (i / s.columns) * s.mapSize,
+                             s.mapSize);
         pushConstants(gpu, cmd, RasterPush{frame, i});
         drawShadowViewList(r, cmd, CULL_VIEW_CASCADE0 + i);
     }
-    vkCmdEndRendering(cmd);
-    imageBarrier(cmd, image, VK_IMAGE_ASPECT_DEPTH_BIT, VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL,
-                 VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL,
-                 VK_PIPELINE_STAGE_2_LATE_FRAGMENT_TESTS_BIT,
-                 VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT,
-                 VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT | VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
-                 VK_ACCESS_2_SHADER_SAMPLED_READ_BIT);
+    endShadowAtlas(gpu, cmd, s.atlas);
 }
 
 void sunCascadeStats(const Renderer& r, nlohmann::json& stats) {
