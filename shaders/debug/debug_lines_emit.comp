@@ -2,11 +2,33 @@
 // --debug-lines lights|blockers: one invocation per light (its range sphere, spot cone, tube
 // segment or area light's rectangle; with blockers, the shadow frustum of every blocker it lists, from the light through
 // the blocker's corners out to its range), then one per blocker (its rectangle and portals).
+// With --debug-lines-at X,Y only the lights whose reach holds the surface point at that pixel.
 #include "debug/debug_lines.glsl"
 #include "common/lighting.glsl"
+#include "lighting/light_cull.glsl"
 
 layout(local_size_x = 64) in;
-layout(push_constant, scalar) uniform Push { uint64_t frame; } pc;
+layout(push_constant, scalar) uniform Push {
+    uint64_t frame;
+    int atX, atY;   // --debug-lines-at (internal pixel), -1: off
+    uint depthSlot; // the frame's depth, sampled when atX >= 0
+} pc;
+
+// The surface point seen at pixel (atX, atY); w = 0 for the sky.
+vec4 pickedSurface(FrameConstants f) {
+    float depth = fetchTextureUniform(pc.depthSlot, ivec2(pc.atX, pc.atY), 0).r;
+    if (depth <= 0.0) return vec4(0.0); // reversed Z: the sky
+    vec2 ndc = (vec2(pc.atX, pc.atY) + 0.5) * f.invViewportSize * 2.0 - 1.0;
+    vec4 w = f.invViewProj * vec4(ndc, depth, 1.0);
+    return vec4(w.xyz / w.w, 1.0);
+}
+
+// Whether the light reaches the surface seen at the picked pixel; never for the sky.
+bool reachesPickedSurface(FrameConstants f, GpuLight light) {
+    vec4 p = pickedSurface(f);
+    vec4 sphere = lightSphere(light);
+    return p.w != 0.0 && (sphere.w < 0.0 || distance(p.xyz, sphere.xyz) <= sphere.w);
+}
 
 vec3 lightColour(GpuLight light) {
     if ((light.flags & LIGHT_FLAG_DARK) != 0u) return vec3(1.0, 0.0, 1.0); // darks: magenta
@@ -105,12 +127,22 @@ void main() {
         lf = LightingFrameRef(f.lighting).l;
         blockerCount = lf.blockerCount;
     }
+    if (i == 0u && pc.atX >= 0) { // the picked point: a small magenta cross
+        vec4 p = pickedSurface(f);
+        float r = 0.15;
+        if (p.w != 0.0)
+            for (int a = 0; a < 3; ++a) {
+                vec3 axis = vec3(a == 0, a == 1, a == 2) * r;
+                debugLine(f, p.xyz - axis, p.xyz + axis, vec3(1.0, 0.0, 1.0));
+            }
+    }
     if (i < f.lightCount) {
         GpuLight light = LightBuffer(f.lights).l[i];
         // Only lights whose range meets the camera frustum (the lines are for what one sees).
         vec4 sphere = vec4(light.position, light.range > 0.0 ? light.range : 1e30);
         for (int k = 0; k < 6; ++k)
             if (dot(f.frustumPlanes[k].xyz, sphere.xyz) + f.frustumPlanes[k].w < -sphere.w) return;
+        if (pc.atX >= 0 && !reachesPickedSurface(f, light)) return;
         if (lights) emitLight(f, light);
         if (blockers && f.lighting != 0ul) emitBlockerFrusta(f, lf, light);
     } else if (blockers && i - f.lightCount < blockerCount) {

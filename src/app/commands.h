@@ -99,6 +99,7 @@ struct RenderOptions {
     std::string captureDir;
     // --inspect X,Y: print what the shading computed at that output pixel (last frame).
     int32_t inspectX = -1, inspectY = -1;
+    int32_t debugLinesAtX = -1, debugLinesAtY = -1; // --debug-lines-at X,Y
 };
 
 struct RenderRun {
@@ -115,6 +116,8 @@ Visualize parseVisualize(const std::string& text);
 MarkingMode parseMarking(const std::string& text);
 // "X,Y" -> pixel; throws InputError naming --inspect.
 void parseInspect(const std::string& text, int32_t& x, int32_t& y);
+// "X,Y" of a pixel for `flag`; one-line InputError otherwise.
+void parsePixel(const char* flag, const std::string& text, int32_t& x, int32_t& y);
 OitMode parseOit(const std::string& text);
 ParticleLighting parseParticleLighting(const std::string& text);
 LightCulling parseLightCulling(const std::string& text);

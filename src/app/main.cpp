@@ -330,6 +330,10 @@ int main(int argc, char** argv) {
                      "lights (ranges, cones), blockers (rectangles, portals, shadow frusta), "
                      "chunks (world boxes of the shadel chunks shaded)")
         ->capture_default_str();
+    std::string debugLinesAt;
+    render->add_option("--debug-lines-at", debugLinesAt,
+                       "X,Y: with --debug-lines lights|blockers, only the lights that reach the "
+                       "surface seen at that pixel (and their blocker frusta)");
     RtFlags rtFlags; // ray tracing (render/raytracing)
     addRayTracingFlags(*render, rtFlags);
     // Seed 004's screen-space passes and tile classification (render/screenspace, tiles).
@@ -626,6 +630,8 @@ int main(int argc, char** argv) {
             ro.lod = parseOnOff("--lod", lod);
             ro.occlusion = parseOnOff("--occlusion", occlusion);
             ro.debugLines = parseDebugLines(debugLines);
+            if (!debugLinesAt.empty())
+                parsePixel("--debug-lines-at", debugLinesAt, ro.debugLinesAtX, ro.debugLinesAtY);
             ro.rt = parseRayTracingFlags(rtFlags);
             ro.screenSpace = parseOnOff("--screen-space", screenSpace);
             ro.tileClassification = parseOnOff("--tile-classification", tileClassification);

@@ -110,13 +110,17 @@ MarkingMode parseMarking(const std::string& text) {
     throw InputError(format("--marking %s: expected auto, raster or visibility", text.c_str()));
 }
 
-void parseInspect(const std::string& text, int32_t& x, int32_t& y) {
+void parsePixel(const char* flag, const std::string& text, int32_t& x, int32_t& y) {
     unsigned px = 0, py = 0;
     char comma = 0, extra = 0;
     if (std::sscanf(text.c_str(), "%u%c%u%c", &px, &comma, &py, &extra) != 3 || comma != ',' ||
         px > 16383 || py > 16383)
-        throw InputError(format("--inspect %s: expected X,Y (a pixel, e.g. 40,20)", text.c_str()));
+        throw InputError(format("%s %s: expected X,Y (a pixel, e.g. 40,20)", flag, text.c_str()));
     x = int32_t(px), y = int32_t(py);
+}
+
+void parseInspect(const std::string& text, int32_t& x, int32_t& y) {
+    parsePixel("--inspect", text, x, y);
 }
 
 ParticleLighting parseParticleLighting(const std::string& text) {
@@ -176,6 +180,9 @@ RenderRun runRender(Gpu& gpu, const RenderOptions& o) {
     if (o.inspectX >= int32_t(o.width) || o.inspectY >= int32_t(o.height))
         throw InputError(format("--inspect %d,%d: outside the %ux%u image", o.inspectX, o.inspectY,
                                 o.width, o.height));
+    if (o.debugLinesAtX >= int32_t(o.width) || o.debugLinesAtY >= int32_t(o.height))
+        throw InputError(format("--debug-lines-at %d,%d: outside the %ux%u image", o.debugLinesAtX,
+                                o.debugLinesAtY, o.width, o.height));
     bool outDir = !o.out.empty() && o.out.back() == '/';
     if (outDir) {
         std::error_code ec;
@@ -353,6 +360,8 @@ RenderRun runRender(Gpu& gpu, const RenderOptions& o) {
     settings.lod = o.lod;
     settings.occlusion = o.occlusion;
     settings.debugLines = o.debugLines;
+    settings.debugLinesAtX = o.debugLinesAtX;
+    settings.debugLinesAtY = o.debugLinesAtY;
     settings.debugLineCapacity = o.debugLineCapacity;
     if (o.visualize == Visualize::RtAo && !o.rt.ao)
         throw InputError("--visualize rt-ao: shows the ray-traced AO of --rt-ao on; it is off");

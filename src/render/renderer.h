@@ -104,7 +104,7 @@ struct RenderSettings {
     LightCulling lightCulling = LightCulling::Tiled;
     bool lightBlockers =
         true;                // --blockers: light blockers and portals stop the lights listing them
-    bool lightGrid = true; // --light-grid: tiles and chunks take candidates from the light grid
+    bool lightGrid = true;   // --light-grid: tiles and chunks take candidates from the light grid
     GiMode gi = GiMode::Off; // --gi (off by default: see render/gi/lpv.h for its cost)
     uint32_t giIterations = 8;         // --gi-iterations: LPV propagation steps
     bool giBlockerCells = true;        // GI taps test only their 4^3 macro-cell's blockers
@@ -117,6 +117,9 @@ struct RenderSettings {
     uint32_t debugLines =
         0; // --debug-lines: DEBUG_LINES_* kinds drawn (render/debug/debug_lines.h)
     uint32_t debugLineCapacity = 256 * 1024; // segments the line buffer holds (8 MiB)
+    // --debug-lines-at X,Y: light lines only for the lights reaching the surface at that pixel
+    // of the output image (-1: every light in view).
+    int32_t debugLinesAtX = -1, debugLinesAtY = -1;
     RtSettings rt;         // --rt-*: ray-traced shadows, AO, GI (render/raytracing)
     bool particles = true; // the scene's GPU particle emitters (render/particles)
     ParticleLighting particleLighting = ParticleLighting::Atlas;

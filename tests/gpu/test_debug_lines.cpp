@@ -56,6 +56,31 @@ TEST(DebugLines, LightsAndBlockersAreDrawnOverTheFrame) {
     EXPECT_LT(changed, pixels / 3); // lines, not a wash over the frame
 }
 
+// builtin:lights draws ~2000 range spheres, a white web; --debug-lines-at keeps the lights that
+// reach the surface at one pixel (plus a 3-segment cross there), and none at a sky pixel. In
+// both paths: the depth it reads back is the prepass's or the visibility pass's.
+TEST(DebugLines, PickedPixelKeepsOnlyTheLightsReachingItsSurface) {
+    for (RenderMode mode : {RenderMode::Forward, RenderMode::Decoupled}) {
+        RenderOptions o = renderOptions("builtin:lights", mode, 192, 108);
+        o.debugLines = DEBUG_LINES_LIGHTS;
+        uint64_t all = lineStat(renderChecked(o), "segments");
+        o.debugLinesAtX = 96, o.debugLinesAtY = 90; // the street below the horizon
+        uint64_t street = lineStat(renderChecked(o), "segments");
+        o.debugLinesAtX = 96, o.debugLinesAtY = 2; // the night sky above it
+        uint64_t sky = lineStat(renderChecked(o), "segments");
+        std::printf("[ figures ] lights 192x108: %llu segments, %llu at the street pixel, "
+                    "%llu at a sky pixel\n",
+                    (unsigned long long)all, (unsigned long long)street, (unsigned long long)sky);
+        EXPECT_GT(street, 3u + 24u) << "the cross and at least one light";
+        EXPECT_LT(street * 10, all) << "a few lights reach one point";
+        EXPECT_EQ(sky, 0u) << "nothing reaches the sky";
+    }
+    RenderOptions bad = renderOptions("builtin:lights", RenderMode::Forward, 192, 108);
+    bad.debugLines = DEBUG_LINES_LIGHTS;
+    bad.debugLinesAtX = 500, bad.debugLinesAtY = 10;
+    EXPECT_THROW(runRender(sharedGpu(), bad), InputError);
+}
+
 // Every shaded chunk with a shadel on its surface emits its box: 12 segments each.
 TEST(DebugLines, ChunkBoxesFollowTheShadedChunks) {
     RenderOptions o = renderOptions("builtin:default", RenderMode::Decoupled, 160, 90);

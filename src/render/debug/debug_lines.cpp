@@ -124,14 +124,34 @@ void recordDebugLinePasses(Renderer& r, FrameRecorder& rec, uint64_t frame, cons
     struct Push {
         uint64_t frame;
     } push{frame};
+    // --debug-lines-at: the pixel in the internal (supersampled) frame, whose depth the emit
+    // pass reads back to the surface point the lights must reach.
+    struct EmitPush {
+        uint64_t frame;
+        int32_t atX, atY;
+        uint32_t depthSlot;
+    } emitPush{frame, -1, -1, slot(gpu, r.depthRead).value};
+    if (r.settings.debugLinesAtX >= 0) {
+        emitPush.atX = r.settings.debugLinesAtX * int32_t(r.settings.ssaa);
+        emitPush.atY = r.settings.debugLinesAtY * int32_t(r.settings.ssaa);
+    }
     pass(rec, "debugLinesEmit", [&](VkCommandBuffer cmd) {
         // Segments appended by earlier passes (shadelShading's chunk boxes) come first.
         memoryBarrier(cmd, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
                       VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
                       VK_ACCESS_2_SHADER_STORAGE_READ_BIT | VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT);
         if (d.mask & (DEBUG_LINES_LIGHTS | DEBUG_LINES_BLOCKERS)) {
+            bool readDepth = emitPush.atX >= 0;
+            if (readDepth) // after every pass that wrote depth; back to the attachment below
+                imageBarrier(cmd, vkImage(gpu, r.depth), VK_IMAGE_ASPECT_DEPTH_BIT,
+                             VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL,
+                             VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL,
+                             VK_PIPELINE_STAGE_2_LATE_FRAGMENT_TESTS_BIT,
+                             VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT,
+                             VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
+                             VK_ACCESS_2_SHADER_SAMPLED_READ_BIT);
             bind(gpu, cmd, d.emit);
-            pushConstants(gpu, cmd, push);
+            pushConstants(gpu, cmd, emitPush);
             // One invocation per light, then one per blocker (the shader reads both counts).
             uint32_t invocations = lightCount + scene.blockerCount;
             if (invocations) vkCmdDispatch(cmd, (invocations + 63) / 64, 1, 1);
@@ -139,6 +159,15 @@ void recordDebugLinePasses(Renderer& r, FrameRecorder& rec, uint64_t frame, cons
                 cmd, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT,
                 VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
                 VK_ACCESS_2_SHADER_STORAGE_READ_BIT | VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT);
+            if (readDepth)
+                imageBarrier(cmd, vkImage(gpu, r.depth), VK_IMAGE_ASPECT_DEPTH_BIT,
+                             VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL,
+                             VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL,
+                             VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, 0,
+                             VK_PIPELINE_STAGE_2_EARLY_FRAGMENT_TESTS_BIT |
+                                 VK_PIPELINE_STAGE_2_LATE_FRAGMENT_TESTS_BIT,
+                             VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_READ_BIT |
+                                 VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT);
         }
         bind(gpu, cmd, d.args);
         pushConstants(gpu, cmd, push);
