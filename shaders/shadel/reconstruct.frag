@@ -34,6 +34,7 @@ vec3 forwardShade(FrameConstants f) {
     si.frontFacing = gl_FrontFacing;
     useTileDecalList(f, gl_FragCoord.xy); // decals, as forward shading applies them
     MaterialSample m = evaluateMaterial(mat, si);
+    useLightListAt(f, gl_FragCoord.xy, inPosition); // the lights as forward shading culls them
     vec3 color = shadeSurface(f, m, inPosition, si.normal);
     if (inspecting(f, uvec2(gl_FragCoord.xy)))
         inspectSurface(f, inInstance, uint(gl_PrimitiveID), m, inPosition, si.normal, color);

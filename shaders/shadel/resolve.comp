@@ -24,7 +24,7 @@ layout(push_constant, scalar) uniform Push {
 // The forward material + lighting at the pixel, from the triangle's interpolated attributes
 // (what the forward raster pass's varyings and dFdx/dFdy would give).
 vec3 forwardShade(FrameConstants f, GpuInstance inst, VisTriangle tri, VisBary bary,
-                  uvec2 vis, bool inspect) {
+                  uvec2 vis, ivec2 pixel, bool inspect) {
     GpuMaterial mat = MaterialBuffer(f.materials).m[inst.material];
     WorldVertex a = fetchWorldVertex(f, inst, tri.v0);
     WorldVertex b = fetchWorldVertex(f, inst, tri.v1);
@@ -39,6 +39,9 @@ vec3 forwardShade(FrameConstants f, GpuInstance inst, VisTriangle tri, VisBary b
     si.uvDy = visInterpolate(bary.dy, a.uv0, b.uv0, c.uv0);
     si.frontFacing = tri.frontFacing;
     MaterialSample m = evaluateMaterial(mat, si);
+    // The lights as forward shading culls them (a tile's list, or the light grid's candidates
+    // at the point): a fallback pixel must not loop over every light of the scene.
+    useLightListAt(f, vec2(pixel) + 0.5, si.position);
     vec3 color = shadeSurface(f, m, si.position, si.normal);
     if (inspect) inspectSurface(f, vis.x, vis.y, m, si.position, si.normal, color);
     return color;
@@ -89,7 +92,7 @@ void resolveQuad(FrameConstants f, ShadelFrame s, ivec2 origin, inout uvec4 coun
             }
             if (r.missing + r.overflowed != 0u || inspect) {
                 useTileDecalList(f, vec2(pixel) + 0.5); // decals, as forward shading applies them
-                vec3 forward = forwardShade(f, inst, q.tri, v.bary, vis, inspect);
+                vec3 forward = forwardShade(f, inst, q.tri, v.bary, vis, pixel, inspect);
                 if (r.missing + r.overflowed != 0u) c = forward;
             }
             if (inspect) shaderPrintF3(f, PRINT_OUTPUT, c);

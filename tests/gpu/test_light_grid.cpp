@@ -144,3 +144,24 @@ TEST(LightGrid, ForwardTileListsAndImageAreTheSameWithAndWithoutTheGrid) {
     EXPECT_EQ(on.stats["lights_visible"], off.stats["lights_visible"]);
     EXPECT_EQ(on.stats["per_pixel_blocker_tiles"], off.stats["per_pixel_blocker_tiles"]);
 }
+
+// A decoupled frame whose storage overflows shades the overflowed pixels forward in the resolve;
+// there they take the grid's candidates at their point (not every light of the scene). The
+// image matches the same frame whose fallbacks read the screen tiles' lists (grid off) up to
+// how per-pixel blocker tests differ from a tile's (tiled vs unculled forward: 62 dB).
+TEST(LightGrid, OverflowFallbackPixelsLightAsWithTileLists) {
+    RenderOptions o = renderOptions("builtin:lights", RenderMode::Decoupled, 192, 108);
+    o.shadeStorageSize = 128;
+    o.capacityControl = false;
+    RenderRun grid = renderChecked(o);
+    o.lightGrid = false;
+    RenderRun tiles = renderChecked(o);
+    EXPECT_GT(grid.stats["overflow_samples"].get<uint64_t>(), 1000u);
+    EXPECT_EQ(grid.stats["light_screen_tiles"], false);
+    EXPECT_EQ(tiles.stats["light_screen_tiles"], true);
+    double p = psnr(grid.frames[0].rgba, tiles.frames[0].rgba);
+    std::printf("[ figures ] lights 192x108, storage 128: %llu overflow samples, grid vs tile "
+                "lists %.2f dB\n",
+                (unsigned long long)grid.stats["overflow_samples"].get<uint64_t>(), p);
+    EXPECT_GE(p, 50.0);
+}
