@@ -84,8 +84,9 @@ using uint = uint32_t;
 #define SPECTRUM_ALL 0x1FFFu
 #define SPECTRUM_MAX_MODES 16u
 #define SPECTRUM_FEATURES_CONSTANT_ID 140
-#define SPECTRUM_MODE_CONSTANT_ID 141        // the mode (bin) a tile / chunk shading permutation runs
-#define CHUNK_SPECTRA_PHASE_CONSTANT_ID 143 // shadel shading: off, classify or shade (chunk_spectra.glsl)
+#define SPECTRUM_MODE_CONSTANT_ID 141 // the mode (bin) a tile / chunk shading permutation runs
+// Shadel shading's phase: off, classify or shade (chunk_spectra.glsl).
+#define CHUNK_SPECTRA_PHASE_CONSTANT_ID 143
 // Specialization constant of shaders/common/lighting.glsl: 1 compiles the distance-field far
 // shadows and AO in (render/distance_fields; forward and shadel shading with --distance-fields).
 #define DISTANCE_FIELD_LIGHTING_CONSTANT_ID 142
@@ -185,20 +186,20 @@ struct GpuMaterial {
 struct GpuLight {
     vec3 position; // the centre of tube lights
     uint type;
-    vec3 direction;    // the way light travels (spots)
-    float range;       // 0 = infinite
-    vec3 color;        // colour * intensity; negated for darks
-    float spotScale;   // round: 1 / max(cos(inner) - cos(outer), 1e-4); square: on tan(angle)
-    float spotOffset;  // round: -cos(outer) * spotScale; square: tan(outer) * spotScale
-    uint flags;        // LIGHT_FLAG_*
-    float halfLength;  // tube: half the segment's length; area: half the width (along axis)
-    float radius;      // tube: the tube's radius (widens the specular lobe); spot: emitter width;
-                       // area: half the height (along cross(direction, axis))
-    vec3 axis;         // tube: the segment's direction; square spot, gobo, area: "right" axis
-    uint blockerFirst; // into LightingFrame::lightBlockers
-    vec4 clipPlane;    // LIGHT_FLAG_CLIP_PLANE: world-space plane, lit side positive
-    uint blockerCount; // blockers this light lists (<= LIGHT_MAX_BLOCKERS_PER_LIGHT)
-    uint shadowIndex;  // into LightingFrame::spotShadows; LIGHT_NO_SHADOW without a shadow map
+    vec3 direction;     // the way light travels (spots)
+    float range;        // 0 = infinite
+    vec3 color;         // colour * intensity; negated for darks
+    float spotScale;    // round: 1 / max(cos(inner) - cos(outer), 1e-4); square: on tan(angle)
+    float spotOffset;   // round: -cos(outer) * spotScale; square: tan(outer) * spotScale
+    uint flags;         // LIGHT_FLAG_*
+    float halfLength;   // tube: half the segment's length; area: half the width (along axis)
+    float radius;       // tube: the tube's radius (widens the specular lobe); spot: emitter width;
+                        // area: half the height (along cross(direction, axis))
+    vec3 axis;          // tube: the segment's direction; square spot, gobo, area: "right" axis
+    uint blockerFirst;  // into LightingFrame::lightBlockers
+    vec4 clipPlane;     // LIGHT_FLAG_CLIP_PLANE: world-space plane, lit side positive
+    uint blockerCount;  // blockers this light lists (<= LIGHT_MAX_BLOCKERS_PER_LIGHT)
+    uint shadowIndex;   // into LightingFrame::spotShadows; LIGHT_NO_SHADOW without a shadow map
     uint textureSlot;   // gobo / area: bindless slot of the projected / emitted texture
     float textureScale; // gobo: UV per unit of tan(angle off the axis) (0.5 / tan(outer) fills
                         // the cone); area: 1
@@ -253,15 +254,15 @@ struct LightingCounters {
      (LIGHT_GRID_BUCKETS - 1u))
 
 struct GpuLightGrid {
-    vec3 origin;       // world position of cell (0,0,0)'s corner, every level
-    float cellSize;    // level 0's cell edge (metres); level l: cellSize * 2^l
-    uint levels;       // levels built (<= LIGHT_GRID_LEVELS)
-    uint globalFirst;  // entries of the lights of infinite range
+    vec3 origin;      // world position of cell (0,0,0)'s corner, every level
+    float cellSize;   // level 0's cell edge (metres); level l: cellSize * 2^l
+    uint levels;      // levels built (<= LIGHT_GRID_LEVELS)
+    uint globalFirst; // entries of the lights of infinite range
     uint globalCount;
     uint pad0;
     uvec2 big[LIGHT_GRID_LEVELS]; // per level: first entry, count of lights too big for its cells
-    uint64_t buckets;  // uvec2 [level * LIGHT_GRID_BUCKETS + bucket]: first entry, count
-    uint64_t entries;  // uint light indices
+    uint64_t buckets;             // uvec2 [level * LIGHT_GRID_BUCKETS + bucket]: first entry, count
+    uint64_t entries;             // uint light indices
 };
 
 // What the tiled-lighting passes share with shading (FrameConstants::lighting).
@@ -306,14 +307,14 @@ struct LightingFrame {
 // The sun's cascades: slices of the camera's view depth, each an orthographic map (a rectangle
 // of one atlas) fitted to its slice's bounding sphere and snapped to its texels.
 struct GpuSunCascades {
-    mat4 viewProj[SUN_MAX_CASCADES]; // world -> the cascade's clip space (depth 0..1)
+    mat4 viewProj[SUN_MAX_CASCADES];  // world -> the cascade's clip space (depth 0..1)
     vec4 atlasRect[SUN_MAX_CASCADES]; // UV offset xy, size zw
-    vec4 splitFar;       // view depth (metres along cameraForward) where cascade i ends
-    vec4 texelWorld;     // a texel's width in metres, per cascade
-    vec3 cameraForward;  // unit: view depth = dot(p - cameraPosition, cameraForward)
+    vec4 splitFar;      // view depth (metres along cameraForward) where cascade i ends
+    vec4 texelWorld;    // a texel's width in metres, per cascade
+    vec3 cameraForward; // unit: view depth = dot(p - cameraPosition, cameraForward)
     uint count;
-    uint atlasSlot;      // bindless slot of the atlas (depth)
-    float depthRange;    // metres from depth 0 to 1 (the same for every cascade)
+    uint atlasSlot;   // bindless slot of the atlas (depth)
+    float depthRange; // metres from depth 0 to 1 (the same for every cascade)
     uint pad0;
     uint pad1;
 };
@@ -641,12 +642,12 @@ struct ShadelFrame {
 #define DECAL_STAGES 4u
 #define DECAL_KIND(stage) (1u << (stage))
 // Procedural masks in the decal's [0,1]^2 projection (shaders/decals/decals.glsl).
-#define DECAL_PATTERN_SPLAT 0u   // a soft-edged ring and disc (graffiti)
-#define DECAL_PATTERN_STRIPES 1u // diagonal stripes (road marking)
-#define DECAL_PATTERN_RIVETS 2u  // a grid of round bumps (height for the normal stage)
-#define DECAL_PATTERN_PUDDLE 3u  // a wobbly blob (wet patch: low roughness)
-#define DECAL_PATTERN_BLOB 4u    // radial falloff (contact shadow under a character)
-#define DECAL_TILE_MAX 256u      // decals one tile's / chunk's list holds
+#define DECAL_PATTERN_SPLAT 0u       // a soft-edged ring and disc (graffiti)
+#define DECAL_PATTERN_STRIPES 1u     // diagonal stripes (road marking)
+#define DECAL_PATTERN_RIVETS 2u      // a grid of round bumps (height for the normal stage)
+#define DECAL_PATTERN_PUDDLE 3u      // a wobbly blob (wet patch: low roughness)
+#define DECAL_PATTERN_BLOB 4u        // radial falloff (contact shadow under a character)
+#define DECAL_TILE_MAX 256u          // decals one tile's / chunk's list holds
 #define DECAL_OBJECT_ALL 0xFFFFFFFFu // an object list that did not fit: every frustum decal
 
 struct GpuDecal {
