@@ -206,14 +206,7 @@ void recordOcclusionPasses(Renderer& r, FrameRecorder& rec, uint64_t frame, cons
     Gpu& gpu = *r.gpu;
     CullingState& c = *r.culling;
     pass(rec, "hizBuild", [&](VkCommandBuffer cmd) {
-        VkImage depth = vkImage(gpu, r.depth);
-        imageBarrier(cmd, depth, VK_IMAGE_ASPECT_DEPTH_BIT,
-                     VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL,
-                     VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL,
-                     VK_PIPELINE_STAGE_2_EARLY_FRAGMENT_TESTS_BIT |
-                         VK_PIPELINE_STAGE_2_LATE_FRAGMENT_TESTS_BIT,
-                     VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT,
-                     VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_SHADER_SAMPLED_READ_BIT);
+        sceneDepthToSampled(r, cmd, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT);
         bind(gpu, cmd, c.hizBuild);
         for (size_t k = 0; k < c.levelSize.size(); ++k) {
             HizPush push{};
@@ -231,14 +224,7 @@ void recordOcclusionPasses(Renderer& r, FrameRecorder& rec, uint64_t frame, cons
                 VK_ACCESS_2_SHADER_STORAGE_READ_BIT | VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT);
         }
         // Back to a depth target (contents kept) for the phase-2 prepass.
-        imageBarrier(cmd, depth, VK_IMAGE_ASPECT_DEPTH_BIT,
-                     VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL,
-                     VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL,
-                     VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_SHADER_SAMPLED_READ_BIT,
-                     VK_PIPELINE_STAGE_2_EARLY_FRAGMENT_TESTS_BIT |
-                         VK_PIPELINE_STAGE_2_LATE_FRAGMENT_TESTS_BIT,
-                     VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_READ_BIT |
-                         VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT);
+        sceneDepthToAttachment(r, cmd, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT);
     });
     pass(rec, "instanceCullPhase2", [&](VkCommandBuffer cmd) {
         bind(gpu, cmd, r.instanceCull);

@@ -7,6 +7,7 @@
 #include "common/shared_types.h"
 #include "core/error.h"
 #include "core/log.h"
+#include "render/forward/forward_passes.h"
 #include "render/gpu_scene.h"
 #include "render/renderer.h"
 #include "rhi/gpu.h"
@@ -143,13 +144,7 @@ void recordDebugLinePasses(Renderer& r, FrameRecorder& rec, uint64_t frame, cons
         if (d.mask & (DEBUG_LINES_LIGHTS | DEBUG_LINES_BLOCKERS)) {
             bool readDepth = emitPush.atX >= 0;
             if (readDepth) // after every pass that wrote depth; back to the attachment below
-                imageBarrier(cmd, vkImage(gpu, r.depth), VK_IMAGE_ASPECT_DEPTH_BIT,
-                             VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL,
-                             VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL,
-                             VK_PIPELINE_STAGE_2_LATE_FRAGMENT_TESTS_BIT,
-                             VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT,
-                             VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
-                             VK_ACCESS_2_SHADER_SAMPLED_READ_BIT);
+                sceneDepthToSampled(r, cmd, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT);
             bind(gpu, cmd, d.emit);
             pushConstants(gpu, cmd, emitPush);
             // One invocation per light, then one per blocker (the shader reads both counts).
@@ -159,15 +154,7 @@ void recordDebugLinePasses(Renderer& r, FrameRecorder& rec, uint64_t frame, cons
                 cmd, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT,
                 VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
                 VK_ACCESS_2_SHADER_STORAGE_READ_BIT | VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT);
-            if (readDepth)
-                imageBarrier(cmd, vkImage(gpu, r.depth), VK_IMAGE_ASPECT_DEPTH_BIT,
-                             VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL,
-                             VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL,
-                             VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, 0,
-                             VK_PIPELINE_STAGE_2_EARLY_FRAGMENT_TESTS_BIT |
-                                 VK_PIPELINE_STAGE_2_LATE_FRAGMENT_TESTS_BIT,
-                             VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_READ_BIT |
-                                 VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT);
+            if (readDepth) sceneDepthToAttachment(r, cmd, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT);
         }
         bind(gpu, cmd, d.args);
         pushConstants(gpu, cmd, push);

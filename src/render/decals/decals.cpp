@@ -8,6 +8,7 @@
 #include <nlohmann/json.hpp>
 
 #include "render/camera.h"
+#include "render/forward/forward_passes.h"
 #include "render/renderer.h"
 
 namespace shadel {
@@ -179,23 +180,11 @@ void recordDecalCulling(Renderer& r, FrameRecorder& rec, uint64_t frame) {
                       VK_ACCESS_2_SHADER_STORAGE_READ_BIT | VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT);
         // Tiles: the prepass depth bounds each tile's frustum (sampled here, then back to the
         // attachment layout later passes test against).
-        imageBarrier(cmd, vkImage(gpu, r.depth), VK_IMAGE_ASPECT_DEPTH_BIT,
-                     VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL,
-                     VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL,
-                     VK_PIPELINE_STAGE_2_LATE_FRAGMENT_TESTS_BIT,
-                     VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT,
-                     VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_SHADER_SAMPLED_READ_BIT);
+        sceneDepthToSampled(r, cmd, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT);
         bind(gpu, cmd, s.tileCull);
         pushConstants(gpu, cmd, TilePush{frame, slot(gpu, r.depthRead).value});
         vkCmdDispatch(cmd, s.tilesX, s.tilesY, 1);
-        imageBarrier(cmd, vkImage(gpu, r.depth), VK_IMAGE_ASPECT_DEPTH_BIT,
-                     VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL,
-                     VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL,
-                     VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, 0,
-                     VK_PIPELINE_STAGE_2_EARLY_FRAGMENT_TESTS_BIT |
-                         VK_PIPELINE_STAGE_2_LATE_FRAGMENT_TESTS_BIT,
-                     VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_READ_BIT |
-                         VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT);
+        sceneDepthToAttachment(r, cmd, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT);
         // Decoupled: one invocation per instance, its coarse list. Shadel shading refines it
         // per chunk in the workgroup, from the positions it rebuilds anyway (decals.h).
         if (r.decoupled && s.instanceCount > 0) {

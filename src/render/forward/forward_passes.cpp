@@ -127,6 +127,25 @@ void drawCameraList(Renderer& r, VkCommandBuffer cmd, uint32_t list) {
     drawPhase2List(r, cmd, list); // occlusion culling's second phase (render/culling)
 }
 
+void sceneDepthToSampled(Renderer& r, VkCommandBuffer cmd, VkPipelineStageFlags2 readers) {
+    imageBarrier(cmd, vkImage(*r.gpu, r.depth), VK_IMAGE_ASPECT_DEPTH_BIT,
+                 VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL,
+                 VK_PIPELINE_STAGE_2_EARLY_FRAGMENT_TESTS_BIT |
+                     VK_PIPELINE_STAGE_2_LATE_FRAGMENT_TESTS_BIT,
+                 VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT, readers,
+                 VK_ACCESS_2_SHADER_SAMPLED_READ_BIT);
+}
+
+void sceneDepthToAttachment(Renderer& r, VkCommandBuffer cmd, VkPipelineStageFlags2 readers) {
+    imageBarrier(cmd, vkImage(*r.gpu, r.depth), VK_IMAGE_ASPECT_DEPTH_BIT,
+                 VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL,
+                 readers, 0,
+                 VK_PIPELINE_STAGE_2_EARLY_FRAGMENT_TESTS_BIT |
+                     VK_PIPELINE_STAGE_2_LATE_FRAGMENT_TESTS_BIT,
+                 VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_READ_BIT |
+                     VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT);
+}
+
 void beginSceneDepthPass(Renderer& r, VkCommandBuffer cmd, bool clear) {
     VkRenderingAttachmentInfo depth{VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO};
     depth.imageView = vkView(*r.gpu, r.depthTarget);

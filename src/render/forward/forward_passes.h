@@ -35,6 +35,11 @@ void beginSceneDepthPass(Renderer& r, VkCommandBuffer cmd, bool clear);
 // Inside a prepass: draws the opaque and decoupled camera lists (what writes depth), ends
 // rendering, and makes the depth visible to the passes that test against it.
 void drawPrepassListsAndEnd(Renderer& r, VkCommandBuffer cmd);
+// The scene depth, written by the passes before, made readable by shaders of the `readers`
+// stages (tile depth bounds, the HiZ pyramid, debug picking, soft particles) ...
+void sceneDepthToSampled(Renderer& r, VkCommandBuffer cmd, VkPipelineStageFlags2 readers);
+// ... then handed back, contents kept, to the depth tests of the passes after.
+void sceneDepthToAttachment(Renderer& r, VkCommandBuffer cmd, VkPipelineStageFlags2 readers);
 // Begins dynamic rendering into the HDR target with the prepass depth (loaded, not cleared).
 void beginSceneColorPass(Renderer& r, VkCommandBuffer cmd, bool clearColor);
 

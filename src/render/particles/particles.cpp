@@ -341,13 +341,7 @@ void recordParticleSprites(Renderer& r, FrameRecorder& rec, uint64_t frame) {
     }
     pass(rec, "particleSpritesHalf", [&](VkCommandBuffer cmd) {
         // The opaque depth is read (2x2 per fragment) instead of attached.
-        imageBarrier(cmd, vkImage(gpu, r.depth), VK_IMAGE_ASPECT_DEPTH_BIT,
-                     VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL,
-                     VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL,
-                     VK_PIPELINE_STAGE_2_EARLY_FRAGMENT_TESTS_BIT |
-                         VK_PIPELINE_STAGE_2_LATE_FRAGMENT_TESTS_BIT,
-                     VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT,
-                     VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT, VK_ACCESS_2_SHADER_SAMPLED_READ_BIT);
+        sceneDepthToSampled(r, cmd, VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT);
         for (TextureHandle t : {s.accumHalf, s.revealHalf})
             imageBarrier(
                 cmd, vkImage(gpu, t), VK_IMAGE_ASPECT_COLOR_BIT, VK_IMAGE_LAYOUT_UNDEFINED,
@@ -371,14 +365,7 @@ void recordParticleSprites(Renderer& r, FrameRecorder& rec, uint64_t frame) {
                 VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT,
                 VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT, VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT,
                 VK_ACCESS_2_SHADER_SAMPLED_READ_BIT);
-        imageBarrier(cmd, vkImage(gpu, r.depth), VK_IMAGE_ASPECT_DEPTH_BIT,
-                     VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL,
-                     VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL,
-                     VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT, 0,
-                     VK_PIPELINE_STAGE_2_EARLY_FRAGMENT_TESTS_BIT |
-                         VK_PIPELINE_STAGE_2_LATE_FRAGMENT_TESTS_BIT,
-                     VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_READ_BIT |
-                         VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT);
+        sceneDepthToAttachment(r, cmd, VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT);
     });
 }
 
