@@ -61,12 +61,9 @@ static void createTargets(Renderer& r) {
     r.depthTarget = createDepthTargetView(gpu, r.depth);
     r.depthRead = createReadView(gpu, r.depth);
 
-    TextureDesc shadow = depth;
-    shadow.name = "sunShadowMap";
-    shadow.width = shadow.height = r.settings.shadowMapSize;
-    r.shadowMap = need(createTexture(gpu, shadow), "the shadow map");
-    r.shadowTarget = createDepthTargetView(gpu, r.shadowMap);
-    r.shadowRead = createReadView(gpu, r.shadowMap);
+    // The sun's whole-scene map: a one-map shadow atlas (render/lighting/shadow_atlas.h).
+    r.sunShadow = createShadowAtlas(gpu, "sunShadow", r.settings.shadowMapSize,
+                                    r.settings.shadowMapSize, "forward_forward.vert.spv");
 }
 
 // --capture names of the targets every frame has (render/debug/capture.h).
@@ -84,7 +81,7 @@ static void registerTargetCaptures(Renderer& r) {
         [&r] { return r.depth; }, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL);
     registerTextureCapture(
         r.captures, gpu, "shadow", "the sun's shadow map depth (EXR)", CaptureKind::Depth,
-        [&r] { return r.shadowMap; }, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL);
+        [&r] { return r.sunShadow.texture; }, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL);
 }
 
 // --marking auto: visibility, unless a feature that needs the raster prepass is on.
@@ -198,9 +195,8 @@ void destroyRenderer(Renderer& r) {
     destroy(gpu, r.hdrRead);
     destroy(gpu, r.depthTarget);
     destroy(gpu, r.depthRead);
-    destroy(gpu, r.shadowTarget);
-    destroy(gpu, r.shadowRead);
-    for (TextureHandle t : {r.hdr, r.depth, r.shadowMap}) destroy(gpu, t);
+    destroyShadowAtlas(gpu, r.sunShadow);
+    for (TextureHandle t : {r.hdr, r.depth}) destroy(gpu, t);
     r.gpu = nullptr;
 }
 
@@ -237,7 +233,7 @@ static gpu::FrameConstants makeFrameConstants(Renderer& r, const GpuScene& scene
     f.exposure = r.settings.exposure;
     f.sunDirection = sun.direction;
     f.sunColor = sun.color;
-    f.sunShadowSlot = scene.sunCastsShadow ? slot(gpu, r.shadowRead).value : NO_TEXTURE;
+    f.sunShadowSlot = scene.sunCastsShadow ? slot(gpu, r.sunShadow.read).value : NO_TEXTURE;
     f.shadowTexelSize = texel;
     f.skyColor = scene.skyColor;
     f.ambientColor = scene.ambientColor;

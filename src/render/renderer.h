@@ -15,6 +15,7 @@
 #include "render/gpu_scene.h"
 #include "render/lighting/feature_spectra.h"
 #include "render/lighting/light_culling.h"
+#include "render/lighting/shadow_atlas.h"
 #include "render/lighting/spot_shadows.h"
 #include "render/lighting/sun_cascades.h"
 #include "render/points_lines/points_lines.h"
@@ -191,11 +192,12 @@ struct Renderer {
     RenderSettings settings;
     // Targets at the internal resolution (width*ssaa x height*ssaa).
     uint32_t internalWidth = 0, internalHeight = 0;
-    TextureHandle hdr, depth, shadowMap;
+    TextureHandle hdr, depth;
     RenderTargetView hdrTarget;
     TextureReadView hdrRead;
-    DepthTargetView depthTarget, shadowTarget;
-    TextureReadView depthRead, shadowRead;
+    DepthTargetView depthTarget;
+    TextureReadView depthRead;
+    ShadowAtlas sunShadow; // the sun's whole-scene map (--sun-cascades: beyond the last slice)
     // Per-frame data.
     BufferHandle frameConstants; // host-visible gpu::FrameConstants
     BufferHandle draws;          // DrawIndexedCommand[DRAW_LIST_COUNT * maxDraws], camera view
@@ -205,7 +207,7 @@ struct Renderer {
     uint32_t maxDraws = 0;
     BufferHandle sceneIndices; // the unified index buffer of the scene being drawn
     glm::vec3 skyColor{0.5f};
-    Pipeline instanceCull, depthPrepass, shadowPass, forwardOpaque, tonemap;
+    Pipeline instanceCull, depthPrepass, forwardOpaque, tonemap;
     ShaderMessageChannel messages;
     FrameRecorder recorder;
     DecoupledStatePtr decoupled;

@@ -35,13 +35,6 @@ void createForwardPipelines(Renderer& r) {
     depth.cullMode = VK_CULL_MODE_NONE; // double-sided materials; backfaces cost little here
     r.depthPrepass = createGraphicsPipeline(gpu, depth);
 
-    GraphicsPipelineDesc shadow = depth;
-    shadow.name = "shadowMap";
-    shadow.depthCompare = VK_COMPARE_OP_LESS_OR_EQUAL;
-    shadow.depthClamp = true;
-    shadow.depthBias = true;
-    r.shadowPass = createGraphicsPipeline(gpu, shadow);
-
     GraphicsPipelineDesc opaque;
     opaque.name = "forwardOpaque";
     opaque.vertexShader = "forward_forward.vert.spv";
@@ -58,8 +51,7 @@ void createForwardPipelines(Renderer& r) {
 }
 
 void destroyForwardPipelines(Renderer& r) {
-    for (Pipeline* p : {&r.instanceCull, &r.depthPrepass, &r.shadowPass, &r.forwardOpaque})
-        destroy(*r.gpu, *p);
+    for (Pipeline* p : {&r.instanceCull, &r.depthPrepass, &r.forwardOpaque}) destroy(*r.gpu, *p);
 }
 
 void recordInstanceCull(Renderer& r, VkCommandBuffer cmd, uint64_t frame, const GpuScene& scene) {
@@ -87,36 +79,10 @@ void recordInstanceCull(Renderer& r, VkCommandBuffer cmd, uint64_t frame, const 
 
 void recordShadowMap(Renderer& r, VkCommandBuffer cmd, uint64_t frame) {
     Gpu& gpu = *r.gpu;
-    VkImage image = vkImage(gpu, r.shadowMap);
-    imageBarrier(
-        cmd, image, VK_IMAGE_ASPECT_DEPTH_BIT, VK_IMAGE_LAYOUT_UNDEFINED,
-        VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL, VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT, 0,
-        VK_PIPELINE_STAGE_2_EARLY_FRAGMENT_TESTS_BIT | VK_PIPELINE_STAGE_2_LATE_FRAGMENT_TESTS_BIT,
-        VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT);
-    VkRenderingAttachmentInfo depth{VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO};
-    depth.imageView = vkView(gpu, r.shadowTarget);
-    depth.imageLayout = VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL;
-    depth.loadOp = VK_ATTACHMENT_LOAD_OP_CLEAR;
-    depth.storeOp = VK_ATTACHMENT_STORE_OP_STORE;
-    depth.clearValue.depthStencil = {1.0f, 0};
-    VkRenderingInfo ri{VK_STRUCTURE_TYPE_RENDERING_INFO};
-    ri.renderArea = {{0, 0}, {r.settings.shadowMapSize, r.settings.shadowMapSize}};
-    ri.layerCount = 1;
-    ri.pDepthAttachment = &depth;
-    vkCmdBeginRendering(cmd, &ri);
-    bind(gpu, cmd, r.shadowPass);
-    setViewport(cmd, r.settings.shadowMapSize, r.settings.shadowMapSize);
-    vkCmdSetDepthBias(cmd, 1.25f, 0.0f, 1.75f);
-    vkCmdBindIndexBuffer(cmd, vkBuffer(gpu, r.sceneIndices), 0, VK_INDEX_TYPE_UINT32);
+    beginShadowAtlas(gpu, cmd, r.sunShadow, vkBuffer(gpu, r.sceneIndices));
     pushConstants(gpu, cmd, RasterPush{frame, 1});
     drawList(r, cmd, r.shadowDraws, DRAW_LIST_COUNT * 4, DRAW_LIST_OPAQUE);
-    vkCmdEndRendering(cmd);
-    imageBarrier(cmd, image, VK_IMAGE_ASPECT_DEPTH_BIT, VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL,
-                 VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL,
-                 VK_PIPELINE_STAGE_2_LATE_FRAGMENT_TESTS_BIT,
-                 VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT,
-                 VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT | VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
-                 VK_ACCESS_2_SHADER_SAMPLED_READ_BIT);
+    endShadowAtlas(gpu, cmd, r.sunShadow);
 }
 
 void drawCameraList(Renderer& r, VkCommandBuffer cmd, uint32_t list) {

@@ -4,6 +4,7 @@
 
 #include "core/error.h"
 #include "rhi/gpu.h"
+#include "rhi/rendering.h"
 #include "rhi/resources.h"
 
 namespace shadel {
@@ -54,17 +55,9 @@ void beginShadowAtlas(Gpu& gpu, VkCommandBuffer cmd, const ShadowAtlas& a, VkBuf
         VK_PIPELINE_STAGE_2_EARLY_FRAGMENT_TESTS_BIT | VK_PIPELINE_STAGE_2_LATE_FRAGMENT_TESTS_BIT,
         VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT |
             VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_READ_BIT);
-    VkRenderingAttachmentInfo depth{VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO};
-    depth.imageView = vkView(gpu, a.target);
-    depth.imageLayout = VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL;
-    depth.loadOp = VK_ATTACHMENT_LOAD_OP_CLEAR;
-    depth.storeOp = VK_ATTACHMENT_STORE_OP_STORE;
-    depth.clearValue.depthStencil = {1.0f, 0};
-    VkRenderingInfo ri{VK_STRUCTURE_TYPE_RENDERING_INFO};
-    ri.renderArea = {{0, 0}, {a.width, a.height}};
-    ri.layerCount = 1;
-    ri.pDepthAttachment = &depth;
-    vkCmdBeginRendering(cmd, &ri);
+    // Cleared to the far plane (shadow maps are not reversed Z); the viewport is the whole
+    // atlas until a map's own is set.
+    beginRendering(cmd, a.width, a.height, {}, {vkView(gpu, a.target), true, 1.0f});
     bind(gpu, cmd, a.pass);
     vkCmdSetDepthBias(cmd, 1.25f, 0.0f, 1.75f);
     vkCmdBindIndexBuffer(cmd, sceneIndices, 0, VK_INDEX_TYPE_UINT32);

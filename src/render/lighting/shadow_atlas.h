@@ -25,7 +25,8 @@ ShadowAtlas createShadowAtlas(Gpu& gpu, const char* name, uint32_t width, uint32
                               const char* vertexShader);
 void destroyShadowAtlas(Gpu& gpu, ShadowAtlas& atlas);
 
-// Clears the atlas and binds its pipeline, depth bias and the scene's index buffer.
+// Clears the atlas and binds its pipeline, depth bias and the scene's index buffer; the viewport
+// covers the whole atlas (one map) until setShadowMapViewport picks a map.
 void beginShadowAtlas(Gpu& gpu, VkCommandBuffer cmd, const ShadowAtlas& atlas,
                       VkBuffer sceneIndices);
 // The viewport and scissor of one square map at texel (x, y).
