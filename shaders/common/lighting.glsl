@@ -87,7 +87,7 @@ void useLightListAt(FrameConstants f, vec2 fragCoord, vec3 position) {
     GpuLightGrid g = LightGridRef(lf.lightGrid).g;
     if (g.levels == 0u) return;
     vec3 c = floor((position - g.origin) / g.cellSize);
-    if (any(greaterThanEqual(abs(c), vec3(float(1 << 28))))) return;
+    if (any(greaterThanEqual(abs(c), vec3(LIGHT_GRID_MAX_CELL)))) return;
     ivec3 cell = ivec3(c);
     gLightListMode = LIGHT_LIST_GRID;
     gLightListAddress = g.entries;
@@ -99,7 +99,8 @@ void useLightListAt(FrameConstants f, vec2 fragCoord, vec3 position) {
 }
 
 uint lightListLength(FrameConstants f) {
-    if (gLightListMode == LIGHT_LIST_BUFFER || gLightListMode == LIGHT_LIST_GRID) return gLightListCount;
+    if (gLightListMode == LIGHT_LIST_BUFFER || gLightListMode == LIGHT_LIST_GRID)
+        return gLightListCount;
 #ifdef SHADEL_LIGHT_LIST_SHARED
     if (gLightListMode == LIGHT_LIST_SHARED) return min(sLightListCount, LIGHT_CHUNK_MAX_LIGHTS);
 #endif
@@ -110,7 +111,9 @@ uvec2 lightListEntry(FrameConstants f, uint i) {
     if (gLightListMode == LIGHT_LIST_BUFFER) return LightListBuffer(gLightListAddress).e[i];
     if (gLightListMode == LIGHT_LIST_GRID) {
         uint list = i < gGridLists[0].y ? 0u : i < gGridLists[0].y + gGridLists[1].y ? 1u : 2u;
-        uint skip = list == 0u ? 0u : list == 1u ? gGridLists[0].y : gGridLists[0].y + gGridLists[1].y;
+        uint skip = list == 0u   ? 0u
+                    : list == 1u ? gGridLists[0].y
+                                 : gGridLists[0].y + gGridLists[1].y;
         uint light = LightGridEntries(gLightListAddress).v[gGridLists[list].x + i - skip];
         return uvec2(light, gGridBlockerMask);
     }

@@ -248,7 +248,8 @@ struct LightingCounters {
 #define LIGHT_GRID_LEVELS 8u
 #define LIGHT_GRID_BUCKETS 4096u // per level; a power of two
 #define LIGHT_GRID_MAX_SPAN 8
-#define LIGHT_GRID_MASK_LIGHTS 8192u // the chunk's shared bit set of candidates (more: no grid)
+#define LIGHT_GRID_MAX_CELL 268435456.0 // |cell coordinate| below 2^28: exact as float and int
+#define LIGHT_GRID_MASK_LIGHTS 8192u    // the chunk's shared bit set of candidates (more: no grid)
 #define LIGHT_GRID_HASH(x, y, z)                                                                   \
     (((uint(x) * 73856093u) ^ (uint(y) * 19349663u) ^ (uint(z) * 83492791u)) &                     \
      (LIGHT_GRID_BUCKETS - 1u))

@@ -44,8 +44,8 @@ bool lightGridQuery(FrameConstants f, uint64_t gridAddress, vec3 boxMin, vec3 bo
     }
     if (q.level >= q.g.levels) return false;
     vec3 a = floor((boxMin - q.g.origin) / cell), b = floor((boxMax - q.g.origin) / cell);
-    const float maxCell = float(1 << 28);
-    if (any(greaterThanEqual(abs(a), vec3(maxCell))) || any(greaterThanEqual(abs(b), vec3(maxCell))))
+    if (any(greaterThanEqual(abs(a), vec3(LIGHT_GRID_MAX_CELL))) ||
+        any(greaterThanEqual(abs(b), vec3(LIGHT_GRID_MAX_CELL))))
         return false;
     q.lo = ivec3(a);
     q.cells = ivec3(b) - q.lo + 1;

@@ -165,3 +165,13 @@ TEST(LightGrid, OverflowFallbackPixelsLightAsWithTileLists) {
                 (unsigned long long)grid.stats["overflow_samples"].get<uint64_t>(), p);
     EXPECT_GE(p, 50.0);
 }
+
+// The grid is built on the CPU only in frames whose lights changed: once for a static scene,
+// every frame with --animate-lights.
+TEST(LightGrid, RebuiltOnlyWhenTheLightsChange) {
+    RenderOptions o = renderOptions("builtin:lights", RenderMode::Forward, 96, 54);
+    o.frames = 3;
+    EXPECT_EQ(renderChecked(o).stats["light_grid_builds"].get<uint32_t>(), 1u);
+    o.animateLights = true;
+    EXPECT_EQ(renderChecked(o).stats["light_grid_builds"].get<uint32_t>(), 3u);
+}

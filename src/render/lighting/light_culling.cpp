@@ -212,6 +212,7 @@ void lightCullingStats(const Renderer& r, const GpuScene& scene, nlohmann::json&
     // Lights the chunks tested to find those pairs (every light per chunk without the grid).
     stats["light_chunk_candidates"] = s.last.lightGridCandidates;
     stats["light_grid_entries"] = s.grid.entries;
+    stats["light_grid_builds"] = s.grid.builds; // rebuilt only in frames whose lights changed
     stats["per_pixel_blocker_chunks"] = s.last.perPixelBlockerChunks;
     stats["light_chunks_overflowed"] = s.last.chunksOverflowed;
     stats["lights_culled_by_blockers"] = s.last.lightsCulledByBlockers;

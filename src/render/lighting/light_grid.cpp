@@ -12,9 +12,6 @@ namespace shadel {
 
 namespace {
 
-// Cell coordinates beyond this are not gridded (the int conversion on the GPU must stay exact).
-constexpr double kMaxCell = 1 << 28;
-
 struct CellRange {
     glm::ivec3 lo, hi;
 };
@@ -27,7 +24,8 @@ bool sphereCells(const gpu::GpuLightGrid& g, glm::vec4 sphere, double cell, Cell
         double c = (double(sphere[a]) - double(g.origin[a])) / cell;
         double r = (double(sphere.w) + margin) / cell;
         double lo = std::floor(c - r), hi = std::floor(c + r);
-        if (!(std::abs(lo) < kMaxCell && std::abs(hi) < kMaxCell)) return false;
+        if (!(std::abs(lo) < LIGHT_GRID_MAX_CELL && std::abs(hi) < LIGHT_GRID_MAX_CELL))
+            return false;
         out.lo[a] = int(lo);
         out.hi[a] = int(hi);
     }
@@ -151,7 +149,8 @@ std::optional<std::vector<uint32_t>> lightGridCandidates(const LightGridData& d,
     glm::vec3 a = glm::floor((boxMin - g.origin) / cell),
               b = glm::floor((boxMax - g.origin) / cell);
     for (int k = 0; k < 3; ++k)
-        if (!(std::abs(a[k]) < float(kMaxCell) && std::abs(b[k]) < float(kMaxCell)))
+        if (!(std::abs(a[k]) < float(LIGHT_GRID_MAX_CELL) &&
+              std::abs(b[k]) < float(LIGHT_GRID_MAX_CELL)))
             return std::nullopt;
     std::vector<uint32_t> out;
     auto take = [&](glm::uvec2 list) {
