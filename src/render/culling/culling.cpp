@@ -274,11 +274,7 @@ void drawShadowViewList(Renderer& r, VkCommandBuffer cmd, uint32_t view) {
     const CullingState& c = *r.culling;
     uint32_t list = c.listOf(view);
     if (list == ~0u) { // whole-scene: the sun's opaque casters
-        vkCmdDrawIndexedIndirectCount(
-            cmd, vkBuffer(gpu, r.shadowDraws),
-            VkDeviceSize(DRAW_LIST_OPAQUE) * r.maxDraws * sizeof(gpu::DrawIndexedCommand),
-            vkBuffer(gpu, r.drawCounts), (DRAW_LIST_COUNT + DRAW_LIST_OPAQUE) * 4, r.maxDraws,
-            sizeof(gpu::DrawIndexedCommand));
+        drawSunShadowList(r, cmd);
         return;
     }
     vkCmdDrawIndexedIndirectCount(cmd, vkBuffer(gpu, c.shadowViewDraws),

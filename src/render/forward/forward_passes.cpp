@@ -81,8 +81,12 @@ void recordShadowMap(Renderer& r, VkCommandBuffer cmd, uint64_t frame) {
     Gpu& gpu = *r.gpu;
     beginShadowAtlas(gpu, cmd, r.sunShadow, vkBuffer(gpu, r.sceneIndices));
     pushConstants(gpu, cmd, RasterPush{frame, 1});
-    drawList(r, cmd, r.shadowDraws, DRAW_LIST_COUNT * 4, DRAW_LIST_OPAQUE);
+    drawSunShadowList(r, cmd);
     endShadowAtlas(gpu, cmd, r.sunShadow);
+}
+
+void drawSunShadowList(Renderer& r, VkCommandBuffer cmd) {
+    drawList(r, cmd, r.shadowDraws, DRAW_LIST_COUNT * 4, DRAW_LIST_OPAQUE);
 }
 
 void drawCameraList(Renderer& r, VkCommandBuffer cmd, uint32_t list) {

@@ -28,6 +28,9 @@ void recordForwardShading(Renderer& r, VkCommandBuffer cmd, uint64_t frame);
 // next to reconstruction (hybrid). Blended instances are drawn by render/oit.
 void drawForwardLists(Renderer& r, VkCommandBuffer cmd, uint64_t frame);
 
+// The sun's culled opaque casters (its whole-scene view): the sun's map, the whole-scene
+// fallback of cascades and spots, and GI's reflective shadow maps draw it.
+void drawSunShadowList(Renderer& r, VkCommandBuffer cmd);
 // Shared by every raster pass that draws the culled camera list (decoupled passes too).
 void drawCameraList(Renderer& r, VkCommandBuffer cmd, uint32_t list);
 // Begins depth-only rendering into the scene depth (cleared for the prepass, loaded after).

@@ -8,6 +8,7 @@
 
 #include "core/log.h"
 #include "gi/gi_types.h"
+#include "render/forward/forward_passes.h"
 #include "render/renderer.h"
 #include "scene/scene.h"
 
@@ -439,11 +440,7 @@ void recordGiReflectiveShadowMaps(Renderer& r, VkCommandBuffer cmd, uint64_t fra
         vkCmdBindIndexBuffer(cmd, vkBuffer(gpu, r.sceneIndices), 0, VK_INDEX_TYPE_UINT32);
         // The sun's shadow list: its volume is fitted to the whole scene, so it also holds
         // every opaque instance a spot inside the scene can see (the GPU clips the rest).
-        vkCmdDrawIndexedIndirectCount(
-            cmd, vkBuffer(gpu, r.shadowDraws),
-            VkDeviceSize(DRAW_LIST_OPAQUE) * r.maxDraws * sizeof(gpu::DrawIndexedCommand),
-            vkBuffer(gpu, r.drawCounts), (DRAW_LIST_COUNT + DRAW_LIST_OPAQUE) * 4, r.maxDraws,
-            sizeof(gpu::DrawIndexedCommand));
+        drawSunShadowList(r, cmd);
         vkCmdEndRendering(cmd);
         for (int k = 0; k < 3; ++k)
             imageBarrier(
