@@ -103,20 +103,8 @@ nlohmann::json runShadowCullingBench(Gpu& gpu, const BenchOptions& b, RenderOpti
                      b.width, b.height);
         o.shadowCulling = culling;
         RenderRun run = runRender(gpu, o);
-        // From the frames themselves: the median of a pass over the frames that ran it, and of
-        // each frame's shadow passes together (frames without a spot-map redraw count less).
-        auto median = [](std::vector<double> v) {
-            std::sort(v.begin(), v.end());
-            size_t n = v.size();
-            return n == 0 ? 0.0 : n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
-        };
-        auto passMedian = [&](const char* pass) {
-            std::vector<double> ms;
-            for (const FrameResult& f : run.frames)
-                for (const PassTiming& t : f.passes)
-                    if (t.name == pass) ms.push_back(t.gpuMs);
-            return median(ms);
-        };
+        // Each pass's median over the frames that ran it (the stats), and the median of each
+        // frame's shadow passes together (frames without a spot-map redraw count less).
         std::vector<double> perFrame;
         for (const FrameResult& f : run.frames) {
             double ms = 0.0;
@@ -124,9 +112,9 @@ nlohmann::json runShadowCullingBench(Gpu& gpu, const BenchOptions& b, RenderOpti
                 for (const char* p : shadowPasses) ms += t.name == p ? t.gpuMs : 0.0;
             perFrame.push_back(ms);
         }
-        for (const char* p : shadowPasses) out["shadow_ms"][name][p] = passMedian(p);
+        for (const char* p : shadowPasses) out["shadow_ms"][name][p] = passMs(run.stats, p);
         out["shadow_ms"][name]["total"] = median(perFrame);
-        out["shadow_ms"][name]["instanceCull"] = passMedian("instanceCull");
+        out["shadow_ms"][name]["instanceCull"] = passMs(run.stats, "instanceCull");
         nlohmann::json stats = std::move(run.stats);
         out["modes"][name] = std::move(stats);
     }

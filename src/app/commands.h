@@ -115,6 +115,8 @@ RenderMode parseMode(const std::string& text);
 Visualize parseVisualize(const std::string& text);
 MarkingMode parseMarking(const std::string& text);
 // "X,Y" -> pixel; throws InputError naming --inspect.
+// The median of `values` (0 for none): the stats' per-frame figures.
+double median(std::vector<double> values);
 void parseInspect(const std::string& text, int32_t& x, int32_t& y);
 // "X,Y" of a pixel for `flag`; one-line InputError otherwise.
 void parsePixel(const char* flag, const std::string& text, int32_t& x, int32_t& y);

@@ -147,7 +147,7 @@ void writePng(const std::string& path, const std::vector<uint8_t>& rgba, uint32_
     writeOutputFile(path, png.data(), png.size());
 }
 
-static double median(std::vector<double> v) {
+double median(std::vector<double> v) {
     if (v.empty()) return 0.0;
     std::sort(v.begin(), v.end());
     size_t n = v.size();
