@@ -180,6 +180,10 @@ RenderRun runRender(Gpu& gpu, const RenderOptions& o) {
     if (o.inspectX >= int32_t(o.width) || o.inspectY >= int32_t(o.height))
         throw InputError(format("--inspect %d,%d: outside the %ux%u image", o.inspectX, o.inspectY,
                                 o.width, o.height));
+    if (o.debugLinesAtX >= 0 && (o.debugLines & (DEBUG_LINES_LIGHTS | DEBUG_LINES_BLOCKERS)) == 0)
+        throw InputError(format("--debug-lines-at %d,%d: picks lights, so it needs --debug-lines "
+                                "lights or blockers",
+                                o.debugLinesAtX, o.debugLinesAtY));
     if (o.debugLinesAtX >= int32_t(o.width) || o.debugLinesAtY >= int32_t(o.height))
         throw InputError(format("--debug-lines-at %d,%d: outside the %ux%u image", o.debugLinesAtX,
                                 o.debugLinesAtY, o.width, o.height));

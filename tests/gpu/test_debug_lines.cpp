@@ -79,6 +79,9 @@ TEST(DebugLines, PickedPixelKeepsOnlyTheLightsReachingItsSurface) {
     bad.debugLines = DEBUG_LINES_LIGHTS;
     bad.debugLinesAtX = 500, bad.debugLinesAtY = 10;
     EXPECT_THROW(runRender(sharedGpu(), bad), InputError);
+    bad.debugLinesAtX = 10;
+    bad.debugLines = DEBUG_LINES_CHUNKS; // no lights to pick
+    EXPECT_THROW(runRender(sharedGpu(), bad), InputError);
 }
 
 // Every shaded chunk with a shadel on its surface emits its box: 12 segments each.
