@@ -215,6 +215,7 @@ nlohmann::json runBench(Gpu& gpu, const BenchOptions& b) {
     o.frames = b.frames;
     o.camera = b.camera;
     o.timing = b.timing;
+    o.threads = b.threads;
     o.shadelsPerMetre = b.shadelsPerMetre;
     o.cacheDir = b.cacheDir;
     o.cameraPath = b.cameraPath;
@@ -324,6 +325,30 @@ nlohmann::json runBench(Gpu& gpu, const BenchOptions& b) {
                     doff > 0 ? don / doff : 0.0);
     }
 
+    if (b.compareThreads) {
+        // Render threading (rhi/frame.h): every mode again with one recording thread. The CPU
+        // frame time (frontend + recording, GPU waits excluded) is the figure threading moves.
+        for (const Mode& m : modes) {
+            std::fprintf(stderr, "bench: %s, --threads 1\n", m.name);
+            o.mode = m.mode;
+            o.reuse = m.reuse;
+            o.threads = 1;
+            nlohmann::json serial = runRender(gpu, o).stats;
+            const nlohmann::json& threaded = out["modes"][m.name];
+            double serialCpu = serial["cpu_frame_ms"], threadedCpu = threaded["cpu_frame_ms"];
+            out["ratios"][std::string("threads_cpu_") + m.name] =
+                serialCpu > 0 ? threadedCpu / serialCpu : 0.0;
+            std::printf("threads (%s): cpu frame %.3f ms with %u threads, %.3f ms serial = %.3f; "
+                        "recording %.3f ms wall, %.3f ms CPU on the workers\n",
+                        m.name, threadedCpu, threaded["recording"]["threads"].get<uint32_t>(),
+                        serialCpu, serialCpu > 0 ? threadedCpu / serialCpu : 0.0,
+                        threaded["recording"]["wall_ms"].get<double>(),
+                        threaded["recording"]["workers_cpu_ms"].get<double>());
+            out["modes"][std::string(m.name) + "_serial"] = std::move(serial);
+        }
+        o.threads = b.threads;
+    }
+
     std::printf("shadel bench: %s at %ux%u on %s, %u frames, %s camera, medians (timing: %s)\n",
                 b.scene.c_str(), b.width, b.height, gpu.device.name.c_str(), b.frames,
                 pathNames[int(b.cameraPath)], forward["timing"].get<std::string>().c_str());
@@ -338,6 +363,11 @@ nlohmann::json runBench(Gpu& gpu, const BenchOptions& b) {
     });
     row("ratio to forward", [&](const nlohmann::json& s) {
         return format("%.3f", fwd > 0 ? s["frame_ms"]["median"].get<double>() / fwd : 0.0);
+    });
+    row("cpu frame ms",
+        [](const nlohmann::json& s) { return format("%.3f", s["cpu_frame_ms"].get<double>()); });
+    row("recording threads", [](const nlohmann::json& s) {
+        return format("%u", s["recording"]["threads"].get<uint32_t>());
     });
     // Passes: union by name, in frame order.
     std::vector<std::string> names;

@@ -32,6 +32,7 @@ struct RenderOptions {
     std::string stats; // FILE.json ; empty = none
     std::string trace; // FILE.json: Chrome trace events of the run; empty = none
     std::optional<TimingMode> timing;
+    uint32_t threads = 0; // --threads: recording threads (0 = auto: defaultRecordingThreads())
     float exposure = 1.0f;
     float shadelsPerMetre = 0.0f; // 0 = auto: view-driven per mesh (render/view_density.h)
     std::string cacheDir;         // empty = default cache directory
@@ -148,6 +149,8 @@ struct BenchOptions {
     std::string camera;
     std::string json;
     std::optional<TimingMode> timing;
+    uint32_t threads = 0;         // --threads N (0 = auto)
+    bool compareThreads = false;  // --threads compare: every mode serial and threaded
     float shadelsPerMetre = 0.0f; // 0 = auto
     std::string cacheDir;
     CameraPath cameraPath = CameraPath::Static;

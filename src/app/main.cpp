@@ -37,6 +37,16 @@ float parseDensity(const std::string& t) {
     return float(v);
 }
 
+// --threads auto | N: threads recording a frame's passes (0 = auto).
+uint32_t parseThreads(const std::string& t) {
+    if (t == "auto") return 0;
+    char* end = nullptr;
+    long v = std::strtol(t.c_str(), &end, 10);
+    if (end == t.c_str() || *end != '\0' || v < 1 || v > 64)
+        throw InputError(format("--threads %s: expected auto or 1..64", t.c_str()));
+    return uint32_t(v);
+}
+
 std::optional<TimingMode> parseTiming(const std::string& t) {
     if (t == "auto") return std::nullopt;
     if (t == "timestamps") return TimingMode::Timestamps;
@@ -133,6 +143,11 @@ int main(int argc, char** argv) {
         ->capture_default_str();
     render->add_option("--out", ro.out, "FILE.png (last frame) or DIR/ (every frame)");
     render->add_option("--stats", ro.stats, "FILE.json");
+    std::string threads = "auto";
+    render
+        ->add_option("--threads", threads,
+                     "auto | N: threads recording the frame's passes (1: serial; auto: up to 4)")
+        ->capture_default_str();
     render->add_option("--timing", timing, "auto | timestamps | submit (per-pass submit+wait)")
         ->capture_default_str();
     render->add_option("--exposure", ro.exposure, "exposure multiplier")
@@ -398,6 +413,12 @@ int main(int argc, char** argv) {
     bench->add_option("--json", bo.json, "write the results as JSON");
     bench->add_option("--plot", bo.plot, "FILE.png: the per-pass comparison as a bar chart");
     bench->add_option("--timing", benchTiming, "auto | timestamps | submit")->capture_default_str();
+    std::string benchThreads = "auto";
+    bench
+        ->add_option("--threads", benchThreads,
+                     "auto | N: threads recording each frame's passes (1: serial), or compare: "
+                     "every mode serial and threaded, CPU frame times side by side")
+        ->capture_default_str();
     bench->add_option("--density", benchDensity, "auto | shadels per metre")->capture_default_str();
     bench->add_option("--cache-dir", bo.cacheDir, "bake cache directory");
     std::string benchCameraPath = "static";
@@ -484,6 +505,9 @@ int main(int argc, char** argv) {
         ->capture_default_str();
     view->add_option("--screenshot", vo.screenshot,
                      "FILE.png: the window's last frame (with --frames), or on the UI's button");
+    std::string viewThreads = "auto";
+    view->add_option("--threads", viewThreads, "auto | N: threads recording the frame's passes")
+        ->capture_default_str();
     view->add_flag("--no-ui", vo.noUi, "no ImGui panel (screenshots show only the frame)");
     view->add_option("--cache-dir", vo.cacheDir, "bake cache directory");
     view->add_option("--shader-source", vo.shaderSource,
@@ -558,6 +582,7 @@ int main(int argc, char** argv) {
         if (*view) {
             parseSize(viewSize, vo.width, vo.height);
             vo.allowExternalFiles = allowExternalFiles;
+            vo.threads = parseThreads(viewThreads);
             vo.cacheLimitBytes = cacheLimitBytes;
             return runViewer(vo, deviceDesc(device, validation));
         }
@@ -573,6 +598,7 @@ int main(int argc, char** argv) {
                 throw InputError(format("--jitter %s: expected none or subpixel", jitter.c_str()));
             ro.jitter = jitter == "subpixel";
             ro.timing = parseTiming(timing);
+            ro.threads = parseThreads(threads);
             ro.shadelsPerMetre = parseDensity(density);
             ro.cameraPath = parseCameraPath(cameraPath);
             if (timeSeconds >= 0.0) ro.time = timeSeconds;
@@ -667,6 +693,8 @@ int main(int argc, char** argv) {
         if (*bench) {
             parseSize(benchSize, bo.width, bo.height);
             bo.timing = parseTiming(benchTiming);
+            bo.compareThreads = benchThreads == "compare";
+            if (!bo.compareThreads) bo.threads = parseThreads(benchThreads);
             bo.shadelsPerMetre = parseDensity(benchDensity);
             bo.cameraPath = parseCameraPath(benchCameraPath);
             bo.marking = parseMarking(benchMarking);

@@ -387,6 +387,7 @@ RenderRun runRender(Gpu& gpu, const RenderOptions& o) {
         throw InputError(e);
     settings.dfShadowStart = o.dfShadowStart;
     settings.timing = o.timing ? *o.timing : defaultTimingMode(gpu);
+    settings.recordingThreads = o.threads ? o.threads : defaultRecordingThreads();
     Renderer renderer;
     RenderRun run;
     try {
@@ -465,6 +466,18 @@ RenderRun runRender(Gpu& gpu, const RenderOptions& o) {
     std::vector<double> threadMs;
     for (auto& f : run.frames) threadMs.push_back(f.cpuThreadMs);
     s["cpu_frame_thread_ms"] = median(threadMs); // the same, as the thread's CPU clock counts it
+    // Render threading (rhi/frame.h): with more than one thread the passes are recorded in
+    // parallel; the wall clock of that and the CPU time each worker spent recording.
+    std::vector<double> recordingMs, recordingCpuMs;
+    for (auto& f : run.frames) {
+        recordingMs.push_back(f.recordingMs);
+        double cpu = 0.0;
+        for (const RecordingWorkerTiming& w : f.recordingWorkers) cpu += w.cpuMs;
+        recordingCpuMs.push_back(cpu);
+    }
+    s["recording"] = {{"threads", settings.recordingThreads},
+                      {"wall_ms", median(recordingMs)},
+                      {"workers_cpu_ms", median(recordingCpuMs)}};
     s["frame_ms"] = {{"median", median(frameMs)},
                      {"min", *std::min_element(frameMs.begin(), frameMs.end())},
                      {"max", *std::max_element(frameMs.begin(), frameMs.end())}};

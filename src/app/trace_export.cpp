@@ -1,9 +1,12 @@
 #include "app/trace_export.h"
 
+#include <algorithm>
+#include <string>
+
 namespace shadel {
 
 nlohmann::json chromeTrace(const std::vector<FrameResult>& frames, const std::string& label) {
-    constexpr int kPid = 1, kCpuTrack = 1, kGpuTrack = 2;
+    constexpr int kPid = 1, kCpuTrack = 1, kGpuTrack = 2, kFirstWorkerTrack = 3;
     nlohmann::json events = nlohmann::json::array();
     auto meta = [&](const char* what, int tid, const std::string& name) {
         nlohmann::json e = {{"name", what}, {"ph", "M"}, {"pid", kPid}, {"args", {{"name", name}}}};
@@ -13,6 +16,11 @@ nlohmann::json chromeTrace(const std::vector<FrameResult>& frames, const std::st
     meta("process_name", 0, "shadel " + label);
     meta("thread_name", kCpuTrack, "CPU");
     meta("thread_name", kGpuTrack, "GPU passes");
+    size_t workers = 0; // threaded frames: one track per recording worker
+    for (const FrameResult& f : frames) workers = std::max(workers, f.recordingWorkers.size());
+    for (size_t w = 0; w < workers; ++w)
+        meta("thread_name", kFirstWorkerTrack + int(w),
+             "CPU recording worker " + std::to_string(w) + (w == 0 ? " (render thread)" : ""));
     auto span = [&](const std::string& name, const char* category, int tid, double startMs,
                     double durationMs, nlohmann::json args) {
         events.push_back({{"name", name},
@@ -29,8 +37,14 @@ nlohmann::json chromeTrace(const std::vector<FrameResult>& frames, const std::st
         span("frame " + std::to_string(i), "cpu", kCpuTrack, f.startMs, f.frameMs,
              {{"frame", i}, {"cpu_frame_ms", f.cpuFrameMs}});
         span("frontend", "cpu", kCpuTrack, f.startMs, f.cpuPrepareMs, {{"frame", i}});
-        // GPU passes start after the frontend has prepared the frame.
+        // GPU passes and recording start after the frontend has prepared the frame.
         double gpuStart = f.startMs + f.cpuPrepareMs;
+        for (size_t w = 0; w < f.recordingWorkers.size(); ++w) {
+            const RecordingWorkerTiming& t = f.recordingWorkers[w];
+            if (!t.passes) continue;
+            span("record passes", "cpu", kFirstWorkerTrack + int(w), gpuStart + t.startMs,
+                 t.durationMs, {{"frame", i}, {"passes", t.passes}, {"cpu_ms", t.cpuMs}});
+        }
         for (const PassTiming& p : f.passes)
             span(p.name, "gpu", kGpuTrack, gpuStart + p.startMs, p.gpuMs, {{"frame", i}});
     }

@@ -1,6 +1,7 @@
 #pragma once
 // --trace FILE.json: the frames of a run as Chrome trace events (chrome://tracing, Perfetto):
-// one track for the CPU (frame, frontend) and one for the GPU passes, named as in --passes.
+// one track for the CPU (frame, frontend), one for the GPU passes, named as in --passes, and
+// in threaded frames one per recording worker (its passes' recording, with its CPU time).
 #include <vector>
 
 #include <nlohmann/json.hpp>

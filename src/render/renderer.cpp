@@ -138,7 +138,7 @@ void initRenderer(Renderer& r, Gpu& gpu, const RenderSettings& requested, const 
     createForwardPipelines(r);
     createTonemapPipeline(r);
     initShaderMessages(gpu, r.messages);
-    initFrameRecorder(gpu, r.recorder, settings.timing);
+    initFrameRecorder(gpu, r.recorder, settings.timing, std::max(1u, settings.recordingThreads));
     if (settings.mode == RenderMode::Decoupled) r.decoupled = createDecoupled(r, scene);
     // Tile shading (--spectra on|single, forward) reads the visibility buffer too.
     if (usesVisibilityBuffer(settings) || usesTileShading(r)) r.visibility = createVisibility(r);
@@ -405,6 +405,8 @@ FrameResult renderFrame(Renderer& r, const GpuScene& scene, const CameraView& ca
 
     FrameResult result;
     result.passes = rec.passes;
+    result.recordingMs = rec.recordingMs;
+    result.recordingWorkers = rec.workerTimings;
     result.frameMs = rec.frameMs;
     result.startMs = startMs;
     result.cpuPrepareMs = prepareMs;

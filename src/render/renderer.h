@@ -80,6 +80,9 @@ struct RenderSettings {
     float exposure = 1.0f;
     uint32_t shadowMapSize = 2048;
     TimingMode timing = TimingMode::SubmitPerPass;
+    // --threads: threads recording the frame's passes (1 = serial, in declaration order;
+    // rhi/frame.h). The images are the same for any count.
+    uint32_t recordingThreads = 1;
     uint32_t shadeStorageSize = 4096; // decoupled: physical shade storage, shadels per side
     uint32_t sheetShadels = 65536;    // decoupled: virtual sheet, shadels per side
     float shadingBias = 0.0f; // decoupled: base MIP bias (the capacity controller adds to it)
@@ -162,6 +165,9 @@ struct FrameResult {
     std::vector<ShaderPrint> prints;        // shaderPrint records of this frame (--inspect)
     uint32_t transparentDraws = 0;          // blended instances drawn (render/oit)
     uint32_t transparentDecoupledDraws = 0; // ... of which shaded in shadel space
+    // Threaded frames: the wall clock of the parallel recording and what each worker did.
+    double recordingMs = 0.0;
+    std::vector<RecordingWorkerTiming> recordingWorkers;
 };
 
 struct DecoupledState; // render/shadel/decoupled.h

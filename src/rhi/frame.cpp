@@ -1,22 +1,59 @@
 #include "rhi/frame.h"
 
+#include <algorithm>
+#include <ctime>
+#include <thread>
+
 #include "core/assert.h"
+#include "core/worker_pool.h"
 #include "rhi/gpu.h"
 
 namespace shadel {
+
+using Clock = std::chrono::steady_clock;
+
+static double msBetween(Clock::time_point from, Clock::time_point to) {
+    return std::chrono::duration<double, std::milli>(to - from).count();
+}
+
+static double threadCpuMs() {
+    timespec t{};
+    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
+    return double(t.tv_sec) * 1e3 + double(t.tv_nsec) * 1e-6;
+}
+
+static VkCommandPool createCommandPool(Gpu& gpu, const std::string& name) {
+    VkCommandPoolCreateInfo ci{VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO};
+    ci.flags = VK_COMMAND_POOL_CREATE_RESET_COMMAND_BUFFER_BIT;
+    ci.queueFamilyIndex = gpu.device.queueFamily;
+    VkCommandPool pool = VK_NULL_HANDLE;
+    VK_CHECK(vkCreateCommandPool(gpu.device.device, &ci, nullptr, &pool));
+    setName(gpu.device, pool, VK_OBJECT_TYPE_COMMAND_POOL, name.c_str());
+    return pool;
+}
 
 TimingMode defaultTimingMode(const Gpu& gpu) {
     return gpu.device.isCpu ? TimingMode::SubmitPerPass : TimingMode::Timestamps;
 }
 
-void initFrameRecorder(Gpu& gpu, FrameRecorder& r, TimingMode mode) {
+// Beyond four, recording a frame of a few dozen passes gains little against waking threads.
+uint32_t defaultRecordingThreads() {
+    return std::clamp(std::thread::hardware_concurrency(), 1u, 4u);
+}
+
+void initFrameRecorder(Gpu& gpu, FrameRecorder& r, TimingMode mode, uint32_t recordingThreads) {
+    SHADEL_ASSERT(recordingThreads >= 1);
     r.gpu = &gpu;
     r.mode = mode;
-    VkCommandPoolCreateInfo ci{VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO};
-    ci.flags = VK_COMMAND_POOL_CREATE_RESET_COMMAND_BUFFER_BIT;
-    ci.queueFamilyIndex = gpu.device.queueFamily;
-    VK_CHECK(vkCreateCommandPool(gpu.device.device, &ci, nullptr, &r.pool));
-    setName(gpu.device, r.pool, VK_OBJECT_TYPE_COMMAND_POOL, "frame.commandPool");
+    r.pool = createCommandPool(gpu, "frame.commandPool");
+    r.recordingThreads = recordingThreads;
+    if (recordingThreads > 1) {
+        r.workers = std::make_shared<WorkerPool>(recordingThreads);
+        r.recordingPools.resize(recordingThreads);
+        for (uint32_t w = 0; w < recordingThreads; ++w)
+            r.recordingPools[w].pool =
+                createCommandPool(gpu, "frame.recordingWorker" + std::to_string(w) + ".pool");
+    }
     VkCommandBufferAllocateInfo ai{VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO};
     ai.commandPool = r.pool;
     ai.level = VK_COMMAND_BUFFER_LEVEL_PRIMARY;
@@ -40,6 +77,8 @@ void destroyFrameRecorder(FrameRecorder& r) {
     vkDestroyQueryPool(dev, r.queries, nullptr);
     vkDestroyFence(dev, r.fence, nullptr);
     vkDestroyCommandPool(dev, r.pool, nullptr);
+    for (RecordingPool& p : r.recordingPools) vkDestroyCommandPool(dev, p.pool, nullptr);
+    r.workers.reset(); // joins the workers
     r = FrameRecorder{};
 }
 
@@ -50,13 +89,16 @@ static void beginCommands(FrameRecorder& r) {
     VK_CHECK(vkBeginCommandBuffer(r.cmd, &bi));
 }
 
-static void submitAndWait(FrameRecorder& r) {
-    VK_CHECK(vkEndCommandBuffer(r.cmd));
-    VkCommandBufferSubmitInfo cbi{VK_STRUCTURE_TYPE_COMMAND_BUFFER_SUBMIT_INFO};
-    cbi.commandBuffer = r.cmd;
+// Submits the (ended) command buffers in order as one batch and waits for the GPU.
+static void submitAndWait(FrameRecorder& r, const VkCommandBuffer* cmds, uint32_t count) {
+    std::vector<VkCommandBufferSubmitInfo> cbis(count);
+    for (uint32_t i = 0; i < count; ++i) {
+        cbis[i] = {VK_STRUCTURE_TYPE_COMMAND_BUFFER_SUBMIT_INFO};
+        cbis[i].commandBuffer = cmds[i];
+    }
     VkSubmitInfo2 si{VK_STRUCTURE_TYPE_SUBMIT_INFO_2};
-    si.commandBufferInfoCount = 1;
-    si.pCommandBufferInfos = &cbi;
+    si.commandBufferInfoCount = count;
+    si.pCommandBufferInfos = cbis.data();
     std::vector<VkSemaphoreSubmitInfo> waits;
     for (VkSemaphore sem : r.waitOnce) {
         VkSemaphoreSubmitInfo w{VK_STRUCTURE_TYPE_SEMAPHORE_SUBMIT_INFO};
@@ -80,14 +122,22 @@ static void submitAndWait(FrameRecorder& r) {
     VK_CHECK(res);
 }
 
+static void submitAndWait(FrameRecorder& r) {
+    VK_CHECK(vkEndCommandBuffer(r.cmd));
+    submitAndWait(r, &r.cmd, 1);
+}
+
 void beginFrame(FrameRecorder& r) {
     Gpu& gpu = *r.gpu;
     prepareBindlessFrame(gpu, gpu.frameIndex);
     r.passes.clear();
+    r.deferred.clear();
+    r.workerTimings.clear();
+    r.recordingMs = 0.0;
     r.gpuWaitMs = 0.0;
     r.frameStart = std::chrono::steady_clock::now();
     vkResetQueryPool(gpu.device.device, r.queries, 0, r.maxPasses * 2);
-    if (r.mode == TimingMode::Timestamps) beginCommands(r);
+    if (r.mode == TimingMode::Timestamps && r.recordingThreads == 1) beginCommands(r);
 }
 
 void pass(FrameRecorder& r, const char* name, const std::function<void(VkCommandBuffer)>& record) {
@@ -95,6 +145,10 @@ void pass(FrameRecorder& r, const char* name, const std::function<void(VkCommand
     uint32_t index = uint32_t(r.passes.size());
     SHADEL_ASSERT(index < r.maxPasses);
     r.passes.push_back({name, 0.0, 0.0});
+    if (r.recordingThreads > 1) { // recorded in endFrame, on the workers
+        r.deferred.push_back({record, VK_NULL_HANDLE});
+        return;
+    }
     if (r.mode == TimingMode::SubmitPerPass) {
         auto start = std::chrono::steady_clock::now();
         r.passes.back().startMs =
@@ -116,10 +170,89 @@ void pass(FrameRecorder& r, const char* name, const std::function<void(VkCommand
     endLabel(gpu, r.cmd);
 }
 
+// Records every kept pass into its own command buffer, on the workers (threaded frames).
+static void recordDeferredPasses(FrameRecorder& r) {
+    Gpu& gpu = *r.gpu;
+    uint32_t n = uint32_t(r.deferred.size());
+    for (RecordingPool& p : r.recordingPools) {
+        VK_CHECK(vkResetCommandPool(gpu.device.device, p.pool, 0));
+        p.used = 0;
+    }
+    r.workerTimings.assign(r.recordingThreads, {});
+    std::vector<Clock::time_point> firstStart(r.recordingThreads), lastEnd(r.recordingThreads);
+    Clock::time_point start = Clock::now();
+    r.workers->parallelFor(n, [&](uint32_t i, uint32_t worker) {
+        Clock::time_point passStart = Clock::now();
+        double cpuStart = threadCpuMs();
+        RecordingPool& p = r.recordingPools[worker];
+        if (p.used == p.buffers.size()) {
+            VkCommandBufferAllocateInfo ai{VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO};
+            ai.commandPool = p.pool;
+            ai.level = VK_COMMAND_BUFFER_LEVEL_PRIMARY;
+            ai.commandBufferCount = 1;
+            VkCommandBuffer cmd = VK_NULL_HANDLE;
+            VK_CHECK(vkAllocateCommandBuffers(gpu.device.device, &ai, &cmd));
+            std::string name = "frame.recordingWorker" + std::to_string(worker) + ".commands" +
+                               std::to_string(p.buffers.size());
+            setName(gpu.device, cmd, VK_OBJECT_TYPE_COMMAND_BUFFER, name.c_str());
+            p.buffers.push_back(cmd);
+        }
+        VkCommandBuffer cmd = p.buffers[p.used++];
+        VkCommandBufferBeginInfo bi{VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
+        bi.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
+        VK_CHECK(vkBeginCommandBuffer(cmd, &bi));
+        const char* name = r.passes[i].name.c_str();
+        beginLabel(gpu, cmd, name);
+        bool stamps = r.mode == TimingMode::Timestamps;
+        if (stamps)
+            vkCmdWriteTimestamp2(cmd, VK_PIPELINE_STAGE_2_TOP_OF_PIPE_BIT, r.queries, i * 2);
+        r.deferred[i].record(cmd);
+        if (stamps)
+            vkCmdWriteTimestamp2(cmd, VK_PIPELINE_STAGE_2_BOTTOM_OF_PIPE_BIT, r.queries, i * 2 + 1);
+        endLabel(gpu, cmd);
+        VK_CHECK(vkEndCommandBuffer(cmd));
+        r.deferred[i].cmd = cmd;
+        RecordingWorkerTiming& t = r.workerTimings[worker];
+        if (t.passes++ == 0) firstStart[worker] = passStart;
+        lastEnd[worker] = Clock::now();
+        t.cpuMs += threadCpuMs() - cpuStart;
+    });
+    r.recordingMs = msBetween(start, Clock::now());
+    for (uint32_t w = 0; w < r.recordingThreads; ++w) {
+        RecordingWorkerTiming& t = r.workerTimings[w];
+        if (!t.passes) continue;
+        t.startMs = msBetween(r.frameStart, firstStart[w]);
+        t.durationMs = msBetween(firstStart[w], lastEnd[w]);
+    }
+}
+
+// Submits the recorded passes in order: one batch (timestamps) or one by one (submit per pass).
+static void submitDeferredPasses(FrameRecorder& r) {
+    uint32_t n = uint32_t(r.deferred.size());
+    if (r.mode == TimingMode::Timestamps) {
+        std::vector<VkCommandBuffer> cmds(n);
+        for (uint32_t i = 0; i < n; ++i) cmds[i] = r.deferred[i].cmd;
+        if (n) submitAndWait(r, cmds.data(), n);
+        return;
+    }
+    for (uint32_t i = 0; i < n; ++i) {
+        Clock::time_point start = Clock::now();
+        r.passes[i].startMs = msBetween(r.frameStart, start);
+        submitAndWait(r, &r.deferred[i].cmd, 1);
+        r.passes[i].gpuMs = msBetween(start, Clock::now());
+    }
+}
+
 void endFrame(FrameRecorder& r) {
     Gpu& gpu = *r.gpu;
-    if (r.mode == TimingMode::Timestamps) {
+    if (r.recordingThreads > 1) {
+        recordDeferredPasses(r);
+        submitDeferredPasses(r);
+        r.deferred.clear(); // the captured state is released with the frame
+    } else if (r.mode == TimingMode::Timestamps) {
         submitAndWait(r);
+    }
+    if (r.mode == TimingMode::Timestamps) {
         uint32_t n = uint32_t(r.passes.size());
         if (n) {
             std::vector<uint64_t> ticks(n * 2);

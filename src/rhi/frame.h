@@ -5,8 +5,18 @@
 // on GPUs whose timestamps are attributed to the pass that ran. SubmitPerPass: each pass is its
 // own submission and the CPU waits for it; slower, but the only trustworthy per-pass figure
 // on lavapipe, whose timestamps after a graphics pass are attributed late.
+//
+// Recording threads (seed 003's parallel command recording). With one thread each pass is
+// recorded when it is declared. With more, `pass` only keeps the pass; endFrame records every
+// kept pass into its own command buffer on a pool of workers (each worker its own command
+// pool), then submits them in declaration order, so the GPU sees the same commands in the same
+// order as the serial frame. Hence the rule for every pass's recording function: it may run
+// later and on another thread, so it captures the frame's locals (push constants, the frame
+// address, counts) by value, refers by reference only to state that outlives the frame
+// (Renderer, a technique's state, the scene), and changes no CPU state another pass reads.
 #include <chrono>
 #include <functional>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -15,6 +25,7 @@
 namespace shadel {
 
 struct Gpu;
+class WorkerPool;
 
 enum class TimingMode { Timestamps, SubmitPerPass };
 
@@ -22,6 +33,26 @@ struct PassTiming {
     std::string name;
     double gpuMs = 0.0;
     double startMs = 0.0; // GPU start relative to the frame's first pass (trace export)
+};
+
+// What one recording worker did in a frame (the trace shows one track per worker).
+struct RecordingWorkerTiming {
+    double startMs = 0.0;    // first pass begun, from the frame's start
+    double durationMs = 0.0; // to the last pass ended
+    double cpuMs = 0.0;      // CPU time of the thread while recording
+    uint32_t passes = 0;
+};
+
+// A worker's command pool and the command buffers it has allocated (reused every frame).
+struct RecordingPool {
+    VkCommandPool pool = VK_NULL_HANDLE;
+    std::vector<VkCommandBuffer> buffers;
+    uint32_t used = 0;
+};
+
+struct DeferredPass {
+    std::function<void(VkCommandBuffer)> record;
+    VkCommandBuffer cmd = VK_NULL_HANDLE; // the buffer a worker recorded it into
 };
 
 struct FrameRecorder {
@@ -39,14 +70,26 @@ struct FrameRecorder {
     // Binary semaphores the frame's next submission waits on (at every stage), then forgets:
     // work queued before the frame that the frame depends on (sparse binds, render/streaming).
     std::vector<VkSemaphore> waitOnce;
+
+    // Recording threads (1 = serial, each pass recorded where it is declared).
+    uint32_t recordingThreads = 1;
+    std::shared_ptr<WorkerPool> workers;
+    std::vector<RecordingPool> recordingPools;        // one per worker
+    std::vector<DeferredPass> deferred;               // this frame's passes, when threaded
+    std::vector<RecordingWorkerTiming> workerTimings; // filled by endFrame() when threaded
+    double recordingMs = 0.0; // wall clock of the parallel recording (threaded)
 };
 
-void initFrameRecorder(Gpu& gpu, FrameRecorder& recorder, TimingMode mode);
+// recordingThreads >= 1; more than one records the frame's passes on that many threads.
+void initFrameRecorder(Gpu& gpu, FrameRecorder& recorder, TimingMode mode,
+                       uint32_t recordingThreads = 1);
 void destroyFrameRecorder(FrameRecorder& recorder);
 TimingMode defaultTimingMode(const Gpu& gpu); // SubmitPerPass on CPU devices
+uint32_t defaultRecordingThreads();           // the hardware threads, at most 4
 
 void beginFrame(FrameRecorder& recorder);
-// Records `record` as the named pass (debug label + timing).
+// Records `record` as the named pass (debug label + timing): now, or with recording threads in
+// endFrame (see the rule at the top).
 void pass(FrameRecorder& recorder, const char* name,
           const std::function<void(VkCommandBuffer)>& record);
 // Submits what is left, waits for the GPU, resolves timings.

@@ -59,6 +59,7 @@ RenderSettings settingsFor(const ViewOptions& o, const ViewerPanel& p, const Gpu
     s.marking = parseMarking(o.marking);
     s.visualize = p.mode == 1 ? parseVisualize(kVisualizeNames[p.visualize]) : Visualize::None;
     s.timing = defaultTimingMode(gpu);
+    s.recordingThreads = o.threads ? o.threads : defaultRecordingThreads();
     s.materialSamples = 16; // as `shadel render`
     return s;
 }

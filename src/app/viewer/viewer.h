@@ -17,6 +17,7 @@ struct ViewOptions {
     uint32_t frames = 0;    // 0 = until the window closes
     std::string screenshot; // PNG of the window's last frame (with --frames) or on request
     bool noUi = false;
+    uint32_t threads = 0; // --threads: recording threads (0 = auto)
     // Hot reload: the GLSL folder watched (default: the source tree's shaders/); empty = off.
     std::string shaderSource = SHADEL_SHADER_SOURCE_DIR;
     std::string cacheDir;

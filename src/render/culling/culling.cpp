@@ -1,6 +1,7 @@
 #include "render/culling/culling.h"
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <cstring>
 #include <string>
@@ -32,7 +33,10 @@ struct CullingState {
     Pipeline hizBuild;
     gpu::GpuCullStats last{}; // the last finished frame's counts
     uint32_t instances = 0;
-    uint32_t dispatches = 0, lastDispatches = 0; // instance_cull.comp dispatches this / last frame
+    // instance_cull.comp dispatches this / last frame (counted while recording, which may run on
+    // several threads at once: rhi/frame.h)
+    std::atomic<uint32_t> dispatches{0};
+    uint32_t lastDispatches = 0;
     // --shadow-culling per-view: one list per cascade and shadow-casting spot.
     BufferHandle shadowViews;      // gpu::GpuShadowCullView[lists] (upload)
     BufferHandle shadowViewDraws;  // DrawIndexedCommand[lists * maxDraws]
@@ -226,7 +230,7 @@ void recordOcclusionPasses(Renderer& r, FrameRecorder& rec, uint64_t frame, cons
         // Back to a depth target (contents kept) for the phase-2 prepass.
         sceneDepthToAttachment(r, cmd, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT);
     });
-    pass(rec, "instanceCullPhase2", [&](VkCommandBuffer cmd) {
+    pass(rec, "instanceCullPhase2", [&, frame](VkCommandBuffer cmd) {
         bind(gpu, cmd, r.instanceCull);
         InstanceCullPush push{
             frame,   address(gpu, c.phase2Draws), address(gpu, c.phase2Counts), r.maxDraws, 0,
@@ -237,7 +241,7 @@ void recordOcclusionPasses(Renderer& r, FrameRecorder& rec, uint64_t frame, cons
                       VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT, VK_PIPELINE_STAGE_2_DRAW_INDIRECT_BIT,
                       VK_ACCESS_2_INDIRECT_COMMAND_READ_BIT);
     });
-    pass(rec, "depthPrepassPhase2", [&](VkCommandBuffer cmd) {
+    pass(rec, "depthPrepassPhase2", [&, frame](VkCommandBuffer cmd) {
         beginSceneDepthPass(r, cmd, false);
         bind(gpu, cmd, r.depthPrepass);
         VkViewport vp{0, 0, float(r.internalWidth), float(r.internalHeight), 0, 1};
@@ -286,7 +290,7 @@ void drawShadowViewList(Renderer& r, VkCommandBuffer cmd, uint32_t view) {
 void finishCullingFrame(Renderer& r) {
     CullingState& c = *r.culling;
     std::memcpy(&c.last, mapped(*r.gpu, c.stats), sizeof(gpu::GpuCullStats));
-    c.lastDispatches = c.dispatches;
+    c.lastDispatches = c.dispatches.load();
     if (c.visibleList) {
         const uint32_t* list = static_cast<const uint32_t*>(mapped(*r.gpu, c.visibleList));
         uint32_t count = std::min(list[0], c.instances);

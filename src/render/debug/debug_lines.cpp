@@ -136,7 +136,7 @@ void recordDebugLinePasses(Renderer& r, FrameRecorder& rec, uint64_t frame, cons
         emitPush.atX = r.settings.debugLinesAtX * int32_t(r.settings.ssaa);
         emitPush.atY = r.settings.debugLinesAtY * int32_t(r.settings.ssaa);
     }
-    pass(rec, "debugLinesEmit", [&](VkCommandBuffer cmd) {
+    pass(rec, "debugLinesEmit", [&, push, emitPush, lightCount](VkCommandBuffer cmd) {
         // Segments appended by earlier passes (shadelShading's chunk boxes) come first.
         memoryBarrier(cmd, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
                       VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
@@ -170,7 +170,7 @@ void recordDebugLinePasses(Renderer& r, FrameRecorder& rec, uint64_t frame, cons
         memoryBarrier(cmd, VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT,
                       VK_PIPELINE_STAGE_2_HOST_BIT, VK_ACCESS_2_HOST_READ_BIT);
     });
-    pass(rec, "debugLines", [&](VkCommandBuffer cmd) {
+    pass(rec, "debugLines", [&, push](VkCommandBuffer cmd) {
         // After every pass that wrote colour or depth.
         memoryBarrier(cmd,
                       VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT |

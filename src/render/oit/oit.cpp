@@ -312,7 +312,7 @@ void recordTransparencyPasses(Renderer& r, FrameRecorder& rec, uint64_t frame) {
     };
 
     if (r.settings.oit == OitMode::Sorted) {
-        pass(rec, "sortedTransparency", [&](VkCommandBuffer cmd) {
+        pass(rec, "sortedTransparency", [&, frame, meshOf](VkCommandBuffer cmd) {
             afterOpaquePasses(cmd);
             beginSceneColorPass(r, cmd, false);
             setViewport(cmd, r.internalWidth, r.internalHeight);
@@ -329,7 +329,7 @@ void recordTransparencyPasses(Renderer& r, FrameRecorder& rec, uint64_t frame) {
         return;
     }
 
-    pass(rec, "oitAccumulate", [&](VkCommandBuffer cmd) {
+    pass(rec, "oitAccumulate", [&, frame, meshOf](VkCommandBuffer cmd) {
         afterOpaquePasses(cmd);
         beginWboitTargets(r, cmd, true);
         bind(gpu, cmd, o.accumulate);
@@ -345,7 +345,7 @@ void recordTransparencyPasses(Renderer& r, FrameRecorder& rec, uint64_t frame) {
     });
     recordParticleSprites(r, rec, frame); // GPU particles, into the same targets
 
-    pass(rec, "oitComposite", [&](VkCommandBuffer cmd) {
+    pass(rec, "oitComposite", [&, frame](VkCommandBuffer cmd) {
         for (TextureHandle t : {o.accum, o.reveal})
             imageBarrier(
                 cmd, vkImage(gpu, t), VK_IMAGE_ASPECT_COLOR_BIT,

@@ -246,7 +246,7 @@ void recordParticlePasses(Renderer& r, FrameRecorder& rec, uint64_t frame) {
     Gpu& gpu = *r.gpu;
     ParticleState& s = *r.particles;
     ParticlePush push{frame, address(gpu, s.frame)};
-    pass(rec, "particleSimulate", [&](VkCommandBuffer cmd) {
+    pass(rec, "particleSimulate", [&, push](VkCommandBuffer cmd) {
         // Last frame's sprites and atlas lighting read the particles and counts.
         memoryBarrier(cmd,
                       VK_PIPELINE_STAGE_2_VERTEX_SHADER_BIT |
@@ -268,7 +268,7 @@ void recordParticlePasses(Renderer& r, FrameRecorder& rec, uint64_t frame) {
             VK_ACCESS_2_SHADER_STORAGE_READ_BIT | VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT);
     });
     if (s.hasMeshes && !r.visibility) // (--marking visibility leaves the colour in GENERAL)
-        pass(rec, "particleMeshes", [&](VkCommandBuffer cmd) {
+        pass(rec, "particleMeshes", [&, push](VkCommandBuffer cmd) {
             // After the opaque scene's colour and depth, before the transparency tests them.
             memoryBarrier(cmd,
                           VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT |
@@ -293,7 +293,7 @@ void recordParticlePasses(Renderer& r, FrameRecorder& rec, uint64_t frame) {
             vkCmdEndRendering(cmd);
         });
     if (r.settings.particleLighting != ParticleLighting::Atlas) return;
-    pass(rec, "particleAtlasLighting", [&](VkCommandBuffer cmd) {
+    pass(rec, "particleAtlasLighting", [&, push](VkCommandBuffer cmd) {
         VkImage atlas = vkImage(gpu, s.atlas);
         // Last frame's sprites sampled it (GENERAL throughout).
         imageBarrier(cmd, atlas, VK_IMAGE_ASPECT_COLOR_BIT, VK_IMAGE_LAYOUT_GENERAL,
@@ -330,7 +330,7 @@ void recordParticleSprites(Renderer& r, FrameRecorder& rec, uint64_t frame) {
     ParticleState& s = *r.particles;
     ParticlePush push{frame, address(gpu, s.frame)};
     if (!s.accumHalf) { // full resolution: into the surfaces' targets
-        pass(rec, "particleSprites", [&](VkCommandBuffer cmd) {
+        pass(rec, "particleSprites", [&, push](VkCommandBuffer cmd) {
             beginWboitTargets(r, cmd, false);
             bind(gpu, cmd, s.sprites);
             pushConstants(gpu, cmd, push);
@@ -339,7 +339,7 @@ void recordParticleSprites(Renderer& r, FrameRecorder& rec, uint64_t frame) {
         });
         return;
     }
-    pass(rec, "particleSpritesHalf", [&](VkCommandBuffer cmd) {
+    pass(rec, "particleSpritesHalf", [&, push](VkCommandBuffer cmd) {
         // The opaque depth is read (2x2 per fragment) instead of attached.
         sceneDepthToSampled(r, cmd, VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT);
         for (TextureHandle t : {s.accumHalf, s.revealHalf})
@@ -381,7 +381,7 @@ void recordParticleAtlasView(Renderer& r, FrameRecorder& rec, uint64_t frame) {
     Gpu& gpu = *r.gpu;
     ParticleState& s = *r.particles;
     ParticlePush push{frame, address(gpu, s.frame)};
-    pass(rec, "particleAtlasView", [&](VkCommandBuffer cmd) {
+    pass(rec, "particleAtlasView", [&, push](VkCommandBuffer cmd) {
         memoryBarrier(
             cmd, VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT,
             VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT, VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT,

@@ -82,7 +82,7 @@ uint32_t pointsLinesVertexCount(const PointsLinesState& s) {
 
 void recordPointsLines(Renderer& r, FrameRecorder& rec, uint64_t frame) {
     if (!r.pointsLines) return;
-    pass(rec, "pointsLines", [&](VkCommandBuffer cmd) {
+    pass(rec, "pointsLines", [&, frame](VkCommandBuffer cmd) {
         Gpu& gpu = *r.gpu;
         PointsLinesState& s = *r.pointsLines;
         // After every pass that wrote colour or depth (raster or compute).

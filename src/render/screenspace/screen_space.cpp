@@ -170,8 +170,9 @@ void destroyScreenSpace(Renderer& r) {
 
 void recordThinGBufferPass(Renderer& r, FrameRecorder& rec, uint64_t frame) {
     if (!r.screenSpace) return;
-    pass(rec, "thinGBuffer",
-         [&](VkCommandBuffer cmd) { recordThinGBuffer(r, r.screenSpace->gbuffer, cmd, frame); });
+    pass(rec, "thinGBuffer", [&, frame](VkCommandBuffer cmd) {
+        recordThinGBuffer(r, r.screenSpace->gbuffer, cmd, frame);
+    });
 }
 
 void recordScreenSpacePasses(Renderer& r, FrameRecorder& rec, uint64_t frame) {
@@ -182,7 +183,7 @@ void recordScreenSpacePasses(Renderer& r, FrameRecorder& rec, uint64_t frame) {
     bool on = r.settings.tileClassification;
     s.classified = on || r.settings.visualize == Visualize::Tiles;
 
-    pass(rec, "depthPyramid", [&](VkCommandBuffer cmd) {
+    pass(rec, "depthPyramid", [&, push](VkCommandBuffer cmd) {
         // The lit image becomes a storage image and the depth a sampled one until the end of
         // the screen-space passes; the intermediate targets start undefined every frame.
         imageBarrier(cmd, vkImage(gpu, r.hdr), VK_IMAGE_ASPECT_COLOR_BIT,
@@ -200,9 +201,10 @@ void recordScreenSpacePasses(Renderer& r, FrameRecorder& rec, uint64_t frame) {
             imageBarrier(cmd, vkImage(gpu, t), VK_IMAGE_ASPECT_COLOR_BIT, VK_IMAGE_LAYOUT_UNDEFINED,
                          VK_IMAGE_LAYOUT_GENERAL, kCompute, kReadWrite, kCompute, kReadWrite);
         bind(gpu, cmd, s.buildPyramid);
+        gpu::ScreenSpacePush levelPush = push;
         for (uint32_t level = 0; level < s.levels; ++level) {
-            push.level = level;
-            pushConstants(gpu, cmd, push);
+            levelPush.level = level;
+            pushConstants(gpu, cmd, levelPush);
             uint32_t w = std::max(r.internalWidth >> level, 1u);
             uint32_t h = std::max(r.internalHeight >> level, 1u);
             vkCmdDispatch(cmd, (w + 7) / 8, (h + 7) / 8, 1);
@@ -211,13 +213,13 @@ void recordScreenSpacePasses(Renderer& r, FrameRecorder& rec, uint64_t frame) {
     });
     if (s.classified)
         pass(rec, "tileClassify",
-             [&](VkCommandBuffer cmd) { recordTileClassification(gpu, cmd, s.tiles, push); });
-    pass(rec, "ssr", [&](VkCommandBuffer cmd) {
+             [&, push](VkCommandBuffer cmd) { recordTileClassification(gpu, cmd, s.tiles, push); });
+    pass(rec, "ssr", [&, push, on](VkCommandBuffer cmd) {
         dispatchPass(r, s, cmd, s.ssrTrace, push, TILE_LIST_SSR);
         if (on) dispatchPass(r, s, cmd, s.ssrClear, push, TILE_LIST_SSR_CLEAR);
         computeBarrier(cmd);
     });
-    pass(rec, "sss", [&](VkCommandBuffer cmd) {
+    pass(rec, "sss", [&, push](VkCommandBuffer cmd) {
         dispatchPass(r, s, cmd, s.sssDownsample, push, TILE_LIST_SSS);
         computeBarrier(cmd);
         dispatchPass(r, s, cmd, s.sssBlurH, push, TILE_LIST_SSS);
@@ -226,18 +228,18 @@ void recordScreenSpacePasses(Renderer& r, FrameRecorder& rec, uint64_t frame) {
         computeBarrier(cmd);
     });
     if (r.distanceFields)
-        pass(rec, "distanceFieldLighting", [&](VkCommandBuffer cmd) {
+        pass(rec, "distanceFieldLighting", [&, push](VkCommandBuffer cmd) {
             beginDistanceFieldOutput(r, *r.distanceFields, cmd);
             dispatchPass(r, s, cmd, s.distanceFieldLighting, push, TILE_LIST_SURFACE);
             recordDistanceFieldReadback(r, *r.distanceFields, cmd);
             computeBarrier(cmd);
         });
-    pass(rec, "sky", [&](VkCommandBuffer cmd) {
+    pass(rec, "sky", [&, push, on](VkCommandBuffer cmd) {
         if (on) dispatchPass(r, s, cmd, s.skyAllSky, push, TILE_LIST_SKY);
         dispatchPass(r, s, cmd, s.sky, push, TILE_LIST_SKY_EDGE);
         computeBarrier(cmd);
     });
-    pass(rec, "screenSpaceComposite", [&](VkCommandBuffer cmd) {
+    pass(rec, "screenSpaceComposite", [&, push](VkCommandBuffer cmd) {
         dispatchPass(r, s, cmd, s.composite, push, TILE_LIST_SURFACE);
         computeBarrier(cmd);
         if (r.settings.visualize == Visualize::Tiles) {

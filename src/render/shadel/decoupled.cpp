@@ -769,7 +769,7 @@ void recordDecoupledPasses(Renderer& r, FrameRecorder& rec, uint64_t frame, cons
     DecoupledState& d = *r.decoupled;
     uint32_t rectGroups = (d.rectBlockCount + 63) / 64;
 
-    pass(rec, "shadelClear", [&](VkCommandBuffer cmd) {
+    pass(rec, "shadelClear", [&, frame, rectGroups](VkCommandBuffer cmd) {
         vkCmdFillBuffer(cmd, vkBuffer(gpu, d.counters), 0, VK_WHOLE_SIZE, 0);
         if (!d.rects.empty())
             vkCmdFillBuffer(cmd, vkBuffer(gpu, d.levelWants), 0, d.rects.size() * 16, 0);
@@ -785,7 +785,7 @@ void recordDecoupledPasses(Renderer& r, FrameRecorder& rec, uint64_t frame, cons
                       VK_ACCESS_2_SHADER_STORAGE_READ_BIT | VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT);
     });
 
-    pass(rec, r.visibility ? "markingCompute" : "marking", [&](VkCommandBuffer cmd) {
+    pass(rec, r.visibility ? "markingCompute" : "marking", [&, frame](VkCommandBuffer cmd) {
         // --marking visibility: a compute pass over the visibility buffer's pixels; the
         // transparent layers behind its nearest surface are marked by raster below.
         if (r.visibility) {
@@ -814,7 +814,7 @@ void recordDecoupledPasses(Renderer& r, FrameRecorder& rec, uint64_t frame, cons
                       VK_ACCESS_2_SHADER_STORAGE_READ_BIT | VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT);
     });
 
-    pass(rec, "shadelAllocate", [&](VkCommandBuffer cmd) {
+    pass(rec, "shadelAllocate", [&, frame, rectGroups](VkCommandBuffer cmd) {
         if (rectGroups) {
             bind(gpu, cmd, d.allocate);
             pushConstants(gpu, cmd, FramePush{frame});
@@ -828,7 +828,7 @@ void recordDecoupledPasses(Renderer& r, FrameRecorder& rec, uint64_t frame, cons
             VK_ACCESS_2_HOST_READ_BIT);
     });
 
-    pass(rec, "workQueues", [&](VkCommandBuffer cmd) {
+    pass(rec, "workQueues", [&, frame](VkCommandBuffer cmd) {
         bind(gpu, cmd, d.queueSetup);
         pushConstants(gpu, cmd, FramePush{frame});
         vkCmdDispatch(cmd, 1, 1, 1);
@@ -845,7 +845,7 @@ void recordDecoupledPasses(Renderer& r, FrameRecorder& rec, uint64_t frame, cons
     });
 
     // Preserved layers: chunks whose inputs did not change copy last frame's shadels.
-    pass(rec, "carryOver", [&](VkCommandBuffer cmd) {
+    pass(rec, "carryOver", [&, frame](VkCommandBuffer cmd) {
         // Reconstruction two frames ago read this storage: order this pass's writes and the
         // shading pass's after it.
         memoryBarrier(cmd, VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT,
@@ -861,9 +861,9 @@ void recordDecoupledPasses(Renderer& r, FrameRecorder& rec, uint64_t frame, cons
 
     if (usesChunkSpectra(r)) // --spectra: chunks binned by the lighting features they need
         pass(rec, "shadelChunkSpectra",
-             [&](VkCommandBuffer cmd) { recordChunkSpectraClassify(r, cmd, frame); });
+             [&, frame](VkCommandBuffer cmd) { recordChunkSpectraClassify(r, cmd, frame); });
 
-    pass(rec, "shadelShading", [&](VkCommandBuffer cmd) {
+    pass(rec, "shadelShading", [&, frame](VkCommandBuffer cmd) {
         if (usesChunkSpectra(r)) { // one permutation per spectrum (render/lighting)
             recordChunkSpectraShading(r, cmd, frame);
         } else {
@@ -879,13 +879,13 @@ void recordDecoupledPasses(Renderer& r, FrameRecorder& rec, uint64_t frame, cons
 
     if (r.visibility) { // compute resolve, then forward (hybrid) objects rastered over it
         pass(rec, "resolveCompute",
-             [&](VkCommandBuffer cmd) { recordResolveCompute(r, cmd, frame); });
+             [&, frame](VkCommandBuffer cmd) { recordResolveCompute(r, cmd, frame); });
         pass(rec, "hybridForward",
-             [&](VkCommandBuffer cmd) { recordHybridForward(r, cmd, frame); });
+             [&, frame](VkCommandBuffer cmd) { recordHybridForward(r, cmd, frame); });
         return;
     }
     // Decoupled objects read their shadels; forward objects (hybrid) shade as usual.
-    pass(rec, "reconstruction", [&](VkCommandBuffer cmd) {
+    pass(rec, "reconstruction", [&, frame](VkCommandBuffer cmd) {
         beginSceneColorPass(r, cmd, true);
         bind(gpu, cmd, d.reconstruct);
         pushConstants(gpu, cmd, RasterPush{frame, 0});
@@ -899,7 +899,7 @@ void recordDecoupledPostPasses(Renderer& r, FrameRecorder& rec, uint64_t frame) 
     if (r.settings.visualize != Visualize::Sheet) return;
     Gpu& gpu = *r.gpu;
     DecoupledState& d = *r.decoupled;
-    pass(rec, "sheetView", [&](VkCommandBuffer cmd) {
+    pass(rec, "sheetView", [&, frame](VkCommandBuffer cmd) {
         uint32_t rowsInUse = 16;
         for (const gpu::GpuShadelRect& rect : d.rects)
             rowsInUse = std::max(rowsInUse, rect.rect.y + rect.rect.w);

@@ -288,7 +288,7 @@ void recordStencilEffects(Renderer& r, FrameRecorder& rec, uint64_t frame,
     VkImage depthStencil = vkImage(gpu, s.depthStencil);
     constexpr VkImageAspectFlags kBoth = VK_IMAGE_ASPECT_DEPTH_BIT | VK_IMAGE_ASPECT_STENCIL_BIT;
 
-    pass(rec, "stencilMark", [&](VkCommandBuffer cmd) {
+    pass(rec, "stencilMark", [&, push, depthStencil, frame](VkCommandBuffer cmd) {
         // The scene depth is sampled by the copy; the targets start undefined every frame.
         imageBarrier(cmd, vkImage(gpu, r.depth), VK_IMAGE_ASPECT_DEPTH_BIT,
                      VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL,
@@ -335,7 +335,7 @@ void recordStencilEffects(Renderer& r, FrameRecorder& rec, uint64_t frame,
         // covers the whole target, as its name says).
         bool culled = s.mode == StencilEffects::On;
         VkRect2D area = culled ? screenRect(r, draws, viewProj, margin) : VkRect2D{};
-        pass(rec, name, [&](VkCommandBuffer cmd) {
+        pass(rec, name, [&, culled, area, last, push](VkCommandBuffer cmd) {
             bool empty = culled && area.extent.width == 0;
             beginDepthStencil(r, s, cmd, false, empty ? VkRect2D{{0, 0}, {1, 1}} : area);
             bind(gpu, cmd, p);

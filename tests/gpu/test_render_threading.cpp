@@ -1,0 +1,169 @@
+// Render threading (issue 16, rhi/frame.h): with --threads N the frame's passes are recorded on
+// N threads, each pass into its own command buffer, and submitted in declaration order. The
+// images must be the same bytes as the serial frame's (--threads 1) for every technique that
+// records passes, in both timing modes, and the workers' work shows in the stats and the trace.
+#include "gpu_test_env.h"
+
+#include <filesystem>
+#include <fstream>
+#include <map>
+
+using namespace shadel;
+using namespace shadel::test;
+
+namespace {
+
+struct ThreadingCase {
+    const char* name;
+    RenderOptions options;
+};
+
+RenderOptions small(const std::string& scene, RenderMode mode) {
+    RenderOptions o = renderOptions(scene, mode, 128, 72);
+    o.frames = 2; // the second frame reuses, carries over and reads back the first one's
+    o.progress = false;
+    return o;
+}
+
+// Every folder under src/render that records passes, at least once.
+std::vector<ThreadingCase> threadingCases() {
+    std::vector<ThreadingCase> cases;
+    cases.push_back({"forward", small("builtin:default", RenderMode::Forward)});
+    cases.push_back({"decoupled_visibility", small("builtin:default", RenderMode::Decoupled)});
+    RenderOptions raster = small("builtin:default", RenderMode::Decoupled);
+    raster.marking = MarkingMode::Raster;
+    raster.cameraPath = CameraPath::Orbit;
+    cases.push_back({"decoupled_raster_orbit", raster});
+    RenderOptions culled = small("builtin:many", RenderMode::Decoupled);
+    culled.occlusion = true;
+    culled.lod = true;
+    culled.sunCascades = 3;
+    cases.push_back({"occlusion_lod_cascades", culled});
+    RenderOptions arena = small("builtin:arena", RenderMode::Forward);
+    arena.screenSpace = true;
+    arena.stencilEffects = StencilEffects::On;
+    arena.visualize = Visualize::None;
+    cases.push_back({"screen_space_stencil", arena});
+    cases.push_back({"particles_oit", small("builtin:particles", RenderMode::Decoupled)});
+    RenderOptions sorted = small("builtin:transparency", RenderMode::Forward);
+    sorted.oit = OitMode::Sorted;
+    cases.push_back({"sorted_transparency", sorted});
+    cases.push_back({"decals", small("builtin:decals", RenderMode::Decoupled)});
+    RenderOptions animated = small("builtin:lights", RenderMode::Decoupled);
+    animated.animateLights = true;
+    cases.push_back({"animated_lights", animated});
+    // Few lines: where thousands overlap, the atomic append order decides which is on top,
+    // and two serial runs already differ.
+    RenderOptions lines = small("builtin:blockers", RenderMode::Decoupled);
+    lines.debugLines = 3; // lights and blockers
+    cases.push_back({"debug_lines", lines});
+    RenderOptions spectra = small("builtin:lights", RenderMode::Forward);
+    spectra.spectra = Spectra::On;
+    cases.push_back({"spectra", spectra});
+    RenderOptions gi = small("builtin:cornell", RenderMode::Decoupled);
+    gi.gi = GiMode::Lpv;
+    cases.push_back({"gi", gi});
+    RenderOptions gallery = small("builtin:textures", RenderMode::Decoupled);
+    gallery.galleryTextureSize = 256;
+    gallery.cameraPath = CameraPath::Walk;
+    gallery.textureBudgetMiB = 8;
+    cases.push_back({"texture_streaming", gallery});
+    RenderOptions skin =
+        small("/usr/share/assimp/models/glTF2/simple_skin/simple_skin.gltf", RenderMode::Decoupled);
+    skin.timeStep = 0.5; // GPU skinning before every view, reposed each frame
+    skin.time = 0.0;
+    cases.push_back({"skinning", skin});
+    cases.push_back({"points_lines",
+                     small(std::string(SHADEL_SOURCE_DIR) + "/tests/data/gltf/strip_fan_lines.gltf",
+                           RenderMode::Forward)});
+    if (sharedGpu().device.optional.rayQuery) {
+        RenderOptions rt = small("builtin:default", RenderMode::Decoupled);
+        rt.rt.shadows = true;
+        rt.rt.ao = true;
+        cases.push_back({"ray_tracing", rt});
+    }
+    return cases;
+}
+
+uint64_t bytesDiffering(const std::vector<uint8_t>& a, const std::vector<uint8_t>& b) {
+    if (a.size() != b.size()) return ~0ull;
+    uint64_t n = 0;
+    for (size_t i = 0; i < a.size(); ++i) n += a[i] != b[i];
+    return n;
+}
+
+} // namespace
+
+TEST(RenderThreading, ThreadedFramesAreTheSerialFramesBytes) {
+    for (TimingMode timing : {TimingMode::SubmitPerPass, TimingMode::Timestamps}) {
+        for (ThreadingCase& c : threadingCases()) {
+            SCOPED_TRACE(std::string(c.name) +
+                         (timing == TimingMode::Timestamps ? " timestamps" : " submit"));
+            // Timestamps (one submission) is the real-GPU mode; the whole list once in it.
+            if (timing == TimingMode::Timestamps && std::string(c.name) != "forward" &&
+                std::string(c.name) != "decoupled_visibility" &&
+                std::string(c.name) != "screen_space_stencil")
+                continue;
+            c.options.timing = timing;
+            c.options.threads = 1;
+            RenderRun serial = renderChecked(c.options);
+            c.options.threads = 3;
+            RenderRun threaded = renderChecked(c.options);
+            ASSERT_EQ(serial.frames.size(), threaded.frames.size());
+            for (size_t f = 0; f < serial.frames.size(); ++f)
+                EXPECT_EQ(bytesDiffering(serial.frames[f].rgba, threaded.frames[f].rgba), 0u)
+                    << "frame " << f << ", " << psnr(serial.frames[f].rgba, threaded.frames[f].rgba)
+                    << " dB";
+            // Same passes, in the same order.
+            ASSERT_EQ(serial.stats["passes"].size(), threaded.stats["passes"].size());
+            for (size_t p = 0; p < serial.stats["passes"].size(); ++p)
+                EXPECT_EQ(serial.stats["passes"][p]["name"], threaded.stats["passes"][p]["name"]);
+            EXPECT_EQ(serial.stats["recording"]["threads"], 1);
+            EXPECT_EQ(threaded.stats["recording"]["threads"], 3);
+            // Every pass of every threaded frame was recorded by some worker, once.
+            for (const FrameResult& f : threaded.frames) {
+                uint32_t recorded = 0;
+                for (const RecordingWorkerTiming& w : f.recordingWorkers) recorded += w.passes;
+                EXPECT_EQ(recorded, f.passes.size());
+            }
+            for (const FrameResult& f : serial.frames) EXPECT_TRUE(f.recordingWorkers.empty());
+        }
+    }
+}
+
+TEST(RenderThreading, TheTraceHasATrackPerRecordingWorker) {
+    std::string path = tempPath("threading-trace.json");
+    RenderOptions o = small("builtin:default", RenderMode::Decoupled);
+    o.threads = 2;
+    o.trace = path;
+    RenderRun run = renderChecked(o);
+    std::ifstream in(path);
+    ASSERT_TRUE(in.good()) << path;
+    nlohmann::json trace = nlohmann::json::parse(in);
+    std::filesystem::remove(path);
+    std::map<int, std::string> trackNames;
+    std::map<int, uint32_t> passesPerTrack;
+    int recordEvents = 0;
+    for (const auto& e : trace["traceEvents"]) {
+        if (e["ph"] == "M" && e["name"] == "thread_name")
+            trackNames[e["tid"].get<int>()] = e["args"]["name"].get<std::string>();
+        if (e["ph"] == "X" && e["name"] == "record passes") {
+            ++recordEvents;
+            EXPECT_GE(e["args"]["cpu_ms"].get<double>(), 0.0);
+            passesPerTrack[e["tid"].get<int>()] += e["args"]["passes"].get<uint32_t>();
+        }
+    }
+    int workerTracks = 0;
+    for (auto& [tid, name] : trackNames) workerTracks += name.rfind("CPU recording worker", 0) == 0;
+    EXPECT_EQ(workerTracks, 2);
+    EXPECT_GE(recordEvents, int(run.frames.size())); // at least one worker per frame
+    uint32_t passes = 0;
+    for (auto& [tid, n] : passesPerTrack) {
+        EXPECT_TRUE(trackNames[tid].rfind("CPU recording worker", 0) == 0) << tid;
+        passes += n;
+    }
+    uint32_t expected = 0;
+    for (const FrameResult& f : run.frames) expected += uint32_t(f.passes.size());
+    EXPECT_EQ(passes, expected);
+    EXPECT_GT(run.stats["recording"]["wall_ms"].get<double>(), 0.0);
+}
