@@ -9,6 +9,11 @@ namespace shadel::gpu {
 #endif
 
 #define GI_CASCADES 3u // camera-centred cascades, each twice the cell size of the last
+// Fixed volumes an artist places (a glTF node's extras "shadel_gi_volume"): the same grid over
+// a box of the scene, injected and propagated once, and read before the cascades where they hold
+// a point.
+#define GI_MAX_LOCAL_VOLUMES 2u
+#define GI_MAX_VOLUMES (GI_CASCADES + GI_MAX_LOCAL_VOLUMES)
 #define GI_GRID 32u    // cells per side of every cascade
 #define GI_MAX_RSMS 3u // the sun + up to two shadow-casting spots
 // Injection adds fixed-point integers (no float atomics are required of the device): one unit
@@ -32,7 +37,7 @@ struct GpuGiBlocker {
     uint portals; // first | count << 16 into GiFrame::portals
 };
 
-// One cascade as the apply reads it.
+// One volume (a camera cascade or a local volume) as the apply reads it.
 struct GiCascade {
     vec3 origin;       // world position of the min corner of cell (0, 0, 0)
     float cellSize;    // metres per cell
@@ -44,8 +49,10 @@ struct GiCascade {
 };
 
 struct GiFrame {
-    GiCascade cascades[GI_CASCADES];
-    uint cascadeCount;
+    // The local volumes first, then the camera cascades finest first: the apply takes a point's
+    // light from the first volume that holds it (blending across each one's border band).
+    GiCascade cascades[GI_MAX_VOLUMES];
+    uint cascadeCount; // volumes in use: local volumes + GI_CASCADES
     float intensity;   // scale of the indirect term (1 = physical estimate)
     uint blockerCount; // light blockers: the apply drops trilinear taps behind one
     uint pad0;

@@ -14,12 +14,12 @@ layout(buffer_reference, scalar) buffer GiInjectBuffer { int v[]; };
 
 layout(push_constant, scalar) uniform Push {
     uint64_t gi;                   // GiFrame
-    uint64_t inject[GI_CASCADES];  // int[GI_INJECT_INTS] per cell, per cascade
+    uint64_t inject[GI_MAX_VOLUMES]; // int[GI_INJECT_INTS] per cell, per volume
     uint positionSlot;
     uint normalSlot;
     uint fluxSlot;
     uint size; // RSM texels per side
-    uint cascadeMask; // bit c: cascade c moved and is injected again this frame
+    uint cascadeMask; // bit c: volume c is (re)injected this frame
 } pc;
 
 void addFixed(GiInjectBuffer b, uint index, float value) {

@@ -1,5 +1,6 @@
 // Apply of the light propagation volume: the indirect irradiance at a surface point, read from
-// the finest cascade that holds it (shared by forward and decoupled shading via lighting.glsl).
+// the first volume that holds it: an artist's local volume, else the finest camera cascade
+// (shared by forward and decoupled shading via lighting.glsl).
 #ifndef SHADEL_GI_LPV_SAMPLE_GLSL
 #define SHADEL_GI_LPV_SAMPLE_GLSL
 #include "common/bindless.glsl"
@@ -50,8 +51,8 @@ float giCascadeWeight(GiCascade c, vec3 p) {
     return clamp((min(border.x, min(border.y, border.z)) - 1.0) / 2.0, 0.0, 1.0);
 }
 
-// Indirect irradiance at p (normal n); 0 when GI is off or p lies outside every cascade. Finer
-// cascades win; a point in a finer cascade's border band blends into the next coarser one.
+// Indirect irradiance at p (normal n); 0 when GI is off or p lies outside every cascade. Local
+// volumes, then finer cascades win; a point in a volume's border band blends into the next one.
 vec3 giIrradiance(uint64_t giFrame, vec3 p, vec3 n) {
     if (giFrame == 0ul) return vec3(0.0);
     GiFrame g = GiFrameRef(giFrame).g;

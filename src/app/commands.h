@@ -71,6 +71,7 @@ struct RenderOptions {
     GiMode gi = GiMode::Off;    // --gi lpv|off
     uint32_t giIterations = 8;  // --gi-iterations
     bool giBlockerCells = true; // --gi-blocker-cells on|off (off: every tap tests every blocker)
+    bool giLocalVolumes = true; // --gi-local-volumes on|off: the scene's fixed GI volumes
     bool giSnap = true;         // --gi-snap on|off (off: debug, cascades slide with the camera)
     std::vector<GiBlocker> giBlockers; // GI light blockers (no flag yet: scenes will carry them)
     double shadelBudget = 64e6;        // MIP-0 shadels the bake may use for the whole scene

@@ -308,7 +308,7 @@ int main(int argc, char** argv) {
                        "FILE.json: Chrome trace events (CPU frontend and GPU passes per frame; "
                        "chrome://tracing, Perfetto)");
     render->add_flag("--passes", ro.printPasses, "print the per-pass timing table");
-    std::string gi = "off", giSnap = "on", giBlockerCells = "on";
+    std::string gi = "off", giSnap = "on", giBlockerCells = "on", giLocalVolumes = "on";
     render
         ->add_option("--gi", gi,
                      "lpv | off: light propagation volume GI (sun + shadow-casting spot RSMs, "
@@ -325,6 +325,11 @@ int main(int argc, char** argv) {
         ->add_option("--gi-blocker-cells", giBlockerCells,
                      "GI: on | off: each tap tests only the light blockers of its 4^3 "
                      "macro-cell (off: every blocker, for comparison)")
+        ->capture_default_str();
+    render
+        ->add_option("--gi-local-volumes", giLocalVolumes,
+                     "GI: on | off: the scene's fixed local volumes (glTF node extras "
+                     "\"shadel_gi_volume\": true), read before the camera cascades")
         ->capture_default_str();
     // World scale (render/culling): instance count of builtin:many, LODs, occlusion culling.
     std::string lod = "off", occlusion = "off";
@@ -651,6 +656,7 @@ int main(int argc, char** argv) {
                 throw InputError(
                     format("--gi-blocker-cells %s: expected on or off", giBlockerCells.c_str()));
             ro.giBlockerCells = giBlockerCells == "on";
+            ro.giLocalVolumes = parseOnOff("--gi-local-volumes", giLocalVolumes);
             if (*instancesFlag && ro.instances == 0)
                 throw InputError("--instances 0: expected 1..1000000");
             ro.lod = parseOnOff("--lod", lod);

@@ -361,6 +361,13 @@ RenderRun runRender(Gpu& gpu, const RenderOptions& o) {
         fromScene.resize(std::min(fromScene.size(), room));
         settings.giBlockers.insert(settings.giBlockers.end(), fromScene.begin(), fromScene.end());
     }
+    if (o.giLocalVolumes && o.gi != GiMode::Off) { // the artist's fixed volumes (render/gi)
+        size_t dropped = 0;
+        settings.giLocalVolumes = giLocalVolumesOf(scene, dropped);
+        if (dropped)
+            SHADEL_WARN("GI: the scene has %zu local volumes; GI uses the first %u",
+                        scene.giVolumes.size(), GI_MAX_LOCAL_VOLUMES);
+    }
     settings.lod = o.lod;
     settings.occlusion = o.occlusion;
     settings.debugLines = o.debugLines;

@@ -115,9 +115,10 @@ struct RenderSettings {
     bool giSnap = true;                // --gi-snap off: cascades slide with the camera (debug)
     float giIntensity = 1.0f;          // scale of the indirect term
     std::vector<GiBlocker> giBlockers; // GI light blockers (axial occlusion in propagation)
-    bool lod = false;                  // GPU LOD selection by projected error (render/culling)
-    float lodErrorPixels = 0.5f;       // the coarsest LOD whose error projects below this is drawn
-    bool occlusion = false; // two-phase hierarchical-Z occlusion culling (render/culling)
+    std::vector<GiLocalVolume> giLocalVolumes; // fixed GI volumes (--gi-local-volumes on)
+    bool lod = false;            // GPU LOD selection by projected error (render/culling)
+    float lodErrorPixels = 0.5f; // the coarsest LOD whose error projects below this is drawn
+    bool occlusion = false;      // two-phase hierarchical-Z occlusion culling (render/culling)
     uint32_t debugLines =
         0; // --debug-lines: DEBUG_LINES_* kinds drawn (render/debug/debug_lines.h)
     uint32_t debugLineCapacity = 256 * 1024; // segments the line buffer holds (8 MiB)

@@ -700,6 +700,9 @@ Scene makeCornell() {
     // Every scene has a sun (the renderer's shadow pass expects one); this one is off.
     b.sun({0.3f, -1.0f, 0.2f}, 0.0f);
     b.camera("main", {0.0f, t + 2.3f, half - 0.1f}, {-0.3f, t + 0.4f, -1.2f}, 0.9f, 0.05f, 30.0f);
+    // The room's own GI volume (finer than the camera cascades, computed once).
+    scene.giVolumes.push_back({"room", Aabb{glm::vec3(-half - t, 0.0f, -half - t),
+                                            glm::vec3(half + t, top + t, half + t)}});
     return scene;
 }
 

@@ -1469,10 +1469,33 @@ private:
         glm::mat3 basis(world);
         glm::vec3 forward = basis * glm::vec3(0, 0, -1);
         if (node.camera >= 0) addCamera(node, index, position, forward, basis * glm::vec3(0, 1, 0));
+        if (node.extras.IsObject() && node.extras.Has("shadel_gi_volume"))
+            addGiVolume(node.extras.Get("shadel_gi_volume"), nodeName, index, world);
         if (auto it = node.extensions.find("KHR_lights_punctual"); it != node.extensions.end()) {
             const tinygltf::Value& light = it->second.Get("light");
             if (light.IsNumber()) addLight(light.GetNumberAsInt(), nodeName, position, forward);
         }
+    }
+
+    // extras "shadel_gi_volume": true -> the node's unit cube in world space is a local GI volume.
+    void addGiVolume(const tinygltf::Value& flag, const std::string& name, int index,
+                     const glm::mat4& world) {
+        if (!flag.IsBool()) {
+            warn(format("node %d: extras.shadel_gi_volume is not a boolean; ignored", index));
+            return;
+        }
+        if (!flag.Get<bool>()) return;
+        Aabb box;
+        for (int c = 0; c < 8; ++c)
+            box.extend(
+                glm::vec3(world * glm::vec4(c & 1 ? 1 : -1, c & 2 ? 1 : -1, c & 4 ? 1 : -1, 1)));
+        glm::vec3 e = box.extent();
+        if (!(std::min(e.x, std::min(e.y, e.z)) > 1e-4f) || !std::isfinite(e.x + e.y + e.z)) {
+            warn(format("node %d: GI volume '%s' has a degenerate box; ignored", index,
+                        name.c_str()));
+            return;
+        }
+        scene_.giVolumes.push_back({name, box});
     }
 
     void addCamera(const tinygltf::Node& node, int nodeIndex, glm::vec3 position, glm::vec3 forward,

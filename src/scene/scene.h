@@ -231,6 +231,15 @@ struct LightBlocker {
     std::vector<Portal> portals;
 };
 
+// A fixed light propagation volume an artist places (seed 001, issue 11): GI is computed once
+// in a grid over this box and read before the camera-centred cascades where it holds a point
+// (render/gi). glTF: a node whose extras have "shadel_gi_volume": true; the box is the node's
+// unit cube ([-1, 1]^3, as an empty's cube display) in world space.
+struct GiVolume {
+    std::string name;
+    Aabb box;
+};
+
 struct Camera {
     std::string name;
     glm::vec3 position{0.0f};
@@ -259,6 +268,7 @@ struct Scene {
     std::vector<SkinPose> skinPoses;       // per skinned node (MeshSkin::skin)
     std::vector<PointLineSet> pointLines;  // glTF points and lines primitives
     std::vector<Decal> decals;             // projected box decals (render/decals)
+    std::vector<GiVolume> giVolumes;       // local GI volumes (render/gi)
     glm::vec3 skyColor{0.55f, 0.7f, 0.95f};
     glm::vec3 ambientColor{0.08f, 0.09f, 0.11f};
 

@@ -8,6 +8,7 @@
 #include <fstream>
 #include <map>
 #include <set>
+#include <sstream>
 
 #include <glm/gtc/type_ptr.hpp>
 
@@ -263,6 +264,45 @@ TEST(GltfImport, BlendMaterialsMapOntoAdditiveness) {
 }
 
 // --- content ------------------------------------------------------------------------------
+
+// Local GI volumes (issue 11): a node whose extras say "shadel_gi_volume": true places one, its
+// unit cube in world space; anything else is warned about and ignored, never fatal.
+TEST(GltfImport, NodeExtrasPlaceLocalGiVolumes) {
+    std::ifstream in(kData + "/gltf/cameras_lights.gltf");
+    std::stringstream text;
+    text << in.rdbuf();
+    std::string gltf = text.str();
+    // Four more children of the root (translated by +10 in x): a volume scaled (2, 1, 3) at
+    // (0, 1, 0), one switched off, one with a non-boolean flag, one flattened to a plane.
+    const std::string volumes =
+        R"({"name": "room volume", "translation": [0, 1, 0], "scale": [2, 1, 3],
+            "extras": {"shadel_gi_volume": true}},
+           {"name": "off", "extras": {"shadel_gi_volume": false}},
+           {"name": "not a flag", "extras": {"shadel_gi_volume": "yes"}},
+           {"name": "flat", "scale": [1, 0, 1], "extras": {"shadel_gi_volume": true}},)";
+    size_t nodes = gltf.find("\"nodes\": [", gltf.find("\"nodes\": [") + 1); // the array
+    ASSERT_NE(nodes, std::string::npos);
+    size_t first = gltf.find('{', nodes);
+    gltf.insert(first, volumes);
+    // The inserted nodes come first: old indices shift by 4; the root's children and the
+    // scene's root follow.
+    size_t rootChildren = gltf.find("\"children\": [", first + volumes.size());
+    ASSERT_NE(rootChildren, std::string::npos);
+    size_t close = gltf.find(']', rootChildren);
+    std::string shifted = "\"children\": [5, 6, 7, 8, 9, 10, 0, 1, 2, 3";
+    gltf.replace(rootChildren, close - rootChildren, shifted);
+    size_t sceneNodes = gltf.find("\"nodes\": [");
+    size_t sceneClose = gltf.find(']', sceneNodes);
+    gltf.replace(sceneNodes, sceneClose - sceneNodes, "\"nodes\": [4");
+    TempDir dir;
+    writeFile(dir.file("volumes.gltf"), gltf);
+    Scene scene = loadScene(dir.file("volumes.gltf"));
+    ASSERT_EQ(scene.giVolumes.size(), 1u);
+    EXPECT_EQ(scene.giVolumes[0].name, "room volume");
+    EXPECT_NEAR(glm::distance(scene.giVolumes[0].box.min, glm::vec3(8, 0, -3)), 0.0f, 1e-5f);
+    EXPECT_NEAR(glm::distance(scene.giVolumes[0].box.max, glm::vec3(12, 2, 3)), 0.0f, 1e-5f);
+    EXPECT_EQ(scene.lights.size(), 3u) << "the file's other content still loads";
+}
 
 TEST(GltfImport, CamerasAndPunctualLightsInWorldSpace) {
     Scene scene = loadScene(kData + "/gltf/cameras_lights.gltf");

@@ -1,5 +1,6 @@
 #include "render/gi/lpv.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 
@@ -32,7 +33,7 @@ struct RsmPush { // shaders/gi/rsm_push.glsl
 
 struct InjectPush { // shaders/gi/inject.comp
     uint64_t gi;
-    uint64_t inject[GI_CASCADES];
+    uint64_t inject[GI_MAX_VOLUMES];
     uint32_t positionSlot, normalSlot, fluxSlot, size;
     uint32_t cascadeMask; // cascades injected this frame
 };
@@ -70,14 +71,18 @@ struct CascadeBuffers {
 
 struct GiState {
     std::vector<Rsm> rsms;
-    CascadeBuffers cascades[GI_CASCADES];
-    BufferHandle frame;    // host-visible GiFrame
-    BufferHandle blockers; // GpuGiBlocker[], when there are any
-    BufferHandle portals;  // vec4[] (min u, min v, max u, max v), when there are any
+    // The volumes, in the order of GiFrame::cascades: local volumes, then the camera cascades.
+    CascadeBuffers cascades[GI_MAX_VOLUMES];
+    uint32_t localCount = 0; // volumes [0, localCount) are local, the next GI_CASCADES cascades
+    std::vector<GiLocalVolume> locals;
+    uint64_t localUpdates = 0; // injections + propagations of a local volume over the run
+    BufferHandle frame;        // host-visible GiFrame
+    BufferHandle blockers;     // GpuGiBlocker[], when there are any
+    BufferHandle portals;      // vec4[] (min u, min v, max u, max v), when there are any
     uint32_t blockerCount = 0;
     std::vector<GiBlocker> blockerList;
     uint64_t blockerCellPairs = 0; // (macro-cell, blocker) pairs of the cascades in use
-    uint64_t cascadePairs[GI_CASCADES] = {};
+    uint64_t cascadePairs[GI_MAX_VOLUMES] = {};
     gpu::GiFrame constants{};
     float baseCellSize = 1.0f;
     Pipeline rsmPass, inject, propagate;
@@ -85,9 +90,11 @@ struct GiState {
     // to the scene, spots do not move for GI), so the RSMs are drawn once; a cascade is injected
     // and propagated again only when it moved (snapped to a new cell) since its last update.
     bool rsmsDrawn = false;
-    bool cascadeValid[GI_CASCADES] = {};
-    glm::vec3 cascadeOrigin[GI_CASCADES] = {}; // where its light was computed (the apply's too)
-    uint64_t cascadeUpdatedFrame[GI_CASCADES] = {};
+    bool cascadeValid[GI_MAX_VOLUMES] = {};
+    glm::vec3 cascadeOrigin[GI_MAX_VOLUMES] = {}; // where its light was computed (the apply's too)
+    uint64_t cascadeUpdatedFrame[GI_MAX_VOLUMES] = {};
+
+    uint32_t volumeCount() const { return localCount + GI_CASCADES; }
     uint32_t dirtyMask = 0; // cascades updated this frame
     uint64_t frames = 0, cascadeUpdates = 0, rsmRenders = 0;
 };
@@ -152,9 +159,14 @@ GiStatePtr createGi(Renderer& r, const GpuScene& scene) {
         }
     for (uint32_t i = 0; i < gi->rsms.size(); ++i) createRsmTargets(gpu, gi->rsms[i], i);
 
-    for (uint32_t c = 0; c < GI_CASCADES; ++c) {
+    gi->locals = r.settings.giLocalVolumes;
+    if (gi->locals.size() > GI_MAX_LOCAL_VOLUMES) gi->locals.resize(GI_MAX_LOCAL_VOLUMES);
+    gi->localCount = uint32_t(gi->locals.size());
+    for (uint32_t c = 0; c < gi->volumeCount(); ++c) {
         CascadeBuffers& b = gi->cascades[c];
-        std::string prefix = "gi.cascade" + std::to_string(c) + ".";
+        std::string prefix = c < gi->localCount
+                                 ? "gi.local." + gi->locals[c].name + "."
+                                 : "gi.cascade" + std::to_string(c - gi->localCount) + ".";
         b.inject = createBuffer(gpu, {prefix + "inject", VkDeviceSize(kCells) * GI_INJECT_INTS * 4,
                                       VK_BUFFER_USAGE_TRANSFER_DST_BIT});
         for (int k = 0; k < 2; ++k)
@@ -197,9 +209,9 @@ GiStatePtr createGi(Renderer& r, const GpuScene& scene) {
         }
         gi->blockerCount = uint32_t(packed.size());
         gi->blockerList = blockers;
-        for (uint32_t c = 0; c < GI_CASCADES; ++c) {
+        for (uint32_t c = 0; c < gi->volumeCount(); ++c) {
             gi->cascades[c].blockerCells =
-                createBuffer(gpu, {"gi.cascade" + std::to_string(c) + ".blockerCells",
+                createBuffer(gpu, {"gi.volume" + std::to_string(c) + ".blockerCells",
                                    VkDeviceSize(GI_MACRO_GRID * GI_MACRO_GRID * GI_MACRO_GRID) * 8,
                                    0, MemoryKind::Upload});
             if (!gi->cascades[c].blockerCells)
@@ -254,6 +266,19 @@ void destroyGi(Renderer& r, GiStatePtr& state) {
     destroy(gpu, state->inject);
     destroy(gpu, state->propagate);
     state.reset();
+}
+
+std::vector<GiLocalVolume> giLocalVolumesOf(const Scene& scene, size_t& dropped) {
+    std::vector<GiLocalVolume> out;
+    dropped = 0;
+    for (const GiVolume& v : scene.giVolumes) {
+        if (out.size() == GI_MAX_LOCAL_VOLUMES) {
+            ++dropped;
+            continue;
+        }
+        out.push_back({v.name, v.box.min, v.box.max});
+    }
+    return out;
 }
 
 std::vector<GiBlocker> giBlockersOf(const Scene& scene) {
@@ -322,48 +347,60 @@ void prepareGiFrame(Renderer& r, const GpuScene& scene, const CameraView& camera
         gi.rsmsDrawn = false;
         for (bool& valid : gi.cascadeValid) valid = false;
     }
-    g.cascadeCount = GI_CASCADES;
+    const uint32_t volumes = gi.volumeCount(), L = gi.localCount;
+    g.cascadeCount = volumes;
     g.intensity = r.settings.giIntensity;
     g.blockerCount = gi.blockerCount;
     g.blockers = gi.blockers ? address(*r.gpu, gi.blockers) : 0;
     g.portals = gi.portals ? address(*r.gpu, gi.portals) : 0;
     g.blockerCells = r.settings.giBlockerCells ? 1u : 0u;
-    glm::vec3 wanted[GI_CASCADES];
+    glm::vec3 wanted[GI_MAX_VOLUMES];
+    float cellSize[GI_MAX_VOLUMES];
     uint32_t moved = 0;
     bool allValid = true;
-    for (uint32_t c = 0; c < GI_CASCADES; ++c) {
-        float cell = gi.baseCellSize * float(1u << c);
-        // Snapped: the grid moves in whole cells, so a surface keeps its cell (and its light)
-        // while the camera moves; unsnapped (a debug option) it slides and the light swims.
-        glm::vec3 corner = camera.position / cell - float(GI_GRID / 2);
-        if (r.settings.giSnap) corner = glm::floor(corner);
-        wanted[c] = corner * cell;
-        if (!gi.cascadeValid[c] || gi.cascadeOrigin[c] != wanted[c]) moved |= 1u << c;
-        allValid = allValid && gi.cascadeValid[c];
+    for (uint32_t v = 0; v < volumes; ++v) {
+        if (v < L) { // a local volume: a fixed cubic grid centred on its box
+            const GiLocalVolume& lv = gi.locals[v];
+            glm::vec3 e = lv.max - lv.min;
+            cellSize[v] = std::max(std::max(e.x, std::max(e.y, e.z)), 1e-3f) / float(GI_GRID);
+            wanted[v] = 0.5f * (lv.min + lv.max) - glm::vec3(0.5f * float(GI_GRID) * cellSize[v]);
+        } else {
+            float cell = gi.baseCellSize * float(1u << (v - L));
+            // Snapped: the grid moves in whole cells, so a surface keeps its cell (and its
+            // light) while the camera moves; unsnapped (a debug option) it slides and swims.
+            glm::vec3 corner = camera.position / cell - float(GI_GRID / 2);
+            if (r.settings.giSnap) corner = glm::floor(corner);
+            wanted[v] = corner * cell;
+            cellSize[v] = cell;
+        }
+        if (!gi.cascadeValid[v] || gi.cascadeOrigin[v] != wanted[v]) moved |= 1u << v;
+        allValid = allValid && gi.cascadeValid[v];
     }
     // Time slicing: after the first frame at most one cascade is injected and propagated per
     // frame, the one waiting longest; the others keep the origin their light was computed at
-    // (a few cells behind the camera at most, inside their 16-cell margin).
+    // (a few cells behind the camera at most, inside their 16-cell margin). Local volumes never
+    // move: they are updated with everything else on the first frame and when lights change.
     // Without snapping (the debug baseline) every cascade follows the camera every frame.
     if (!allValid || !r.settings.giSnap) {
         gi.dirtyMask = moved;
     } else if (moved) {
-        uint32_t pick = GI_CASCADES;
-        for (uint32_t c = 0; c < GI_CASCADES; ++c)
+        uint32_t pick = volumes;
+        for (uint32_t c = L; c < volumes; ++c)
             if ((moved & (1u << c)) &&
-                (pick == GI_CASCADES || gi.cascadeUpdatedFrame[c] < gi.cascadeUpdatedFrame[pick]))
+                (pick == volumes || gi.cascadeUpdatedFrame[c] < gi.cascadeUpdatedFrame[pick]))
                 pick = c;
-        gi.dirtyMask = 1u << pick;
+        if (pick < volumes) gi.dirtyMask = 1u << pick;
     }
-    for (uint32_t c = 0; c < GI_CASCADES; ++c) {
+    for (uint32_t c = 0; c < volumes; ++c) {
         if (gi.dirtyMask & (1u << c)) {
             gi.cascadeOrigin[c] = wanted[c];
             gi.cascadeValid[c] = true;
             gi.cascadeUpdatedFrame[c] = gi.frames;
+            if (c < L) gi.localUpdates++;
         }
         gpu::GiCascade& gc = g.cascades[c];
         gc.origin = gi.cascadeOrigin[c];
-        gc.cellSize = gi.baseCellSize * float(1u << c);
+        gc.cellSize = cellSize[c];
         gc.radiance = address(*r.gpu, gi.cascades[c].accum);
         gc.geometry = address(*r.gpu, gi.cascades[c].geometry);
         if (gi.cascades[c].blockerCells) {
@@ -456,10 +493,10 @@ void recordGiInjection(Renderer& r, VkCommandBuffer cmd) {
     Gpu& gpu = *r.gpu;
     GiState& gi = *r.gi;
     if (!gi.dirtyMask) return;
-    for (uint32_t c = 0; c < GI_CASCADES; ++c)
+    for (uint32_t c = 0; c < gi.volumeCount(); ++c)
         if (gi.dirtyMask & (1u << c)) {
             vkCmdFillBuffer(cmd, vkBuffer(gpu, gi.cascades[c].inject), 0, VK_WHOLE_SIZE, 0);
-            gi.cascadeUpdates++;
+            if (c >= gi.localCount) gi.cascadeUpdates++; // (local volumes: localUpdates)
         }
     memoryBarrier(cmd, VK_PIPELINE_STAGE_2_CLEAR_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT,
                   VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
@@ -468,7 +505,7 @@ void recordGiInjection(Renderer& r, VkCommandBuffer cmd) {
     for (Rsm& rsm : gi.rsms) {
         InjectPush push{};
         push.gi = address(gpu, gi.frame);
-        for (uint32_t c = 0; c < GI_CASCADES; ++c)
+        for (uint32_t c = 0; c < gi.volumeCount(); ++c)
             push.inject[c] = address(gpu, gi.cascades[c].inject);
         push.positionSlot = slot(gpu, rsm.readViews[0]).value;
         push.normalSlot = slot(gpu, rsm.readViews[1]).value;
@@ -484,7 +521,7 @@ void recordGiInjection(Renderer& r, VkCommandBuffer cmd) {
                   VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
                   VK_ACCESS_2_SHADER_STORAGE_READ_BIT | VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT);
     bind(gpu, cmd, gi.propagate);
-    for (uint32_t c = 0; c < GI_CASCADES; ++c) {
+    for (uint32_t c = 0; c < gi.volumeCount(); ++c) {
         if (!(gi.dirtyMask & (1u << c))) continue;
         CascadeBuffers& b = gi.cascades[c];
         PropagatePush push{};
@@ -510,15 +547,30 @@ void recordGiInjection(Renderer& r, VkCommandBuffer cmd) {
                   VK_ACCESS_2_SHADER_STORAGE_READ_BIT | VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT);
 }
 
+// Propagation steps of volume v. Light crosses one cell per step, so the cascades' few steps
+// (--gi-iterations, every time one moves) carry it a few metres. A local volume is propagated
+// once (and again only when the lights change), so it runs until light has crossed the whole
+// grid: GI_GRID steps. On builtin:cornell (its room volume has cells half as wide as cascade
+// 0's) the floor by the red wall reads red/green 1.10 after 16 steps and 1.39 after 32; the
+// cascades alone give 1.28 after 8.
+static uint32_t propagationSteps(const GiState& gi, uint32_t v, uint32_t iterations) {
+    return v < gi.localCount ? std::max(iterations, GI_GRID) : iterations;
+}
+
 void recordGiPropagation(Renderer& r, VkCommandBuffer cmd) {
     Gpu& gpu = *r.gpu;
     GiState& gi = *r.gi;
     if (!gi.dirtyMask) return;
     bind(gpu, cmd, gi.propagate);
-    for (uint32_t step = 0; step < r.settings.giIterations; ++step) {
-        // The three cascades are independent: one barrier per step serves them all.
-        for (uint32_t c = 0; c < GI_CASCADES; ++c) {
+    uint32_t steps = 0;
+    for (uint32_t c = 0; c < gi.volumeCount(); ++c)
+        if (gi.dirtyMask & (1u << c))
+            steps = std::max(steps, propagationSteps(gi, c, r.settings.giIterations));
+    for (uint32_t step = 0; step < steps; ++step) {
+        // The volumes are independent: one barrier per step serves them all.
+        for (uint32_t c = 0; c < gi.volumeCount(); ++c) {
             if (!(gi.dirtyMask & (1u << c))) continue;
+            if (step >= propagationSteps(gi, c, r.settings.giIterations)) continue;
             CascadeBuffers& b = gi.cascades[c];
             PropagatePush push{};
             push.source = address(gpu, b.light[step & 1]);
@@ -535,7 +587,7 @@ void recordGiPropagation(Renderer& r, VkCommandBuffer cmd) {
             VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT,
             VK_ACCESS_2_SHADER_STORAGE_READ_BIT | VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT);
     }
-    if (r.settings.giIterations == 0)
+    if (steps == 0)
         memoryBarrier(cmd, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
                       VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT, VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT,
                       VK_ACCESS_2_SHADER_STORAGE_READ_BIT);
@@ -543,8 +595,17 @@ void recordGiPropagation(Renderer& r, VkCommandBuffer cmd) {
 
 void giStats(const Renderer& r, nlohmann::json& stats) {
     const GiState& gi = *r.gi;
-    nlohmann::json cascades = nlohmann::json::array();
-    for (uint32_t c = 0; c < GI_CASCADES; ++c) {
+    nlohmann::json cascades = nlohmann::json::array(), locals = nlohmann::json::array();
+    for (uint32_t c = 0; c < gi.localCount; ++c) {
+        const gpu::GiCascade& gc = gi.constants.cascades[c];
+        locals.push_back({{"name", gi.locals[c].name},
+                          {"propagation_steps", propagationSteps(gi, c, r.settings.giIterations)},
+                          {"cell_size", gc.cellSize},
+                          {"extent", gc.cellSize * GI_GRID},
+                          {"origin", {gc.origin.x, gc.origin.y, gc.origin.z}},
+                          {"cells", kCells}});
+    }
+    for (uint32_t c = gi.localCount; c < gi.volumeCount(); ++c) {
         const gpu::GiCascade& gc = gi.constants.cascades[c];
         cascades.push_back({{"cell_size", gc.cellSize},
                             {"extent", gc.cellSize * GI_GRID},
@@ -553,8 +614,12 @@ void giStats(const Renderer& r, nlohmann::json& stats) {
     }
     stats["gi"] = {{"mode", "lpv"},
                    {"cascades", cascades},
+                   {"local_volumes", locals},
+                   // Injections + propagations of a local volume (the first frame's, and one
+                   // per change of the lights): they do not follow the camera.
+                   {"local_volume_updates", gi.localUpdates},
                    {"grid", GI_GRID},
-                   {"cells", kCells * GI_CASCADES},
+                   {"cells", kCells * gi.volumeCount()},
                    {"iterations", r.settings.giIterations},
                    {"snap", r.settings.giSnap},
                    {"blockers", gi.blockerCount},
@@ -568,7 +633,7 @@ void giStats(const Renderer& r, nlohmann::json& stats) {
                    // Blockers a macro-cell's taps test, on average (all blockers without culling).
                    {"blockers_per_macro_cell",
                     double(gi.blockerCellPairs) /
-                        double(GI_CASCADES * GI_MACRO_GRID * GI_MACRO_GRID * GI_MACRO_GRID)},
+                        double(gi.volumeCount() * GI_MACRO_GRID * GI_MACRO_GRID * GI_MACRO_GRID)},
                    {"reflective_shadow_maps", gi.rsms.size()},
                    {"rsm_renders", gi.rsmRenders},
                    // Injections + propagations of one cascade over the run (a cascade is

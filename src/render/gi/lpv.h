@@ -2,9 +2,11 @@
 // Light propagation volume GI (seed 001, after Kaplanyan and Dachsbacher 2010): reflective
 // shadow maps from the sun and shadow-casting spots, injected as 2-band SH into three
 // camera-centred cascades of 32^3 cells (snapped to their cell size so they do not swim),
-// propagated N steps with geometry occlusion, and read by the shared lighting code
+// propagated N steps with geometry occlusion, plus up to two fixed local volumes an artist
+// places (GiLocalVolume, computed once), and read by the shared lighting code
 // (shaders/gi/lpv_sample.glsl via shaders/common/lighting.glsl).
 #include <memory>
+#include <string>
 #include <vector>
 
 #include <glm/glm.hpp>
@@ -34,9 +36,20 @@ struct GiBlocker {
     std::vector<glm::vec4> portals; // min u, min v, max u, max v: metres along axisU, axisV
 };
 
+// A local volume (Scene::GiVolume, seed 001's "local volumes an artist places"): the same
+// grid as a cascade, cubic, centred on the box and just covering its longest side; it never
+// moves, so it is injected and propagated only when the lights change, and the apply reads it
+// before the camera cascades wherever it holds the point.
+struct GiLocalVolume {
+    std::string name;
+    glm::vec3 min{0.0f}, max{0.0f};
+};
+
 struct Scene;
 // The scene's light blockers as GI blockers (the same rectangles and portals).
 std::vector<GiBlocker> giBlockersOf(const Scene& scene);
+// The scene's local GI volumes, at most GI_MAX_LOCAL_VOLUMES (the rest are counted in dropped).
+std::vector<GiLocalVolume> giLocalVolumesOf(const Scene& scene, size_t& dropped);
 
 struct GiStateDeleter {
     void operator()(GiState* state) const;
