@@ -8,7 +8,7 @@ Per frame: the cache's resident texture memory (MiB, from the stats' texture_str
 .resident_bytes_per_frame), its allocated memory (texture_memory_peak_bytes) and the PSNR of the
 streamed frame against the same frame with every texture resident (frame_NNNN.png in both
 folders; with --stride N frames 0-5, every Nth and the last, linear between: decoding 1280x720 PNGs in pure
-Python takes seconds each). The PNG has two panels: memory (MiB) and PSNR (dB, capped at 60,
+Python takes seconds each; after a --camera-cut, the six frames after the cut too). The PNG has two panels: memory (MiB) and PSNR (dB, capped at 60,
 the 35 dB line dashed).
 """
 import json, math, os, sys
@@ -101,7 +101,12 @@ def main():
     allocated = stats['texture_memory_peak_bytes'] / 1048576.0
     frames = len(memory)
     # The first frames densely (convergence from the cold start), then every stride-th.
-    measured = sorted(set(list(range(min(frames, 6))) + list(range(0, frames, stride)) + [frames - 1]))
+    measured = set(list(range(min(frames, 6))) + list(range(0, frames, stride)) + [frames - 1])
+    # render --camera-cut: the frame before the cut and the six after it densely too.
+    cut = stats.get('camera_cut', {}).get('frame')
+    if cut is not None:
+        measured |= set(range(max(cut - 1, 0), min(cut + 7, frames)))
+    measured = sorted(measured)
     db = {}
     for f in measured:
         name = 'frame_%04d.png' % f

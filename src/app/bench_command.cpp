@@ -1,6 +1,7 @@
 #include <algorithm>
 #include <cstdio>
 #include <fstream>
+#include <map>
 
 #include "app/bench_plot.h"
 #include "app/commands.h"
@@ -199,6 +200,114 @@ nlohmann::json runStencilBench(Gpu& gpu, const BenchOptions& b, RenderOptions o)
     return out;
 }
 
+// --streaming-compare: the same frames (forward and decoupled, reuse as --reuse-refresh says)
+// with every texture resident, and streamed at --texture-budget through the layered cache and
+// through sparse residency (when the device has it). The figure is the render thread's CPU time
+// per frame (cpu_frame_thread_ms: the thread's own clock, so other processes taking the cores
+// do not inflate it): the "no stalls" check is streaming / resident <= 1.10. The modes
+// run in rounds, each round every residency once in a rotated order, so the machine's drift
+// over the bench hits them alike; the median is over the frames of every round.
+nlohmann::json runStreamingBench(Gpu& gpu, const BenchOptions& b, RenderOptions o) {
+    nlohmann::json out;
+    out["scene"] = b.scene;
+    out["device"] = gpu.device.name;
+    out["frames"] = b.frames;
+    out["rounds"] = b.rounds;
+    out["size"] = format("%ux%u", b.width, b.height);
+    out["texture_budget_mib"] = b.textureBudgetMiB;
+    o.galleryTextureSize = b.galleryTextureSize;
+    struct Residency {
+        const char* name;
+        double budgetMiB;
+        StreamingMode mode;
+    };
+    std::vector<Residency> residencies = {{"resident", 0.0, StreamingMode::Layered},
+                                          {"layered", b.textureBudgetMiB, StreamingMode::Layered}};
+    if (gpu.device.optional.sparseResidency) {
+        // A one-frame probe: the sparse tails can need more than a small budget (lavapipe pages
+        // every level down to 1x1, 28 MiB for the gallery), then the bench compares layered only.
+        RenderOptions probe = o;
+        probe.frames = 1;
+        probe.width = probe.height = 16;
+        probe.textureBudgetMiB = b.textureBudgetMiB;
+        probe.streaming = StreamingMode::Sparse;
+        try {
+            runRender(gpu, probe);
+            residencies.push_back({"sparse", b.textureBudgetMiB, StreamingMode::Sparse});
+        } catch (const InputError& e) {
+            SHADEL_WARN("bench --streaming-compare: sparse left out: %s", e.what());
+        }
+    } else {
+        SHADEL_WARN("bench --streaming-compare: %s has no sparse residency; layered only",
+                    gpu.device.name.c_str());
+    }
+    const std::pair<const char*, RenderMode> renderModes[] = {{"forward", RenderMode::Forward},
+                                                              {"decoupled", RenderMode::Decoupled}};
+    // Per render mode and residency: every round's frames, and the last round's stats.
+    std::map<std::string, std::vector<double>> threadMs, streamingMs, frameMs;
+    for (uint32_t round = 0; round < b.rounds; ++round) {
+        for (const auto& [modeName, mode] : renderModes) {
+            for (size_t k = 0; k < residencies.size(); ++k) {
+                const Residency& res = residencies[(k + round) % residencies.size()];
+                std::fprintf(stderr, "bench: round %u/%u, %s, %s, %u frames at %ux%u\n", round + 1,
+                             b.rounds, modeName, res.name, b.frames, b.width, b.height);
+                o.mode = mode;
+                o.textureBudgetMiB = res.budgetMiB;
+                o.streaming = res.mode;
+                RenderRun run = runRender(gpu, o);
+                if (!run.stats.contains("texture_streaming"))
+                    throw InputError(format("bench --streaming-compare: %s has no textures to "
+                                            "stream (try builtin:textures)",
+                                            b.scene.c_str()));
+                std::string key = std::string(modeName) + "_" + res.name;
+                for (const FrameResult& f : run.frames) {
+                    threadMs[key].push_back(f.cpuThreadMs);
+                    streamingMs[key].push_back(f.cpuStreamingMs);
+                    frameMs[key].push_back(f.frameMs);
+                }
+                // Per round (a round the machine slowed shows here) and per frame.
+                nlohmann::json& row = out["streaming"][modeName][res.name];
+                row["cpu_frame_thread_ms_per_round"].push_back(run.stats["cpu_frame_thread_ms"]);
+                std::vector<double> frames;
+                for (const FrameResult& f : run.frames) frames.push_back(f.cpuThreadMs);
+                row["cpu_frame_thread_ms_per_frame"].push_back(frames);
+                out["modes"][key] = std::move(run.stats);
+            }
+        }
+    }
+    std::printf("shadel bench --streaming-compare: %s at %ux%u on %s, %u frames x %u rounds, "
+                "--texture-budget %g MiB, medians over every round's frames\n",
+                b.scene.c_str(), b.width, b.height, gpu.device.name.c_str(), b.frames, b.rounds,
+                b.textureBudgetMiB);
+    std::printf("  %-10s %-9s %16s %14s %10s %12s %14s  %s\n", "mode", "textures", "cpu thread ms",
+                "of which strm", "ratio", "frame ms", "peak MiB", "cpu thread ms per round");
+    for (const auto& [modeName, mode] : renderModes) {
+        double residentMs = median(threadMs[std::string(modeName) + "_resident"]);
+        for (const Residency& res : residencies) {
+            std::string key = std::string(modeName) + "_" + res.name;
+            double ms = median(threadMs[key]);
+            double ratio = residentMs > 0 ? ms / residentMs : 0.0;
+            nlohmann::json& row = out["streaming"][modeName][res.name];
+            row["cpu_frame_thread_ms"] = ms;
+            row["cpu_streaming_thread_ms"] = median(streamingMs[key]);
+            row["frame_ms"] = median(frameMs[key]);
+            row["texture_memory_peak_bytes"] = out["modes"][key]["texture_memory_peak_bytes"];
+            if (res.budgetMiB > 0.0)
+                out["ratios"][std::string("streaming_") + modeName + "_" + res.name] = ratio;
+            std::string rounds;
+            for (const auto& r : row["cpu_frame_thread_ms_per_round"])
+                rounds += format(" %.3f", r.get<double>());
+            std::printf("  %-10s %-9s %13.3f ms %11.3f ms %10.3f %9.1f ms %14.1f %s\n", modeName,
+                        res.name, ms, row["cpu_streaming_thread_ms"].get<double>(), ratio,
+                        row["frame_ms"].get<double>(),
+                        double(row["texture_memory_peak_bytes"].get<uint64_t>()) / 1048576.0,
+                        rounds.c_str());
+        }
+    }
+    if (!b.json.empty()) writeOutputFile(b.json, out.dump(2) + "\n");
+    return out;
+}
+
 } // namespace
 
 // Renders the same scene over the same camera path forward, decoupled with reuse off and
@@ -232,6 +341,7 @@ nlohmann::json runBench(Gpu& gpu, const BenchOptions& b) {
     if (b.compareShadowCulling) return runShadowCullingBench(gpu, b, o);
     if (b.compareParticleLighting) return runParticleLightingBench(gpu, b, o);
     if (b.compareStencil) return runStencilBench(gpu, b, o);
+    if (b.compareStreaming) return runStreamingBench(gpu, b, o);
 
     struct Mode {
         const char* name;

@@ -68,6 +68,10 @@ struct RenderOptions {
     bool proxyShadows = true;                                    // --proxy-shadows on|off
     ShadowCulling shadowCulling = ShadowCulling::PerView; // --shadow-culling per-view|whole-scene
     CameraPath cameraPath = CameraPath::Static;
+    // --camera-cut NAME@FRAME: from that frame on the camera path starts from the scene's
+    // camera NAME instead (a cut, with what the earlier frames streamed or cached still warm).
+    std::string cutCamera;
+    uint32_t cutFrame = 0;
     GiMode gi = GiMode::Off;    // --gi lpv|off
     uint32_t giIterations = 8;  // --gi-iterations
     bool giBlockerCells = true; // --gi-blocker-cells on|off (off: every tap tests every blocker)
@@ -120,6 +124,8 @@ MarkingMode parseMarking(const std::string& text);
 // The median of `values` (0 for none): the stats' per-frame figures.
 double median(std::vector<double> values);
 void parseInspect(const std::string& text, int32_t& x, int32_t& y);
+// --camera-cut "NAME@FRAME" -> camera name and frame (>= 1); one-line InputError otherwise.
+void parseCameraCut(const std::string& text, std::string& camera, uint32_t& frame);
 // "X,Y" of a pixel for `flag`; one-line InputError otherwise.
 void parsePixel(const char* flag, const std::string& text, int32_t& x, int32_t& y);
 OitMode parseOit(const std::string& text);
@@ -178,9 +184,16 @@ struct BenchOptions {
     // --shadow-culling-compare: forward only, per-view against whole-scene shadow culling
     // (ratios.shadow_culling_frame|shadow_passes = per-view / whole-scene; app/bench_command.cpp).
     bool compareShadowCulling = false;
-    uint32_t sunCascades = 1; // --sun-cascades, every mode
-    uint32_t instances = 0;   // --instances (builtin:many), every mode; 0 = the scene's default
-    std::string plot;         // --plot FILE.png: per-pass bar chart (app/bench_plot.h)
+    // --streaming-compare: forward and decoupled with every texture resident, and streamed at
+    // --texture-budget (layered; sparse where the device has it), --rounds rounds interleaved;
+    // ratios.streaming_<mode>_<layered|sparse> = streamed / resident render-thread CPU time.
+    bool compareStreaming = false;
+    double textureBudgetMiB = 128.0; // --texture-budget (streaming compare)
+    uint32_t galleryTextureSize = 0; // --gallery-texture-size (builtin:textures; 0 = 2048)
+    uint32_t rounds = 3;             // --rounds (streaming compare)
+    uint32_t sunCascades = 1;        // --sun-cascades, every mode
+    uint32_t instances = 0; // --instances (builtin:many), every mode; 0 = the scene's default
+    std::string plot;       // --plot FILE.png: per-pass bar chart (app/bench_plot.h)
 };
 nlohmann::json runBench(Gpu& gpu, const BenchOptions& options);
 

@@ -204,6 +204,10 @@ int main(int argc, char** argv) {
         ->add_option("--camera-path", cameraPath,
                      "static | orbit | walk: camera motion over --frames")
         ->capture_default_str();
+    std::string cameraCut;
+    render->add_option("--camera-cut", cameraCut,
+                       "CAMERA@FRAME: from FRAME on, the camera path starts from the scene's "
+                       "camera CAMERA (a cut; e.g. builtin:textures back@30)");
     render
         ->add_option("--capacity-control", capacityControl,
                      "decoupled: on | off: raise the shading bias when storage runs short")
@@ -437,6 +441,21 @@ int main(int argc, char** argv) {
     bench->add_flag("--shadow-culling-compare", bo.compareShadowCulling,
                     "instead of the three modes: forward with --shadow-culling per-view and "
                     "whole-scene; frame and shadow-pass medians and their ratios");
+    bench->add_flag("--streaming-compare", bo.compareStreaming,
+                    "instead of the three modes: forward and decoupled with every texture "
+                    "resident and streamed at --texture-budget (layered, sparse), --rounds "
+                    "interleaved rounds; render-thread CPU time per frame and its ratios");
+    bench
+        ->add_option("--texture-budget", bo.textureBudgetMiB,
+                     "MiB: the streamed runs' texture budget (--streaming-compare)")
+        ->capture_default_str()
+        ->check(finiteInRange(kTextureBudgetRange));
+    bench->add_option("--gallery-texture-size", bo.galleryTextureSize,
+                      "builtin:textures: side of each texture (power of two, default 2048)");
+    bench
+        ->add_option("--rounds", bo.rounds,
+                     "--streaming-compare: rounds, each running every residency once")
+        ->capture_default_str();
     std::string benchSunCascades = "1";
     bench->add_option("--sun-cascades", benchSunCascades, "1..4: the sun's cascaded maps")
         ->capture_default_str();
@@ -606,6 +625,7 @@ int main(int argc, char** argv) {
             ro.threads = parseThreads(threads);
             ro.shadelsPerMetre = parseDensity(density);
             ro.cameraPath = parseCameraPath(cameraPath);
+            if (!cameraCut.empty()) parseCameraCut(cameraCut, ro.cutCamera, ro.cutFrame);
             if (timeSeconds >= 0.0) ro.time = timeSeconds;
             if (skinning != "gpu" && skinning != "cpu")
                 throw InputError(format("--skinning %s: expected gpu or cpu", skinning.c_str()));
@@ -706,6 +726,10 @@ int main(int argc, char** argv) {
             bo.marking = parseMarking(benchMarking);
             bo.lightGrid = parseOnOff("--light-grid", benchLightGrid);
             bo.sunCascades = parseSunCascades(benchSunCascades);
+            if (bo.rounds < 1 || bo.rounds > 100)
+                throw InputError(format("--rounds %u: expected 1..100", bo.rounds));
+            if (bo.compareStreaming && !(bo.textureBudgetMiB > 0.0))
+                throw InputError("--streaming-compare: needs a --texture-budget above 0 MiB");
             if (*benchInstancesFlag && bo.instances == 0)
                 throw InputError("--instances 0: expected 1..1000000");
             bo.compareLightCulling = benchLightCulling == "compare";

@@ -123,6 +123,17 @@ void parseInspect(const std::string& text, int32_t& x, int32_t& y) {
     parsePixel("--inspect", text, x, y);
 }
 
+void parseCameraCut(const std::string& text, std::string& camera, uint32_t& frame) {
+    size_t at = text.rfind('@');
+    std::string digits = at == std::string::npos ? "" : text.substr(at + 1);
+    if (at == std::string::npos || at == 0 || digits.empty() || digits.size() > 9 ||
+        digits.find_first_not_of("0123456789") != std::string::npos || std::stoul(digits) == 0)
+        throw InputError(format(
+            "--camera-cut %s: expected CAMERA@FRAME (a scene camera, frame >= 1)", text.c_str()));
+    camera = text.substr(0, at);
+    frame = uint32_t(std::stoul(digits));
+}
+
 ParticleLighting parseParticleLighting(const std::string& text) {
     if (text == "atlas") return ParticleLighting::Atlas;
     if (text == "pixel") return ParticleLighting::Pixel;
@@ -216,6 +227,14 @@ RenderRun runRender(Gpu& gpu, const RenderOptions& o) {
     builtin.galleryTextureSize = o.galleryTextureSize;
     Scene scene = loadScene(o.scene, {o.allowExternalFiles, o.time}, builtin);
     Camera camera = runCamera(scene, o.camera, o.cameraOverrides, float(o.width) / float(o.height));
+    std::optional<Camera> cutCamera; // --camera-cut
+    if (!o.cutCamera.empty()) {
+        if (o.cutFrame < 1 || o.cutFrame >= o.frames)
+            throw InputError(format("--camera-cut %s@%u: the cut frame must be in 1..%u (--frames "
+                                    "%u)",
+                                    o.cutCamera.c_str(), o.cutFrame, o.frames - 1, o.frames));
+        cutCamera = runCamera(scene, o.cutCamera, {}, float(o.width) / float(o.height));
+    }
     // The camera path is fixed by the loaded scene's bounds (chunking does not move it).
     Aabb bounds = scene.worldBounds();
 
@@ -231,6 +250,11 @@ RenderRun runRender(Gpu& gpu, const RenderOptions& o) {
         // modes draw the same (split) scene, so pixel coverage is identical between them.
         RunViews views =
             runViews(camera, o.cameraPath, o.frames, bounds, o.width * o.ssaa, o.height * o.ssaa);
+        if (cutCamera) { // the views after the cut need their densities too
+            RunViews after = runViews(*cutCamera, o.cameraPath, o.frames, bounds, o.width * o.ssaa,
+                                      o.height * o.ssaa);
+            views.views.insert(views.views.end(), after.views.begin(), after.views.end());
+        }
         ViewDensityOptions vo;
         vo.budget = o.shadelBudget;
         // Playback rewrites each mesh's posed vertices one to one: meshes stay whole.
@@ -419,7 +443,8 @@ RenderRun runRender(Gpu& gpu, const RenderOptions& o) {
         bool tty = isatty(STDERR_FILENO);
         for (uint32_t i = 0; i < o.frames; ++i) {
             glm::vec2 jitter = o.jitter ? subpixelJitter(i) : glm::vec2(0.0f);
-            Camera onPath = cameraOnPath(camera, o.cameraPath, i, o.frames, bounds);
+            const Camera& start = cutCamera && i >= o.cutFrame ? *cutCamera : camera;
+            Camera onPath = cameraOnPath(start, o.cameraPath, i, o.frames, bounds);
             CameraView view =
                 makeCameraView(onPath, o.width * o.ssaa, o.height * o.ssaa, jitter * float(o.ssaa));
             if (playback && i > 0) {
@@ -457,6 +482,7 @@ RenderRun runRender(Gpu& gpu, const RenderOptions& o) {
     s["driver"] = gpu.device.driver;
     s["scene"] = o.scene;
     s["camera"] = camera.name;
+    if (cutCamera) s["camera_cut"] = {{"camera", cutCamera->name}, {"frame", o.cutFrame}};
     s["mode"] = modeName(o.mode);
     if (o.mode == RenderMode::Decoupled)
         s["marking"] = renderer.settings.marking == MarkingMode::Raster ? "raster" : "visibility";
@@ -485,6 +511,9 @@ RenderRun runRender(Gpu& gpu, const RenderOptions& o) {
     s["recording"] = {{"threads", settings.recordingThreads},
                       {"wall_ms", median(recordingMs)},
                       {"workers_cpu_ms", median(recordingCpuMs)}};
+    std::vector<double> streamingMs;
+    for (auto& f : run.frames) streamingMs.push_back(f.cpuStreamingMs);
+    s["cpu_streaming_thread_ms"] = median(streamingMs); // of which the texture streaming frontend
     s["frame_ms"] = {{"median", median(frameMs)},
                      {"min", *std::min_element(frameMs.begin(), frameMs.end())},
                      {"max", *std::max_element(frameMs.begin(), frameMs.end())}};

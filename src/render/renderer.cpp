@@ -313,11 +313,14 @@ FrameResult renderFrame(Renderer& r, const GpuScene& scene, const CameraView& ca
     // Before beginFrame (streaming rebinds texture slots in the set this frame uses) and before
     // the decoupled frontend (which must not carry over shading of re-streamed textures).
     r.changedMaterials.clear();
+    double streamingMs = 0.0; // the streaming frontend's share of cpuThreadMs
     if (r.streaming) {
+        double streamingStart = threadCpuMs();
         prepareTextureStreaming(*r.streaming, camera, float(r.internalHeight), constants);
         r.changedMaterials = restreamedMaterials(*r.streaming);
         if (VkSemaphore bound = takeTextureStreamingWait(*r.streaming)) // sparse page binds
             r.recorder.waitOnce.push_back(bound);
+        streamingMs += threadCpuMs() - streamingStart;
     }
     // Edited materials reshade like re-streamed ones.
     if (!r.edits.materialsChanged.empty()) {
@@ -348,8 +351,11 @@ FrameResult renderFrame(Renderer& r, const GpuScene& scene, const CameraView& ca
     if (r.debugLines) // --debug-lines: any later pass may append segments
         pass(rec, "debugLinesClear", [&](VkCommandBuffer cmd) { recordDebugLinesClear(r, cmd); });
     if (r.streaming) // landed texture loads copied in, the feedback buffer cleared
-        pass(rec, "textureStreaming",
-             [&](VkCommandBuffer cmd) { recordTextureStreaming(*r.streaming, cmd); });
+        pass(rec, "textureStreaming", [&](VkCommandBuffer cmd) {
+            double recordStart = threadCpuMs();
+            recordTextureStreaming(*r.streaming, cmd);
+            streamingMs += threadCpuMs() - recordStart;
+        });
     if (r.skinning) // skinned vertices for every view below (render/skinning)
         pass(rec, "skinning", [&](VkCommandBuffer cmd) { recordSkinning(r, cmd); });
     pass(rec, "instanceCull",
@@ -425,7 +431,11 @@ FrameResult renderFrame(Renderer& r, const GpuScene& scene, const CameraView& ca
     finishCullingFrame(r);
     if (r.rt) finishRayTracingFrame(r);
     finishScreenSpaceFrame(r);
-    if (r.streaming) finishTextureStreamingFrame(*r.streaming);
+    if (r.streaming) {
+        double finishStart = threadCpuMs();
+        finishTextureStreamingFrame(*r.streaming);
+        streamingMs += threadCpuMs() - finishStart;
+    }
     finishSceneEdits(r);
     r.framesRendered++;
     size_t bytes = size_t(r.settings.width) * r.settings.height * 4;
@@ -433,6 +443,7 @@ FrameResult renderFrame(Renderer& r, const GpuScene& scene, const CameraView& ca
     std::memcpy(result.rgba.data(), mapped(gpu, r.pixels), bytes);
     for (size_t i = 3; i < bytes; i += 4) result.pixelsCovered += result.rgba[i] != 0;
     result.cpuThreadMs = threadCpuMs() - threadStart;
+    result.cpuStreamingMs = streamingMs;
     return result;
 }
 

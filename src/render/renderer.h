@@ -161,6 +161,9 @@ struct FrameResult {
     // CPU time the rendering thread consumed in renderFrame (CLOCK_THREAD_CPUTIME_ID): not
     // inflated when other processes take the cores, as the wall-clock cpuFrameMs is.
     double cpuThreadMs = 0.0;
+    // Of which the texture streaming frontend (prepare, recording its copies, finish): the
+    // render thread's share of streaming, the rest runs on its worker (render/streaming).
+    double cpuStreamingMs = 0.0;
     double startMs = 0.0; // since the renderer was created (trace export)
     uint32_t shaderAsserts = 0;
     std::vector<ShaderPrint> prints;        // shaderPrint records of this frame (--inspect)
