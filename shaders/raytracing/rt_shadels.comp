@@ -38,6 +38,7 @@ void main() {
     if (tri == 0xFFFFu) { // no surface here (outside every chart and its gutter): never read
         imageStore(gImagesRgba16f[rt.shadelTermsWrite], atlas, vec4(1.0, 1.0, 0.0, 0.0));
         imageStore(gImagesRgba16f[rt.shadelIndirectWrite], atlas, vec4(0.0));
+        if (rt.spotShadowCount != 0u) imageStore(gImagesRgba32ui[rt.shadelSpotWrite], atlas, uvec4(0xFFFFFFFFu));
         return;
     }
     GpuInstance inst = InstanceBuffer(f.instances).i[tile.object];
@@ -71,6 +72,8 @@ void main() {
         if (count == 0.0) {
             imageStore(gImagesRgba16f[rt.shadelTermsWrite], atlas, vec4(1.0, 1.0, 0.0, 0.0));
             imageStore(gImagesRgba16f[rt.shadelIndirectWrite], atlas, vec4(0.0));
+            if (rt.spotShadowCount != 0u)
+                imageStore(gImagesRgba32ui[rt.shadelSpotWrite], atlas, uvec4(0xFFFFFFFFu));
         }
         return;
     }
@@ -89,4 +92,11 @@ void main() {
     imageStore(gImagesRgba16f[rt.shadelTermsWrite], atlas, terms);
     imageStore(gImagesRgba16f[rt.shadelIndirectWrite], atlas,
                vec4(mix(indirectHistory.rgb, indirect, w), total));
+    if (rt.spotShadowCount != 0u) {
+        // 8 bits per spot: a running mean below 1/16 per frame would round to no change.
+        uvec4 spots = rtSpotVisibilities(f, rt, p, ng, seed ^ 0x7a3c1u, sampleBase);
+        uvec4 spotHistory = count == 0.0 ? spots : imageLoad(gImagesRgba32ui[rt.shadelSpotWrite], atlas);
+        imageStore(gImagesRgba32ui[rt.shadelSpotWrite], atlas,
+                   rtMixSpotVisibilities(spotHistory, spots, max(w, 1.0 / 16.0), rt.spotShadowCount));
+    }
 }

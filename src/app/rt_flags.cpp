@@ -10,7 +10,10 @@ namespace shadel {
 
 void addRayTracingFlags(CLI::App& render, RtFlags& f) {
     RtSettings& s = f.settings;
-    render.add_option("--rt-shadows", f.shadows, "on | off: ray-traced sun shadows")
+    render
+        .add_option(
+            "--rt-shadows", f.shadows,
+            "on | off: ray-traced sun and shadow-casting spot shadows (in place of the maps)")
         ->capture_default_str();
     render.add_option("--rt-ao", f.ao, "on | off: ray-traced ambient occlusion")
         ->capture_default_str();

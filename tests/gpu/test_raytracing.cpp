@@ -1,5 +1,6 @@
 // Ray tracing (render/raytracing, issue 20): BLASes per mesh LOD in TLSF pools with the
 // least-detailed fallback, the per-frame TLAS, and the ray-traced effects of the forward path.
+#include <algorithm>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
@@ -253,4 +254,75 @@ TEST(RayTracing, ShadelAoFlickersLessThanPerPixelAtTheSameRayBudget) {
     EXPECT_GE(forwardRays, shadelRays * 0.9);
     EXPECT_GT(flickerForward, 0.0);
     EXPECT_LE(flickerShadel, 0.5 * flickerForward);
+}
+
+namespace {
+
+double luma(const std::vector<uint8_t>& p, size_t i) {
+    return 0.2126 * p[i] + 0.7152 * p[i + 1] + 0.0722 * p[i + 2];
+}
+
+// Pixels that `shadowed` makes darker than `unshadowed` by more than `by` (luma), and those it
+// makes brighter by more than 2.
+struct ShadowPixels {
+    std::vector<size_t> darker;
+    size_t brighter = 0;
+};
+ShadowPixels shadowPixels(const RenderRun& shadowed, const RenderRun& unshadowed, double by) {
+    const auto& a = shadowed.frames.back().rgba;
+    const auto& b = unshadowed.frames.back().rgba;
+    ShadowPixels s;
+    for (size_t i = 0; i < a.size(); i += 4) {
+        double d = luma(b, i) - luma(a, i);
+        if (d > by) s.darker.push_back(i);
+        s.brighter += d < -2.0;
+    }
+    return s;
+}
+
+} // namespace
+
+// builtin:lights: 16 shadow-casting spots over posts. --rt-shadows traces them (hard: one ray
+// to the light; soft: --rt-shadow-rays over the lamp head) in place of their maps, in the
+// shared lighting code, so both paths get them.
+TEST(RayTracing, SpotShadowsAgreeWithTheSpotShadowMaps) {
+    if (!sharedGpu().device.optional.rayQuery) GTEST_SKIP() << "no ray query on this device";
+    for (RenderMode mode : {RenderMode::Forward, RenderMode::Decoupled}) {
+        SCOPED_TRACE(mode == RenderMode::Forward ? "forward" : "decoupled");
+        RenderOptions o = renderOptions("builtin:lights", mode, 192, 108);
+        o.progress = false;
+        RenderRun maps = renderChecked(o);
+        o.spotShadows = false;
+        RenderRun mapsOff = renderChecked(o);
+        o.rt.shadows = true;
+        RenderRun tracedOff = renderChecked(o); // the sun traced, no spot shadows at all
+        o.spotShadows = true;
+        RenderRun traced = renderChecked(o);
+        EXPECT_EQ(traced.stats["rt"]["spot_shadows"].get<uint64_t>(), 16u);
+        EXPECT_EQ(tracedOff.stats["rt"]["spot_shadows"].get<uint64_t>(), 0u);
+        double db = psnr(traced.frames.back().rgba, maps.frames.back().rgba);
+        // The occluders in the spots' cones (the posts) darken the street with RT on, and the
+        // traced spot shadows only remove light.
+        ShadowPixels rt = shadowPixels(traced, tracedOff, 8.0);
+        ShadowPixels map = shadowPixels(maps, mapsOff, 2.0);
+        size_t agree = 0;
+        for (size_t i : rt.darker)
+            agree += std::find(map.darker.begin(), map.darker.end(), i) != map.darker.end();
+        std::printf("RT spot shadows vs maps: %.2f dB; %zu pixels darkened by the traced spot "
+                    "shadows, %zu of them by the maps too\n",
+                    db, rt.darker.size(), agree);
+        EXPECT_GE(db, 30.0);
+        EXPECT_GE(rt.darker.size(), 20u) << "no traced spot shadow darkened the street";
+        EXPECT_EQ(rt.brighter, 0u) << "a traced shadow never adds light";
+        EXPECT_GE(double(agree), 0.75 * double(rt.darker.size())) << "not where the maps' are";
+        if (mode == RenderMode::Decoupled) break;
+        // Soft: 4 jittered rays over the 0.4 m lamp heads; still the maps' shadows (PCSS on the
+        // soft spots), and the penumbrae change the image.
+        o.rt.shadowRays = 4;
+        RenderRun soft = renderChecked(o);
+        double softDb = psnr(soft.frames.back().rgba, maps.frames.back().rgba);
+        std::printf("soft RT spot shadows vs maps: %.2f dB\n", softDb);
+        EXPECT_GE(softDb, 30.0);
+        EXPECT_LT(psnr(soft.frames.back().rgba, traced.frames.back().rgba), 99.0);
+    }
 }

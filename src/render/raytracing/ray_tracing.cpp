@@ -21,13 +21,16 @@ struct RayTracingState {
     std::unique_ptr<BlasPools> pools;
     BlasSet blases;
     Tlas tlas;
-    BufferHandle frame;        // gpu::RtFrame (host-visible)
-    BufferHandle instanceLods; // uint per instance: first index of its BLAS's LOD (host-visible)
-    BufferHandle counters;     // gpu::RtCounters (readback)
-    // Forward path: the per-pixel terms (sun, AO, -, distance) and the indirect light.
-    TextureHandle terms, indirect;
-    RenderTargetView termsTarget, indirectTarget;
-    TextureReadView termsRead, indirectRead;
+    BufferHandle frame;           // gpu::RtFrame (host-visible)
+    BufferHandle instanceLods;    // uint per instance: first index of its BLAS's LOD (host-visible)
+    BufferHandle counters;        // gpu::RtCounters (readback)
+    BufferHandle spotLights;      // uint per spot shadow index: its light (host-visible)
+    uint32_t spotShadowCount = 0; // shadow-casting spots traced (--rt-shadows, --spot-shadows)
+    // Forward path: the per-pixel terms (sun, AO, -, distance), the indirect light and the
+    // shadow-casting spots' visibilities (8 bits each, rgba32ui).
+    TextureHandle terms, indirect, spots;
+    RenderTargetView termsTarget, indirectTarget, spotsTarget;
+    TextureReadView termsRead, indirectRead, spotsRead;
     Pipeline pixelTerms;
     RtShadelCache shadelCache; // decoupled mode: the terms per shadel, accumulated over frames
     uint32_t raysLastFrame = 0;
@@ -59,16 +62,23 @@ static void createPixelTargets(Renderer& r, RayTracingState& s) {
     s.terms = createTexture(gpu, d);
     d.name = "rt.pixelIndirect";
     s.indirect = createTexture(gpu, d);
-    if (!s.terms || !s.indirect) throw DeviceError("out of GPU memory for the ray-traced terms");
+    d.format = VK_FORMAT_R32G32B32A32_UINT;
+    d.name = "rt.pixelSpotShadows";
+    s.spots = createTexture(gpu, d);
+    if (!s.terms || !s.indirect || !s.spots)
+        throw DeviceError("out of GPU memory for the ray-traced terms");
     s.termsTarget = createRenderTargetView(gpu, s.terms);
     s.indirectTarget = createRenderTargetView(gpu, s.indirect);
     s.termsRead = createReadView(gpu, s.terms);
     s.indirectRead = createReadView(gpu, s.indirect);
+    s.spotsTarget = createRenderTargetView(gpu, s.spots);
+    s.spotsRead = createReadView(gpu, s.spots);
     GraphicsPipelineDesc p;
     p.name = "rtPixelTerms";
     p.vertexShader = "forward_forward.vert.spv";
     p.fragmentShader = "raytracing_rt_pixel.frag.spv";
-    p.colorFormats = {VK_FORMAT_R16G16B16A16_SFLOAT, VK_FORMAT_R16G16B16A16_SFLOAT};
+    p.colorFormats = {VK_FORMAT_R16G16B16A16_SFLOAT, VK_FORMAT_R16G16B16A16_SFLOAT,
+                      VK_FORMAT_R32G32B32A32_UINT};
     p.depthFormat = VK_FORMAT_D32_SFLOAT;
     p.depthWrite = false;
     p.depthCompare = VK_COMPARE_OP_EQUAL; // the prepass resolved visibility
@@ -95,12 +105,24 @@ RayTracingStatePtr createRayTracing(Renderer& r, const GpuScene& scene) {
                            MemoryKind::Upload});
     s.counters =
         createBuffer(gpu, {"rt.counters", sizeof(gpu::RtCounters), 0, MemoryKind::Readback});
-    if (!s.frame || !s.instanceLods || !s.counters)
+    // Ray-traced spot shadows: the shadow-casting spots (GpuLight::shadowIndex, given in light
+    // order at load), traced in place of their maps; without spot shadow maps there are none.
+    std::vector<uint32_t> spotLights(LIGHT_MAX_SPOT_SHADOWS, 0);
+    if (rt.shadows && r.settings.spotShadows)
+        for (uint32_t i = 0; i < scene.lightInfo.size(); ++i)
+            if (uint32_t k = scene.lightInfo[i].shadowIndex; k < LIGHT_MAX_SPOT_SHADOWS) {
+                spotLights[k] = i;
+                s.spotShadowCount = std::max(s.spotShadowCount, k + 1);
+            }
+    s.spotLights =
+        createBuffer(gpu, {"rt.spotLights", spotLights.size() * 4, 0, MemoryKind::Upload});
+    if (!s.frame || !s.instanceLods || !s.counters || !s.spotLights)
         throw DeviceError("out of GPU memory for the ray-tracing frame buffers");
+    std::memcpy(mapped(gpu, s.spotLights), spotLights.data(), spotLights.size() * 4);
     if (tracesPerPixel(r))
         createPixelTargets(r, s);
     else
-        createRtShadelCache(r, scene, s.shadelCache);
+        createRtShadelCache(r, scene, s.spotShadowCount != 0, s.shadelCache);
     return state;
 }
 
@@ -112,7 +134,7 @@ void destroyRayTracing(Renderer& r, RayTracingStatePtr& state) {
     destroyTlas(gpu, s.fn, s.tlas);
     destroyBlases(gpu, s.fn, *s.pools, s.blases);
     s.pools.reset();
-    for (BufferHandle b : {s.frame, s.instanceLods, s.counters})
+    for (BufferHandle b : {s.frame, s.instanceLods, s.counters, s.spotLights})
         if (b) destroy(gpu, b);
     if (s.terms) {
         destroy(gpu, s.pixelTerms);
@@ -120,8 +142,11 @@ void destroyRayTracing(Renderer& r, RayTracingStatePtr& state) {
         destroy(gpu, s.indirectTarget);
         destroy(gpu, s.termsRead);
         destroy(gpu, s.indirectRead);
+        destroy(gpu, s.spotsTarget);
+        destroy(gpu, s.spotsRead);
         destroy(gpu, s.terms);
         destroy(gpu, s.indirect);
+        destroy(gpu, s.spots);
     }
     state.reset();
 }
@@ -195,6 +220,9 @@ void prepareRayTracingFrame(Renderer& r, const GpuScene& scene, const CameraView
     f.spatialFilter = rt.spatialFilter;
     f.normalOffset = 2e-4f;
     f.raysPerShadel = rt.raysPerShadel;
+    f.spotShadowCount = s.spotShadowCount;
+    f.spotLights = address(gpu, s.spotLights);
+    f.pixelSpotSlot = s.spots ? slot(gpu, s.spotsRead).value : NO_TEXTURE;
     if (s.shadelCache.terms) prepareRtShadelCache(r, scene, camera, s.shadelCache, f);
     std::memcpy(mapped(gpu, s.frame), &f, sizeof(f));
     constants.rt = address(gpu, s.frame);
@@ -213,7 +241,7 @@ void recordTlasBuild(Renderer& r, VkCommandBuffer cmd) {
 void recordRayTracedPixels(Renderer& r, VkCommandBuffer cmd, uint64_t frame) {
     Gpu& gpu = *r.gpu;
     RayTracingState& s = *r.rt;
-    for (TextureHandle t : {s.terms, s.indirect})
+    for (TextureHandle t : {s.terms, s.indirect, s.spots})
         imageBarrier(cmd, vkImage(gpu, t), VK_IMAGE_ASPECT_COLOR_BIT, VK_IMAGE_LAYOUT_UNDEFINED,
                      VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL,
                      VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT, 0,
@@ -221,13 +249,15 @@ void recordRayTracedPixels(Renderer& r, VkCommandBuffer cmd, uint64_t frame) {
                      VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT);
     // Cleared to 0: distance 0 means nothing traced.
     beginRendering(cmd, r.internalWidth, r.internalHeight,
-                   {{vkView(gpu, s.termsTarget), true}, {vkView(gpu, s.indirectTarget), true}},
+                   {{vkView(gpu, s.termsTarget), true},
+                    {vkView(gpu, s.indirectTarget), true},
+                    {vkView(gpu, s.spotsTarget), true}},
                    {vkView(gpu, r.depthTarget)});
     bind(gpu, cmd, s.pixelTerms);
     pushConstants(gpu, cmd, RasterPush{frame, 0});
     drawCameraList(r, cmd, DRAW_LIST_OPAQUE);
     vkCmdEndRendering(cmd);
-    for (TextureHandle t : {s.terms, s.indirect})
+    for (TextureHandle t : {s.terms, s.indirect, s.spots})
         imageBarrier(
             cmd, vkImage(gpu, t), VK_IMAGE_ASPECT_COLOR_BIT,
             VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL,
@@ -260,6 +290,7 @@ void rayTracingStats(const Renderer& r, nlohmann::json& stats) {
     const RtSettings& rt = r.settings.rt;
     stats["rt"] = {
         {"shadows", rt.shadows},
+        {"spot_shadows", s.spotShadowCount},
         {"ao", rt.ao},
         {"gi", rt.gi},
         {"blas_uncompacted_bytes", s.blases.stats.uncompactedBytes},

@@ -5,7 +5,8 @@
 namespace shadel {
 
 struct RtSettings {
-    bool shadows = false; // --rt-shadows: the sun's visibility traced instead of the shadow map
+    bool shadows = false; // --rt-shadows: the sun's and the shadow-casting spots' visibility traced
+                          // instead of their shadow maps
     bool ao = false;      // --rt-ao: ray-traced ambient occlusion
     bool gi = false;      // --rt-gi: one bounce of ray-traced diffuse light
     // Sun rays per sample: 1 = hard shadows, more = soft (jittered over the sun's disc).
