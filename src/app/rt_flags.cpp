@@ -57,6 +57,12 @@ void addRayTracingFlags(CLI::App& render, RtFlags& f) {
                     "decoupled: rays a cached texel accumulates, then reuses until its inputs "
                     "change, 1..1024")
         ->capture_default_str();
+    render
+        .add_option("--rt-animated-blas", f.animatedBlas,
+                    "on | off: GPU-skinned meshes' BLASes refit as the pose changes (rebuilt "
+                    "every 8 refits; beyond 16 m at most every ceil(distance / 16 m) frames); "
+                    "off: the bind pose's")
+        ->capture_default_str();
     render.add_option("--blas-pool-mb", s.blasPoolMb, "BLAS memory pool size in MiB, 1..4096")
         ->capture_default_str();
     render
@@ -72,6 +78,7 @@ RtSettings parseRayTracingFlags(const RtFlags& f) {
     s.ao = parseOnOff("--rt-ao", f.ao);
     s.gi = parseOnOff("--rt-gi", f.gi);
     s.spatialFilter = parseOnOff("--rt-filter", f.filter);
+    s.animatedBlas = parseOnOff("--rt-animated-blas", f.animatedBlas);
     auto count = [](const char* flag, uint32_t v, uint32_t lo, uint32_t hi) {
         if (v < lo || v > hi) throw InputError(format("%s %u: expected %u..%u", flag, v, lo, hi));
     };

@@ -9,6 +9,8 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <nlohmann/json.hpp>
+
 #include "gpu_test_env.h"
 
 using namespace shadel;
@@ -325,4 +327,92 @@ TEST(RayTracing, SpotShadowsAgreeWithTheSpotShadowMaps) {
         EXPECT_GE(softDb, 30.0);
         EXPECT_LT(psnr(soft.frames.back().rgba, traced.frames.back().rgba), 99.0);
     }
+}
+
+namespace {
+
+// assimp's simple_skin (a strip of two joints bending over 0..5.5 s) over a floor, lit by a low
+// sun from the front, so the strip's shadow on the floor shows its pose. Written next to the
+// test's other files: the floor's data in a .bin beside the .gltf.
+std::string skinnedStripOverAFloor() {
+    std::ifstream in("/usr/share/assimp/models/glTF2/simple_skin/simple_skin.gltf");
+    nlohmann::json g = nlohmann::json::parse(in);
+    const float pos[12] = {-3, 0, -4, 4, 0, -4, 4, 0, 3, -3, 0, 3};
+    const float nrm[12] = {0, 1, 0, 0, 1, 0, 0, 1, 0, 0, 1, 0};
+    const uint16_t idx[8] = {0, 2, 1, 0, 3, 2, 0, 0};
+    std::string bin = tempPath("skin_floor.bin");
+    std::ofstream out(bin, std::ios::binary);
+    out.write(reinterpret_cast<const char*>(pos), sizeof(pos));
+    out.write(reinterpret_cast<const char*>(nrm), sizeof(nrm));
+    out.write(reinterpret_cast<const char*>(idx), sizeof(idx));
+    out.close();
+    size_t b = g["buffers"].size(), v = g["bufferViews"].size(), a = g["accessors"].size();
+    g["buffers"].push_back(
+        {{"byteLength", 112}, {"uri", std::filesystem::path(bin).filename().string()}});
+    g["bufferViews"].push_back({{"buffer", b}, {"byteOffset", 0}, {"byteLength", 48}});
+    g["bufferViews"].push_back({{"buffer", b}, {"byteOffset", 48}, {"byteLength", 48}});
+    g["bufferViews"].push_back({{"buffer", b}, {"byteOffset", 96}, {"byteLength", 12}});
+    g["accessors"].push_back({{"bufferView", v},
+                              {"componentType", 5126},
+                              {"count", 4},
+                              {"type", "VEC3"},
+                              {"min", {-3, 0, -4}},
+                              {"max", {4, 0, 3}}});
+    g["accessors"].push_back(
+        {{"bufferView", v + 1}, {"componentType", 5126}, {"count", 4}, {"type", "VEC3"}});
+    g["accessors"].push_back(
+        {{"bufferView", v + 2}, {"componentType", 5123}, {"count", 6}, {"type", "SCALAR"}});
+    g["meshes"].push_back(
+        {{"primitives",
+          {{{"attributes", {{"POSITION", a}, {"NORMAL", a + 1}}}, {"indices", a + 2}}}}});
+    g["nodes"].push_back({{"mesh", g["meshes"].size() - 1}});
+    g["scenes"][0]["nodes"].push_back(g["nodes"].size() - 1);
+    // The sun travels along (0.3, -0.6, -1): the node's rotation of -Z onto it.
+    g["extensionsUsed"] = {"KHR_lights_punctual"};
+    g["extensions"]["KHR_lights_punctual"]["lights"] = {
+        {{"type", "directional"}, {"color", {1, 1, 1}}, {"intensity", 3.0}}};
+    g["nodes"].push_back({{"rotation", {-0.26041905, -0.13020952, 0.0, 0.95667518}},
+                          {"extensions", {{"KHR_lights_punctual", {{"light", 0}}}}}});
+    g["scenes"][0]["nodes"].push_back(g["nodes"].size() - 1);
+    std::string path = tempPath("skin_floor.gltf");
+    std::ofstream(path) << g.dump();
+    return path;
+}
+
+} // namespace
+
+// Animated BLASes: the GPU-skinned strip's BLAS is refit to each frame's pose (--time-step), so
+// its traced shadow on the floor is the shadow map's at every time; the bind pose's static BLAS
+// (--rt-animated-blas off) casts the wrong one.
+TEST(RayTracing, SkinnedBlasRefitsFollowThePose) {
+    if (!sharedGpu().device.optional.rayQuery) GTEST_SKIP() << "no ray query on this device";
+    RenderOptions o = renderOptions(skinnedStripOverAFloor(), RenderMode::Forward, 160, 90);
+    o.progress = false;
+    o.cameraOverrides.from = glm::vec3(0.5f, 3.0f, 5.0f);
+    o.cameraOverrides.lookAt = glm::vec3(0.5f, 0.7f, -1.0f);
+    o.frames = 3;
+    o.time = 0.2; // frames at 0.2, 0.6 and 1.0 s: three poses
+    o.timeStep = 0.4;
+    RenderRun maps = renderChecked(o);
+    o.rt.shadows = true;
+    RenderRun refit = renderChecked(o);
+    o.rt.animatedBlas = false;
+    RenderRun bindPose = renderChecked(o);
+    const auto& s = refit.stats;
+    EXPECT_EQ(s["rt"]["animated_blases"].get<uint64_t>(), 1u);
+    // Near the camera every changed pose is an update: the first a build, then refits.
+    EXPECT_EQ(s["blas_rebuilds"].get<uint64_t>(), 1u);
+    EXPECT_EQ(s["blas_refits"].get<uint64_t>(), 2u);
+    EXPECT_EQ(bindPose.stats["blas_refits"].get<uint64_t>(), 0u);
+    for (size_t f : {1, 2}) {
+        double db = psnr(refit.frames[f].rgba, maps.frames[f].rgba);
+        double stale = psnr(bindPose.frames[f].rgba, maps.frames[f].rgba);
+        std::printf("t = %.1f s: refit RT shadows vs shadow map %.2f dB (bind-pose BLAS %.2f dB)\n",
+                    0.2 + 0.4 * double(f), db, stale);
+        EXPECT_GE(db, 30.0);
+        EXPECT_GT(db, stale + 6.0) << "the refit BLAS casts no better shadow than the bind pose's";
+    }
+    double poses = psnr(refit.frames[1].rgba, refit.frames[2].rgba);
+    std::printf("t = 0.6 s vs 1.0 s: %.2f dB\n", poses);
+    EXPECT_LT(poses, 40.0) << "the two times' images do not differ";
 }

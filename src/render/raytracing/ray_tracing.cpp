@@ -12,6 +12,7 @@
 #include "render/raytracing/acceleration_structures.h"
 #include "render/raytracing/rt_shadel_cache.h"
 #include "render/renderer.h"
+#include "render/skinning/skinning.h"
 #include "rhi/rendering.h"
 
 namespace shadel {
@@ -20,6 +21,11 @@ struct RayTracingState {
     RtFunctions fn;
     std::unique_ptr<BlasPools> pools;
     BlasSet blases;
+    // GPU-skinned meshes: their own BLAS over the deformed vertices, refit as the pose changes
+    // (created on the first frame with skinning: the renderer comes before the skinning state).
+    AnimatedBlasSet animated;
+    bool animatedCreated = false;
+    std::vector<AnimatedBlasUpdate> animatedUpdates; // this frame's
     Tlas tlas;
     BufferHandle frame;           // gpu::RtFrame (host-visible)
     BufferHandle instanceLods;    // uint per instance: first index of its BLAS's LOD (host-visible)
@@ -132,6 +138,7 @@ void destroyRayTracing(Renderer& r, RayTracingStatePtr& state) {
     RayTracingState& s = *state;
     destroyRtShadelCache(r, s.shadelCache);
     destroyTlas(gpu, s.fn, s.tlas);
+    destroyAnimatedBlases(gpu, s.fn, *s.pools, s.animated);
     destroyBlases(gpu, s.fn, *s.pools, s.blases);
     s.pools.reset();
     for (BufferHandle b : {s.frame, s.instanceLods, s.counters, s.spotLights})
@@ -156,6 +163,43 @@ static float distanceToBox(glm::vec3 p, glm::vec3 lo, glm::vec3 hi) {
     return glm::length(glm::max(glm::max(lo - p, p - hi), glm::vec3(0.0f)));
 }
 
+// Distance throttle of animated BLAS refits: within kRefitNearDistance of the camera a BLAS is
+// refit every frame its pose changed; farther, at most once per ceil(distance /
+// kRefitNearDistance) frames (so 2 beyond 16 m, 3 beyond 32 m, ...), up to kRefitMaxPeriod.
+constexpr float kRefitNearDistance = 16.0f;
+constexpr uint32_t kRefitMaxPeriod = 8;
+
+static uint32_t refitPeriod(float distance) {
+    float period = std::ceil(distance / kRefitNearDistance);
+    return uint32_t(std::clamp(period, 1.0f, float(kRefitMaxPeriod)));
+}
+
+// Which animated BLASes are built or refit this frame (recorded at the top of rtBuildTlas).
+static void planAnimatedBlasUpdates(Renderer& r, RayTracingState& s, const GpuScene& scene,
+                                    const std::vector<float>& meshDistance) {
+    s.animatedUpdates.clear();
+    if (!r.skinning || !r.settings.rt.animatedBlas) return;
+    if (!s.animatedCreated) {
+        createAnimatedBlases(*r.gpu, s.fn, *s.pools, scene, skinnedMeshes(*r.skinning),
+                             skinnedVerticesAddress(r, *r.skinning), s.animated);
+        s.animatedCreated = true;
+    }
+    uint64_t pose = skinPoseVersion(*r.skinning);
+    uint64_t frame = r.framesRendered;
+    for (uint32_t k = 0; k < s.animated.blases.size(); ++k) {
+        AnimatedBlas& a = s.animated.blases[k];
+        if (a.built && a.builtPose == pose) continue; // the pose did not change
+        if (a.built && frame - a.lastUpdateFrame < refitPeriod(meshDistance[a.mesh])) continue;
+        bool rebuild = !a.built || a.refitsSinceBuild >= kRefitsPerRebuild;
+        s.animatedUpdates.push_back({k, rebuild});
+        a.built = true; // by the time the TLAS is built
+        a.refitsSinceBuild = rebuild ? 0 : a.refitsSinceBuild + 1;
+        a.builtPose = pose;
+        a.lastUpdateFrame = frame;
+        (rebuild ? s.animated.rebuilds : s.animated.refits)++;
+    }
+}
+
 void prepareRayTracingFrame(Renderer& r, const GpuScene& scene, const CameraView& camera,
                             gpu::FrameConstants& constants) {
     Gpu& gpu = *r.gpu;
@@ -172,6 +216,15 @@ void prepareRayTracingFrame(Renderer& r, const GpuScene& scene, const CameraView
     float pixelsPerUnit = std::abs(camera.proj[1][1]) * 0.5f * float(r.internalHeight);
     uint32_t count = 0;
     s.fallbackInstances = 0;
+    if (r.skinning) { // animated BLASes: their nearest instance's distance throttles refits
+        std::vector<float> meshDistance(scene.meshInfo.size(), INFINITY);
+        for (uint32_t i = 0; i < scene.instanceCount; ++i) {
+            const gpu::GpuInstance& inst = scene.instanceInfo[i];
+            float& d = meshDistance[inst.mesh];
+            d = std::min(d, distanceToBox(camera.position, inst.worldMin, inst.worldMax));
+        }
+        planAnimatedBlasUpdates(r, s, scene, meshDistance);
+    }
     for (uint32_t i = 0; i < scene.instanceCount; ++i) {
         const gpu::GpuInstance& inst = scene.instanceInfo[i];
         const std::vector<int32_t>& chain = s.blases.meshLods[inst.mesh];
@@ -186,19 +239,26 @@ void prepareRayTracingFrame(Renderer& r, const GpuScene& scene, const CameraView
                info.lod[lod + 1].error * scale * pixelsPerUnit <=
                    r.settings.lodErrorPixels * std::max(d, 1e-3f))
             ++lod;
+        int32_t animated = inst.mesh < s.animated.byMesh.size() ? s.animated.byMesh[inst.mesh] : -1;
         int32_t b = chain[lod];
-        if (b < 0) continue; // no BLAS at all for this mesh (even the least-detailed failed)
-        const Blas& blas = s.blases.blases[b];
-        s.fallbackInstances += blas.lod != lod;
+        if (b < 0 && animated < 0) continue; // no BLAS at all (even the least-detailed failed)
         VkAccelerationStructureInstanceKHR& o = out[count++];
+        if (animated >= 0) { // skinned: the posed LOD 0
+            const AnimatedBlas& a = s.animated.blases[animated];
+            o.accelerationStructureReference = a.address;
+            lods[i] = a.firstIndex;
+        } else {
+            const Blas& blas = s.blases.blases[b];
+            s.fallbackInstances += blas.lod != lod;
+            o.accelerationStructureReference = blas.address;
+            lods[i] = blas.firstIndex;
+        }
         for (int row = 0; row < 3; ++row)
             for (int col = 0; col < 4; ++col) o.transform.matrix[row][col] = inst.model[col][row];
         o.instanceCustomIndex = i;
         o.mask = 0xFF;
         o.instanceShaderBindingTableRecordOffset = 0;
         o.flags = VK_GEOMETRY_INSTANCE_TRIANGLE_FACING_CULL_DISABLE_BIT_KHR;
-        o.accelerationStructureReference = blas.address;
-        lods[i] = blas.firstIndex;
     }
     s.tlas.instanceCount = count;
 
@@ -235,6 +295,7 @@ void recordTlasBuild(Renderer& r, VkCommandBuffer cmd) {
     memoryBarrier(cmd, VK_PIPELINE_STAGE_2_CLEAR_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT,
                   VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT | VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
                   VK_ACCESS_2_SHADER_STORAGE_READ_BIT | VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT);
+    recordAnimatedBlasUpdates(gpu, s.fn, cmd, s.animated, s.animatedUpdates);
     recordTlasBuild(gpu, s.fn, cmd, s.tlas);
 }
 
@@ -286,6 +347,9 @@ void rayTracingStats(const Renderer& r, nlohmann::json& stats) {
     stats["blas_pools"] = pools.poolCount;
     stats["blas_fallbacks"] = s.blases.stats.fallbacks;
     stats["tlas_instances"] = s.tlas.instanceCount;
+    // Animated (skinned) BLASes, over the run: refits, and builds (each one's first included).
+    stats["blas_refits"] = s.animated.refits;
+    stats["blas_rebuilds"] = s.animated.rebuilds;
     stats["rays_traced"] = s.raysLastFrame;
     const RtSettings& rt = r.settings.rt;
     stats["rt"] = {
@@ -298,6 +362,9 @@ void rayTracingStats(const Renderer& r, nlohmann::json& stats) {
         {"blas_pool_failed_allocations", pools.failedAllocations},
         {"meshes_without_blas", s.blases.stats.meshesWithoutBlas},
         {"tlas_fallback_instances", s.fallbackInstances},
+        {"animated_blases", s.animated.blases.size()},
+        {"animated_blases_without_room", s.animated.withoutRoom},
+        {"animated_blas_updates_this_frame", s.animatedUpdates.size()},
         {"rays_traced_mean", s.framesTraced ? double(s.raysTotal) / s.framesTraced : 0.0}};
     if (s.shadelCache.terms)
         stats["rt"]["shadel_cache"] = {

@@ -23,6 +23,9 @@ struct RtSettings {
     uint32_t blasPoolMb = 128;
     uint32_t blasPoolLimit = 16;
     float distance = 0.0f; // TLAS instances within this distance of the camera (0 = all)
+    // GPU-skinned meshes get their own BLAS, refit as the pose changes (off: the bind pose's
+    // static BLAS, the comparison of the animated-BLAS test).
+    bool animatedBlas = true;
 
     bool enabled() const { return shadows || ao || gi; }
 };
