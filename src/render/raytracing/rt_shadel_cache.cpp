@@ -124,6 +124,10 @@ void prepareRtShadelCache(Renderer& r, const GpuScene& scene, const CameraView& 
     c.texelsTraced = 0;
     c.instancesCached = 0;
     c.instancesWithoutRoom = 0;
+    // Animated playback reposed something (render/animation: moved or skinned): its shadows,
+    // occlusion and bounce light reach other instances too, so every history restarts.
+    bool sceneMoved = std::find(r.reposedInstances.begin(), r.reposedInstances.end(), 1) !=
+                      r.reposedInstances.end();
     for (uint32_t i = 0; i < scene.instanceCount; ++i) {
         RtShadelCache::Entry& e = c.entries[i];
         gpu::RtShadelObject& o = c.objects[i];
@@ -145,8 +149,8 @@ void prepareRtShadelCache(Renderer& r, const GpuScene& scene, const CameraView& 
         bool keep = e.placement && std::abs(int(level) - int(e.level)) <= 1;
         // Moved, or a light changed (GI, or ray-traced spot shadows): the history no longer holds.
         bool lightsMatter = r.settings.rt.gi || rt.spotShadowCount != 0;
-        bool reset =
-            !keep || e.model != inst.model || (lightsMatter && !r.changedLightVolumes.empty());
+        bool reset = !keep || e.model != inst.model || sceneMoved ||
+                     (lightsMatter && !r.changedLightVolumes.empty());
         if (!keep) {
             if (e.placement) c.atlas->remove(e.placement->id);
             glm::uvec2 size = levelSize(mesh->mip0Size, level);
