@@ -79,7 +79,10 @@ void main() {
     }
 
     vec4 indirectHistory = imageLoad(gImagesRgba16f[rt.shadelIndirectWrite], atlas);
-    uint rays = rt.raysPerShadel;
+    // A texel's first frame (new in view, or reset) traces RT_SHADEL_FIRST_RAYS: with one ray
+    // its estimate is 0 or 1 and the next frames' running mean swings widely (a moving camera
+    // shows new texels every frame: that swing is most of the shadel path's flicker).
+    uint rays = count == 0.0 ? max(rt.raysPerShadel, RT_SHADEL_FIRST_RAYS) : rt.raysPerShadel;
     uint seed = rtHash(tile.object * 0x9e3779b9u ^ rtHash(uint(atlas.x) | uint(atlas.y) << 16));
     uint sampleBase = uint(count); // continue the sequence: no sample is drawn twice
     float sun = rt.shadows != 0u ? rtSunVisibility(f, rt, p, ng, seed, sampleBase) : 1.0;

@@ -19,6 +19,7 @@ struct RtCounters {
 // MIP of its shadel space, coarser than the lit layer; rays accumulate there over frames.
 #define RT_SHADEL_VALID 1u // the instance has a rect in the cache this frame
 #define RT_SHADEL_RESET 2u // its history is void (new rect, moved, or a changed input): restart
+#define RT_SHADEL_FIRST_RAYS 4u // AO / GI rays of a texel's first traced frame (at least)
 
 struct RtShadelObject {
     uvec2 origin;     // texel of the atlas where the rect starts

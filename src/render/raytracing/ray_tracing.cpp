@@ -372,6 +372,7 @@ void rayTracingStats(const Renderer& r, nlohmann::json& stats) {
             {"history_rays", rt.historyRays},
             {"instances", s.shadelCache.instancesCached},
             {"instances_without_room", s.shadelCache.instancesWithoutRoom},
+            {"history_resets", s.shadelCache.historyResets},
             {"rays_per_shadel", rt.raysPerShadel},
             {"mip_offset", rt.shadelMipOffset}};
 }

@@ -168,6 +168,7 @@ void prepareRtShadelCache(Renderer& r, const GpuScene& scene, const CameraView& 
         o.level = e.level;
         o.idMapOffset = mesh->idMapOffset[e.level];
         o.flags = RT_SHADEL_VALID | (reset ? RT_SHADEL_RESET : 0u);
+        c.historyResets += reset;
         c.instancesCached++;
         c.texelsTraced += size.x * size.y;
         for (uint32_t y = 0; y < (size.y + 7) / 8; ++y)

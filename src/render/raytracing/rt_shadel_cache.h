@@ -44,6 +44,7 @@ struct RtShadelCache {
     uint32_t texelsTraced = 0; // this frame
     uint32_t instancesCached = 0;
     uint32_t instancesWithoutRoom = 0; // visible decoupled instances the atlas had no room for
+    uint64_t historyResets = 0;        // over the run: instance rects whose history restarted
 };
 
 // spotShadows: with the rgba32ui layer of the shadow-casting spots' visibilities.
