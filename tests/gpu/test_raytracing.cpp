@@ -423,3 +423,27 @@ TEST(RayTracing, SkinnedBlasRefitsFollowThePose) {
         EXPECT_LT(poses, 40.0) << "the two times' images do not differ";
     }
 }
+
+// The refit schedule: near the camera every changed pose is an update, every 9th a build (after
+// 8 refits); 60 m away (beyond 16 m: at most one update per ceil(60 / 16) = 4 frames) fewer.
+TEST(RayTracing, SkinnedBlasRebuildsAfterEightRefitsAndFarOnesUpdateLessOften) {
+    if (!sharedGpu().device.optional.rayQuery) GTEST_SKIP() << "no ray query on this device";
+    RenderOptions o = renderOptions("/usr/share/assimp/models/glTF2/simple_skin/simple_skin.gltf",
+                                    RenderMode::Forward, 64, 36);
+    o.progress = false;
+    o.cameraOverrides.lookAt = glm::vec3(0.5f, 1.0f, 0.0f);
+    o.frames = 10;
+    o.time = 0.0;
+    o.timeStep = 0.1; // a new pose every frame
+    o.rt.shadows = true;
+    o.cameraOverrides.from = glm::vec3(0.5f, 1.0f, 4.0f);
+    RenderRun near = renderChecked(o);
+    o.cameraOverrides.from = glm::vec3(0.5f, 1.0f, 60.0f);
+    RenderRun far = renderChecked(o);
+    // Frames 0 and 9 build, 1..8 refit.
+    EXPECT_EQ(near.stats["blas_refits"].get<uint64_t>(), 8u);
+    EXPECT_EQ(near.stats["blas_rebuilds"].get<uint64_t>(), 2u);
+    // Frames 0 (build), 4 and 8 (refits).
+    EXPECT_EQ(far.stats["blas_refits"].get<uint64_t>(), 2u);
+    EXPECT_EQ(far.stats["blas_rebuilds"].get<uint64_t>(), 1u);
+}
