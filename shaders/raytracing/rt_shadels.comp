@@ -95,8 +95,10 @@ void main() {
     imageStore(gImagesRgba16f[rt.shadelTermsWrite], atlas, terms);
     imageStore(gImagesRgba16f[rt.shadelIndirectWrite], atlas,
                vec4(mix(indirectHistory.rgb, indirect, w), total));
-    if (rt.spotShadowCount != 0u) {
-        // 8 bits per spot: a running mean below 1/16 per frame would round to no change.
+    // Hard spot shadows are exact from the first frame (one ray to each light from a fixed
+    // point): traced again only after a reset. Soft ones accumulate; 8 bits per spot: a running
+    // mean below 1/16 per frame would round to no change.
+    if (rt.spotShadowCount != 0u && (count == 0.0 || rt.shadowRays > 1u)) {
         uvec4 spots = rtSpotVisibilities(f, rt, p, ng, seed ^ 0x7a3c1u, sampleBase);
         uvec4 spotHistory = count == 0.0 ? spots : imageLoad(gImagesRgba32ui[rt.shadelSpotWrite], atlas);
         imageStore(gImagesRgba32ui[rt.shadelSpotWrite], atlas,
