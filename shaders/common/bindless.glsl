@@ -14,10 +14,12 @@
 #include "common/asserts.h"
 
 layout(set = 0, binding = 0) uniform texture2D gTextures[];
+layout(set = 0, binding = 0) uniform utexture2D gUTextures[]; // the same table, uint formats
 // Storage images, one alias per format the engine writes.
 layout(set = 0, binding = 1, rgba16f) uniform image2D gImagesRgba16f[];
 layout(set = 0, binding = 1, rgba8) uniform image2D gImagesRgba8[];
 layout(set = 0, binding = 1, r32ui) uniform uimage2D gImagesR32ui[];
+layout(set = 0, binding = 1, rgba32ui) uniform uimage2D gImagesRgba32ui[];
 layout(set = 0, binding = 2) uniform sampler gSamplers[4];
 layout(set = 0, binding = 2) uniform samplerShadow gShadowSamplers[4];
 

@@ -482,6 +482,14 @@ bool gRtSun = false;          // gRtSunVisibility replaces the sun's shadow map
 float gRtSunVisibility = 1.0;
 float gRtOcclusion = 1.0;     // ambient occlusion: multiplies the ambient term
 vec3 gRtIndirect = vec3(0.0); // one-bounce diffuse light: irradiance / pi (times the albedo here)
+// Ray-traced spot shadows: the visibility of each shadow-casting spot, 8 bits per
+// GpuLight::shadowIndex (raytracing/rt_types.h), in place of the spot shadow maps.
+bool gRtSpots = false;
+uvec4 gRtSpotVisibility = uvec4(0xFFFFFFFFu);
+
+float rtSpotVisibility(uvec4 packed, uint shadowIndex) {
+    return float((packed[shadowIndex >> 2u] >> ((shadowIndex & 3u) * 8u)) & 0xFFu) / 255.0;
+}
 
 // Everything that lights a surface point, evaluated for a viewer at f.cameraPosition.
 vec3 shadeSurface(FrameConstants f, MaterialSample m, vec3 worldPos, vec3 geometricNormal) {
@@ -560,7 +568,8 @@ vec3 shadeSurface(FrameConstants f, MaterialSample m, vec3 worldPos, vec3 geomet
             continue;
         vec3 c = evaluateLight(light, m, n, v, worldPos);
         if (spotShadows && light.shadowIndex != LIGHT_NO_SHADOW && any(notEqual(c, vec3(0.0))))
-            c *= spotShadow(lf, light, worldPos, geometricNormal);
+            c *= gRtSpots ? rtSpotVisibility(gRtSpotVisibility, light.shadowIndex)
+                          : spotShadow(lf, light, worldPos, geometricNormal);
         direct += c;
     }
     // Darks subtract light; they never make a surface emit negative light.

@@ -8,6 +8,17 @@
 #include "common/lighting.glsl"
 #include "raytracing/rt_frame.glsl"
 
+// Per-spot sums over `weight` samples, packed back into 8 bits each.
+uvec4 rtPackSpotMeans(float sum[LIGHT_MAX_SPOT_SHADOWS], float weight, uint count) {
+    uvec4 packed = uvec4(0xFFFFFFFFu);
+    for (uint k = 0u; k < count; ++k) {
+        uint shift = (k & 3u) * 8u;
+        uint q = uint(round(clamp(sum[k] / weight, 0.0, 1.0) * 255.0));
+        packed[k >> 2u] = (packed[k >> 2u] & ~(0xFFu << shift)) | (q << shift);
+    }
+    return packed;
+}
+
 void useRayTracedPixelTerms(FrameConstants f, vec2 fragCoord) {
     if (f.rt == 0ul) return;
     RtFrame rt = RtFrameRef(f.rt).r;
@@ -35,6 +46,25 @@ void useRayTracedPixelTerms(FrameConstants f, vec2 fragCoord) {
         if (rt.shadowRays > 1u) terms.x = sum.x / weight;
         indirect = indirectSum / weight;
     }
+    if (rt.spotShadowCount != 0u) {
+        gRtSpots = true;
+        gRtSpotVisibility = texelFetch(gUTextures[rt.pixelSpotSlot], p, 0);
+        if (rt.spatialFilter != 0u && rt.shadowRays > 1u) { // soft: as noisy as the sun's
+            float sum[LIGHT_MAX_SPOT_SHADOWS];
+            for (uint k = 0u; k < rt.spotShadowCount; ++k) sum[k] = 0.0;
+            float weight = 0.0;
+            for (int y = -1; y <= 1; ++y)
+                for (int x = -1; x <= 1; ++x) {
+                    ivec2 q = clamp(p + ivec2(x, y), ivec2(0), size - 1);
+                    vec4 t = texelFetch(gTextures[rt.pixelTermsSlot], q, 0);
+                    if (t.w <= 0.0 || abs(t.w - centre.w) > 0.03 * centre.w) continue;
+                    uvec4 v = texelFetch(gUTextures[rt.pixelSpotSlot], q, 0);
+                    for (uint k = 0u; k < rt.spotShadowCount; ++k) sum[k] += rtSpotVisibility(v, k);
+                    weight += 1.0;
+                }
+            gRtSpotVisibility = rtPackSpotMeans(sum, weight, rt.spotShadowCount);
+        }
+    }
     gRtSun = rt.shadows != 0u;
     gRtSunVisibility = terms.x;
     gRtOcclusion = rt.ao != 0u ? terms.y : 1.0;
@@ -55,6 +85,8 @@ void useRayTracedShadelTerms(FrameConstants f, uint object, vec2 shadelUv) {
     vec2 fr = t - vec2(t0);
     vec4 terms = vec4(0.0);
     vec3 indirect = vec3(0.0);
+    float spots[LIGHT_MAX_SPOT_SHADOWS];
+    for (uint j = 0u; j < rt.spotShadowCount; ++j) spots[j] = 0.0;
     float weight = 0.0;
     for (int k = 0; k < 4; ++k) {
         ivec2 d = ivec2(k & 1, k >> 1);
@@ -64,9 +96,17 @@ void useRayTracedShadelTerms(FrameConstants f, uint object, vec2 shadelUv) {
         if (v.w <= 0.0) continue; // no surface there
         terms += v * w;
         if (rt.gi != 0u) indirect += texelFetch(gTextures[rt.shadelIndirectRead], q, 0).rgb * w;
+        if (rt.spotShadowCount != 0u) {
+            uvec4 sv = texelFetch(gUTextures[rt.shadelSpotRead], q, 0);
+            for (uint j = 0u; j < rt.spotShadowCount; ++j) spots[j] += rtSpotVisibility(sv, j) * w;
+        }
         weight += w;
     }
     if (weight <= 0.0) return;
+    if (rt.spotShadowCount != 0u) {
+        gRtSpots = true;
+        gRtSpotVisibility = rtPackSpotMeans(spots, weight, rt.spotShadowCount);
+    }
     gRtSun = rt.shadows != 0u;
     gRtSunVisibility = terms.x / weight;
     gRtOcclusion = rt.ao != 0u ? terms.y / weight : 1.0;

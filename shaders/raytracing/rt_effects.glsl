@@ -83,6 +83,62 @@ float rtSunVisibility(FrameConstants f, RtFrame rt, vec3 p, vec3 ng, uint seed, 
     return visible / float(rays);
 }
 
+// The visibility of every shadow-casting spot from p (RtFrame::spotShadowCount of them), 8 bits
+// each by shadow index (rtSpotVisibility in common/lighting.glsl reads them). Spots that cannot
+// light p (outside the cone or the range) trace nothing and read 1. One ray to the light: hard;
+// with --rt-shadow-rays N > 1 and an emitter (GpuLight::radius > 0), N rays to points of a disc
+// of that radius facing p: soft.
+uvec4 rtSpotVisibilities(FrameConstants f, RtFrame rt, vec3 p, vec3 ng, uint seed, uint sampleBase) {
+    uvec4 packed = uvec4(0xFFFFFFFFu);
+    if (rt.spotShadowCount == 0u) return packed;
+    LightBuffer lights = LightBuffer(f.lights);
+    UintBuffer spotLights = UintBuffer(rt.spotLights);
+    uint traced = 0u;
+    for (uint k = 0u; k < rt.spotShadowCount; ++k) {
+        GpuLight light = lights.l[spotLights.v[k]];
+        vec3 toLight = light.position - p;
+        float dist = length(toLight);
+        vec3 dir = toLight / max(dist, 1e-4);
+        if (spotFactor(light, dir) <= 0.0 || (light.range > 0.0 && dist >= light.range)) continue;
+        bool soft = rt.shadowRays > 1u && light.radius > 0.0;
+        uint rays = soft ? rt.shadowRays : 1u;
+        mat3 disc = rtBasis(dir);
+        float visible = 0.0;
+        for (uint i = 0u; i < rays; ++i) {
+            vec3 target = light.position;
+            if (soft) {
+                vec2 u = rtSample2(seed ^ (k * 0x632be5abu + 0x2545f491u), sampleBase + i);
+                float r = light.radius * sqrt(u.x);
+                float phi = 6.28318530718 * u.y;
+                target += disc[0] * (r * cos(phi)) + disc[1] * (r * sin(phi));
+            }
+            vec3 d = target - p;
+            float len = length(d);
+            d /= max(len, 1e-4);
+            // The ray stops just short of the emitter (a lamp's own surface at the light is not
+            // an occluder of its light).
+            visible += rtOccluded(rt, rtOrigin(f, rt, p, ng, d), d, len * 0.999) ? 0.0 : 1.0;
+        }
+        traced += rays;
+        uint q = uint(round(visible / float(rays) * 255.0));
+        uint shift = (k & 3u) * 8u;
+        packed[k >> 2u] = (packed[k >> 2u] & ~(0xFFu << shift)) | (q << shift);
+    }
+    rtCountRays(rt, traced);
+    return packed;
+}
+
+// Spot visibilities `a` moved towards `b` by `w` (each of the 8-bit fields).
+uvec4 rtMixSpotVisibilities(uvec4 a, uvec4 b, float w, uint count) {
+    uvec4 out_ = a;
+    for (uint k = 0u; k < count; ++k) {
+        float v = mix(rtSpotVisibility(a, k), rtSpotVisibility(b, k), w);
+        uint shift = (k & 3u) * 8u;
+        out_[k >> 2u] = (out_[k >> 2u] & ~(0xFFu << shift)) | (uint(round(v * 255.0)) << shift);
+    }
+    return out_;
+}
+
 // Unoccluded fraction of `rays` cosine rays of length aoRadius (1 = open).
 float rtAmbientOcclusion(FrameConstants f, RtFrame rt, vec3 p, vec3 n, vec3 ng, uint seed,
                          uint sampleBase, uint rays) {

@@ -2,7 +2,7 @@
 // Forward path: the ray-traced terms of every opaque pixel (drawn with the prepass depth, equal
 // test), read by forward shading through raytracing/rt_apply.glsl. Target 0: sun visibility,
 // AO, unused, distance to the camera (0 = nothing traced, for the filter); target 1: one-bounce
-// indirect light. A new random rotation every frame: per-pixel results are noisy over time.
+// indirect light; target 2: the shadow-casting spots' visibilities (8 bits each). A new random rotation every frame: per-pixel results are noisy over time.
 #include "raytracing/rt_effects.glsl"
 
 // The depth test before the shader: a fragment the prepass hid must not trace (nor count) rays;
@@ -22,6 +22,7 @@ layout(location = 4) flat in uint inInstance;
 
 layout(location = 0) out vec4 outTerms;
 layout(location = 1) out vec4 outIndirect;
+layout(location = 2) out uvec4 outSpots;
 
 void main() {
     FrameConstants f = FrameConstantsRef(pc.frame).f;
@@ -43,6 +44,7 @@ void main() {
     if (gl_HelperInvocation) {
         outTerms = vec4(0.0);
         outIndirect = vec4(0.0);
+        outSpots = uvec4(0xFFFFFFFFu);
         return;
     }
     if (dot(ng, f.cameraPosition - inPosition) < 0.0) ng = -ng;
@@ -51,6 +53,8 @@ void main() {
     float sun = rt.shadows != 0u ? rtSunVisibility(f, rt, inPosition, ng, seed, 0u) : 1.0;
     float ao = rt.ao != 0u ? rtAmbientOcclusion(f, rt, inPosition, n, ng, seed, 0u, rt.aoRays) : 1.0;
     vec3 indirect = rt.gi != 0u ? rtIndirectDiffuse(f, rt, inPosition, n, ng, seed, 0u, rt.giRays) : vec3(0.0);
+    outSpots = rt.spotShadowCount != 0u ? rtSpotVisibilities(f, rt, inPosition, ng, seed ^ 0x7a3c1u, 0u)
+                                        : uvec4(0xFFFFFFFFu);
     outTerms = vec4(sun, ao, 0.0, max(length(inPosition - f.cameraPosition), 1e-6));
     outIndirect = vec4(indirect, 1.0);
 }

@@ -38,6 +38,7 @@ void main() {
     if (tri == 0xFFFFu) { // no surface here (outside every chart and its gutter): never read
         imageStore(gImagesRgba16f[rt.shadelTermsWrite], atlas, vec4(1.0, 1.0, 0.0, 0.0));
         imageStore(gImagesRgba16f[rt.shadelIndirectWrite], atlas, vec4(0.0));
+        if (rt.spotShadowCount != 0u) imageStore(gImagesRgba32ui[rt.shadelSpotWrite], atlas, uvec4(0xFFFFFFFFu));
         return;
     }
     GpuInstance inst = InstanceBuffer(f.instances).i[tile.object];
@@ -71,12 +72,17 @@ void main() {
         if (count == 0.0) {
             imageStore(gImagesRgba16f[rt.shadelTermsWrite], atlas, vec4(1.0, 1.0, 0.0, 0.0));
             imageStore(gImagesRgba16f[rt.shadelIndirectWrite], atlas, vec4(0.0));
+            if (rt.spotShadowCount != 0u)
+                imageStore(gImagesRgba32ui[rt.shadelSpotWrite], atlas, uvec4(0xFFFFFFFFu));
         }
         return;
     }
 
     vec4 indirectHistory = imageLoad(gImagesRgba16f[rt.shadelIndirectWrite], atlas);
-    uint rays = rt.raysPerShadel;
+    // A texel's first frame (new in view, or reset) traces RT_SHADEL_FIRST_RAYS: with one ray
+    // its estimate is 0 or 1 and the next frames' running mean swings widely (a moving camera
+    // shows new texels every frame: that swing is most of the shadel path's flicker).
+    uint rays = count == 0.0 ? max(rt.raysPerShadel, RT_SHADEL_FIRST_RAYS) : rt.raysPerShadel;
     uint seed = rtHash(tile.object * 0x9e3779b9u ^ rtHash(uint(atlas.x) | uint(atlas.y) << 16));
     uint sampleBase = uint(count); // continue the sequence: no sample is drawn twice
     float sun = rt.shadows != 0u ? rtSunVisibility(f, rt, p, ng, seed, sampleBase) : 1.0;
@@ -89,4 +95,13 @@ void main() {
     imageStore(gImagesRgba16f[rt.shadelTermsWrite], atlas, terms);
     imageStore(gImagesRgba16f[rt.shadelIndirectWrite], atlas,
                vec4(mix(indirectHistory.rgb, indirect, w), total));
+    // Hard spot shadows are exact from the first frame (one ray to each light from a fixed
+    // point): traced again only after a reset. Soft ones accumulate; 8 bits per spot: a running
+    // mean below 1/16 per frame would round to no change.
+    if (rt.spotShadowCount != 0u && (count == 0.0 || rt.shadowRays > 1u)) {
+        uvec4 spots = rtSpotVisibilities(f, rt, p, ng, seed ^ 0x7a3c1u, sampleBase);
+        uvec4 spotHistory = count == 0.0 ? spots : imageLoad(gImagesRgba32ui[rt.shadelSpotWrite], atlas);
+        imageStore(gImagesRgba32ui[rt.shadelSpotWrite], atlas,
+                   rtMixSpotVisibilities(spotHistory, spots, max(w, 1.0 / 16.0), rt.spotShadowCount));
+    }
 }

@@ -19,6 +19,7 @@ struct RtCounters {
 // MIP of its shadel space, coarser than the lit layer; rays accumulate there over frames.
 #define RT_SHADEL_VALID 1u // the instance has a rect in the cache this frame
 #define RT_SHADEL_RESET 2u // its history is void (new rect, moved, or a changed input): restart
+#define RT_SHADEL_FIRST_RAYS 4u // AO / GI rays of a texel's first traced frame (at least)
 
 struct RtShadelObject {
     uvec2 origin;     // texel of the atlas where the rect starts
@@ -63,6 +64,15 @@ struct RtFrame {
     uint shadelTermsRead;     //   ... the same, sampled
     uint shadelIndirectWrite; // cache atlas: indirect light, rays accumulated
     uint shadelIndirectRead;
+    // Spot shadows (--rt-shadows on, scenes with shadow-casting spots): the visibility of every
+    // shadow-casting spot (by GpuLight::shadowIndex), 8 bits each, packed in a uvec4 per sample
+    // (rtPackSpot / rtSpotVisibility in raytracing/rt_spots.glsl).
+    uint spotShadowCount;     // shadow-casting spots traced (<= LIGHT_MAX_SPOT_SHADOWS), 0: none
+    uint64_t spotLights;      // uint per shadow index: the light's index in FrameConstants::lights
+    uint pixelSpotSlot;       // forward: bindless read slot of the traced spot visibilities (uint)
+    uint shadelSpotWrite;     // cache atlas: spot visibilities (storage, rgba32ui)
+    uint shadelSpotRead;      //   ... the same, sampled
+    uint pad0;
 };
 
 #ifdef __cplusplus

@@ -10,7 +10,10 @@ namespace shadel {
 
 void addRayTracingFlags(CLI::App& render, RtFlags& f) {
     RtSettings& s = f.settings;
-    render.add_option("--rt-shadows", f.shadows, "on | off: ray-traced sun shadows")
+    render
+        .add_option(
+            "--rt-shadows", f.shadows,
+            "on | off: ray-traced sun and shadow-casting spot shadows (in place of the maps)")
         ->capture_default_str();
     render.add_option("--rt-ao", f.ao, "on | off: ray-traced ambient occlusion")
         ->capture_default_str();
@@ -54,6 +57,12 @@ void addRayTracingFlags(CLI::App& render, RtFlags& f) {
                     "decoupled: rays a cached texel accumulates, then reuses until its inputs "
                     "change, 1..1024")
         ->capture_default_str();
+    render
+        .add_option("--rt-animated-blas", f.animatedBlas,
+                    "on | off: GPU-skinned meshes' BLASes refit as the pose changes (rebuilt "
+                    "every 8 refits; beyond 16 m at most every ceil(distance / 16 m) frames); "
+                    "off: the bind pose's")
+        ->capture_default_str();
     render.add_option("--blas-pool-mb", s.blasPoolMb, "BLAS memory pool size in MiB, 1..4096")
         ->capture_default_str();
     render
@@ -69,6 +78,7 @@ RtSettings parseRayTracingFlags(const RtFlags& f) {
     s.ao = parseOnOff("--rt-ao", f.ao);
     s.gi = parseOnOff("--rt-gi", f.gi);
     s.spatialFilter = parseOnOff("--rt-filter", f.filter);
+    s.animatedBlas = parseOnOff("--rt-animated-blas", f.animatedBlas);
     auto count = [](const char* flag, uint32_t v, uint32_t lo, uint32_t hi) {
         if (v < lo || v > hi) throw InputError(format("%s %u: expected %u..%u", flag, v, lo, hi));
     };

@@ -10,7 +10,7 @@
 namespace shadel {
 
 struct RtFlags {
-    std::string shadows = "off", ao = "off", gi = "off", filter = "on";
+    std::string shadows = "off", ao = "off", gi = "off", filter = "on", animatedBlas = "on";
     RtSettings settings; // the numeric flags land here directly
 };
 

@@ -1,5 +1,6 @@
 // Ray tracing (render/raytracing, issue 20): BLASes per mesh LOD in TLSF pools with the
 // least-detailed fallback, the per-frame TLAS, and the ray-traced effects of the forward path.
+#include <algorithm>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
@@ -7,6 +8,8 @@
 #include <sstream>
 #include <sys/wait.h>
 #include <unistd.h>
+
+#include <nlohmann/json.hpp>
 
 #include "gpu_test_env.h"
 
@@ -253,4 +256,194 @@ TEST(RayTracing, ShadelAoFlickersLessThanPerPixelAtTheSameRayBudget) {
     EXPECT_GE(forwardRays, shadelRays * 0.9);
     EXPECT_GT(flickerForward, 0.0);
     EXPECT_LE(flickerShadel, 0.5 * flickerForward);
+}
+
+namespace {
+
+double luma(const std::vector<uint8_t>& p, size_t i) {
+    return 0.2126 * p[i] + 0.7152 * p[i + 1] + 0.0722 * p[i + 2];
+}
+
+// Pixels that `shadowed` makes darker than `unshadowed` by more than `by` (luma), and those it
+// makes brighter by more than 2.
+struct ShadowPixels {
+    std::vector<size_t> darker;
+    size_t brighter = 0;
+};
+ShadowPixels shadowPixels(const RenderRun& shadowed, const RenderRun& unshadowed, double by) {
+    const auto& a = shadowed.frames.back().rgba;
+    const auto& b = unshadowed.frames.back().rgba;
+    ShadowPixels s;
+    for (size_t i = 0; i < a.size(); i += 4) {
+        double d = luma(b, i) - luma(a, i);
+        if (d > by) s.darker.push_back(i);
+        s.brighter += d < -2.0;
+    }
+    return s;
+}
+
+} // namespace
+
+// builtin:lights: 16 shadow-casting spots over posts. --rt-shadows traces them (hard: one ray
+// to the light; soft: --rt-shadow-rays over the lamp head) in place of their maps, in the
+// shared lighting code, so both paths get them.
+TEST(RayTracing, SpotShadowsAgreeWithTheSpotShadowMaps) {
+    if (!sharedGpu().device.optional.rayQuery) GTEST_SKIP() << "no ray query on this device";
+    for (RenderMode mode : {RenderMode::Forward, RenderMode::Decoupled}) {
+        SCOPED_TRACE(mode == RenderMode::Forward ? "forward" : "decoupled");
+        RenderOptions o = renderOptions("builtin:lights", mode, 192, 108);
+        o.progress = false;
+        RenderRun maps = renderChecked(o);
+        o.spotShadows = false;
+        RenderRun mapsOff = renderChecked(o);
+        o.rt.shadows = true;
+        RenderRun tracedOff = renderChecked(o); // the sun traced, no spot shadows at all
+        o.spotShadows = true;
+        RenderRun traced = renderChecked(o);
+        EXPECT_EQ(traced.stats["rt"]["spot_shadows"].get<uint64_t>(), 16u);
+        EXPECT_EQ(tracedOff.stats["rt"]["spot_shadows"].get<uint64_t>(), 0u);
+        double db = psnr(traced.frames.back().rgba, maps.frames.back().rgba);
+        // The occluders in the spots' cones (the posts) darken the street with RT on, and the
+        // traced spot shadows only remove light.
+        ShadowPixels rt = shadowPixels(traced, tracedOff, 8.0);
+        ShadowPixels map = shadowPixels(maps, mapsOff, 2.0);
+        size_t agree = 0;
+        for (size_t i : rt.darker)
+            agree += std::find(map.darker.begin(), map.darker.end(), i) != map.darker.end();
+        std::printf("RT spot shadows vs maps: %.2f dB; %zu pixels darkened by the traced spot "
+                    "shadows, %zu of them by the maps too\n",
+                    db, rt.darker.size(), agree);
+        EXPECT_GE(db, 30.0);
+        EXPECT_GE(rt.darker.size(), 20u) << "no traced spot shadow darkened the street";
+        EXPECT_EQ(rt.brighter, 0u) << "a traced shadow never adds light";
+        EXPECT_GE(double(agree), 0.75 * double(rt.darker.size())) << "not where the maps' are";
+        if (mode == RenderMode::Decoupled) break;
+        // Soft: 4 jittered rays over the 0.4 m lamp heads; still the maps' shadows (PCSS on the
+        // soft spots), and the penumbrae change the image.
+        o.rt.shadowRays = 4;
+        RenderRun soft = renderChecked(o);
+        double softDb = psnr(soft.frames.back().rgba, maps.frames.back().rgba);
+        std::printf("soft RT spot shadows vs maps: %.2f dB\n", softDb);
+        EXPECT_GE(softDb, 30.0);
+        EXPECT_LT(psnr(soft.frames.back().rgba, traced.frames.back().rgba), 99.0);
+    }
+}
+
+namespace {
+
+// assimp's simple_skin (a strip of two joints bending over 0..5.5 s) over a floor, lit by a low
+// sun from the front, so the strip's shadow on the floor shows its pose. Written next to the
+// test's other files: the floor's data in a .bin beside the .gltf.
+std::string skinnedStripOverAFloor() {
+    std::ifstream in("/usr/share/assimp/models/glTF2/simple_skin/simple_skin.gltf");
+    nlohmann::json g = nlohmann::json::parse(in);
+    const float pos[12] = {-3, 0, -4, 4, 0, -4, 4, 0, 3, -3, 0, 3};
+    const float nrm[12] = {0, 1, 0, 0, 1, 0, 0, 1, 0, 0, 1, 0};
+    const uint16_t idx[8] = {0, 2, 1, 0, 3, 2, 0, 0};
+    std::string bin = tempPath("skin_floor.bin");
+    std::ofstream out(bin, std::ios::binary);
+    out.write(reinterpret_cast<const char*>(pos), sizeof(pos));
+    out.write(reinterpret_cast<const char*>(nrm), sizeof(nrm));
+    out.write(reinterpret_cast<const char*>(idx), sizeof(idx));
+    out.close();
+    size_t b = g["buffers"].size(), v = g["bufferViews"].size(), a = g["accessors"].size();
+    g["buffers"].push_back(
+        {{"byteLength", 112}, {"uri", std::filesystem::path(bin).filename().string()}});
+    g["bufferViews"].push_back({{"buffer", b}, {"byteOffset", 0}, {"byteLength", 48}});
+    g["bufferViews"].push_back({{"buffer", b}, {"byteOffset", 48}, {"byteLength", 48}});
+    g["bufferViews"].push_back({{"buffer", b}, {"byteOffset", 96}, {"byteLength", 12}});
+    g["accessors"].push_back({{"bufferView", v},
+                              {"componentType", 5126},
+                              {"count", 4},
+                              {"type", "VEC3"},
+                              {"min", {-3, 0, -4}},
+                              {"max", {4, 0, 3}}});
+    g["accessors"].push_back(
+        {{"bufferView", v + 1}, {"componentType", 5126}, {"count", 4}, {"type", "VEC3"}});
+    g["accessors"].push_back(
+        {{"bufferView", v + 2}, {"componentType", 5123}, {"count", 6}, {"type", "SCALAR"}});
+    g["meshes"].push_back(
+        {{"primitives",
+          {{{"attributes", {{"POSITION", a}, {"NORMAL", a + 1}}}, {"indices", a + 2}}}}});
+    g["nodes"].push_back({{"mesh", g["meshes"].size() - 1}});
+    g["scenes"][0]["nodes"].push_back(g["nodes"].size() - 1);
+    // The sun travels along (0.3, -0.6, -1): the node's rotation of -Z onto it.
+    g["extensionsUsed"] = {"KHR_lights_punctual"};
+    g["extensions"]["KHR_lights_punctual"]["lights"] = {
+        {{"type", "directional"}, {"color", {1, 1, 1}}, {"intensity", 3.0}}};
+    g["nodes"].push_back({{"rotation", {-0.26041905, -0.13020952, 0.0, 0.95667518}},
+                          {"extensions", {{"KHR_lights_punctual", {{"light", 0}}}}}});
+    g["scenes"][0]["nodes"].push_back(g["nodes"].size() - 1);
+    std::string path = tempPath("skin_floor.gltf");
+    std::ofstream(path) << g.dump();
+    return path;
+}
+
+} // namespace
+
+// Animated BLASes: the GPU-skinned strip's BLAS is refit to each frame's pose (--time-step), so
+// its traced shadow on the floor is the shadow map's at every time; the bind pose's static BLAS
+// (--rt-animated-blas off) casts the wrong one.
+TEST(RayTracing, SkinnedBlasRefitsFollowThePose) {
+    if (!sharedGpu().device.optional.rayQuery) GTEST_SKIP() << "no ray query on this device";
+    std::string scene = skinnedStripOverAFloor();
+    // The shadel path too: its RT cache restarts every history when playback reposes anything.
+    for (RenderMode mode : {RenderMode::Forward, RenderMode::Decoupled}) {
+        SCOPED_TRACE(mode == RenderMode::Forward ? "forward" : "decoupled");
+        RenderOptions o = renderOptions(scene, mode, 160, 90);
+        o.progress = false;
+        o.cameraOverrides.from = glm::vec3(0.5f, 3.0f, 5.0f);
+        o.cameraOverrides.lookAt = glm::vec3(0.5f, 0.7f, -1.0f);
+        o.frames = 3;
+        o.time = 0.2; // frames at 0.2, 0.6 and 1.0 s: three poses
+        o.timeStep = 0.4;
+        RenderRun maps = renderChecked(o);
+        o.rt.shadows = true;
+        RenderRun refit = renderChecked(o);
+        o.rt.animatedBlas = false;
+        RenderRun bindPose = renderChecked(o);
+        const auto& s = refit.stats;
+        EXPECT_EQ(s["rt"]["animated_blases"].get<uint64_t>(), 1u);
+        // Near the camera every changed pose is an update: the first a build, then refits.
+        EXPECT_EQ(s["blas_rebuilds"].get<uint64_t>(), 1u);
+        EXPECT_EQ(s["blas_refits"].get<uint64_t>(), 2u);
+        EXPECT_EQ(bindPose.stats["blas_refits"].get<uint64_t>(), 0u);
+        for (size_t f : {1, 2}) {
+            double db = psnr(refit.frames[f].rgba, maps.frames[f].rgba);
+            double stale = psnr(bindPose.frames[f].rgba, maps.frames[f].rgba);
+            std::printf(
+                "t = %.1f s: refit RT shadows vs shadow map %.2f dB (bind-pose BLAS %.2f dB)\n",
+                0.2 + 0.4 * double(f), db, stale);
+            EXPECT_GE(db, 30.0);
+            EXPECT_GT(db, stale + 5.0)
+                << "the refit BLAS casts no better shadow than the bind pose's";
+        }
+        double poses = psnr(refit.frames[1].rgba, refit.frames[2].rgba);
+        std::printf("t = 0.6 s vs 1.0 s: %.2f dB\n", poses);
+        EXPECT_LT(poses, 40.0) << "the two times' images do not differ";
+    }
+}
+
+// The refit schedule: near the camera every changed pose is an update, every 9th a build (after
+// 8 refits); 60 m away (beyond 16 m: at most one update per ceil(60 / 16) = 4 frames) fewer.
+TEST(RayTracing, SkinnedBlasRebuildsAfterEightRefitsAndFarOnesUpdateLessOften) {
+    if (!sharedGpu().device.optional.rayQuery) GTEST_SKIP() << "no ray query on this device";
+    RenderOptions o = renderOptions("/usr/share/assimp/models/glTF2/simple_skin/simple_skin.gltf",
+                                    RenderMode::Forward, 64, 36);
+    o.progress = false;
+    o.cameraOverrides.lookAt = glm::vec3(0.5f, 1.0f, 0.0f);
+    o.frames = 10;
+    o.time = 0.0;
+    o.timeStep = 0.1; // a new pose every frame
+    o.rt.shadows = true;
+    o.cameraOverrides.from = glm::vec3(0.5f, 1.0f, 4.0f);
+    RenderRun near = renderChecked(o);
+    o.cameraOverrides.from = glm::vec3(0.5f, 1.0f, 60.0f);
+    RenderRun far = renderChecked(o);
+    // Frames 0 and 9 build, 1..8 refit.
+    EXPECT_EQ(near.stats["blas_refits"].get<uint64_t>(), 8u);
+    EXPECT_EQ(near.stats["blas_rebuilds"].get<uint64_t>(), 2u);
+    // Frames 0 (build), 4 and 8 (refits).
+    EXPECT_EQ(far.stats["blas_refits"].get<uint64_t>(), 2u);
+    EXPECT_EQ(far.stats["blas_rebuilds"].get<uint64_t>(), 1u);
 }

@@ -294,6 +294,119 @@ void destroyBlases(Gpu& gpu, const RtFunctions& fn, BlasPools& pools, BlasSet& s
     set = {};
 }
 
+static VkAccelerationStructureBuildGeometryInfoKHR animatedBuildInfo(const AnimatedBlas& a) {
+    VkAccelerationStructureBuildGeometryInfoKHR b{
+        VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_BUILD_GEOMETRY_INFO_KHR};
+    b.type = VK_ACCELERATION_STRUCTURE_TYPE_BOTTOM_LEVEL_KHR;
+    b.flags = VK_BUILD_ACCELERATION_STRUCTURE_ALLOW_UPDATE_BIT_KHR |
+              VK_BUILD_ACCELERATION_STRUCTURE_PREFER_FAST_BUILD_BIT_KHR;
+    b.geometryCount = 1;
+    b.pGeometries = &a.geometry;
+    return b;
+}
+
+void createAnimatedBlases(Gpu& gpu, const RtFunctions& fn, BlasPools& pools, const GpuScene& scene,
+                          const std::vector<uint32_t>& meshes, VkDeviceAddress deformedVertices,
+                          AnimatedBlasSet& out) {
+    out = {};
+    out.byMesh.assign(scene.meshInfo.size(), -1);
+    std::vector<uint32_t> vertexCounts = meshVertexCounts(gpu, scene);
+    VkDeviceAddress indices = address(gpu, scene.indices);
+    VkDeviceSize scratchAlign = scratchAlignment(gpu.device);
+    for (uint32_t m : meshes) {
+        if (m >= scene.meshInfo.size() || vertexCounts[m] == 0 || scene.lodInfo[m].lodCount == 0)
+            continue;
+        AnimatedBlas a;
+        a.mesh = m;
+        a.firstIndex = scene.lodInfo[m].lod[0].firstIndex;
+        a.triangles = scene.lodInfo[m].lod[0].indexCount / 3;
+        if (a.triangles == 0) continue;
+        VkAccelerationStructureGeometryTrianglesDataKHR& t = a.geometry.geometry.triangles;
+        a.geometry.geometryType = VK_GEOMETRY_TYPE_TRIANGLES_KHR;
+        a.geometry.flags = VK_GEOMETRY_OPAQUE_BIT_KHR;
+        t = {VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_GEOMETRY_TRIANGLES_DATA_KHR};
+        t.vertexFormat = VK_FORMAT_R32G32B32_SFLOAT;
+        t.vertexData.deviceAddress =
+            deformedVertices +
+            VkDeviceSize(scene.meshInfo[m].vertexOffset) * sizeof(gpu::GpuVertex);
+        t.vertexStride = sizeof(gpu::GpuVertex);
+        t.maxVertex = vertexCounts[m] - 1;
+        t.indexType = VK_INDEX_TYPE_UINT32;
+        t.indexData.deviceAddress = indices + VkDeviceSize(a.firstIndex) * 4;
+        VkAccelerationStructureBuildGeometryInfoKHR b = animatedBuildInfo(a);
+        VkAccelerationStructureBuildSizesInfoKHR sizes{
+            VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_BUILD_SIZES_INFO_KHR};
+        fn.buildSizes(gpu.device.device, VK_ACCELERATION_STRUCTURE_BUILD_TYPE_DEVICE_KHR, &b,
+                      &a.triangles, &sizes);
+        std::optional<BlasRange> range = pools.allocate(sizes.accelerationStructureSize);
+        if (!range) {
+            out.withoutRoom++;
+            continue;
+        }
+        a.memory = *range;
+        a.handle = createAs(gpu, fn, range->buffer, range->offset, sizes.accelerationStructureSize,
+                            VK_ACCELERATION_STRUCTURE_TYPE_BOTTOM_LEVEL_KHR,
+                            format("rt.blas.animated.mesh%u", m));
+        a.address = asAddress(gpu, fn, a.handle);
+        VkDeviceSize scratch = std::max(sizes.buildScratchSize, sizes.updateScratchSize);
+        a.scratch = temporaryBuffer(gpu, "rt.blasAnimatedScratch", scratch + scratchAlign, 0);
+        a.scratchAddress = alignUp(address(gpu, a.scratch), scratchAlign);
+        out.byMesh[m] = int32_t(out.blases.size());
+        out.blases.push_back(a);
+    }
+}
+
+void destroyAnimatedBlases(Gpu& gpu, const RtFunctions& fn, BlasPools& pools,
+                           AnimatedBlasSet& set) {
+    for (AnimatedBlas& a : set.blases) {
+        fn.destroy(gpu.device.device, a.handle, nullptr);
+        pools.free(a.memory);
+        destroy(gpu, a.scratch);
+    }
+    set = {};
+}
+
+void recordAnimatedBlasUpdates(Gpu& gpu, const RtFunctions& fn, VkCommandBuffer cmd,
+                               AnimatedBlasSet& set,
+                               const std::vector<AnimatedBlasUpdate>& updates) {
+    if (updates.empty()) return;
+    // The skinning pass wrote the vertices these read; last frame's ray queries (and TLAS
+    // build) read the BLASes they overwrite.
+    memoryBarrier(cmd,
+                  VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT |
+                      VK_PIPELINE_STAGE_2_ACCELERATION_STRUCTURE_BUILD_BIT_KHR,
+                  VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT |
+                      VK_ACCESS_2_ACCELERATION_STRUCTURE_READ_BIT_KHR,
+                  VK_PIPELINE_STAGE_2_ACCELERATION_STRUCTURE_BUILD_BIT_KHR,
+                  VK_ACCESS_2_SHADER_READ_BIT | VK_ACCESS_2_ACCELERATION_STRUCTURE_READ_BIT_KHR |
+                      VK_ACCESS_2_ACCELERATION_STRUCTURE_WRITE_BIT_KHR);
+    std::vector<VkAccelerationStructureBuildGeometryInfoKHR> infos;
+    std::vector<VkAccelerationStructureBuildRangeInfoKHR> ranges(updates.size());
+    std::vector<const VkAccelerationStructureBuildRangeInfoKHR*> rangePtrs;
+    for (size_t i = 0; i < updates.size(); ++i) {
+        AnimatedBlas& a = set.blases[updates[i].blas];
+        bool rebuild = updates[i].rebuild;
+        VkAccelerationStructureBuildGeometryInfoKHR b = animatedBuildInfo(a);
+        b.mode = rebuild ? VK_BUILD_ACCELERATION_STRUCTURE_MODE_BUILD_KHR
+                         : VK_BUILD_ACCELERATION_STRUCTURE_MODE_UPDATE_KHR;
+        b.srcAccelerationStructure = rebuild ? VK_NULL_HANDLE : a.handle; // refit in place
+        b.dstAccelerationStructure = a.handle;
+        b.scratchData.deviceAddress = a.scratchAddress;
+        infos.push_back(b);
+        ranges[i] = {a.triangles, 0, 0, 0};
+        rangePtrs.push_back(&ranges[i]);
+    }
+    beginLabel(gpu, cmd, "rtUpdateAnimatedBlases");
+    fn.cmdBuild(cmd, uint32_t(infos.size()), infos.data(), rangePtrs.data());
+    endLabel(gpu, cmd);
+    memoryBarrier(cmd, VK_PIPELINE_STAGE_2_ACCELERATION_STRUCTURE_BUILD_BIT_KHR,
+                  VK_ACCESS_2_ACCELERATION_STRUCTURE_WRITE_BIT_KHR,
+                  VK_PIPELINE_STAGE_2_ACCELERATION_STRUCTURE_BUILD_BIT_KHR |
+                      VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT |
+                      VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
+                  VK_ACCESS_2_ACCELERATION_STRUCTURE_READ_BIT_KHR);
+}
+
 void createTlas(Gpu& gpu, const RtFunctions& fn, uint32_t maxInstances, Tlas& out) {
     out.maxInstances = std::max(maxInstances, 1u);
     out.instances = createBuffer(

@@ -51,6 +51,51 @@ void buildBlases(Gpu& gpu, const RtFunctions& fn, BlasPools& pools, const GpuSce
                  BlasSet& out);
 void destroyBlases(Gpu& gpu, const RtFunctions& fn, BlasPools& pools, BlasSet& set);
 
+// Animated (GPU-skinned) meshes: one BLAS per mesh over its LOD 0, read from the deformed vertex
+// buffer (render/skinning), built with ALLOW_UPDATE so a changed pose is a refit
+// (VK_BUILD_ACCELERATION_STRUCTURE_MODE_UPDATE) instead of a build; a refit keeps the first
+// build's tree, whose boxes loosen as the pose departs from it, so every kRefitsPerRebuild refits
+// it is built again. Storage in the BLAS pools (not compacted: an updatable BLAS is refit in
+// place); without room the mesh keeps its static (bind-pose) BLAS.
+struct AnimatedBlas {
+    uint32_t mesh = 0;
+    VkAccelerationStructureKHR handle = VK_NULL_HANDLE;
+    VkDeviceAddress address = 0;
+    BlasRange memory;
+    BufferHandle scratch; // max(build, update) scratch, this BLAS's own
+    VkDeviceAddress scratchAddress = 0;
+    VkAccelerationStructureGeometryKHR geometry{
+        VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_GEOMETRY_KHR};
+    uint32_t firstIndex = 0, triangles = 0;
+    bool built = false;
+    uint64_t builtPose = 0;       // skin pose version it was last built or refit for
+    uint64_t lastUpdateFrame = 0; // frame of that build or refit
+    uint32_t refitsSinceBuild = 0;
+};
+constexpr uint32_t kRefitsPerRebuild = 8;
+
+struct AnimatedBlasSet {
+    std::vector<AnimatedBlas> blases;
+    std::vector<int32_t> byMesh; // index into blases, or -1
+    uint32_t withoutRoom = 0;    // skinned meshes the pools had no room for (static BLAS kept)
+    uint64_t refits = 0, rebuilds = 0; // over the run; rebuilds include each first build
+};
+
+// `deformedVertices`: the skinned vertex buffer's address (the unified layout).
+void createAnimatedBlases(Gpu& gpu, const RtFunctions& fn, BlasPools& pools, const GpuScene& scene,
+                          const std::vector<uint32_t>& meshes, VkDeviceAddress deformedVertices,
+                          AnimatedBlasSet& out);
+void destroyAnimatedBlases(Gpu& gpu, const RtFunctions& fn, BlasPools& pools, AnimatedBlasSet& set);
+// One build or refit per listed BLAS (rebuild: MODE_BUILD, else MODE_UPDATE), after the skinning
+// pass's writes, with the barriers that order them before the TLAS build and ray queries.
+struct AnimatedBlasUpdate {
+    uint32_t blas = 0;
+    bool rebuild = false;
+};
+void recordAnimatedBlasUpdates(Gpu& gpu, const RtFunctions& fn, VkCommandBuffer cmd,
+                               AnimatedBlasSet& set,
+                               const std::vector<AnimatedBlasUpdate>& updates);
+
 // The top level: storage and scratch sized for every instance of the scene, rebuilt each frame.
 struct Tlas {
     VkAccelerationStructureKHR handle = VK_NULL_HANDLE;

@@ -1,7 +1,8 @@
 #pragma once
 // Ray tracing (seed 003, issue 20): BLASes per mesh LOD in TLSF pools, a TLAS rebuilt every
-// frame from the instances within the ray-tracing distance, and ray-traced sun shadows, ambient
-// occlusion and one-bounce diffuse GI (shaders/raytracing/rt_effects.glsl). The forward path
+// frame from the instances within the ray-tracing distance, and ray-traced sun and
+// shadow-casting spot shadows, ambient occlusion and one-bounce diffuse GI
+// (shaders/raytracing/rt_effects.glsl). The forward path
 // traces per pixel in `rtPixelTerms` (before forward shading, which reads the result through
 // shaders/raytracing/rt_apply.glsl). Needs VK_KHR_ray_query + VK_KHR_acceleration_structure:
 // without them, asking for any --rt-* effect is an input error.

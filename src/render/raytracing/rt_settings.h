@@ -5,7 +5,8 @@
 namespace shadel {
 
 struct RtSettings {
-    bool shadows = false; // --rt-shadows: the sun's visibility traced instead of the shadow map
+    bool shadows = false; // --rt-shadows: the sun's and the shadow-casting spots' visibility traced
+                          // instead of their shadow maps
     bool ao = false;      // --rt-ao: ray-traced ambient occlusion
     bool gi = false;      // --rt-gi: one bounce of ray-traced diffuse light
     // Sun rays per sample: 1 = hard shadows, more = soft (jittered over the sun's disc).
@@ -22,6 +23,9 @@ struct RtSettings {
     uint32_t blasPoolMb = 128;
     uint32_t blasPoolLimit = 16;
     float distance = 0.0f; // TLAS instances within this distance of the camera (0 = all)
+    // GPU-skinned meshes get their own BLAS, refit as the pose changes (off: the bind pose's
+    // static BLAS, the comparison of the animated-BLAS test).
+    bool animatedBlas = true;
 
     bool enabled() const { return shadows || ao || gi; }
 };

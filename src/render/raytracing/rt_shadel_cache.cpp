@@ -10,7 +10,8 @@
 
 namespace shadel {
 
-// 2048^2 texels of two rgba16f layers: 64 MiB. At two MIPs coarser than the lit layer that is
+// 2048^2 texels of two rgba16f layers: 64 MiB (and 64 more for the rgba32ui spot visibilities
+// when spot shadows are traced). At two MIPs coarser than the lit layer that is
 // 16x fewer texels than a 4096^2 shade storage holds shadels, so it is never the bottleneck.
 static constexpr uint32_t kAtlasSize = 2048;
 static constexpr uint32_t kAtlasAlignment = 8; // rects in whole tiles
@@ -22,7 +23,7 @@ struct RtShadelPush {
     uint64_t frame;
 };
 
-void createRtShadelCache(Renderer& r, const GpuScene& scene, RtShadelCache& c) {
+void createRtShadelCache(Renderer& r, const GpuScene& scene, bool spotShadows, RtShadelCache& c) {
     Gpu& gpu = *r.gpu;
     c.atlasSize = kAtlasSize;
     TextureDesc d;
@@ -33,19 +34,30 @@ void createRtShadelCache(Renderer& r, const GpuScene& scene, RtShadelCache& c) {
     c.terms = createTexture(gpu, d);
     d.name = "rt.shadelCache.indirect";
     c.indirect = createTexture(gpu, d);
+    if (spotShadows) {
+        d.format = VK_FORMAT_R32G32B32A32_UINT; // the spots' visibilities, 8 bits each
+        d.name = "rt.shadelCache.spotShadows";
+        c.spots = createTexture(gpu, d);
+        if (!c.spots) throw DeviceError("out of GPU memory for the RT shadel cache");
+    }
     if (!c.terms || !c.indirect) throw DeviceError("out of GPU memory for the RT shadel cache");
     immediateSubmit(gpu, [&](VkCommandBuffer cmd) {
-        for (TextureHandle t : {c.terms, c.indirect})
-            imageBarrier(cmd, vkImage(gpu, t), VK_IMAGE_ASPECT_COLOR_BIT, VK_IMAGE_LAYOUT_UNDEFINED,
-                         VK_IMAGE_LAYOUT_GENERAL, VK_PIPELINE_STAGE_2_NONE, 0,
-                         VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
-                         VK_ACCESS_2_SHADER_STORAGE_READ_BIT |
-                             VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT);
+        for (TextureHandle t : {c.terms, c.indirect, c.spots})
+            if (t)
+                imageBarrier(cmd, vkImage(gpu, t), VK_IMAGE_ASPECT_COLOR_BIT,
+                             VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_GENERAL,
+                             VK_PIPELINE_STAGE_2_NONE, 0, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
+                             VK_ACCESS_2_SHADER_STORAGE_READ_BIT |
+                                 VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT);
     });
     c.termsWrite = createWriteView(gpu, c.terms);
     c.indirectWrite = createWriteView(gpu, c.indirect);
     c.termsRead = createReadView(gpu, c.terms);
     c.indirectRead = createReadView(gpu, c.indirect);
+    if (c.spots) {
+        c.spotsWrite = createWriteView(gpu, c.spots);
+        c.spotsRead = createReadView(gpu, c.spots);
+    }
     c.atlas =
         std::make_unique<BlockAllocator<2>>(Extent<2>{kAtlasSize, kAtlasSize}, kAtlasAlignment);
     c.entries.assign(scene.instanceCount, {});
@@ -69,6 +81,11 @@ void destroyRtShadelCache(Renderer& r, RtShadelCache& c) {
     destroy(gpu, c.indirectWrite);
     destroy(gpu, c.termsRead);
     destroy(gpu, c.indirectRead);
+    if (c.spots) {
+        destroy(gpu, c.spotsWrite);
+        destroy(gpu, c.spotsRead);
+        destroy(gpu, c.spots);
+    }
     destroy(gpu, c.terms);
     destroy(gpu, c.indirect);
     destroy(gpu, c.objectBuffer);
@@ -107,6 +124,10 @@ void prepareRtShadelCache(Renderer& r, const GpuScene& scene, const CameraView& 
     c.texelsTraced = 0;
     c.instancesCached = 0;
     c.instancesWithoutRoom = 0;
+    // Animated playback reposed something (render/animation: moved or skinned): its shadows,
+    // occlusion and bounce light reach other instances too, so every history restarts.
+    bool sceneMoved = std::find(r.reposedInstances.begin(), r.reposedInstances.end(), 1) !=
+                      r.reposedInstances.end();
     for (uint32_t i = 0; i < scene.instanceCount; ++i) {
         RtShadelCache::Entry& e = c.entries[i];
         gpu::RtShadelObject& o = c.objects[i];
@@ -126,9 +147,10 @@ void prepareRtShadelCache(Renderer& r, const GpuScene& scene, const CameraView& 
         uint32_t level = cacheLevel(r, *mesh, inst, camera);
         // Hysteresis: a rect is kept while its level stays within one of the wanted one.
         bool keep = e.placement && std::abs(int(level) - int(e.level)) <= 1;
-        // Moved, or (GI) a light changed: the history no longer holds.
-        bool reset =
-            !keep || e.model != inst.model || (r.settings.rt.gi && !r.changedLightVolumes.empty());
+        // Moved, or a light changed (GI, or ray-traced spot shadows): the history no longer holds.
+        bool lightsMatter = r.settings.rt.gi || rt.spotShadowCount != 0;
+        bool reset = !keep || e.model != inst.model || sceneMoved ||
+                     (lightsMatter && !r.changedLightVolumes.empty());
         if (!keep) {
             if (e.placement) c.atlas->remove(e.placement->id);
             glm::uvec2 size = levelSize(mesh->mip0Size, level);
@@ -146,6 +168,7 @@ void prepareRtShadelCache(Renderer& r, const GpuScene& scene, const CameraView& 
         o.level = e.level;
         o.idMapOffset = mesh->idMapOffset[e.level];
         o.flags = RT_SHADEL_VALID | (reset ? RT_SHADEL_RESET : 0u);
+        c.historyResets += reset;
         c.instancesCached++;
         c.texelsTraced += size.x * size.y;
         for (uint32_t y = 0; y < (size.y + 7) / 8; ++y)
@@ -164,6 +187,8 @@ void prepareRtShadelCache(Renderer& r, const GpuScene& scene, const CameraView& 
     rt.shadelTermsRead = slot(gpu, c.termsRead).value;
     rt.shadelIndirectWrite = slot(gpu, c.indirectWrite).value;
     rt.shadelIndirectRead = slot(gpu, c.indirectRead).value;
+    rt.shadelSpotWrite = c.spots ? slot(gpu, c.spotsWrite).value : NO_TEXTURE;
+    rt.shadelSpotRead = c.spots ? slot(gpu, c.spotsRead).value : NO_TEXTURE;
 }
 
 void recordRtShadelTrace(Renderer& r, VkCommandBuffer cmd, uint64_t frame, RtShadelCache& c) {

@@ -25,8 +25,9 @@ struct CameraView;
 struct RtShadelCache {
     uint32_t atlasSize = 0;
     TextureHandle terms, indirect; // rgba16f, GENERAL
-    TextureWriteView termsWrite, indirectWrite;
-    TextureReadView termsRead, indirectRead;
+    TextureHandle spots;           // rgba32ui, GENERAL: spot visibilities, 8 bits each
+    TextureWriteView termsWrite, indirectWrite, spotsWrite;
+    TextureReadView termsRead, indirectRead, spotsRead;
     std::unique_ptr<BlockAllocator<2>> atlas;
     struct Entry {
         std::optional<Placement<2>> placement;
@@ -43,9 +44,12 @@ struct RtShadelCache {
     uint32_t texelsTraced = 0; // this frame
     uint32_t instancesCached = 0;
     uint32_t instancesWithoutRoom = 0; // visible decoupled instances the atlas had no room for
+    uint64_t historyResets = 0;        // over the run: instance rects whose history restarted
 };
 
-void createRtShadelCache(Renderer& r, const GpuScene& scene, RtShadelCache& cache);
+// spotShadows: with the rgba32ui layer of the shadow-casting spots' visibilities.
+void createRtShadelCache(Renderer& r, const GpuScene& scene, bool spotShadows,
+                         RtShadelCache& cache);
 void destroyRtShadelCache(Renderer& r, RtShadelCache& cache);
 // CPU: rects for this frame's decoupled instances, the tiles to trace; fills rt's cache fields.
 void prepareRtShadelCache(Renderer& r, const GpuScene& scene, const CameraView& camera,

@@ -34,6 +34,8 @@ struct SkinningState {
     std::vector<uint32_t> firstMatrix; // per skin pose
     uint32_t matrixCount = 0;
     uint32_t vertexCount = 0;
+    std::vector<uint32_t> meshes; // skinned by this pass
+    uint64_t poseVersion = 0;
     Pipeline pipeline;
 };
 
@@ -53,11 +55,13 @@ SkinningStatePtr createSkinning(Renderer& r, const Scene& scene, const GpuScene&
     // upload's order (baked seams duplicate vertices, fetch order permutes them).
     std::vector<gpu::GpuVertex> bind;
     std::vector<SkinVertex> skin;
+    std::vector<uint32_t> meshes;
     for (size_t m = 0; m < scene.meshes.size() && m < gpuScene.meshInfo.size(); ++m) {
         const MeshSkin* s = scene.meshes[m].skin.get();
         if (!s || s->bindVertices.size() != scene.meshes[m].vertices.size() ||
             s->skin >= scene.skinPoses.size())
             continue;
+        meshes.push_back(uint32_t(m));
         uint32_t first = uint32_t(gpuScene.meshInfo[m].vertexOffset);
         uint32_t end = m + 1 < gpuScene.meshInfo.size()
                            ? uint32_t(gpuScene.meshInfo[m + 1].vertexOffset)
@@ -72,6 +76,7 @@ SkinningStatePtr createSkinning(Renderer& r, const Scene& scene, const GpuScene&
     if (skin.empty()) return nullptr;
     SkinningStatePtr st(new SkinningState);
     st->firstMatrix = firstMatrix;
+    st->meshes = std::move(meshes);
     st->matrixCount = matrixCount;
     st->vertexCount = uint32_t(skin.size());
     VkDeviceSize total = size(gpu, gpuScene.vertices);
@@ -80,7 +85,14 @@ SkinningStatePtr createSkinning(Renderer& r, const Scene& scene, const GpuScene&
         if (!b) throw DeviceError(format("out of GPU memory for %s", name));
         return b;
     };
-    st->deformed = device("skinning.deformedVertices", total);
+    // Also the skinned meshes' BLAS input (render/raytracing) where the device traces rays.
+    VkBufferUsageFlags rtInput =
+        gpu.device.optional.rayQuery
+            ? VK_BUFFER_USAGE_ACCELERATION_STRUCTURE_BUILD_INPUT_READ_ONLY_BIT_KHR
+            : 0;
+    st->deformed =
+        createBuffer(gpu, {"skinning.deformedVertices", total, rtInput, MemoryKind::DeviceLocal});
+    if (!st->deformed) throw DeviceError("out of GPU memory for skinning.deformedVertices");
     st->bindVertices = device("skinning.bindVertices", bind.size() * sizeof(gpu::GpuVertex));
     st->skinVertices = device("skinning.influences", skin.size() * sizeof(SkinVertex));
     st->matrices = createBuffer(gpu, {"skinning.jointMatrices",
@@ -115,14 +127,18 @@ void setSkinPoses(Renderer& r, SkinningState& s, const std::vector<SkinPose>& po
         throw InputError(
             format("skinning: %zu skin poses, expected %zu", poses.size(), s.firstMatrix.size()));
     auto* out = static_cast<glm::mat4*>(mapped(*r.gpu, s.matrices));
+    bool changed = s.poseVersion == 0;
     for (size_t k = 0; k < poses.size(); ++k) {
         uint32_t count = k + 1 < s.firstMatrix.size() ? s.firstMatrix[k + 1] - s.firstMatrix[k]
                                                       : s.matrixCount - s.firstMatrix[k];
         if (poses[k].joints.size() != count)
             throw InputError(format("skinning: skin %zu has %zu joints, expected %u", k,
                                     poses[k].joints.size(), count));
+        changed = changed || std::memcmp(out + s.firstMatrix[k], poses[k].joints.data(),
+                                         count * sizeof(glm::mat4)) != 0;
         std::memcpy(out + s.firstMatrix[k], poses[k].joints.data(), count * sizeof(glm::mat4));
     }
+    if (changed) s.poseVersion++;
 }
 
 uint64_t skinnedVerticesAddress(const Renderer& r, const SkinningState& s) {
@@ -131,6 +147,14 @@ uint64_t skinnedVerticesAddress(const Renderer& r, const SkinningState& s) {
 
 uint32_t skinnedVertexCount(const SkinningState& s) {
     return s.vertexCount;
+}
+
+const std::vector<uint32_t>& skinnedMeshes(const SkinningState& s) {
+    return s.meshes;
+}
+
+uint64_t skinPoseVersion(const SkinningState& s) {
+    return s.poseVersion;
 }
 
 void recordSkinning(Renderer& r, VkCommandBuffer cmd) {

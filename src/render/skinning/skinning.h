@@ -5,7 +5,8 @@
 // unified vertex buffer; FrameConstants::vertices points every pass at that copy. Joint
 // matrices are uploaded per frame (animated playback hands each frame's pose). Meshes the
 // importer could not keep whole, or `--skinning cpu`, draw the importer's CPU-skinned vertices.
-// The ray-tracing BLASes keep reading the unified buffer (no refits yet).
+// The ray-tracing BLASes of skinned meshes are built from the deformed buffer and refit when the
+// pose changes (render/raytracing/acceleration_structures.h).
 #include <cstdint>
 #include <memory>
 #include <vector>
@@ -35,5 +36,9 @@ uint64_t skinnedVerticesAddress(const Renderer& r, const SkinningState& s);
 // The compute pass; its writes are visible to every later vertex, fragment and compute read.
 void recordSkinning(Renderer& r, VkCommandBuffer cmd);
 uint32_t skinnedVertexCount(const SkinningState& s);
+// The meshes whose vertices the pass deforms.
+const std::vector<uint32_t>& skinnedMeshes(const SkinningState& s);
+// Grows each time setSkinPoses hands over joint matrices that differ from the last ones.
+uint64_t skinPoseVersion(const SkinningState& s);
 
 } // namespace shadel
