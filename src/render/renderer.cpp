@@ -313,7 +313,8 @@ FrameResult renderFrame(Renderer& r, const GpuScene& scene, const CameraView& ca
     // Before beginFrame (streaming rebinds texture slots in the set this frame uses) and before
     // the decoupled frontend (which must not carry over shading of re-streamed textures).
     r.changedMaterials.clear();
-    double streamingMs = 0.0; // the streaming frontend's share of cpuThreadMs
+    // The streaming frontend's CPU time (its pass may be recorded on a worker: rhi/frame.h).
+    double streamingMs = 0.0;
     if (r.streaming) {
         double streamingStart = threadCpuMs();
         prepareTextureStreaming(*r.streaming, camera, float(r.internalHeight), constants);
