@@ -436,25 +436,44 @@ nlohmann::json runBench(Gpu& gpu, const BenchOptions& b) {
     }
 
     if (b.compareThreads) {
-        // Render threading (rhi/frame.h): every mode again with one recording thread. The CPU
-        // frame time (frontend + recording, GPU waits excluded) is the figure threading moves.
+        // Render threading (rhi/frame.h): every mode serial (--threads 1) and threaded, in two
+        // rounds of opposite order (serial first, then threaded first) so that warm-up and the
+        // machine's drift hit both alike; each figure is the mean of its two runs' medians.
+        // cpu_frame_ms is the wall clock of frontend + recording (GPU waits excluded): what
+        // parallel recording shortens; cpu_frame_thread_ms the render thread's own CPU clock.
+        uint32_t threaded = b.threads ? b.threads : defaultRecordingThreads();
         for (const Mode& m : modes) {
-            std::fprintf(stderr, "bench: %s, --threads 1\n", m.name);
             o.mode = m.mode;
             o.reuse = m.reuse;
-            o.threads = 1;
-            nlohmann::json serial = runRender(gpu, o).stats;
-            const nlohmann::json& threaded = out["modes"][m.name];
-            double serialCpu = serial["cpu_frame_ms"], threadedCpu = threaded["cpu_frame_ms"];
+            double wall[2] = {0, 0}, thread[2] = {0, 0}, workers = 0, recording = 0;
+            for (int round = 0; round < 2; ++round)
+                for (int k = 0; k < 2; ++k) {
+                    bool serial = (k == 0) == (round == 0); // S,T then T,S
+                    std::fprintf(stderr, "bench: %s, --threads %u (round %d)\n", m.name,
+                                 serial ? 1u : threaded, round + 1);
+                    o.threads = serial ? 1 : threaded;
+                    nlohmann::json st = runRender(gpu, o).stats;
+                    wall[serial ? 0 : 1] += 0.5 * st["cpu_frame_ms"].get<double>();
+                    thread[serial ? 0 : 1] += 0.5 * st["cpu_frame_thread_ms"].get<double>();
+                    if (!serial) {
+                        workers += 0.5 * st["recording"]["workers_cpu_ms"].get<double>();
+                        recording += 0.5 * st["recording"]["wall_ms"].get<double>();
+                    }
+                }
+            out["threads"][m.name] = {{"threads", threaded},
+                                      {"cpu_frame_ms_serial", wall[0]},
+                                      {"cpu_frame_ms_threaded", wall[1]},
+                                      {"cpu_frame_thread_ms_serial", thread[0]},
+                                      {"cpu_frame_thread_ms_threaded", thread[1]},
+                                      {"recording_wall_ms", recording},
+                                      {"recording_workers_cpu_ms", workers}};
             out["ratios"][std::string("threads_cpu_") + m.name] =
-                serialCpu > 0 ? threadedCpu / serialCpu : 0.0;
-            std::printf("threads (%s): cpu frame %.3f ms with %u threads, %.3f ms serial = %.3f; "
-                        "recording %.3f ms wall, %.3f ms CPU on the workers\n",
-                        m.name, threadedCpu, threaded["recording"]["threads"].get<uint32_t>(),
-                        serialCpu, serialCpu > 0 ? threadedCpu / serialCpu : 0.0,
-                        threaded["recording"]["wall_ms"].get<double>(),
-                        threaded["recording"]["workers_cpu_ms"].get<double>());
-            out["modes"][std::string(m.name) + "_serial"] = std::move(serial);
+                wall[0] > 0 ? wall[1] / wall[0] : 0.0;
+            std::printf("threads (%s): cpu frame %.3f ms with %u threads, %.3f ms serial = %.3f "
+                        "(render thread's CPU clock %.3f / %.3f ms); recording %.3f ms wall, "
+                        "%.3f ms CPU on the workers\n",
+                        m.name, wall[1], threaded, wall[0], wall[0] > 0 ? wall[1] / wall[0] : 0.0,
+                        thread[1], thread[0], recording, workers);
         }
         o.threads = b.threads;
     }

@@ -135,7 +135,8 @@ TEST(Gi, BadFlagsAreOneLineAndExitCode2) {
     for (const std::string args :
          {"render --size 16x16 --gi radiosity", "render --size 16x16 --gi-snap maybe",
           "render --size 16x16 --scene builtin:cornell --gi lpv --gi-iterations 65",
-          "render --size 16x16 --scene builtin:cornell --visualize gi"}) {
+          "render --size 16x16 --scene builtin:cornell --visualize gi",
+          "render --size 16x16 --scene builtin:cornell --gi lpv --gi-local-volumes some"}) {
         std::string cmd =
             std::string("timeout 120 ") + SHADEL_BINARY + " " + args + " >/dev/null 2>" + err;
         int status = std::system(cmd.c_str());

@@ -7,6 +7,8 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <sstream>
+#include <sys/wait.h>
 
 using namespace shadel;
 using namespace shadel::test;
@@ -166,4 +168,22 @@ TEST(RenderThreading, TheTraceHasATrackPerRecordingWorker) {
     for (const FrameResult& f : run.frames) expected += uint32_t(f.passes.size());
     EXPECT_EQ(passes, expected);
     EXPECT_GT(run.stats["recording"]["wall_ms"].get<double>(), 0.0);
+}
+
+TEST(RenderThreading, BadThreadCountsAreOneLineAndExitCode2) {
+    std::string err = tempPath("threads_stderr.txt");
+    for (const std::string args :
+         {"render --size 16x16 --threads 0", "render --threads 65", "render --threads two",
+          "bench --threads -1", "view --threads 1.5"}) {
+        std::string cmd =
+            std::string("timeout 120 ") + SHADEL_BINARY + " " + args + " >/dev/null 2>" + err;
+        int status = std::system(cmd.c_str());
+        EXPECT_EQ(WIFEXITED(status) ? WEXITSTATUS(status) : -1, 2) << args;
+        std::ifstream in(err);
+        std::stringstream text;
+        text << in.rdbuf();
+        std::string line = text.str();
+        EXPECT_EQ(std::count(line.begin(), line.end(), '\n'), 1) << args << ": " << line;
+        EXPECT_NE(line.find("--threads"), std::string::npos) << args << ": " << line;
+    }
 }
