@@ -19,6 +19,13 @@ uvec4 rtPackSpotMeans(float sum[LIGHT_MAX_SPOT_SHADOWS], float weight, uint coun
     return packed;
 }
 
+// The filter's taps: a 3x3 neighbour q whose traced surface is the centre's (view distance
+// within 3%); its terms in t.
+bool rtFilterTap(uint termsSlot, ivec2 q, vec4 centre, out vec4 t) {
+    t = texelFetch(gTextures[termsSlot], q, 0);
+    return t.w > 0.0 && abs(t.w - centre.w) <= 0.03 * centre.w;
+}
+
 void useRayTracedPixelTerms(FrameConstants f, vec2 fragCoord) {
     if (f.rt == 0ul) return;
     RtFrame rt = RtFrameRef(f.rt).r;
@@ -36,8 +43,8 @@ void useRayTracedPixelTerms(FrameConstants f, vec2 fragCoord) {
         for (int y = -1; y <= 1; ++y)
             for (int x = -1; x <= 1; ++x) {
                 ivec2 q = clamp(p + ivec2(x, y), ivec2(0), size - 1);
-                vec4 t = texelFetch(gTextures[rt.pixelTermsSlot], q, 0);
-                if (t.w <= 0.0 || abs(t.w - centre.w) > 0.03 * centre.w) continue;
+                vec4 t;
+                if (!rtFilterTap(rt.pixelTermsSlot, q, centre, t)) continue;
                 sum += t;
                 if (rt.gi != 0u) indirectSum += texelFetch(gTextures[rt.pixelIndirectSlot], q, 0).rgb;
                 weight += 1.0;
@@ -56,8 +63,8 @@ void useRayTracedPixelTerms(FrameConstants f, vec2 fragCoord) {
             for (int y = -1; y <= 1; ++y)
                 for (int x = -1; x <= 1; ++x) {
                     ivec2 q = clamp(p + ivec2(x, y), ivec2(0), size - 1);
-                    vec4 t = texelFetch(gTextures[rt.pixelTermsSlot], q, 0);
-                    if (t.w <= 0.0 || abs(t.w - centre.w) > 0.03 * centre.w) continue;
+                    vec4 t;
+                    if (!rtFilterTap(rt.pixelTermsSlot, q, centre, t)) continue;
                     uvec4 v = texelFetch(gUTextures[rt.pixelSpotSlot], q, 0);
                     for (uint k = 0u; k < rt.spotShadowCount; ++k) sum[k] += rtSpotVisibility(v, k);
                     weight += 1.0;
