@@ -67,11 +67,11 @@ struct RtFrame {
     // Spot shadows (--rt-shadows on, scenes with shadow-casting spots): the visibility of every
     // shadow-casting spot (by GpuLight::shadowIndex), 8 bits each, packed in a uvec4 per sample
     // (rtPackSpot / rtSpotVisibility in raytracing/rt_spots.glsl).
-    uint spotShadowCount;     // shadow-casting spots traced (<= LIGHT_MAX_SPOT_SHADOWS), 0: none
-    uint64_t spotLights;      // uint per shadow index: the light's index in FrameConstants::lights
-    uint pixelSpotSlot;       // forward: bindless read slot of the traced spot visibilities (uint)
-    uint shadelSpotWrite;     // cache atlas: spot visibilities (storage, rgba32ui)
-    uint shadelSpotRead;      //   ... the same, sampled
+    uint spotShadowCount; // shadow-casting spots traced (<= LIGHT_MAX_SPOT_SHADOWS), 0: none
+    uint64_t spotLights;  // uint per shadow index: the light's index in FrameConstants::lights
+    uint pixelSpotSlot;   // forward: bindless read slot of the traced spot visibilities (uint)
+    uint shadelSpotWrite; // cache atlas: spot visibilities (storage, rgba32ui)
+    uint shadelSpotRead;  //   ... the same, sampled
     uint pad0;
 };
 
