@@ -36,10 +36,14 @@ void useRayTracedPixelTerms(FrameConstants f, vec2 fragCoord) {
     if (centre.w <= 0.0) return; // nothing traced here (not an opaque surface)
     vec4 terms = centre;
     vec3 indirect = rt.gi != 0u ? texelFetch(gTextures[rt.pixelIndirectSlot], p, 0).rgb : vec3(0.0);
+    // Soft spot shadows are as noisy as the sun's: filtered with the same taps.
+    bool filterSpots = rt.spatialFilter != 0u && rt.spotShadowCount != 0u && rt.shadowRays > 1u;
+    float spotSum[LIGHT_MAX_SPOT_SHADOWS];
+    for (uint k = 0u; k < rt.spotShadowCount && filterSpots; ++k) spotSum[k] = 0.0;
+    float weight = 0.0;
     if (rt.spatialFilter != 0u) {
         vec4 sum = vec4(0.0);
         vec3 indirectSum = vec3(0.0);
-        float weight = 0.0;
         for (int y = -1; y <= 1; ++y)
             for (int x = -1; x <= 1; ++x) {
                 ivec2 q = clamp(p + ivec2(x, y), ivec2(0), size - 1);
@@ -47,6 +51,10 @@ void useRayTracedPixelTerms(FrameConstants f, vec2 fragCoord) {
                 if (!rtFilterTap(rt.pixelTermsSlot, q, centre, t)) continue;
                 sum += t;
                 if (rt.gi != 0u) indirectSum += texelFetch(gTextures[rt.pixelIndirectSlot], q, 0).rgb;
+                if (filterSpots) {
+                    uvec4 v = texelFetch(gUTextures[rt.pixelSpotSlot], q, 0);
+                    for (uint k = 0u; k < rt.spotShadowCount; ++k) spotSum[k] += rtSpotVisibility(v, k);
+                }
                 weight += 1.0;
             }
         terms.y = sum.y / weight; // the centre always passes
@@ -55,22 +63,8 @@ void useRayTracedPixelTerms(FrameConstants f, vec2 fragCoord) {
     }
     if (rt.spotShadowCount != 0u) {
         gRtSpots = true;
-        gRtSpotVisibility = texelFetch(gUTextures[rt.pixelSpotSlot], p, 0);
-        if (rt.spatialFilter != 0u && rt.shadowRays > 1u) { // soft: as noisy as the sun's
-            float sum[LIGHT_MAX_SPOT_SHADOWS];
-            for (uint k = 0u; k < rt.spotShadowCount; ++k) sum[k] = 0.0;
-            float weight = 0.0;
-            for (int y = -1; y <= 1; ++y)
-                for (int x = -1; x <= 1; ++x) {
-                    ivec2 q = clamp(p + ivec2(x, y), ivec2(0), size - 1);
-                    vec4 t;
-                    if (!rtFilterTap(rt.pixelTermsSlot, q, centre, t)) continue;
-                    uvec4 v = texelFetch(gUTextures[rt.pixelSpotSlot], q, 0);
-                    for (uint k = 0u; k < rt.spotShadowCount; ++k) sum[k] += rtSpotVisibility(v, k);
-                    weight += 1.0;
-                }
-            gRtSpotVisibility = rtPackSpotMeans(sum, weight, rt.spotShadowCount);
-        }
+        gRtSpotVisibility = filterSpots ? rtPackSpotMeans(spotSum, weight, rt.spotShadowCount)
+                                        : texelFetch(gUTextures[rt.pixelSpotSlot], p, 0);
     }
     gRtSun = rt.shadows != 0u;
     gRtSunVisibility = terms.x;
