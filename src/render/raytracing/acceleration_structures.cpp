@@ -219,6 +219,26 @@ static void buildBatch(Gpu& gpu, const RtFunctions& fn, BlasPools& pools,
     jobs.clear();
 }
 
+// One opaque triangle geometry: mesh m's vertices in the unified layout at `vertices` (the
+// scene's, or GPU-skinned ones laid out alike), its indices from `firstIndex`.
+static VkAccelerationStructureGeometryKHR
+meshTriangles(const GpuScene& scene, uint32_t m, VkDeviceAddress vertices, uint32_t vertexCount,
+              VkDeviceAddress indices, uint32_t firstIndex) {
+    VkAccelerationStructureGeometryKHR g{VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_GEOMETRY_KHR};
+    g.geometryType = VK_GEOMETRY_TYPE_TRIANGLES_KHR;
+    g.flags = VK_GEOMETRY_OPAQUE_BIT_KHR;
+    VkAccelerationStructureGeometryTrianglesDataKHR& t = g.geometry.triangles;
+    t = {VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_GEOMETRY_TRIANGLES_DATA_KHR};
+    t.vertexFormat = VK_FORMAT_R32G32B32_SFLOAT;
+    t.vertexData.deviceAddress =
+        vertices + VkDeviceSize(scene.meshInfo[m].vertexOffset) * sizeof(gpu::GpuVertex);
+    t.vertexStride = sizeof(gpu::GpuVertex);
+    t.maxVertex = vertexCount - 1;
+    t.indexType = VK_INDEX_TYPE_UINT32;
+    t.indexData.deviceAddress = indices + VkDeviceSize(firstIndex) * 4;
+    return g;
+}
+
 void buildBlases(Gpu& gpu, const RtFunctions& fn, BlasPools& pools, const GpuScene& scene,
                  BlasSet& out) {
     out = {};
@@ -247,17 +267,7 @@ void buildBlases(Gpu& gpu, const RtFunctions& fn, BlasPools& pools, const GpuSce
             j.firstIndex = chain.lod[j.lod].firstIndex;
             j.triangles = chain.lod[j.lod].indexCount / 3;
             if (j.triangles == 0) continue;
-            VkAccelerationStructureGeometryTrianglesDataKHR& t = j.geometry.geometry.triangles;
-            j.geometry.geometryType = VK_GEOMETRY_TYPE_TRIANGLES_KHR;
-            j.geometry.flags = VK_GEOMETRY_OPAQUE_BIT_KHR;
-            t = {VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_GEOMETRY_TRIANGLES_DATA_KHR};
-            t.vertexFormat = VK_FORMAT_R32G32B32_SFLOAT;
-            t.vertexData.deviceAddress =
-                vertices + VkDeviceSize(scene.meshInfo[m].vertexOffset) * sizeof(gpu::GpuVertex);
-            t.vertexStride = sizeof(gpu::GpuVertex);
-            t.maxVertex = vertexCounts[m] - 1;
-            t.indexType = VK_INDEX_TYPE_UINT32;
-            t.indexData.deviceAddress = indices + VkDeviceSize(j.firstIndex) * 4;
+            j.geometry = meshTriangles(scene, m, vertices, vertexCounts[m], indices, j.firstIndex);
             VkAccelerationStructureBuildGeometryInfoKHR b{
                 VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_BUILD_GEOMETRY_INFO_KHR};
             b.type = VK_ACCELERATION_STRUCTURE_TYPE_BOTTOM_LEVEL_KHR;
@@ -321,18 +331,8 @@ void createAnimatedBlases(Gpu& gpu, const RtFunctions& fn, BlasPools& pools, con
         a.firstIndex = scene.lodInfo[m].lod[0].firstIndex;
         a.triangles = scene.lodInfo[m].lod[0].indexCount / 3;
         if (a.triangles == 0) continue;
-        VkAccelerationStructureGeometryTrianglesDataKHR& t = a.geometry.geometry.triangles;
-        a.geometry.geometryType = VK_GEOMETRY_TYPE_TRIANGLES_KHR;
-        a.geometry.flags = VK_GEOMETRY_OPAQUE_BIT_KHR;
-        t = {VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_GEOMETRY_TRIANGLES_DATA_KHR};
-        t.vertexFormat = VK_FORMAT_R32G32B32_SFLOAT;
-        t.vertexData.deviceAddress =
-            deformedVertices +
-            VkDeviceSize(scene.meshInfo[m].vertexOffset) * sizeof(gpu::GpuVertex);
-        t.vertexStride = sizeof(gpu::GpuVertex);
-        t.maxVertex = vertexCounts[m] - 1;
-        t.indexType = VK_INDEX_TYPE_UINT32;
-        t.indexData.deviceAddress = indices + VkDeviceSize(a.firstIndex) * 4;
+        a.geometry =
+            meshTriangles(scene, m, deformedVertices, vertexCounts[m], indices, a.firstIndex);
         VkAccelerationStructureBuildGeometryInfoKHR b = animatedBuildInfo(a);
         VkAccelerationStructureBuildSizesInfoKHR sizes{
             VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_BUILD_SIZES_INFO_KHR};
