@@ -554,7 +554,8 @@ void recordGiInjection(Renderer& r, VkCommandBuffer cmd) {
 // 0's) the floor by the red wall reads red/green 1.10 after 16 steps and 1.39 after 32; the
 // cascades alone give 1.28 after 8.
 static uint32_t propagationSteps(const GiState& gi, uint32_t v, uint32_t iterations) {
-    return v < gi.localCount ? std::max(iterations, GI_GRID) : iterations;
+    // (--gi-iterations 0, injection only, holds for every volume.)
+    return v < gi.localCount && iterations > 0 ? std::max(iterations, GI_GRID) : iterations;
 }
 
 void recordGiPropagation(Renderer& r, VkCommandBuffer cmd) {
