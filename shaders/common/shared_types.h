@@ -495,8 +495,8 @@ struct ShaderMessage {
 #define SHADEL_INVALID 0xFFFFFFFFu
 #define SHADEL_OBJECT_DECOUPLED 1u // allocated in the sheet this frame: drawn decoupled
 // Its bounds meet a light that changed this frame: carried-over chunks check their shadels.
-#define SHADEL_OBJECT_NEAR_CHANGED_LIGHT 2u
-#define SHADEL_MAX_CHANGED_LIGHTS 256u
+#define SHADEL_OBJECT_NEAR_CHANGE 2u
+#define SHADEL_MAX_CHANGED_VOLUMES 256u
 // Material layers of the shade storage (seed: "layers of different bit depths"): every layer
 // shares the slot allocation; each has its own format.
 #define SHADEL_LAYER_RADIANCE 0u // lit colour, RGBA16F
@@ -568,6 +568,13 @@ struct GpuShadelWork {
     uint mip;
 };
 
+// Why a marked chunk is shaded rather than carried over (GpuShadelCounters::shadedBecause).
+#define SHADEL_SHADED_LEVEL_CHANGED 0u // reuse off, or the object's level or inputs changed
+#define SHADEL_SHADED_NEW 1u           // last frame did not store the chunk
+#define SHADEL_SHADED_REFRESH 2u       // stored, but its turn to be refreshed
+#define SHADEL_SHADED_NEAR_CHANGE 3u   // a changed region meets the object: shading decides
+#define SHADEL_SHADED_REASONS 4
+
 struct GpuShadelCounters {
     // Chunks requested through each hashed counter. The counters only spread the atomics: once
     // every block has its place within its counter, the sections are laid end to end
@@ -589,6 +596,8 @@ struct GpuShadelCounters {
     // Sampled reconstructed pixels read from a coarser level than they wanted because that
     // level's window (last frame's marks + margin) did not hold them yet.
     uint windowFallbackPixels;
+    // Chunks queued for shading, by why they could not be carried over (SHADEL_SHADED_*).
+    uint shadedBecause[SHADEL_SHADED_REASONS];
     uvec4 fillDispatch;  // x, y, z, marked blocks in the list: indirect args of the queue fill
     uvec4 shadeDispatch; // x, y, z, queue length: indirect args of the shading pass
     uvec4 copyDispatch;  // x, y, z, queue length: indirect args of the carry-over pass
@@ -615,12 +624,14 @@ struct ShadelFrame {
     uint prevLayerReadSlot[SHADEL_LAYERS]; // last frame's layers (sampled): preserved layers
     uint64_t prevOccupancy;                // last frame's occupancy masks
     uint64_t prevOffsetMap;                // last frame's offset map
-    uint64_t changedLights; // vec4 (centre, radius) of what lights that changed reach
+    // Regions whose lighting changed since last frame (render/shadel/reuse_invalidation.h):
+    // capsules, two vec4s each: (a, radius), (b, 0); infinite radius = everywhere.
+    uint64_t changedVolumes;
     // uvec4 per rect: the level blocks this frame's samples wanted, in window or not
     // {0xFFFF - min x, 0xFFFF - min y, max x + 1, max y + 1} (atomicMax; 0 = none), read back
     // to place next frame's windows.
     uint64_t levelWants;
-    uint changedLightCount;
+    uint changedVolumeCount;
     uint frameNumber; // frames rendered by this renderer (refresh phase)
     uint reuse;       // 0: reshade everything (--reuse off)
     uint storageChunksPerRow;

@@ -3,8 +3,9 @@
 // place in the counter) and publishes it in the offset map. Each of its marked chunks then goes
 // to one of two queues: carried over from last frame's storage (preserved layers: the object's
 // level is unchanged, last frame stored the chunk, and it is not the chunk's turn to be
-// refreshed) or shaded. Chunks of objects a changed light reaches are queued for shading, which
-// checks their shadels against the lights and may still carry them over (shade.comp).
+// refreshed) or shaded. Chunks of objects a changed region meets (a light or a caster that
+// changed) are queued for shading, which checks their shadels against the regions and may
+// still carry them over (shade.comp).
 #include "shadel/shadel.glsl"
 
 layout(local_size_x = 64) in;
@@ -32,12 +33,14 @@ void main() {
     atomicAdd(counters.c.chunksPerMip[mip], n);
 
     ShadelObjectRef o = shadelObject(s, entry.z);
-    bool copyable = s.reuse != 0u && ((o.v.reuseLevels >> mip) & 1u) != 0u &&
-                    (o.v.flags & SHADEL_OBJECT_NEAR_CHANGED_LIGHT) == 0u;
+    bool levelReusable = s.reuse != 0u && ((o.v.reuseLevels >> mip) & 1u) != 0u;
+    bool nearChange = (o.v.flags & SHADEL_OBJECT_NEAR_CHANGE) != 0u;
+    bool copyable = levelReusable && !nearChange;
     uint64_t prevMask = copyable ? Uint64Buffer(s.prevOccupancy).v[block] : 0ul;
     uint prevBase = copyable ? UintBuffer(s.prevOffsetMap).v[block] : SHADEL_INVALID;
     uvec2 blockXy = uvec2(block % s.sheetBlocks, block / s.sheetBlocks);
     uint k = 0u;
+    uvec4 shadedBecause = uvec4(0u); // summed here: one atomic per reason and block
     for (uint bit = 0u; bit < 64u; ++bit) {
         if ((mask & (1ul << bit)) == 0ul) continue;
         uvec2 chunk = blockXy * 8u + uvec2(bit % 8u, bit / 8u);
@@ -47,12 +50,20 @@ void main() {
         w.object = entry.z;
         w.mip = mip;
         ++k;
-        if ((prevMask & (1ul << bit)) != 0ul && prevBase != SHADEL_INVALID &&
-            !shadelRefreshDue(s, o, w.chunk)) {
+        bool stored = (prevMask & (1ul << bit)) != 0ul && prevBase != SHADEL_INVALID;
+        bool refresh = stored && shadelRefreshDue(s, o, w.chunk);
+        if (stored && !refresh) {
             w.chunk = chunkSlot(prevMask, prevBase, bit); // where last frame stored it
             ShadelWorkBuffer(s.copyQueue).w[atomicAdd(counters.c.copyCount, 1u)] = w;
-        } else {
-            ShadelWorkBuffer(s.queue).w[atomicAdd(counters.c.shadeCount, 1u)] = w;
+            continue;
         }
+        ShadelWorkBuffer(s.queue).w[atomicAdd(counters.c.shadeCount, 1u)] = w;
+        uint reason = !levelReusable ? SHADEL_SHADED_LEVEL_CHANGED
+                      : nearChange   ? SHADEL_SHADED_NEAR_CHANGE
+                      : refresh      ? SHADEL_SHADED_REFRESH
+                                     : SHADEL_SHADED_NEW;
+        shadedBecause[reason]++;
     }
+    for (uint reason = 0u; reason < SHADEL_SHADED_REASONS; ++reason)
+        if (shadedBecause[reason] != 0u) atomicAdd(counters.c.shadedBecause[reason], shadedBecause[reason]);
 }

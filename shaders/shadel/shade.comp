@@ -59,12 +59,13 @@ void carryOver(ShadelFrame s, uint fromSlot, ivec2 outTexel) {
     if (gl_LocalInvocationIndex == 0u) atomicAdd(ShadelCountersRef(s.counters).c.chunksReused, 1u);
 }
 
-shared bool chunkNearChangedLight;
+shared bool chunkNearChange;
 
-// Whether any shadel of the chunk lies within reach of a light that changed this frame (the
-// object's bounds do, or this is not called). Only positions are rebuilt. Call in uniform flow.
-bool chunkTouchesChangedLight(FrameConstants f, ShadelFrame s, ShadelObjectRef o, GpuShadelWork work) {
-    if (gl_LocalInvocationIndex == 0u) chunkNearChangedLight = false;
+// Whether any shadel of the chunk lies in a region whose lighting changed this frame (a light
+// or a caster that changed: render/shadel/reuse_invalidation.h; the object's bounds meet one,
+// or this is not called). Only positions are rebuilt. Call in uniform control flow.
+bool chunkTouchesChange(FrameConstants f, ShadelFrame s, ShadelObjectRef o, GpuShadelWork work) {
+    if (gl_LocalInvocationIndex == 0u) chunkNearChange = false;
     barrier();
     uvec2 size = levelSize(o, work.mip);
     uvec2 shadel = levelShadel(o, work.mip, uvec2(work.chunk & 0xFFFFu, work.chunk >> 16) *
@@ -84,14 +85,16 @@ bool chunkTouchesChangedLight(FrameConstants f, ShadelFrame s, ShadelObjectRef o
         VertexBuffer vb = VertexBuffer(f.vertices);
         vec3 p = shadelInterpolate(b, vb.v[i0].position, vb.v[i1].position, vb.v[i2].position);
         vec3 world = (inst.model * vec4(p, 1.0)).xyz;
-        Vec4Buffer lights = Vec4Buffer(s.changedLights);
-        for (uint i = 0u; i < s.changedLightCount; ++i) {
-            vec4 l = lights.v[i];
-            if (isinf(l.w) || distance(world, l.xyz) <= l.w) chunkNearChangedLight = true;
+        Vec4Buffer volumes = Vec4Buffer(s.changedVolumes);
+        for (uint i = 0u; i < s.changedVolumeCount; ++i) {
+            vec4 a = volumes.v[2u * i];
+            vec3 ab = volumes.v[2u * i + 1u].xyz - a.xyz; // capsule a-b, radius a.w
+            float t = clamp(dot(world - a.xyz, ab) / max(dot(ab, ab), 1e-12), 0.0, 1.0);
+            if (isinf(a.w) || distance(world, a.xyz + t * ab) <= a.w) chunkNearChange = true;
         }
     }
     barrier();
-    return chunkNearChangedLight;
+    return chunkNearChange;
 }
 
 shared uint sBoxMin[3], sBoxMax[3];
@@ -203,14 +206,14 @@ void main() {
     ShadelObjectRef o = shadelObject(s, work.object);
     uvec2 local = gl_LocalInvocationID.xy;
     ivec2 outTexel = storageTexel(s, work.slot, local);
-    // Chunks of objects a changed light reaches come here even when reusable (the fill pass
-    // cannot tell which of their shadels the light reaches): carry over those it does not.
+    // Chunks of objects a changed region meets come here even when reusable (the fill pass
+    // cannot tell which of their shadels the change reaches): carry over those it does not.
     // (With spectra the classify phase decided: a binned chunk is shaded.)
     int carrySlot = kChunkSpectraPhase != CHUNK_SPECTRA_SHADE &&
-                            (o.v.flags & SHADEL_OBJECT_NEAR_CHANGED_LIGHT) != 0u
+                            (o.v.flags & SHADEL_OBJECT_NEAR_CHANGE) != 0u
                         ? carrySource(s, o, work)
                         : -1;
-    if (carrySlot >= 0 && chunkTouchesChangedLight(f, s, o, work)) carrySlot = -1;
+    if (carrySlot >= 0 && chunkTouchesChange(f, s, o, work)) carrySlot = -1;
     if (carrySlot >= 0) {
         carryOver(s, uint(carrySlot), outTexel);
         return;

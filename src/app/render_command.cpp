@@ -449,7 +449,7 @@ RenderRun runRender(Gpu& gpu, const RenderOptions& o) {
                 makeCameraView(onPath, o.width * o.ssaa, o.height * o.ssaa, jitter * float(o.ssaa));
             if (playback && i > 0) {
                 poseFrame(gpu, *playback, i, gpuScene, renderer.reposedInstances,
-                          renderer.skinning != nullptr);
+                          renderer.skinning != nullptr, &renderer.reposedFrom);
                 if (renderer.skinning)
                     setSkinPoses(renderer, *renderer.skinning, playback->drawn.skinPoses);
             }

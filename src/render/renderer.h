@@ -251,6 +251,7 @@ struct Renderer {
     // Per instance: animated playback (render/animation) moved or deformed it before this frame;
     // empty without playback. Decoupled reuse reshades these; spot shadow maps are redrawn.
     std::vector<uint8_t> reposedInstances;
+    std::vector<Aabb> reposedFrom;  // per instance: its world bounds before the playback moved it
     SpectraStatePtr spectra;        // --spectra on|single (render/lighting/feature_spectra.h)
     SpotShadowStatePtr spotShadows; // shadow-casting spots (render/lighting/spot_shadows.h)
     SunCascadeStatePtr sunCascades; // --sun-cascades 2..4 (render/lighting/sun_cascades.h)

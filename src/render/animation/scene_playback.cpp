@@ -26,8 +26,9 @@ static bool sameVertices(const Mesh& a, const Mesh& b) {
 }
 
 void poseFrame(Gpu& gpu, ScenePlayback& p, uint32_t frame, GpuScene& gpuScene,
-               std::vector<uint8_t>& reposed, bool gpuSkinned) {
+               std::vector<uint8_t>& reposed, bool gpuSkinned, std::vector<Aabb>* reposedFrom) {
     reposed.assign(gpuScene.instanceCount, 0);
+    if (reposedFrom) reposedFrom->assign(gpuScene.instanceCount, Aabb{});
     SceneFileOptions options = p.options;
     options.time = p.startTime + double(frame) * p.step;
     // The first frame's import already gave the file's warnings; they would repeat each frame.
@@ -98,6 +99,7 @@ void poseFrame(Gpu& gpu, ScenePlayback& p, uint32_t frame, GpuScene& gpuScene,
         if (moved || meshMoved[inst.mesh]) {
             inst.transform = now.transform;
             gpu::GpuInstance& g = gpuScene.instanceInfo[i];
+            if (reposedFrom) (*reposedFrom)[i] = Aabb{g.worldMin, g.worldMax};
             g.model = inst.transform;
             g.normalMatrix = glm::transpose(glm::inverse(inst.transform));
             Aabb world = transformAabb(drawn.meshes[inst.mesh].bounds, inst.transform);

@@ -35,10 +35,13 @@ ScenePlayback startPlayback(const std::string& spec, const SceneFileOptions& opt
 // Poses the file at T0 + frame * step and writes what changed since the drawn pose into
 // `gpuScene` (between frames: the GPU is idle). `reposed` gets one byte per instance: 1 when
 // its transform or its mesh's vertices changed. Throws InputError when the posed file no longer
-// matches the drawn scene's structure.
+// matches the drawn scene's structure. `reposedFrom` (optional) gets, per instance, the world
+// bounds it had before this pose (meaningful where `reposed` is 1): what it no longer covers or
+// shadows (decoupled reuse reshades there).
 // With `gpuSkinned`, meshes carrying GPU skinning input (Mesh::skin) are not written: the
 // skinning pass (render/skinning) deforms them from `drawn.skinPoses`, which the caller hands it.
 void poseFrame(Gpu& gpu, ScenePlayback& playback, uint32_t frame, GpuScene& gpuScene,
-               std::vector<uint8_t>& reposed, bool gpuSkinned = false);
+               std::vector<uint8_t>& reposed, bool gpuSkinned = false,
+               std::vector<Aabb>* reposedFrom = nullptr);
 
 } // namespace shadel

@@ -15,6 +15,7 @@
 #include "render/oit/oit.h"
 #include "render/renderer.h"
 #include "render/shadel/capacity_control.h"
+#include "render/shadel/reuse_invalidation.h"
 #include "render/shadel/shade_storage.h"
 #include "render/shadel/visibility.h"
 
@@ -117,13 +118,14 @@ struct DecoupledState {
     uint32_t refreshPeriod = 8;
     glm::vec3 lastCameraPosition{0.0f}; // the previous frame's (view drift of carried shadels)
     uint32_t objectsReusable = 0;
-    BufferHandle allocId;       // uint per block (upload: written by the CPU allocator)
-    BufferHandle counters;      // GpuShadelCounters (readback, also indirect args)
-    BufferHandle markedBlocks;  // uvec4 per marked block, capacityChunks of them
-    BufferHandle queue;         // GpuShadelWork[capacity]: chunks to shade
-    BufferHandle copyQueue;     // GpuShadelWork[capacity]: chunks carried over from last frame
-    BufferHandle changedLights; // vec4[SHADEL_MAX_CHANGED_LIGHTS] (upload)
-    bool changedLightsOverflow = false;
+    BufferHandle allocId;        // uint per block (upload: written by the CPU allocator)
+    BufferHandle counters;       // GpuShadelCounters (readback, also indirect args)
+    BufferHandle markedBlocks;   // uvec4 per marked block, capacityChunks of them
+    BufferHandle queue;          // GpuShadelWork[capacity]: chunks to shade
+    BufferHandle copyQueue;      // GpuShadelWork[capacity]: chunks carried over from last frame
+    BufferHandle changedVolumes; // ChangedVolume[SHADEL_MAX_CHANGED_VOLUMES] (upload)
+    std::vector<ChangedVolume> changes; // this frame's (render/shadel/reuse_invalidation.h)
+    bool changesOverflow = false;       // more than the buffer holds: everything changed
     ShadeStorage storage;
     Pipeline clear, allocate, queueSetup, fillQueue, dispatchSetup, carryOver, shade, sheetView,
         mark, markTransparent, reconstruct;
@@ -204,7 +206,8 @@ DecoupledStatePtr createDecoupled(Renderer& r, const GpuScene& scene) {
         return need(createBuffer(gpu, {name, bytes, usage, MemoryKind::DeviceLocal}), name);
     };
     d.frameInfo = upload("shadel.frame", sizeof(gpu::ShadelFrame));
-    d.changedLights = upload("shadel.changedLights", SHADEL_MAX_CHANGED_LIGHTS * 16);
+    d.changedVolumes =
+        upload("shadel.changedVolumes", SHADEL_MAX_CHANGED_VOLUMES * sizeof(ChangedVolume));
     d.objectBuffer = upload("shadel.objects", d.gpuObjects.size() * sizeof(gpu::GpuShadelObject));
     // Every object starts forward; frames rewrite only the entries they visit.
     std::memset(mapped(gpu, d.objectBuffer), 0, d.gpuObjects.size() * sizeof(gpu::GpuShadelObject));
@@ -297,9 +300,10 @@ void destroyDecoupled(Renderer& r, DecoupledStatePtr& state) {
           &d.shade, &d.sheetView, &d.mark, &d.markTransparent, &d.reconstruct})
         destroy(gpu, *p);
     destroyShadeStorage(gpu, d.storage);
-    for (BufferHandle b : {d.frameInfo, d.changedLights, d.objectBuffer, d.rectBuffer, d.levelWants,
-                           d.occupancy[0], d.occupancy[1], d.offsetMap[0], d.offsetMap[1],
-                           d.allocId, d.counters, d.markedBlocks, d.queue, d.copyQueue})
+    for (BufferHandle b :
+         {d.frameInfo, d.changedVolumes, d.objectBuffer, d.rectBuffer, d.levelWants, d.occupancy[0],
+          d.occupancy[1], d.offsetMap[0], d.offsetMap[1], d.allocId, d.counters, d.markedBlocks,
+          d.queue, d.copyQueue})
         destroy(gpu, b);
     state.reset();
 }
@@ -499,18 +503,6 @@ static uint32_t finestMipNeeded(const CameraView& camera, float viewportHeight,
     return std::min(uint32_t(lod), mesh.mipCount - 1);
 }
 
-// Which of the spheres (xyz centre, w radius; infinite radius = everything) a box meets.
-enum class LightReach { None, Bounded, Everything };
-static LightReach reachOf(const std::vector<glm::vec4>& spheres, glm::vec3 bmin, glm::vec3 bmax) {
-    LightReach reach = LightReach::None;
-    for (const glm::vec4& s : spheres) {
-        if (!std::isfinite(s.w)) return LightReach::Everything;
-        glm::vec3 nearest = glm::clamp(glm::vec3(s), bmin, bmax);
-        if (glm::length(nearest - glm::vec3(s)) <= s.w) reach = LightReach::Bounded;
-    }
-    return reach;
-}
-
 // How many frames a carried-over chunk of this object may go unshaded. Specular and Fresnel
 // follow the view direction; seen from the object, the camera's last step turned it by about
 // step / distance radians. A specular lobe is about roughness^2 radians wide, so the view may
@@ -571,10 +563,12 @@ void prepareDecoupledFrame(Renderer& r, const GpuScene& scene, const CameraView&
     d.objectsDecoupled = d.objectsForward = d.objectsSmallForward = d.objectsSheetLimited = 0;
     d.firstMipHistogram.fill(0);
     d.objectsReusable = 0;
-    d.changedLightsOverflow = r.changedLightVolumes.size() > SHADEL_MAX_CHANGED_LIGHTS;
-    if (!d.changedLightsOverflow && !r.changedLightVolumes.empty())
-        std::memcpy(mapped(gpu, d.changedLights), r.changedLightVolumes.data(),
-                    r.changedLightVolumes.size() * sizeof(glm::vec4));
+    d.changes =
+        changedVolumes(r, scene, constants.sunDirection, glm::length(constants.sunColor) > 0.0f);
+    d.changesOverflow = d.changes.size() > SHADEL_MAX_CHANGED_VOLUMES;
+    if (!d.changesOverflow && !d.changes.empty())
+        std::memcpy(mapped(gpu, d.changedVolumes), d.changes.data(),
+                    d.changes.size() * sizeof(ChangedVolume));
     // Instances near the frustum's bounds, and last frame's (to free or clear what they held):
     // every other instance stays unwanted, with its zero entry and no rects.
     d.visit.clear();
@@ -655,12 +649,13 @@ void prepareDecoupledFrame(Renderer& r, const GpuScene& scene, const CameraView&
         // invalidate what they reach.
         // View-dependent terms (specular) drift with the camera: the shading pass reshades
         // every chunk at least once per refresh period.
-        // A light that changed and reaches the object: its chunks check their own shadels
-        // against the light (shade.comp); an unbounded one (or too many) changes everything.
-        LightReach reach = d.changedLightsOverflow
-                               ? LightReach::Everything
-                               : reachOf(r.changedLightVolumes, inst.worldMin, inst.worldMax);
-        if (reach == LightReach::Bounded) g.flags |= SHADEL_OBJECT_NEAR_CHANGED_LIGHT;
+        // A change that reaches the object (a light that changed, a caster that moved, its
+        // shadow: reuse_invalidation.h): its chunks check their own shadels against the changed
+        // regions (shade.comp); an unbounded one (or too many) changes everything.
+        ChangeReach reach = d.changesOverflow
+                                ? ChangeReach::Everything
+                                : changeReach(d.changes, inst.worldMin, inst.worldMax);
+        if (reach == ChangeReach::Bounded) g.flags |= SHADEL_OBJECT_NEAR_CHANGE;
         // Its material changed (texture streaming changed what a texture of it holds, or it
         // was edited): reshade it.
         bool restreamed =
@@ -668,7 +663,7 @@ void prepareDecoupledFrame(Renderer& r, const GpuScene& scene, const CameraView&
         // Animated playback posed it anew (moved or deformed): its shadels are shaded again.
         bool reposed = i < r.reposedInstances.size() && r.reposedInstances[i] != 0;
         bool inputsUnchanged =
-            d.reuse && wasDecoupled && reach != LightReach::Everything && !restreamed && !reposed;
+            d.reuse && wasDecoupled && reach != ChangeReach::Everything && !restreamed && !reposed;
         for (uint32_t k = o.firstMip; k < mesh.mipCount && inputsUnchanged; ++k)
             if (o.levelSince[k] < d.frameNumber) g.reuseLevels |= 1u << k;
         bool known = inst.material < scene.materialInfo.size();
@@ -728,9 +723,9 @@ void prepareDecoupledFrame(Renderer& r, const GpuScene& scene, const CameraView&
         s.prevLayerReadSlot[l] = slot(gpu, d.storage.frames[prev][l].read).value;
     }
     s.storageReadSlot = s.layerReadSlot[SHADEL_LAYER_RADIANCE];
-    s.changedLights = address(gpu, d.changedLights);
+    s.changedVolumes = address(gpu, d.changedVolumes);
     s.levelWants = address(gpu, d.levelWants);
-    s.changedLightCount = d.changedLightsOverflow ? 0u : uint32_t(r.changedLightVolumes.size());
+    s.changedVolumeCount = d.changesOverflow ? 0u : uint32_t(d.changes.size());
     s.frameNumber = uint32_t(d.frameNumber);
     s.reuse = d.reuse ? 1u : 0u;
     s.storageChunksPerRow = d.storageSize / SHADEL_CHUNK;
@@ -991,6 +986,18 @@ void decoupledStats(const Renderer& r, nlohmann::json& s) {
         reusedSum += d.history[i].counters.chunksReused;
     }
     s["reuse_fraction"] = storedSum ? double(reusedSum) / double(storedSum) : 0.0;
+    // Why the rest was shaded, as fractions of the same stored chunks (over the same frames):
+    // what a better reuse could still win, and from where.
+    const char* const reasonNames[SHADEL_SHADED_REASONS] = {"level_changed", "new", "refresh",
+                                                            "near_change"};
+    nlohmann::json because = nlohmann::json::object();
+    for (uint32_t k = 0; k < SHADEL_SHADED_REASONS; ++k) {
+        uint64_t sum = 0;
+        for (size_t i = d.history.size() > 1 ? 1 : 0; i < d.history.size(); ++i)
+            sum += d.history[i].counters.shadedBecause[k];
+        because[reasonNames[k]] = storedSum ? double(sum) / double(storedSum) : 0.0;
+    }
+    s["shaded_because"] = because;
     // Shadels per covered pixel: the storage's density (shaded or carried over).
     s["shadels_per_pixel"] = covered ? double(stored) / double(covered) : 0.0;
     s["chunks_allocated"] = last.counters.chunksAllocated;
