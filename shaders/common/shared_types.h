@@ -569,10 +569,11 @@ struct GpuShadelWork {
 };
 
 // Why a marked chunk is shaded rather than carried over (GpuShadelCounters::shadedBecause).
-#define SHADEL_SHADED_LEVEL_CHANGED 0u // reuse off, or the object's level or inputs changed
-#define SHADEL_SHADED_NEW 1u           // last frame did not store the chunk
-#define SHADEL_SHADED_REFRESH 2u       // stored, but its turn to be refreshed
-#define SHADEL_SHADED_NEAR_CHANGE 3u   // a changed region meets the object: shading decides
+#define SHADEL_SHADED_NOT_REUSABLE                                                                 \
+    0u                               // reuse off; the object is new, or its level or inputs changed
+#define SHADEL_SHADED_NEW 1u         // last frame did not store the chunk
+#define SHADEL_SHADED_REFRESH 2u     // stored, but its turn to be refreshed
+#define SHADEL_SHADED_NEAR_CHANGE 3u // a changed region meets the object: shading decides
 #define SHADEL_SHADED_REASONS 4
 
 struct GpuShadelCounters {

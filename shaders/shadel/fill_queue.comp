@@ -58,7 +58,7 @@ void main() {
             continue;
         }
         ShadelWorkBuffer(s.queue).w[atomicAdd(counters.c.shadeCount, 1u)] = w;
-        uint reason = !levelReusable ? SHADEL_SHADED_LEVEL_CHANGED
+        uint reason = !levelReusable ? SHADEL_SHADED_NOT_REUSABLE
                       : nearChange   ? SHADEL_SHADED_NEAR_CHANGE
                       : refresh      ? SHADEL_SHADED_REFRESH
                                      : SHADEL_SHADED_NEW;

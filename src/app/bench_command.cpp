@@ -521,6 +521,12 @@ nlohmann::json runBench(Gpu& gpu, const BenchOptions& b) {
     row("shadels per covered pixel", decoupledOnly("shadels_per_pixel", "%.3f"));
     row("shadels shaded (last)", decoupledOnly("shadels_shaded", ""));
     row("reuse fraction", decoupledOnly("reuse_fraction", "%.3f"));
+    // Why the chunks not carried over were shaded (fractions of the stored chunks).
+    for (const char* reason : {"new", "refresh", "not_reusable", "near_change"})
+        row(("  shaded: " + std::string(reason)).c_str(), [reason](const nlohmann::json& s) {
+            if (!s.contains("shaded_because")) return std::string("-");
+            return format("%.3f", s["shaded_because"][reason].get<double>());
+        });
     row("occupancy bits per shadel", decoupledOnly("occupancy_bits_per_shadel", "%.3f"));
     row("reconstruction misses", decoupledOnly("reconstruction_misses", ""));
     if (b.compareLightCulling)

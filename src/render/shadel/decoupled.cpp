@@ -988,7 +988,7 @@ void decoupledStats(const Renderer& r, nlohmann::json& s) {
     s["reuse_fraction"] = storedSum ? double(reusedSum) / double(storedSum) : 0.0;
     // Why the rest was shaded, as fractions of the same stored chunks (over the same frames):
     // what a better reuse could still win, and from where.
-    const char* const reasonNames[SHADEL_SHADED_REASONS] = {"level_changed", "new", "refresh",
+    const char* const reasonNames[SHADEL_SHADED_REASONS] = {"not_reusable", "new", "refresh",
                                                             "near_change"};
     nlohmann::json because = nlohmann::json::object();
     for (uint32_t k = 0; k < SHADEL_SHADED_REASONS; ++k) {
