@@ -158,7 +158,9 @@ nlohmann::json runShadowCullingBench(Gpu& gpu, const BenchOptions& b, RenderOpti
 
 // --stencil-compare: the same forward frames with --screen-space on and the stencil effects,
 // stencil-culled and full-screen (the same shaders on every pixel, branching per pixel). The
-// ratio of each effect pass is culled / full-screen; the marks (stencilMark) are reported apart.
+// ratio of each effect pass is culled / full-screen; the marks (stencilMark) are reported apart,
+// and so is the unbounded stencil draw (one triangle over the whole target, the stencil test
+// alone culling) the culled passes improve on by drawing only over their instances' rects.
 nlohmann::json runStencilBench(Gpu& gpu, const BenchOptions& b, RenderOptions o) {
     nlohmann::json out;
     out["scene"] = b.scene;
@@ -167,6 +169,7 @@ nlohmann::json runStencilBench(Gpu& gpu, const BenchOptions& b, RenderOptions o)
     o.mode = RenderMode::Forward;
     o.screenSpace = true;
     for (auto [name, mode] : {std::pair{"stencil", StencilEffects::On},
+                              std::pair{"stencil_unbounded", StencilEffects::OnUnbounded},
                               std::pair{"fullscreen", StencilEffects::FullScreen}}) {
         std::fprintf(stderr, "bench: stencil effects %s, %u frames at %ux%u\n", name, b.frames,
                      b.width, b.height);
@@ -184,6 +187,9 @@ nlohmann::json runStencilBench(Gpu& gpu, const BenchOptions& b, RenderOptions o)
                          {"water_composite", water},
                          {"water_composite_fullscreen", waterFull},
                          {"stencil_mark", passMs(culled, "stencilMark")}};
+    const nlohmann::json& unbounded = out["modes"]["stencil_unbounded"];
+    out["stencil_ms"]["character_outline_unbounded"] = passMs(unbounded, "characterOutline");
+    out["stencil_ms"]["water_composite_unbounded"] = passMs(unbounded, "waterComposite");
     out["ratios"]["stencil_outline"] = outlineFull > 0 ? outline / outlineFull : 0.0;
     out["ratios"]["stencil_water"] = waterFull > 0 ? water / waterFull : 0.0;
     std::printf("shadel bench --stencil-compare: %s at %ux%u on %s, %u frames, medians (timing: "
@@ -194,6 +200,10 @@ nlohmann::json runStencilBench(Gpu& gpu, const BenchOptions& b, RenderOptions o)
                 outlineFull, out["ratios"]["stencil_outline"].get<double>());
     std::printf("  waterComposite    stencil %.3f ms / full-screen %.3f ms = %.3f\n", water,
                 waterFull, out["ratios"]["stencil_water"].get<double>());
+    std::printf("  unbounded stencil draws (whole target): characterOutline %.3f ms, "
+                "waterComposite %.3f ms\n",
+                out["stencil_ms"]["character_outline_unbounded"].get<double>(),
+                out["stencil_ms"]["water_composite_unbounded"].get<double>());
     std::printf("  stencilMark (depth-stencil copy + marks) %.3f ms\n",
                 out["stencil_ms"]["stencil_mark"].get<double>());
     if (!b.json.empty()) writeOutputFile(b.json, out.dump(2) + "\n");

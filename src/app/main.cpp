@@ -382,10 +382,12 @@ int main(int argc, char** argv) {
                      "beyond this distance from the camera (0: everywhere), the shadow map nearer")
         ->capture_default_str();
     render
-        ->add_option("--stencil-effects", stencilEffects,
-                     "off | on | fullscreen: water composite and character outline with "
-                     "occlusion tint, culled by the stencil test (fullscreen: every pixel, "
-                     "the baseline; needs --screen-space on)")
+        ->add_option(
+            "--stencil-effects", stencilEffects,
+            "off | on | on-unbounded | fullscreen: water composite and character "
+            "outline with occlusion tint, culled by the stencil test within their "
+            "instances' screen rects (on-unbounded: full-screen triangles with the "
+            "stencil test; fullscreen: every pixel, the baseline; needs --screen-space on)")
         ->capture_default_str();
     // Texture streaming (render/streaming).
     render
@@ -688,12 +690,15 @@ int main(int argc, char** argv) {
             ro.screenSpace = parseOnOff("--screen-space", screenSpace);
             ro.tileClassification = parseOnOff("--tile-classification", tileClassification);
             ro.distanceFields = parseOnOff("--distance-fields", distanceFields);
-            if (stencilEffects != "off" && stencilEffects != "on" && stencilEffects != "fullscreen")
-                throw InputError(format("--stencil-effects %s: expected off, on or fullscreen",
-                                        stencilEffects.c_str()));
-            ro.stencilEffects = stencilEffects == "on"           ? StencilEffects::On
-                                : stencilEffects == "fullscreen" ? StencilEffects::FullScreen
-                                                                 : StencilEffects::Off;
+            if (stencilEffects != "off" && stencilEffects != "on" &&
+                stencilEffects != "fullscreen" && stencilEffects != "on-unbounded")
+                throw InputError(
+                    format("--stencil-effects %s: expected off, on, on-unbounded or fullscreen",
+                           stencilEffects.c_str()));
+            ro.stencilEffects = stencilEffects == "on"             ? StencilEffects::On
+                                : stencilEffects == "fullscreen"   ? StencilEffects::FullScreen
+                                : stencilEffects == "on-unbounded" ? StencilEffects::OnUnbounded
+                                                                   : StencilEffects::Off;
             if (streaming != "layered" && streaming != "sparse")
                 throw InputError(
                     format("--streaming %s: expected layered or sparse", streaming.c_str()));

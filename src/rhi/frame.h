@@ -65,7 +65,7 @@ struct FrameRecorder {
     uint32_t maxPasses = 64;
     std::vector<PassTiming> passes; // filled by endFrame()
     double frameMs = 0.0;           // wall clock from beginFrame to the GPU finishing
-    double gpuWaitMs = 0.0;         // of which the CPU waited on fences
+    double gpuWaitMs = 0.0;         // of which the CPU waited on fences or blocked in a submit
     std::chrono::steady_clock::time_point frameStart;
     // Binary semaphores the frame's next submission waits on (at every stage), then forgets:
     // work queued before the frame that the frame depends on (sparse binds, render/streaming).

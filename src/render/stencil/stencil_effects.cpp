@@ -9,6 +9,7 @@
 #include "render/forward/forward_passes.h"
 #include "render/renderer.h"
 #include "render/screenspace/screen_space.h"
+#include "render/stencil/screen_rects.h"
 #include "stencil/stencil_bits.h"
 
 namespace shadel {
@@ -125,32 +126,20 @@ void drawMarks(Renderer& r, VkCommandBuffer cmd, const Pipeline& p,
         vkCmdDrawIndexed(cmd, d.indexCount, 1, d.firstIndex, d.vertexOffset, d.instance);
 }
 
-// The pixels the instances' world boxes can cover, grown by `margin` (a coarse stand-in for
-// hierarchical stencil: lavapipe tests the stencil per pixel, so a full-screen triangle over a
-// few stencil pixels still costs a test per pixel; the rect keeps the test near them). The whole
-// target when a box reaches behind the camera.
-VkRect2D screenRect(const Renderer& r, const std::vector<MarkDraw>& draws,
-                    const glm::mat4& viewProj, int margin) {
+// Disjoint rects covering every pixel the instances' world boxes can cover (a coarse stand-in
+// for hierarchical stencil: lavapipe tests the stencil per pixel, so a full-screen triangle over
+// a few stencil pixels still costs a test per pixel; the rects keep the tests near them). The
+// effects write only their own stencil pixels, which the instances cover, so a margin of a pixel
+// for rounding is enough (the outline lies inside the silhouette).
+std::vector<PixelRect> effectRects(const Renderer& r, const std::vector<MarkDraw>& draws,
+                                   const glm::mat4& viewProj) {
     int w = int(r.internalWidth), h = int(r.internalHeight);
-    VkRect2D whole{{0, 0}, {uint32_t(w), uint32_t(h)}};
-    glm::vec2 lo(1e9f), hi(-1e9f);
-    for (const MarkDraw& d : draws)
-        for (int c = 0; c < 8; ++c) {
-            glm::vec3 p((c & 1) ? d.worldMax.x : d.worldMin.x,
-                        (c & 2) ? d.worldMax.y : d.worldMin.y,
-                        (c & 4) ? d.worldMax.z : d.worldMin.z);
-            glm::vec4 clip = viewProj * glm::vec4(p, 1.0f);
-            if (clip.w <= 1e-4f) return whole;
-            glm::vec2 px = (glm::vec2(clip) / clip.w * 0.5f + 0.5f) * glm::vec2(w, h);
-            lo = glm::min(lo, px);
-            hi = glm::max(hi, px);
-        }
-    int x0 = std::clamp(int(std::floor(lo.x)) - margin, 0, w);
-    int y0 = std::clamp(int(std::floor(lo.y)) - margin, 0, h);
-    int x1 = std::clamp(int(std::ceil(hi.x)) + margin, 0, w);
-    int y1 = std::clamp(int(std::ceil(hi.y)) + margin, 0, h);
-    if (x1 <= x0 || y1 <= y0) return {{0, 0}, {0, 0}};
-    return {{x0, y0}, {uint32_t(x1 - x0), uint32_t(y1 - y0)}};
+    std::vector<PixelRect> boxes;
+    for (const MarkDraw& d : draws) {
+        PixelRect box = projectedBoxRect(viewProj, d.worldMin, d.worldMax, w, h, 1);
+        if (!box.empty()) boxes.push_back(box);
+    }
+    return disjointCover(boxes);
 }
 
 gpu::ScreenSpacePush effectPush(Renderer& r, const StencilEffectsState& s, uint64_t frame) {
@@ -248,18 +237,21 @@ StencilEffectsStatePtr createStencilEffects(Renderer& r, const Scene& scene,
     effect.depthTest = false;
     effect.depthWrite = false;
     effect.cullMode = VK_CULL_MODE_NONE;
-    effect.stencilTest = mode == StencilEffects::On;
-    effect.name = mode == StencilEffects::On ? "waterComposite" : "waterCompositeFullScreen";
+    bool culled = mode != StencilEffects::FullScreen;
+    effect.stencilTest = culled;
+    effect.name = culled ? "waterComposite" : "waterCompositeFullScreen";
     effect.fragmentShader = "stencil_water_composite.frag.spv";
     effect.stencil = stencilOps(VK_COMPARE_OP_EQUAL, STENCIL_WATER, VK_STENCIL_OP_KEEP);
     s->water = createGraphicsPipeline(gpu, effect);
-    effect.name = mode == StencilEffects::On ? "characterOutline" : "characterOutlineFullScreen";
+    effect.name = culled ? "characterOutline" : "characterOutlineFullScreen";
     effect.fragmentShader = "stencil_character_outline.frag.spv";
     effect.stencil = stencilOps(VK_COMPARE_OP_EQUAL, STENCIL_CHARACTER, VK_STENCIL_OP_KEEP);
     s->outline = createGraphicsPipeline(gpu, effect);
     SHADEL_INFO("stencil effects: %zu water and %zu character instances, %s", s->waterDraws.size(),
                 s->characterDraws.size(),
-                mode == StencilEffects::On ? "stencil-culled" : "full-screen");
+                mode == StencilEffects::On            ? "stencil-culled in their screen rects"
+                : mode == StencilEffects::OnUnbounded ? "stencil-culled, full-screen triangles"
+                                                      : "full-screen");
     return s;
 }
 
@@ -330,17 +322,40 @@ void recordStencilEffects(Renderer& r, FrameRecorder& rec, uint64_t frame,
                      VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT, kFragment, kStorageReadWrite);
     });
     auto effect = [&](const char* name, const Pipeline& p, const std::vector<MarkDraw>& draws,
-                      int margin, bool last) {
-        // Stencil-culled: only the rect the marked instances can cover (the full-screen version
-        // covers the whole target, as its name says).
-        bool culled = s.mode == StencilEffects::On;
-        VkRect2D area = culled ? screenRect(r, draws, viewProj, margin) : VkRect2D{};
-        pass(rec, name, [&, culled, area, last, push](VkCommandBuffer cmd) {
-            bool empty = culled && area.extent.width == 0;
-            beginDepthStencil(r, s, cmd, false, empty ? VkRect2D{{0, 0}, {1, 1}} : area);
+                      bool last) {
+        // Stencil-culled: one full-screen triangle per disjoint rect its instances can cover,
+        // each scissored to its rect (none when they are all off-screen); unbounded: one
+        // triangle over the whole target, the stencil test alone culling; the full-screen
+        // version covers the whole target without the stencil test, as its name says.
+        bool bounded = s.mode == StencilEffects::On;
+        const VkRect2D whole{{0, 0}, {r.internalWidth, r.internalHeight}};
+        std::vector<VkRect2D> rects;
+        if (bounded)
+            for (const PixelRect& pr : effectRects(r, draws, viewProj))
+                rects.push_back(
+                    {{pr.x0, pr.y0}, {uint32_t(pr.x1 - pr.x0), uint32_t(pr.y1 - pr.y0)}});
+        else
+            rects.push_back(whole);
+        // The render area: the rects' bounds (a pixel when there is nothing to draw).
+        VkRect2D area{{0, 0}, {1, 1}};
+        if (!rects.empty()) {
+            int x0 = r.internalWidth, y0 = r.internalHeight, x1 = 0, y1 = 0;
+            for (const VkRect2D& rc : rects) {
+                x0 = std::min(x0, rc.offset.x);
+                y0 = std::min(y0, rc.offset.y);
+                x1 = std::max(x1, rc.offset.x + int(rc.extent.width));
+                y1 = std::max(y1, rc.offset.y + int(rc.extent.height));
+            }
+            area = {{x0, y0}, {uint32_t(x1 - x0), uint32_t(y1 - y0)}};
+        }
+        pass(rec, name, [&, rects, area, last, push](VkCommandBuffer cmd) {
+            beginDepthStencil(r, s, cmd, false, area);
             bind(gpu, cmd, p);
             pushConstants(gpu, cmd, push);
-            if (!empty) vkCmdDraw(cmd, 3, 1, 0, 0);
+            for (const VkRect2D& rc : rects) {
+                vkCmdSetScissor(cmd, 0, 1, &rc);
+                vkCmdDraw(cmd, 3, 1, 0, 0);
+            }
             vkCmdEndRendering(cmd);
             if (!last)
                 memoryBarrier(cmd, kFragment, VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT, kFragment,
@@ -354,10 +369,9 @@ void recordStencilEffects(Renderer& r, FrameRecorder& rec, uint64_t frame,
         });
     };
     bool full = s.mode == StencilEffects::FullScreen;
-    int outlineRadius = std::max(1, int(r.internalHeight) / 360); // character_outline.frag
-    effect(full ? "waterCompositeFullScreen" : "waterComposite", s.water, s.waterDraws, 1, false);
+    effect(full ? "waterCompositeFullScreen" : "waterComposite", s.water, s.waterDraws, false);
     effect(full ? "characterOutlineFullScreen" : "characterOutline", s.outline, s.characterDraws,
-           outlineRadius + 1, true);
+           true);
 }
 
 } // namespace shadel

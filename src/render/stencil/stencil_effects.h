@@ -8,6 +8,7 @@
 // where they are seen and, with the depth test inverted, where they are hidden. The full-screen
 // version (--stencil-effects fullscreen) runs the same shaders on every pixel without the
 // stencil test, branching per pixel: the same image, the baseline of `bench --stencil-compare`.
+// The culled effects draw only over their instances' screen rects (render/stencil/screen_rects).
 #include <memory>
 
 #include <glm/glm.hpp>
@@ -26,7 +27,11 @@ struct StencilEffectsStateDeleter {
 };
 using StencilEffectsStatePtr = std::unique_ptr<StencilEffectsState, StencilEffectsStateDeleter>;
 
-enum class StencilEffects : uint32_t { Off, On, FullScreen };
+// On: the effects' triangles are scissored to disjoint rects covering their instances' projected
+// boxes, so the stencil is tested only near them. OnUnbounded (--stencil-effects on-unbounded):
+// one triangle over the whole target, the stencil test alone culling (the same image; the
+// reference of the bounded draw in tests and benchmarks).
+enum class StencilEffects : uint32_t { Off, On, FullScreen, OnUnbounded };
 
 // Water instances by their material class, characters by Instance::character.
 StencilEffectsStatePtr createStencilEffects(Renderer& r, const Scene& scene,
