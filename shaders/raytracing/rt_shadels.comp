@@ -27,9 +27,9 @@ uint texelTriangle(ShadelFrame s, RtShadelObject o, uvec2 texel) {
 // (RtFrame::shadelTexelPixelScale: the far part of a large object whose nearest point set the
 // MIP) is traced by one of its texels (`turn`: the first with a surface; `surfaces`: a bit each)
 // into a history its texels share, as a texel of the next coarser MIP would be. Decided from
-// that texel, so the block's four threads agree. (Rotating the turn over the block's texels
-// spreads the rays over its area but mixes texels of different surfaces at coarse MIPs: two
-// 256-ray references of the same view then differed by 28 dB, against 48 dB with a fixed one.)
+// that texel, so the block's four threads agree. (A turn rotating over the block's texels
+// frame by frame was tried: two 256-ray references of one view, 4 x 64 and 8 x 32 rays, then
+// differed by 28 dB, against 48 dB with the fixed texel; not understood, so left out.)
 struct BlockTurn {
     bool finer;
     uint turn;
@@ -105,11 +105,12 @@ void main() {
     // Blocks finer than needed (far parts of large objects) trace one texel into the history
     // the block's texels share: as many rays as a texel of the MIP they should have had. Texels
     // without a surface are written empty by their own threads below.
-    BlockTurn block = blockTurn(f, rt, s, o, tile.object, texel >> 1u);
-    uint self = (texel.x & 1u) + 2u * (texel.y & 1u);
     // Not with hard traced shadows (the sun's or the spots'): exact per point, they would lose
     // resolution (the skinned strip's shadow fell from 46.6 to 42.2 dB against its map).
     bool hardShadows = rt.shadows != 0u && rt.shadowRays == 1u;
+    BlockTurn block = hardShadows ? BlockTurn(false, 0u, 0u)
+                                  : blockTurn(f, rt, s, o, tile.object, texel >> 1u);
+    uint self = (texel.x & 1u) + 2u * (texel.y & 1u);
     bool blockShared = block.finer && !hardShadows && (block.surfaces & (1u << self)) != 0u;
     if (blockShared && self != block.turn) return; // the block's turn texel writes this one
     uint blockTexels = blockShared ? block.surfaces : 0u;
