@@ -74,7 +74,11 @@ void useRayTracedPixelTerms(FrameConstants f, vec2 fragCoord) {
 layout(buffer_reference, scalar) readonly buffer RtShadelObjectRefs { RtShadelObject o[]; };
 
 // Shadel path: the object's RT cache (rt_shadels.comp), read bilinearly at the shadel's UV in
-// the object's shadel space (texels with no surface are left out of the filter).
+// the object's shadel space (texels with no surface are left out of the filter). While those
+// texels hold few rays (new in view, or reset) the noisy terms (AO, GI, soft sun) also pool the
+// rays of the 4x4 texels around (a tent two texels wide, each texel weighted by its rays, texels
+// of another surface left out), blended out as the bilinear texels reach RT_SHADEL_FILTER_RAYS:
+// what the forward path's 3x3 filter does per pixel, here only until the history holds enough.
 void useRayTracedShadelTerms(FrameConstants f, uint object, vec2 shadelUv) {
     if (f.rt == 0ul) return;
     RtFrame rt = RtFrameRef(f.rt).r;
@@ -84,8 +88,9 @@ void useRayTracedShadelTerms(FrameConstants f, uint object, vec2 shadelUv) {
     vec2 t = clamp(shadelUv * vec2(o.size) - 0.5, vec2(0.0), vec2(o.size) - 1.0);
     ivec2 t0 = ivec2(floor(t));
     vec2 fr = t - vec2(t0);
-    vec4 terms = vec4(0.0);
+    vec4 terms = vec4(0.0); // sun, AO, -, rays
     vec3 indirect = vec3(0.0);
+    vec3 normalSum = vec3(0.0);
     float spots[LIGHT_MAX_SPOT_SHADOWS];
     for (uint j = 0u; j < rt.spotShadowCount; ++j) spots[j] = 0.0;
     float weight = 0.0;
@@ -95,22 +100,62 @@ void useRayTracedShadelTerms(FrameConstants f, uint object, vec2 shadelUv) {
         vec4 v = texelFetch(gTextures[rt.shadelTermsRead], q, 0);
         float w = (d.x == 1 ? fr.x : 1.0 - fr.x) * (d.y == 1 ? fr.y : 1.0 - fr.y);
         if (v.w <= 0.0) continue; // no surface there
+        vec4 ind = texelFetch(gTextures[rt.shadelIndirectRead], q, 0);
         terms += v * w;
-        if (rt.gi != 0u) indirect += texelFetch(gTextures[rt.shadelIndirectRead], q, 0).rgb * w;
+        indirect += ind.rgb * w;
+        normalSum += rtOctDecode(vec2(v.z, ind.w)) * w;
         if (rt.spotShadowCount != 0u) {
             uvec4 sv = texelFetch(gUTextures[rt.shadelSpotRead], q, 0);
             for (uint j = 0u; j < rt.spotShadowCount; ++j) spots[j] += rtSpotVisibility(sv, j) * w;
         }
         weight += w;
     }
-    if (weight <= 0.0) return;
-    if (rt.spotShadowCount != 0u) {
+    // No rays under the bilinear taps yet (texels waiting their turn, rt_shadels.comp): the
+    // pooled neighbours alone.
+    bool traced = weight > 0.0;
+    terms = traced ? terms / weight : vec4(1.0, 1.0, 0.0, 0.0);
+    indirect = traced ? indirect / weight : vec3(0.0);
+    // Few rays yet: the rays of the same surface around, pooled.
+    float history = clamp(terms.w / RT_SHADEL_FILTER_RAYS, 0.0, 1.0);
+    if (history < 1.0) {
+        // The surface: the bilinear taps' normal, or with none traced, the nearest texel's.
+        vec3 centreNormal = normalSum;
+        if (!traced) {
+            ivec2 q = ivec2(o.origin) + clamp(ivec2(round(t)), ivec2(0), ivec2(o.size) - 1);
+            centreNormal = rtOctDecode(vec2(texelFetch(gTextures[rt.shadelTermsRead], q, 0).z,
+                                            texelFetch(gTextures[rt.shadelIndirectRead], q, 0).w));
+        }
+        centreNormal = normalize(centreNormal);
+        vec3 pooled = vec3(0.0); // sun, AO, rays
+        vec3 pooledIndirect = vec3(0.0);
+        for (int y = -1; y <= 2; ++y)
+            for (int x = -1; x <= 2; ++x) {
+                ivec2 c = t0 + ivec2(x, y);
+                if (any(lessThan(c, ivec2(0))) || any(greaterThanEqual(c, ivec2(o.size)))) continue;
+                vec2 tent = max(1.0 - abs(vec2(c) - t) * 0.5, vec2(0.0));
+                ivec2 q = ivec2(o.origin) + c;
+                vec4 v = texelFetch(gTextures[rt.shadelTermsRead], q, 0);
+                if (v.w <= 0.0) continue;
+                vec4 ind = texelFetch(gTextures[rt.shadelIndirectRead], q, 0);
+                if (dot(rtOctDecode(vec2(v.z, ind.w)), centreNormal) < 0.9) continue;
+                float w = tent.x * tent.y * v.w;
+                pooled += vec3(v.xy, 1.0) * w;
+                pooledIndirect += ind.rgb * w;
+            }
+        if (!traced && pooled.z <= 0.0) return; // nothing traced around yet
+        if (pooled.z > 0.0) {
+            terms.y = mix(pooled.y / pooled.z, terms.y, history);
+            if (rt.shadowRays > 1u || !traced) terms.x = mix(pooled.x / pooled.z, terms.x, history);
+            indirect = mix(pooledIndirect / pooled.z, indirect, history);
+        }
+    }
+    if (rt.spotShadowCount != 0u && traced) {
         gRtSpots = true;
         gRtSpotVisibility = rtPackSpotMeans(spots, weight, rt.spotShadowCount);
     }
     gRtSun = rt.shadows != 0u;
-    gRtSunVisibility = terms.x / weight;
-    gRtOcclusion = rt.ao != 0u ? terms.y / weight : 1.0;
-    gRtIndirect = indirect / weight;
+    gRtSunVisibility = terms.x;
+    gRtOcclusion = rt.ao != 0u ? terms.y : 1.0;
+    gRtIndirect = indirect;
 }
 #endif

@@ -18,6 +18,78 @@ uint cachedTriangle(ShadelFrame s, uint offset) {
     return (word >> ((offset & 1u) * 16u)) & 0xFFFFu;
 }
 
+// The texel's triangle (0xFFFF: no surface), from the level's triangle-ID map.
+uint texelTriangle(ShadelFrame s, RtShadelObject o, uvec2 texel) {
+    return cachedTriangle(s, o.idMapOffset + texel.y * o.size.x + texel.x);
+}
+
+// A 2x2 block of texels finer on screen than the cache's MIP was chosen for
+// (RtFrame::shadelTexelPixelScale: the far part of a large object whose nearest point set the
+// MIP) is traced by one of its texels (`turn`: the first with a surface; `surfaces`: a bit each)
+// into a history its texels share, as a texel of the next coarser MIP would be. Decided from
+// that texel, so the block's four threads agree. (A turn rotating over the block's texels
+// frame by frame was tried: two 256-ray references of one view, 4 x 64 and 8 x 32 rays, then
+// differed by 28 dB, against 48 dB with the fixed texel; not understood, so left out.)
+struct BlockTurn {
+    bool finer;
+    uint turn;
+    uint surfaces;
+};
+
+BlockTurn blockTurn(FrameConstants f, RtFrame rt, ShadelFrame s, RtShadelObject o, uint object,
+                    uvec2 block) {
+    BlockTurn b = BlockTurn(false, 0u, 0u);
+    bool decided = false;
+    for (uint k = 0u; k < 4u; ++k) {
+        uvec2 texel = block * 2u + uvec2(k & 1u, k >> 1u);
+        if (any(greaterThanEqual(texel, o.size))) continue;
+        uint tri = texelTriangle(s, o, texel);
+        if (tri == 0xFFFFu) continue;
+        b.surfaces |= 1u << k;
+        if (decided) continue;
+        decided = true;
+        GpuInstance inst = InstanceBuffer(f.instances).i[object];
+        GpuMesh mesh = MeshBuffer(f.meshes).m[inst.mesh];
+        IndexBuffer indices = IndexBuffer(f.indices);
+        uint i0 = indices.i[mesh.firstIndex + tri * 3u] + uint(mesh.vertexOffset);
+        uint i1 = indices.i[mesh.firstIndex + tri * 3u + 1u] + uint(mesh.vertexOffset);
+        uint i2 = indices.i[mesh.firstIndex + tri * 3u + 2u] + uint(mesh.vertexOffset);
+        VertexBuffer vb = VertexBuffer(f.vertices);
+        Vec2Buffer uvs = Vec2Buffer(s.shadelUvs);
+        vec3 e1 = (inst.model * vec4(vb.v[i1].position - vb.v[i0].position, 0.0)).xyz;
+        vec3 e2 = (inst.model * vec4(vb.v[i2].position - vb.v[i0].position, 0.0)).xyz;
+        vec2 u1 = (uvs.v[i1] - uvs.v[i0]) * vec2(o.size), u2 = (uvs.v[i2] - uvs.v[i0]) * vec2(o.size);
+        float texels = abs(u1.x * u2.y - u1.y * u2.x); // the triangle's area in texels, x2
+        float side = sqrt(length(cross(e1, e2)) / max(texels, 1e-12)); // a texel's, world units
+        vec3 bary = shadelBarycentrics(shadelCenterUv(texel, o.size), uvs.v[i0], uvs.v[i1], uvs.v[i2]);
+        bary = max(bary, vec3(0.0));
+        bary /= max(bary.x + bary.y + bary.z, 1e-6);
+        vec3 p = (inst.model * vec4(shadelInterpolate(bary, vb.v[i0].position, vb.v[i1].position,
+                                                      vb.v[i2].position), 1.0)).xyz;
+        b.finer = side * rt.shadelTexelPixelScale < length(f.cameraPosition - p);
+    }
+    b.turn = b.surfaces == 0u ? 0u : uint(findLSB(b.surfaces));
+    return b;
+}
+
+// Writes the texel, or, given its block's texels (a bit each), those of its 2x2 block.
+void storeTerms(RtFrame rt, RtShadelObject o, uvec2 texel, uint blockTexels, vec4 terms, vec4 indirect) {
+    for (uint k = 0u; k < (blockTexels != 0u ? 4u : 1u); ++k) {
+        uvec2 t = blockTexels != 0u ? (texel & ~1u) + uvec2(k & 1u, k >> 1u) : texel;
+        if (blockTexels != 0u && (blockTexels & (1u << k)) == 0u) continue;
+        imageStore(gImagesRgba16f[rt.shadelTermsWrite], ivec2(o.origin + t), terms);
+        imageStore(gImagesRgba16f[rt.shadelIndirectWrite], ivec2(o.origin + t), indirect);
+    }
+}
+
+void storeSpots(RtFrame rt, RtShadelObject o, uvec2 texel, uint blockTexels, uvec4 spots) {
+    for (uint k = 0u; k < (blockTexels != 0u ? 4u : 1u); ++k) {
+        uvec2 t = blockTexels != 0u ? (texel & ~1u) + uvec2(k & 1u, k >> 1u) : texel;
+        if (blockTexels != 0u && (blockTexels & (1u << k)) == 0u) continue;
+        imageStore(gImagesRgba32ui[rt.shadelSpotWrite], ivec2(o.origin + t), spots);
+    }
+}
+
 void main() {
     FrameConstants f = FrameConstantsRef(pc.frame).f;
     RtFrame rt = RtFrameRef(f.rt).r;
@@ -29,12 +101,25 @@ void main() {
     uvec2 texel = uvec2(tile.tile & 0xFFFFu, tile.tile >> 16) * 8u + gl_LocalInvocationID.xy;
     if (any(greaterThanEqual(texel, o.size))) return;
     ivec2 atlas = ivec2(o.origin + texel);
+    bool reset = (o.flags & RT_SHADEL_RESET) != 0u;
+    // Blocks finer than needed (far parts of large objects) trace one texel into the history
+    // the block's texels share: as many rays as a texel of the MIP they should have had. Texels
+    // without a surface are written empty by their own threads below.
+    // Not with hard traced shadows (the sun's or the spots'): exact per point, they would lose
+    // resolution (the skinned strip's shadow fell from 46.6 to 42.2 dB against its map).
+    bool hardShadows = rt.shadows != 0u && rt.shadowRays == 1u;
+    BlockTurn block = hardShadows ? BlockTurn(false, 0u, 0u)
+                                  : blockTurn(f, rt, s, o, tile.object, texel >> 1u);
+    uint self = (texel.x & 1u) + 2u * (texel.y & 1u);
+    bool blockShared = block.finer && !hardShadows && (block.surfaces & (1u << self)) != 0u;
+    if (blockShared && self != block.turn) return; // the block's turn texel writes this one
+    uint blockTexels = blockShared ? block.surfaces : 0u;
     vec4 history = imageLoad(gImagesRgba16f[rt.shadelTermsWrite], atlas);
-    float count = (o.flags & RT_SHADEL_RESET) != 0u ? 0.0 : history.w;
+    float count = reset ? 0.0 : history.w;
     // Converged: the texel is reused as it is until its inputs change (the seed's "trace once
     // per shadel and reuse"; a reset starts it again).
     if (count >= float(rt.historyRays)) return;
-    uint tri = cachedTriangle(s, o.idMapOffset + texel.y * o.size.x + texel.x);
+    uint tri = texelTriangle(s, o, texel);
     if (tri == 0xFFFFu) { // no surface here (outside every chart and its gutter): never read
         imageStore(gImagesRgba16f[rt.shadelTermsWrite], atlas, vec4(1.0, 1.0, 0.0, 0.0));
         imageStore(gImagesRgba16f[rt.shadelIndirectWrite], atlas, vec4(0.0));
@@ -70,19 +155,17 @@ void main() {
     for (int i = 0; i < 6; ++i) inView = inView && dot(f.frustumPlanes[i], vec4(p, 1.0)) >= -margin;
     if (!facing || !inView) {
         if (count == 0.0) {
-            imageStore(gImagesRgba16f[rt.shadelTermsWrite], atlas, vec4(1.0, 1.0, 0.0, 0.0));
-            imageStore(gImagesRgba16f[rt.shadelIndirectWrite], atlas, vec4(0.0));
-            if (rt.spotShadowCount != 0u)
-                imageStore(gImagesRgba32ui[rt.shadelSpotWrite], atlas, uvec4(0xFFFFFFFFu));
+            storeTerms(rt, o, texel, blockTexels, vec4(1.0, 1.0, 0.0, 0.0), vec4(0.0));
+            if (rt.spotShadowCount != 0u) storeSpots(rt, o, texel, blockTexels, uvec4(0xFFFFFFFFu));
         }
         return;
     }
 
     vec4 indirectHistory = imageLoad(gImagesRgba16f[rt.shadelIndirectWrite], atlas);
-    // A texel's first frame (new in view, or reset) traces RT_SHADEL_FIRST_RAYS: with one ray
-    // its estimate is 0 or 1 and the next frames' running mean swings widely (a moving camera
-    // shows new texels every frame: that swing is most of the shadel path's flicker).
-    uint rays = count == 0.0 ? max(rt.raysPerShadel, RT_SHADEL_FIRST_RAYS) : rt.raysPerShadel;
+    // A texel's first frame (new in view, or reset) traces no more than the others: while a
+    // texel holds few rays, the read (useRayTracedShadelTerms) pools its neighbours' rays
+    // instead (more rays on first frames were most of the path's cost under a moving camera).
+    uint rays = rt.raysPerShadel;
     uint seed = rtHash(tile.object * 0x9e3779b9u ^ rtHash(uint(atlas.x) | uint(atlas.y) << 16));
     uint sampleBase = uint(count); // continue the sequence: no sample is drawn twice
     float sun = rt.shadows != 0u ? rtSunVisibility(f, rt, p, ng, seed, sampleBase) : 1.0;
@@ -91,17 +174,18 @@ void main() {
     // The running mean of every ray so far.
     float total = count + float(rays);
     float w = float(rays) / total;
-    vec4 terms = vec4(mix(history.xy, vec2(sun, ao), w), 0.0, total);
-    imageStore(gImagesRgba16f[rt.shadelTermsWrite], atlas, terms);
-    imageStore(gImagesRgba16f[rt.shadelIndirectWrite], atlas,
-               vec4(mix(indirectHistory.rgb, indirect, w), total));
+    // The shading normal (octahedral) rides along: the read's wider filter pools only texels of
+    // the same surface (at the cache's MIPs a chart's gutter is under a texel wide).
+    vec2 octNormal = rtOctEncode(n);
+    vec4 terms = vec4(mix(history.xy, vec2(sun, ao), w), octNormal.x, total);
+    storeTerms(rt, o, texel, blockTexels, terms, vec4(mix(indirectHistory.rgb, indirect, w), octNormal.y));
     // Hard spot shadows are exact from the first frame (one ray to each light from a fixed
     // point): traced again only after a reset. Soft ones accumulate; 8 bits per spot: a running
     // mean below 1/16 per frame would round to no change.
     if (rt.spotShadowCount != 0u && (count == 0.0 || rt.shadowRays > 1u)) {
         uvec4 spots = rtSpotVisibilities(f, rt, p, ng, seed ^ 0x7a3c1u, sampleBase);
         uvec4 spotHistory = count == 0.0 ? spots : imageLoad(gImagesRgba32ui[rt.shadelSpotWrite], atlas);
-        imageStore(gImagesRgba32ui[rt.shadelSpotWrite], atlas,
+        storeSpots(rt, o, texel, blockTexels,
                    rtMixSpotVisibilities(spotHistory, spots, max(w, 1.0 / 16.0), rt.spotShadowCount));
     }
 }

@@ -19,7 +19,9 @@ struct RtCounters {
 // MIP of its shadel space, coarser than the lit layer; rays accumulate there over frames.
 #define RT_SHADEL_VALID 1u // the instance has a rect in the cache this frame
 #define RT_SHADEL_RESET 2u // its history is void (new rect, moved, or a changed input): restart
-#define RT_SHADEL_FIRST_RAYS 4u // AO / GI rays of a texel's first traced frame (at least)
+// Reading the cache: a texel holding fewer rays than this borrows its neighbours' (a wider,
+// ray-count-weighted filter blended out as the rays accumulate; raytracing/rt_apply.glsl).
+#define RT_SHADEL_FILTER_RAYS 16.0
 
 struct RtShadelObject {
     uvec2 origin;     // texel of the atlas where the rect starts
@@ -59,10 +61,11 @@ struct RtFrame {
     uint64_t shadelObjects; // RtShadelObject per instance, 0 when not decoupled
     uint64_t shadelTiles;   // RtShadelTile[shadelTileCount]
     uint shadelTileCount;
-    uint historyRays;         // a texel with this many rays accumulated is done: no more are traced
-    uint shadelTermsWrite;    // cache atlas: sun, AO, -, rays accumulated (storage, rgba16f)
-    uint shadelTermsRead;     //   ... the same, sampled
-    uint shadelIndirectWrite; // cache atlas: indirect light, rays accumulated
+    uint historyRays; // a texel with this many rays accumulated is done: no more are traced
+    uint
+        shadelTermsWrite; // cache atlas: sun, AO, normal oct x, rays accumulated (storage, rgba16f)
+    uint shadelTermsRead; //   ... the same, sampled
+    uint shadelIndirectWrite; // cache atlas: indirect light, normal oct y
     uint shadelIndirectRead;
     // Spot shadows (--rt-shadows on, scenes with shadow-casting spots): the visibility of every
     // shadow-casting spot (by GpuLight::shadowIndex), 8 bits each, packed in a uvec4 per sample
@@ -72,7 +75,11 @@ struct RtFrame {
     uint pixelSpotSlot;   // forward: bindless read slot of the traced spot visibilities (uint)
     uint shadelSpotWrite; // cache atlas: spot visibilities (storage, rgba32ui)
     uint shadelSpotRead;  //   ... the same, sampled
-    uint pad0;
+    // Shadel path: a cached texel's side in pixels is its world side * this / its distance;
+    // this is scaled so that 1 is half the side the cache's MIP was chosen for (at the
+    // instance's nearest point). A 2x2 block of texels below it (far parts of large objects)
+    // is traced once, into a history its texels share (rt_shadels.comp).
+    float shadelTexelPixelScale;
 };
 
 #ifdef __cplusplus

@@ -283,6 +283,9 @@ void prepareRayTracingFrame(Renderer& r, const GpuScene& scene, const CameraView
     f.spotShadowCount = s.spotShadowCount;
     f.spotLights = address(gpu, s.spotLights);
     f.pixelSpotSlot = s.spots ? slot(gpu, s.spotsRead).value : NO_TEXTURE;
+    // The cache's MIP gives texels of 2^(offset - 1) .. 2^offset pixels at the instance's
+    // nearest point (rt_shadel_cache.cpp, cacheLevel); 1 below is half the least of that.
+    f.shadelTexelPixelScale = pixelsPerUnit / std::exp2(float(rt.shadelMipOffset) - 1.0f);
     if (s.shadelCache.terms) prepareRtShadelCache(r, scene, camera, s.shadelCache, f);
     std::memcpy(mapped(gpu, s.frame), &f, sizeof(f));
     constants.rt = address(gpu, s.frame);

@@ -4,7 +4,9 @@
 // shadel space, --rt-shadel-mip-offset levels coarser than the finest its view can need, kept
 // while it stays in view. Each frame `rtShadelTrace` traces --rays-per-shadel rays per texel and
 // averages them into the texel's history (reset when the rect is new or the instance moved), so
-// the result converges over frames in object space and does not swim with the camera. Shading
+// the result converges over frames in object space and does not swim with the camera. Texels
+// much finer on screen than the MIP was chosen for (the far part of a large object) share one
+// traced history per 2x2 block; while texels hold few rays, reads pool their neighbours'. Shading
 // (shaders/shadel/shade.comp) reads it bilinearly through raytracing/rt_apply.glsl.
 #include <memory>
 #include <optional>
