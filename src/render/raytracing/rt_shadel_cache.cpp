@@ -29,7 +29,8 @@ void createRtShadelCache(Renderer& r, const GpuScene& scene, bool spotShadows, R
     TextureDesc d;
     d.format = VK_FORMAT_R16G16B16A16_SFLOAT;
     d.width = d.height = kAtlasSize;
-    d.usage = VK_IMAGE_USAGE_STORAGE_BIT | VK_IMAGE_USAGE_SAMPLED_BIT;
+    d.usage = VK_IMAGE_USAGE_STORAGE_BIT | VK_IMAGE_USAGE_SAMPLED_BIT |
+              VK_IMAGE_USAGE_TRANSFER_DST_BIT; // cleared once, below
     d.name = "rt.shadelCache.terms";
     c.terms = createTexture(gpu, d);
     d.name = "rt.shadelCache.indirect";
@@ -41,14 +42,27 @@ void createRtShadelCache(Renderer& r, const GpuScene& scene, bool spotShadows, R
         if (!c.spots) throw DeviceError("out of GPU memory for the RT shadel cache");
     }
     if (!c.terms || !c.indirect) throw DeviceError("out of GPU memory for the RT shadel cache");
+    // Every texel starts empty (no rays, no surface): the read pools texels around the ones it
+    // needs (rt_apply.glsl), and memory an earlier renderer used must never show through.
     immediateSubmit(gpu, [&](VkCommandBuffer cmd) {
-        for (TextureHandle t : {c.terms, c.indirect, c.spots})
-            if (t)
-                imageBarrier(cmd, vkImage(gpu, t), VK_IMAGE_ASPECT_COLOR_BIT,
-                             VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_GENERAL,
-                             VK_PIPELINE_STAGE_2_NONE, 0, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
-                             VK_ACCESS_2_SHADER_STORAGE_READ_BIT |
-                                 VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT);
+        VkImageSubresourceRange all{VK_IMAGE_ASPECT_COLOR_BIT, 0, 1, 0, 1};
+        for (TextureHandle t : {c.terms, c.indirect, c.spots}) {
+            if (!t) continue;
+            imageBarrier(cmd, vkImage(gpu, t), VK_IMAGE_ASPECT_COLOR_BIT, VK_IMAGE_LAYOUT_UNDEFINED,
+                         VK_IMAGE_LAYOUT_GENERAL, VK_PIPELINE_STAGE_2_NONE, 0,
+                         VK_PIPELINE_STAGE_2_CLEAR_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT);
+            VkClearColorValue empty{};
+            if (t == c.terms) empty.float32[0] = empty.float32[1] = 1.0f; // sun, AO, -, rays
+            if (t == c.spots)
+                empty.uint32[0] = empty.uint32[1] = empty.uint32[2] = empty.uint32[3] =
+                    0xFFFFFFFFu; // every spot visible
+            vkCmdClearColorImage(cmd, vkImage(gpu, t), VK_IMAGE_LAYOUT_GENERAL, &empty, 1, &all);
+            imageBarrier(cmd, vkImage(gpu, t), VK_IMAGE_ASPECT_COLOR_BIT, VK_IMAGE_LAYOUT_GENERAL,
+                         VK_IMAGE_LAYOUT_GENERAL, VK_PIPELINE_STAGE_2_CLEAR_BIT,
+                         VK_ACCESS_2_TRANSFER_WRITE_BIT, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
+                         VK_ACCESS_2_SHADER_STORAGE_READ_BIT |
+                             VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT);
+        }
     });
     c.termsWrite = createWriteView(gpu, c.terms);
     c.indirectWrite = createWriteView(gpu, c.indirect);
