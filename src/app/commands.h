@@ -91,6 +91,7 @@ struct RenderOptions {
     bool tileClassification = true; // --tile-classification: per-tile dispatch (render/tiles)
     bool distanceFields = false;    // --distance-fields: DF shadows + AO (render/distance_fields)
     float dfShadowStart = 40.0f;    // --df-shadow-start: metres beyond which the DF shadows apply
+    float dfResidency = 0.0f;       // --df-residency: metres (0: every field resident)
     // --stencil-effects on|fullscreen: water composite + character outline (render/stencil)
     StencilEffects stencilEffects = StencilEffects::Off;
     // Texture streaming (render/streaming): --texture-budget MiB (0 = none: every texture

@@ -382,6 +382,12 @@ int main(int argc, char** argv) {
                      "beyond this distance from the camera (0: everywhere), the shadow map nearer")
         ->capture_default_str();
     render
+        ->add_option("--df-residency", ro.dfResidency,
+                     "metres: with --distance-fields on, only the fields of meshes with an "
+                     "instance this near the camera stay in the 3-D atlas, streamed in and out "
+                     "as the camera moves (0: every field, placed at load)")
+        ->capture_default_str();
+    render
         ->add_option(
             "--stencil-effects", stencilEffects,
             "off | on | on-unbounded | fullscreen: water composite and character "

@@ -417,6 +417,9 @@ RenderRun runRender(Gpu& gpu, const RenderOptions& o) {
         !e.empty())
         throw InputError(e);
     settings.dfShadowStart = o.dfShadowStart;
+    if (std::string e = checkFiniteInRange("--df-residency", o.dfResidency, {0.0, 1e6}); !e.empty())
+        throw InputError(e);
+    settings.dfResidencyDistance = o.dfResidency;
     settings.timing = o.timing ? *o.timing : defaultTimingMode(gpu);
     settings.recordingThreads = o.threads ? o.threads : defaultRecordingThreads();
     Renderer renderer;

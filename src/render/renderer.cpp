@@ -333,6 +333,7 @@ FrameResult renderFrame(Renderer& r, const GpuScene& scene, const CameraView& ca
         r, scene, r.lightsLastFrame.empty() ? scene.lightInfo : r.lightsLastFrame, constants);
     if (r.gi) prepareGiFrame(r, scene, camera, constants);
     if (r.distanceFields && r.settings.distanceFieldLighting) { // render/distance_fields
+        updateDistanceFieldResidency(r, *r.distanceFields, camera.position);
         constants.distanceFields = distanceFieldFrameAddress(r, *r.distanceFields);
         constants.dfShadowStart = r.settings.dfShadowStart;
     }

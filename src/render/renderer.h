@@ -141,6 +141,9 @@ struct RenderSettings {
     // metres from the camera (0: everywhere).
     bool distanceFieldLighting = false;
     float dfShadowStart = 40.0f;
+    // Metres: only the fields of meshes with an instance this near the camera are in the atlas
+    // (streamed in and out as the camera moves); 0: every field, placed at load.
+    float dfResidencyDistance = 0.0f;
     Spectra spectra = Spectra::Off; // forward: per-tile shading permutations (render/lighting)
     bool sunSoftShadows = false;    // --sun-shadows pcss: variable penumbra (render/lighting)
     bool spotShadows = true;        // --spot-shadows: shadow maps of shadow-casting spots

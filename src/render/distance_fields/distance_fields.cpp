@@ -19,9 +19,24 @@ namespace shadel {
 // longest side.
 constexpr Extent<3> kAtlasSize{128, 128, 128};
 
+// A field not wanted for this many frames leaves the atlas (its room is reused); one wanted again
+// within them is still there.
+constexpr uint64_t kResidencyKeepFrames = 8;
+
 struct DistanceFieldState {
     DistanceFieldAtlas atlas{kAtlasSize};
     BufferHandle atlasBuffer, meshes, instances, frame, readback;
+    // Residency (--df-residency): every field stays on the CPU; the atlas holds those of meshes
+    // with an instance within the distance of the camera. The atlas's CPU copy is uploaded
+    // whole on a frame whose residency changed (8 MiB; rare).
+    float residencyDistance = 0.0f;                     // 0: every field placed at load, for good
+    std::vector<MeshDistanceField> fields;              // per mesh; empty: casts none
+    std::vector<gpu::GpuDistanceFieldMesh> meshInfo;    // what `meshes` holds
+    std::vector<gpu::GpuDistanceFieldInstance> casters; // what `instances` holds
+    std::vector<uint64_t> lastWanted;                   // per mesh: frame it was last wanted
+    std::vector<float> volume;                          // what `atlasBuffer` holds
+    uint64_t frameNumber = 0;
+    uint64_t streamedIn = 0, evicted = 0, noRoom = 0; // over the run
     TextureHandle output; // RGBA8: DF sun visibility, shadow-map visibility, DF AO, covered
     TextureWriteView outputWrite;
     uint32_t meshesWithField = 0, meshesPlaced = 0, instancesCasting = 0, cacheHits = 0;
@@ -35,6 +50,67 @@ void DistanceFieldStateDeleter::operator()(DistanceFieldState* s) const {
     delete s;
 }
 
+// Places mesh m's field in the atlas and its CPU copy; false when the atlas has no room (the
+// mesh then casts no distance-field shadow until room frees up).
+static bool placeField(DistanceFieldState& s, uint32_t m) {
+    const MeshDistanceField& f = s.fields[m];
+    auto place = s.atlas.add(m, {f.resolution.x, f.resolution.y, f.resolution.z});
+    if (!place) return false;
+    ++s.meshesPlaced;
+    for (uint32_t z = 0; z < f.resolution.z; ++z)
+        for (uint32_t y = 0; y < f.resolution.y; ++y) {
+            size_t row = (size_t(place->origin[2] + z) * kAtlasSize[1] + place->origin[1] + y) *
+                             kAtlasSize[0] +
+                         place->origin[0];
+            std::memcpy(&s.volume[row],
+                        &f.distances[(size_t(z) * f.resolution.y + y) * f.resolution.x],
+                        f.resolution.x * sizeof(float));
+        }
+    gpu::GpuDistanceFieldMesh& g = s.meshInfo[m];
+    g.atlasOrigin = {place->origin[0], place->origin[1], place->origin[2]};
+    g.valid = 1;
+    g.resolution = f.resolution;
+    g.voxelSize = f.voxelSize;
+    g.origin = f.origin;
+    return true;
+}
+
+static void evictField(DistanceFieldState& s, uint32_t m) {
+    s.atlas.remove(m);
+    s.meshInfo[m].valid = 0;
+    --s.meshesPlaced;
+}
+
+void updateDistanceFieldResidency(Renderer& r, DistanceFieldState& s, glm::vec3 camera) {
+    ++s.frameNumber;
+    if (s.residencyDistance == 0.0f) return;
+    for (const gpu::GpuDistanceFieldInstance& c : s.casters) {
+        glm::vec3 nearest = glm::clamp(camera, c.worldMin, c.worldMax);
+        if (glm::length(nearest - camera) <= s.residencyDistance)
+            s.lastWanted[c.mesh] = s.frameNumber;
+    }
+    bool changed = false;
+    // Out first, so the room they free can take the fields coming in.
+    for (uint32_t m = 0; m < s.fields.size(); ++m)
+        if (s.meshInfo[m].valid && s.frameNumber - s.lastWanted[m] > kResidencyKeepFrames) {
+            evictField(s, m);
+            ++s.evicted;
+            changed = true;
+        }
+    for (uint32_t m = 0; m < s.fields.size(); ++m) {
+        if (s.meshInfo[m].valid || s.lastWanted[m] != s.frameNumber) continue;
+        if (!placeField(s, m)) {
+            ++s.noRoom;
+            continue;
+        }
+        ++s.streamedIn;
+        changed = true;
+    }
+    if (!changed) return; // between frames: the GPU is idle
+    uploadBuffer(*r.gpu, s.atlasBuffer, s.volume.data(), s.volume.size() * sizeof(float));
+    uploadBuffer(*r.gpu, s.meshes, s.meshInfo.data(), s.meshInfo.size() * sizeof(s.meshInfo[0]));
+}
+
 DistanceFieldStatePtr createDistanceFields(Renderer& r, const Scene& scene,
                                            const GpuScene& gpuScene, const std::string& cacheDir) {
     Gpu& gpu = *r.gpu;
@@ -46,8 +122,11 @@ DistanceFieldStatePtr createDistanceFields(Renderer& r, const Scene& scene,
         if (inst.mesh < casts.size() &&
             !(gpuScene.materialInfo[inst.material].flags & MATERIAL_ALPHA_BLEND))
             casts[inst.mesh] = true;
-    std::vector<float> volume(size_t(kAtlasSize[0]) * kAtlasSize[1] * kAtlasSize[2], 1e3f);
-    std::vector<gpu::GpuDistanceFieldMesh> meshes(std::max<size_t>(scene.meshes.size(), 1));
+    s->residencyDistance = r.settings.dfResidencyDistance;
+    s->volume.assign(size_t(kAtlasSize[0]) * kAtlasSize[1] * kAtlasSize[2], 1e3f);
+    s->meshInfo.assign(std::max<size_t>(scene.meshes.size(), 1), {});
+    s->fields.resize(scene.meshes.size());
+    s->lastWanted.assign(scene.meshes.size(), 0);
     for (size_t m = 0; m < scene.meshes.size(); ++m) {
         if (!casts[m]) continue;
         bool cached = false;
@@ -55,28 +134,13 @@ DistanceFieldStatePtr createDistanceFields(Renderer& r, const Scene& scene,
         if (f.distances.empty()) continue;
         s->cacheHits += cached;
         ++s->meshesWithField;
-        auto place = s->atlas.add(uint32_t(m), {f.resolution.x, f.resolution.y, f.resolution.z});
-        if (!place) continue; // no room: this mesh casts no distance-field shadow
-        ++s->meshesPlaced;
-        for (uint32_t z = 0; z < f.resolution.z; ++z)
-            for (uint32_t y = 0; y < f.resolution.y; ++y)
-                for (uint32_t x = 0; x < f.resolution.x; ++x) {
-                    size_t at =
-                        (size_t(place->origin[2] + z) * kAtlasSize[1] + place->origin[1] + y) *
-                            kAtlasSize[0] +
-                        place->origin[0] + x;
-                    volume[at] = f.at(x, y, z);
-                }
-        gpu::GpuDistanceFieldMesh& g = meshes[m];
-        g.atlasOrigin = {place->origin[0], place->origin[1], place->origin[2]};
-        g.valid = 1;
-        g.resolution = f.resolution;
-        g.voxelSize = f.voxelSize;
-        g.origin = f.origin;
+        s->fields[m] = std::move(f);
+        // With a residency distance the first frame places what it wants.
+        if (s->residencyDistance == 0.0f) placeField(*s, uint32_t(m));
     }
-    std::vector<gpu::GpuDistanceFieldInstance> instances;
+    std::vector<gpu::GpuDistanceFieldInstance>& instances = s->casters;
     for (const gpu::GpuInstance& inst : gpuScene.instanceInfo) {
-        if (inst.mesh >= meshes.size() || !meshes[inst.mesh].valid) continue;
+        if (inst.mesh >= s->fields.size() || s->fields[inst.mesh].distances.empty()) continue;
         gpu::GpuDistanceFieldInstance d{};
         d.worldToObject = glm::inverse(inst.model);
         d.scale = glm::length(glm::vec3(inst.model[0]));
@@ -96,8 +160,9 @@ DistanceFieldStatePtr createDistanceFields(Renderer& r, const Scene& scene,
         uploadBuffer(gpu, b, data, bytes);
         return b;
     };
-    s->atlasBuffer = buffer("df.atlas", volume.data(), volume.size() * sizeof(float));
-    s->meshes = buffer("df.meshes", meshes.data(), meshes.size() * sizeof(meshes[0]));
+    s->atlasBuffer = buffer("df.atlas", s->volume.data(), s->volume.size() * sizeof(float));
+    s->meshes =
+        buffer("df.meshes", s->meshInfo.data(), s->meshInfo.size() * sizeof(s->meshInfo[0]));
     s->instances =
         buffer("df.instances", instances.data(), instances.size() * sizeof(instances[0]));
     gpu::DistanceFieldFrame frame{};
@@ -205,6 +270,11 @@ void finishDistanceFieldFrame(Renderer& r, DistanceFieldState& s) {
 void distanceFieldStats(const DistanceFieldState& s, nlohmann::json& stats) {
     stats["distance_fields"] = {{"meshes", s.meshesWithField},
                                 {"meshes_in_atlas", s.meshesPlaced},
+                                {"residency_distance", s.residencyDistance},
+                                {"streamed_in", s.streamedIn},
+                                {"evicted", s.evicted},
+                                {"no_room", s.noRoom},
+                                {"atlas_valid", s.atlas.validate()},
                                 {"from_cache", s.cacheHits},
                                 {"instances", s.instancesCasting},
                                 {"atlas_voxels_used", s.atlas.usedVoxels()},

@@ -8,6 +8,7 @@
 #include <memory>
 #include <string>
 
+#include <glm/glm.hpp>
 #include <nlohmann/json.hpp>
 
 #include "rhi/vk.h"
@@ -28,6 +29,10 @@ using DistanceFieldStatePtr = std::unique_ptr<DistanceFieldState, DistanceFieldS
 DistanceFieldStatePtr createDistanceFields(Renderer& r, const Scene& scene,
                                            const GpuScene& gpuScene, const std::string& cacheDir);
 void destroyDistanceFields(Renderer& r, DistanceFieldState& s);
+// Before each frame: with --df-residency, the fields of meshes with an instance within that
+// distance of the camera come into the atlas, and those not wanted for a few frames leave it
+// (their room is reused). Without it every field was placed at load and this does nothing.
+void updateDistanceFieldResidency(Renderer& r, DistanceFieldState& s, glm::vec3 camera);
 
 // For the screen-space passes (render/screenspace): the DistanceFieldFrame address and the
 // output image's storage slot; the pass itself; its output read back after the frame.
