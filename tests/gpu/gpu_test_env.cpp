@@ -76,6 +76,13 @@ double meanFrameDelta(const RenderRun& run) {
     return sum / double(std::max<size_t>(n, 1));
 }
 
+double worstFramePsnr(const RenderRun& a, const RenderRun& b) {
+    double worst = 1e9;
+    for (size_t i = 0; i < a.frames.size() && i < b.frames.size(); ++i)
+        worst = std::min(worst, psnr(a.frames[i].rgba, b.frames[i].rgba));
+    return worst;
+}
+
 std::string tempPath(const std::string& name) {
     return (std::filesystem::temp_directory_path() /
             ("shadel-test-" + std::to_string(getpid()) + "-" + name))

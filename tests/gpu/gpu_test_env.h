@@ -26,4 +26,7 @@ std::string tempPath(const std::string& name);
 // Flicker: mean absolute difference between consecutive frames, over all colour channels.
 double meanFrameDelta(const RenderRun& run);
 
+// The lowest PSNR between the runs' frames of the same index (the runs have as many frames).
+double worstFramePsnr(const RenderRun& a, const RenderRun& b);
+
 } // namespace shadel::test

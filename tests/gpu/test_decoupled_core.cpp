@@ -210,9 +210,7 @@ TEST(DecoupledCore, ReuseChangesNothingVisibleOnAnOrbit) {
         RenderRun off = renderChecked(o);
         o.reuse = true;
         RenderRun on = renderChecked(o);
-        double worst = 1e9;
-        for (size_t i = 0; i < on.frames.size(); ++i)
-            worst = std::min(worst, psnr(on.frames[i].rgba, off.frames[i].rgba));
+        double worst = worstFramePsnr(on, off);
         double fraction = on.stats["reuse_fraction"].get<double>();
         std::printf("[ figures ] default 320x180 orbit, 24 frames%s: reuse fraction %.3f, worst "
                     "frame %.2f dB against reuse off\n",
@@ -292,9 +290,7 @@ TEST(DecoupledCore, LevelWindowsFollowAnOrbitWithoutHoles) {
     RenderRun whole = renderChecked(o);
     o.levelWindows = true;
     RenderRun windows = renderChecked(o);
-    double worst = 1e9;
-    for (size_t i = 0; i < windows.frames.size(); ++i)
-        worst = std::min(worst, psnr(windows.frames[i].rgba, whole.frames[i].rgba));
+    double worst = worstFramePsnr(windows, whole);
     double fallback = windows.stats["window_fallback_pixel_fraction"].get<double>();
     std::printf("[ figures ] default 320x180 orbit, 12 frames: sheet blocks %llu vs %llu whole, "
                 "worst frame %.2f dB, last frame's window fallbacks %.4f of pixels\n",

@@ -93,30 +93,21 @@ std::string writeMovingCasterScene(const std::string& name) {
                     {{"mesh", 1}, {"name", "caster"}, {"translation", {-3.0, 1.5, 0.0}}}};
     doc["bufferViews"] = {view(0, 48),  view(48, 48),  view(96, 288), view(384, 288),
                           view(672, 8), view(680, 24), view(ib, 12),  view(ib + 12, 72)};
-    doc["accessors"] = {
-        {{"bufferView", 0},
-         {"componentType", 5126},
-         {"count", 4},
-         {"type", "VEC3"},
-         {"min", {-5, 0, -5}},
-         {"max", {5, 0, 5}}},
-        {{"bufferView", 1}, {"componentType", 5126}, {"count", 4}, {"type", "VEC3"}},
-        {{"bufferView", 2},
-         {"componentType", 5126},
-         {"count", 24},
-         {"type", "VEC3"},
-         {"min", {-0.5, -0.5, -0.5}},
-         {"max", {0.5, 0.5, 0.5}}},
-        {{"bufferView", 3}, {"componentType", 5126}, {"count", 24}, {"type", "VEC3"}},
-        {{"bufferView", 4},
-         {"componentType", 5126},
-         {"count", 2},
-         {"type", "SCALAR"},
-         {"min", {0.0}},
-         {"max", {2.0}}},
-        {{"bufferView", 5}, {"componentType", 5126}, {"count", 2}, {"type", "VEC3"}},
-        {{"bufferView", 6}, {"componentType", 5123}, {"count", 6}, {"type", "SCALAR"}},
-        {{"bufferView", 7}, {"componentType", 5123}, {"count", 36}, {"type", "SCALAR"}}};
+    auto accessor = [](int view, int component, int count, const char* type) {
+        return json{
+            {"bufferView", view}, {"componentType", component}, {"count", count}, {"type", type}};
+    };
+    const int f32 = 5126, u16 = 5123;
+    doc["accessors"] = {accessor(0, f32, 4, "VEC3"),   accessor(1, f32, 4, "VEC3"),
+                        accessor(2, f32, 24, "VEC3"),  accessor(3, f32, 24, "VEC3"),
+                        accessor(4, f32, 2, "SCALAR"), accessor(5, f32, 2, "VEC3"),
+                        accessor(6, u16, 6, "SCALAR"), accessor(7, u16, 36, "SCALAR")};
+    doc["accessors"][0]["min"] = {-5, 0, -5}; // positions and key times carry their bounds
+    doc["accessors"][0]["max"] = {5, 0, 5};
+    doc["accessors"][2]["min"] = {-0.5, -0.5, -0.5};
+    doc["accessors"][2]["max"] = {0.5, 0.5, 0.5};
+    doc["accessors"][4]["min"] = {0.0};
+    doc["accessors"][4]["max"] = {2.0};
     json grey = {{"pbrMetallicRoughness",
                   {{"baseColorFactor", {0.8, 0.8, 0.8, 1.0}},
                    {"metallicFactor", 0.0},
@@ -156,9 +147,7 @@ TEST(GltfFeaturesPlayback, MovingCasterShadowsAreNotCarriedOverByReuse) {
     RenderRun off = renderChecked(o);
     o.reuse = true;
     RenderRun on = renderChecked(o);
-    double worst = 1e9;
-    for (size_t i = 0; i < on.frames.size(); ++i)
-        worst = std::min(worst, psnr(on.frames[i].rgba, off.frames[i].rgba));
+    double worst = worstFramePsnr(on, off);
     double moved = psnr(off.frames.front().rgba, off.frames.back().rgba);
     double fraction = on.stats["reuse_fraction"].get<double>();
     std::printf("[ figures ] moving caster 320x180, 8 frames: reuse on vs off worst frame %.2f dB "
