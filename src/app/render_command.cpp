@@ -455,7 +455,23 @@ RenderRun runRender(Gpu& gpu, const RenderOptions& o) {
                           renderer.skinning != nullptr, &renderer.reposedFrom);
                 if (renderer.skinning)
                     setSkinPoses(renderer, *renderer.skinning, playback->drawn.skinPoses);
+                if (playback->lastWasPrefetched) { // it ran beside the last frame (trace)
+                    FrameResult& last = run.frames.back();
+                    auto ms = [](auto d) {
+                        return std::chrono::duration<double, std::milli>(d).count();
+                    };
+                    last.frontendWorker = true;
+                    last.frontendWorkerStartMs =
+                        ms(playback->lastImport.start - renderer.createdAt);
+                    last.frontendWorkerMs =
+                        ms(playback->lastImport.end - playback->lastImport.start);
+                    last.frontendWorkerCpuMs = playback->lastImport.cpuMs;
+                }
             }
+            // Frontend/backend overlap: with recording threads, the next frame's scene update
+            // (its pose imported from the file) runs on a worker while this frame renders.
+            if (playback && renderer.settings.recordingThreads > 1 && i + 1 < o.frames)
+                prefetchPose(*playback, i + 1);
             run.frames.push_back(renderFrame(renderer, gpuScene, view));
             if (o.progress && o.frames > 1 && tty)
                 std::fprintf(stderr, "\rrender: frame %u/%u (%.1f ms)", i + 1, o.frames,
@@ -595,7 +611,11 @@ RenderRun runRender(Gpu& gpu, const RenderOptions& o) {
                           {"time_step", playback->step},
                           {"instances_reposed", playback->instancesReposed},
                           {"meshes_reposed", playback->meshesReposed},
-                          {"vertices_written", playback->verticesWritten}};
+                          {"vertices_written", playback->verticesWritten},
+                          // The next frame's import on the frontend worker, beside this frame.
+                          {"frontend_prefetched", playback->prefetched},
+                          {"frontend_worker_cpu_ms", playback->prefetchCpuMs},
+                          {"frontend_wait_ms", playback->prefetchWaitMs}};
     s["points_lines_vertices"] =
         renderer.pointsLines ? pointsLinesVertexCount(*renderer.pointsLines) : 0u;
     s["skinning"] = {

@@ -6,7 +6,7 @@
 namespace shadel {
 
 nlohmann::json chromeTrace(const std::vector<FrameResult>& frames, const std::string& label) {
-    constexpr int kPid = 1, kCpuTrack = 1, kGpuTrack = 2, kFirstWorkerTrack = 3;
+    constexpr int kPid = 1, kCpuTrack = 1, kGpuTrack = 2, kFrontendTrack = 3, kFirstWorkerTrack = 4;
     nlohmann::json events = nlohmann::json::array();
     auto meta = [&](const char* what, int tid, const std::string& name) {
         nlohmann::json e = {{"name", what}, {"ph", "M"}, {"pid", kPid}, {"args", {{"name", name}}}};
@@ -16,6 +16,9 @@ nlohmann::json chromeTrace(const std::vector<FrameResult>& frames, const std::st
     meta("process_name", 0, "shadel " + label);
     meta("thread_name", kCpuTrack, "CPU");
     meta("thread_name", kGpuTrack, "GPU passes");
+    bool frontendWorker = std::any_of(frames.begin(), frames.end(),
+                                      [](const FrameResult& f) { return f.frontendWorker; });
+    if (frontendWorker) meta("thread_name", kFrontendTrack, "CPU frontend worker (next frame)");
     size_t workers = 0; // threaded frames: one track per recording worker
     for (const FrameResult& f : frames) workers = std::max(workers, f.recordingWorkers.size());
     for (size_t w = 0; w < workers; ++w)
@@ -45,6 +48,10 @@ nlohmann::json chromeTrace(const std::vector<FrameResult>& frames, const std::st
             span("record passes", "cpu", kFirstWorkerTrack + int(w), gpuStart + t.startMs,
                  t.durationMs, {{"frame", i}, {"passes", t.passes}, {"cpu_ms", t.cpuMs}});
         }
+        if (f.frontendWorker) // the next frame's scene update, beside this frame's backend
+            span("scene update (frame " + std::to_string(i + 1) + ")", "cpu", kFrontendTrack,
+                 f.frontendWorkerStartMs, f.frontendWorkerMs,
+                 {{"frame", i + 1}, {"cpu_ms", f.frontendWorkerCpuMs}});
         for (const PassTiming& p : f.passes)
             span(p.name, "gpu", kGpuTrack, gpuStart + p.startMs, p.gpuMs, {{"frame", i}});
     }

@@ -6,7 +6,15 @@
 namespace shadel {
 
 static LogLevel g_level = LogLevel::Info;
+static thread_local LogLevel t_floor = LogLevel::Debug; // ScopedThreadLogLevel
 static std::mutex g_logMutex;
+
+ScopedThreadLogLevel::ScopedThreadLogLevel(LogLevel atLeast) : m_previous(t_floor) {
+    t_floor = atLeast;
+}
+ScopedThreadLogLevel::~ScopedThreadLogLevel() {
+    t_floor = m_previous;
+}
 
 void setLogLevel(LogLevel level) {
     g_level = level;
@@ -16,7 +24,7 @@ LogLevel logLevel() {
 }
 
 void logLine(LogLevel level, const char* fmt, ...) {
-    if (level < g_level) return;
+    if (level < g_level || level < t_floor) return;
     static const char* prefix[] = {"debug: ", "", "warning: ", "error: "};
     std::lock_guard lock(g_logMutex);
     std::fputs(prefix[int(level)], stderr);

@@ -9,6 +9,20 @@ enum class LogLevel { Debug, Info, Warn, Error };
 
 void setLogLevel(LogLevel level);
 LogLevel logLevel();
+
+// Raises the level for the calling thread only, while it lives: a worker repeating work whose
+// warnings the main thread already gave (the next frame's scene import) stays quiet without
+// silencing the other threads.
+class ScopedThreadLogLevel {
+public:
+    explicit ScopedThreadLogLevel(LogLevel atLeast);
+    ~ScopedThreadLogLevel();
+    ScopedThreadLogLevel(const ScopedThreadLogLevel&) = delete;
+    ScopedThreadLogLevel& operator=(const ScopedThreadLogLevel&) = delete;
+
+private:
+    LogLevel m_previous;
+};
 void logLine(LogLevel level, const char* fmt, ...) __attribute__((format(printf, 2, 3)));
 
 std::string format(const char* fmt, ...) __attribute__((format(printf, 1, 2)));

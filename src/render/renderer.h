@@ -168,6 +168,11 @@ struct FrameResult {
     // render thread's share of streaming, the rest runs on its worker (render/streaming).
     double cpuStreamingMs = 0.0;
     double startMs = 0.0; // since the renderer was created (trace export)
+    // The frontend worker's import of the next frame's pose, run beside this frame's backend
+    // (animated playback with recording threads: render/animation prefetchPose). Since the
+    // renderer was created; the worker thread's CPU time.
+    bool frontendWorker = false;
+    double frontendWorkerStartMs = 0.0, frontendWorkerMs = 0.0, frontendWorkerCpuMs = 0.0;
     uint32_t shaderAsserts = 0;
     std::vector<ShaderPrint> prints;        // shaderPrint records of this frame (--inspect)
     uint32_t transparentDraws = 0;          // blended instances drawn (render/oit)

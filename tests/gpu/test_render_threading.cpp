@@ -170,6 +170,57 @@ TEST(RenderThreading, TheTraceHasATrackPerRecordingWorker) {
     EXPECT_GT(run.stats["recording"]["wall_ms"].get<double>(), 0.0);
 }
 
+// Frontend/backend overlap: with recording threads, animated playback imports the next frame's
+// pose on a frontend worker while the current frame is recorded, submitted and drawn. Every
+// pose after the first comes from the worker, each import runs inside the previous frame's
+// span (the trace's frontend track), and the frames are those of the serial run, byte for byte.
+TEST(RenderThreading, NextFramesSceneUpdateRunsBesideThisFrame) {
+    std::string path = tempPath("frontend-trace.json");
+    RenderOptions o =
+        small("/usr/share/assimp/models/glTF2/simple_skin/simple_skin.gltf", RenderMode::Decoupled);
+    o.frames = 4;
+    o.time = 0.0;
+    o.timeStep = 0.5;
+    o.threads = 1;
+    RenderRun serial = renderChecked(o);
+    o.threads = 3;
+    o.trace = path;
+    RenderRun overlapped = renderChecked(o);
+    EXPECT_EQ(serial.stats["animation"]["frontend_prefetched"].get<uint32_t>(), 0u);
+    EXPECT_EQ(overlapped.stats["animation"]["frontend_prefetched"].get<uint32_t>(), 3u);
+    ASSERT_EQ(serial.frames.size(), overlapped.frames.size());
+    for (size_t f = 0; f < serial.frames.size(); ++f)
+        EXPECT_EQ(serial.frames[f].rgba, overlapped.frames[f].rgba) << "frame " << f;
+    std::ifstream in(path);
+    ASSERT_TRUE(in.good()) << path;
+    nlohmann::json trace = nlohmann::json::parse(in);
+    std::filesystem::remove(path);
+    int frontendTrack = -1;
+    std::map<int, std::pair<double, double>> frameSpans; // frame -> [start, end] (us)
+    for (const auto& e : trace["traceEvents"]) {
+        if (e["ph"] == "M" && e["name"] == "thread_name" &&
+            e["args"]["name"].get<std::string>().rfind("CPU frontend worker", 0) == 0)
+            frontendTrack = e["tid"].get<int>();
+        std::string name = e["name"].get<std::string>();
+        if (e["ph"] == "X" && name.rfind("frame ", 0) == 0)
+            frameSpans[std::stoi(name.substr(6))] = {
+                e["ts"].get<double>(), e["ts"].get<double>() + e["dur"].get<double>()};
+    }
+    ASSERT_GE(frontendTrack, 0);
+    int imports = 0;
+    for (const auto& e : trace["traceEvents"]) {
+        if (e["ph"] != "X" || e["tid"] != frontendTrack) continue;
+        ++imports;
+        int next = e["args"]["frame"].get<int>();
+        ASSERT_GE(next, 1);
+        auto [start, end] = frameSpans.at(next - 1);
+        EXPECT_GE(e["ts"].get<double>(), start - 1.0) << "frame " << next; // began with it
+        EXPECT_LE(e["ts"].get<double>(), end) << "frame " << next;
+        EXPECT_GE(e["args"]["cpu_ms"].get<double>(), 0.0);
+    }
+    EXPECT_EQ(imports, 3);
+}
+
 TEST(RenderThreading, BadThreadCountsAreOneLineAndExitCode2) {
     std::string err = tempPath("threads_stderr.txt");
     for (const std::string args :

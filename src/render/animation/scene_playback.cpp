@@ -1,6 +1,7 @@
 #include "render/animation/scene_playback.h"
 
 #include <cstring>
+#include <ctime>
 
 #include "core/error.h"
 #include "core/log.h"
@@ -19,6 +20,29 @@ ScenePlayback startPlayback(const std::string& spec, const SceneFileOptions& opt
     return p;
 }
 
+static double threadCpuMs() {
+    timespec t{};
+    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
+    return double(t.tv_sec) * 1e3 + double(t.tv_nsec) * 1e-6;
+}
+
+void prefetchPose(ScenePlayback& p, uint32_t frame) {
+    SceneFileOptions options = p.options;
+    options.time = p.startTime + double(frame) * p.step;
+    p.nextFrame = frame;
+    p.next = std::async(std::launch::async, [spec = p.spec, options] {
+        // The first frame's import already gave the file's warnings; they would repeat.
+        ScopedThreadLogLevel quiet(LogLevel::Error);
+        ScenePlayback::Import out;
+        out.start = std::chrono::steady_clock::now();
+        double cpuStart = threadCpuMs();
+        out.scene = loadScene(spec, options);
+        out.cpuMs = threadCpuMs() - cpuStart;
+        out.end = std::chrono::steady_clock::now();
+        return out;
+    });
+}
+
 static bool sameVertices(const Mesh& a, const Mesh& b) {
     return a.vertices.size() == b.vertices.size() &&
            std::memcmp(a.vertices.data(), b.vertices.data(), a.vertices.size() * sizeof(Vertex)) ==
@@ -31,17 +55,24 @@ void poseFrame(Gpu& gpu, ScenePlayback& p, uint32_t frame, GpuScene& gpuScene,
     if (reposedFrom) reposedFrom->assign(gpuScene.instanceCount, Aabb{});
     SceneFileOptions options = p.options;
     options.time = p.startTime + double(frame) * p.step;
-    // The first frame's import already gave the file's warnings; they would repeat each frame.
-    LogLevel level = logLevel();
-    if (level < LogLevel::Error) setLogLevel(LogLevel::Error);
     Scene posed;
-    try {
+    p.lastWasPrefetched = false;
+    if (p.next.valid() && p.nextFrame == frame) { // imported while the last frame rendered
+        auto waitStart = std::chrono::steady_clock::now();
+        p.lastImport = p.next.get(); // rethrows the worker's InputError
+        p.prefetchWaitMs +=
+            std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - waitStart)
+                .count();
+        p.prefetchCpuMs += p.lastImport.cpuMs;
+        p.prefetched++;
+        p.lastWasPrefetched = true;
+        posed = std::move(p.lastImport.scene);
+    } else {
+        p.next = {}; // another frame's (waited for, not used)
+        // The first frame's import already gave the file's warnings; they would repeat.
+        ScopedThreadLogLevel quiet(LogLevel::Error);
         posed = loadScene(p.spec, options);
-    } catch (...) {
-        setLogLevel(level);
-        throw;
     }
-    setLogLevel(level);
     Scene& drawn = p.drawn;
     if (posed.meshes.size() != drawn.meshes.size() ||
         posed.instances.size() != drawn.instances.size() ||

@@ -7,7 +7,9 @@
 // shadel UVs and triangle-ID maps (baked from the T0 pose); its marking, shading and
 // reconstruction read the deformed vertices, and `reposed` tells the reuse logic
 // (render/shadel) not to carry its shadels over.
+#include <chrono>
 #include <cstdint>
+#include <future>
 #include <string>
 #include <vector>
 
@@ -25,7 +27,26 @@ struct ScenePlayback {
     Scene drawn;              // the pose the GPU scene holds (instances, meshes)
     // Totals over the run (stats).
     uint64_t instancesReposed = 0, meshesReposed = 0, verticesWritten = 0;
+
+    // Frontend/backend overlap (seed 003): the next frame's pose is imported on a worker thread
+    // (prefetchPose) while this frame is recorded, submitted and drawn; poseFrame takes it.
+    struct Import {
+        Scene scene;
+        std::chrono::steady_clock::time_point start, end;
+        double cpuMs = 0.0; // the worker thread's CPU time
+    };
+    std::future<Import> next;
+    uint32_t nextFrame = 0;
+    Import lastImport; // the prefetched import poseFrame took last (trace)
+    bool lastWasPrefetched = false;
+    uint32_t prefetched = 0;     // poses taken from the worker
+    double prefetchCpuMs = 0.0;  // the worker's CPU time, total
+    double prefetchWaitMs = 0.0; // poseFrame waiting for the worker, total
 };
+
+// Starts importing the pose of `frame` on a worker thread (the frame after the one about to be
+// rendered); poseFrame(frame) takes the result, or imports it itself without a prefetch.
+void prefetchPose(ScenePlayback& playback, uint32_t frame);
 
 // `drawn` is the scene uploaded for the first frame (posed at T0, meshes not split into chunks:
 // their vertices map one to one onto the file's).
