@@ -87,3 +87,27 @@ TEST(DistanceFields, ResidencyStreamsFieldsAsTheCameraMoves) {
     EXPECT_GE(same, 50.0);
     EXPECT_LT(missing, 45.0);
 }
+
+// A field that comes into the atlas or leaves it adds or takes away its DF shadow and occlusion:
+// decoupled reuse must not carry over the shading it changed (reuse_invalidation.h). Every
+// frame with reuse matches the frame shaded from scratch (carried over, frame 3 fell to 49 dB).
+TEST(DistanceFields, ResidencyChangesAreNotCarriedOverByReuse) {
+    RenderOptions o = withFields("builtin:arena", RenderMode::Decoupled, 0.0f, 192, 108);
+    o.frames = 12;
+    o.cameraPath = CameraPath::Orbit;
+    o.dfResidency = 8.0f;
+    o.reuse = false;
+    RenderRun off = renderChecked(o);
+    o.reuse = true;
+    RenderRun on = renderChecked(o);
+    double worst = worstFramePsnr(on, off);
+    const auto& df = on.stats["distance_fields"];
+    std::printf("[ figures ] arena 192x108 orbit, --df-residency 8: %llu streamed in, %llu "
+                "evicted; reuse on vs off worst frame %.2f dB, reuse fraction %.3f\n",
+                (unsigned long long)df["streamed_in"].get<uint64_t>(),
+                (unsigned long long)df["evicted"].get<uint64_t>(), worst,
+                on.stats["reuse_fraction"].get<double>());
+    EXPECT_GT(df["evicted"].get<uint64_t>(), 0u);
+    EXPECT_GE(worst, 58.0);
+    EXPECT_GT(on.stats["reuse_fraction"].get<double>(), 0.2);
+}

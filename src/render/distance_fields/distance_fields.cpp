@@ -33,8 +33,10 @@ struct DistanceFieldState {
     std::vector<MeshDistanceField> fields;              // per mesh; empty: casts none
     std::vector<gpu::GpuDistanceFieldMesh> meshInfo;    // what `meshes` holds
     std::vector<gpu::GpuDistanceFieldInstance> casters; // what `instances` holds
-    std::vector<uint64_t> lastWanted;                   // per mesh: frame it was last wanted
-    std::vector<float> volume;                          // what `atlasBuffer` holds
+    std::vector<uint32_t> casterInstance;               // their scene instances
+    std::vector<uint32_t> relit;      // scene instances whose field came or went this frame
+    std::vector<uint64_t> lastWanted; // per mesh: frame it was last wanted
+    std::vector<float> volume;        // what `atlasBuffer` holds
     uint64_t frameNumber = 0;
     uint64_t streamedIn = 0, evicted = 0, noRoom = 0; // over the run
     TextureHandle output; // RGBA8: DF sun visibility, shadow-map visibility, DF AO, covered
@@ -83,7 +85,10 @@ static void evictField(DistanceFieldState& s, uint32_t m) {
 
 void updateDistanceFieldResidency(Renderer& r, DistanceFieldState& s, glm::vec3 camera) {
     ++s.frameNumber;
+    s.relit.clear();
     if (s.residencyDistance == 0.0f) return;
+    std::vector<uint8_t> wasResident(s.fields.size());
+    for (uint32_t m = 0; m < s.fields.size(); ++m) wasResident[m] = uint8_t(s.meshInfo[m].valid);
     for (const gpu::GpuDistanceFieldInstance& c : s.casters) {
         glm::vec3 nearest = glm::clamp(camera, c.worldMin, c.worldMax);
         if (glm::length(nearest - camera) <= s.residencyDistance)
@@ -106,7 +111,13 @@ void updateDistanceFieldResidency(Renderer& r, DistanceFieldState& s, glm::vec3 
         ++s.streamedIn;
         changed = true;
     }
-    if (!changed) return; // between frames: the GPU is idle
+    if (!changed) return;
+    // What casts a distance-field shadow changed: shading that carried those shadows (decoupled
+    // reuse) is stale where they fall (render/shadel/reuse_invalidation.h).
+    for (size_t c = 0; c < s.casters.size(); ++c)
+        if (wasResident[s.casters[c].mesh] != uint8_t(s.meshInfo[s.casters[c].mesh].valid))
+            s.relit.push_back(s.casterInstance[c]);
+    // Between frames: the GPU is idle.
     uploadBuffer(*r.gpu, s.atlasBuffer, s.volume.data(), s.volume.size() * sizeof(float));
     uploadBuffer(*r.gpu, s.meshes, s.meshInfo.data(), s.meshInfo.size() * sizeof(s.meshInfo[0]));
 }
@@ -148,6 +159,7 @@ DistanceFieldStatePtr createDistanceFields(Renderer& r, const Scene& scene,
         d.worldMax = inst.worldMax;
         d.mesh = inst.mesh;
         instances.push_back(d);
+        s->casterInstance.push_back(uint32_t(&inst - gpuScene.instanceInfo.data()));
     }
     s->instancesCasting = uint32_t(instances.size());
     if (instances.empty()) instances.push_back({});
@@ -205,6 +217,10 @@ void destroyDistanceFields(Renderer& r, DistanceFieldState& s) {
     destroy(gpu, s.output);
     for (BufferHandle b : {s.atlasBuffer, s.meshes, s.instances, s.frame, s.readback})
         if (b) destroy(gpu, b);
+}
+
+const std::vector<uint32_t>& distanceFieldRelitInstances(const DistanceFieldState& s) {
+    return s.relit;
 }
 
 uint64_t distanceFieldFrameAddress(const Renderer& r, const DistanceFieldState& s) {

@@ -7,6 +7,7 @@
 // hand), not a 3-D image: the rhi has 2-D textures only.
 #include <memory>
 #include <string>
+#include <vector>
 
 #include <glm/glm.hpp>
 #include <nlohmann/json.hpp>
@@ -33,6 +34,9 @@ void destroyDistanceFields(Renderer& r, DistanceFieldState& s);
 // distance of the camera come into the atlas, and those not wanted for a few frames leave it
 // (their room is reused). Without it every field was placed at load and this does nothing.
 void updateDistanceFieldResidency(Renderer& r, DistanceFieldState& s, glm::vec3 camera);
+// The scene instances whose field came into the atlas or left it this frame: their DF shadows
+// and occlusion appeared or vanished (the decoupled reuse reshades where they fall).
+const std::vector<uint32_t>& distanceFieldRelitInstances(const DistanceFieldState& s);
 
 // For the screen-space passes (render/screenspace): the DistanceFieldFrame address and the
 // output image's storage slot; the pass itself; its output read back after the frame.

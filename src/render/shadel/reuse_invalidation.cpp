@@ -4,6 +4,7 @@
 #include <cmath>
 #include <limits>
 
+#include "render/distance_fields/distance_fields.h"
 #include "render/lighting/light_culling.h"
 #include "render/renderer.h"
 
@@ -72,6 +73,13 @@ std::vector<ChangedVolume> changedVolumes(const Renderer& r, const GpuScene& sce
             volumes.push_back(
                 sphereVolume(glm::vec3(0.0f), std::numeric_limits<float>::infinity()));
     }
+    if (r.distanceFields)
+        for (uint32_t i : distanceFieldRelitInstances(*r.distanceFields)) {
+            if (i >= scene.instanceInfo.size()) continue;
+            const gpu::GpuInstance& inst = scene.instanceInfo[i];
+            casterVolumes(boundingSphere(inst.worldMin, inst.worldMax), scene, lights, sunDirection,
+                          sunShadows, volumes);
+        }
     return volumes;
 }
 

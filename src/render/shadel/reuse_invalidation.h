@@ -28,7 +28,9 @@ struct ChangedVolume {
 // - instances animated playback moved or deformed (Renderer::reposedInstances), at their old
 //   and new places: the space around them (ambient occlusion, contact), the sun shadow they
 //   cast (a capsule from them along the sun's direction across the scene) and the reach of every
-//   shadow-casting light whose range they are in (the shadow can fall anywhere there).
+//   shadow-casting light whose range they are in (the shadow can fall anywhere there);
+// - instances whose distance field came into the atlas or left it (--df-residency): the same
+//   regions at their place (their DF shadow and occlusion appeared or vanished).
 // `sunDirection`: the way the sun's light travels; `sunShadows`: the sun casts shadows.
 std::vector<ChangedVolume> changedVolumes(const Renderer& r, const GpuScene& scene,
                                           glm::vec3 sunDirection, bool sunShadows);
