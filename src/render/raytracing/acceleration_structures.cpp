@@ -110,6 +110,28 @@ BufferHandle temporaryBuffer(Gpu& gpu, const char* name, VkDeviceSize size,
 // then allocates each from the pools in job order and copies it there compacted. A failed
 // allocation maps the LOD to the mesh's least-detailed BLAS (built in an earlier position of
 // the order: least-detailed LODs of every mesh come first).
+// One triangle geometry's BLAS build info: static BLASes are compacted and fast to trace,
+// animated ones (refit every pose) fast to build and updatable.
+constexpr VkBuildAccelerationStructureFlagsKHR kStaticBlasFlags =
+    VK_BUILD_ACCELERATION_STRUCTURE_PREFER_FAST_TRACE_BIT_KHR |
+    VK_BUILD_ACCELERATION_STRUCTURE_ALLOW_COMPACTION_BIT_KHR;
+constexpr VkBuildAccelerationStructureFlagsKHR kAnimatedBlasFlags =
+    VK_BUILD_ACCELERATION_STRUCTURE_ALLOW_UPDATE_BIT_KHR |
+    VK_BUILD_ACCELERATION_STRUCTURE_PREFER_FAST_BUILD_BIT_KHR;
+
+static VkAccelerationStructureBuildGeometryInfoKHR
+blasBuildInfo(const VkAccelerationStructureGeometryKHR& geometry,
+              VkBuildAccelerationStructureFlagsKHR flags) {
+    VkAccelerationStructureBuildGeometryInfoKHR b{
+        VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_BUILD_GEOMETRY_INFO_KHR};
+    b.type = VK_ACCELERATION_STRUCTURE_TYPE_BOTTOM_LEVEL_KHR;
+    b.flags = flags;
+    b.mode = VK_BUILD_ACCELERATION_STRUCTURE_MODE_BUILD_KHR;
+    b.geometryCount = 1;
+    b.pGeometries = &geometry;
+    return b;
+}
+
 static void buildBatch(Gpu& gpu, const RtFunctions& fn, BlasPools& pools,
                        std::vector<BlasJob>& jobs, VkDeviceSize asBytes, VkDeviceSize scratchBytes,
                        VkDeviceSize scratchAlign, BlasSet& out) {
@@ -135,14 +157,8 @@ static void buildBatch(Gpu& gpu, const RtFunctions& fn, BlasPools& pools,
     std::vector<VkAccelerationStructureKHR> handles(jobs.size());
     for (size_t i = 0; i < jobs.size(); ++i) {
         VkAccelerationStructureBuildGeometryInfoKHR& b = infos[i];
-        b = {VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_BUILD_GEOMETRY_INFO_KHR};
-        b.type = VK_ACCELERATION_STRUCTURE_TYPE_BOTTOM_LEVEL_KHR;
-        b.flags = VK_BUILD_ACCELERATION_STRUCTURE_PREFER_FAST_TRACE_BIT_KHR |
-                  VK_BUILD_ACCELERATION_STRUCTURE_ALLOW_COMPACTION_BIT_KHR;
-        b.mode = VK_BUILD_ACCELERATION_STRUCTURE_MODE_BUILD_KHR;
+        b = blasBuildInfo(jobs[i].geometry, kStaticBlasFlags);
         b.dstAccelerationStructure = jobs[i].temporary;
-        b.geometryCount = 1;
-        b.pGeometries = &jobs[i].geometry;
         b.scratchData.deviceAddress = scratchBase + jobs[i].scratchOffset;
         ranges[i] = {jobs[i].triangles, 0, 0, 0};
         rangePtrs[i] = &ranges[i];
@@ -268,13 +284,8 @@ void buildBlases(Gpu& gpu, const RtFunctions& fn, BlasPools& pools, const GpuSce
             j.triangles = chain.lod[j.lod].indexCount / 3;
             if (j.triangles == 0) continue;
             j.geometry = meshTriangles(scene, m, vertices, vertexCounts[m], indices, j.firstIndex);
-            VkAccelerationStructureBuildGeometryInfoKHR b{
-                VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_BUILD_GEOMETRY_INFO_KHR};
-            b.type = VK_ACCELERATION_STRUCTURE_TYPE_BOTTOM_LEVEL_KHR;
-            b.flags = VK_BUILD_ACCELERATION_STRUCTURE_PREFER_FAST_TRACE_BIT_KHR |
-                      VK_BUILD_ACCELERATION_STRUCTURE_ALLOW_COMPACTION_BIT_KHR;
-            b.geometryCount = 1;
-            b.pGeometries = &j.geometry;
+            VkAccelerationStructureBuildGeometryInfoKHR b =
+                blasBuildInfo(j.geometry, kStaticBlasFlags);
             fn.buildSizes(gpu.device.device, VK_ACCELERATION_STRUCTURE_BUILD_TYPE_DEVICE_KHR, &b,
                           &j.triangles, &j.sizes);
             if (!batch.empty() && asBytes + j.sizes.accelerationStructureSize > kBatchBytes) {
@@ -305,14 +316,7 @@ void destroyBlases(Gpu& gpu, const RtFunctions& fn, BlasPools& pools, BlasSet& s
 }
 
 static VkAccelerationStructureBuildGeometryInfoKHR animatedBuildInfo(const AnimatedBlas& a) {
-    VkAccelerationStructureBuildGeometryInfoKHR b{
-        VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_BUILD_GEOMETRY_INFO_KHR};
-    b.type = VK_ACCELERATION_STRUCTURE_TYPE_BOTTOM_LEVEL_KHR;
-    b.flags = VK_BUILD_ACCELERATION_STRUCTURE_ALLOW_UPDATE_BIT_KHR |
-              VK_BUILD_ACCELERATION_STRUCTURE_PREFER_FAST_BUILD_BIT_KHR;
-    b.geometryCount = 1;
-    b.pGeometries = &a.geometry;
-    return b;
+    return blasBuildInfo(a.geometry, kAnimatedBlasFlags);
 }
 
 void createAnimatedBlases(Gpu& gpu, const RtFunctions& fn, BlasPools& pools, const GpuScene& scene,
