@@ -3,6 +3,7 @@
 
 #include <cmath>
 #include <filesystem>
+#include <fstream>
 
 namespace shadel::test {
 
@@ -74,6 +75,15 @@ double meanFrameDelta(const RenderRun& run) {
             for (int c = 0; c < 3; ++c, ++n) sum += std::abs(double(a[i + c]) - double(b[i + c]));
     }
     return sum / double(std::max<size_t>(n, 1));
+}
+
+nlohmann::json takeJsonFile(const std::string& path) {
+    std::ifstream in(path);
+    if (!in.good()) return nullptr;
+    nlohmann::json j = nlohmann::json::parse(in);
+    in.close();
+    std::filesystem::remove(path);
+    return j;
 }
 
 double worstFramePsnr(const RenderRun& a, const RenderRun& b) {

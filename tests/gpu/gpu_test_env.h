@@ -3,6 +3,8 @@
 // Every test checks afterwards that no validation error and no shader assert happened.
 #include <gtest/gtest.h>
 
+#include <nlohmann/json.hpp>
+
 #include "app/commands.h"
 #include "rhi/gpu.h"
 
@@ -25,6 +27,9 @@ std::string tempPath(const std::string& name);
 
 // Flicker: mean absolute difference between consecutive frames, over all colour channels.
 double meanFrameDelta(const RenderRun& run);
+
+// The JSON a run wrote to `path` (a --trace file), then the file removed; null if it is missing.
+nlohmann::json takeJsonFile(const std::string& path);
 
 // The lowest PSNR between the runs' frames of the same index (the runs have as many frames).
 double worstFramePsnr(const RenderRun& a, const RenderRun& b);

@@ -139,10 +139,8 @@ TEST(RenderThreading, TheTraceHasATrackPerRecordingWorker) {
     o.threads = 2;
     o.trace = path;
     RenderRun run = renderChecked(o);
-    std::ifstream in(path);
-    ASSERT_TRUE(in.good()) << path;
-    nlohmann::json trace = nlohmann::json::parse(in);
-    std::filesystem::remove(path);
+    nlohmann::json trace = takeJsonFile(path);
+    ASSERT_FALSE(trace.is_null()) << path;
     std::map<int, std::string> trackNames;
     std::map<int, uint32_t> passesPerTrack;
     int recordEvents = 0;
@@ -191,10 +189,8 @@ TEST(RenderThreading, NextFramesSceneUpdateRunsBesideThisFrame) {
     ASSERT_EQ(serial.frames.size(), overlapped.frames.size());
     for (size_t f = 0; f < serial.frames.size(); ++f)
         EXPECT_EQ(serial.frames[f].rgba, overlapped.frames[f].rgba) << "frame " << f;
-    std::ifstream in(path);
-    ASSERT_TRUE(in.good()) << path;
-    nlohmann::json trace = nlohmann::json::parse(in);
-    std::filesystem::remove(path);
+    nlohmann::json trace = takeJsonFile(path);
+    ASSERT_FALSE(trace.is_null()) << path;
     int frontendTrack = -1;
     std::map<int, std::pair<double, double>> frameSpans; // frame -> [start, end] (us)
     for (const auto& e : trace["traceEvents"]) {

@@ -21,10 +21,8 @@ TEST(Trace, OneEventPerPassPerFrameNamedAsThePasses) {
     o.frames = 3;
     o.trace = path;
     RenderRun run = renderChecked(o);
-    std::ifstream in(path);
-    ASSERT_TRUE(in.good()) << path;
-    nlohmann::json trace = nlohmann::json::parse(in);
-    std::filesystem::remove(path);
+    nlohmann::json trace = takeJsonFile(path);
+    ASSERT_FALSE(trace.is_null()) << path;
 
     std::map<std::string, int> gpuEvents;
     int frames = 0, frontends = 0;
