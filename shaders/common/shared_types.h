@@ -574,7 +574,8 @@ struct GpuShadelWork {
 #define SHADEL_SHADED_NEW 1u         // last frame did not store the chunk
 #define SHADEL_SHADED_REFRESH 2u     // stored, but its turn to be refreshed
 #define SHADEL_SHADED_NEAR_CHANGE 3u // a changed region meets the object: shading decides
-#define SHADEL_SHADED_REASONS 4
+#define SHADEL_SHADED_RT_HISTORY 4u  // the ray-traced terms under it doubled their rays
+#define SHADEL_SHADED_REASONS 5
 
 struct GpuShadelCounters {
     // Chunks requested through each hashed counter. The counters only spread the atomics: once

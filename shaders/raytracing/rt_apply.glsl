@@ -71,7 +71,6 @@ void useRayTracedPixelTerms(FrameConstants f, vec2 fragCoord) {
     gRtOcclusion = rt.ao != 0u ? terms.y : 1.0;
     gRtIndirect = indirect;
 }
-layout(buffer_reference, scalar) readonly buffer RtShadelObjectRefs { RtShadelObject o[]; };
 
 // Shadel path: the object's RT cache (rt_shadels.comp), read bilinearly at the shadel's UV in
 // the object's shadel space (texels with no surface are left out of the filter). While those

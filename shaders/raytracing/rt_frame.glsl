@@ -6,6 +6,7 @@
 
 layout(buffer_reference, scalar) readonly buffer RtFrameRef { RtFrame r; };
 layout(buffer_reference, scalar) buffer RtCountersRef { RtCounters c; };
+layout(buffer_reference, scalar) readonly buffer RtShadelObjectRefs { RtShadelObject o[]; };
 
 // Unit normals as two numbers in [-1, 1] (octahedral): the RT cache stores its texels' normals.
 vec2 rtOctEncode(vec3 n) {

@@ -10,7 +10,6 @@
 
 layout(local_size_x = 8, local_size_y = 8) in;
 layout(push_constant, scalar) uniform Push { uint64_t frame; } pc;
-layout(buffer_reference, scalar) readonly buffer RtShadelObjects { RtShadelObject o[]; };
 layout(buffer_reference, scalar) readonly buffer RtShadelTiles { RtShadelTile t[]; };
 
 uint cachedTriangle(ShadelFrame s, uint offset) {
@@ -97,7 +96,7 @@ void main() {
     uint tileIndex = gl_WorkGroupID.y * 32768u + gl_WorkGroupID.x;
     if (tileIndex >= rt.shadelTileCount) return;
     RtShadelTile tile = RtShadelTiles(rt.shadelTiles).t[tileIndex];
-    RtShadelObject o = RtShadelObjects(rt.shadelObjects).o[tile.object];
+    RtShadelObject o = RtShadelObjectRefs(rt.shadelObjects).o[tile.object];
     uvec2 texel = uvec2(tile.tile & 0xFFFFu, tile.tile >> 16) * 8u + gl_LocalInvocationID.xy;
     if (any(greaterThanEqual(texel, o.size))) return;
     ivec2 atlas = ivec2(o.origin + texel);

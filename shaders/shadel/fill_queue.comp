@@ -5,8 +5,10 @@
 // level is unchanged, last frame stored the chunk, and it is not the chunk's turn to be
 // refreshed) or shaded. Chunks of objects a changed region meets (a light or a caster that
 // changed) are queued for shading, which checks their shadels against the regions and may
-// still carry them over (shade.comp).
+// still carry them over (shade.comp). With ray-traced terms, a chunk is also reshaded when the
+// RT cache under it doubled its rays (raytracing/rt_history.glsl).
 #include "shadel/shadel.glsl"
+#include "raytracing/rt_history.glsl"
 
 layout(local_size_x = 64) in;
 layout(push_constant, scalar) uniform Push { uint64_t frame; } pc;
@@ -40,7 +42,8 @@ void main() {
     uint prevBase = copyable ? UintBuffer(s.prevOffsetMap).v[block] : SHADEL_INVALID;
     uvec2 blockXy = uvec2(block % s.sheetBlocks, block / s.sheetBlocks);
     uint k = 0u;
-    uvec4 shadedBecause = uvec4(0u); // summed here: one atomic per reason and block
+    uint shadedBecause[SHADEL_SHADED_REASONS]; // summed here: one atomic per reason and block
+    for (uint reason = 0u; reason < SHADEL_SHADED_REASONS; ++reason) shadedBecause[reason] = 0u;
     for (uint bit = 0u; bit < 64u; ++bit) {
         if ((mask & (1ul << bit)) == 0ul) continue;
         uvec2 chunk = blockXy * 8u + uvec2(bit % 8u, bit / 8u);
@@ -52,7 +55,17 @@ void main() {
         ++k;
         bool stored = (prevMask & (1ul << bit)) != 0ul && prevBase != SHADEL_INVALID;
         bool refresh = stored && shadelRefreshDue(s, o, w.chunk);
-        if (stored && !refresh) {
+        bool rtHistory = false;
+        if (stored && !refresh && f.rt != 0ul) {
+            uvec2 size = levelSize(o, mip);
+            vec2 uvs[4];
+            for (int q = 0; q < 4; ++q) { // the centres of the chunk's four quarters
+                uvec2 quarter = uvec2(2 + 4 * (q & 1), 2 + 4 * (q >> 1));
+                uvs[q] = vec2(levelShadel(o, mip, chunk * SHADEL_CHUNK + quarter)) / vec2(size);
+            }
+            rtHistory = rtHistoryStepped(f, entry.z, uvs, w.chunk);
+        }
+        if (stored && !refresh && !rtHistory) {
             w.chunk = chunkSlot(prevMask, prevBase, bit); // where last frame stored it
             ShadelWorkBuffer(s.copyQueue).w[atomicAdd(counters.c.copyCount, 1u)] = w;
             continue;
@@ -61,6 +74,7 @@ void main() {
         uint reason = !levelReusable ? SHADEL_SHADED_NOT_REUSABLE
                       : nearChange   ? SHADEL_SHADED_NEAR_CHANGE
                       : refresh      ? SHADEL_SHADED_REFRESH
+                      : rtHistory    ? SHADEL_SHADED_RT_HISTORY
                                      : SHADEL_SHADED_NEW;
         shadedBecause[reason]++;
     }

@@ -220,6 +220,43 @@ TEST(RayTracing, ShadelAoConvergesToTheHighRayReference) {
     EXPECT_GT(sixteen.stats["rt"]["shadel_cache"]["instances"].get<uint64_t>(), 0u);
 }
 
+// Decoupled reuse while the RT cache converges (a still camera): a carried-over chunk keeps the
+// RT terms it was shaded with, so it is reshaded each time the cache under it doubles its rays
+// (raytracing/rt_history.glsl). Against the converged image, reuse on must stay close to reuse
+// off (which reshades every chunk every frame) on every frame; carrying the terms over until the
+// round-robin refresh trailed it by 5-9 dB.
+TEST(RayTracing, ShadelReuseFollowsTheRtCacheAsItConverges) {
+    if (!sharedGpu().device.optional.rayQuery) GTEST_SKIP() << "no ray query on this device";
+    auto options = [](uint32_t frames, uint32_t rays, bool reuse) {
+        RenderOptions o = shadelAoOptions(frames, rays, 2);
+        o.width = 160;
+        o.height = 90;
+        o.rt.aoRadius = 1.0f;
+        o.reuse = reuse;
+        return o;
+    };
+    RenderRun converged = renderChecked(options(1, 256, false));
+    RenderRun on = renderChecked(options(8, 1, true));
+    RenderRun off = renderChecked(options(8, 1, false));
+    double gapSum = 0.0, worstGap = 0.0;
+    for (size_t f = 1; f < on.frames.size(); ++f) {
+        double dbOn = psnr(on.frames[f].rgba, converged.frames.back().rgba);
+        double dbOff = psnr(off.frames[f].rgba, converged.frames.back().rgba);
+        std::printf("frame %zu vs 256 rays: reuse on %.2f dB, off %.2f dB\n", f, dbOn, dbOff);
+        gapSum += dbOff - dbOn;
+        worstGap = std::max(worstGap, dbOff - dbOn);
+    }
+    double meanGap = gapSum / double(on.frames.size() - 1);
+    double reuse = on.stats["reuse_fraction"].get<double>();
+    double rtHistory = on.stats["shaded_because"]["rt_history"].get<double>();
+    std::printf("gap mean %.2f dB, worst %.2f dB; reuse %.3f, reshaded for RT history %.3f\n",
+                meanGap, worstGap, reuse, rtHistory);
+    EXPECT_LE(meanGap, 2.5);
+    EXPECT_LE(worstGap, 4.0);
+    EXPECT_GT(rtHistory, 0.0);
+    EXPECT_GE(reuse, 0.3) << "reuse must still carry most chunks over";
+}
+
 // Mean absolute change between consecutive frames from frame `first` on (colour channels).
 double flickerFrom(const RenderRun& run, size_t first) {
     double sum = 0;

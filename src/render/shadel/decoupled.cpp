@@ -989,7 +989,7 @@ void decoupledStats(const Renderer& r, nlohmann::json& s) {
     // Why the rest was shaded, as fractions of the same stored chunks (over the same frames):
     // what a better reuse could still win, and from where.
     const char* const reasonNames[SHADEL_SHADED_REASONS] = {"not_reusable", "new", "refresh",
-                                                            "near_change"};
+                                                            "near_change", "rt_history"};
     nlohmann::json because = nlohmann::json::object();
     for (uint32_t k = 0; k < SHADEL_SHADED_REASONS; ++k) {
         uint64_t sum = 0;
