@@ -1,12 +1,15 @@
 #version 460
 // Shadel path: traces the RT cache (render/raytracing/rt_shadel_cache.h). One 8x8 workgroup
 // per tile of a visible instance's rect, one thread per texel of its shadel space at the cache's
-// MIP: the texel's triangle (the level's triangle-ID map) and clamped barycentrics rebuild the
+// MIP. Only texels this frame's marking marked are traced (the pass runs between marking and
+// shading): a texel in the view frustum but hidden behind other surfaces waits until it is
+// seen. The texel's triangle (the level's triangle-ID map) and clamped barycentrics rebuild the
 // surface as the shading pass does, then --rays-per-shadel AO and GI rays (and the sun's) are
 // traced and averaged into the history, each frame continuing the texel's low-discrepancy
 // sequence where the last one stopped.
 #include "raytracing/rt_effects.glsl"
 #include "common/shadel_bary.h"
+#include "shadel/shadel.glsl"
 
 layout(local_size_x = 8, local_size_y = 8) in;
 layout(push_constant, scalar) uniform Push { uint64_t frame; } pc;
@@ -89,6 +92,21 @@ void storeSpots(RtFrame rt, RtShadelObject o, uvec2 texel, uint blockTexels, uve
     }
 }
 
+// Whether this frame's marking marked a chunk over shadel-UV `uv` of the object at any of its
+// levels (the texel is seen, near enough to its centre: chunks are 8 shadels wide). Instances
+// shaded forward (hybrid) have no marks: always.
+bool shadelMarkedAt(ShadelFrame s, uint object, vec2 uv) {
+    ShadelObjectRef o = shadelObject(s, object);
+    if ((o.v.flags & SHADEL_OBJECT_DECOUPLED) == 0u) return true;
+    Uint64Buffer occupancy = Uint64Buffer(s.occupancy);
+    for (uint mip = o.v.firstMip; mip < o.v.mipCount; ++mip) {
+        if (!windowHolds(o, mip, uv)) continue;
+        uvec2 sheet = sheetShadel(o, mip, ivec2(floor(uv * vec2(levelSize(o, mip)))));
+        if ((occupancy.v[blockIndex(s, sheet)] & (1ul << chunkBit(sheet))) != 0ul) return true;
+    }
+    return false;
+}
+
 void main() {
     FrameConstants f = FrameConstantsRef(pc.frame).f;
     RtFrame rt = RtFrameRef(f.rt).r;
@@ -118,6 +136,15 @@ void main() {
     // Converged: the texel is reused as it is until its inputs change (the seed's "trace once
     // per shadel and reuse"; a reset starts it again).
     if (count >= float(rt.historyRays)) return;
+    // Seen this frame? (A shared block is tested at its centre: it stands for all four texels.)
+    vec2 seenAt = blockShared ? vec2((texel & ~1u) + 1u) / vec2(o.size) : shadelCenterUv(texel, o.size);
+    if (!shadelMarkedAt(s, tile.object, seenAt)) {
+        if (count == 0.0) { // never read as it is: empty until traced
+            storeTerms(rt, o, texel, blockTexels, vec4(1.0, 1.0, 0.0, 0.0), vec4(0.0));
+            if (rt.spotShadowCount != 0u) storeSpots(rt, o, texel, blockTexels, uvec4(0xFFFFFFFFu));
+        }
+        return;
+    }
     uint tri = texelTriangle(s, o, texel);
     if (tri == 0xFFFFu) { // no surface here (outside every chart and its gutter): never read
         imageStore(gImagesRgba16f[rt.shadelTermsWrite], atlas, vec4(1.0, 1.0, 0.0, 0.0));

@@ -388,17 +388,18 @@ FrameResult renderFrame(Renderer& r, const GpuScene& scene, const CameraView& ca
         pass(rec, "rtPixelTerms",
              [&](VkCommandBuffer cmd) { recordRayTracedPixels(r, cmd, frame); });
     if (r.settings.mode == RenderMode::Forward) // decal lists per tile (render/decals)
-        recordDecalCulling(r, rec, frame);      // (decoupled: in recordDecoupledPasses)
+        recordDecalCulling(r, rec, frame);      // (decoupled: in recordDecoupledShading)
     if (usesTileShading(r)) { // forward, per-tile permutations (render/lighting/feature_spectra.h)
         pass(rec, "tileShading", [&](VkCommandBuffer cmd) { recordTileShading(r, cmd, frame); });
     } else if (r.settings.mode == RenderMode::Forward) {
         pass(rec, "forwardShading",
              [&](VkCommandBuffer cmd) { recordForwardShading(r, cmd, frame); });
     } else {
-        if (r.rt) // the RT cache the shadel shading reads (render/raytracing)
+        recordDecoupledMarking(r, rec, frame); // what the frame's pixels read, in shadel space
+        if (r.rt) // the RT cache the shadel shading reads, where marked (render/raytracing)
             pass(rec, "rtShadelTrace",
                  [&](VkCommandBuffer cmd) { recordRayTracedShadels(r, cmd, frame); });
-        recordDecoupledPasses(r, rec, frame, scene);
+        recordDecoupledShading(r, rec, frame, scene);
     }
     recordParticlePasses(r, rec, frame);    // GPU particles: simulation, atlas lighting
     recordScreenSpacePasses(r, rec, frame); // sky, SSR, SSS over classified tiles

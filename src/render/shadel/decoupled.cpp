@@ -759,7 +759,7 @@ ShadelShadingQueue shadelShadingQueue(const Renderer& r) {
     return {d.counters, offsetof(gpu::GpuShadelCounters, shadeDispatch), d.capacityChunks};
 }
 
-void recordDecoupledPasses(Renderer& r, FrameRecorder& rec, uint64_t frame, const GpuScene&) {
+void recordDecoupledMarking(Renderer& r, FrameRecorder& rec, uint64_t frame) {
     Gpu& gpu = *r.gpu;
     DecoupledState& d = *r.decoupled;
     uint32_t rectGroups = (d.rectBlockCount + 63) / 64;
@@ -822,6 +822,11 @@ void recordDecoupledPasses(Renderer& r, FrameRecorder& rec, uint64_t frame, cons
             VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT, VK_PIPELINE_STAGE_2_HOST_BIT,
             VK_ACCESS_2_HOST_READ_BIT);
     });
+}
+
+void recordDecoupledShading(Renderer& r, FrameRecorder& rec, uint64_t frame, const GpuScene&) {
+    Gpu& gpu = *r.gpu;
+    DecoupledState& d = *r.decoupled;
 
     pass(rec, "workQueues", [&, frame](VkCommandBuffer cmd) {
         bind(gpu, cmd, d.queueSetup);

@@ -21,8 +21,10 @@ void destroyDecoupled(Renderer& r, DecoupledStatePtr& state);
 // sheet, shading bias; fills the decoupled fields of the frame constants.
 void prepareDecoupledFrame(Renderer& r, const GpuScene& scene, const CameraView& camera,
                            gpu::FrameConstants& constants);
-// Marking, allocation, work queues, shading, reconstruction.
-void recordDecoupledPasses(Renderer& r, FrameRecorder& rec, uint64_t frame, const GpuScene& scene);
+// Marking and allocation: after them the occupancy masks say which chunks the frame reads.
+void recordDecoupledMarking(Renderer& r, FrameRecorder& rec, uint64_t frame);
+// Work queues, carry-over, shading, reconstruction.
+void recordDecoupledShading(Renderer& r, FrameRecorder& rec, uint64_t frame, const GpuScene& scene);
 // Passes after tonemapping (the sheet view).
 void recordDecoupledPostPasses(Renderer& r, FrameRecorder& rec, uint64_t frame);
 // Whether the instance is shaded in shadel space this frame (after prepareDecoupledFrame).
