@@ -15,7 +15,7 @@ layout(push_constant, scalar) uniform Push {
     uint width;
     uint height;
     uint hdrSlot; // (the resolve's)
-    uint addressSlot;
+    uint64_t addresses; // ResolveAddressBuffer
 } pc;
 
 void main() {
@@ -47,6 +47,6 @@ void main() {
                 address = packResolveAddress(m, magnified);
             }
         }
-        imageStore(gImagesRgba32ui[pc.addressSlot], pixel, address);
+        ResolveAddressBuffer(pc.addresses).v[resolveAddressIndex(pixel, pc.width)] = address;
     }
 }

@@ -22,7 +22,7 @@ layout(push_constant, scalar) uniform Push {
     uint width;
     uint height;
     uint hdrSlot;
-    uint addressSlot;
+    uint64_t addresses; // ResolveAddressBuffer
 } pc;
 
 // The forward material + lighting at the pixel, from the triangle's interpolated attributes
@@ -117,7 +117,8 @@ void resolveQuad(FrameConstants f, ShadelFrame s, ivec2 origin, inout uvec4 coun
     for (int i = 0; i < 4; ++i) {
         ivec2 pixel = origin + ivec2(i & 1, i >> 1);
         if (pixel.x >= int(pc.width) || pixel.y >= int(pc.height)) continue;
-        ResolveAddress a = unpackResolveAddress(imageLoad(gImagesRgba32ui[pc.addressSlot], pixel));
+        ResolveAddress a = unpackResolveAddress(
+            ResolveAddressBuffer(pc.addresses).v[resolveAddressIndex(pixel, pc.width)]);
         vec4 color = vec4(f.skyColor, 0.0); // what the raster colour pass clears to
         bool rebuild = a.kind == RESOLVE_ADDRESS_REBUILD || f.visualize != VISUALIZE_NONE ||
                        inspecting(f, uvec2(pixel));

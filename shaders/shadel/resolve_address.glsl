@@ -1,7 +1,7 @@
 // Reconstruction addresses (--marking visibility): the compute marking already knows, per
 // pixel, which sheet shadels and weights the resolve will read (its first tap's levels after
-// fitting to the windows, and their bilinear footprints). It writes them into a screen-sized
-// RGBA32UI target, so the resolve skips the visibility buffer, the triangle setup, the MIP
+// fitting to the windows, and their bilinear footprints). It writes them into a buffer of 16
+// bytes per pixel, so the resolve skips the visibility buffer, the triangle setup, the MIP
 // choice and the window fitting and does only the chunk lookups (allocation happens between the
 // passes), the storage fetches and the filter.
 //
@@ -17,6 +17,14 @@
 #define RESOLVE_ADDRESS_NONE 0u    // no decoupled surface: the sky (hybrid objects drawn over it)
 #define RESOLVE_ADDRESS_READY 1u   // the footprints below
 #define RESOLVE_ADDRESS_REBUILD 2u // the resolve rebuilds the sample (more than one tap)
+
+// Laid out by 2x2 quads, the unit both passes walk: a quad's four pixels are 64 bytes together.
+layout(buffer_reference, scalar) buffer ResolveAddressBuffer { uvec4 v[]; };
+
+uint resolveAddressIndex(ivec2 pixel, uint width) {
+    uvec2 p = uvec2(pixel);
+    return (((p.y >> 1) * ((width + 1u) >> 1) + (p.x >> 1)) << 2) + ((p.y & 1u) << 1) + (p.x & 1u);
+}
 
 const uint kAddressCoordBits = 18u;
 const uint kAddressWeightBits = 9u;
