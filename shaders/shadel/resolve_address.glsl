@@ -43,18 +43,18 @@ struct ResolveAddress {
 };
 
 uint packAddressAxis(uint lo, uint hi, float weight, uint extra) {
-    uint word = lo;
-    word = bitfieldInsert(word, uint(round(clamp(weight, 0.0, 1.0) * kAddressWeightScale)),
-                          int(kAddressCoordBits), int(kAddressWeightBits));
-    word = bitfieldInsert(word, hi != lo ? 1u : 0u, int(kAddressStepBit), 1);
-    return bitfieldInsert(word, extra, int(kAddressExtraBit), 4);
+    // Every field is in range by construction: lo < 2^18 (the sheet), weight in [0, 1) (a
+    // fraction), hi - lo in {0, 1}, extra < 16: plain shifts, no masks.
+    uint w = uint(weight * kAddressWeightScale + 0.5);
+    return lo | (w << kAddressCoordBits) | ((hi - lo) << kAddressStepBit) |
+           (extra << kAddressExtraBit);
 }
 
 void unpackAddressAxis(uint word, out uint lo, out uint hi, out float weight) {
-    lo = bitfieldExtract(word, 0, int(kAddressCoordBits));
-    hi = lo + bitfieldExtract(word, int(kAddressStepBit), 1);
-    weight = float(bitfieldExtract(word, int(kAddressCoordBits), int(kAddressWeightBits))) /
-             kAddressWeightScale;
+    lo = word & ((1u << kAddressCoordBits) - 1u);
+    hi = lo + ((word >> kAddressStepBit) & 1u);
+    weight = float((word >> kAddressCoordBits) & ((1u << kAddressWeightBits) - 1u)) *
+             (1.0 / kAddressWeightScale);
 }
 
 uvec4 resolveAddressNone() { return uvec4(0u); } // kind RESOLVE_ADDRESS_NONE
@@ -62,7 +62,7 @@ uvec4 resolveAddressNone() { return uvec4(0u); } // kind RESOLVE_ADDRESS_NONE
 // magnified: the MIP-0 shadel is larger than the pixel (the resolve's statistics).
 uvec4 packResolveAddress(MarkedSample m, bool magnified) {
     if (m.taps != 1u) return uvec4(RESOLVE_ADDRESS_REBUILD << kAddressExtraBit, 0u, 0u, 0u);
-    uint blend = m.levels.two ? uint(round(clamp(m.levels.blend, 0.0, 1.0) * 255.0)) : 0u;
+    uint blend = m.levels.two ? uint(m.levels.blend * 255.0 + 0.5) : 0u;
     uint extraX = RESOLVE_ADDRESS_READY | (m.levels.two ? 4u : 0u) | (m.windowFallback ? 8u : 0u);
     LevelFootprint a = m.footprint0, b = m.footprint1;
     return uvec4(packAddressAxis(a.lo.x, a.hi.x, a.weight.x, extraX),
@@ -78,7 +78,8 @@ ResolveAddress unpackResolveAddress(uvec4 word) {
     a.two = (extraX & 4u) != 0u;
     a.windowFallback = (extraX & 8u) != 0u;
     a.magnified = (word.y >> kAddressExtraBit) != 0u;
-    a.blend = float((word.z >> kAddressExtraBit) | ((word.w >> kAddressExtraBit) << 4)) / 255.0;
+    a.blend = float((word.z >> kAddressExtraBit) | ((word.w >> kAddressExtraBit) << 4)) *
+              (1.0 / 255.0);
     unpackAddressAxis(word.x, a.footprint0.lo.x, a.footprint0.hi.x, a.footprint0.weight.x);
     unpackAddressAxis(word.y, a.footprint0.lo.y, a.footprint0.hi.y, a.footprint0.weight.y);
     unpackAddressAxis(word.z, a.footprint1.lo.x, a.footprint1.hi.x, a.footprint1.weight.x);
