@@ -30,12 +30,8 @@ void markChunk(ShadelFrame s, uvec2 sheet) {
     if ((occupancy.v[block] & bit) == 0ul) atomicOr(occupancy.v[block], bit);
 }
 
-void markLevel(ShadelFrame s, ShadelObjectRef o, uint mip, vec2 uv) {
-    ivec2 t0;
-    vec2 w;
-    bilinearFootprint(o, mip, uv, t0, w);
-    uvec2 a = sheetShadel(o, mip, t0);
-    uvec2 b = sheetShadel(o, mip, t0 + ivec2(1));
+void markFootprint(ShadelFrame s, LevelFootprint fp) {
+    uvec2 a = fp.lo, b = fp.hi;
     // The four taps span at most 2x2 chunks; mark each distinct one.
     markChunk(s, a);
     if (b.x / SHADEL_CHUNK != a.x / SHADEL_CHUNK) markChunk(s, uvec2(b.x, a.y));
@@ -61,18 +57,44 @@ void wantLevel(ShadelFrame s, ShadelObjectRef o, uint mip, vec2 uv) {
     atomicMax(wants.v[at].w, box.w);
 }
 
+// What marking found for a sample's first tap: the levels after fitting to the windows and
+// their footprints, exactly what reconstruction will read (the compute marking hands them to
+// the resolve: shadel/resolve_address.glsl).
+struct MarkedSample {
+    ShadelLevels levels;
+    LevelFootprint footprint0; // at levels.mip0
+    LevelFootprint footprint1; // at levels.mip1 (when levels.two)
+    bool windowFallback;       // a wanted level's window did not hold the tap
+    uint taps;
+};
+
 // texelDx/Dy: screen derivatives of the sample's MIP-0 shadel coordinate (shadelUv * mip0Size).
-void markSample(ShadelFrame s, ShadelObjectRef o, vec2 shadelUv, vec2 texelDx, vec2 texelDy) {
+MarkedSample markSample(ShadelFrame s, ShadelObjectRef o, vec2 shadelUv, vec2 texelDx,
+                        vec2 texelDy) {
     ShadelLevels wanted = shadelLevels(o, texelDx, texelDy, s.shadingBias, s.trilinearBand);
     ShadelAniso a = shadelAniso(texelDx, texelDy);
+    MarkedSample m;
+    m.taps = a.taps;
     for (uint i = 0u; i < a.taps; ++i) { // the same taps reconstruction reads
         vec2 uv = shadelTapUv(o.v.mip0Size, shadelUv, a, i);
         ShadelLevels l = wanted;
         uint unheld = fitLevelsToWindows(o, uv, l);
         for (uint k = wanted.mip0; (unheld >> k) != 0u; ++k)
             if (((unheld >> k) & 1u) != 0u) wantLevel(s, o, k, uv);
-        markLevel(s, o, l.mip0, uv);
-        if (l.two) markLevel(s, o, l.mip1, uv);
+        LevelFootprint fp0 = levelFootprint(o, l.mip0, uv);
+        markFootprint(s, fp0);
+        LevelFootprint fp1 = fp0;
+        if (l.two) {
+            fp1 = levelFootprint(o, l.mip1, uv);
+            markFootprint(s, fp1);
+        }
+        if (i == 0u) {
+            m.levels = l;
+            m.footprint0 = fp0;
+            m.footprint1 = fp1;
+            m.windowFallback = unheld != 0u;
+        }
     }
+    return m;
 }
 #endif

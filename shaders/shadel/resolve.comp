@@ -1,11 +1,14 @@
 #version 460
-// Compute resolve (--marking visibility): one invocation per 2x2 quad of pixels. Decoupled
-// pixels read their shadels with the same samples as the compute marking
-// (shadel/vis_shadel.glsl) and the same filter as the raster reconstruction
-// (shadel/resolve.glsl); misses and overflow are shaded forward here from the rebuilt
-// attributes. Every other pixel gets the sky: forward (hybrid) instances are drawn over it by
-// the raster pass that follows.
+// Compute resolve (--marking visibility): one invocation per 2x2 quad of pixels. A decoupled
+// pixel reads the reconstruction address the compute marking wrote (shadel/resolve_address.glsl:
+// the footprints of the levels it marked) and does only the chunk lookups, the storage fetches
+// and the filter of the raster reconstruction (shadel/resolve.glsl). The debug views,
+// --inspect and the rare misses and overflow rebuild the sample from the visibility buffer
+// instead (shadel/vis_shadel.glsl, the same samples as the marking): misses and overflow are
+// shaded forward here from the rebuilt attributes. Every other pixel gets the sky: forward
+// (hybrid) instances are drawn over it by the raster pass that follows.
 #include "shadel/resolve.glsl"
+#include "shadel/resolve_address.glsl"
 #include "shadel/vis_shadel.glsl"
 #include "common/lighting.glsl"
 #include "common/vertex.glsl"
@@ -19,6 +22,7 @@ layout(push_constant, scalar) uniform Push {
     uint width;
     uint height;
     uint hdrSlot;
+    uint64_t addresses; // ResolveAddressBuffer
 } pc;
 
 // The forward material + lighting at the pixel, from the triangle's interpolated attributes
@@ -50,54 +54,88 @@ vec3 forwardShade(FrameConstants f, GpuInstance inst, VisTriangle tri, VisBary b
 // The frame's counters summed per workgroup first: one global atomic per group and counter.
 shared uint sMagnified, sSampled, sMisses, sOverflow;
 
+// The filter over the footprints marking addressed; missing/overflowed count the lookups that
+// found no storage (the pixel is then rebuilt and shaded forward).
+vec3 resolveAddressed(ShadelFrame s, ResolveAddress a, uint layerSlot, inout uint missing,
+                      inout uint overflowed) {
+    uint64_t mask;
+    vec3 c = sampleFootprint(s, a.footprint0, layerSlot, missing, overflowed, mask);
+    if (a.two)
+        c = mix(c, sampleFootprint(s, a.footprint1, layerSlot, missing, overflowed, mask), a.blend);
+    return c;
+}
+
+// The pixel rebuilt from the visibility buffer: the sample, the reconstruction with its debug
+// views and inspection, and the forward shading of misses and overflow. The quad's setup is
+// shared by its pixels of the same triangle (current, o, inst, q).
+vec4 resolveRebuilt(FrameConstants f, ShadelFrame s, ivec2 origin, int i, ivec2 pixel,
+                    inout uvec2 current, inout ShadelObjectRef o, inout GpuInstance inst,
+                    inout VisQuad q, inout uvec4 counts) {
+    uvec2 vis = loadVisibility(pc.visibilitySlot, pixel);
+    if (vis.x == VISIBILITY_NONE) return vec4(f.skyColor, 0.0);
+    if (vis != current) {
+        current = vis;
+        o = shadelObject(s, vis.x);
+        if ((o.v.flags & SHADEL_OBJECT_DECOUPLED) != 0u) {
+            inst = InstanceBuffer(f.instances).i[vis.x];
+            visQuadSetup(f, s, inst, vis.x, vis.y, origin, q);
+        }
+    }
+    if ((o.v.flags & SHADEL_OBJECT_DECOUPLED) == 0u) return vec4(f.skyColor, 0.0);
+    VisShadel v = visShadelSample(q, o, i);
+    Reconstruction r = reconstructSample(s, o, v.shadelUv, v.texelDx, v.texelDy, pixel,
+                                         reconstructionLayer(f, s));
+    counts += uvec4(r.magnified ? 1u : 0u, r.sampled ? 1u : 0u, r.missing != 0u ? 1u : 0u,
+                    r.overflowed != 0u ? 1u : 0u);
+    if (r.sampled && r.windowFallback) // rare: only where a window lags the view
+        atomicAdd(ShadelCountersRef(s.counters).c.windowFallbackPixels, 1u);
+    vec3 c = r.color;
+    bool inspect = inspecting(f, uvec2(pixel));
+    if (inspect) {
+        vec4 clip = f.viewProj * vec4(visInterpolate(v.bary.center,
+            fetchWorldVertex(f, inst, q.tri.v0).position,
+            fetchWorldVertex(f, inst, q.tri.v1).position,
+            fetchWorldVertex(f, inst, q.tri.v2).position), 1.0);
+        beginInspect(f, vis.x, vis.y, vec4(vec2(pixel) + 0.5, clip.z / clip.w, 1.0));
+        inspectShadels(f, s, o, r, v.shadelUv, v.texelDx, v.texelDy);
+    }
+    if (r.missing + r.overflowed != 0u || inspect) {
+        useTileDecalList(f, vec2(pixel) + 0.5); // decals, as forward shading applies them
+        vec3 forward = forwardShade(f, inst, q.tri, v.bary, vis, pixel, inspect);
+        if (r.missing + r.overflowed != 0u) c = forward;
+    }
+    if (inspect) shaderPrintF3(f, PRINT_OUTPUT, c);
+    return vec4(visualizeReconstruction(f, o, r, c, v.shadelUv, v.texelDx, v.texelDy), 1.0);
+}
+
 void resolveQuad(FrameConstants f, ShadelFrame s, ivec2 origin, inout uvec4 counts) {
     uvec2 current = uvec2(VISIBILITY_NONE);
     VisQuad q;
     ShadelObjectRef o;
     GpuInstance inst;
+    uint layerSlot = reconstructionLayer(f, s);
     for (int i = 0; i < 4; ++i) {
         ivec2 pixel = origin + ivec2(i & 1, i >> 1);
         if (pixel.x >= int(pc.width) || pixel.y >= int(pc.height)) continue;
+        ResolveAddress a = unpackResolveAddress(
+            ResolveAddressBuffer(pc.addresses).v[resolveAddressIndex(pixel, pc.width)]);
         vec4 color = vec4(f.skyColor, 0.0); // what the raster colour pass clears to
-        uvec2 vis = loadVisibility(pc.visibilitySlot, pixel);
-        bool decoupled = false;
-        if (vis.x != VISIBILITY_NONE) {
-            if (vis != current) {
-                current = vis;
-                o = shadelObject(s, vis.x);
-                if ((o.v.flags & SHADEL_OBJECT_DECOUPLED) != 0u) {
-                    inst = InstanceBuffer(f.instances).i[vis.x];
-                    visQuadSetup(f, s, inst, vis.x, vis.y, origin, q);
-                }
+        bool rebuild = a.kind == RESOLVE_ADDRESS_REBUILD || f.visualize != VISUALIZE_NONE ||
+                       inspecting(f, uvec2(pixel));
+        if (a.kind == RESOLVE_ADDRESS_READY && !rebuild) {
+            uint missing = 0u, overflowed = 0u;
+            vec3 c = resolveAddressed(s, a, layerSlot, missing, overflowed);
+            if (missing + overflowed == 0u) {
+                bool sampled = all(equal(pixel & 1, ivec2(0))); // as reconstructSample samples
+                counts += uvec4(sampled && a.magnified ? 1u : 0u, sampled ? 1u : 0u, 0u, 0u);
+                if (sampled && a.windowFallback)
+                    atomicAdd(ShadelCountersRef(s.counters).c.windowFallbackPixels, 1u);
+                color = vec4(c, 1.0);
+            } else {
+                rebuild = true; // rare: shaded forward from the rebuilt attributes
             }
-            decoupled = (o.v.flags & SHADEL_OBJECT_DECOUPLED) != 0u;
         }
-        if (decoupled) {
-            VisShadel v = visShadelSample(q, o, i);
-            Reconstruction r = reconstructSample(s, o, v.shadelUv, v.texelDx, v.texelDy, pixel,
-                                                 reconstructionLayer(f, s));
-            counts += uvec4(r.magnified ? 1u : 0u, r.sampled ? 1u : 0u, r.missing != 0u ? 1u : 0u,
-                            r.overflowed != 0u ? 1u : 0u);
-            if (r.sampled && r.windowFallback) // rare: only where a window lags the view
-                atomicAdd(ShadelCountersRef(s.counters).c.windowFallbackPixels, 1u);
-            vec3 c = r.color;
-            bool inspect = inspecting(f, uvec2(pixel));
-            if (inspect) {
-                vec4 clip = f.viewProj * vec4(visInterpolate(v.bary.center,
-                    fetchWorldVertex(f, inst, q.tri.v0).position,
-                    fetchWorldVertex(f, inst, q.tri.v1).position,
-                    fetchWorldVertex(f, inst, q.tri.v2).position), 1.0);
-                beginInspect(f, vis.x, vis.y, vec4(vec2(pixel) + 0.5, clip.z / clip.w, 1.0));
-                inspectShadels(f, s, o, r, v.shadelUv, v.texelDx, v.texelDy);
-            }
-            if (r.missing + r.overflowed != 0u || inspect) {
-                useTileDecalList(f, vec2(pixel) + 0.5); // decals, as forward shading applies them
-                vec3 forward = forwardShade(f, inst, q.tri, v.bary, vis, pixel, inspect);
-                if (r.missing + r.overflowed != 0u) c = forward;
-            }
-            if (inspect) shaderPrintF3(f, PRINT_OUTPUT, c);
-            color = vec4(visualizeReconstruction(f, o, r, c, v.shadelUv, v.texelDx, v.texelDy), 1.0);
-        }
+        if (rebuild) color = resolveRebuilt(f, s, origin, i, pixel, current, o, inst, q, counts);
         imageStore(gImagesRgba16f[pc.hdrSlot], pixel, color);
     }
 }

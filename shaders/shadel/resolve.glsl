@@ -27,11 +27,9 @@ vec3 storageTap(ShadelFrame s, uint layerSlot, int slot, uvec2 sheet) {
     return fetchTextureUniform(layerSlot, storageTexel(s, uint(slot), sheet % SHADEL_CHUNK), 0).rgb;
 }
 
-vec3 sampleLevel(ShadelFrame s, ShadelObjectRef o, uint mip, vec2 uv, uint layerSlot,
-                 inout uint missing, inout uint overflowed, out uint64_t firstMask) {
-    ivec2 t0;
-    vec2 w;
-    bilinearFootprint(o, mip, uv, t0, w);
+// The bilinear filter over a level footprint (levelFootprint).
+vec3 sampleFootprint(ShadelFrame s, LevelFootprint fp, uint layerSlot, inout uint missing,
+                     inout uint overflowed, out uint64_t firstMask) {
     // The footprint's two columns and two rows in the sheet (clamped to the level). Each of its
     // four taps reads the chunk holding it; one chunk lookup serves all four unless the
     // footprint crosses a chunk edge (15 of 64 positions), which costs only the extra lookups:
@@ -39,7 +37,8 @@ vec3 sampleLevel(ShadelFrame s, ShadelObjectRef o, uint mip, vec2 uv, uint layer
     // path of one filtered fetch inside a chunk plus a four-tap path at chunk edges made almost
     // every group run both: 1 - (49/64)^8 of 8-lane groups have an edge lane. Measured on
     // lavapipe at 1280x720, builtin:default, orbit: resolveCompute 134-142 ms -> 107 ms.)
-    uvec2 lo = sheetShadel(o, mip, t0), hi = sheetShadel(o, mip, t0 + ivec2(1));
+    uvec2 lo = fp.lo, hi = fp.hi;
+    vec2 w = fp.weight;
     bvec2 cross = notEqual(lo / SHADEL_CHUNK, hi / SHADEL_CHUNK);
     uint64_t mask; // of the other lookups (only the first is reported)
     int s00 = chunkSlotAt(s, lo, missing, overflowed, firstMask);
@@ -53,6 +52,12 @@ vec3 sampleLevel(ShadelFrame s, ShadelObjectRef o, uint mip, vec2 uv, uint layer
     vec3 c01 = storageTap(s, layerSlot, s01, uvec2(lo.x, hi.y));
     vec3 c11 = storageTap(s, layerSlot, s11, hi);
     return mix(mix(c00, c10, w.x), mix(c01, c11, w.x), w.y);
+}
+
+vec3 sampleLevel(ShadelFrame s, ShadelObjectRef o, uint mip, vec2 uv, uint layerSlot,
+                 inout uint missing, inout uint overflowed, out uint64_t firstMask) {
+    return sampleFootprint(s, levelFootprint(o, mip, uv), layerSlot, missing, overflowed,
+                           firstMask);
 }
 
 struct Reconstruction {

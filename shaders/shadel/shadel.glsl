@@ -146,6 +146,24 @@ uvec2 sheetShadel(ShadelObjectRef o, uint mip, ivec2 texel) {
     return o.v.rect[mip].xy * SHADEL_BLOCK + levelTexel(o, mip, texel) - windowOrigin(o, mip);
 }
 
+// A sample's 2x2 bilinear footprint at one level, in the sheet: the first and last shadel (the
+// last is the first + 0 or 1 on each axis: clamped at the level's edge) and the weights of the
+// second column and row. Marking marks its chunks, reconstruction reads them.
+struct LevelFootprint {
+    uvec2 lo;
+    uvec2 hi;
+    vec2 weight;
+};
+
+LevelFootprint levelFootprint(ShadelObjectRef o, uint mip, vec2 uv) {
+    ivec2 t0;
+    LevelFootprint fp;
+    bilinearFootprint(o, mip, uv, t0, fp.weight);
+    fp.lo = sheetShadel(o, mip, t0);
+    fp.hi = sheetShadel(o, mip, t0 + ivec2(1));
+    return fp;
+}
+
 // The level texel of a sheet shadel of the object's level `mip` (the inverse of sheetShadel).
 uvec2 levelShadel(ShadelObjectRef o, uint mip, uvec2 sheet) {
     return sheet - o.v.rect[mip].xy * SHADEL_BLOCK + windowOrigin(o, mip);

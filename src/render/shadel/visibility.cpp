@@ -12,6 +12,9 @@ struct VisibilityState {
     RenderTargetView idsTarget;
     TextureReadView idsRead;
     TextureWriteView hdrWrite; // the scene colour target as a storage image (resolve)
+    // "reconstructionAddress" (decoupled only): 16 bytes per pixel, the levels' footprints the
+    // compute marking marked, read by the resolve (shaders/shadel/resolve_address.glsl).
+    BufferHandle address;
     Pipeline prepass, mark, resolve;
 };
 
@@ -26,13 +29,18 @@ struct ComputePush {
     uint32_t width;
     uint32_t height;
     uint32_t hdrSlot;
+    uint64_t address;
 };
 
 ComputePush computePush(Renderer& r, uint64_t frame) {
     Gpu& gpu = *r.gpu;
     VisibilityState& v = *r.visibility;
-    return {frame, slot(gpu, v.idsRead).value, r.internalWidth, r.internalHeight,
-            slot(gpu, v.hdrWrite).value};
+    return {frame,
+            slot(gpu, v.idsRead).value,
+            r.internalWidth,
+            r.internalHeight,
+            slot(gpu, v.hdrWrite).value,
+            v.address ? address(gpu, v.address) : 0u};
 }
 
 void dispatchPixels(Renderer& r, VkCommandBuffer cmd) {
@@ -59,6 +67,13 @@ VisibilityStatePtr createVisibility(Renderer& r) {
     v.idsTarget = createRenderTargetView(gpu, v.ids);
     v.idsRead = createReadView(gpu, v.ids);
     v.hdrWrite = createWriteView(gpu, r.hdr);
+    if (r.settings.mode == RenderMode::Decoupled) { // (tile shading reads only the IDs)
+        // A buffer, not an RGBA32UI image: on lavapipe the image stores made the marking pass
+        // cost as much more as the resolve saved. Laid out by 2x2 quads, as both passes walk.
+        VkDeviceSize quads = VkDeviceSize((r.internalWidth + 1) / 2) * ((r.internalHeight + 1) / 2);
+        v.address = createBuffer(gpu, {"reconstructionAddress", quads * 4 * 16});
+        if (!v.address) throw DeviceError("out of GPU memory for the reconstruction addresses");
+    }
 
     GraphicsPipelineDesc prepass;
     prepass.name = "visibilityPrepass";
@@ -83,6 +98,7 @@ void destroyVisibility(Renderer& r, VisibilityStatePtr& state) {
     VisibilityState& v = *state;
     for (Pipeline* p : {&v.prepass, &v.mark, &v.resolve}) destroy(gpu, *p);
     destroy(gpu, v.hdrWrite);
+    if (v.address) destroy(gpu, v.address);
     destroy(gpu, v.idsRead);
     destroy(gpu, v.idsTarget);
     destroy(gpu, v.ids);
@@ -143,6 +159,9 @@ void recordVisibilityPrepass(Renderer& r, VkCommandBuffer cmd, uint64_t frame) {
 
 void recordMarkingCompute(Renderer& r, VkCommandBuffer cmd, uint64_t frame) {
     Gpu& gpu = *r.gpu;
+    // Every pixel's address is written again, after last frame's resolve read them.
+    memoryBarrier(cmd, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_SHADER_STORAGE_READ_BIT,
+                  VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT);
     bind(gpu, cmd, r.visibility->mark);
     pushConstants(gpu, cmd, computePush(r, frame));
     dispatchPixels(r, cmd);

@@ -30,9 +30,11 @@ uint32_t visibilityHdrWriteSlot(Renderer& r);
 
 // "visibilityPrepass": reversed-Z depth + instance/triangle IDs of opaque and decoupled lists.
 void recordVisibilityPrepass(Renderer& r, VkCommandBuffer cmd, uint64_t frame);
-// "markingCompute": occupancy bits from the visibility buffer (after shadelClear).
+// "markingCompute": occupancy bits from the visibility buffer (after shadelClear), and per
+// pixel the footprints it marked ("reconstructionAddress") for the resolve.
 void recordMarkingCompute(Renderer& r, VkCommandBuffer cmd, uint64_t frame);
-// "resolveCompute": decoupled pixels reconstructed (and forward fallback) into the HDR target.
+// "resolveCompute": decoupled pixels reconstructed from their addresses (rebuilt from the
+// visibility buffer for debug views, --inspect, and the forward fallback) into the HDR target.
 void recordResolveCompute(Renderer& r, VkCommandBuffer cmd, uint64_t frame);
 // "hybridForward": forward opaque + blended lists drawn over the resolved image.
 void recordHybridForward(Renderer& r, VkCommandBuffer cmd, uint64_t frame);
