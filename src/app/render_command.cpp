@@ -165,6 +165,42 @@ double median(std::vector<double> v) {
     return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
 }
 
+// The render thread's CPU scopes (FrameResult::cpuScopes: the frontend's steps with --trace,
+// every submit always): per name, the median over frames of the frame's sum of wall clock and
+// of the thread's CPU time, plus "submit (all passes)". Listed in order of first appearance.
+static nlohmann::json cpuScopeStats(const std::vector<FrameResult>& frames) {
+    std::vector<std::string> names;
+    std::map<std::string, std::pair<std::vector<double>, std::vector<double>>> perName;
+    for (const FrameResult& f : frames) {
+        std::map<std::string, std::pair<double, double>> sums;
+        for (const CpuScope& c : f.cpuScopes) {
+            for (const std::string& name :
+                 {c.name,
+                  std::string(c.name.rfind("submit ", 0) == 0 ? "submit (all passes)" : "")}) {
+                if (name.empty()) continue;
+                auto [it, added] = sums.try_emplace(name, 0.0, 0.0);
+                it->second.first += c.wallMs;
+                it->second.second += c.cpuMs;
+            }
+        }
+        for (auto& [name, sum] : sums) {
+            auto [it, added] = perName.try_emplace(name);
+            if (added) names.push_back(name);
+            it->second.first.push_back(sum.first);
+            it->second.second.push_back(sum.second);
+        }
+    }
+    nlohmann::json out = nlohmann::json::array();
+    for (const std::string& name : names) {
+        auto& [wall, cpu] = perName[name];
+        out.push_back({{"name", name},
+                       {"wall_ms", median(wall)},
+                       {"thread_cpu_ms", median(cpu)},
+                       {"frames", wall.size()}});
+    }
+    return out;
+}
+
 static const char* modeName(RenderMode m) {
     return m == RenderMode::Forward ? "forward" : "decoupled";
 }
@@ -365,6 +401,7 @@ RenderRun runRender(Gpu& gpu, const RenderOptions& o) {
     settings.decals = o.decals;
     settings.proxyShadows = o.proxyShadows;
     settings.shadowCulling = o.shadowCulling;
+    settings.cpuScopes = !o.trace.empty(); // the trace's finer CPU spans (stats "cpu_scopes")
     requireCount("--gi-iterations", o.giIterations, 0, 64);
     if (o.visualize == Visualize::Gi && o.gi == GiMode::Off)
         throw InputError("--visualize gi: shows the indirect light of --gi lpv; GI is off");
@@ -530,6 +567,7 @@ RenderRun runRender(Gpu& gpu, const RenderOptions& o) {
     s["recording"] = {{"threads", settings.recordingThreads},
                       {"wall_ms", median(recordingMs)},
                       {"workers_cpu_ms", median(recordingCpuMs)}};
+    s["cpu_scopes"] = cpuScopeStats(run.frames);
     std::vector<double> streamingMs;
     for (auto& f : run.frames) streamingMs.push_back(f.cpuStreamingMs);
     s["cpu_streaming_thread_ms"] = median(streamingMs); // of which the texture streaming frontend
@@ -541,7 +579,7 @@ RenderRun runRender(Gpu& gpu, const RenderOptions& o) {
     // change, the first frame builds what later frames reuse), so the i-th pass of one frame
     // is not the i-th of another. Listed in order of first appearance.
     std::vector<std::pair<std::string, int>> passKeys;
-    std::map<std::pair<std::string, int>, std::vector<double>> passMs;
+    std::map<std::pair<std::string, int>, std::vector<double>> passMs, recordCpuMs;
     for (auto& f : run.frames) {
         std::map<std::string, int> seen;
         for (auto& pt : f.passes) {
@@ -549,12 +587,17 @@ RenderRun runRender(Gpu& gpu, const RenderOptions& o) {
             auto [it, added] = passMs.try_emplace(key);
             if (added) passKeys.push_back(key);
             it->second.push_back(pt.gpuMs);
+            recordCpuMs[key].push_back(pt.recordCpuMs);
         }
     }
     nlohmann::json passes = nlohmann::json::array();
     for (auto& key : passKeys) {
         const std::vector<double>& ms = passMs[key];
-        passes.push_back({{"name", key.first}, {"gpu_ms", median(ms)}, {"frames", ms.size()}});
+        nlohmann::json p = {{"name", key.first}, {"gpu_ms", median(ms)}, {"frames", ms.size()}};
+        // Threaded recording times every pass; serial recording with --trace.
+        if (settings.recordingThreads > 1 || settings.cpuScopes)
+            p["record_cpu_ms"] = median(recordCpuMs[key]);
+        passes.push_back(p);
     }
     s["passes"] = passes;
     uint64_t asserts = 0;

@@ -40,6 +40,10 @@ nlohmann::json chromeTrace(const std::vector<FrameResult>& frames, const std::st
         span("frame " + std::to_string(i), "cpu", kCpuTrack, f.startMs, f.frameMs,
              {{"frame", i}, {"cpu_frame_ms", f.cpuFrameMs}});
         span("frontend", "cpu", kCpuTrack, f.startMs, f.cpuPrepareMs, {{"frame", i}});
+        // Finer scopes of the render thread (--trace): the frontend's steps, the submits.
+        for (const CpuScope& c : f.cpuScopes)
+            span(c.name, "cpu", kCpuTrack, f.startMs + c.startMs, c.wallMs,
+                 {{"frame", i}, {"thread_cpu_ms", c.cpuMs}});
         // GPU passes and recording start after the frontend has prepared the frame.
         double gpuStart = f.startMs + f.cpuPrepareMs;
         for (size_t w = 0; w < f.recordingWorkers.size(); ++w) {
@@ -53,7 +57,8 @@ nlohmann::json chromeTrace(const std::vector<FrameResult>& frames, const std::st
                  f.frontendWorkerStartMs, f.frontendWorkerMs,
                  {{"frame", i + 1}, {"cpu_ms", f.frontendWorkerCpuMs}});
         for (const PassTiming& p : f.passes)
-            span(p.name, "gpu", kGpuTrack, gpuStart + p.startMs, p.gpuMs, {{"frame", i}});
+            span(p.name, "gpu", kGpuTrack, gpuStart + p.startMs, p.gpuMs,
+                 {{"frame", i}, {"record_cpu_ms", p.recordCpuMs}});
     }
     return {{"traceEvents", events}, {"displayTimeUnit", "ms"}};
 }

@@ -1,7 +1,6 @@
 #include "render/renderer.h"
 
 #include <cstring>
-#include <ctime>
 #include <limits>
 
 #include <glm/gtc/matrix_transform.hpp>
@@ -290,12 +289,6 @@ static void updateLights(Renderer& r, const GpuScene& scene, gpu::FrameConstants
 // One frame, top to bottom. Forward: cull, shadow, depth prepass, shading, tonemap.
 // Decoupled replaces shading with marking, allocation, work queues, shadel shading and
 // reconstruction (render/shadel/decoupled.h).
-static double threadCpuMs() {
-    timespec t{};
-    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
-    return double(t.tv_sec) * 1e3 + double(t.tv_nsec) * 1e-6;
-}
-
 FrameResult renderFrame(Renderer& r, const GpuScene& scene, const CameraView& camera) {
     Gpu& gpu = *r.gpu;
     double threadStart = threadCpuMs();
@@ -305,17 +298,25 @@ FrameResult renderFrame(Renderer& r, const GpuScene& scene, const CameraView& ca
     };
     Clock::time_point cpuStart = Clock::now();
     double startMs = std::chrono::duration<double, std::milli>(cpuStart - r.createdAt).count();
+    r.cpuScopes.clear();
+    r.frameCpuStart = cpuStart;
+    r.recorder.timeRecording = r.settings.cpuScopes;
     r.sceneIndices = scene.indices;
     r.skyColor = scene.skyColor;
-    gpu::FrameConstants constants = makeFrameConstants(r, scene, camera);
-    if (r.skinning) constants.vertices = skinnedVerticesAddress(r, *r.skinning); // every view
-    updateLights(r, scene, constants);
+    gpu::FrameConstants constants;
+    {
+        auto timer = cpuScope(r, "constants + lights");
+        constants = makeFrameConstants(r, scene, camera);
+        if (r.skinning) constants.vertices = skinnedVerticesAddress(r, *r.skinning); // every view
+        updateLights(r, scene, constants);
+    }
     // Before beginFrame (streaming rebinds texture slots in the set this frame uses) and before
     // the decoupled frontend (which must not carry over shading of re-streamed textures).
     r.changedMaterials.clear();
     // The streaming frontend's CPU time (its pass may be recorded on a worker: rhi/frame.h).
     double streamingMs = 0.0;
     if (r.streaming) {
+        auto timer = cpuScope(r, "texture streaming");
         double streamingStart = threadCpuMs();
         prepareTextureStreaming(*r.streaming, camera, float(r.internalHeight), constants);
         r.changedMaterials = restreamedMaterials(*r.streaming);
@@ -329,26 +330,46 @@ FrameResult renderFrame(Renderer& r, const GpuScene& scene, const CameraView& ca
         for (size_t i = 0; i < r.edits.materialsChanged.size(); ++i)
             r.changedMaterials[i] |= r.edits.materialsChanged[i];
     }
-    constants.lighting = prepareLightCulling(
-        r, scene, r.lightsLastFrame.empty() ? scene.lightInfo : r.lightsLastFrame, constants);
-    if (r.gi) prepareGiFrame(r, scene, camera, constants);
+    {
+        auto timer = cpuScope(r, "light culling");
+        constants.lighting = prepareLightCulling(
+            r, scene, r.lightsLastFrame.empty() ? scene.lightInfo : r.lightsLastFrame, constants);
+    }
+    if (r.gi) {
+        auto timer = cpuScope(r, "gi");
+        prepareGiFrame(r, scene, camera, constants);
+    }
     if (r.distanceFields && r.settings.distanceFieldLighting) { // render/distance_fields
+        auto timer = cpuScope(r, "distance fields");
         updateDistanceFieldResidency(r, *r.distanceFields, camera.position);
         constants.distanceFields = distanceFieldFrameAddress(r, *r.distanceFields);
         constants.dfShadowStart = r.settings.dfShadowStart;
     }
-    if (r.decoupled) prepareDecoupledFrame(r, scene, camera, constants);
-    prepareTransparentDraws(r, scene, camera);
-    prepareParticleFrame(r);
-    prepareCullingFrame(r, scene, constants);
-    constants.decals = prepareDecalFrame(r, constants);
+    if (r.decoupled) {
+        auto timer = cpuScope(r, "decoupled coarse allocation");
+        prepareDecoupledFrame(r, scene, camera, constants);
+    }
+    {
+        auto timer = cpuScope(r, "transparency + particles");
+        prepareTransparentDraws(r, scene, camera);
+        prepareParticleFrame(r);
+    }
+    {
+        auto timer = cpuScope(r, "culling + decals");
+        prepareCullingFrame(r, scene, constants);
+        constants.decals = prepareDecalFrame(r, constants);
+    }
     constants.debugLines = debugLinesAddress(r);
-    if (r.rt) prepareRayTracingFrame(r, scene, camera, constants);
+    if (r.rt) {
+        auto timer = cpuScope(r, "ray tracing");
+        prepareRayTracingFrame(r, scene, camera, constants);
+    }
     std::memcpy(mapped(gpu, r.frameConstants), &constants, sizeof(constants));
     uint64_t frame = address(gpu, r.frameConstants);
     double prepareMs = msSince(cpuStart);
 
     FrameRecorder& rec = r.recorder;
+    auto declaring = cpuScope(r, "declare passes");
     beginFrame(rec);
     if (r.debugLines) // --debug-lines: any later pass may append segments
         pass(rec, "debugLinesClear", [&](VkCommandBuffer cmd) { recordDebugLinesClear(r, cmd); });
@@ -410,7 +431,11 @@ FrameResult renderFrame(Renderer& r, const GpuScene& scene, const CameraView& ca
     recordParticleAtlasView(r, rec, frame); // --visualize particle-atlas
     pass(rec, "tonemap", [&](VkCommandBuffer cmd) { recordTonemap(r, cmd, frame); });
     if (r.decoupled) recordDecoupledPostPasses(r, rec, frame);
-    endFrame(rec);
+    declaring.stop();
+    {
+        auto timer = cpuScope(r, "end frame: record, submit, wait");
+        endFrame(rec);
+    }
 
     FrameResult result;
     result.passes = rec.passes;
@@ -422,6 +447,7 @@ FrameResult renderFrame(Renderer& r, const GpuScene& scene, const CameraView& ca
     // CPU cost: the whole call minus the time spent waiting for the GPU (submit-per-pass waits
     // inside the passes, so this is an upper bound there).
     result.cpuFrameMs = prepareMs + std::max(0.0, msSince(cpuStart) - prepareMs - rec.gpuWaitMs);
+    auto finishing = cpuScope(r, "finish: read back, stats");
     result.shaderAsserts = collectShaderMessages(gpu, r.messages);
     result.prints = r.messages.prints;
     result.transparentDecoupledDraws = decoupledTransparentDraws(r);
@@ -445,7 +471,15 @@ FrameResult renderFrame(Renderer& r, const GpuScene& scene, const CameraView& ca
     result.rgba.resize(bytes);
     std::memcpy(result.rgba.data(), mapped(gpu, r.pixels), bytes);
     for (size_t i = 3; i < bytes; i += 4) result.pixelsCovered += result.rgba[i] != 0;
+    finishing.stop();
     result.cpuThreadMs = threadCpuMs() - threadStart;
+    result.cpuScopes = std::move(r.cpuScopes);
+    double recorderStartMs =
+        std::chrono::duration<double, std::milli>(rec.frameStart - cpuStart).count();
+    for (CpuScope submit : rec.submits) { // from the recorder's frame start
+        submit.startMs += recorderStartMs;
+        result.cpuScopes.push_back(std::move(submit));
+    }
     result.cpuStreamingMs = streamingMs;
     return result;
 }

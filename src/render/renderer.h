@@ -152,6 +152,9 @@ struct RenderSettings {
         true;           // --proxy-shadows: shadow views draw proxy index sets (render/culling)
     bool decals = true; // --decals: the scene's projected box decals (render/decals)
     ShadowCulling shadowCulling = ShadowCulling::PerView; // cascades' and spots' caster lists
+    // --trace: time the frame's CPU scopes (FrameResult::cpuScopes) and each pass's recording.
+    // Off by default: reading a thread's CPU clock costs ~0.7 us, which would add to cpuFrameMs.
+    bool cpuScopes = false;
 };
 
 struct FrameResult {
@@ -180,6 +183,9 @@ struct FrameResult {
     // Threaded frames: the wall clock of the parallel recording and what each worker did.
     double recordingMs = 0.0;
     std::vector<RecordingWorkerTiming> recordingWorkers;
+    // With RenderSettings::cpuScopes: the render thread's named CPU scopes (frontend steps,
+    // recording, submits, finish), from startMs; submits are there in every case.
+    std::vector<CpuScope> cpuScopes;
 };
 
 struct DecoupledState; // render/shadel/decoupled.h
@@ -265,7 +271,16 @@ struct Renderer {
     SunCascadeStatePtr sunCascades; // --sun-cascades 2..4 (render/lighting/sun_cascades.h)
     DecalStatePtr decals;           // --decals on, scenes with decals (render/decals/decals.h)
     std::chrono::steady_clock::time_point createdAt = std::chrono::steady_clock::now();
+    // This frame's CPU scopes so far (RenderSettings::cpuScopes) and their origin.
+    std::vector<CpuScope> cpuScopes;
+    std::chrono::steady_clock::time_point frameCpuStart;
 };
+
+// Times the enclosing block as the CPU scope `name` of this frame (nothing unless
+// RenderSettings::cpuScopes).
+inline CpuScopeTimer cpuScope(Renderer& r, const char* name) {
+    return CpuScopeTimer(r.settings.cpuScopes ? &r.cpuScopes : nullptr, name, r.frameCpuStart);
+}
 
 void initRenderer(Renderer& renderer, Gpu& gpu, const RenderSettings& settings,
                   const GpuScene& scene);

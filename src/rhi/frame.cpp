@@ -1,10 +1,10 @@
 #include "rhi/frame.h"
 
 #include <algorithm>
-#include <ctime>
 #include <thread>
 
 #include "core/assert.h"
+#include "core/cpu_scope.h"
 #include "core/worker_pool.h"
 #include "rhi/gpu.h"
 
@@ -14,12 +14,6 @@ using Clock = std::chrono::steady_clock;
 
 static double msBetween(Clock::time_point from, Clock::time_point to) {
     return std::chrono::duration<double, std::milli>(to - from).count();
-}
-
-static double threadCpuMs() {
-    timespec t{};
-    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
-    return double(t.tv_sec) * 1e3 + double(t.tv_nsec) * 1e-6;
 }
 
 static VkCommandPool createCommandPool(Gpu& gpu, const std::string& name) {
@@ -89,8 +83,10 @@ static void beginCommands(FrameRecorder& r) {
     VK_CHECK(vkBeginCommandBuffer(r.cmd, &bi));
 }
 
-// Submits the (ended) command buffers in order as one batch and waits for the GPU.
-static void submitAndWait(FrameRecorder& r, const VkCommandBuffer* cmds, uint32_t count) {
+// Submits the (ended) command buffers in order as one batch and waits for the GPU. `name` names
+// the submission's CPU scope ("submit NAME").
+static void submitAndWait(FrameRecorder& r, const VkCommandBuffer* cmds, uint32_t count,
+                          const std::string& name) {
     std::vector<VkCommandBufferSubmitInfo> cbis(count);
     for (uint32_t i = 0; i < count; ++i) {
         cbis[i] = {VK_STRUCTURE_TYPE_COMMAND_BUFFER_SUBMIT_INFO};
@@ -114,11 +110,13 @@ static void submitAndWait(FrameRecorder& r, const VkCommandBuffer* cmds, uint32_
     double submitCpuStart = threadCpuMs();
     VK_CHECK(vkQueueSubmit2(r.gpu->device.queue, 1, &si, r.fence));
     auto waitStart = std::chrono::steady_clock::now();
+    double submitCpuMs = threadCpuMs() - submitCpuStart;
+    double submitWallMs = msBetween(submitStart, waitStart);
+    r.submits.push_back(
+        {"submit " + name, msBetween(r.frameStart, submitStart), submitWallMs, submitCpuMs});
     // A CPU device's submit can block on its queue thread (lavapipe: up to 16 ms at 1M instances
     // with ~0.01 ms of this thread's CPU): the blocked part is waiting for the GPU too.
-    r.gpuWaitMs +=
-        std::max(0.0, std::chrono::duration<double, std::milli>(waitStart - submitStart).count() -
-                          (threadCpuMs() - submitCpuStart));
+    r.gpuWaitMs += std::max(0.0, submitWallMs - submitCpuMs);
     VkResult res =
         vkWaitForFences(r.gpu->device.device, 1, &r.fence, VK_TRUE, 120ull * 1000000000ull);
     r.gpuWaitMs +=
@@ -129,9 +127,9 @@ static void submitAndWait(FrameRecorder& r, const VkCommandBuffer* cmds, uint32_
     VK_CHECK(res);
 }
 
-static void submitAndWait(FrameRecorder& r) {
+static void submitAndWait(FrameRecorder& r, const std::string& name) {
     VK_CHECK(vkEndCommandBuffer(r.cmd));
-    submitAndWait(r, &r.cmd, 1);
+    submitAndWait(r, &r.cmd, 1, name);
 }
 
 void beginFrame(FrameRecorder& r) {
@@ -140,6 +138,7 @@ void beginFrame(FrameRecorder& r) {
     r.passes.clear();
     r.deferred.clear();
     r.workerTimings.clear();
+    r.submits.clear();
     r.recordingMs = 0.0;
     r.gpuWaitMs = 0.0;
     r.frameStart = std::chrono::steady_clock::now();
@@ -151,7 +150,7 @@ void pass(FrameRecorder& r, const char* name, const std::function<void(VkCommand
     Gpu& gpu = *r.gpu;
     uint32_t index = uint32_t(r.passes.size());
     SHADEL_ASSERT(index < r.maxPasses);
-    r.passes.push_back({name, 0.0, 0.0});
+    r.passes.push_back({name, 0.0, 0.0, 0.0});
     if (r.recordingThreads > 1) { // recorded in endFrame, on the workers
         r.deferred.push_back({record, VK_NULL_HANDLE});
         return;
@@ -160,21 +159,25 @@ void pass(FrameRecorder& r, const char* name, const std::function<void(VkCommand
         auto start = std::chrono::steady_clock::now();
         r.passes.back().startMs =
             std::chrono::duration<double, std::milli>(start - r.frameStart).count();
+        double cpuStart = r.timeRecording ? threadCpuMs() : 0.0;
         beginCommands(r);
         beginLabel(gpu, r.cmd, name);
         record(r.cmd);
         endLabel(gpu, r.cmd);
-        submitAndWait(r);
+        if (r.timeRecording) r.passes.back().recordCpuMs = threadCpuMs() - cpuStart;
+        submitAndWait(r, r.passes.back().name);
         r.passes.back().gpuMs =
             std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
                 .count();
         return;
     }
+    double cpuStart = r.timeRecording ? threadCpuMs() : 0.0;
     beginLabel(gpu, r.cmd, name);
     vkCmdWriteTimestamp2(r.cmd, VK_PIPELINE_STAGE_2_TOP_OF_PIPE_BIT, r.queries, index * 2);
     record(r.cmd);
     vkCmdWriteTimestamp2(r.cmd, VK_PIPELINE_STAGE_2_BOTTOM_OF_PIPE_BIT, r.queries, index * 2 + 1);
     endLabel(gpu, r.cmd);
+    if (r.timeRecording) r.passes.back().recordCpuMs = threadCpuMs() - cpuStart;
 }
 
 // Records every kept pass into its own command buffer, on the workers (threaded frames).
@@ -219,6 +222,7 @@ static void recordDeferredPasses(FrameRecorder& r) {
         endLabel(gpu, cmd);
         VK_CHECK(vkEndCommandBuffer(cmd));
         r.deferred[i].cmd = cmd;
+        r.passes[i].recordCpuMs = threadCpuMs() - cpuStart; // only this worker writes pass i
         RecordingWorkerTiming& t = r.workerTimings[worker];
         if (t.passes++ == 0) firstStart[worker] = passStart;
         lastEnd[worker] = Clock::now();
@@ -239,13 +243,13 @@ static void submitDeferredPasses(FrameRecorder& r) {
     if (r.mode == TimingMode::Timestamps) {
         std::vector<VkCommandBuffer> cmds(n);
         for (uint32_t i = 0; i < n; ++i) cmds[i] = r.deferred[i].cmd;
-        if (n) submitAndWait(r, cmds.data(), n);
+        if (n) submitAndWait(r, cmds.data(), n, "frame");
         return;
     }
     for (uint32_t i = 0; i < n; ++i) {
         Clock::time_point start = Clock::now();
         r.passes[i].startMs = msBetween(r.frameStart, start);
-        submitAndWait(r, &r.deferred[i].cmd, 1);
+        submitAndWait(r, &r.deferred[i].cmd, 1, r.passes[i].name);
         r.passes[i].gpuMs = msBetween(start, Clock::now());
     }
 }
@@ -257,7 +261,7 @@ void endFrame(FrameRecorder& r) {
         submitDeferredPasses(r);
         r.deferred.clear(); // the captured state is released with the frame
     } else if (r.mode == TimingMode::Timestamps) {
-        submitAndWait(r);
+        submitAndWait(r, "frame");
     }
     if (r.mode == TimingMode::Timestamps) {
         uint32_t n = uint32_t(r.passes.size());

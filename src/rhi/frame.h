@@ -20,6 +20,7 @@
 #include <string>
 #include <vector>
 
+#include "core/cpu_scope.h"
 #include "rhi/vk.h"
 
 namespace shadel {
@@ -32,7 +33,8 @@ enum class TimingMode { Timestamps, SubmitPerPass };
 struct PassTiming {
     std::string name;
     double gpuMs = 0.0;
-    double startMs = 0.0; // GPU start relative to the frame's first pass (trace export)
+    double startMs = 0.0;     // GPU start relative to the frame's first pass (trace export)
+    double recordCpuMs = 0.0; // CPU time of the thread that recorded it (trace, stats)
 };
 
 // What one recording worker did in a frame (the trace shows one track per worker).
@@ -66,6 +68,14 @@ struct FrameRecorder {
     std::vector<PassTiming> passes; // filled by endFrame()
     double frameMs = 0.0;           // wall clock from beginFrame to the GPU finishing
     double gpuWaitMs = 0.0;         // of which the CPU waited on fences or blocked in a submit
+    // This frame's vkQueueSubmit2 calls ("submit PASS", or "submit frame" with one batch), from
+    // frameStart: the wall clock and the render thread's CPU time inside each (the difference
+    // is blocked, counted in gpuWaitMs).
+    std::vector<CpuScope> submits;
+    // Serial recording: time each pass's recording (PassTiming::recordCpuMs). Off by default:
+    // two reads of the thread's CPU clock per pass cost about a microsecond, which would add to
+    // the CPU cost measured (threaded recording times its passes anyway).
+    bool timeRecording = false;
     std::chrono::steady_clock::time_point frameStart;
     // Binary semaphores the frame's next submission waits on (at every stage), then forgets:
     // work queued before the frame that the frame depends on (sparse binds, render/streaming).

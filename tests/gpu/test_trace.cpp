@@ -46,3 +46,65 @@ TEST(Trace, OneEventPerPassPerFrameNamedAsThePasses) {
         EXPECT_EQ(gpuEvents[p["name"].get<std::string>()], 3) << p["name"];
     EXPECT_GT(run.stats["cpu_frame_ms"].get<double>(), 0.0);
 }
+
+// --trace itemises the render thread's CPU (the frontend's steps, every submit) with its thread
+// CPU time beside the wall clock, and the stats list the same scopes (median per frame).
+TEST(Trace, CpuScopesItemiseTheFrontendAndEverySubmit) {
+    std::string path = (std::filesystem::temp_directory_path() /
+                        ("shadel-trace-scopes-" + std::to_string(::getpid()) + ".json"))
+                           .string();
+    RenderOptions o;
+    o.scene = "builtin:smooth";
+    o.mode = RenderMode::Decoupled;
+    o.width = 96;
+    o.height = 54;
+    o.frames = 3;
+    o.trace = path;
+    RenderRun run = renderChecked(o);
+    nlohmann::json trace = takeJsonFile(path);
+    ASSERT_FALSE(trace.is_null()) << path;
+
+    struct Span {
+        double start, end;
+    };
+    std::map<int, Span> frontend;
+    std::map<int, std::vector<Span>> allocation;
+    std::map<int, std::map<std::string, int>> submits; // per frame, per pass
+    std::map<int, std::map<std::string, int>> passes;
+    for (const auto& e : trace["traceEvents"]) {
+        if (e["ph"] != "X") continue;
+        int frame = e["args"]["frame"].get<int>();
+        std::string name = e["name"].get<std::string>();
+        double ts = e["ts"].get<double>(), dur = e["dur"].get<double>();
+        if (e["cat"] == "gpu") passes[frame][name]++;
+        if (e["cat"] != "cpu") continue;
+        if (name == "frontend") frontend[frame] = {ts, ts + dur};
+        if (name == "decoupled coarse allocation" || name.rfind("submit ", 0) == 0) {
+            ASSERT_TRUE(e["args"].contains("thread_cpu_ms")) << name;
+            double cpuMs = e["args"]["thread_cpu_ms"].get<double>();
+            EXPECT_GE(cpuMs, 0.0) << name;
+            // A thread cannot run longer than the wall clock (+ the clocks' granularity).
+            EXPECT_LE(cpuMs, dur / 1000.0 + 0.05) << name;
+        }
+        if (name == "decoupled coarse allocation") allocation[frame].push_back({ts, ts + dur});
+        if (name.rfind("submit ", 0) == 0) submits[frame][name.substr(7)]++;
+    }
+    ASSERT_EQ(frontend.size(), 3u);
+    for (int f = 0; f < 3; ++f) {
+        ASSERT_EQ(allocation[f].size(), 1u) << "frame " << f;
+        // Inside its frame's frontend (microseconds; the export rounds nothing).
+        EXPECT_GE(allocation[f][0].start, frontend[f].start - 1e-3) << "frame " << f;
+        EXPECT_LE(allocation[f][0].end, frontend[f].end + 1e-3) << "frame " << f;
+        // Submit per pass on lavapipe (timestamps elsewhere: one submit for the frame).
+        if (run.stats["timing"] == "submit-per-pass")
+            EXPECT_EQ(submits[f], passes[f]) << "frame " << f;
+        else
+            EXPECT_EQ(submits[f], (std::map<std::string, int>{{"frame", 1}})) << "frame " << f;
+    }
+    std::map<std::string, double> statScopes;
+    for (const auto& s : run.stats["cpu_scopes"])
+        statScopes[s["name"].get<std::string>()] = s["thread_cpu_ms"].get<double>();
+    EXPECT_TRUE(statScopes.count("decoupled coarse allocation"));
+    EXPECT_TRUE(statScopes.count("submit (all passes)"));
+    for (const auto& p : run.stats["passes"]) EXPECT_TRUE(p.contains("record_cpu_ms")) << p["name"];
+}

@@ -52,6 +52,20 @@ struct ObjectSlot {
     std::array<glm::uvec2, SHADEL_MAX_MIPS> windowOrigin{};
     std::array<glm::uvec4, SHADEL_MAX_MIPS> wanted{};
     std::array<uint64_t, SHADEL_MAX_MIPS> wantedFor{};
+    bool newThisFrame = false; // taken from the pool this frame: its instance's GPU entry is zero
+};
+
+constexpr uint32_t kNoSlot = ~0u;
+
+// What the coarse allocation keeps of every instance: 12 bytes. The rest (ObjectSlot and the
+// GpuShadelObject's CPU copy, ~0.9 KB) lives in a slot of a pool, held only while the instance
+// has sheet rects or a non-zero GpuShadelObject, so the memory a frame walks follows the view,
+// not the world (at 1M instances, per-instance arrays of that size spread the few hundred
+// visited objects over ~0.9 GB: a cache and TLB miss per field).
+struct InstanceEntry {
+    uint32_t slot = kNoSlot;
+    uint32_t visitedFrame = 0; // frame number + 1 when visited this frame (0: not)
+    uint32_t seenFrame = 0;    // frame number + 1 when the GPU saw it last frame
 };
 
 // The part of a level a rect holds, in level blocks.
@@ -85,15 +99,15 @@ struct DecoupledState {
     CapacityController controller;
     float trilinearBand = 1.0f;
     std::vector<SheetRegion> regions;
-    std::vector<ObjectSlot> objects;
-    std::vector<gpu::GpuShadelObject> gpuObjects;
+    std::vector<InstanceEntry> instances;          // per instance
+    std::vector<ObjectSlot> slots;                 // the pool (InstanceEntry::slot)
+    std::vector<gpu::GpuShadelObject> slotObjects; // per slot: its instance's GpuShadelObject
+    std::vector<uint32_t> freeSlots;
     // The coarse allocation visits only instances near the view (render/culling/instance_grid.h)
     // and those it touched last frame, so its cost follows the view, not the world's size.
     InstanceGrid grid;
-    std::vector<uint32_t> visit;        // this frame's instances to decide
-    std::vector<uint32_t> touched;      // instances with a GpuShadelObject entry or sheet rects
-    std::vector<uint64_t> visitedFrame; // per instance: frameNumber + 1 when visited
-    std::vector<uint64_t> seenFrame;    // per instance: frameNumber + 1 when the GPU saw it
+    std::vector<uint32_t> visit;   // this frame's instances to decide
+    std::vector<uint32_t> touched; // instances with a GpuShadelObject entry or sheet rects
     std::vector<gpu::GpuShadelRect> rects;
     uint32_t rectBlockCount = 0;
     bool levelWindows = true;      // --level-windows
@@ -193,8 +207,7 @@ DecoupledStatePtr createDecoupled(Renderer& r, const GpuScene& scene) {
         x += region.width;
         d.regions.push_back(std::move(region));
     }
-    d.objects.resize(scene.instanceCount);
-    d.gpuObjects.resize(std::max(scene.instanceCount, 1u));
+    d.instances.assign(scene.instanceCount, InstanceEntry{});
     uint64_t blocks = uint64_t(d.sheetBlocks) * d.sheetBlocks;
     uint32_t chunksPerSide = d.storageSize / SHADEL_CHUNK;
     d.capacityChunks = chunksPerSide * chunksPerSide;
@@ -208,12 +221,12 @@ DecoupledStatePtr createDecoupled(Renderer& r, const GpuScene& scene) {
     d.frameInfo = upload("shadel.frame", sizeof(gpu::ShadelFrame));
     d.changedVolumes =
         upload("shadel.changedVolumes", SHADEL_MAX_CHANGED_VOLUMES * sizeof(ChangedVolume));
-    d.objectBuffer = upload("shadel.objects", d.gpuObjects.size() * sizeof(gpu::GpuShadelObject));
+    VkDeviceSize objectBytes =
+        VkDeviceSize(std::max(scene.instanceCount, 1u)) * sizeof(gpu::GpuShadelObject);
+    d.objectBuffer = upload("shadel.objects", objectBytes);
     // Every object starts forward; frames rewrite only the entries they visit.
-    std::memset(mapped(gpu, d.objectBuffer), 0, d.gpuObjects.size() * sizeof(gpu::GpuShadelObject));
+    std::memset(mapped(gpu, d.objectBuffer), 0, objectBytes);
     d.grid.build(scene.instanceInfo);
-    d.visitedFrame.assign(scene.instanceCount, 0);
-    d.seenFrame.assign(scene.instanceCount, 0);
     size_t maxRects = std::max<size_t>(scene.instanceCount, 1) * SHADEL_MAX_MIPS;
     d.rectBuffer = upload("shadel.rects", maxRects * sizeof(gpu::GpuShadelRect));
     d.levelWants =
@@ -550,6 +563,24 @@ static float projectedDiameter(const CameraView& camera, float viewportHeight, g
     return 2.0f * radius * focal / std::sqrt(distance * distance - radius * radius);
 }
 
+// A slot for an instance that has none: a fresh ObjectSlot (no rects) and a zero GPU entry, as
+// every instance without a slot has.
+static uint32_t takeSlot(DecoupledState& d) {
+    uint32_t s;
+    if (d.freeSlots.empty()) {
+        s = uint32_t(d.slots.size());
+        d.slots.emplace_back();
+        d.slotObjects.emplace_back();
+    } else {
+        s = d.freeSlots.back();
+        d.freeSlots.pop_back();
+        d.slots[s] = ObjectSlot{};
+        d.slotObjects[s] = gpu::GpuShadelObject{};
+    }
+    d.slots[s].newThisFrame = true;
+    return s;
+}
+
 void prepareDecoupledFrame(Renderer& r, const GpuScene& scene, const CameraView& camera,
                            gpu::FrameConstants& constants) {
     Gpu& gpu = *r.gpu;
@@ -583,9 +614,10 @@ void prepareDecoupledFrame(Renderer& r, const GpuScene& scene, const CameraView&
     // (seed 004: the CPU estimator and the GPU agree on what is seen); an instance that appears
     // is drawn forward for one frame. Otherwise every instance near the frustum.
     const std::vector<uint32_t>* seen = visibleLastFrame(r);
+    const uint32_t frameMark = uint32_t(d.frameNumber + 1); // visitedFrame, seenFrame
     if (seen) {
         d.visit.insert(d.visit.end(), seen->begin(), seen->end());
-        for (uint32_t i : *seen) d.seenFrame[i] = d.frameNumber + 1;
+        for (uint32_t i : *seen) d.instances[i].seenFrame = frameMark;
     } else {
         // Animated playback moved instances (render/animation): the grid follows their bounds.
         if (std::find(r.reposedInstances.begin(), r.reposedInstances.end(), 1) !=
@@ -596,15 +628,11 @@ void prepareDecoupledFrame(Renderer& r, const GpuScene& scene, const CameraView&
     d.visit.insert(d.visit.end(), d.touched.begin(), d.touched.end());
     d.touched.clear();
     for (uint32_t i : d.visit) {
-        if (d.visitedFrame[i] == d.frameNumber + 1) continue;
-        d.visitedFrame[i] = d.frameNumber + 1;
+        InstanceEntry& entry = d.instances[i];
+        if (entry.visitedFrame == frameMark) continue;
+        entry.visitedFrame = frameMark;
         const gpu::GpuInstance& inst = scene.instanceInfo[i];
         const ShadelMeshInfo& mesh = scene.shadelMeshes[inst.mesh];
-        ObjectSlot& o = d.objects[i];
-        bool wasDecoupled = o.decoupledLastFrame;
-        o.decoupledLastFrame = false;
-        gpu::GpuShadelObject& g = d.gpuObjects[i];
-        g = gpu::GpuShadelObject{};
         glm::vec3 margin = (inst.worldMax - inst.worldMin) * d.frustumMargin;
         // Transparent surfaces are shaded in shadel space too and reconstructed into the WBOIT
         // targets (render/oit); the sorted reference keeps them forward. (The visibility buffer
@@ -614,7 +642,7 @@ void prepareDecoupledFrame(Renderer& r, const GpuScene& scene, const CameraView&
         bool transparentForward = blended && r.settings.oit != OitMode::Wboit;
         // Hidden by occlusion last frame: its rects go back (it returns forward for a frame).
         bool wanted = mesh.mipCount > 0 && !transparentForward &&
-                      (!seen || d.seenFrame[i] == d.frameNumber + 1) &&
+                      (!seen || entry.seenFrame == frameMark) &&
                       boxVisible(planes, inst.worldMin - margin, inst.worldMax + margin);
         // Hybrid (seed: "small objects fall back to a direct only render"): an object a few
         // pixels across would still shade whole chunks at its coarsest MIP; forward is cheaper.
@@ -623,9 +651,18 @@ void prepareDecoupledFrame(Renderer& r, const GpuScene& scene, const CameraView&
                                        0.5f * (inst.worldMin + inst.worldMax),
                                        0.5f * glm::length(inst.worldMax - inst.worldMin)) <
                          r.settings.forwardBelowPixels;
+        if (small) d.objectsSmallForward++, d.objectsForward++;
+        // Drawn forward: without a slot it holds nothing and its GPU entry is zero already (the
+        // common case of the many small instances the GPU sees every frame: no slot churn).
+        if ((!wanted || small) && entry.slot == kNoSlot) continue;
+        if (entry.slot == kNoSlot) entry.slot = takeSlot(d);
+        ObjectSlot& o = d.slots[entry.slot];
+        bool wasDecoupled = o.decoupledLastFrame;
+        o.decoupledLastFrame = false;
+        gpu::GpuShadelObject& g = d.slotObjects[entry.slot];
+        g = gpu::GpuShadelObject{};
         if (!wanted || small) {
             if (o.allocated) freeObject(gpu, d, o);
-            if (small) d.objectsSmallForward++, d.objectsForward++;
             continue;
         }
         uint32_t wantFirst =
@@ -691,10 +728,21 @@ void prepareDecoupledFrame(Renderer& r, const GpuScene& scene, const CameraView&
     d.lastCameraPosition = camera.position;
     auto* objects = static_cast<gpu::GpuShadelObject*>(mapped(gpu, d.objectBuffer));
     for (uint32_t i : d.visit) {
-        if (d.visitedFrame[i] != d.frameNumber + 1) continue;
-        d.visitedFrame[i] = 0; // once per instance (visit may list it twice)
-        objects[i] = d.gpuObjects[i];
-        if (d.gpuObjects[i].flags != 0 || d.objects[i].allocated) d.touched.push_back(i);
+        InstanceEntry& entry = d.instances[i];
+        if (entry.visitedFrame != frameMark) continue;
+        entry.visitedFrame = 0;              // once per instance (visit may list it twice)
+        if (entry.slot == kNoSlot) continue; // forward, holding nothing: its entry stays zero
+        ObjectSlot& o = d.slots[entry.slot];
+        const gpu::GpuShadelObject& g = d.slotObjects[entry.slot];
+        bool touched = g.flags != 0 || o.allocated;
+        if (touched || !o.newThisFrame) objects[i] = g; // else its entry is zero already
+        o.newThisFrame = false;
+        if (touched) {
+            d.touched.push_back(i);
+        } else { // nothing held: the slot goes back to the pool
+            d.freeSlots.push_back(entry.slot);
+            entry.slot = kNoSlot;
+        }
     }
     std::memcpy(mapped(gpu, d.rectBuffer), d.rects.data(),
                 d.rects.size() * sizeof(gpu::GpuShadelRect));
@@ -922,8 +970,9 @@ void recordDecoupledPostPasses(Renderer& r, FrameRecorder& rec, uint64_t frame) 
 
 bool drawnDecoupled(const Renderer& r, uint32_t instance) {
     const DecoupledState* d = r.decoupled.get();
-    return d && instance < d->gpuObjects.size() &&
-           (d->gpuObjects[instance].flags & SHADEL_OBJECT_DECOUPLED) != 0u;
+    if (!d || instance >= d->instances.size()) return false;
+    uint32_t slot = d->instances[instance].slot;
+    return slot != kNoSlot && (d->slotObjects[slot].flags & SHADEL_OBJECT_DECOUPLED) != 0u;
 }
 
 void finishDecoupledFrame(Renderer& r) {
@@ -942,7 +991,7 @@ void finishDecoupledFrame(Renderer& r) {
     const auto* wants = static_cast<const glm::uvec4*>(mapped(*r.gpu, d.levelWants));
     for (size_t i = 0; d.levelWindows && i < d.rects.size(); ++i) { // off: nothing reads them
         const gpu::GpuShadelRect& rect = d.rects[i];
-        ObjectSlot& o = d.objects[rect.object];
+        ObjectSlot& o = d.slots[d.instances[rect.object].slot]; // has rects: holds a slot
         glm::uvec4 w = wants[i];
         o.wanted[rect.mip] = w.z == 0 ? glm::uvec4(0) // nothing wanted
                                       : glm::uvec4(0xFFFFu - w.x, 0xFFFFu - w.y, w.z, w.w);
