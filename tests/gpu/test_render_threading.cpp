@@ -176,6 +176,11 @@ TEST(RenderThreading, NextFramesSceneUpdateRunsBesideThisFrame) {
     std::string path = tempPath("frontend-trace.json");
     RenderOptions o =
         small("/usr/share/assimp/models/glTF2/simple_skin/simple_skin.gltf", RenderMode::Decoupled);
+    // Frames long enough (tens of ms on lavapipe) that the worker's start, which a loaded machine
+    // can delay by milliseconds, still falls inside the frame it overlaps: at 128x72 it failed
+    // 2 runs in 3 while other renders shared the cores.
+    o.width = 320;
+    o.height = 180;
     o.frames = 4;
     o.time = 0.0;
     o.timeStep = 0.5;
