@@ -3,12 +3,15 @@
 #include <algorithm>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <glm/glm.hpp>
+#include <glm/gtc/quaternion.hpp>
 #include <nlohmann/json.hpp>
 
 #include "gpu_test_env.h"
@@ -412,6 +415,147 @@ ShadowPixels shadowPixels(const RenderRun& shadowed, const RenderRun& unshadowed
 }
 
 } // namespace
+
+namespace {
+
+// A thin post (4 cm square, 1.5 m tall) on a square floor `floorSize` metres wide, a sun along
+// (0.6, -0.6, 0.5) and a camera looking down at the post's foot: the floor fills the view at
+// either size, so only the sun's shadow map resolution differs (its whole-scene map is fitted
+// to the scene: ~20 cm texels over 400 m, ~2 cm over 40 m).
+std::string thinPostScene(const std::string& name, float floorSize) {
+    std::vector<float> f;
+    std::vector<uint16_t> indices = {0, 2, 1, 0, 3, 2};
+    float h = floorSize / 2;
+    f.insert(f.end(), {-h, 0, -h, h, 0, -h, h, 0, h, -h, 0, h});
+    f.insert(f.end(), {0, 1, 0, 0, 1, 0, 0, 1, 0, 0, 1, 0});
+    std::vector<float> postNormals;
+    const float half[3] = {0.02f, 0.75f, 0.02f};
+    uint16_t face = 0;
+    for (int axis = 0; axis < 3; ++axis)
+        for (float sign : {1.0f, -1.0f}) {
+            int u = (axis + 1) % 3, v = (axis + 2) % 3; // cross(u, v) = +axis
+            for (int corner = 0; corner < 4; ++corner) {
+                float p[3], n[3] = {0, 0, 0};
+                p[axis] = half[axis] * sign;
+                p[u] = (corner & 1) ? half[u] : -half[u];
+                p[v] = (corner & 2) ? half[v] : -half[v];
+                p[1] += 0.75f; // standing on the floor
+                n[axis] = sign;
+                f.insert(f.end(), {p[0], p[1], p[2]});
+                postNormals.insert(postNormals.end(), {n[0], n[1], n[2]});
+            }
+            uint16_t b = uint16_t(face++ * 4); // counter-clockwise seen from outside
+            if (sign > 0)
+                indices.insert(indices.end(), {b, uint16_t(b + 1), uint16_t(b + 3), b,
+                                               uint16_t(b + 3), uint16_t(b + 2)});
+            else
+                indices.insert(indices.end(), {b, uint16_t(b + 3), uint16_t(b + 1), b,
+                                               uint16_t(b + 2), uint16_t(b + 3)});
+        }
+    f.insert(f.end(), postNormals.begin(), postNormals.end());
+    std::vector<uint8_t> bin(f.size() * 4 + indices.size() * 2);
+    std::memcpy(bin.data(), f.data(), f.size() * 4);
+    std::memcpy(bin.data() + f.size() * 4, indices.data(), indices.size() * 2);
+    using nlohmann::json;
+    auto view = [](size_t offset, size_t bytes) {
+        return json{{"buffer", 0}, {"byteOffset", offset}, {"byteLength", bytes}};
+    };
+    auto accessor = [](int view, int component, int count, const char* type) {
+        return json{
+            {"bufferView", view}, {"componentType", component}, {"count", count}, {"type", type}};
+    };
+    auto rotationTowards = [](glm::vec3 direction) { // -Z onto `direction`, +Y up
+        glm::quat q = glm::quatLookAtRH(glm::normalize(direction), glm::vec3(0, 1, 0));
+        return json{q.x, q.y, q.z, q.w};
+    };
+    size_t ib = f.size() * 4;
+    json doc;
+    doc["asset"] = {{"version", "2.0"}};
+    doc["scene"] = 0;
+    doc["scenes"] = {{{"nodes", {0, 1, 2, 3}}}};
+    doc["extensionsUsed"] = {"KHR_lights_punctual"};
+    doc["extensions"]["KHR_lights_punctual"]["lights"] = {
+        {{"type", "directional"}, {"intensity", 3.0}, {"color", {1, 1, 1}}}};
+    glm::vec3 eye(-1.2f, 2.5f, -2.4f), target(0.5f, 0.0f, 0.5f);
+    doc["nodes"] = {{{"mesh", 0}, {"name", "floor"}},
+                    {{"mesh", 1}, {"name", "post"}},
+                    {{"name", "sun"},
+                     {"rotation", rotationTowards(glm::vec3(0.6f, -0.6f, 0.5f))},
+                     {"extensions", {{"KHR_lights_punctual", {{"light", 0}}}}}},
+                    {{"name", "camera"},
+                     {"camera", 0},
+                     {"translation", {eye.x, eye.y, eye.z}},
+                     {"rotation", rotationTowards(target - eye)}}};
+    doc["cameras"] = {{{"type", "perspective"},
+                       {"perspective", {{"yfov", 0.9}, {"znear", 0.05}, {"zfar", 1000.0}}}}};
+    doc["bufferViews"] = {view(0, 48),    view(48, 48), view(96, 288),
+                          view(384, 288), view(ib, 12), view(ib + 12, 72)};
+    const int f32 = 5126, u16 = 5123;
+    doc["accessors"] = {accessor(0, f32, 4, "VEC3"),   accessor(1, f32, 4, "VEC3"),
+                        accessor(2, f32, 24, "VEC3"),  accessor(3, f32, 24, "VEC3"),
+                        accessor(4, u16, 6, "SCALAR"), accessor(5, u16, 36, "SCALAR")};
+    doc["accessors"][0]["min"] = {-h, 0, -h};
+    doc["accessors"][0]["max"] = {h, 0, h};
+    doc["accessors"][2]["min"] = {-0.02, 0.0, -0.02};
+    doc["accessors"][2]["max"] = {0.02, 1.5, 0.02};
+    doc["materials"] = {{{"pbrMetallicRoughness",
+                          {{"baseColorFactor", {0.8, 0.8, 0.8, 1.0}},
+                           {"metallicFactor", 0.0},
+                           {"roughnessFactor", 0.8}}}}};
+    doc["meshes"] = {
+        {{"primitives",
+          {{{"attributes", {{"POSITION", 0}, {"NORMAL", 1}}}, {"indices", 4}, {"material", 0}}}}},
+        {{"primitives",
+          {{{"attributes", {{"POSITION", 2}, {"NORMAL", 3}}}, {"indices", 5}, {"material", 0}}}}}};
+    std::string gltf = tempPath(name + ".gltf"), binPath = tempPath(name + ".bin");
+    doc["buffers"] = {
+        {{"byteLength", bin.size()}, {"uri", binPath.substr(binPath.find_last_of('/') + 1)}}};
+    std::ofstream(binPath, std::ios::binary)
+        .write(reinterpret_cast<const char*>(bin.data()), std::streamsize(bin.size()));
+    std::ofstream(gltf) << doc.dump();
+    return gltf;
+}
+
+} // namespace
+
+// The shadow map's failure that ray-traced sun shadows fix: resolution over a large scene. The
+// sun's one whole-scene map spreads 2048 texels over the scene; on a 400 m floor a 4 cm post's
+// shadow falls between its texels and is lost, where the same map over a 40 m floor resolves it.
+// Traced shadows do not depend on the scene's size: the big floor with RT shows the shadow the
+// small floor's map shows, and sharper. (The other classic failure, contact gaps from the map's
+// depth bias, is also absent: a ray leaves the receiver itself.)
+TEST(RayTracing, SunShadowsKeepAThinCastersShadowTheWholeSceneMapLoses) {
+    if (!sharedGpu().device.optional.rayQuery) GTEST_SKIP() << "no ray query on this device";
+    auto options = [](const std::string& scene, RenderMode mode, bool traced) {
+        RenderOptions o = renderOptions(scene, mode, 320, 180);
+        o.progress = false;
+        o.rt.shadows = traced;
+        return o;
+    };
+    std::string big = thinPostScene("thin_post_400m", 400.0f);
+    std::string small = thinPostScene("thin_post_40m", 40.0f);
+    for (RenderMode mode : {RenderMode::Forward, RenderMode::Decoupled}) {
+        SCOPED_TRACE(mode == RenderMode::Forward ? "forward" : "decoupled");
+        RenderRun bigMap = renderChecked(options(big, mode, false));
+        RenderRun bigTraced = renderChecked(options(big, mode, true));
+        RenderRun smallMap = renderChecked(options(small, mode, false));
+        // The post's shadow: where each render is darker than the big floor's map render.
+        ShadowPixels resolved = shadowPixels(smallMap, bigMap, 8.0);
+        ShadowPixels traced = shadowPixels(bigTraced, bigMap, 8.0);
+        size_t agree = 0;
+        for (size_t i : traced.darker)
+            agree += std::find(resolved.darker.begin(), resolved.darker.end(), i) !=
+                     resolved.darker.end();
+        std::printf("thin post's shadow: %zu pixels with the 40 m map, %zu traced on the 400 m "
+                    "floor (%zu of them in the map's), 400 m map vs traced %.2f dB\n",
+                    resolved.darker.size(), traced.darker.size(), agree,
+                    psnr(bigMap.frames.back().rgba, bigTraced.frames.back().rgba));
+        EXPECT_GE(resolved.darker.size(), 60u) << "the 40 m map should show the post's shadow";
+        EXPECT_GE(double(traced.darker.size()), 0.5 * double(resolved.darker.size()));
+        EXPECT_GE(double(agree), 0.75 * double(traced.darker.size())) << "not where the map's is";
+        EXPECT_EQ(traced.brighter, 0u) << "tracing only takes away light the map let through";
+    }
+}
 
 // builtin:lights: 16 shadow-casting spots over posts. --rt-shadows traces them (hard: one ray
 // to the light; soft: --rt-shadow-rays over the lamp head) in place of their maps, in the
