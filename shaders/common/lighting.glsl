@@ -486,6 +486,11 @@ vec3 gRtIndirect = vec3(0.0); // one-bounce diffuse light: irradiance / pi (time
 // GpuLight::shadowIndex (raytracing/rt_types.h), in place of the spot shadow maps.
 bool gRtSpots = false;
 uvec4 gRtSpotVisibility = uvec4(0xFFFFFFFFu);
+// Out: the sun visibility the last shadeSurface lit with (shadow map, soft shadows, distance
+// fields or ray traced). A caller lighting the same point again (shadels/prefilter.glsl: the
+// same shadel with another base colour) passes it back as gRtSunVisibility instead of paying
+// for the shadow taps twice.
+float gSunVisibilityUsed = 1.0;
 
 float rtSpotVisibility(uvec4 packed, uint shadowIndex) {
     return float((packed[shadowIndex >> 2u] >> ((shadowIndex & 3u) * 8u)) & 0xFFu) / 255.0;
@@ -551,6 +556,7 @@ vec3 shadeSurface(FrameConstants f, MaterialSample m, vec3 worldPos, vec3 geomet
             }
         }
         color += brdf(m, n, v, l, f.sunColor * shadow);
+        gSunVisibilityUsed = shadow;
     }
     bool spotShadows = SPECTRUM_HAS(SPECTRUM_SPOT_SHADOWS) && haveLighting &&
                        lf.spotShadowAtlas != NO_TEXTURE;

@@ -1,5 +1,5 @@
 // The classify phase of the shadel path's feature spectra (chunk_spectra.glsl). Included by
-// shade.comp after its chunk light culling, whose shared box (sBoxMin/sBoxMax) and list it reads.
+// shade.comp after its chunk light culling, whose box (gChunkBox*) and shared list it reads.
 #ifndef SHADEL_CHUNK_SPECTRA_CLASSIFY_GLSL
 #define SHADEL_CHUNK_SPECTRA_CLASSIFY_GLSL
 #include "lighting/chunk_spectra.glsl"
@@ -13,12 +13,9 @@ void classifyChunkSpectrum(FrameConstants f, uint workIndex) {
     if (tid == 0u) sChunkFeatures = 0u;
     barrier();
     bool culled = gLightListMode == LIGHT_LIST_SHARED;
-    bool anyShadel = sBoxMax[0] != 0u;
+    bool anyShadel = gChunkHasBox;
     if (culled && anyShadel) {
-        vec3 boxMin = vec3(orderedBitsFloat(sBoxMin[0]), orderedBitsFloat(sBoxMin[1]),
-                           orderedBitsFloat(sBoxMin[2]));
-        vec3 boxMax = vec3(orderedBitsFloat(sBoxMax[0]), orderedBitsFloat(sBoxMax[1]),
-                           orderedBitsFloat(sBoxMax[2]));
+        vec3 boxMin = gChunkBoxMin, boxMax = gChunkBoxMax;
         vec3 corners[8];
         for (int i = 0; i < 8; ++i)
             corners[i] = vec3((i & 1) != 0 ? boxMax.x : boxMin.x, (i & 2) != 0 ? boxMax.y : boxMin.y,

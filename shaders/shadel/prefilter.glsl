@@ -5,7 +5,7 @@
 // so they are supersampled: n x n stratified samples, n in proportion to how many pattern cells
 // the footprint spans (two samples per cell), capped at sqrt(maxSamples). The jitter is a hash of
 // the shadel, so every frame shades the same samples (no flicker). Lighting runs at the centre
-// (twice when supersampled, see prefilteredShade). Normals are averaged unnormalised: a short mean normal means the normals under the
+// (twice when supersampled, see prefilteredShade; the sun's shadow is sampled once). Normals are averaged unnormalised: a short mean normal means the normals under the
 // footprint vary, and Toksvig's factor widens the specular lobe (toksvigRoughness), so specular
 // does not alias either. Forward and shadel paths share evaluateMaterial (shaders/common).
 #ifndef SHADEL_PREFILTER_GLSL
@@ -20,6 +20,8 @@ float proceduralFrequency(GpuMaterial m) {
     if (m.procedural == PROCEDURAL_BRICKS) return 2.0 * m.proceduralScale; // two rows per unit
     return 0.0;
 }
+
+#define PREFILTER_KEPT_SAMPLES 16u // base colours prefilteredShade keeps between its passes
 
 uint prefilterHash(uvec3 v) {
     uint h = v.x * 0x8da6b343u ^ v.y * 0xd8163841u ^ v.z * 0xcb1ab31fu;
@@ -68,10 +70,15 @@ vec3 prefilteredShade(FrameConstants f, GpuMaterial mat, SurfaceInput si, vec2 c
     sum.roughness = 0.0; sum.occlusion = 0.0; sum.emissive = vec3(0.0);
     uint h = prefilterHash(seed);
     MaterialSample last;
+    // The samples' base colours, kept for the display pass below when they fit (n <= 4: every
+    // n of the default --material-samples 16); more samples are evaluated again there.
+    vec3 bases[PREFILTER_KEPT_SAMPLES];
+    bool keep = n * n <= PREFILTER_KEPT_SAMPLES;
     for (uint j = 0u; j < n; ++j) {
         for (uint i = 0u; i < n; ++i) {
             SurfaceInput sub = prefilterSample(si, i, j, n, h, centre, step, s0, s1, s2, t0, t1, t2);
             MaterialSample one = evaluateMaterial(mat, sub);
+            if (keep) bases[j * n + i] = one.baseColor;
             last = one;
             sum.baseColor += one.baseColor; sum.alpha += one.alpha; sum.normal += one.normal;
             sum.metallic += one.metallic; sum.roughness += one.roughness;
@@ -89,15 +96,26 @@ vec3 prefilteredShade(FrameConstants f, GpuMaterial mat, SurfaceInput si, vec2 c
     material = vec4(clamp(sum.baseColor * w, 0.0, 1.0), m.roughness);
     m.baseColor = vec3(0.0);
     vec3 c0 = shadeSurface(f, m, si.position, si.normal);
+    // The second pass lights the same point: it takes the first's sun visibility as a given
+    // one (as ray-traced visibility is given) rather than sampling the shadow map again: the
+    // same value, so the same colour, without the shadow taps.
+    bool givenSun = gRtSun;
+    float givenSunVisibility = gRtSunVisibility;
+    gRtSun = true;
+    gRtSunVisibility = gSunVisibilityUsed;
     m.baseColor = vec3(1.0);
     vec3 c1 = shadeSurface(f, m, si.position, si.normal);
+    gRtSun = givenSun;
+    gRtSunVisibility = givenSunVisibility;
     float exposure = max(f.exposure, 1e-6);
     vec3 display = vec3(0.0);
-    h = prefilterHash(seed); // the same samples again
+    h = prefilterHash(seed); // the same samples again (when not kept)
     for (uint j = 0u; j < n; ++j) {
         for (uint i = 0u; i < n; ++i) {
-            SurfaceInput sub = prefilterSample(si, i, j, n, h, centre, step, s0, s1, s2, t0, t1, t2);
-            vec3 base = evaluateMaterial(mat, sub).baseColor;
+            vec3 base = keep ? bases[j * n + i]
+                             : evaluateMaterial(mat, prefilterSample(si, i, j, n, h, centre, step,
+                                                                     s0, s1, s2, t0, t1, t2))
+                                   .baseColor;
             display += acesFit(max(c0 + base * (c1 - c0), vec3(0.0)) * exposure);
         }
     }
