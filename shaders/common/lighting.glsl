@@ -469,6 +469,9 @@ vec3 evaluateLight(GpuLight light, MaterialSample m, vec3 n, vec3 v, vec3 p) {
     float dist = length(toLight);
     vec3 dir = toLight / max(dist, 1e-4);
     vec3 radiance = light.color * rangeAttenuation(dist, light.range) * spotFactor(light, dir);
+    // Beyond its range or outside its cone a light adds nothing: skip the BRDF (without light
+    // culling, e.g. few lights on screen, every surface loops over every light).
+    if (all(equal(radiance, vec3(0.0)))) return vec3(0.0);
     if (SPECTRUM_HAS(SPECTRUM_PROJECTED) && (light.flags & LIGHT_FLAG_PROJECTED) != 0u &&
         any(notEqual(radiance, vec3(0.0))))
         radiance *= goboColor(light, dir, dist);
