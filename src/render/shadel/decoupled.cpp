@@ -36,32 +36,34 @@ struct SheetRegion {
 };
 
 // An object's rects in the sheet: levels firstMip .. mipCount-1 (finer levels only while the
-// camera can need them).
+// camera can need them). The fields a steady frame reads come first (kSlotHotBytes): the rest
+// is read only when levels are placed or windows updated.
 struct ObjectSlot {
     bool allocated = false;
     bool decoupledLastFrame = false; // its rects were in last frame's list (maps hold its marks)
-    std::array<uint64_t, SHADEL_MAX_MIPS> levelSince{}; // frame number each level was placed
-    uint32_t firstMip = 0;
-    uint32_t mipCount = 0;
-    std::array<BlockId, SHADEL_MAX_MIPS> ids{};
-    std::array<glm::uvec4, SHADEL_MAX_MIPS> rects{};
-    // Level windows: where each level's rect sits in the level (origin in level blocks; the
-    // rect's z, w are its size), and the level blocks last frame's samples wanted there
-    // (min x, min y, max x + 1, max y + 1; empty when min >= max), valid for the frame
-    // numbered wantedFor - 1 (one frame of readback latency; 0: no feedback yet).
-    std::array<glm::uvec2, SHADEL_MAX_MIPS> windowOrigin{};
-    std::array<glm::uvec4, SHADEL_MAX_MIPS> wanted{};
-    std::array<uint64_t, SHADEL_MAX_MIPS> wantedFor{};
+    bool newThisFrame = false; // taken from the pool this frame: its instance's GPU entry is zero
     // Skipping the level-window update (updateObjectRects): its inputs are the wants of the
     // level and its neighbours and the level's current window, and the update leaves a window
     // that the same inputs keep. So when the wants read back equal the ones the last update saw
     // (wantsSettled, set by finishDecoupledFrame), the levels are the same as then (firstMip
     // unchanged for two frames) and no placement failed (windowRetry), it would keep them all.
     bool wantsSettled = false;
-    bool windowRetry = false;     // a window's new rect did not fit: try again next frame
+    bool windowRetry = false; // a window's new rect did not fit: try again next frame
+    uint32_t firstMip = 0;
+    uint32_t mipCount = 0;
     uint64_t firstMipChanged = 0; // frame number firstMip last changed (levels added/dropped)
-    bool newThisFrame = false; // taken from the pool this frame: its instance's GPU entry is zero
+    std::array<uint64_t, SHADEL_MAX_MIPS> levelSince{}; // frame number each level was placed
+    std::array<glm::uvec4, SHADEL_MAX_MIPS> rects{};
+    // Level windows: where each level's rect sits in the level (origin in level blocks; the
+    // rect's z, w are its size), and the level blocks last frame's samples wanted there
+    // (min x, min y, max x + 1, max y + 1; empty when min >= max), valid for the frame
+    // numbered wantedFor - 1 (one frame of readback latency; 0: no feedback yet).
+    std::array<glm::uvec2, SHADEL_MAX_MIPS> windowOrigin{};
+    std::array<BlockId, SHADEL_MAX_MIPS> ids{};
+    std::array<glm::uvec4, SHADEL_MAX_MIPS> wanted{};
+    std::array<uint64_t, SHADEL_MAX_MIPS> wantedFor{};
 };
+constexpr size_t kSlotHotBytes = offsetof(ObjectSlot, ids);
 
 constexpr uint32_t kNoSlot = ~0u;
 
@@ -606,7 +608,14 @@ static uint32_t takeSlot(DecoupledState& d) {
 // instances: 160 MB of GpuInstance, 12 MB of InstanceEntry, 272 MB of GpuShadelObject), so
 // each visit starts with cache and TLB misses (builtin:many 1M: 37% of the coarse allocation's
 // samples sat on the first GpuInstance load). Fetching a few visits ahead overlaps them.
-constexpr size_t kPrefetchAhead = 4;
+// Two stages: an instance's entries first, then (its entry read by then) its slot.
+constexpr size_t kPrefetchAhead = 8;
+
+static void prefetchLines(const void* p, size_t bytes, int write) {
+    const char* c = static_cast<const char*>(p);
+    for (size_t o = 0; o < bytes; o += 64)
+        write ? __builtin_prefetch(c + o, 1) : __builtin_prefetch(c + o, 0);
+}
 
 static void prefetchInstance(const DecoupledState& d, const GpuScene& scene, uint32_t i) {
     __builtin_prefetch(&d.instances[i]);
@@ -614,6 +623,13 @@ static void prefetchInstance(const DecoupledState& d, const GpuScene& scene, uin
     __builtin_prefetch(inst);                                        // model
     __builtin_prefetch(inst + offsetof(gpu::GpuInstance, worldMin)); // bounds, mesh, material
     __builtin_prefetch(inst + sizeof(gpu::GpuInstance) - 1);
+}
+
+static void prefetchSlot(const DecoupledState& d, uint32_t i) {
+    uint32_t s = d.instances[i].slot;
+    if (s == kNoSlot) return;
+    prefetchLines(&d.slots[s], kSlotHotBytes, 0);
+    prefetchLines(&d.slotObjects[s], sizeof(gpu::GpuShadelObject), 1); // rewritten
 }
 
 void prepareDecoupledFrame(Renderer& r, const GpuScene& scene, const CameraView& camera,
@@ -665,6 +681,8 @@ void prepareDecoupledFrame(Renderer& r, const GpuScene& scene, const CameraView&
     for (size_t v = 0; v < d.visit.size(); ++v) {
         if (v + kPrefetchAhead < d.visit.size())
             prefetchInstance(d, scene, d.visit[v + kPrefetchAhead]);
+        if (v + kPrefetchAhead / 2 < d.visit.size())
+            prefetchSlot(d, d.visit[v + kPrefetchAhead / 2]);
         uint32_t i = d.visit[v];
         InstanceEntry& entry = d.instances[i];
         if (entry.visitedFrame == frameMark) continue;
@@ -767,7 +785,7 @@ void prepareDecoupledFrame(Renderer& r, const GpuScene& scene, const CameraView&
     auto* objects = static_cast<gpu::GpuShadelObject*>(mapped(gpu, d.objectBuffer));
     for (size_t v = 0; v < d.visit.size(); ++v) {
         if (v + kPrefetchAhead < d.visit.size()) // its GPU entry, written below
-            __builtin_prefetch(&objects[d.visit[v + kPrefetchAhead]], 1);
+            prefetchLines(&objects[d.visit[v + kPrefetchAhead]], sizeof(gpu::GpuShadelObject), 1);
         uint32_t i = d.visit[v];
         InstanceEntry& entry = d.instances[i];
         if (entry.visitedFrame != frameMark) continue;
