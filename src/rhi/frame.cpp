@@ -87,15 +87,15 @@ static void beginCommands(FrameRecorder& r) {
 // the submission's CPU scope ("submit NAME").
 static void submitAndWait(FrameRecorder& r, const VkCommandBuffer* cmds, uint32_t count,
                           const std::string& name) {
-    std::vector<VkCommandBufferSubmitInfo> cbis(count);
-    for (uint32_t i = 0; i < count; ++i) {
-        cbis[i] = {VK_STRUCTURE_TYPE_COMMAND_BUFFER_SUBMIT_INFO};
-        cbis[i].commandBuffer = cmds[i];
-    }
+    // The recorder's vectors, reused: a submit allocates nothing (one per pass on CPU devices).
+    std::vector<VkCommandBufferSubmitInfo>& cbis = r.submitCommandBuffers;
+    cbis.assign(count, {VK_STRUCTURE_TYPE_COMMAND_BUFFER_SUBMIT_INFO});
+    for (uint32_t i = 0; i < count; ++i) cbis[i].commandBuffer = cmds[i];
     VkSubmitInfo2 si{VK_STRUCTURE_TYPE_SUBMIT_INFO_2};
     si.commandBufferInfoCount = count;
     si.pCommandBufferInfos = cbis.data();
-    std::vector<VkSemaphoreSubmitInfo> waits;
+    std::vector<VkSemaphoreSubmitInfo>& waits = r.submitWaits;
+    waits.clear();
     for (VkSemaphore sem : r.waitOnce) {
         VkSemaphoreSubmitInfo w{VK_STRUCTURE_TYPE_SEMAPHORE_SUBMIT_INFO};
         w.semaphore = sem;

@@ -80,6 +80,8 @@ struct FrameRecorder {
     // Binary semaphores the frame's next submission waits on (at every stage), then forgets:
     // work queued before the frame that the frame depends on (sparse binds, render/streaming).
     std::vector<VkSemaphore> waitOnce;
+    std::vector<VkCommandBufferSubmitInfo> submitCommandBuffers; // a submit's (reused)
+    std::vector<VkSemaphoreSubmitInfo> submitWaits;
 
     // Recording threads (1 = serial, each pass recorded where it is declared).
     uint32_t recordingThreads = 1;

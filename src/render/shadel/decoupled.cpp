@@ -36,24 +36,34 @@ struct SheetRegion {
 };
 
 // An object's rects in the sheet: levels firstMip .. mipCount-1 (finer levels only while the
-// camera can need them).
+// camera can need them). The fields a steady frame reads come first (kSlotHotBytes): the rest
+// is read only when levels are placed or windows updated.
 struct ObjectSlot {
     bool allocated = false;
     bool decoupledLastFrame = false; // its rects were in last frame's list (maps hold its marks)
-    std::array<uint64_t, SHADEL_MAX_MIPS> levelSince{}; // frame number each level was placed
+    bool newThisFrame = false; // taken from the pool this frame: its instance's GPU entry is zero
+    // Skipping the level-window update (updateObjectRects): its inputs are the wants of the
+    // level and its neighbours and the level's current window, and the update leaves a window
+    // that the same inputs keep. So when the wants read back equal the ones the last update saw
+    // (wantsSettled, set by finishDecoupledFrame), the levels are the same as then (firstMip
+    // unchanged for two frames) and no placement failed (windowRetry), it would keep them all.
+    bool wantsSettled = false;
+    bool windowRetry = false; // a window's new rect did not fit: try again next frame
     uint32_t firstMip = 0;
     uint32_t mipCount = 0;
-    std::array<BlockId, SHADEL_MAX_MIPS> ids{};
+    uint64_t firstMipChanged = 0; // frame number firstMip last changed (levels added/dropped)
+    std::array<uint64_t, SHADEL_MAX_MIPS> levelSince{}; // frame number each level was placed
     std::array<glm::uvec4, SHADEL_MAX_MIPS> rects{};
     // Level windows: where each level's rect sits in the level (origin in level blocks; the
     // rect's z, w are its size), and the level blocks last frame's samples wanted there
     // (min x, min y, max x + 1, max y + 1; empty when min >= max), valid for the frame
     // numbered wantedFor - 1 (one frame of readback latency; 0: no feedback yet).
     std::array<glm::uvec2, SHADEL_MAX_MIPS> windowOrigin{};
+    std::array<BlockId, SHADEL_MAX_MIPS> ids{};
     std::array<glm::uvec4, SHADEL_MAX_MIPS> wanted{};
     std::array<uint64_t, SHADEL_MAX_MIPS> wantedFor{};
-    bool newThisFrame = false; // taken from the pool this frame: its instance's GPU entry is zero
 };
+constexpr size_t kSlotHotBytes = offsetof(ObjectSlot, ids);
 
 constexpr uint32_t kNoSlot = ~0u;
 
@@ -450,7 +460,10 @@ static void updateLevelWindow(Gpu& gpu, DecoupledState& d, ObjectSlot& o, uint32
     std::optional<Placement<2>> placed;
     if (target.size.x * target.size.y != 0) {
         placed = d.regions[k].allocator->insert(Extent<2>{target.size.x, target.size.y});
-        if (!placed) return;
+        if (!placed) {
+            o.windowRetry = true;
+            return;
+        }
     }
     freeLevel(gpu, d, o, k);
     d.windowMoves++;
@@ -466,13 +479,16 @@ static void updateLevelWindow(Gpu& gpu, DecoupledState& d, ObjectSlot& o, uint32
 // (with one level of slack, so a camera hovering at a boundary does not churn the sheet) as it
 // moves away. Returns false when the object has no rects at all (drawn forward this frame).
 static bool updateObjectRects(Gpu& gpu, DecoupledState& d, ObjectSlot& o, uint32_t object,
-                              const ShadelMeshInfo& mesh, uint32_t wantFirst, bool& limited) {
+                              const ShadelMeshInfo& mesh, uint32_t wantFirst, bool wasDecoupled,
+                              bool& limited) {
     limited = false;
     if (!o.allocated) {
         o.mipCount = mesh.mipCount;
         o.firstMip = mesh.mipCount;
         o.allocated = true;
+        o.firstMipChanged = d.frameNumber;
     }
+    uint32_t firstMip = o.firstMip;
     while (o.firstMip > wantFirst && allocateLevel(gpu, d, o, object, mesh, o.firstMip - 1))
         --o.firstMip;
     if (o.firstMip > wantFirst) limited = true; // the sheet is full: clamped to coarser levels
@@ -481,6 +497,13 @@ static bool updateObjectRects(Gpu& gpu, DecoupledState& d, ObjectSlot& o, uint32
         o.allocated = false;
         return false;
     }
+    if (o.firstMip != firstMip) o.firstMipChanged = d.frameNumber;
+    // The wants and levels are those the last update (last frame's) kept or placed: it would
+    // keep every window again (most objects of a steady view).
+    bool settled =
+        wasDecoupled && o.wantsSettled && !o.windowRetry && o.firstMipChanged + 2 <= d.frameNumber;
+    if (settled) return true;
+    o.windowRetry = false;
     for (uint32_t k = o.firstMip; k < o.mipCount; ++k)
         if (o.levelSince[k] < d.frameNumber) updateLevelWindow(gpu, d, o, object, mesh, k);
     return true;
@@ -581,6 +604,34 @@ static uint32_t takeSlot(DecoupledState& d) {
     return s;
 }
 
+// The visited instances are scattered over per-instance arrays of the whole world (at 1M
+// instances: 160 MB of GpuInstance, 12 MB of InstanceEntry, 272 MB of GpuShadelObject), so
+// each visit starts with cache and TLB misses (builtin:many 1M: 37% of the coarse allocation's
+// samples sat on the first GpuInstance load). Fetching a few visits ahead overlaps them.
+// Two stages: an instance's entries first, then (its entry read by then) its slot.
+constexpr size_t kPrefetchAhead = 8;
+
+static void prefetchLines(const void* p, size_t bytes, int write) {
+    const char* c = static_cast<const char*>(p);
+    for (size_t o = 0; o < bytes; o += 64)
+        write ? __builtin_prefetch(c + o, 1) : __builtin_prefetch(c + o, 0);
+}
+
+static void prefetchInstance(const DecoupledState& d, const GpuScene& scene, uint32_t i) {
+    __builtin_prefetch(&d.instances[i]);
+    const auto* inst = reinterpret_cast<const char*>(&scene.instanceInfo[i]);
+    __builtin_prefetch(inst);                                        // model
+    __builtin_prefetch(inst + offsetof(gpu::GpuInstance, worldMin)); // bounds, mesh, material
+    __builtin_prefetch(inst + sizeof(gpu::GpuInstance) - 1);
+}
+
+static void prefetchSlot(const DecoupledState& d, uint32_t i) {
+    uint32_t s = d.instances[i].slot;
+    if (s == kNoSlot) return;
+    prefetchLines(&d.slots[s], kSlotHotBytes, 0);
+    prefetchLines(&d.slotObjects[s], sizeof(gpu::GpuShadelObject), 1); // rewritten
+}
+
 void prepareDecoupledFrame(Renderer& r, const GpuScene& scene, const CameraView& camera,
                            gpu::FrameConstants& constants) {
     Gpu& gpu = *r.gpu;
@@ -627,7 +678,12 @@ void prepareDecoupledFrame(Renderer& r, const GpuScene& scene, const CameraView&
     }
     d.visit.insert(d.visit.end(), d.touched.begin(), d.touched.end());
     d.touched.clear();
-    for (uint32_t i : d.visit) {
+    for (size_t v = 0; v < d.visit.size(); ++v) {
+        if (v + kPrefetchAhead < d.visit.size())
+            prefetchInstance(d, scene, d.visit[v + kPrefetchAhead]);
+        if (v + kPrefetchAhead / 2 < d.visit.size())
+            prefetchSlot(d, d.visit[v + kPrefetchAhead / 2]);
+        uint32_t i = d.visit[v];
         InstanceEntry& entry = d.instances[i];
         if (entry.visitedFrame == frameMark) continue;
         entry.visitedFrame = frameMark;
@@ -672,7 +728,7 @@ void prepareDecoupledFrame(Renderer& r, const GpuScene& scene, const CameraView&
                                   inst.worldMin - margin, inst.worldMax + margin, d.shadingBias);
         bool limited = false;
         // No room in the sheet: drawn forward this frame, retried next frame.
-        if (!updateObjectRects(gpu, d, o, i, mesh, wantFirst, limited)) {
+        if (!updateObjectRects(gpu, d, o, i, mesh, wantFirst, wasDecoupled, limited)) {
             d.objectsForward++;
             continue;
         }
@@ -727,7 +783,10 @@ void prepareDecoupledFrame(Renderer& r, const GpuScene& scene, const CameraView&
     }
     d.lastCameraPosition = camera.position;
     auto* objects = static_cast<gpu::GpuShadelObject*>(mapped(gpu, d.objectBuffer));
-    for (uint32_t i : d.visit) {
+    for (size_t v = 0; v < d.visit.size(); ++v) {
+        if (v + kPrefetchAhead < d.visit.size()) // its GPU entry, written below
+            prefetchLines(&objects[d.visit[v + kPrefetchAhead]], sizeof(gpu::GpuShadelObject), 1);
+        uint32_t i = d.visit[v];
         InstanceEntry& entry = d.instances[i];
         if (entry.visitedFrame != frameMark) continue;
         entry.visitedFrame = 0;              // once per instance (visit may list it twice)
@@ -993,8 +1052,13 @@ void finishDecoupledFrame(Renderer& r) {
         const gpu::GpuShadelRect& rect = d.rects[i];
         ObjectSlot& o = d.slots[d.instances[rect.object].slot]; // has rects: holds a slot
         glm::uvec4 w = wants[i];
-        o.wanted[rect.mip] = w.z == 0 ? glm::uvec4(0) // nothing wanted
-                                      : glm::uvec4(0xFFFFu - w.x, 0xFFFFu - w.y, w.z, w.w);
+        glm::uvec4 wanted = w.z == 0 ? glm::uvec4(0) // nothing wanted
+                                     : glm::uvec4(0xFFFFu - w.x, 0xFFFFu - w.y, w.z, w.w);
+        // Settled: every level's wants, valid this frame, are the same next frame (an object's
+        // rects are listed in order from its firstMip).
+        bool same = o.wantedFor[rect.mip] == d.frameNumber + 1 && o.wanted[rect.mip] == wanted;
+        o.wantsSettled = (rect.mip == o.firstMip || o.wantsSettled) && same;
+        o.wanted[rect.mip] = wanted;
         o.wantedFor[rect.mip] = d.frameNumber + 2; // next frame's number + 1 (0: none yet)
     }
     f.shadingBias = d.shadingBias;
