@@ -2,6 +2,7 @@
 #include <unistd.h>
 
 #include <cmath>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 
@@ -91,6 +92,56 @@ double worstFramePsnr(const RenderRun& a, const RenderRun& b) {
     for (size_t i = 0; i < a.frames.size() && i < b.frames.size(); ++i)
         worst = std::min(worst, psnr(a.frames[i].rgba, b.frames[i].rgba));
     return worst;
+}
+
+void appendBox(const float centre[3], const float half[3], std::vector<float>& positions,
+               std::vector<float>& normals, std::vector<uint16_t>& indices) {
+    uint16_t face = 0;
+    for (int axis = 0; axis < 3; ++axis)
+        for (float sign : {-1.0f, 1.0f}) {
+            int u = (axis + 1) % 3, v = (axis + 2) % 3; // cross(u, v) = +axis
+            for (int corner = 0; corner < 4; ++corner) {
+                float p[3], n[3] = {0.0f, 0.0f, 0.0f};
+                p[axis] = half[axis] * sign;
+                p[u] = (corner & 1) ? half[u] : -half[u];
+                p[v] = (corner & 2) ? half[v] : -half[v];
+                n[axis] = sign;
+                for (int k = 0; k < 3; ++k) positions.push_back(centre[k] + p[k]);
+                normals.insert(normals.end(), {n[0], n[1], n[2]});
+            }
+            uint16_t b = uint16_t(face++ * 4);
+            if (sign > 0)
+                indices.insert(indices.end(), {b, uint16_t(b + 1), uint16_t(b + 3), b,
+                                               uint16_t(b + 3), uint16_t(b + 2)});
+            else
+                indices.insert(indices.end(), {b, uint16_t(b + 3), uint16_t(b + 1), b,
+                                               uint16_t(b + 2), uint16_t(b + 3)});
+        }
+}
+
+std::string writeGltf(const std::string& name, nlohmann::json doc, const std::vector<float>& floats,
+                      const std::vector<uint16_t>& indices) {
+    std::vector<uint8_t> bin(floats.size() * 4 + indices.size() * 2);
+    std::memcpy(bin.data(), floats.data(), floats.size() * 4);
+    std::memcpy(bin.data() + floats.size() * 4, indices.data(), indices.size() * 2);
+    std::string gltf = tempPath(name + ".gltf"), binPath = tempPath(name + ".bin");
+    doc["buffers"] = {
+        {{"byteLength", bin.size()}, {"uri", std::filesystem::path(binPath).filename().string()}}};
+    std::ofstream(binPath, std::ios::binary)
+        .write(reinterpret_cast<const char*>(bin.data()), std::streamsize(bin.size()));
+    std::ofstream(gltf) << doc.dump();
+    return gltf;
+}
+
+nlohmann::json gltfBufferView(size_t byteOffset, size_t byteLength) {
+    return {{"buffer", 0}, {"byteOffset", byteOffset}, {"byteLength", byteLength}};
+}
+
+nlohmann::json gltfAccessor(int bufferView, int componentType, int count, const char* type) {
+    return {{"bufferView", bufferView},
+            {"componentType", componentType},
+            {"count", count},
+            {"type", type}};
 }
 
 std::string tempPath(const std::string& name) {

@@ -34,4 +34,16 @@ nlohmann::json takeJsonFile(const std::string& path);
 // The lowest PSNR between the runs' frames of the same index (the runs have as many frames).
 double worstFramePsnr(const RenderRun& a, const RenderRun& b);
 
+// Test scenes written as glTF. appendBox: an axis-aligned box (centre, half extents) as 24
+// vertices, 4 per face with the face's normal, and 36 indices counter-clockwise seen from
+// outside, numbered from the box's first vertex (the box is its own mesh).
+void appendBox(const float centre[3], const float half[3], std::vector<float>& positions,
+               std::vector<float>& normals, std::vector<uint16_t>& indices);
+// Writes `doc` to tempPath(NAME.gltf) with one buffer, NAME.bin beside it: `floats`, then
+// `indices` (16-bit) from byte floats.size() * 4; returns the .gltf path.
+std::string writeGltf(const std::string& name, nlohmann::json doc, const std::vector<float>& floats,
+                      const std::vector<uint16_t>& indices);
+nlohmann::json gltfBufferView(size_t byteOffset, size_t byteLength); // of buffer 0
+nlohmann::json gltfAccessor(int bufferView, int componentType, int count, const char* type);
+
 } // namespace shadel::test

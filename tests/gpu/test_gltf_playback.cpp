@@ -54,36 +54,13 @@ std::string writeMovingCasterScene(const std::string& name) {
     for (int i = 0; i < 4; ++i) push3(0.0f, 1.0f, 0.0f);
     indices.insert(indices.end(), {0, 2, 1, 1, 2, 3});
     std::vector<float> cubeNormals;
-    uint16_t face = 0; // cube vertices are numbered from 0 in their own mesh, 4 per face
-    for (int axis = 0; axis < 3; ++axis)
-        for (float sign : {-1.0f, 1.0f}) {
-            int u = (axis + 1) % 3, v = (axis + 2) % 3; // cross(u, v) = +axis
-            for (int corner = 0; corner < 4; ++corner) {
-                float p[3], n[3] = {0.0f, 0.0f, 0.0f};
-                p[axis] = 0.5f * sign;
-                p[u] = (corner & 1) ? 0.5f : -0.5f;
-                p[v] = (corner & 2) ? 0.5f : -0.5f;
-                n[axis] = sign;
-                push3(p[0], p[1], p[2]);
-                cubeNormals.insert(cubeNormals.end(), {n[0], n[1], n[2]});
-            }
-            uint16_t b = uint16_t(face++ * 4); // counter-clockwise seen from outside
-            if (sign > 0)
-                indices.insert(indices.end(), {b, uint16_t(b + 1), uint16_t(b + 3), b,
-                                               uint16_t(b + 3), uint16_t(b + 2)});
-            else
-                indices.insert(indices.end(), {b, uint16_t(b + 3), uint16_t(b + 1), b,
-                                               uint16_t(b + 2), uint16_t(b + 3)});
-        }
+    const float cubeCentre[3] = {0.0f, 0.0f, 0.0f}, cubeHalf[3] = {0.5f, 0.5f, 0.5f};
+    appendBox(cubeCentre, cubeHalf, f, cubeNormals, indices);
     f.insert(f.end(), cubeNormals.begin(), cubeNormals.end());
     f.insert(f.end(), {0.0f, 2.0f, -3.0f, 1.5f, 0.0f, 3.0f, 1.5f, 0.0f});
-    std::vector<uint8_t> bin(f.size() * 4 + indices.size() * 2);
-    std::memcpy(bin.data(), f.data(), f.size() * 4);
-    std::memcpy(bin.data() + f.size() * 4, indices.data(), indices.size() * 2);
     using nlohmann::json;
-    auto view = [](size_t offset, size_t bytes) {
-        return json{{"buffer", 0}, {"byteOffset", offset}, {"byteLength", bytes}};
-    };
+    auto view = gltfBufferView;
+    auto accessor = gltfAccessor;
     size_t ib = f.size() * 4;
     json doc;
     doc["asset"] = {{"version", "2.0"}};
@@ -93,10 +70,6 @@ std::string writeMovingCasterScene(const std::string& name) {
                     {{"mesh", 1}, {"name", "caster"}, {"translation", {-3.0, 1.5, 0.0}}}};
     doc["bufferViews"] = {view(0, 48),  view(48, 48),  view(96, 288), view(384, 288),
                           view(672, 8), view(680, 24), view(ib, 12),  view(ib + 12, 72)};
-    auto accessor = [](int view, int component, int count, const char* type) {
-        return json{
-            {"bufferView", view}, {"componentType", component}, {"count", count}, {"type", type}};
-    };
     const int f32 = 5126, u16 = 5123;
     doc["accessors"] = {accessor(0, f32, 4, "VEC3"),   accessor(1, f32, 4, "VEC3"),
                         accessor(2, f32, 24, "VEC3"),  accessor(3, f32, 24, "VEC3"),
@@ -121,13 +94,7 @@ std::string writeMovingCasterScene(const std::string& name) {
     doc["animations"] = {
         {{"channels", {{{"sampler", 0}, {"target", {{"node", 1}, {"path", "translation"}}}}}},
          {"samplers", {{{"input", 4}, {"output", 5}, {"interpolation", "LINEAR"}}}}}};
-    std::string gltf = tempPath(name + ".gltf"), binPath = tempPath(name + ".bin");
-    doc["buffers"] = {
-        {{"byteLength", bin.size()}, {"uri", binPath.substr(binPath.find_last_of('/') + 1)}}};
-    std::ofstream(binPath, std::ios::binary)
-        .write(reinterpret_cast<const char*>(bin.data()), std::streamsize(bin.size()));
-    std::ofstream(gltf) << doc.dump();
-    return gltf;
+    return writeGltf(name, doc, f, indices);
 }
 
 } // namespace

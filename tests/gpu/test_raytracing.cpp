@@ -429,41 +429,12 @@ std::string thinPostScene(const std::string& name, float floorSize) {
     f.insert(f.end(), {-h, 0, -h, h, 0, -h, h, 0, h, -h, 0, h});
     f.insert(f.end(), {0, 1, 0, 0, 1, 0, 0, 1, 0, 0, 1, 0});
     std::vector<float> postNormals;
-    const float half[3] = {0.02f, 0.75f, 0.02f};
-    uint16_t face = 0;
-    for (int axis = 0; axis < 3; ++axis)
-        for (float sign : {1.0f, -1.0f}) {
-            int u = (axis + 1) % 3, v = (axis + 2) % 3; // cross(u, v) = +axis
-            for (int corner = 0; corner < 4; ++corner) {
-                float p[3], n[3] = {0, 0, 0};
-                p[axis] = half[axis] * sign;
-                p[u] = (corner & 1) ? half[u] : -half[u];
-                p[v] = (corner & 2) ? half[v] : -half[v];
-                p[1] += 0.75f; // standing on the floor
-                n[axis] = sign;
-                f.insert(f.end(), {p[0], p[1], p[2]});
-                postNormals.insert(postNormals.end(), {n[0], n[1], n[2]});
-            }
-            uint16_t b = uint16_t(face++ * 4); // counter-clockwise seen from outside
-            if (sign > 0)
-                indices.insert(indices.end(), {b, uint16_t(b + 1), uint16_t(b + 3), b,
-                                               uint16_t(b + 3), uint16_t(b + 2)});
-            else
-                indices.insert(indices.end(), {b, uint16_t(b + 3), uint16_t(b + 1), b,
-                                               uint16_t(b + 2), uint16_t(b + 3)});
-        }
+    const float postCentre[3] = {0.0f, 0.75f, 0.0f}, postHalf[3] = {0.02f, 0.75f, 0.02f};
+    appendBox(postCentre, postHalf, f, postNormals, indices);
     f.insert(f.end(), postNormals.begin(), postNormals.end());
-    std::vector<uint8_t> bin(f.size() * 4 + indices.size() * 2);
-    std::memcpy(bin.data(), f.data(), f.size() * 4);
-    std::memcpy(bin.data() + f.size() * 4, indices.data(), indices.size() * 2);
     using nlohmann::json;
-    auto view = [](size_t offset, size_t bytes) {
-        return json{{"buffer", 0}, {"byteOffset", offset}, {"byteLength", bytes}};
-    };
-    auto accessor = [](int view, int component, int count, const char* type) {
-        return json{
-            {"bufferView", view}, {"componentType", component}, {"count", count}, {"type", type}};
-    };
+    auto view = gltfBufferView;
+    auto accessor = gltfAccessor;
     auto rotationTowards = [](glm::vec3 direction) { // -Z onto `direction`, +Y up
         glm::quat q = glm::quatLookAtRH(glm::normalize(direction), glm::vec3(0, 1, 0));
         return json{q.x, q.y, q.z, q.w};
@@ -507,13 +478,7 @@ std::string thinPostScene(const std::string& name, float floorSize) {
           {{{"attributes", {{"POSITION", 0}, {"NORMAL", 1}}}, {"indices", 4}, {"material", 0}}}}},
         {{"primitives",
           {{{"attributes", {{"POSITION", 2}, {"NORMAL", 3}}}, {"indices", 5}, {"material", 0}}}}}};
-    std::string gltf = tempPath(name + ".gltf"), binPath = tempPath(name + ".bin");
-    doc["buffers"] = {
-        {{"byteLength", bin.size()}, {"uri", binPath.substr(binPath.find_last_of('/') + 1)}}};
-    std::ofstream(binPath, std::ios::binary)
-        .write(reinterpret_cast<const char*>(bin.data()), std::streamsize(bin.size()));
-    std::ofstream(gltf) << doc.dump();
-    return gltf;
+    return writeGltf(name, doc, f, indices);
 }
 
 } // namespace

@@ -9,20 +9,28 @@
 using namespace shadel;
 using namespace shadel::test;
 
-TEST(Trace, OneEventPerPassPerFrameNamedAsThePasses) {
-    std::string path = (std::filesystem::temp_directory_path() /
-                        ("shadel-trace-" + std::to_string(::getpid()) + ".json"))
-                           .string();
-    RenderOptions o;
-    o.scene = "builtin:smooth";
-    o.mode = RenderMode::Decoupled;
-    o.width = 96;
-    o.height = 54;
+namespace {
+
+// builtin:smooth in decoupled mode, 96x54, 3 frames, with --trace: the run and its trace.
+struct TracedRun {
+    RenderRun run;
+    nlohmann::json trace;
+};
+TracedRun tracedRun(const std::string& name) {
+    std::string path = tempPath(name + ".json");
+    RenderOptions o = renderOptions("builtin:smooth", RenderMode::Decoupled, 96, 54);
     o.frames = 3;
     o.trace = path;
-    RenderRun run = renderChecked(o);
-    nlohmann::json trace = takeJsonFile(path);
-    ASSERT_FALSE(trace.is_null()) << path;
+    TracedRun t{renderChecked(o), nlohmann::json()};
+    t.trace = takeJsonFile(path);
+    return t;
+}
+
+} // namespace
+
+TEST(Trace, OneEventPerPassPerFrameNamedAsThePasses) {
+    auto [run, trace] = tracedRun("trace");
+    ASSERT_FALSE(trace.is_null());
 
     std::map<std::string, int> gpuEvents;
     int frames = 0, frontends = 0;
@@ -50,19 +58,8 @@ TEST(Trace, OneEventPerPassPerFrameNamedAsThePasses) {
 // --trace itemises the render thread's CPU (the frontend's steps, every submit) with its thread
 // CPU time beside the wall clock, and the stats list the same scopes (median per frame).
 TEST(Trace, CpuScopesItemiseTheFrontendAndEverySubmit) {
-    std::string path = (std::filesystem::temp_directory_path() /
-                        ("shadel-trace-scopes-" + std::to_string(::getpid()) + ".json"))
-                           .string();
-    RenderOptions o;
-    o.scene = "builtin:smooth";
-    o.mode = RenderMode::Decoupled;
-    o.width = 96;
-    o.height = 54;
-    o.frames = 3;
-    o.trace = path;
-    RenderRun run = renderChecked(o);
-    nlohmann::json trace = takeJsonFile(path);
-    ASSERT_FALSE(trace.is_null()) << path;
+    auto [run, trace] = tracedRun("trace-scopes");
+    ASSERT_FALSE(trace.is_null());
 
     struct Span {
         double start, end;
