@@ -144,6 +144,15 @@ nlohmann::json gltfAccessor(int bufferView, int componentType, int count, const 
             {"type", type}};
 }
 
+ReuseRuns renderReuseOnAndOff(RenderOptions o) {
+    ReuseRuns r;
+    o.reuse = false;
+    r.off = renderChecked(o);
+    o.reuse = true;
+    r.on = renderChecked(o);
+    return r;
+}
+
 std::string tempPath(const std::string& name) {
     return (std::filesystem::temp_directory_path() /
             ("shadel-test-" + std::to_string(getpid()) + "-" + name))

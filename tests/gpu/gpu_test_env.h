@@ -34,6 +34,12 @@ nlohmann::json takeJsonFile(const std::string& path);
 // The lowest PSNR between the runs' frames of the same index (the runs have as many frames).
 double worstFramePsnr(const RenderRun& a, const RenderRun& b);
 
+// The same decoupled run with --reuse on and off (checked as renderChecked checks them).
+struct ReuseRuns {
+    RenderRun on, off;
+};
+ReuseRuns renderReuseOnAndOff(RenderOptions o);
+
 // Test scenes written as glTF. appendBox: an axis-aligned box (centre, half extents) as 24
 // vertices, 4 per face with the face's normal, and 36 indices counter-clockwise seen from
 // outside, numbered from the box's first vertex (the box is its own mesh).

@@ -96,10 +96,7 @@ TEST(DistanceFields, ResidencyChangesAreNotCarriedOverByReuse) {
     o.frames = 12;
     o.cameraPath = CameraPath::Orbit;
     o.dfResidency = 8.0f;
-    o.reuse = false;
-    RenderRun off = renderChecked(o);
-    o.reuse = true;
-    RenderRun on = renderChecked(o);
+    auto [on, off] = renderReuseOnAndOff(o);
     double worst = worstFramePsnr(on, off);
     const auto& df = on.stats["distance_fields"];
     std::printf("[ figures ] arena 192x108 orbit, --df-residency 8: %llu streamed in, %llu "

@@ -110,10 +110,7 @@ TEST(GltfFeaturesPlayback, MovingCasterShadowsAreNotCarriedOverByReuse) {
     o.frames = 8;
     o.time = 0.0;
     o.timeStep = 0.25;
-    o.reuse = false;
-    RenderRun off = renderChecked(o);
-    o.reuse = true;
-    RenderRun on = renderChecked(o);
+    auto [on, off] = renderReuseOnAndOff(o);
     double worst = worstFramePsnr(on, off);
     double moved = psnr(off.frames.front().rgba, off.frames.back().rgba);
     double fraction = on.stats["reuse_fraction"].get<double>();
