@@ -497,6 +497,7 @@ struct ShaderMessage {
 // Its bounds meet a light that changed this frame: carried-over chunks check their shadels.
 #define SHADEL_OBJECT_NEAR_CHANGE 2u
 #define SHADEL_MAX_CHANGED_VOLUMES 256u
+#define SHADEL_CHUNK_VIEW_NONE 0xFFFFFFFFu // ShadelFrame::chunkViews: a NaN centre
 // Material layers of the shade storage (seed: "layers of different bit depths"): every layer
 // shares the slot allocation; each has its own format.
 #define SHADEL_LAYER_RADIANCE 0u // lit colour, RGBA16F
@@ -512,9 +513,13 @@ struct GpuShadelObject {
     // Bit k: MIP k's rect and every shading input of the object (transform, material, lights in
     // range) are unchanged since last frame, so last frame's shadels there may be carried over.
     uint reuseLevels;
-    // Frames a carried-over chunk may go unshaded: fewer where the camera's motion, seen from
-    // the object, turns the view direction faster (view-dependent terms drift).
+    // Frames a carried-over chunk may go unshaded (--reuse-refresh), whatever the view does.
     uint refreshPeriod;
+    // Radians the direction from a carried-over chunk to the camera may turn since the chunk was
+    // shaded before its view-dependent terms (specular, Fresnel) visibly lag: its material's
+    // specular lobe width, widened by how little of its light is specular (a rough dielectric
+    // tolerates far more than a polished metal). Checked per chunk (ShadelFrame::chunkViews).
+    float viewDriftLimit;
     uint firstRect; // index of its firstMip rect in ShadelFrame::rects (levels follow in order)
     uint idMapOffset[SHADEL_MAX_MIPS]; // in 16-bit units into ShadelFrame::idMaps
     uvec4 rect[SHADEL_MAX_MIPS];       // x, y, w, h in blocks of the virtual sheet
@@ -549,7 +554,7 @@ struct GpuDebugLines {
 
 // sizeof(GpuShadelObject) in the scalar layout: shaders address one object in place
 // (ShadelObjectRef); static_assert'ed on the C++ side.
-#define GPU_SHADEL_OBJECT_BYTES (32u + 24u * SHADEL_MAX_MIPS)
+#define GPU_SHADEL_OBJECT_BYTES (36u + 24u * SHADEL_MAX_MIPS)
 
 // One rectangle of the sheet in use this frame (the clear and allocation passes walk these).
 struct GpuShadelRect {
@@ -575,7 +580,8 @@ struct GpuShadelWork {
 #define SHADEL_SHADED_REFRESH 2u     // stored, but its turn to be refreshed
 #define SHADEL_SHADED_NEAR_CHANGE 3u // a changed region meets the object: shading decides
 #define SHADEL_SHADED_RT_HISTORY 4u  // the ray-traced terms under it doubled their rays
-#define SHADEL_SHADED_REASONS 5
+#define SHADEL_SHADED_VIEW 5u        // the view turned past what its specular tolerates
+#define SHADEL_SHADED_REASONS 6
 
 struct GpuShadelCounters {
     // Chunks requested through each hashed counter. The counters only spread the atomics: once
@@ -626,6 +632,11 @@ struct ShadelFrame {
     uint prevLayerReadSlot[SHADEL_LAYERS]; // last frame's layers (sampled): preserved layers
     uint64_t prevOccupancy;                // last frame's occupancy masks
     uint64_t prevOffsetMap;                // last frame's offset map
+    // Reuse: per storage slot, where its chunk was seen from when shaded (carried over with it):
+    // uvec4 {centre of the chunk's world box (float bits), the unit direction from the centre to
+    // the camera (octahedral, packSnorm2x16)}; x = SHADEL_CHUNK_VIEW_NONE: nothing shaded in it.
+    uint64_t chunkViews;
+    uint64_t prevChunkViews; // last frame's
     // Regions whose lighting changed since last frame (render/shadel/reuse_invalidation.h):
     // capsules, two vec4s each: (a, radius), (b, 0); infinite radius = everywhere.
     uint64_t changedVolumes;

@@ -30,5 +30,8 @@ void main() {
         imageStore(gImagesRgba8[materialOut], to + ivec2(x, 0),
                    fetchTextureUniform(materialIn, from + ivec2(x, 0), 0));
     }
-    if (row == 0u) atomicAdd(counters.c.chunksReused, 1u);
+    if (row == 0u) { // where it was seen from when shaded travels with it
+        Uvec4Buffer(frame.s.chunkViews).v[work.slot] = Uvec4Buffer(frame.s.prevChunkViews).v[work.chunk];
+        atomicAdd(counters.c.chunksReused, 1u);
+    }
 }

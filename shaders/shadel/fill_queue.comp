@@ -2,9 +2,9 @@
 // Work queue fill: each marked block gets its storage offset (its counter's section base + its
 // place in the counter) and publishes it in the offset map. Each of its marked chunks then goes
 // to one of two queues: carried over from last frame's storage (preserved layers: the object's
-// level is unchanged, last frame stored the chunk, and it is not the chunk's turn to be
-// refreshed) or shaded. Chunks of objects a changed region meets (a light or a caster that
-// changed) are queued for shading, which checks their shadels against the regions and may
+// level is unchanged, last frame stored the chunk, it is not the chunk's turn to be refreshed,
+// and the view did not turn past what its specular tolerates) or shaded. Chunks of objects a
+// changed region meets (a light or a caster that changed) are queued for shading, which checks their shadels against the regions and may
 // still carry them over (shade.comp). With ray-traced terms, a chunk is also reshaded when the
 // RT cache under it doubled its rays (raytracing/rt_history.glsl).
 #include "shadel/shadel.glsl"
@@ -54,9 +54,11 @@ void main() {
         w.mip = mip;
         ++k;
         bool stored = (prevMask & (1ul << bit)) != 0ul && prevBase != SHADEL_INVALID;
+        uint prevSlot = stored ? chunkSlot(prevMask, prevBase, bit) : SHADEL_INVALID;
         bool refresh = stored && shadelRefreshDue(s, o, w.chunk);
+        bool viewTurned = stored && !refresh && chunkViewTurned(s, o, prevSlot, f.cameraPosition);
         bool rtHistory = false;
-        if (stored && !refresh && f.rt != 0ul) {
+        if (stored && !refresh && !viewTurned && f.rt != 0ul) {
             uvec2 size = levelSize(o, mip);
             vec2 uvs[4];
             for (int q = 0; q < 4; ++q) { // the centres of the chunk's four quarters
@@ -65,8 +67,8 @@ void main() {
             }
             rtHistory = rtHistoryStepped(f, entry.z, uvs, w.chunk);
         }
-        if (stored && !refresh && !rtHistory) {
-            w.chunk = chunkSlot(prevMask, prevBase, bit); // where last frame stored it
+        if (stored && !refresh && !viewTurned && !rtHistory) {
+            w.chunk = prevSlot; // where last frame stored it
             ShadelWorkBuffer(s.copyQueue).w[atomicAdd(counters.c.copyCount, 1u)] = w;
             continue;
         }
@@ -74,6 +76,7 @@ void main() {
         uint reason = !levelReusable ? SHADEL_SHADED_NOT_REUSABLE
                       : nearChange   ? SHADEL_SHADED_NEAR_CHANGE
                       : refresh      ? SHADEL_SHADED_REFRESH
+                      : viewTurned   ? SHADEL_SHADED_VIEW
                       : rtHistory    ? SHADEL_SHADED_RT_HISTORY
                                      : SHADEL_SHADED_NEW;
         shadedBecause[reason]++;

@@ -50,13 +50,16 @@ int carrySource(ShadelFrame s, ShadelObjectRef o, GpuShadelWork work) {
     return int(chunkSlot(prevMask, prevBase, bit));
 }
 
-void carryOver(ShadelFrame s, uint fromSlot, ivec2 outTexel) {
+void carryOver(ShadelFrame s, uint fromSlot, uint toSlot, ivec2 outTexel) {
     ivec2 from = storageTexel(s, fromSlot, gl_LocalInvocationID.xy);
     imageStore(gImagesRgba16f[s.layerWriteSlot[SHADEL_LAYER_RADIANCE]], outTexel,
                fetchTexture(s.prevLayerReadSlot[SHADEL_LAYER_RADIANCE], from, 0));
     imageStore(gImagesRgba8[s.layerWriteSlot[SHADEL_LAYER_MATERIAL]], outTexel,
                fetchTexture(s.prevLayerReadSlot[SHADEL_LAYER_MATERIAL], from, 0));
-    if (gl_LocalInvocationIndex == 0u) atomicAdd(ShadelCountersRef(s.counters).c.chunksReused, 1u);
+    if (gl_LocalInvocationIndex == 0u) {
+        Uvec4Buffer(s.chunkViews).v[toSlot] = Uvec4Buffer(s.prevChunkViews).v[fromSlot];
+        atomicAdd(ShadelCountersRef(s.counters).c.chunksReused, 1u);
+    }
 }
 
 shared bool chunkNearChange;
@@ -97,9 +100,10 @@ bool chunkTouchesChange(FrameConstants f, ShadelFrame s, ShadelObjectRef o, GpuS
     return chunkNearChange;
 }
 
-// cullChunkLights keeps the box for the spectra's classify phase (chunk_spectra_classify.glsl).
+// cullChunkLights keeps the box for the spectra's classify phase (chunk_spectra_classify.glsl)
+// and the chunk's view record (recordChunkView).
 vec3 gChunkBoxMin = vec3(0.0), gChunkBoxMax = vec3(0.0);
-bool gChunkHasBox = false;
+bool gChunkHasBox = false, gChunkBoxKnown = false;
 
 // The chunk's world box from its shading invocations' positions, with one barrier: each
 // subgroup reduces its lanes (subgroupMin/Max of the order-preserving bits, so the box is the
@@ -146,6 +150,7 @@ void cullChunkLights(FrameConstants f, bool shading, vec3 p) {
     vec3 boxMin, boxMax;
     gChunkHasBox = chunkBox(shading, p, boxMin, boxMax);
     gChunkBoxMin = boxMin, gChunkBoxMax = boxMax;
+    gChunkBoxKnown = true;
     gLightListMode = LIGHT_LIST_SHARED;
     if (!gChunkHasBox) { // no shadel to shade
         if (tid == 0u) sLightListCount = 0u;
@@ -198,6 +203,21 @@ void cullChunkLights(FrameConstants f, bool shading, vec3 p) {
 
 #include "lighting/chunk_spectra_classify.glsl" // --spectra: binning chunks by features
 
+// Reuse: records where the chunk is seen from as it is shaded (its world box's centre and the
+// direction to the camera), so fill_queue.comp reshades it once the view turned too far for its
+// specular (chunkViewTurned). The box is light culling's when that ran, else built here (one
+// barrier). Call in uniform control flow.
+void recordChunkView(FrameConstants f, ShadelFrame s, uint slot, bool shading, vec3 p) {
+    if (s.reuse == 0u) return;
+    if (!gChunkBoxKnown) {
+        gChunkHasBox = chunkBox(shading, p, gChunkBoxMin, gChunkBoxMax);
+        gChunkBoxKnown = true;
+    }
+    if (gl_LocalInvocationIndex == 0u)
+        Uvec4Buffer(s.chunkViews).v[slot] =
+            chunkViewRecord(gChunkHasBox, gChunkBoxMin, gChunkBoxMax, f.cameraPosition);
+}
+
 // The decal stats of this shadel's list (useShadelDecalList): (decal, shadel) pairs, and the
 // decals kept marked visible, one atomic per subgroup. Any control flow.
 void countShadelDecals(FrameConstants f, uint object, uint pairs) {
@@ -237,7 +257,7 @@ void main() {
                         : -1;
     if (carrySlot >= 0 && chunkTouchesChange(f, s, o, work)) carrySlot = -1;
     if (carrySlot >= 0) {
-        carryOver(s, uint(carrySlot), outTexel);
+        carryOver(s, uint(carrySlot), work.slot, outTexel);
         return;
     }
 
@@ -283,6 +303,7 @@ void main() {
         classifyChunkSpectrum(f, workIndex);
         return;
     }
+    recordChunkView(f, s, work.slot, shading, si.position);
     // --debug-lines chunks: this chunk's world box, coloured by MIP (uniform over the workgroup).
     if (debugLinesOn(f, DEBUG_LINES_CHUNKS))
         debugWorkgroupBox(f, shading, si.position, debugLevelColour(work.mip));

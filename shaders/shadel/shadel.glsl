@@ -185,10 +185,51 @@ uint chunkSlot(uint64_t mask, uint base, uint bit) {
     return base + bitCount(uint(below)) + bitCount(uint(below >> 32));
 }
 
-// Preserved layers: a carried-over chunk is still reshaded once per its object's refresh
-// period, each chunk at its own phase, so view-dependent terms never lag for long.
+// Preserved layers: a carried-over chunk is still reshaded once per refresh period
+// (--reuse-refresh), each chunk at its own phase, so nothing goes stale for long (view-dependent
+// terms are reshaded sooner when the view turns: chunkViewTurned).
 bool shadelRefreshDue(ShadelFrame s, ShadelObjectRef o, uint chunk) {
     return (((chunk * 2654435761u) >> 20) + s.frameNumber) % max(o.v.refreshPeriod, 1u) == 0u;
+}
+
+// Octahedral mapping of a unit vector to [-1, 1]^2 and back (chunk view directions).
+vec2 shadelOctEncode(vec3 n) {
+    n /= abs(n.x) + abs(n.y) + abs(n.z);
+    vec2 signs = vec2(n.x >= 0.0 ? 1.0 : -1.0, n.y >= 0.0 ? 1.0 : -1.0);
+    return n.z >= 0.0 ? n.xy : (1.0 - abs(n.yx)) * signs;
+}
+vec3 shadelOctDecode(vec2 e) {
+    vec3 n = vec3(e, 1.0 - abs(e.x) - abs(e.y));
+    float t = max(-n.z, 0.0);
+    n.xy += vec2(n.x >= 0.0 ? -t : t, n.y >= 0.0 ? -t : t);
+    return normalize(n);
+}
+
+// Preserved layers: what a chunk's record holds (ShadelFrame::chunkViews) when it was shaded
+// with its world box [lo, hi] seen from `camera`; none when no shadel of it was shaded.
+uvec4 chunkViewRecord(bool shaded, vec3 lo, vec3 hi, vec3 camera) {
+    if (!shaded) return uvec4(SHADEL_CHUNK_VIEW_NONE);
+    vec3 centre = 0.5 * (lo + hi);
+    vec3 toCamera = camera - centre;
+    float len = length(toCamera);
+    vec3 dir = len > 0.0 ? toCamera / len : vec3(0.0, 0.0, 1.0);
+    return uvec4(floatBitsToUint(centre), packSnorm2x16(shadelOctEncode(dir)));
+}
+
+// Whether the view of a carried-over chunk turned, since it was shaded, past what its object's
+// specular tolerates (GpuShadelObject::viewDriftLimit): the angle between the directions from
+// the chunk's centre to the camera then and now. Chunks far from the camera turn slowly and are
+// carried over long; a chunk near a moving camera is reshaded as often as its lobe needs.
+bool chunkViewTurned(ShadelFrame s, ShadelObjectRef o, uint prevSlot, vec3 camera) {
+    uvec4 record = Uvec4Buffer(s.prevChunkViews).v[prevSlot];
+    if (record.x == SHADEL_CHUNK_VIEW_NONE) return false; // nothing in it is ever seen
+    vec3 centre = uintBitsToFloat(record.xyz);
+    vec3 then = shadelOctDecode(unpackSnorm2x16(record.w));
+    vec3 toCamera = camera - centre;
+    float len = length(toCamera);
+    if (len <= 0.0) return true;
+    // cos of the limit, against the cos of the turn: no acos per chunk.
+    return dot(then, toCamera / len) < cos(o.v.viewDriftLimit);
 }
 
 ivec2 storageTexel(ShadelFrame s, uint slot, uvec2 inChunk) {

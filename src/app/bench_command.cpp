@@ -532,7 +532,8 @@ nlohmann::json runBench(Gpu& gpu, const BenchOptions& b) {
     row("shadels shaded (last)", decoupledOnly("shadels_shaded", ""));
     row("reuse fraction", decoupledOnly("reuse_fraction", "%.3f"));
     // Why the chunks not carried over were shaded (fractions of the stored chunks).
-    for (const char* reason : {"new", "refresh", "not_reusable", "near_change", "rt_history"})
+    for (const char* reason :
+         {"new", "refresh", "view", "not_reusable", "near_change", "rt_history"})
         row(("  shaded: " + std::string(reason)).c_str(), [reason](const nlohmann::json& s) {
             if (!s.contains("shaded_because")) return std::string("-");
             return format("%.3f", s["shaded_because"][reason].get<double>());

@@ -49,7 +49,7 @@ struct RenderOptions {
     bool levelWindows = true;
     bool capacityControl = true;
     bool reuse = true;
-    uint32_t reuseRefreshPeriod = 8;
+    uint32_t reuseRefreshPeriod = 16;
     bool animateLights = false;
     OitMode oit = OitMode::Wboit;                                // --oit wboit|sorted
     std::optional<uint64_t> shuffleDrawsSeed;                    // --shuffle-draws SEED
@@ -163,7 +163,7 @@ struct BenchOptions {
     std::string cacheDir;
     CameraPath cameraPath = CameraPath::Static;
     bool animateLights = false;
-    uint32_t reuseRefreshPeriod = 8;
+    uint32_t reuseRefreshPeriod = 16;
     uint64_t cacheLimitBytes = 4ull << 30;
     MarkingMode marking = MarkingMode::Auto; // decoupled and reuse modes
     bool lightGrid = true;                   // --light-grid on|off

@@ -499,7 +499,7 @@ int main(int argc, char** argv) {
         ->capture_default_str();
     bench
         ->add_option("--reuse-refresh", bo.reuseRefreshPeriod,
-                     "reuse mode: reshade every carried-over chunk once per N frames")
+                     "reuse mode: reshade every carried-over chunk at least once per N frames")
         ->capture_default_str();
 
     // bake

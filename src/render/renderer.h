@@ -98,7 +98,7 @@ struct RenderSettings {
     bool levelWindows = true;    // decoupled: fine levels' rects hold only what the view wanted
     bool capacityControl = true; // decoupled: steer the shading bias from storage use
     bool reuse = true;           // decoupled: carry unchanged shadels over from last frame
-    uint32_t reuseRefreshPeriod = 8; // decoupled: reshade every carried chunk this often
+    uint32_t reuseRefreshPeriod = 16; // decoupled: reshade every carried chunk this often
     // --inspect X,Y: the output pixel whose shading is printed (shaders/debug/inspect.glsl).
     int32_t inspectX = -1, inspectY = -1;
     bool animateLights = false;   // point and spot lights move on small circles

@@ -228,6 +228,34 @@ TEST(DecoupledCore, ReuseChangesNothingVisibleOnAnOrbit) {
     }
 }
 
+// What keeps a carried-over chunk's specular from lagging is its own view: each chunk is
+// reshaded once the direction from it to the camera turned past its material's tolerance
+// (chunkViewTurned), not on a timer. With the round-robin refresh out of the way
+// (--reuse-refresh 1024), an orbit still matches the frames shaded from scratch (without the
+// view check: 36.2 dB), and a still camera reshades nothing for its view.
+TEST(DecoupledCore, ReuseReshadesChunksWhoseViewTurned) {
+    RenderOptions o = decoupled("builtin:default", 320, 180);
+    o.frames = 24;
+    o.cameraPath = CameraPath::Orbit;
+    o.reuseRefreshPeriod = 1024;
+    auto [on, off] = renderReuseOnAndOff(o);
+    double worst = worstFramePsnr(on, off);
+    const auto& because = on.stats["shaded_because"];
+    std::printf("[ figures ] default 320x180 orbit, 24 frames, --reuse-refresh 1024: reuse "
+                "fraction %.3f, shaded for the view %.3f, worst frame %.2f dB against reuse off\n",
+                on.stats["reuse_fraction"].get<double>(), because["view"].get<double>(), worst);
+    EXPECT_GE(worst, 40.0);
+    EXPECT_GT(because["view"].get<double>(), 0.01);
+    EXPECT_LT(because["refresh"].get<double>(), 0.01);
+    EXPECT_GT(on.stats["reuse_fraction"].get<double>(), 0.7);
+
+    o.cameraPath = CameraPath::Static;
+    o.frames = 6;
+    RenderRun still = renderChecked(o);
+    EXPECT_EQ(still.stats["shaded_because"]["view"].get<double>(), 0.0);
+    EXPECT_GT(still.stats["reuse_fraction"].get<double>(), 0.9);
+}
+
 // --visualize layer:material shows the material layer (base colour + roughness) in place of
 // the lit radiance layer.
 TEST(DecoupledCore, MaterialLayerIsVisibleAndDiffersFromRadiance) {

@@ -90,21 +90,27 @@ TEST(DistanceFields, ResidencyStreamsFieldsAsTheCameraMoves) {
 
 // A field that comes into the atlas or leaves it adds or takes away its DF shadow and occlusion:
 // decoupled reuse must not carry over the shading it changed (reuse_invalidation.h). Every
-// frame with reuse matches the frame shaded from scratch (carried over, frame 3 fell to 49 dB).
+// frame with reuse matches the frame shaded from scratch as closely as it does when every field
+// stays resident (reuse carries view-dependent terms within a tolerance, chunkViewTurned);
+// carried over, frame 3 fell to 49 dB.
 TEST(DistanceFields, ResidencyChangesAreNotCarriedOverByReuse) {
     RenderOptions o = withFields("builtin:arena", RenderMode::Decoupled, 0.0f, 192, 108);
     o.frames = 12;
     o.cameraPath = CameraPath::Orbit;
+    auto [residentOn, residentOff] = renderReuseOnAndOff(o); // every field resident
+    double resident = worstFramePsnr(residentOn, residentOff);
     o.dfResidency = 8.0f;
     auto [on, off] = renderReuseOnAndOff(o);
     double worst = worstFramePsnr(on, off);
     const auto& df = on.stats["distance_fields"];
     std::printf("[ figures ] arena 192x108 orbit, --df-residency 8: %llu streamed in, %llu "
-                "evicted; reuse on vs off worst frame %.2f dB, reuse fraction %.3f\n",
+                "evicted; reuse on vs off worst frame %.2f dB (every field resident: %.2f dB), "
+                "reuse fraction %.3f\n",
                 (unsigned long long)df["streamed_in"].get<uint64_t>(),
-                (unsigned long long)df["evicted"].get<uint64_t>(), worst,
+                (unsigned long long)df["evicted"].get<uint64_t>(), worst, resident,
                 on.stats["reuse_fraction"].get<double>());
     EXPECT_GT(df["evicted"].get<uint64_t>(), 0u);
-    EXPECT_GE(worst, 58.0);
+    EXPECT_GE(worst, resident - 1.0);
+    EXPECT_GE(worst, 52.0);
     EXPECT_GT(on.stats["reuse_fraction"].get<double>(), 0.2);
 }

@@ -136,11 +136,12 @@ struct DecoupledState {
     // so a chunk finds where its shadels were last frame.
     std::array<BufferHandle, 2> occupancy; // uint64 per block
     std::array<BufferHandle, 2> offsetMap; // uint per block
-    uint64_t frameNumber = 0;              // frames prepared so far
+    // uvec4 per storage slot: where its chunk was seen from when shaded (ShadelFrame::chunkViews)
+    std::array<BufferHandle, 2> chunkViews;
+    uint64_t frameNumber = 0; // frames prepared so far
     uint32_t parity() const { return uint32_t(frameNumber & 1); }
     bool reuse = true;
-    uint32_t refreshPeriod = 8;
-    glm::vec3 lastCameraPosition{0.0f}; // the previous frame's (view drift of carried shadels)
+    uint32_t refreshPeriod = 16; // --reuse-refresh
     uint32_t objectsReusable = 0;
     BufferHandle allocId;        // uint per block (upload: written by the CPU allocator)
     BufferHandle counters;       // GpuShadelCounters (readback, also indirect args)
@@ -278,6 +279,8 @@ DecoupledStatePtr createDecoupled(Renderer& r, const GpuScene& scene) {
         device("shadel.workQueue", VkDeviceSize(d.capacityChunks) * sizeof(gpu::GpuShadelWork));
     d.copyQueue = device("shadel.carryOverQueue",
                          VkDeviceSize(d.capacityChunks) * sizeof(gpu::GpuShadelWork));
+    d.chunkViews = {device("shadel.chunkViews.frame0", VkDeviceSize(d.capacityChunks) * 16),
+                    device("shadel.chunkViews.frame1", VkDeviceSize(d.capacityChunks) * 16)};
 
     d.clear = createComputePipeline(gpu, "shadelClear", "shadel_clear.comp.spv");
     d.allocate = createComputePipeline(gpu, "shadelAllocate", "shadel_allocate.comp.spv");
@@ -326,7 +329,7 @@ void destroyDecoupled(Renderer& r, DecoupledStatePtr& state) {
     for (BufferHandle b :
          {d.frameInfo, d.changedVolumes, d.objectBuffer, d.rectBuffer, d.levelWants, d.occupancy[0],
           d.occupancy[1], d.offsetMap[0], d.offsetMap[1], d.allocId, d.counters, d.markedBlocks,
-          d.queue, d.copyQueue})
+          d.queue, d.copyQueue, d.chunkViews[0], d.chunkViews[1]})
         destroy(gpu, b);
     state.reset();
 }
@@ -539,33 +542,27 @@ static uint32_t finestMipNeeded(const CameraView& camera, float viewportHeight,
     return std::min(uint32_t(lod), mesh.mipCount - 1);
 }
 
-// How many frames a carried-over chunk of this object may go unshaded. Specular and Fresnel
-// follow the view direction; seen from the object, the camera's last step turned it by about
-// step / distance radians. A specular lobe is about roughness^2 radians wide, so the view may
-// drift by about that much before the carried specular visibly lags (at most --reuse-refresh
-// frames, also when the camera stands still). Only the specular part lags, and a dielectric
-// reflects about F0 = 4% of the light specularly (metals all of it): the drift a lag of the whole
-// lobe's width costs is scaled by that share (doubled for Fresnel's rise towards grazing
-// angles), so a rough dielectric is carried over far longer than a polished metal. Roughness
-// textures only lower the factor's roughness, so glossier texels than the factor can lag
-// somewhat more.
-// Cap of the specular-share gain (below). builtin:default 320x180, 24-frame orbit, reuse on vs
-// off: gain 1 (no share) reused 55.2% of the chunks, worst frame 51.0 dB; 2: 67.3%, 46.2 dB;
-// 3: 70.8%, 45.5 dB; 4: 71.7%, 43.5 dB.
-constexpr float SPECULAR_SHARE_MAX_GAIN = 3.0f;
+// How far the view of a carried-over chunk may turn before its specular visibly lags
+// (GpuShadelObject::viewDriftLimit, checked per chunk: shadel.glsl chunkViewTurned). Specular and
+// Fresnel follow the view direction, and a specular lobe is about roughness^2 radians wide, so
+// the direction from the chunk to the camera may turn by about that much. Only the specular part
+// lags, and a dielectric reflects about F0 = 4% of the light specularly (metals all of it): the
+// turn a lag of the whole lobe's width costs is scaled by that share (doubled for Fresnel's rise
+// towards grazing angles), so a rough dielectric is carried over far longer than a polished
+// metal. Roughness textures only lower the factor's roughness, so glossier texels than the
+// factor can lag somewhat more.
+// Cap of the specular-share gain (below), with the round-robin refresh period. builtin:default
+// 320x180, 24-frame orbit, reuse on vs off (reuse fraction, worst frame): gain 1, period 16:
+// 0.736, 47.5 dB; 1, 32: 0.755, 46.6 dB; 2, 16: 0.774, 45.5 dB; 2, 32: 0.796, 43.7 dB; 3, 32:
+// 0.807, 41.3 dB. (Checked per object, at the nearest point of its box against the last step's
+// turn, gain 3 and period 8 reused 0.712 at 45.9 dB: the near end of a large object set the pace of
+// all its chunks.)
+constexpr float SPECULAR_SHARE_MAX_GAIN = 2.0f;
 
-static uint32_t refreshPeriodFor(const DecoupledState& d, const CameraView& camera, glm::vec3 bmin,
-                                 glm::vec3 bmax, float roughness, float metallic) {
+static float viewDriftLimitFor(float roughness, float metallic) {
     float lobeWidth = std::clamp(roughness * roughness, 0.01f, 0.4f);
     float specularShare = glm::mix(2.0f * 0.04f, 1.0f, std::clamp(metallic, 0.0f, 1.0f));
-    float maxViewDrift = lobeWidth * std::min(1.0f / specularShare, SPECULAR_SHARE_MAX_GAIN);
-    float step = glm::length(camera.position - d.lastCameraPosition);
-    if (d.frameNumber == 0 || step <= 0.0f) return d.refreshPeriod;
-    glm::vec3 nearest = glm::clamp(camera.position, bmin, bmax);
-    float distance = glm::length(nearest - camera.position);
-    float turnPerFrame = step / std::max(distance, 1e-3f);
-    float frames = maxViewDrift / turnPerFrame;
-    return uint32_t(std::clamp(frames, 1.0f, float(d.refreshPeriod)));
+    return lobeWidth * std::min(1.0f / specularShare, SPECULAR_SHARE_MAX_GAIN);
 }
 
 static bool boxVisible(const std::array<glm::vec4, 6>& planes, glm::vec3 bmin, glm::vec3 bmax) {
@@ -762,8 +759,8 @@ void prepareDecoupledFrame(Renderer& r, const GpuScene& scene, const CameraView&
         bool known = inst.material < scene.materialInfo.size();
         float roughness = known ? scene.materialInfo[inst.material].roughnessFactor : 1.0f;
         float metallic = known ? scene.materialInfo[inst.material].metallicFactor : 1.0f;
-        g.refreshPeriod =
-            refreshPeriodFor(d, camera, inst.worldMin, inst.worldMax, roughness, metallic);
+        g.refreshPeriod = d.refreshPeriod;
+        g.viewDriftLimit = viewDriftLimitFor(roughness, metallic);
         d.objectsReusable += g.reuseLevels != 0;
         d.firstMipHistogram[o.firstMip]++;
         g.mip0Size = mesh.mip0Size;
@@ -781,7 +778,6 @@ void prepareDecoupledFrame(Renderer& r, const GpuScene& scene, const CameraView&
             d.wholeLevelBlocks += uint64_t(whole.x) * whole.y;
         }
     }
-    d.lastCameraPosition = camera.position;
     auto* objects = static_cast<gpu::GpuShadelObject*>(mapped(gpu, d.objectBuffer));
     for (size_t v = 0; v < d.visit.size(); ++v) {
         if (v + kPrefetchAhead < d.visit.size()) // its GPU entry, written below
@@ -813,6 +809,8 @@ void prepareDecoupledFrame(Renderer& r, const GpuScene& scene, const CameraView&
     s.offsetMap = address(gpu, d.offsetMap[now]);
     s.prevOccupancy = address(gpu, d.occupancy[prev]);
     s.prevOffsetMap = address(gpu, d.offsetMap[prev]);
+    s.chunkViews = address(gpu, d.chunkViews[now]);
+    s.prevChunkViews = address(gpu, d.chunkViews[prev]);
     s.allocId = address(gpu, d.allocId);
     s.counters = address(gpu, d.counters);
     s.rects = address(gpu, d.rectBuffer);
@@ -1106,8 +1104,8 @@ void decoupledStats(const Renderer& r, nlohmann::json& s) {
     s["reuse_fraction"] = storedSum ? double(reusedSum) / double(storedSum) : 0.0;
     // Why the rest was shaded, as fractions of the same stored chunks (over the same frames):
     // what a better reuse could still win, and from where.
-    const char* const reasonNames[SHADEL_SHADED_REASONS] = {"not_reusable", "new", "refresh",
-                                                            "near_change", "rt_history"};
+    const char* const reasonNames[SHADEL_SHADED_REASONS] = {"not_reusable", "new",        "refresh",
+                                                            "near_change",  "rt_history", "view"};
     nlohmann::json because = nlohmann::json::object();
     for (uint32_t k = 0; k < SHADEL_SHADED_REASONS; ++k) {
         uint64_t sum = 0;
