@@ -510,8 +510,9 @@ struct GpuShadelObject {
     uint mipCount;
     uint flags;
     uint firstMip; // finest MIP with a rect this frame (the CPU's estimate of what it can need)
-    // Bit k: MIP k's rect and every shading input of the object (transform, material, lights in
-    // range) are unchanged since last frame, so last frame's shadels there may be carried over.
+    // Bit k: MIP k was placed before this frame (or only its window moved: prevRect*) and every
+    // shading input of the object (transform, material, lights in range) is unchanged since
+    // last frame, so last frame's shadels there may be carried over.
     uint reuseLevels;
     // Frames a carried-over chunk may go unshaded (--reuse-refresh), whatever the view does.
     uint refreshPeriod;
@@ -527,6 +528,12 @@ struct GpuShadelObject {
     // frame's marks plus a margin), placed at this origin in level blocks (x | y << 16); a
     // coarse level's window is the whole level (origin 0).
     uint window[SHADEL_MAX_MIPS];
+    // Preserved layers across a window move: where the level's rect and window were last frame
+    // (rect origin x | y << 16 and size w | h << 16 in sheet blocks, window origin in level
+    // blocks x | y << 16); this frame's when the level stayed in place (prevBlockIndex).
+    uint prevRectOrigin[SHADEL_MAX_MIPS];
+    uint prevRectSize[SHADEL_MAX_MIPS];
+    uint prevWindow[SHADEL_MAX_MIPS];
 };
 
 // 3-D debug lines (render/debug/debug_lines.h, shaders/debug/debug_lines.glsl): shaders append
@@ -554,7 +561,7 @@ struct GpuDebugLines {
 
 // sizeof(GpuShadelObject) in the scalar layout: shaders address one object in place
 // (ShadelObjectRef); static_assert'ed on the C++ side.
-#define GPU_SHADEL_OBJECT_BYTES (36u + 24u * SHADEL_MAX_MIPS)
+#define GPU_SHADEL_OBJECT_BYTES (36u + 36u * SHADEL_MAX_MIPS)
 
 // One rectangle of the sheet in use this frame (the clear and allocation passes walk these).
 struct GpuShadelRect {

@@ -38,8 +38,9 @@ void main() {
     bool levelReusable = s.reuse != 0u && ((o.v.reuseLevels >> mip) & 1u) != 0u;
     bool nearChange = (o.v.flags & SHADEL_OBJECT_NEAR_CHANGE) != 0u;
     bool copyable = levelReusable && !nearChange;
-    uint64_t prevMask = copyable ? Uint64Buffer(s.prevOccupancy).v[block] : 0ul;
-    uint prevBase = copyable ? UintBuffer(s.prevOffsetMap).v[block] : SHADEL_INVALID;
+    uint prevBlock = copyable ? prevBlockIndex(s, o, mip, block) : SHADEL_INVALID;
+    uint64_t prevMask = prevBlock != SHADEL_INVALID ? Uint64Buffer(s.prevOccupancy).v[prevBlock] : 0ul;
+    uint prevBase = prevBlock != SHADEL_INVALID ? UintBuffer(s.prevOffsetMap).v[prevBlock] : SHADEL_INVALID;
     uvec2 blockXy = uvec2(block % s.sheetBlocks, block / s.sheetBlocks);
     uint k = 0u;
     uint shadedBecause[SHADEL_SHADED_REASONS]; // summed here: one atomic per reason and block

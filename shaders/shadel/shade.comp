@@ -42,7 +42,8 @@ int carrySource(ShadelFrame s, ShadelObjectRef o, GpuShadelWork work) {
     if (s.reuse == 0u || ((o.v.reuseLevels >> work.mip) & 1u) == 0u) return -1;
     if (shadelRefreshDue(s, o, work.chunk)) return -1;
     uvec2 sheet = uvec2(work.chunk & 0xFFFFu, work.chunk >> 16) * SHADEL_CHUNK;
-    uint block = blockIndex(s, sheet);
+    uint block = prevBlockIndex(s, o, work.mip, blockIndex(s, sheet));
+    if (block == SHADEL_INVALID) return -1;
     uint bit = chunkBit(sheet);
     uint64_t prevMask = Uint64Buffer(s.prevOccupancy).v[block];
     uint prevBase = UintBuffer(s.prevOffsetMap).v[block];

@@ -174,6 +174,22 @@ uint blockIndex(ShadelFrame s, uvec2 sheetShadel) {
     return b.y * s.sheetBlocks + b.x;
 }
 
+// Preserved layers: the block of last frame's sheet that held this frame's sheet block `block`
+// of the object's level `mip`, or SHADEL_INVALID where last frame's window did not hold it. A
+// level whose window moved was placed anew (GpuShadelObject::prevRect*); windows and rects are
+// whole blocks, so a block maps to one block with the same chunk bits.
+uint prevBlockIndex(ShadelFrame s, ShadelObjectRef o, uint mip, uint block) {
+    uvec2 sheetBlock = uvec2(block % s.sheetBlocks, block / s.sheetBlocks);
+    uvec2 levelBlock = sheetBlock - o.v.rect[mip].xy + windowOrigin(o, mip) / SHADEL_BLOCK;
+    uint w = o.v.prevWindow[mip], origin = o.v.prevRectOrigin[mip], size = o.v.prevRectSize[mip];
+    uvec2 prevWindow = uvec2(w & 0xFFFFu, w >> 16);
+    uvec2 prevSize = uvec2(size & 0xFFFFu, size >> 16);
+    if (any(lessThan(levelBlock, prevWindow)) || any(greaterThanEqual(levelBlock, prevWindow + prevSize)))
+        return SHADEL_INVALID;
+    uvec2 prev = uvec2(origin & 0xFFFFu, origin >> 16) + levelBlock - prevWindow;
+    return prev.y * s.sheetBlocks + prev.x;
+}
+
 uint chunkBit(uvec2 sheetShadel) {
     uvec2 c = (sheetShadel / SHADEL_CHUNK) % (SHADEL_BLOCK / SHADEL_CHUNK);
     return c.y * 8u + c.x;

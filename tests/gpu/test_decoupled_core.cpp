@@ -256,6 +256,28 @@ TEST(DecoupledCore, ReuseReshadesChunksWhoseViewTurned) {
     EXPECT_GT(still.stats["reuse_fraction"].get<double>(), 0.9);
 }
 
+// Level windows follow the view, so on an orbit fine levels move in the sheet. A moved level's
+// shadels that the old window held are carried over from where they were (prevBlockIndex),
+// not shaded again: the chunks shaded because their level was not reusable stay few (4.4% of
+// the stored chunks at 640x360 when a move made the whole level unreusable), and the frames
+// still match the frames shaded from scratch.
+TEST(DecoupledCore, ReuseCarriesShadelsAcrossLevelWindowMoves) {
+    RenderOptions o = decoupled("builtin:default", 640, 360);
+    o.frames = 24;
+    o.cameraPath = CameraPath::Orbit;
+    auto [on, off] = renderReuseOnAndOff(o);
+    double worst = worstFramePsnr(on, off);
+    double notReusable = on.stats["shaded_because"]["not_reusable"].get<double>();
+    std::printf("[ figures ] default 640x360 orbit, 24 frames: %llu window moves, reuse fraction "
+                "%.3f, shaded as not reusable %.3f, worst frame %.2f dB against reuse off\n",
+                (unsigned long long)stat(on, "level_window_moves"),
+                on.stats["reuse_fraction"].get<double>(), notReusable, worst);
+    EXPECT_GT(stat(on, "level_window_moves"), 10u);
+    EXPECT_LT(notReusable, 0.025);
+    EXPECT_GE(worst, 40.0);
+    EXPECT_EQ(stat(on, "reconstruction_misses"), 0u);
+}
+
 // --visualize layer:material shows the material layer (base colour + roughness) in place of
 // the lit radiance layer.
 TEST(DecoupledCore, MaterialLayerIsVisibleAndDiffersFromRadiance) {

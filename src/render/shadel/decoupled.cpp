@@ -62,6 +62,12 @@ struct ObjectSlot {
     std::array<BlockId, SHADEL_MAX_MIPS> ids{};
     std::array<glm::uvec4, SHADEL_MAX_MIPS> wanted{};
     std::array<uint64_t, SHADEL_MAX_MIPS> wantedFor{};
+    // A level whose window moved this frame (movedAt: the frame number) was placed anew; where
+    // it was (rect, window origin), so last frame's shadels still in the new window are carried
+    // over (GpuShadelObject::prevRect*).
+    std::array<glm::uvec4, SHADEL_MAX_MIPS> movedFromRect{};
+    std::array<glm::uvec2, SHADEL_MAX_MIPS> movedFromWindow{};
+    std::array<uint64_t, SHADEL_MAX_MIPS> movedAt{};
 };
 constexpr size_t kSlotHotBytes = offsetof(ObjectSlot, ids);
 
@@ -415,9 +421,10 @@ static LevelWindow targetWindow(const DecoupledState& d, const ObjectSlot& o,
     return {lo, hi - lo};
 }
 
-// Hysteresis: the level keeps its window (and its place, so its shadels can be carried over)
-// while the window holds the wanted blocks with one block to spare and is at most twice the
-// target's area; a view hovering at an edge does not move the rect every frame.
+// Hysteresis: the level keeps its window (and its place; a moved window's shadels are carried
+// over where the old window held them, but the blocks it newly holds are shaded) while the window
+// holds the wanted blocks with one block to spare and is at most twice the target's area; a view
+// hovering at an edge does not move the rect every frame.
 static bool keepWindow(const DecoupledState& d, const ObjectSlot& o, const ShadelMeshInfo& mesh,
                        uint32_t k, LevelWindow target) {
     LevelWindow now = currentWindow(o, k);
@@ -467,6 +474,11 @@ static void updateLevelWindow(Gpu& gpu, DecoupledState& d, ObjectSlot& o, uint32
             o.windowRetry = true;
             return;
         }
+    }
+    if (placed && o.ids[k].valid()) { // moved: what the old window held can be carried over
+        o.movedFromRect[k] = o.rects[k];
+        o.movedFromWindow[k] = o.windowOrigin[k];
+        o.movedAt[k] = d.frameNumber;
     }
     freeLevel(gpu, d, o, k);
     d.windowMoves++;
@@ -755,7 +767,8 @@ void prepareDecoupledFrame(Renderer& r, const GpuScene& scene, const CameraView&
         bool inputsUnchanged =
             d.reuse && wasDecoupled && reach != ChangeReach::Everything && !restreamed && !reposed;
         for (uint32_t k = o.firstMip; k < mesh.mipCount && inputsUnchanged; ++k)
-            if (o.levelSince[k] < d.frameNumber) g.reuseLevels |= 1u << k;
+            if (o.levelSince[k] < d.frameNumber || o.movedAt[k] == d.frameNumber)
+                g.reuseLevels |= 1u << k;
         bool known = inst.material < scene.materialInfo.size();
         float roughness = known ? scene.materialInfo[inst.material].roughnessFactor : 1.0f;
         float metallic = known ? scene.materialInfo[inst.material].metallicFactor : 1.0f;
@@ -772,6 +785,12 @@ void prepareDecoupledFrame(Renderer& r, const GpuScene& scene, const CameraView&
             g.idMapOffset[k] = mesh.idMapOffset[k];
             g.rect[k] = o.rects[k];
             g.window[k] = o.windowOrigin[k].x | (o.windowOrigin[k].y << 16);
+            bool moved = o.movedAt[k] == d.frameNumber;
+            glm::uvec4 prevRect = moved ? o.movedFromRect[k] : o.rects[k];
+            glm::uvec2 prevWindow = moved ? o.movedFromWindow[k] : o.windowOrigin[k];
+            g.prevRectOrigin[k] = prevRect.x | (prevRect.y << 16);
+            g.prevRectSize[k] = prevRect.z | (prevRect.w << 16);
+            g.prevWindow[k] = prevWindow.x | (prevWindow.y << 16);
             d.rects.push_back({o.rects[k], i, k, d.rectBlockCount, 0});
             d.rectBlockCount += o.rects[k].z * o.rects[k].w;
             glm::uvec2 whole = levelBlocks(mesh, k);
