@@ -19,6 +19,20 @@ double passMs(const nlohmann::json& stats, const char* name) {
     return 0.0;
 }
 
+// The passes --spectra on and single differ in (bench --spectra compare): the shading the
+// permutations replace plus spectra's own classify + bin work, so that its overhead is charged.
+// Forward: the tile pass (light culling, which also classifies and bins each tile) and the tile
+// shading; decoupled: the chunk classify + bin pass and the per-spectrum shadel shading.
+const char* const kForwardSpectraPasses[] = {"lightCulling", "tileShading"};
+const char* const kDecoupledSpectraPasses[] = {"shadelChunkSpectra", "shadelShading"};
+
+template <size_t N>
+double spectraShadingMs(const nlohmann::json& stats, const char* const (&names)[N]) {
+    double ms = 0.0;
+    for (const char* name : names) ms += passMs(stats, name);
+    return ms;
+}
+
 // --particle-lighting-compare: the same forward frames with the particles lit through the
 // atlas, per pixel and per vertex. The particle lighting cost of a mode is what its particle
 // passes cost beyond the vertex-lit sprites (whose lighting is 4 evaluations per sprite):
@@ -417,9 +431,17 @@ nlohmann::json runBench(Gpu& gpu, const BenchOptions& b) {
         double single = out["modes"]["forward_spectra_single"]["frame_ms"]["median"];
         out["ratios"]["spectra_forward"] = single > 0 ? on / single : 0.0;
         out["ratios"]["spectra_forward_vs_raster"] = fwd > 0 ? on / fwd : 0.0;
+        double onPass = spectraShadingMs(out["modes"]["forward_spectra"], kForwardSpectraPasses);
+        double singlePass =
+            spectraShadingMs(out["modes"]["forward_spectra_single"], kForwardSpectraPasses);
+        out["ratios"]["spectra_forward_shading"] = singlePass > 0 ? onPass / singlePass : 0.0;
+        out["spectra_shading_ms"]["forward"] = {{"on", onPass}, {"single", singlePass}};
         std::printf("spectra (forward): on %.3f ms, single %.3f ms, raster %.3f ms; on / single "
                     "%.3f, on / raster %.3f\n",
                     on, single, fwd, single > 0 ? on / single : 0.0, fwd > 0 ? on / fwd : 0.0);
+        std::printf("spectra (forward) shading passes (lightCulling + tileShading): on %.3f ms, "
+                    "single %.3f ms; on / single %.3f\n",
+                    onPass, singlePass, singlePass > 0 ? onPass / singlePass : 0.0);
 
         // Decoupled (reuse off): chunks binned by spectra, and by one all-features permutation
         // (the same classify + bin passes), against the plain shading pass of --spectra off.
@@ -439,10 +461,19 @@ nlohmann::json runBench(Gpu& gpu, const BenchOptions& b) {
         double doff = out["modes"]["decoupled"]["frame_ms"]["median"];
         out["ratios"]["spectra_decoupled"] = dsingle > 0 ? don / dsingle : 0.0;
         out["ratios"]["spectra_decoupled_vs_off"] = doff > 0 ? don / doff : 0.0;
+        double donPass =
+            spectraShadingMs(out["modes"]["decoupled_spectra"], kDecoupledSpectraPasses);
+        double dsinglePass =
+            spectraShadingMs(out["modes"]["decoupled_spectra_single"], kDecoupledSpectraPasses);
+        out["ratios"]["spectra_decoupled_shading"] = dsinglePass > 0 ? donPass / dsinglePass : 0.0;
+        out["spectra_shading_ms"]["decoupled"] = {{"on", donPass}, {"single", dsinglePass}};
         std::printf("spectra (decoupled): on %.3f ms, single %.3f ms, off %.3f ms; on / single "
                     "%.3f, on / off %.3f\n",
                     don, dsingle, doff, dsingle > 0 ? don / dsingle : 0.0,
                     doff > 0 ? don / doff : 0.0);
+        std::printf("spectra (decoupled) shading passes (shadelChunkSpectra + shadelShading): on "
+                    "%.3f ms, single %.3f ms; on / single %.3f\n",
+                    donPass, dsinglePass, dsinglePass > 0 ? donPass / dsinglePass : 0.0);
     }
 
     if (b.compareThreads) {
