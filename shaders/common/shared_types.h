@@ -332,13 +332,22 @@ struct GpuSpotShadow {
 
 // Feature spectra (render/lighting/feature_spectra.h): the tile pass bins every tile into the
 // first mode (cheapest first) whose features cover what the tile needs.
+#define CHUNK_LIST_NONE 0xFFFFFFFFu // SpectraFrame::chunkRanges: no stored list
+
 struct SpectraFrame {
     uint64_t dispatch;     // VkDispatchIndirectCommand per mode: x = tiles binned to it
     uint64_t tileBins;     // uint tile indices: mode m's list starts at m * binCapacity
     uint64_t superfluous;  // uint per (mode, feature bit): binned tiles that did not need it
     uint64_t featureTiles; // uint per feature bit: tiles that needed it; then per feature set
+    // Shadel chunks: the light list the classify phase culled for each queued chunk, so the
+    // shading permutations read it instead of culling the chunk again (0 for screen tiles).
+    uint64_t chunkLists;     // uvec2 entries (light, blocker mask), a pool
+    uint64_t chunkRanges;    // uvec2 per shading-queue index: (first entry, count); count
+                             // CHUNK_LIST_NONE when the pool was full (the chunk is culled again)
+    uint64_t chunkListCount; // uint[2]: pool entries taken this frame, chunks culled again
     uint modeCount;
-    uint binCapacity; // tiles (each mode's list can hold every tile)
+    uint binCapacity;       // tiles (each mode's list can hold every tile)
+    uint chunkListCapacity; // entries of the chunkLists pool
     uint modeFeatures[SPECTRUM_MAX_MODES];
 };
 

@@ -298,7 +298,9 @@ void main() {
     si.uv = uv;
     si.uvDx = uvDx;
     si.uvDy = uvDy;
-    if (f.lighting != 0ul && LightingFrameRef(f.lighting).l.tiled != 0u)
+    // A spectrum's permutation reads the list its chunk's classify phase culled.
+    if (f.lighting != 0ul && LightingFrameRef(f.lighting).l.tiled != 0u &&
+        !(kChunkSpectraPhase == CHUNK_SPECTRA_SHADE && loadChunkLightList(f, workIndex)))
         cullChunkLights(f, shading, si.position);
     if (kChunkSpectraPhase == CHUNK_SPECTRA_CLASSIFY) {
         classifyChunkSpectrum(f, workIndex);

@@ -495,7 +495,8 @@ int main(int argc, char** argv) {
     bench
         ->add_option("--spectra", benchSpectra,
                      "off | compare: compare also renders forward and decoupled with --spectra "
-                     "on and single and reports on / single and on / off frame-time ratios")
+                     "on and single and reports on / single and on / off frame-time ratios, and "
+                     "on / single of the shading passes (with spectra's classify + bin)")
         ->capture_default_str();
     bench
         ->add_option("--reuse-refresh", bo.reuseRefreshPeriod,

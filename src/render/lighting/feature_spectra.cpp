@@ -25,6 +25,20 @@ namespace {
 // here. The seed's gain is GPU occupancy (fewer registers per thread); a CPU rasterizer has no
 // such limit, and a tile's features are uniform across its workgroup, so branches for features
 // it lacks are already skipped at run time.
+// Measured at the pass (bench --spectra compare --timing submit: on and single in two rounds of
+// opposite order, shading = the tile pass + tile shading, or the chunk classify + shadel
+// shading), 1280x720, 8 frames, machine shared (load 6.7-7.5 on 2 cores): forward frame
+// on / single 1.000 and 0.945, shading passes 0.987 and 0.933 (two runs of the same shaders);
+// decoupled shading 1.019 before and 0.969 after the permutations read the classify phase's
+// lists (shading sum 1581 -> 1260 ms on, 1552 -> 1300 ms single; frame on / off 1.311 -> 1.091).
+// Why the permutations do not pay here (builtin:lights 640x360, forward): the same bins shaded
+// by all-features pipelines cost the same per ms of the tile pass (tileShading 136/138 ms with
+// lightCulling 59 ms, against 165/167 ms with 75 ms); a never-taken branch of 200 sin() per
+// light added at most ~15%, so llvmpipe jumps over what a light does not use; reading the
+// tile's list from a workgroup-uniform index changed nothing; without lights the tile shading
+// costs ~25 of ~215 ms, the rest is the lights each pixel does need (BRDF, spot shadows; area
+// lights ~10%). Granularity cannot help where the work is needed: 325 of 920 tiles (640x360)
+// have per-pixel blocker pairs and with them nearly every other feature.
 // Gobos and textured area lights (a texture read per light, area lights a 4x4 integral) are
 // the costliest kinds and light only a few tiles of builtin:lights: two modes add both, to the
 // punctual lights (builtin:textured-lights: most lit tiles) and to the street's, so tiles
@@ -79,9 +93,13 @@ struct SpectraState {
     BufferHandle tileBins;     // modes x tiles (or chunks of the shading queue)
     BufferHandle superfluous;  // modes x features (readback)
     BufferHandle featureTiles; // features (readback)
+    // Chunks: the classify phase's light lists (pool, per-chunk ranges, the pool's counter).
+    BufferHandle chunkLists, chunkRanges, chunkListCount;
+    uint32_t chunkListCapacity = 0;
     uint32_t tiles = 0;
     // Last frame's counts.
     std::vector<uint32_t> binned, lastSuperfluous, lastFeatureTiles;
+    uint32_t lastChunkListEntries = 0, lastChunksCulledAgain = 0;
 };
 
 void SpectraStateDeleter::operator()(SpectraState* state) const {
@@ -132,6 +150,18 @@ SpectraStatePtr createFeatureSpectra(Renderer& r) {
         createBuffer(gpu, {"spectra.featureTiles", (SPECTRUM_FEATURE_COUNT + SPECTRUM_ALL + 1) * 4,
                            0, MemoryKind::Readback}));
     if (s->chunks) {
+        // The classify phase culls each chunk's lights; the shading permutations read its list
+        // back instead of culling again (on builtin:lights at 1280x720 that culling was a third
+        // of the classify pass). 8 entries per queue slot: 13.7 (light, chunk) pairs per shaded
+        // chunk there, and the queue holds far more chunks than a frame shades; a chunk whose
+        // list does not fit is culled again by its permutation (the same list either way).
+        s->chunkListCapacity = s->tiles * 8u;
+        s->chunkLists =
+            need(createBuffer(gpu, {"spectra.chunkLists", uint64_t(s->chunkListCapacity) * 8, 0}));
+        s->chunkRanges =
+            need(createBuffer(gpu, {"spectra.chunkRanges", uint64_t(s->tiles) * 8, 0}));
+        s->chunkListCount = need(createBuffer(
+            gpu, {"spectra.chunkListCount", 8, 0, MemoryKind::Readback})); // entries, culled again
         // Permutations of the shadel shading itself (shade.comp), with its other constants.
         std::vector<std::pair<uint32_t, uint32_t>> base;
         if (r.settings.distanceFieldLighting)
@@ -166,6 +196,8 @@ void destroyFeatureSpectra(Renderer& r, SpectraStatePtr& state) {
     if (state->chunks) {
         destroy(gpu, state->classify);
         destroy(gpu, state->setup);
+        for (BufferHandle b : {state->chunkLists, state->chunkRanges, state->chunkListCount})
+            destroy(gpu, b);
     }
     for (BufferHandle b :
          {state->frame, state->dispatch, state->tileBins, state->superfluous, state->featureTiles})
@@ -184,6 +216,12 @@ uint64_t prepareFeatureSpectra(Renderer& r, uint32_t tilesX, uint32_t tilesY) {
     f.featureTiles = address(gpu, s.featureTiles);
     f.modeCount = uint32_t(s.modes.size());
     f.binCapacity = s.chunks ? s.tiles : tilesX * tilesY;
+    if (s.chunks) {
+        f.chunkLists = address(gpu, s.chunkLists);
+        f.chunkRanges = address(gpu, s.chunkRanges);
+        f.chunkListCount = address(gpu, s.chunkListCount);
+        f.chunkListCapacity = s.chunkListCapacity;
+    }
     for (size_t m = 0; m < s.modes.size(); ++m) f.modeFeatures[m] = s.modes[m];
     std::memcpy(mapped(gpu, s.frame), &f, sizeof(f));
     return address(gpu, s.frame);
@@ -202,6 +240,7 @@ void recordSpectraReset(Renderer& r, VkCommandBuffer cmd) {
     vkCmdUpdateBuffer(cmd, vkBuffer(gpu, s.dispatch), 0, args.size() * 4, args.data());
     vkCmdFillBuffer(cmd, vkBuffer(gpu, s.superfluous), 0, VK_WHOLE_SIZE, 0);
     vkCmdFillBuffer(cmd, vkBuffer(gpu, s.featureTiles), 0, VK_WHOLE_SIZE, 0);
+    if (s.chunks) vkCmdFillBuffer(cmd, vkBuffer(gpu, s.chunkListCount), 0, VK_WHOLE_SIZE, 0);
     // Before the tile pass's atomics (vkCmdUpdateBuffer counts as a transfer: ALL_TRANSFER).
     memoryBarrier(cmd, VK_PIPELINE_STAGE_2_ALL_TRANSFER_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT,
                   VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
@@ -279,6 +318,11 @@ void readFeatureSpectraStats(Renderer& r) {
     s.lastSuperfluous.assign(sup, sup + modes * SPECTRUM_FEATURE_COUNT);
     const uint32_t* ft = static_cast<const uint32_t*>(mapped(gpu, s.featureTiles));
     s.lastFeatureTiles.assign(ft, ft + SPECTRUM_FEATURE_COUNT + SPECTRUM_ALL + 1);
+    if (s.chunks) {
+        const uint32_t* lists = static_cast<const uint32_t*>(mapped(gpu, s.chunkListCount));
+        s.lastChunkListEntries = lists[0];
+        s.lastChunksCulledAgain = lists[1];
+    }
 }
 
 void featureSpectraStats(const Renderer& r, nlohmann::json& stats) {
@@ -317,6 +361,13 @@ void featureSpectraStats(const Renderer& r, nlohmann::json& stats) {
     stats["spectra_superfluous"] = superfluous; // mode -> feature -> tiles not needing it
     stats["spectra_superfluous_total"] = superfluousTotal; // (tile, feature) pairs
     stats["tile_features"] = features;                     // feature -> tiles needing it
+    if (s.chunks) {
+        // The classify phase's lists the permutations read (entries, blocked lights included),
+        // and the chunks whose list did not fit the pool, culled again by their permutation.
+        stats["spectra_chunk_list_entries"] = s.lastChunkListEntries;
+        stats["spectra_chunk_list_capacity"] = s.chunkListCapacity;
+        stats["spectra_chunks_culled_again"] = s.lastChunksCulledAgain;
+    }
 }
 
 } // namespace shadel
