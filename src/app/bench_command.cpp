@@ -9,6 +9,7 @@
 #include "app/output_files.h"
 #include "core/error.h"
 #include "core/log.h"
+#include "scene/builtin_scenes.h"
 
 namespace shadel {
 
@@ -326,7 +327,169 @@ nlohmann::json runStreamingBench(Gpu& gpu, const BenchOptions& b, RenderOptions 
     return out;
 }
 
+// The row of a run's stats "cpu_scopes" named `name` (null when the run did not time it).
+const nlohmann::json* cpuScopeRow(const nlohmann::json& stats, const char* name) {
+    for (const auto& row : stats["cpu_scopes"])
+        if (row["name"] == name) return &row;
+    return nullptr;
+}
+
+// --instance-scaling: builtin:many at each instance count with --lod on (and --occlusion as
+// given), forward and/or decoupled, in --rounds rounds; each round renders every count once, in
+// an order rotated per round, so the machine's drift and the other processes on its cores hit
+// every count alike. A count's figure is the median of its per-round medians (min and max of
+// those are the spread); the ratio is cpu(N) / cpu(first N) within each round, then the median
+// of those. cpu_frame_ms is the CPU time of renderFrame alone (GPU waits excluded): the scene's
+// build, the bake and the upload happen before the first frame, outside it.
+nlohmann::json runInstanceScalingBench(Gpu& gpu, const BenchOptions& b, RenderOptions o) {
+    if (b.scene != "builtin:many")
+        throw InputError(format("bench --instance-scaling: --scene %s: needs builtin:many (the "
+                                "scene whose instance count --instances sets)",
+                                b.scene.c_str()));
+    if (b.scalingModes.empty())
+        throw InputError("bench --instance-scaling: expected a --mode (forward, decoupled, both)");
+    for (uint32_t n : b.instanceScaling)
+        if (n == 0 || n > kManyMaxInstances)
+            throw InputError(format("bench --instance-scaling: %u instances: expected 1..%u", n,
+                                    kManyMaxInstances));
+    const std::vector<uint32_t>& counts = b.instanceScaling;
+    nlohmann::json out;
+    out["scene"] = b.scene;
+    out["device"] = gpu.device.name;
+    out["frames"] = b.frames;
+    out["rounds"] = b.rounds;
+    out["size"] = format("%ux%u", b.width, b.height);
+    out["lod"] = "on";
+    out["occlusion"] = b.scalingOcclusion ? "on" : "off";
+    out["cpu_scopes"] = b.cpuScopes;
+    out["instance_counts"] = counts;
+    o.lod = true;
+    o.occlusion = b.scalingOcclusion;
+    o.cpuScopes = b.cpuScopes;
+    const char* coarseScope = "decoupled coarse allocation";
+    const char* submitScope = "submit (all passes)"; // timed in every run
+    struct PerRound {
+        std::vector<double> cpu, thread, prepare, gpu, submits, coarse;
+    };
+    std::map<std::pair<RenderMode, uint32_t>, PerRound> rounds;
+    uint32_t runs = b.rounds * uint32_t(b.scalingModes.size() * counts.size()), run = 0;
+    for (uint32_t round = 0; round < b.rounds; ++round) {
+        for (RenderMode mode : b.scalingModes) {
+            for (size_t k = 0; k < counts.size(); ++k) {
+                uint32_t n = counts[(k + round) % counts.size()];
+                std::fprintf(stderr,
+                             "bench: run %u/%u: round %u/%u, %s, %u instances, %u frames at "
+                             "%ux%u\n",
+                             ++run, runs, round + 1, b.rounds, modeName(mode), n, b.frames, b.width,
+                             b.height);
+                o.mode = mode;
+                o.instances = n;
+                RenderRun r = runRender(gpu, o);
+                PerRound& pr = rounds[{mode, n}];
+                pr.cpu.push_back(r.stats["cpu_frame_ms"]);
+                pr.thread.push_back(r.stats["cpu_frame_thread_ms"]);
+                pr.gpu.push_back(r.stats["frame_ms"]["median"]);
+                std::vector<double> prepare;
+                for (const FrameResult& f : r.frames) prepare.push_back(f.cpuPrepareMs);
+                pr.prepare.push_back(median(prepare));
+                const nlohmann::json* submits = cpuScopeRow(r.stats, submitScope);
+                // The submits' own CPU time: the part of them cpu_frame_ms counts (a CPU
+                // device's blocking inside a submit counts as waiting for the GPU: rhi/frame.cpp).
+                pr.submits.push_back(submits ? (*submits)["thread_cpu_ms"].get<double>() : 0.0);
+                if (const nlohmann::json* coarse = cpuScopeRow(r.stats, coarseScope))
+                    pr.coarse.push_back((*coarse)["wall_ms"]);
+                out["modes"][format("%s_%u", modeName(mode), n)] = std::move(r.stats);
+            }
+        }
+    }
+    auto minOf = [](const std::vector<double>& v) { return *std::min_element(v.begin(), v.end()); };
+    auto maxOf = [](const std::vector<double>& v) { return *std::max_element(v.begin(), v.end()); };
+    const nlohmann::json& firstStats =
+        out["modes"][format("%s_%u", modeName(b.scalingModes[0]), counts[0])];
+    std::printf("shadel bench --instance-scaling: %s at %ux%u on %s, %u frames x %u rounds, --lod "
+                "on --occlusion %s; medians of the per-round medians [min..max] (timing: %s)\n",
+                b.scene.c_str(), b.width, b.height, gpu.device.name.c_str(), b.frames, b.rounds,
+                b.scalingOcclusion ? "on" : "off", firstStats["timing"].get<std::string>().c_str());
+    std::printf("  %-9s %9s %8s %24s %22s %10s %10s %10s %10s\n", "mode", "instances", "drawn",
+                "cpu frame ms", "cpu ratio to first", "prepare", "coarse", "submits", "gpu frame");
+    for (RenderMode mode : b.scalingModes) {
+        const char* name = modeName(mode);
+        const PerRound& first = rounds[{mode, counts[0]}];
+        for (uint32_t n : counts) {
+            const PerRound& pr = rounds[{mode, n}];
+            const nlohmann::json& stats = out["modes"][format("%s_%u", name, n)];
+            std::vector<double> ratios;
+            for (size_t i = 0; i < pr.cpu.size(); ++i)
+                ratios.push_back(first.cpu[i] > 0 ? pr.cpu[i] / first.cpu[i] : 0.0);
+            nlohmann::json& row = out["instance_scaling"][name][std::to_string(n)];
+            row = {{"instances", stats["instances"]},
+                   {"instances_drawn", stats["instances_drawn"]},
+                   {"triangles_drawn", stats["triangles_drawn"]},
+                   {"cpu_frame_ms", median(pr.cpu)},
+                   {"cpu_frame_ms_min", minOf(pr.cpu)},
+                   {"cpu_frame_ms_max", maxOf(pr.cpu)},
+                   {"cpu_frame_ms_per_round", pr.cpu},
+                   {"cpu_frame_thread_ms", median(pr.thread)},
+                   {"cpu_prepare_ms", median(pr.prepare)},
+                   {"cpu_submits_ms", median(pr.submits)},
+                   {"frame_ms", median(pr.gpu)},
+                   {"frame_ms_per_round", pr.gpu},
+                   {"cpu_ratio", median(ratios)},
+                   {"cpu_ratio_min", minOf(ratios)},
+                   {"cpu_ratio_max", maxOf(ratios)},
+                   {"cpu_ratio_per_round", ratios}};
+            if (!pr.coarse.empty()) row["cpu_coarse_allocation_ms"] = median(pr.coarse);
+            if (n != counts[0])
+                out["ratios"][format("instance_scaling_cpu_%s_%u", name, n)] = median(ratios);
+            std::string coarse = pr.coarse.empty() ? "-" : format("%.3f", median(pr.coarse));
+            std::printf("  %-9s %9u %8u %8.3f [%.3f..%.3f] %8.3f [%.2f..%.2f] %10.3f %10s %10.3f "
+                        "%10.1f\n",
+                        name, n, stats["instances_drawn"].get<uint32_t>(), median(pr.cpu),
+                        minOf(pr.cpu), maxOf(pr.cpu), median(ratios), minOf(ratios), maxOf(ratios),
+                        median(pr.prepare), coarse.c_str(), median(pr.submits), median(pr.gpu));
+        }
+        for (uint32_t n : counts) {
+            if (n == counts[0]) continue;
+            std::string perRound;
+            for (const auto& r :
+                 out["instance_scaling"][name][std::to_string(n)]["cpu_ratio_per_round"])
+                perRound += format(" %.3f", r.get<double>());
+            std::printf("  %s cpu(%u) / cpu(%u) per round:%s\n", name, n, counts[0],
+                        perRound.c_str());
+        }
+    }
+    std::printf("  (ms: cpu frame = renderFrame without GPU waits; prepare = its CPU frontend; "
+                "coarse = the decoupled coarse allocation, with --cpu-scopes; submits = the "
+                "vkQueueSubmit calls' thread CPU time; gpu frame = frame time)\n");
+    if (!b.json.empty()) writeOutputFile(b.json, out.dump(2) + "\n");
+    return out;
+}
+
 } // namespace
+
+std::vector<uint32_t> parseInstanceCounts(const std::string& text) {
+    if (text.empty())
+        throw InputError(format("--instance-scaling '': expected instance counts N,N,... (each "
+                                "1..%u)",
+                                kManyMaxInstances));
+    std::vector<uint32_t> counts;
+    size_t start = 0;
+    while (start <= text.size()) {
+        size_t end = std::min(text.find(',', start), text.size());
+        std::string item = text.substr(start, end - start);
+        bool digits = !item.empty() && item.size() <= 7 &&
+                      item.find_first_not_of("0123456789") == std::string::npos;
+        uint32_t n = digits ? uint32_t(std::stoul(item)) : 0;
+        if (n == 0 || n > kManyMaxInstances)
+            throw InputError(format("--instance-scaling %s: '%s' is not an instance count 1..%u",
+                                    text.c_str(), item.c_str(), kManyMaxInstances));
+        if (std::find(counts.begin(), counts.end(), n) != counts.end())
+            throw InputError(format("--instance-scaling %s: %u appears twice", text.c_str(), n));
+        counts.push_back(n);
+        start = end + 1;
+    }
+    return counts;
+}
 
 // Renders the same scene over the same camera path forward, decoupled with reuse off and
 // decoupled with reuse on, in one process, and prints per-pass medians and frame-time ratios
@@ -360,6 +523,7 @@ nlohmann::json runBench(Gpu& gpu, const BenchOptions& b) {
     if (b.compareParticleLighting) return runParticleLightingBench(gpu, b, o);
     if (b.compareStencil) return runStencilBench(gpu, b, o);
     if (b.compareStreaming) return runStreamingBench(gpu, b, o);
+    if (!b.instanceScaling.empty()) return runInstanceScalingBench(gpu, b, o);
 
     struct Mode {
         const char* name;

@@ -81,9 +81,13 @@ struct RenderOptions {
     double shadelBudget = 64e6;        // MIP-0 shadels the bake may use for the whole scene
     bool printPasses = false;
     bool progress = true;
-    uint32_t instances = 0;  // builtin:many (--instances); 0 = the scene's default
-    bool lod = false;        // --lod: GPU LOD selection (render/culling)
-    bool occlusion = false;  // --occlusion: two-phase hierarchical-Z culling (render/culling)
+    uint32_t instances = 0; // builtin:many (--instances); 0 = the scene's default
+    bool lod = false;       // --lod: GPU LOD selection (render/culling)
+    bool occlusion = false; // --occlusion: two-phase hierarchical-Z culling (render/culling)
+    // Time the frame's CPU scopes (stats "cpu_scopes": the frontend's steps, each pass's
+    // recording) without writing a trace; --trace turns it on too. Each scope reads the thread's
+    // CPU clock, which adds to cpu_frame_ms.
+    bool cpuScopes = false;
     uint32_t debugLines = 0; // --debug-lines: DEBUG_LINES_* kinds (render/debug/debug_lines.h)
     uint32_t debugLineCapacity = 256 * 1024; // segments the line buffer holds (tests: smaller)
     RtSettings rt;                  // --rt-*, --rays-per-shadel, --blas-pool-*: render/raytracing
@@ -119,6 +123,7 @@ struct RenderRun {
 // Parses "WxH"; throws InputError naming the flag.
 void parseSize(const std::string& text, uint32_t& width, uint32_t& height);
 RenderMode parseMode(const std::string& text);
+const char* modeName(RenderMode mode); // "forward" | "decoupled"
 Visualize parseVisualize(const std::string& text);
 MarkingMode parseMarking(const std::string& text);
 // "X,Y" -> pixel; throws InputError naming --inspect.
@@ -191,11 +196,20 @@ struct BenchOptions {
     bool compareStreaming = false;
     double textureBudgetMiB = 128.0; // --texture-budget (streaming compare)
     uint32_t galleryTextureSize = 0; // --gallery-texture-size (builtin:textures; 0 = 2048)
-    uint32_t rounds = 3;             // --rounds (streaming compare)
-    uint32_t sunCascades = 1;        // --sun-cascades, every mode
-    uint32_t instances = 0; // --instances (builtin:many), every mode; 0 = the scene's default
-    std::string plot;       // --plot FILE.png: per-pass bar chart (app/bench_plot.h)
+    uint32_t rounds = 3;             // --rounds (streaming compare, instance scaling)
+    // --instance-scaling N,N,...: builtin:many at each count (--lod on), --rounds rounds
+    // interleaved; cpu_frame_ms per count and ratios cpu(N) / cpu(first N) (app/bench_command.cpp).
+    std::vector<uint32_t> instanceScaling;
+    std::vector<RenderMode> scalingModes = {RenderMode::Forward, RenderMode::Decoupled}; // --mode
+    bool scalingOcclusion = true; // --occlusion on|off (instance scaling)
+    bool cpuScopes = false;       // --cpu-scopes (instance scaling): the frontend's steps timed
+    uint32_t sunCascades = 1;     // --sun-cascades, every mode
+    uint32_t instances = 0;       // --instances (builtin:many), every mode; 0 = the scene's default
+    std::string plot;             // --plot FILE.png: per-pass bar chart (app/bench_plot.h)
 };
 nlohmann::json runBench(Gpu& gpu, const BenchOptions& options);
+// "1000,10000,1000000" -> the counts for --instance-scaling, each 1..kManyMaxInstances and none
+// twice; one-line InputError naming the flag and the input otherwise.
+std::vector<uint32_t> parseInstanceCounts(const std::string& text);
 
 } // namespace shadel

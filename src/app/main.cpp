@@ -462,8 +462,29 @@ int main(int argc, char** argv) {
                       "builtin:textures: side of each texture (power of two, default 2048)");
     bench
         ->add_option("--rounds", bo.rounds,
-                     "--streaming-compare: rounds, each running every residency once")
+                     "--streaming-compare, --instance-scaling: rounds, each running every "
+                     "residency or instance count once")
         ->capture_default_str();
+    std::string benchInstanceScaling, benchScalingMode = "both", benchScalingOcclusion = "on";
+    auto* benchInstanceScalingFlag = bench->add_option(
+        "--instance-scaling", benchInstanceScaling,
+        "N,N,...: instead of the three modes: builtin:many at each instance count (1..1000000) "
+        "with --lod on, --rounds interleaved rounds; median cpu_frame_ms per count and its ratio "
+        "to the first count's");
+    auto* benchScalingModeFlag =
+        bench
+            ->add_option("--mode", benchScalingMode,
+                         "forward | decoupled | both: the --instance-scaling render modes")
+            ->capture_default_str();
+    auto* benchScalingOcclusionFlag =
+        bench
+            ->add_option("--occlusion", benchScalingOcclusion,
+                         "on | off: --instance-scaling with hierarchical-Z occlusion culling")
+            ->capture_default_str();
+    auto* benchCpuScopesFlag =
+        bench->add_flag("--cpu-scopes", bo.cpuScopes,
+                        "--instance-scaling: time the frame's CPU scopes (the decoupled coarse "
+                        "allocation among them; the clock reads add to cpu_frame_ms)");
     std::string benchSunCascades = "1";
     bench->add_option("--sun-cascades", benchSunCascades, "1..4: the sun's cascaded maps")
         ->capture_default_str();
@@ -744,6 +765,28 @@ int main(int argc, char** argv) {
                 throw InputError("--streaming-compare: needs a --texture-budget above 0 MiB");
             if (*benchInstancesFlag && bo.instances == 0)
                 throw InputError("--instances 0: expected 1..1000000");
+            if (*benchInstanceScalingFlag) {
+                bo.instanceScaling = parseInstanceCounts(benchInstanceScaling);
+                if (*benchInstancesFlag)
+                    throw InputError("--instances: not with --instance-scaling (which sets the "
+                                     "counts)");
+                if (benchScalingMode == "both")
+                    bo.scalingModes = {RenderMode::Forward, RenderMode::Decoupled};
+                else if (benchScalingMode == "forward" || benchScalingMode == "decoupled")
+                    bo.scalingModes = {parseMode(benchScalingMode)};
+                else
+                    throw InputError(format("bench --mode %s: expected forward, decoupled or both",
+                                            benchScalingMode.c_str()));
+                bo.scalingOcclusion = parseOnOff("--occlusion", benchScalingOcclusion);
+            } else {
+                for (auto [flag, name] : {std::pair{benchScalingModeFlag, "--mode"},
+                                          std::pair{benchScalingOcclusionFlag, "--occlusion"},
+                                          std::pair{benchCpuScopesFlag, "--cpu-scopes"}})
+                    if (*flag)
+                        throw InputError(format("bench %s: only with --instance-scaling (the "
+                                                "other benches choose their own)",
+                                                name));
+            }
             bo.compareLightCulling = benchLightCulling == "compare";
             if (!bo.compareLightCulling) bo.lightCulling = parseLightCulling(benchLightCulling);
             bo.compareSpectra = benchSpectra == "compare";

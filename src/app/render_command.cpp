@@ -201,7 +201,7 @@ static nlohmann::json cpuScopeStats(const std::vector<FrameResult>& frames) {
     return out;
 }
 
-static const char* modeName(RenderMode m) {
+const char* modeName(RenderMode m) {
     return m == RenderMode::Forward ? "forward" : "decoupled";
 }
 
@@ -401,7 +401,8 @@ RenderRun runRender(Gpu& gpu, const RenderOptions& o) {
     settings.decals = o.decals;
     settings.proxyShadows = o.proxyShadows;
     settings.shadowCulling = o.shadowCulling;
-    settings.cpuScopes = !o.trace.empty(); // the trace's finer CPU spans (stats "cpu_scopes")
+    // The trace's finer CPU spans (stats "cpu_scopes").
+    settings.cpuScopes = !o.trace.empty() || o.cpuScopes;
     requireCount("--gi-iterations", o.giIterations, 0, 64);
     if (o.visualize == Visualize::Gi && o.gi == GiMode::Off)
         throw InputError("--visualize gi: shows the indirect light of --gi lpv; GI is off");

@@ -301,3 +301,77 @@ TEST(World, DecoupledAllocatesForTheGpuVisibleSet) {
     EXPECT_EQ(culled.stats["reconstruction_misses"].get<uint64_t>(), 0u);
     EXPECT_GE(p, 35.0);
 }
+
+// bench --instance-scaling at test scale: two counts, two rounds, both modes. Each count's
+// figure is the median of its per-round medians and each ratio is taken within a round, so the
+// reported ratios must follow from the per-round figures; the counts must reach the scene.
+TEST(World, BenchInstanceScalingReportsPerRoundMediansAndRatios) {
+    BenchOptions b;
+    b.scene = "builtin:many";
+    b.width = 128, b.height = 72;
+    b.frames = 2;
+    b.rounds = 2;
+    b.shadelsPerMetre = 4.0f; // unsplit: the GPU's instances are the scene's
+    b.instanceScaling = {300, 40};
+    b.cpuScopes = true;
+    b.json = tempPath("instance_scaling.json");
+    nlohmann::json out = runBench(sharedGpu(), b);
+    EXPECT_EQ(takeJsonFile(b.json), out);
+    EXPECT_EQ(out["lod"], "on");
+    EXPECT_EQ(out["occlusion"], "on");
+    for (const char* mode : {"forward", "decoupled"}) {
+        const nlohmann::json& first = out["instance_scaling"][mode]["300"];
+        for (uint32_t n : b.instanceScaling) {
+            SCOPED_TRACE(std::string(mode) + " " + std::to_string(n));
+            const nlohmann::json& row = out["instance_scaling"][mode][std::to_string(n)];
+            ASSERT_TRUE(row.is_object()) << out["instance_scaling"].dump();
+            EXPECT_EQ(row["instances"].get<uint32_t>(), n);
+            EXPECT_GT(row["instances_drawn"].get<uint32_t>(), 0u);
+            EXPECT_LE(row["instances_drawn"].get<uint32_t>(), n);
+            const nlohmann::json& stats = out["modes"][std::string(mode) + "_" + std::to_string(n)];
+            EXPECT_EQ(stats["culling"]["lod"], "on");
+            EXPECT_EQ(stats["culling"]["occlusion"], "on");
+            auto cpu = row["cpu_frame_ms_per_round"].get<std::vector<double>>();
+            auto firstCpu = first["cpu_frame_ms_per_round"].get<std::vector<double>>();
+            auto ratios = row["cpu_ratio_per_round"].get<std::vector<double>>();
+            ASSERT_EQ(cpu.size(), b.rounds);
+            ASSERT_EQ(ratios.size(), b.rounds);
+            for (uint32_t i = 0; i < b.rounds; ++i) {
+                EXPECT_GT(cpu[i], 0.0);
+                EXPECT_DOUBLE_EQ(ratios[i], cpu[i] / firstCpu[i]);
+            }
+            EXPECT_DOUBLE_EQ(row["cpu_frame_ms"].get<double>(), median(cpu));
+            EXPECT_DOUBLE_EQ(row["cpu_frame_ms_min"].get<double>(), std::min(cpu[0], cpu[1]));
+            EXPECT_DOUBLE_EQ(row["cpu_frame_ms_max"].get<double>(), std::max(cpu[0], cpu[1]));
+            EXPECT_DOUBLE_EQ(row["cpu_ratio"].get<double>(), median(ratios));
+            EXPECT_GT(row["frame_ms"].get<double>(), 0.0);
+            // The coarse allocation is the decoupled path's frontend step.
+            EXPECT_EQ(row.contains("cpu_coarse_allocation_ms"), std::string(mode) == "decoupled");
+        }
+        EXPECT_DOUBLE_EQ(first["cpu_ratio"].get<double>(), 1.0);
+        EXPECT_DOUBLE_EQ(
+            out["ratios"][std::string("instance_scaling_cpu_") + mode + "_40"].get<double>(),
+            out["instance_scaling"][mode]["40"]["cpu_ratio"].get<double>());
+    }
+}
+
+TEST(World, BadInstanceScalingIsOneLineNamingTheInputAndExitCode2) {
+    const std::pair<const char*, const char*> cases[] = {
+        {"--scene builtin:many --instance-scaling ''", "--instance-scaling ''"},
+        {"--scene builtin:many --instance-scaling 1000,0", "'0'"},
+        {"--scene builtin:many --instance-scaling 10,1000001", "'1000001'"},
+        {"--scene builtin:many --instance-scaling 10,ten", "'ten'"},
+        {"--scene builtin:many --instance-scaling 10,10", "10 appears twice"},
+        {"--scene builtin:default --instance-scaling 10,20", "builtin:default"},
+        {"--scene builtin:many --instance-scaling 10 --mode sideways", "--mode sideways"},
+        {"--scene builtin:many --instance-scaling 10 --occlusion 1", "--occlusion 1"},
+        {"--scene builtin:many --instance-scaling 10 --instances 5", "--instances"},
+        {"--scene builtin:many --mode forward", "--mode"}};
+    for (const auto& [args, named] : cases) {
+        std::string cmd = std::string("bench --size 16x16 --frames 1 ") + args, err;
+        EXPECT_EQ(runShadel(cmd, err), 2) << cmd << ": " << err;
+        EXPECT_EQ(err.rfind("shadel: ", 0), 0u) << cmd << ": " << err;
+        EXPECT_EQ(std::count(err.begin(), err.end(), '\n'), 1) << cmd << ": " << err;
+        EXPECT_NE(err.find(named), std::string::npos) << cmd << ": " << err;
+    }
+}

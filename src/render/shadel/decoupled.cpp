@@ -118,6 +118,11 @@ struct DecoupledState {
     std::vector<InstanceEntry> instances;          // per instance
     std::vector<ObjectSlot> slots;                 // the pool (InstanceEntry::slot)
     std::vector<gpu::GpuShadelObject> slotObjects; // per slot: its instance's GpuShadelObject
+    // Per slot: what its instance's entry in objectBuffer holds (valid unless newThisFrame), so
+    // an unchanged entry (most of them while the camera stands still) is not written again: the
+    // entries are scattered over the whole world's buffer (272 MB at 1M instances), and each
+    // write costs cache and TLB misses.
+    std::vector<gpu::GpuShadelObject> slotObjectsUploaded;
     std::vector<uint32_t> freeSlots;
     // The coarse allocation visits only instances near the view (render/culling/instance_grid.h)
     // and those it touched last frame, so its cost follows the view, not the world's size.
@@ -603,6 +608,7 @@ static uint32_t takeSlot(DecoupledState& d) {
         s = uint32_t(d.slots.size());
         d.slots.emplace_back();
         d.slotObjects.emplace_back();
+        d.slotObjectsUploaded.emplace_back();
     } else {
         s = d.freeSlots.back();
         d.freeSlots.pop_back();
@@ -798,9 +804,25 @@ void prepareDecoupledFrame(Renderer& r, const GpuScene& scene, const CameraView&
         }
     }
     auto* objects = static_cast<gpu::GpuShadelObject*>(mapped(gpu, d.objectBuffer));
+    // Whether the slot's instance entry must be written: a new slot's entry is zero, another's
+    // holds what was uploaded last.
+    auto entryChanged = [&d](uint32_t s) {
+        return d.slots[s].newThisFrame || std::memcmp(&d.slotObjectsUploaded[s], &d.slotObjects[s],
+                                                      sizeof(gpu::GpuShadelObject)) != 0;
+    };
     for (size_t v = 0; v < d.visit.size(); ++v) {
-        if (v + kPrefetchAhead < d.visit.size()) // its GPU entry, written below
-            prefetchLines(&objects[d.visit[v + kPrefetchAhead]], sizeof(gpu::GpuShadelObject), 1);
+        // Two stages ahead: the slot's uploaded copy, then (compared by then) the GPU entry of
+        // an instance that writes it. An instance without a slot writes nothing.
+        if (v + 2 * kPrefetchAhead < d.visit.size()) {
+            uint32_t s = d.instances[d.visit[v + 2 * kPrefetchAhead]].slot;
+            if (s != kNoSlot)
+                prefetchLines(&d.slotObjectsUploaded[s], sizeof(gpu::GpuShadelObject), 0);
+        }
+        if (v + kPrefetchAhead < d.visit.size()) {
+            uint32_t j = d.visit[v + kPrefetchAhead], s = d.instances[j].slot;
+            if (s != kNoSlot && entryChanged(s))
+                prefetchLines(&objects[j], sizeof(gpu::GpuShadelObject), 1);
+        }
         uint32_t i = d.visit[v];
         InstanceEntry& entry = d.instances[i];
         if (entry.visitedFrame != frameMark) continue;
@@ -809,7 +831,12 @@ void prepareDecoupledFrame(Renderer& r, const GpuScene& scene, const CameraView&
         ObjectSlot& o = d.slots[entry.slot];
         const gpu::GpuShadelObject& g = d.slotObjects[entry.slot];
         bool touched = g.flags != 0 || o.allocated;
-        if (touched || !o.newThisFrame) objects[i] = g; // else its entry is zero already
+        if (touched || !o.newThisFrame) { // else its entry is zero already
+            if (entryChanged(entry.slot)) {
+                objects[i] = g;
+                d.slotObjectsUploaded[entry.slot] = g;
+            }
+        }
         o.newThisFrame = false;
         if (touched) {
             d.touched.push_back(i);
