@@ -219,6 +219,17 @@ nlohmann::json runStencilBench(Gpu& gpu, const BenchOptions& b, RenderOptions o)
     return out;
 }
 
+// What every bench run in interleaved rounds reports first.
+static nlohmann::json roundsBenchHeader(const Gpu& gpu, const BenchOptions& b) {
+    nlohmann::json out;
+    out["scene"] = b.scene;
+    out["device"] = gpu.device.name;
+    out["frames"] = b.frames;
+    out["rounds"] = b.rounds;
+    out["size"] = format("%ux%u", b.width, b.height);
+    return out;
+}
+
 // --streaming-compare: the same frames (forward and decoupled, reuse as --reuse-refresh says)
 // with every texture resident, and streamed at --texture-budget through the layered cache and
 // through sparse residency (when the device has it). The figure is the render thread's CPU time
@@ -227,12 +238,7 @@ nlohmann::json runStencilBench(Gpu& gpu, const BenchOptions& b, RenderOptions o)
 // run in rounds, each round every residency once in a rotated order, so the machine's drift
 // over the bench hits them alike; the median is over the frames of every round.
 nlohmann::json runStreamingBench(Gpu& gpu, const BenchOptions& b, RenderOptions o) {
-    nlohmann::json out;
-    out["scene"] = b.scene;
-    out["device"] = gpu.device.name;
-    out["frames"] = b.frames;
-    out["rounds"] = b.rounds;
-    out["size"] = format("%ux%u", b.width, b.height);
+    nlohmann::json out = roundsBenchHeader(gpu, b);
     out["texture_budget_mib"] = b.textureBudgetMiB;
     o.galleryTextureSize = b.galleryTextureSize;
     struct Residency {
@@ -353,12 +359,7 @@ nlohmann::json runInstanceScalingBench(Gpu& gpu, const BenchOptions& b, RenderOp
             throw InputError(format("bench --instance-scaling: %u instances: expected 1..%u", n,
                                     kManyMaxInstances));
     const std::vector<uint32_t>& counts = b.instanceScaling;
-    nlohmann::json out;
-    out["scene"] = b.scene;
-    out["device"] = gpu.device.name;
-    out["frames"] = b.frames;
-    out["rounds"] = b.rounds;
-    out["size"] = format("%ux%u", b.width, b.height);
+    nlohmann::json out = roundsBenchHeader(gpu, b);
     out["lod"] = "on";
     out["occlusion"] = b.scalingOcclusion ? "on" : "off";
     out["cpu_scopes"] = b.cpuScopes;
