@@ -4,9 +4,10 @@
 // to one of two queues: carried over from last frame's storage (preserved layers: the object's
 // level is unchanged, last frame stored the chunk, it is not the chunk's turn to be refreshed,
 // and the view did not turn past what its specular tolerates) or shaded. Chunks of objects a
-// changed region meets (a light or a caster that changed) are queued for shading, which checks their shadels against the regions and may
-// still carry them over (shade.comp). With ray-traced terms, a chunk is also reshaded when the
-// RT cache under it doubled its rays (raytracing/rt_history.glsl).
+// changed region meets (a light or a caster that changed) are queued for shading, which checks
+// their shadels against the regions and may still carry them over (shade.comp). With ray-traced
+// terms, a chunk is also reshaded when the RT cache under it doubled its rays
+// (raytracing/rt_history.glsl).
 #include "shadel/shadel.glsl"
 #include "raytracing/rt_history.glsl"
 

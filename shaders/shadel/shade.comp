@@ -36,9 +36,10 @@ uint triangleId(ShadelFrame s, uint offset) {
 // Preserved layers (seed: "GetIndexPrevSampleVirtualCoords ... if it was computed last frame
 // it's there"). Where last frame stored this chunk, returns its storage slot then; -1 when the
 // chunk must be shaded: reuse off, the object's level changed (reuseLevels, decided on the
-// CPU), or this chunk's turn to be refreshed (each chunk is reshaded once per refresh period,
-// at its own phase, so view-dependent terms never lag for long). Uniform over the workgroup.
-int carrySource(ShadelFrame s, ShadelObjectRef o, GpuShadelWork work) {
+// CPU), this chunk's turn to be refreshed (each chunk is reshaded once per refresh period, at
+// its own phase), or its view turned past what its specular tolerates (chunkViewTurned).
+// Uniform over the workgroup.
+int carrySource(ShadelFrame s, ShadelObjectRef o, GpuShadelWork work, vec3 camera) {
     if (s.reuse == 0u || ((o.v.reuseLevels >> work.mip) & 1u) == 0u) return -1;
     if (shadelRefreshDue(s, o, work.chunk)) return -1;
     uvec2 sheet = uvec2(work.chunk & 0xFFFFu, work.chunk >> 16) * SHADEL_CHUNK;
@@ -48,7 +49,8 @@ int carrySource(ShadelFrame s, ShadelObjectRef o, GpuShadelWork work) {
     uint64_t prevMask = Uint64Buffer(s.prevOccupancy).v[block];
     uint prevBase = UintBuffer(s.prevOffsetMap).v[block];
     if ((prevMask & (1ul << bit)) == 0ul || prevBase == SHADEL_INVALID) return -1;
-    return int(chunkSlot(prevMask, prevBase, bit));
+    uint slot = chunkSlot(prevMask, prevBase, bit);
+    return chunkViewTurned(s, o, slot, camera) ? -1 : int(slot);
 }
 
 void carryOver(ShadelFrame s, uint fromSlot, uint toSlot, ivec2 outTexel) {
@@ -254,7 +256,7 @@ void main() {
     // (With spectra the classify phase decided: a binned chunk is shaded.)
     int carrySlot = kChunkSpectraPhase != CHUNK_SPECTRA_SHADE &&
                             (o.v.flags & SHADEL_OBJECT_NEAR_CHANGE) != 0u
-                        ? carrySource(s, o, work)
+                        ? carrySource(s, o, work, f.cameraPosition)
                         : -1;
     if (carrySlot >= 0 && chunkTouchesChange(f, s, o, work)) carrySlot = -1;
     if (carrySlot >= 0) {
