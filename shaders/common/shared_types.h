@@ -595,7 +595,7 @@ struct GpuShadelWork {
 #define SHADEL_SHADED_NEW 1u         // last frame did not store the chunk
 #define SHADEL_SHADED_REFRESH 2u     // stored, but its turn to be refreshed
 #define SHADEL_SHADED_NEAR_CHANGE 3u // a changed region meets the object: shading decides
-#define SHADEL_SHADED_RT_HISTORY 4u  // the ray-traced terms under it doubled their rays
+#define SHADEL_SHADED_RT_HISTORY 4u  // the RT cache under it gained sqrt 2 x rays
 #define SHADEL_SHADED_VIEW 5u        // the view turned past what its specular tolerates
 #define SHADEL_SHADED_REASONS 6
 

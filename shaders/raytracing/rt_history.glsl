@@ -1,10 +1,11 @@
 // Decoupled reuse with ray-traced terms: a chunk carried over keeps the RT terms (AO, GI, soft
 // shadows) it was shaded with, while the RT cache under it (rt_shadels.comp) keeps adding rays,
 // so a carried image would trail the cache by up to the refresh period. Instead a carried chunk
-// is reshaded each time the cache's ray count under it passes a doubling: at 1, 2, 4, 8, ... rays,
-// times a per-chunk factor in [1, 2) so the reshades of a still view spread over frames instead
-// of all landing on the same frame. What a carried chunk shows then holds at least half the rays
-// the cache holds, and the reshades cost O(log rays) per chunk, not one per frame.
+// is reshaded each time the cache's ray count under it passes a step: at 1, 1.41, 2, 2.83, 4, ...
+// rays (powers of RT_HISTORY_STEP = sqrt 2), times a per-chunk factor in [1, RT_HISTORY_STEP) so
+// the reshades of a still view spread over frames instead of all landing on the same frame. What
+// a carried chunk shows then holds at least 71% of the rays the cache holds, and the reshades
+// cost O(log rays) per chunk, not one per frame.
 #ifndef SHADEL_RT_HISTORY_GLSL
 #define SHADEL_RT_HISTORY_GLSL
 #include "raytracing/rt_frame.glsl"
@@ -13,8 +14,12 @@
 // camera, AO, 16 frames, PSNR per frame against a 256-ray render): reuse off 34.6 / 39.7 / 46.4
 // dB at frames 1 / 3 / 15; carrying RT terms over until the refresh 27.8 / 28.9 / 45.0 (reuse
 // 0.874); steps of 2: 34.5 / 37.6 / 45.6 (reuse 0.650); steps of sqrt 2: 34.5 / 38.0 / 45.5
-// (reuse 0.488).
-const float RT_HISTORY_STEP = 2.0;
+// (reuse 0.488). Those were with --reuse-refresh 8, whose round robin also reshaded every chunk
+// within 8 frames. Since the refresh is 16 (chunks now follow their own view), the round robin
+// no longer hides the steps' lag: the still-camera AO at 96x54 after 16 frames
+// (RayTracing.ShadelAoConvergesToTheHighRayReference) gave 34.17 dB with steps of 2 and 35.75 dB
+// with steps of sqrt 2 (a carried chunk then shows at least 71% of the cache's rays).
+const float RT_HISTORY_STEP = 1.41421356;
 
 // Whether the cache texel at `shadelUv` of `object` crossed one of the chunk's thresholds with
 // this frame's rays (rt_shadels.comp ran before; a texel traced this frame holds `rays` more).

@@ -6,7 +6,7 @@
 // and the view did not turn past what its specular tolerates) or shaded. Chunks of objects a
 // changed region meets (a light or a caster that changed) are queued for shading, which checks
 // their shadels against the regions and may still carry them over (shade.comp). With ray-traced
-// terms, a chunk is also reshaded when the RT cache under it doubled its rays
+// terms, a chunk is also reshaded when the RT cache under it gained a factor of sqrt 2 in rays
 // (raytracing/rt_history.glsl).
 #include "shadel/shadel.glsl"
 #include "raytracing/rt_history.glsl"
