@@ -523,13 +523,12 @@ struct GpuShadelObject {
     // shading input of the object (transform, material, lights in range) is unchanged since
     // last frame, so last frame's shadels there may be carried over.
     uint reuseLevels;
-    // Frames a carried-over chunk may go unshaded (--reuse-refresh), whatever the view does.
-    uint refreshPeriod;
-    // Radians the direction from a carried-over chunk to the camera may turn since the chunk was
-    // shaded before its view-dependent terms (specular, Fresnel) visibly lag: its material's
-    // specular lobe width, widened by how little of its light is specular (a rough dielectric
-    // tolerates far more than a polished metal). Checked per chunk (ShadelFrame::chunkViews).
-    float viewDriftLimit;
+    // Cosine of the angle the direction from a carried-over chunk to the camera may turn since
+    // the chunk was shaded before its view-dependent terms (specular, Fresnel) visibly lag: its
+    // material's specular lobe width, widened by how little of its light is specular (a rough
+    // dielectric tolerates far more than a polished metal). Checked per chunk
+    // (ShadelFrame::chunkViews).
+    float viewDriftCos;
     uint firstRect; // index of its firstMip rect in ShadelFrame::rects (levels follow in order)
     uint idMapOffset[SHADEL_MAX_MIPS]; // in 16-bit units into ShadelFrame::idMaps
     uvec4 rect[SHADEL_MAX_MIPS];       // x, y, w, h in blocks of the virtual sheet
@@ -570,7 +569,7 @@ struct GpuDebugLines {
 
 // sizeof(GpuShadelObject) in the scalar layout: shaders address one object in place
 // (ShadelObjectRef); static_assert'ed on the C++ side.
-#define GPU_SHADEL_OBJECT_BYTES (36u + 36u * SHADEL_MAX_MIPS)
+#define GPU_SHADEL_OBJECT_BYTES (32u + 36u * SHADEL_MAX_MIPS)
 
 // One rectangle of the sheet in use this frame (the clear and allocation passes walk these).
 struct GpuShadelRect {
@@ -661,8 +660,9 @@ struct ShadelFrame {
     // to place next frame's windows.
     uint64_t levelWants;
     uint changedVolumeCount;
-    uint frameNumber; // frames rendered by this renderer (refresh phase)
-    uint reuse;       // 0: reshade everything (--reuse off)
+    uint frameNumber;   // frames rendered by this renderer (refresh phase)
+    uint reuse;         // 0: reshade everything (--reuse off)
+    uint refreshPeriod; // frames a carried-over chunk may go unshaded (--reuse-refresh)
     uint storageChunksPerRow;
     uint capacityChunks;
     uint markedCapacity;     // entries of markedBlocks (= capacityChunks: a block needs >= 1 chunk)

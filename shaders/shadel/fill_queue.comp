@@ -57,7 +57,7 @@ void main() {
         ++k;
         bool stored = (prevMask & (1ul << bit)) != 0ul && prevBase != SHADEL_INVALID;
         uint prevSlot = stored ? chunkSlot(prevMask, prevBase, bit) : SHADEL_INVALID;
-        bool refresh = stored && shadelRefreshDue(s, o, w.chunk);
+        bool refresh = stored && shadelRefreshDue(s, w.chunk);
         bool viewTurned = stored && !refresh && chunkViewTurned(s, o, prevSlot, f.cameraPosition);
         bool rtHistory = false;
         if (stored && !refresh && !viewTurned && f.rt != 0ul) {

@@ -41,7 +41,7 @@ uint triangleId(ShadelFrame s, uint offset) {
 // Uniform over the workgroup.
 int carrySource(ShadelFrame s, ShadelObjectRef o, GpuShadelWork work, vec3 camera) {
     if (s.reuse == 0u || ((o.v.reuseLevels >> work.mip) & 1u) == 0u) return -1;
-    if (shadelRefreshDue(s, o, work.chunk)) return -1;
+    if (shadelRefreshDue(s, work.chunk)) return -1;
     uvec2 sheet = uvec2(work.chunk & 0xFFFFu, work.chunk >> 16) * SHADEL_CHUNK;
     uint block = prevBlockIndex(s, o, work.mip, blockIndex(s, sheet));
     if (block == SHADEL_INVALID) return -1;

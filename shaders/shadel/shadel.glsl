@@ -204,8 +204,8 @@ uint chunkSlot(uint64_t mask, uint base, uint bit) {
 // Preserved layers: a carried-over chunk is still reshaded once per refresh period
 // (--reuse-refresh), each chunk at its own phase, so nothing goes stale for long (view-dependent
 // terms are reshaded sooner when the view turns: chunkViewTurned).
-bool shadelRefreshDue(ShadelFrame s, ShadelObjectRef o, uint chunk) {
-    return (((chunk * 2654435761u) >> 20) + s.frameNumber) % max(o.v.refreshPeriod, 1u) == 0u;
+bool shadelRefreshDue(ShadelFrame s, uint chunk) {
+    return (((chunk * 2654435761u) >> 20) + s.frameNumber) % max(s.refreshPeriod, 1u) == 0u;
 }
 
 // Octahedral mapping of a unit vector to [-1, 1]^2 and back (chunk view directions).
@@ -233,7 +233,7 @@ uvec4 chunkViewRecord(bool shaded, vec3 lo, vec3 hi, vec3 camera) {
 }
 
 // Whether the view of a carried-over chunk turned, since it was shaded, past what its object's
-// specular tolerates (GpuShadelObject::viewDriftLimit): the angle between the directions from
+// specular tolerates (GpuShadelObject::viewDriftCos): the angle between the directions from
 // the chunk's centre to the camera then and now. Chunks far from the camera turn slowly and are
 // carried over long; a chunk near a moving camera is reshaded as often as its lobe needs.
 bool chunkViewTurned(ShadelFrame s, ShadelObjectRef o, uint prevSlot, vec3 camera) {
@@ -244,8 +244,7 @@ bool chunkViewTurned(ShadelFrame s, ShadelObjectRef o, uint prevSlot, vec3 camer
     vec3 toCamera = camera - centre;
     float len = length(toCamera);
     if (len <= 0.0) return true;
-    // cos of the limit, against the cos of the turn: no acos per chunk.
-    return dot(then, toCamera / len) < cos(o.v.viewDriftLimit);
+    return dot(then, toCamera / len) < o.v.viewDriftCos; // cosines: no acos per chunk
 }
 
 ivec2 storageTexel(ShadelFrame s, uint slot, uvec2 inChunk) {

@@ -560,13 +560,13 @@ static uint32_t finestMipNeeded(const CameraView& camera, float viewportHeight,
 }
 
 // How far the view of a carried-over chunk may turn before its specular visibly lags
-// (GpuShadelObject::viewDriftLimit, checked per chunk: shadel.glsl chunkViewTurned). Specular and
-// Fresnel follow the view direction, and a specular lobe is about roughness^2 radians wide, so
-// the direction from the chunk to the camera may turn by about that much. Only the specular part
-// lags, and a dielectric reflects about F0 = 4% of the light specularly (metals all of it): the
-// turn a lag of the whole lobe's width costs is scaled by that share (doubled for Fresnel's rise
-// towards grazing angles), so a rough dielectric is carried over far longer than a polished
-// metal. Roughness textures only lower the factor's roughness, so glossier texels than the
+// (GpuShadelObject::viewDriftCos holds its cosine, checked per chunk: shadel.glsl chunkViewTurned).
+// Specular and Fresnel follow the view direction, and a specular lobe is about roughness^2 radians
+// wide, so the direction from the chunk to the camera may turn by about that much. Only the
+// specular part lags, and a dielectric reflects about F0 = 4% of the light specularly (metals all
+// of it): the turn a lag of the whole lobe's width costs is scaled by that share (doubled for
+// Fresnel's rise towards grazing angles), so a rough dielectric is carried over far longer than a
+// polished metal. Roughness textures only lower the factor's roughness, so glossier texels than the
 // factor can lag somewhat more.
 // Cap of the specular-share gain (below), with the round-robin refresh period. builtin:default
 // 320x180, 24-frame orbit, reuse on vs off (reuse fraction, worst frame): gain 1, period 16:
@@ -778,8 +778,7 @@ void prepareDecoupledFrame(Renderer& r, const GpuScene& scene, const CameraView&
         bool known = inst.material < scene.materialInfo.size();
         float roughness = known ? scene.materialInfo[inst.material].roughnessFactor : 1.0f;
         float metallic = known ? scene.materialInfo[inst.material].metallicFactor : 1.0f;
-        g.refreshPeriod = d.refreshPeriod;
-        g.viewDriftLimit = viewDriftLimitFor(roughness, metallic);
+        g.viewDriftCos = std::cos(viewDriftLimitFor(roughness, metallic));
         d.objectsReusable += g.reuseLevels != 0;
         d.firstMipHistogram[o.firstMip]++;
         g.mip0Size = mesh.mip0Size;
@@ -879,6 +878,7 @@ void prepareDecoupledFrame(Renderer& r, const GpuScene& scene, const CameraView&
     s.changedVolumeCount = d.changesOverflow ? 0u : uint32_t(d.changes.size());
     s.frameNumber = uint32_t(d.frameNumber);
     s.reuse = d.reuse ? 1u : 0u;
+    s.refreshPeriod = d.refreshPeriod;
     s.storageChunksPerRow = d.storageSize / SHADEL_CHUNK;
     s.capacityChunks = d.capacityChunks;
     s.markedCapacity = d.capacityChunks;
