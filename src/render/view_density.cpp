@@ -33,52 +33,88 @@ double meshArea(const Mesh& mesh) {
     return a;
 }
 
-// Splits the meshes that are large for the distances they are seen from; instances of a split
-// mesh become one instance per chunk (same transform, same order).
+// Whether a mesh part (its object-space box) is small enough for the distance one instance sees
+// it from: kept whole unless it is larger than its nearest distance and would be big on the sheet.
+// Monotone: a sub-box of a box that passes passes too (smaller, and no nearer).
+bool wholeForInstance(const Aabb& box, const Instance& inst, const RunViews& views,
+                      const ViewDensityOptions& o) {
+    Aabb world = transformAabb(box, inst.transform);
+    float d = nearestVisibleDistance(views, world);
+    if (d == kNotVisible) return true;
+    float e = maxExtent(world);
+    return !(e > o.chunkPerDistance * d &&
+             e * o.safety * views.focalPixels / d > o.minChunkShadels);
+}
+
+// Splits the meshes that are large for the distances they are seen from. Only the instances
+// that need it are split (one instance per chunk, same transform, in place of the original);
+// the other instances of the mesh keep it whole. A city of a million buildings sharing three
+// meshes, of which a few stand next to the camera, gets a few hundred chunk instances, not
+// the million times the chunk count. Since the test is monotone, deciding the chunks over the
+// instances that need splitting gives the chunks a decision over all instances would give.
 Scene chunkScene(const Scene& scene, const RunViews& views, const ViewDensityOptions& o,
                  uint32_t& meshesSplit, uint32_t& chunksMade) {
     Scene out = scene;
     out.meshes.clear();
     out.instances.clear();
-    std::vector<std::vector<uint32_t>> instancesOf(scene.meshes.size());
-    for (uint32_t i = 0; i < scene.instances.size(); ++i)
-        if (scene.instances[i].mesh < scene.meshes.size())
-            instancesOf[scene.instances[i].mesh].push_back(i);
-    std::vector<std::vector<uint32_t>> newMeshes(scene.meshes.size());
-    const float f = views.focalPixels;
+    // Per mesh, the instances for which the whole mesh is too large (they take the chunks).
+    std::vector<std::vector<uint32_t>> splitFor(scene.meshes.size());
+    std::vector<uint32_t> instanceCount(scene.meshes.size(), 0);
+    std::vector<uint8_t> takesChunks(scene.instances.size(), 0);
+    for (uint32_t i = 0; i < scene.instances.size(); ++i) {
+        const Instance& inst = scene.instances[i];
+        if (inst.mesh >= scene.meshes.size()) continue;
+        ++instanceCount[inst.mesh];
+        const Mesh& mesh = scene.meshes[inst.mesh];
+        float extent = mesh.bounds.valid() ? maxExtent(mesh.bounds) : 0.0f;
+        if (!(extent > 0) || !std::isfinite(extent)) continue;
+        if (!wholeForInstance(mesh.bounds, inst, views, o)) {
+            splitFor[inst.mesh].push_back(i);
+            takesChunks[i] = 1;
+        }
+    }
+    std::vector<std::vector<uint32_t>> chunkMeshes(scene.meshes.size());
+    std::vector<uint32_t> wholeMesh(scene.meshes.size(), ~0u);
     for (size_t m = 0; m < scene.meshes.size(); ++m) {
         const Mesh& mesh = scene.meshes[m];
-        float extent = mesh.bounds.valid() ? maxExtent(mesh.bounds) : 0.0f;
-        std::vector<Mesh> parts;
-        if (!instancesOf[m].empty() && extent > 0 && std::isfinite(extent)) {
-            float cell = pow2Ceil(extent / float(std::max(o.maxCellsPerAxis, 1u)));
-            auto wholeNode = [&](const Aabb& box) {
-                for (uint32_t i : instancesOf[m]) {
-                    Aabb world = transformAabb(box, scene.instances[i].transform);
-                    float d = nearestVisibleDistance(views, world);
-                    if (d == kNotVisible) continue;
-                    float e = maxExtent(world);
-                    if (e > o.chunkPerDistance * d && e * o.safety * f / d > o.minChunkShadels)
-                        return false;
-                }
-                return true;
-            };
-            parts = splitMeshOnGrid(mesh, cell, wholeNode);
-        } else {
-            parts.push_back(mesh);
+        // The whole mesh stays for the instances that do not take chunks (and for none at all:
+        // meshes keep their place in the list whether or not an instance uses them).
+        bool keepsWhole = splitFor[m].empty() || splitFor[m].size() < instanceCount[m];
+        if (keepsWhole) {
+            wholeMesh[m] = uint32_t(out.meshes.size());
+            out.meshes.push_back(mesh);
+        }
+        if (splitFor[m].empty()) continue;
+        float cell = pow2Ceil(maxExtent(mesh.bounds) / float(std::max(o.maxCellsPerAxis, 1u)));
+        auto wholeNode = [&](const Aabb& box) {
+            for (uint32_t i : splitFor[m])
+                if (!wholeForInstance(box, scene.instances[i], views, o)) return false;
+            return true;
+        };
+        std::vector<Mesh> parts = splitMeshOnGrid(mesh, cell, wholeNode);
+        if (parts.size() == 1 && keepsWhole) { // a single cell: the whole mesh it is
+            chunkMeshes[m].push_back(wholeMesh[m]);
+            continue;
         }
         if (parts.size() > 1) ++meshesSplit, chunksMade += uint32_t(parts.size());
         for (Mesh& part : parts) {
-            newMeshes[m].push_back(uint32_t(out.meshes.size()));
+            chunkMeshes[m].push_back(uint32_t(out.meshes.size()));
             out.meshes.push_back(std::move(part));
         }
     }
-    for (const Instance& inst : scene.instances) {
+    for (uint32_t i = 0; i < scene.instances.size(); ++i) {
+        const Instance& inst = scene.instances[i];
         if (inst.mesh >= scene.meshes.size()) {
             out.instances.push_back(inst);
             continue;
         }
-        const std::vector<uint32_t>& parts = newMeshes[inst.mesh];
+        if (!takesChunks[i]) {
+            Instance whole = inst;
+            whole.mesh = wholeMesh[inst.mesh];
+            out.instances.push_back(std::move(whole));
+            continue;
+        }
+        const std::vector<uint32_t>& parts = chunkMeshes[inst.mesh];
         for (size_t k = 0; k < parts.size(); ++k) {
             Instance chunk = inst;
             chunk.mesh = parts[k];

@@ -1,7 +1,9 @@
 #include "rhi/gpu.h"
+#include <algorithm>
 
 #include "rhi/shader_reload.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 
@@ -78,16 +80,24 @@ void uploadBuffer(Gpu& gpu, BufferHandle dst, const void* data, VkDeviceSize byt
         std::memcpy(static_cast<uint8_t*>(ptr) + dstOffset, data, bytes);
         return;
     }
-    BufferHandle staging = createBuffer(gpu, {"staging.upload", bytes, 0, MemoryKind::Upload});
+    // Through a staging buffer of at most kUploadChunk bytes, one copy per chunk: a scene's
+    // largest array never needs as much host-visible memory again, and no single copy region
+    // grows past what drivers handle well (lavapipe's copy took a 3.9 GB size as negative).
+    constexpr VkDeviceSize kUploadChunk = VkDeviceSize(64) << 20;
+    VkDeviceSize chunk = std::min(bytes, kUploadChunk);
+    BufferHandle staging = createBuffer(gpu, {"staging.upload", chunk, 0, MemoryKind::Upload});
     if (!staging) throw DeviceError("out of host-visible memory for an upload staging buffer");
-    std::memcpy(mapped(gpu, staging), data, bytes);
-    immediateSubmit(gpu, [&](VkCommandBuffer cmd) {
-        VkBufferCopy copy{0, dstOffset, bytes};
-        vkCmdCopyBuffer(cmd, vkBuffer(gpu, staging), vkBuffer(gpu, dst), 1, &copy);
-        memoryBarrier(cmd, VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT,
-                      VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT,
-                      VK_ACCESS_2_MEMORY_READ_BIT | VK_ACCESS_2_MEMORY_WRITE_BIT);
-    });
+    for (VkDeviceSize done = 0; done < bytes; done += chunk) {
+        VkDeviceSize n = std::min(chunk, bytes - done);
+        std::memcpy(mapped(gpu, staging), static_cast<const uint8_t*>(data) + done, n);
+        immediateSubmit(gpu, [&](VkCommandBuffer cmd) {
+            VkBufferCopy copy{0, dstOffset + done, n};
+            vkCmdCopyBuffer(cmd, vkBuffer(gpu, staging), vkBuffer(gpu, dst), 1, &copy);
+            memoryBarrier(cmd, VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT,
+                          VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT,
+                          VK_ACCESS_2_MEMORY_READ_BIT | VK_ACCESS_2_MEMORY_WRITE_BIT);
+        });
+    }
     destroy(gpu, staging);
 }
 

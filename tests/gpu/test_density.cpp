@@ -163,3 +163,38 @@ TEST(Density, NearbyCamerasChooseTheSameChunksAndDensities) {
     for (float d : da.meshDensity) // powers of 2^(1/4)
         EXPECT_NEAR(std::log2(d) * 4.0f, std::round(std::log2(d) * 4.0f), 1e-3f) << d;
 }
+
+// Only the instances seen close enough take a mesh's chunks; the rest of the instances sharing
+// the mesh keep it whole. builtin:many's buildings share three meshes: splitting all of them for
+// the few next to the street multiplied a million instances by the chunk count (24M instances,
+// a 3.9 GB instance buffer).
+TEST(Density, OnlyInstancesSeenCloseTakeTheChunks) {
+    BuiltinSceneOptions options;
+    options.instances = 20000;
+    Scene scene = loadScene("builtin:many", {}, options);
+    Camera start = findCamera(scene, "");
+    RunViews views = runViews(start, CameraPath::Orbit, 24, scene.worldBounds(), 320, 180);
+    ViewDensity d = viewDrivenDensity(scene, views, ViewDensityOptions{});
+    ASSERT_GT(d.meshesSplit, 0u); // the ground and the buildings by the street are split
+    size_t added = d.scene.instances.size() - scene.instances.size();
+    EXPECT_LT(added, 2000u) << "chunks of instances nobody sees close";
+    // Every instance is still drawn: the whole mesh or all of its chunks, same transform.
+    size_t whole = 0;
+    for (const Instance& inst : d.scene.instances)
+        whole += d.scene.meshes[inst.mesh].name.find(" chunk ") == std::string::npos;
+    EXPECT_GT(whole, scene.instances.size() * 9 / 10);
+    // The chunks of a split instance cover the same triangles as the mesh it replaces.
+    auto area = [](const Mesh& m) {
+        double a = 0;
+        for (size_t i = 0; i + 2 < m.indices.size(); i += 3)
+            a += 0.5 *
+                 glm::length(glm::cross(
+                     m.vertices[m.indices[i + 1]].position - m.vertices[m.indices[i]].position,
+                     m.vertices[m.indices[i + 2]].position - m.vertices[m.indices[i]].position));
+        return a;
+    };
+    double original = 0, drawn = 0;
+    for (const Instance& inst : scene.instances) original += area(scene.meshes[inst.mesh]);
+    for (const Instance& inst : d.scene.instances) drawn += area(d.scene.meshes[inst.mesh]);
+    EXPECT_NEAR(drawn, original, 1e-4 * original);
+}
