@@ -87,6 +87,10 @@ using uint = uint32_t;
 #define SPECTRUM_MODE_CONSTANT_ID 141 // the mode (bin) a tile / chunk shading permutation runs
 // Shadel shading's phase: off, classify or shade (chunk_spectra.glsl).
 #define CHUNK_SPECTRA_PHASE_CONSTANT_ID 143
+// Whether the scene has alpha-masked materials (the visibility prepass's alpha test): without
+// them the test and its discard are compiled out, so the depth test runs before the fragment
+// shader (early Z) instead of after it for every covered fragment.
+#define ALPHA_MASK_CONSTANT_ID 144
 // Specialization constant of shaders/common/lighting.glsl: 1 compiles the distance-field far
 // shadows and AO in (render/distance_fields; forward and shadel shading with --distance-fields).
 #define DISTANCE_FIELD_LIGHTING_CONSTANT_ID 142

@@ -1,5 +1,6 @@
 #version 460
-// Depth prepass / shadow pass: only alpha-masked materials need a fragment shader's work.
+// Depth prepass / shadow pass: only alpha-masked materials need a fragment shader's work. A
+// scene without them draws these passes depth-only (no fragment shader: early Z).
 #include "common/material.glsl"
 
 layout(push_constant, scalar) uniform Push {

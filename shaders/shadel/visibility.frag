@@ -14,15 +14,19 @@ layout(location = 4) flat in uint inInstance;
 
 layout(location = 0) out uvec2 outVisibility;
 
+layout(constant_id = ALPHA_MASK_CONSTANT_ID) const bool kAlphaMasked = true;
+
 void main() {
-    FrameConstants f = FrameConstantsRef(pc.frame).f;
-    GpuInstance inst = InstanceBuffer(f.instances).i[inInstance];
-    GpuMaterial m = MaterialBuffer(f.materials).m[inst.material];
-    if ((m.flags & MATERIAL_ALPHA_MASK) != 0u) {
-        float alpha = m.baseColorFactor.a;
-        if (m.baseColorTexture != NO_TEXTURE)
-            alpha *= sampleTexture(m.baseColorTexture, SAMPLER_LINEAR_REPEAT, inUv, dFdx(inUv), dFdy(inUv)).a;
-        if (alpha < m.alphaCutoff) discard;
+    if (kAlphaMasked) { // compiled out for scenes without alpha-masked materials: early Z
+        FrameConstants f = FrameConstantsRef(pc.frame).f;
+        GpuInstance inst = InstanceBuffer(f.instances).i[inInstance];
+        GpuMaterial m = MaterialBuffer(f.materials).m[inst.material];
+        if ((m.flags & MATERIAL_ALPHA_MASK) != 0u) {
+            float alpha = m.baseColorFactor.a;
+            if (m.baseColorTexture != NO_TEXTURE)
+                alpha *= sampleTexture(m.baseColorTexture, SAMPLER_LINEAR_REPEAT, inUv, dFdx(inUv), dFdy(inUv)).a;
+            if (alpha < m.alphaCutoff) discard;
+        }
     }
     outVisibility = uvec2(inInstance, uint(gl_PrimitiveID));
 }

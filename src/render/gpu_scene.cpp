@@ -362,4 +362,10 @@ void destroyScene(Gpu& gpu, GpuScene& s) {
     s = GpuScene{};
 }
 
+bool hasAlphaMaskedMaterials(const GpuScene& scene) {
+    for (const gpu::GpuMaterial& m : scene.materialInfo)
+        if (m.flags & MATERIAL_ALPHA_MASK) return true;
+    return false;
+}
+
 } // namespace shadel

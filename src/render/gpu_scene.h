@@ -75,4 +75,7 @@ gpu::GpuLight gpuLight(const Light& light, std::vector<uint32_t>& blockerLists,
                        uint32_t textureSlot = NO_TEXTURE);
 void destroyScene(Gpu& gpu, GpuScene& scene);
 
+// Whether any material is alpha-masked (glTF alphaMode MASK).
+bool hasAlphaMaskedMaterials(const GpuScene& scene);
+
 } // namespace shadel

@@ -61,8 +61,9 @@ static void createTargets(Renderer& r) {
     r.depthRead = createReadView(gpu, r.depth);
 
     // The sun's whole-scene map: a one-map shadow atlas (render/lighting/shadow_atlas.h).
-    r.sunShadow = createShadowAtlas(gpu, "sunShadow", r.settings.shadowMapSize,
-                                    r.settings.shadowMapSize, "forward_forward.vert.spv");
+    r.sunShadow =
+        createShadowAtlas(gpu, "sunShadow", r.settings.shadowMapSize, r.settings.shadowMapSize,
+                          "forward_forward.vert.spv", r.alphaMasked);
 }
 
 // --capture names of the targets every frame has (render/debug/capture.h).
@@ -94,6 +95,7 @@ void initRenderer(Renderer& r, Gpu& gpu, const RenderSettings& requested, const 
     const RenderSettings settings = resolveMarking(requested);
     r.gpu = &gpu;
     r.settings = settings;
+    r.alphaMasked = hasAlphaMaskedMaterials(scene);
     if (settings.width == 0 || settings.height == 0 || settings.ssaa == 0)
         throw InputError("--size and --ssaa must be positive");
     if (settings.spectra != Spectra::Off && settings.lightCulling != LightCulling::Tiled)

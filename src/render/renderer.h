@@ -232,6 +232,10 @@ struct Renderer {
     BufferHandle sceneIndices; // the unified index buffer of the scene being drawn
     glm::vec3 skyColor{0.5f};
     Pipeline instanceCull, depthPrepass, forwardOpaque, tonemap;
+    // The scene has alpha-masked materials: the depth-only passes (prepass, shadow maps) and the
+    // visibility prepass run their alpha test. Without them they are depth-only / have the test
+    // compiled out, so the depth test runs before any fragment shading (early Z).
+    bool alphaMasked = true;
     ShaderMessageChannel messages;
     FrameRecorder recorder;
     DecoupledStatePtr decoupled;

@@ -30,7 +30,7 @@ void createForwardPipelines(Renderer& r) {
     GraphicsPipelineDesc depth;
     depth.name = "depthPrepass";
     depth.vertexShader = "forward_forward.vert.spv";
-    depth.fragmentShader = "forward_depth.frag.spv";
+    depth.fragmentShader = r.alphaMasked ? "forward_depth.frag.spv" : ""; // (Renderer::alphaMasked)
     depth.depthFormat = VK_FORMAT_D32_SFLOAT;
     depth.cullMode = VK_CULL_MODE_NONE; // double-sided materials; backfaces cost little here
     r.depthPrepass = createGraphicsPipeline(gpu, depth);

@@ -10,7 +10,7 @@
 namespace shadel {
 
 ShadowAtlas createShadowAtlas(Gpu& gpu, const char* name, uint32_t width, uint32_t height,
-                              const char* vertexShader) {
+                              const char* vertexShader, bool alphaMasked) {
     ShadowAtlas a;
     a.width = width;
     a.height = height;
@@ -28,7 +28,7 @@ ShadowAtlas createShadowAtlas(Gpu& gpu, const char* name, uint32_t width, uint32
     GraphicsPipelineDesc pass;
     pass.name = name;
     pass.vertexShader = vertexShader;
-    pass.fragmentShader = "forward_depth.frag.spv";
+    pass.fragmentShader = alphaMasked ? "forward_depth.frag.spv" : "";
     pass.depthFormat = VK_FORMAT_D32_SFLOAT;
     pass.depthCompare = VK_COMPARE_OP_LESS_OR_EQUAL;
     pass.cullMode = VK_CULL_MODE_NONE;

@@ -21,8 +21,10 @@ struct ShadowAtlas {
 };
 
 // `name` names the texture ("<name>Atlas") and the pipeline; throws DeviceError when out of memory.
+// `alphaMasked`: the scene has alpha-masked materials, whose casters the fragment shader tests;
+// without them the pass is depth-only.
 ShadowAtlas createShadowAtlas(Gpu& gpu, const char* name, uint32_t width, uint32_t height,
-                              const char* vertexShader);
+                              const char* vertexShader, bool alphaMasked);
 void destroyShadowAtlas(Gpu& gpu, ShadowAtlas& atlas);
 
 // Clears the atlas and binds its pipeline, depth bias and the scene's index buffer; the viewport

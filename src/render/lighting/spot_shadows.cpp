@@ -79,7 +79,7 @@ SpotShadowStatePtr createSpotShadows(Renderer& r, const GpuScene& scene) {
         gpu, {"spotShadows", lightOf.size() * sizeof(gpu::GpuSpotShadow), 0, MemoryKind::Upload});
     if (!s->shadows) throw DeviceError("out of GPU memory for the spot shadow atlas");
     s->atlas = createShadowAtlas(gpu, "spotShadow", kAtlasSize, kAtlasSize,
-                                 "lighting_spot_shadow.vert.spv");
+                                 "lighting_spot_shadow.vert.spv", r.alphaMasked);
     return s;
 }
 

@@ -53,7 +53,7 @@ SunCascadeStatePtr createSunCascades(Renderer& r, const GpuScene& scene) {
     if (!s->cascades) throw DeviceError("out of GPU memory for the sun's cascades");
     s->atlas = createShadowAtlas(gpu, "sunCascade", s->mapSize * s->columns,
                                  s->mapSize * ((s->count + s->columns - 1) / s->columns),
-                                 "lighting_sun_cascade.vert.spv");
+                                 "lighting_sun_cascade.vert.spv", r.alphaMasked);
     return s;
 }
 

@@ -79,6 +79,7 @@ VisibilityStatePtr createVisibility(Renderer& r) {
     prepass.name = "visibilityPrepass";
     prepass.vertexShader = "forward_forward.vert.spv";
     prepass.fragmentShader = "shadel_visibility.frag.spv";
+    prepass.specialization = {{ALPHA_MASK_CONSTANT_ID, r.alphaMasked ? 1u : 0u}};
     prepass.colorFormats = {VK_FORMAT_R32G32_UINT};
     prepass.depthFormat = VK_FORMAT_D32_SFLOAT;
     prepass.cullMode = VK_CULL_MODE_NONE; // as the depth prepass
