@@ -65,6 +65,38 @@ uvec2 lightGridSource(LightGridQuery q, uint source) {
     return LightGridBuckets(q.g.buckets).b[q.level * LIGHT_GRID_BUCKETS + LIGHT_GRID_HASH(at.x, at.y, at.z)];
 }
 
+// The query's candidates as one range: each source's (first entry, count) and their total, so
+// a workgroup takes its candidates `threads` at a time however they spread over the sources
+// (a loop per source left most invocations idle on the small buckets: on builtin:lights at
+// 1280x720, ~100 candidates a chunk over up to 10 sources). At most 2 + 2x2x2 sources: the
+// level's cells are at least the box's size.
+#define LIGHT_GRID_MAX_SOURCES 10u
+struct LightGridCandidates {
+    uvec2 lists[LIGHT_GRID_MAX_SOURCES];
+    uint sources;
+    uint total;
+};
+
+LightGridCandidates lightGridCandidates(LightGridQuery q) {
+    LightGridCandidates c;
+    c.sources = min(lightGridSources(q), LIGHT_GRID_MAX_SOURCES);
+    c.total = 0u;
+    for (uint s = 0u; s < LIGHT_GRID_MAX_SOURCES; ++s) {
+        c.lists[s] = s < c.sources ? lightGridSource(q, s) : uvec2(0u);
+        c.total += c.lists[s].y;
+    }
+    return c;
+}
+
+// Where candidate k (< c.total) sits in the grid's entries.
+uint lightGridCandidateEntry(LightGridCandidates c, uint k) {
+    for (uint s = 0u; s < LIGHT_GRID_MAX_SOURCES; ++s) {
+        if (k < c.lists[s].y) return c.lists[s].x + k;
+        k -= c.lists[s].y;
+    }
+    return 0u; // not reached for k < c.total
+}
+
 void lightGridMaskClear(uint lightCount, uint threads) {
     for (uint w = gl_LocalInvocationIndex; w < (lightCount + 31u) / 32u; w += threads) sGridMask[w] = 0u;
     if (gl_LocalInvocationIndex == 0u) sGridCandidates = 0u;
@@ -98,13 +130,11 @@ bool gridChunkLights(FrameConstants f, uint64_t gridAddress, vec3 boxMin, vec3 b
     LightBuffer lights = LightBuffer(f.lights);
     UintBuffer entries = UintBuffer(q.g.entries);
     uint tested = 0u;
-    for (uint source = 0u; source < lightGridSources(q); ++source) {
-        uvec2 list = lightGridSource(q, source);
-        for (uint i = gl_LocalInvocationIndex; i < list.y; i += threads) {
-            uint index = entries.v[list.x + i];
-            if (chunkKeepsLight(lights.l[index], boxMin, boxMax, corners)) atomicOr(sGridMask[index >> 5], 1u << (index & 31u));
-            tested++;
-        }
+    LightGridCandidates candidates = lightGridCandidates(q);
+    for (uint k = gl_LocalInvocationIndex; k < candidates.total; k += threads) {
+        uint index = entries.v[lightGridCandidateEntry(candidates, k)];
+        if (chunkKeepsLight(lights.l[index], boxMin, boxMax, corners)) atomicOr(sGridMask[index >> 5], 1u << (index & 31u));
+        tested++;
     }
     if (tested != 0u) atomicAdd(sGridCandidates, tested);
     barrier();

@@ -133,14 +133,12 @@ void main() {
     if (lightGridQuery(f, lf.lightGrid, boxMin, boxMax, grid)) {
         lightGridMaskClear(f.lightCount, THREADS);
         UintBuffer entries = UintBuffer(grid.g.entries);
-        for (uint source = 0u; source < lightGridSources(grid); ++source) {
-            uvec2 list = lightGridSource(grid, source);
-            for (uint i = tid; i < list.y; i += THREADS) {
-                uint index = entries.v[list.x + i];
-                if (tileKeepsLight(lights.l[index], planes, boxMin, boxMax, corners, centre, radius) &&
-                    inFrustumLights(frustumLights, lf.frustumLightCount, index))
-                    atomicOr(sGridMask[index >> 5], 1u << (index & 31u));
-            }
+        LightGridCandidates candidates = lightGridCandidates(grid);
+        for (uint k = tid; k < candidates.total; k += THREADS) {
+            uint index = entries.v[lightGridCandidateEntry(candidates, k)];
+            if (tileKeepsLight(lights.l[index], planes, boxMin, boxMax, corners, centre, radius) &&
+                inFrustumLights(frustumLights, lf.frustumLightCount, index))
+                atomicOr(sGridMask[index >> 5], 1u << (index & 31u));
         }
         barrier();
         lightGridMaskCompact(f.lightCount, THREADS);
