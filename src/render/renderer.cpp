@@ -299,6 +299,7 @@ FrameResult renderFrame(Renderer& r, const GpuScene& scene, const CameraView& ca
     Clock::time_point cpuStart = Clock::now();
     double startMs = std::chrono::duration<double, std::milli>(cpuStart - r.createdAt).count();
     r.cpuScopes.clear();
+    r.frontendTaken.clear();
     r.frameCpuStart = cpuStart;
     r.recorder.timeRecording = r.settings.cpuScopes;
     r.sceneIndices = scene.indices;
