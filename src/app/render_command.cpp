@@ -509,11 +509,12 @@ RenderRun runRender(Gpu& gpu, const RenderOptions& o) {
             }
             // Frontend/backend overlap: with recording threads, the next frame's scene update
             // (its pose imported from the file) runs on a worker while this frame renders, and
-            // so does the decoupled coarse allocation's grid visit (render/shadel/coarse_visit.h;
-            // not with playback, whose next bounds are written only before that frame).
+            // the decoupled coarse allocation's grid visit while it records, submits and waits
+            // (render/shadel/coarse_visit.h; not with playback, which writes the next frame's
+            // bounds only before it).
             if (renderer.settings.recordingThreads > 1 && i + 1 < o.frames) {
                 if (playback) prefetchPose(*playback, i + 1);
-                prefetchCoarseVisit(renderer, gpuScene, viewOfFrame(i + 1), playback.has_value());
+                renderer.nextFrame = Renderer::NextFrame{viewOfFrame(i + 1), playback.has_value()};
             }
             run.frames.push_back(renderFrame(renderer, gpuScene, view));
             if (i > 0) // what this frame took from the worker ran beside the last one

@@ -368,6 +368,11 @@ FrameResult renderFrame(Renderer& r, const GpuScene& scene, const CameraView& ca
     std::memcpy(mapped(gpu, r.frameConstants), &constants, sizeof(constants));
     uint64_t frame = address(gpu, r.frameConstants);
     double prepareMs = msSince(cpuStart);
+    if (r.nextFrame) { // the next frame's frontend beside this frame's backend
+        if (r.decoupled)
+            prefetchCoarseVisit(r, scene, r.nextFrame->camera, r.nextFrame->sceneMoves);
+        r.nextFrame.reset();
+    }
 
     FrameRecorder& rec = r.recorder;
     auto declaring = cpuScope(r, "declare passes");

@@ -2,6 +2,7 @@
 // The renderer: owns render targets, pipelines and per-frame buffers, and renders one frame
 // as a list of passes (renderFrame in renderer.cpp reads top to bottom).
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -284,6 +285,16 @@ struct Renderer {
     // This frame's frontend work that ran ahead on the frontend worker (the decoupled coarse
     // visit): the caller files it under the frame it ran beside (FrameResult::frontendWorker).
     std::vector<FrontendWorkerTask> frontendTaken;
+    // Frontend/backend overlap (issue 16): set by a caller that renders a known sequence with
+    // recording threads, for one renderFrame. Once this frame's frontend is done, the next
+    // frame's decoupled grid visit (render/shadel/coarse_visit.h) runs on the frontend worker
+    // while this frame records, submits and waits. `sceneMoves`: animated playback writes the
+    // next frame's bounds only before it, so its visit is not prefetched (counted).
+    struct NextFrame {
+        CameraView camera;
+        bool sceneMoves = false;
+    };
+    std::optional<NextFrame> nextFrame;
 };
 
 // Times the enclosing block as the CPU scope `name` of this frame (nothing unless

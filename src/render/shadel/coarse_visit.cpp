@@ -89,6 +89,7 @@ CoarseInstanceView viewInstance(const CoarseVisitPolicy& policy, const GpuScene&
                 projectedDiameter(
                     camera, policy.viewportHeight, 0.5f * (inst.worldMin + inst.worldMax),
                     0.5f * glm::length(inst.worldMax - inst.worldMin)) < policy.forwardBelowPixels;
+    if (out.small) return out; // drawn forward: no MIP needed (most of a wide world's instances)
     out.lodBeforeBias = policy.sheetAllMips
                             ? kNeedsMip0
                             : footprintLod(camera, policy.viewportHeight, inst, mesh,

@@ -36,7 +36,7 @@ struct CoarseInstanceView {
     bool small = false;
     // log2 of the footprint lower bound finestMipNeeded compares, before the frame's shading
     // bias (which the capacity controller sets from the last frame's readback): -inf when MIP 0
-    // is needed whatever the bias.
+    // is needed whatever the bias. Computed only when inFrustum and not small.
     float lodBeforeBias = 0.0f;
 };
 

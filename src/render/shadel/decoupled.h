@@ -21,11 +21,11 @@ void destroyDecoupled(Renderer& r, DecoupledStatePtr& state);
 // sheet, shading bias; fills the decoupled fields of the frame constants.
 void prepareDecoupledFrame(Renderer& r, const GpuScene& scene, const CameraView& camera,
                            gpu::FrameConstants& constants);
-// Frontend/backend overlap (issue 16): starts the grid visit (coarse_visit.h) of the frame after
-// the one about to be rendered on the frontend worker, for `nextCamera`; that frame's
-// prepareDecoupledFrame takes it. Call before renderFrame. Nothing with --occlusion on (the
-// visit is last frame's visible set, a readback) or when `sceneMoves` (animated playback: the
-// next frame's bounds are written only before it; counted).
+// Frontend/backend overlap (issue 16): starts the grid visit (coarse_visit.h) of the next frame
+// on the frontend worker, for `nextCamera`; that frame's prepareDecoupledFrame takes it. Called
+// by renderFrame after this frame's frontend (Renderer::nextFrame). Nothing with --occlusion on
+// (the visit is last frame's visible set, a readback) or when `sceneMoves` (animated playback:
+// the next frame's bounds are written only before it; counted).
 void prefetchCoarseVisit(Renderer& r, const GpuScene& scene, const CameraView& nextCamera,
                          bool sceneMoves);
 // Marking and allocation: after them the occupancy masks say which chunks the frame reads.
