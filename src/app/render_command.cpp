@@ -482,12 +482,15 @@ RenderRun runRender(Gpu& gpu, const RenderOptions& o) {
         }
         requireCapturesExist(renderer.captures, o.captures); // before minutes of rendering
         bool tty = isatty(STDERR_FILENO);
-        for (uint32_t i = 0; i < o.frames; ++i) {
+        auto viewOfFrame = [&](uint32_t i) {
             glm::vec2 jitter = o.jitter ? subpixelJitter(i) : glm::vec2(0.0f);
             const Camera& start = cutCamera && i >= o.cutFrame ? *cutCamera : camera;
             Camera onPath = cameraOnPath(start, o.cameraPath, i, o.frames, bounds);
-            CameraView view =
-                makeCameraView(onPath, o.width * o.ssaa, o.height * o.ssaa, jitter * float(o.ssaa));
+            return makeCameraView(onPath, o.width * o.ssaa, o.height * o.ssaa,
+                                  jitter * float(o.ssaa));
+        };
+        for (uint32_t i = 0; i < o.frames; ++i) {
+            CameraView view = viewOfFrame(i);
             if (playback && i > 0) {
                 poseFrame(gpu, *playback, i, gpuScene, renderer.reposedInstances,
                           renderer.skinning != nullptr, &renderer.reposedFrom);
@@ -498,19 +501,25 @@ RenderRun runRender(Gpu& gpu, const RenderOptions& o) {
                     auto ms = [](auto d) {
                         return std::chrono::duration<double, std::milli>(d).count();
                     };
-                    last.frontendWorker = true;
-                    last.frontendWorkerStartMs =
-                        ms(playback->lastImport.start - renderer.createdAt);
-                    last.frontendWorkerMs =
-                        ms(playback->lastImport.end - playback->lastImport.start);
-                    last.frontendWorkerCpuMs = playback->lastImport.cpuMs;
+                    last.frontendWorker.push_back(
+                        {"scene update", ms(playback->lastImport.start - renderer.createdAt),
+                         ms(playback->lastImport.end - playback->lastImport.start),
+                         playback->lastImport.cpuMs});
                 }
             }
             // Frontend/backend overlap: with recording threads, the next frame's scene update
-            // (its pose imported from the file) runs on a worker while this frame renders.
-            if (playback && renderer.settings.recordingThreads > 1 && i + 1 < o.frames)
-                prefetchPose(*playback, i + 1);
+            // (its pose imported from the file) runs on a worker while this frame renders, and
+            // the decoupled coarse allocation's grid visit while it records, submits and waits
+            // (render/shadel/coarse_visit.h; not with playback, which writes the next frame's
+            // bounds only before it).
+            if (renderer.settings.recordingThreads > 1 && i + 1 < o.frames) {
+                if (playback) prefetchPose(*playback, i + 1);
+                renderer.nextFrame = Renderer::NextFrame{viewOfFrame(i + 1), playback.has_value()};
+            }
             run.frames.push_back(renderFrame(renderer, gpuScene, view));
+            if (i > 0) // what this frame took from the worker ran beside the last one
+                for (FrontendWorkerTask& t : renderer.frontendTaken)
+                    run.frames[i - 1].frontendWorker.push_back(t);
             if (o.progress && o.frames > 1 && tty)
                 std::fprintf(stderr, "\rrender: frame %u/%u (%.1f ms)", i + 1, o.frames,
                              run.frames.back().frameMs);

@@ -16,8 +16,9 @@ nlohmann::json chromeTrace(const std::vector<FrameResult>& frames, const std::st
     meta("process_name", 0, "shadel " + label);
     meta("thread_name", kCpuTrack, "CPU");
     meta("thread_name", kGpuTrack, "GPU passes");
-    bool frontendWorker = std::any_of(frames.begin(), frames.end(),
-                                      [](const FrameResult& f) { return f.frontendWorker; });
+    bool frontendWorker = std::any_of(frames.begin(), frames.end(), [](const FrameResult& f) {
+        return !f.frontendWorker.empty();
+    });
     if (frontendWorker) meta("thread_name", kFrontendTrack, "CPU frontend worker (next frame)");
     size_t workers = 0; // threaded frames: one track per recording worker
     for (const FrameResult& f : frames) workers = std::max(workers, f.recordingWorkers.size());
@@ -52,10 +53,11 @@ nlohmann::json chromeTrace(const std::vector<FrameResult>& frames, const std::st
             span("record passes", "cpu", kFirstWorkerTrack + int(w), gpuStart + t.startMs,
                  t.durationMs, {{"frame", i}, {"passes", t.passes}, {"cpu_ms", t.cpuMs}});
         }
-        if (f.frontendWorker) // the next frame's scene update, beside this frame's backend
-            span("scene update (frame " + std::to_string(i + 1) + ")", "cpu", kFrontendTrack,
-                 f.frontendWorkerStartMs, f.frontendWorkerMs,
-                 {{"frame", i + 1}, {"cpu_ms", f.frontendWorkerCpuMs}});
+        // The next frame's frontend work that ran beside this frame's backend (scene update,
+        // coarse visit).
+        for (const FrontendWorkerTask& t : f.frontendWorker)
+            span(std::string(t.name) + " (frame " + std::to_string(i + 1) + ")", "cpu",
+                 kFrontendTrack, t.startMs, t.wallMs, {{"frame", i + 1}, {"cpu_ms", t.cpuMs}});
         for (const PassTiming& p : f.passes)
             span(p.name, "gpu", kGpuTrack, gpuStart + p.startMs, p.gpuMs,
                  {{"frame", i}, {"record_cpu_ms", p.recordCpuMs}});

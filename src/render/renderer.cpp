@@ -301,6 +301,7 @@ FrameResult renderFrame(Renderer& r, const GpuScene& scene, const CameraView& ca
     Clock::time_point cpuStart = Clock::now();
     double startMs = std::chrono::duration<double, std::milli>(cpuStart - r.createdAt).count();
     r.cpuScopes.clear();
+    r.frontendTaken.clear();
     r.frameCpuStart = cpuStart;
     r.recorder.timeRecording = r.settings.cpuScopes;
     r.sceneIndices = scene.indices;
@@ -369,6 +370,11 @@ FrameResult renderFrame(Renderer& r, const GpuScene& scene, const CameraView& ca
     std::memcpy(mapped(gpu, r.frameConstants), &constants, sizeof(constants));
     uint64_t frame = address(gpu, r.frameConstants);
     double prepareMs = msSince(cpuStart);
+    if (r.nextFrame) { // the next frame's frontend beside this frame's backend
+        if (r.decoupled)
+            prefetchCoarseVisit(r, scene, r.nextFrame->camera, r.nextFrame->sceneMoves);
+        r.nextFrame.reset();
+    }
 
     FrameRecorder& rec = r.recorder;
     auto declaring = cpuScope(r, "declare passes");

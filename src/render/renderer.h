@@ -2,6 +2,7 @@
 // The renderer: owns render targets, pipelines and per-frame buffers, and renders one frame
 // as a list of passes (renderFrame in renderer.cpp reads top to bottom).
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -157,6 +158,14 @@ struct RenderSettings {
     bool cpuScopes = false;
 };
 
+// A piece of a frame's frontend that ran ahead on the frontend worker (trace: its own track).
+struct FrontendWorkerTask {
+    const char* name = "";
+    double startMs = 0.0; // since the renderer was created
+    double wallMs = 0.0;
+    double cpuMs = 0.0; // the worker thread's CPU time
+};
+
 struct FrameResult {
     std::vector<uint8_t> rgba; // width x height RGBA8, alpha = 255 where geometry covers the pixel
     uint64_t pixelsCovered = 0;
@@ -171,11 +180,10 @@ struct FrameResult {
     // render thread's share of streaming, the rest runs on its worker (render/streaming).
     double cpuStreamingMs = 0.0;
     double startMs = 0.0; // since the renderer was created (trace export)
-    // The frontend worker's import of the next frame's pose, run beside this frame's backend
-    // (animated playback with recording threads: render/animation prefetchPose). Since the
-    // renderer was created; the worker thread's CPU time.
-    bool frontendWorker = false;
-    double frontendWorkerStartMs = 0.0, frontendWorkerMs = 0.0, frontendWorkerCpuMs = 0.0;
+    // The next frame's frontend work that ran on the frontend worker beside this frame's backend
+    // (with recording threads: the pose import of animated playback, render/animation
+    // prefetchPose; the decoupled coarse visit, render/shadel/coarse_visit.h).
+    std::vector<FrontendWorkerTask> frontendWorker;
     uint32_t shaderAsserts = 0;
     std::vector<ShaderPrint> prints;        // shaderPrint records of this frame (--inspect)
     uint32_t transparentDraws = 0;          // blended instances drawn (render/oit)
@@ -278,6 +286,19 @@ struct Renderer {
     // This frame's CPU scopes so far (RenderSettings::cpuScopes) and their origin.
     std::vector<CpuScope> cpuScopes;
     std::chrono::steady_clock::time_point frameCpuStart;
+    // This frame's frontend work that ran ahead on the frontend worker (the decoupled coarse
+    // visit): the caller files it under the frame it ran beside (FrameResult::frontendWorker).
+    std::vector<FrontendWorkerTask> frontendTaken;
+    // Frontend/backend overlap (issue 16): set by a caller that renders a known sequence with
+    // recording threads, for one renderFrame. Once this frame's frontend is done, the next
+    // frame's decoupled grid visit (render/shadel/coarse_visit.h) runs on the frontend worker
+    // while this frame records, submits and waits. `sceneMoves`: animated playback writes the
+    // next frame's bounds only before it, so its visit is not prefetched (counted).
+    struct NextFrame {
+        CameraView camera;
+        bool sceneMoves = false;
+    };
+    std::optional<NextFrame> nextFrame;
 };
 
 // Times the enclosing block as the CPU scope `name` of this frame (nothing unless

@@ -229,6 +229,96 @@ TEST(RenderThreading, NextFramesSceneUpdateRunsBesideThisFrame) {
     EXPECT_EQ(imports, 3);
 }
 
+namespace {
+
+// The stats that must not depend on the thread count: everything but the clocks, the
+// recording workers and where the frontend's work ran.
+nlohmann::json withoutTimings(nlohmann::json s) {
+    for (const char* key :
+         {"cpu_frame_ms", "cpu_frame_thread_ms", "cpu_scopes", "cpu_streaming_thread_ms",
+          "frame_ms", "recording", "frontend", "bake_seconds"})
+        s.erase(key);
+    if (s.contains("view_density")) s["view_density"].erase("seconds");
+    for (auto& p : s["passes"]) {
+        p.erase("gpu_ms");
+        p.erase("record_cpu_ms");
+    }
+    return s;
+}
+
+} // namespace
+
+// Frontend/backend overlap of the decoupled coarse allocation (render/shadel/coarse_visit.h):
+// with recording threads, the grid visit of the next frame runs on the frontend worker while
+// this frame is recorded, submitted and drawn. Over a moving camera the frames and the stats are
+// those of the serial run (which visits inline), and the threaded run took its visits from the
+// worker (the trace shows them on the frontend track beside the frame before theirs). With
+// --occlusion on a frame visits the GPU's visible set of the last frame (a readback): nothing is
+// prefetched there, and the frames are still the serial ones.
+TEST(RenderThreading, NextFramesCoarseVisitRunsBesideThisFrame) {
+    for (bool occlusion : {false, true}) {
+        for (CameraPath path : {CameraPath::Orbit, CameraPath::Walk}) {
+            SCOPED_TRACE(std::string(occlusion ? "occlusion on" : "occlusion off") +
+                         (path == CameraPath::Orbit ? ", orbit" : ", walk"));
+            RenderOptions o = small("builtin:many", RenderMode::Decoupled);
+            o.instances = 2000;
+            o.width = 160;
+            o.height = 90;
+            o.frames = 5;
+            o.lod = true;
+            o.occlusion = occlusion;
+            o.cameraPath = path;
+            o.threads = 1;
+            RenderRun serial = renderChecked(o);
+            o.threads = 3;
+            std::string tracePath = tempPath("coarse-visit-trace.json");
+            o.trace = tracePath;
+            RenderRun threaded = renderChecked(o);
+            ASSERT_EQ(serial.frames.size(), threaded.frames.size());
+            for (size_t f = 0; f < serial.frames.size(); ++f)
+                EXPECT_EQ(bytesDiffering(serial.frames[f].rgba, threaded.frames[f].rgba), 0u)
+                    << "frame " << f;
+            EXPECT_EQ(withoutTimings(serial.stats), withoutTimings(threaded.stats));
+            const nlohmann::json &one = serial.stats["frontend"],
+                                 &three = threaded.stats["frontend"];
+            EXPECT_EQ(one["prefetched_visits"].get<uint32_t>(), 0u);
+            EXPECT_EQ(three["visits_discarded"].get<uint32_t>(), 0u);
+            nlohmann::json trace = takeJsonFile(tracePath);
+            ASSERT_FALSE(trace.is_null()) << tracePath;
+            int frontendTrack = -1;
+            for (const auto& e : trace["traceEvents"])
+                if (e["ph"] == "M" && e["name"] == "thread_name" &&
+                    e["args"]["name"].get<std::string>().rfind("CPU frontend worker", 0) == 0)
+                    frontendTrack = e["tid"].get<int>();
+            int visitSpans = 0;
+            for (const auto& e : trace["traceEvents"])
+                if (e["ph"] == "X" &&
+                    e["name"].get<std::string>().rfind("coarse visit (frame", 0) == 0) {
+                    ++visitSpans;
+                    int next = e["args"]["frame"].get<int>();
+                    ASSERT_GE(next, 1);
+                    EXPECT_LT(next, int(o.frames));
+                    EXPECT_EQ(e["tid"].get<int>(), frontendTrack) << "frame " << next;
+                    EXPECT_GE(e["args"]["cpu_ms"].get<double>(), 0.0);
+                }
+            if (occlusion) {
+                // Only the first frame visits the grid (no readback yet), inline in both runs.
+                EXPECT_EQ(three["prefetched_visits"].get<uint32_t>(), 0u);
+                EXPECT_EQ(three["inline_visits"].get<uint32_t>(), 1u);
+                EXPECT_EQ(three["readback_visits"].get<uint32_t>(), o.frames - 1);
+                EXPECT_EQ(visitSpans, 0);
+            } else {
+                // Every frame after the first took its visit from the worker.
+                EXPECT_EQ(one["inline_visits"].get<uint32_t>(), o.frames);
+                EXPECT_EQ(three["prefetched_visits"].get<uint32_t>(), o.frames - 1);
+                EXPECT_EQ(three["inline_visits"].get<uint32_t>(), 1u);
+                EXPECT_GT(three["visit_worker_cpu_ms"].get<double>(), 0.0);
+                EXPECT_EQ(visitSpans, int(o.frames) - 1);
+            }
+        }
+    }
+}
+
 TEST(RenderThreading, BadThreadCountsAreOneLineAndExitCode2) {
     std::string err = tempPath("threads_stderr.txt");
     for (const std::string args :

@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cstring>
+#include <future>
 
 #include <nlohmann/json.hpp>
 
@@ -15,6 +16,7 @@
 #include "render/oit/oit.h"
 #include "render/renderer.h"
 #include "render/shadel/capacity_control.h"
+#include "render/shadel/coarse_visit.h"
 #include "render/shadel/reuse_invalidation.h"
 #include "render/shadel/shade_storage.h"
 #include "render/shadel/visibility.h"
@@ -115,7 +117,11 @@ struct DecoupledState {
     CapacityController controller;
     float trilinearBand = 1.0f;
     std::vector<SheetRegion> regions;
-    std::vector<InstanceEntry> instances;          // per instance
+    std::vector<InstanceEntry> instances; // per instance
+    // A bit per instance: it holds a slot (InstanceEntry::slot). The visit skips the instances of
+    // the grid's answer that the camera leaves forward and that hold nothing (at 100k instances
+    // ~9 in 10 of them) on this bit (12 KB) instead of their entries (1.2 MB, scattered reads).
+    std::vector<uint64_t> holdsSlot;
     std::vector<ObjectSlot> slots;                 // the pool (InstanceEntry::slot)
     std::vector<gpu::GpuShadelObject> slotObjects; // per slot: its instance's GpuShadelObject
     // Per slot: what its instance's entry in objectBuffer holds (valid unless newThisFrame), so
@@ -127,6 +133,19 @@ struct DecoupledState {
     // The coarse allocation visits only instances near the view (render/culling/instance_grid.h)
     // and those it touched last frame, so its cost follows the view, not the world's size.
     InstanceGrid grid;
+    // The visit's first half (coarse_visit.h): this frame's, computed inline or taken from the
+    // frontend worker, which computes the next frame's beside this frame's backend (double
+    // buffered: the worker fills one while the frame reads the other). The pending one is
+    // tagged with its frame number and declared after the grid it reads, so it is joined
+    // (std::async's future) before the grid is destroyed.
+    CoarseVisitPolicy visitPolicy;
+    CoarseVisit coarseVisit, spareVisit; // spare: the last frame's, its vectors reused
+    struct PendingVisit {
+        std::future<CoarseVisit> visit;
+        uint64_t frame = 0;
+    };
+    PendingVisit pendingVisit;
+    FrontendVisitStats visitStats;
     std::vector<uint32_t> visit;   // this frame's instances to decide
     std::vector<uint32_t> touched; // instances with a GpuShadelObject entry or sheet rects
     std::vector<gpu::GpuShadelRect> rects;
@@ -230,6 +249,7 @@ DecoupledStatePtr createDecoupled(Renderer& r, const GpuScene& scene) {
         d.regions.push_back(std::move(region));
     }
     d.instances.assign(scene.instanceCount, InstanceEntry{});
+    d.holdsSlot.assign((size_t(scene.instanceCount) + 63) / 64, 0);
     uint64_t blocks = uint64_t(d.sheetBlocks) * d.sheetBlocks;
     uint32_t chunksPerSide = d.storageSize / SHADEL_CHUNK;
     d.capacityChunks = chunksPerSide * chunksPerSide;
@@ -249,6 +269,11 @@ DecoupledStatePtr createDecoupled(Renderer& r, const GpuScene& scene) {
     // Every object starts forward; frames rewrite only the entries they visit.
     std::memset(mapped(gpu, d.objectBuffer), 0, objectBytes);
     d.grid.build(scene.instanceInfo);
+    d.visitPolicy.viewportHeight = float(r.internalHeight);
+    d.visitPolicy.frustumMargin = d.frustumMargin;
+    d.visitPolicy.forwardBelowPixels = rs.forwardBelowPixels;
+    d.visitPolicy.blendedForward = rs.oit != OitMode::Wboit;
+    d.visitPolicy.sheetAllMips = rs.sheetAllMips;
     size_t maxRects = std::max<size_t>(scene.instanceCount, 1) * SHADEL_MAX_MIPS;
     d.rectBuffer = upload("shadel.rects", maxRects * sizeof(gpu::GpuShadelRect));
     d.levelWants =
@@ -529,36 +554,6 @@ static bool updateObjectRects(Gpu& gpu, DecoupledState& d, ObjectSlot& o, uint32
     return true;
 }
 
-// The finest MIP the reconstruction filter can read anywhere on the instance this frame: a
-// lower bound of its screen footprint in MIP-0 shadels. The nearest view depth of the (margin-
-// padded) bounds bounds every point's depth; a pixel there spans at least depth * cos(the
-// screen's half-diagonal angle) / focal world units in any screen direction; one world unit
-// holds at most shadelsPerUnit / (largest scale of the instance) MIP-0 shadels on average, and
-// charts vary around that average (stretch, density CV <= 0.2), hence one MIP of slack.
-static uint32_t finestMipNeeded(const CameraView& camera, float viewportHeight,
-                                const gpu::GpuInstance& inst, const ShadelMeshInfo& mesh,
-                                glm::vec3 boundsMin, glm::vec3 boundsMax, float bias) {
-    if (mesh.shadelsPerUnit <= 0.0f || mesh.mipCount <= 1) return 0;
-    float nearestDepth = 1e30f;
-    for (int c = 0; c < 8; ++c) {
-        glm::vec3 corner{c & 1 ? boundsMax.x : boundsMin.x, c & 2 ? boundsMax.y : boundsMin.y,
-                         c & 4 ? boundsMax.z : boundsMin.z};
-        nearestDepth = std::min(nearestDepth, -(camera.view * glm::vec4(corner, 1.0f)).z);
-    }
-    if (nearestDepth <= camera.znear) return 0;
-    float tanX = 1.0f / std::abs(camera.proj[0][0]), tanY = 1.0f / std::abs(camera.proj[1][1]);
-    float cosEdge = 1.0f / std::sqrt(1.0f + tanX * tanX + tanY * tanY);
-    float focal = 0.5f * viewportHeight * std::abs(camera.proj[1][1]);
-    float pixelWorld = nearestDepth * cosEdge / focal;
-    glm::mat3 m(inst.model);
-    float scale = std::max({glm::length(m[0]), glm::length(m[1]), glm::length(m[2]), 1e-12f});
-    constexpr float kDensitySlack = 0.5f;
-    float footprint = pixelWorld * mesh.shadelsPerUnit / scale * kDensitySlack;
-    float lod = std::log2(std::max(footprint, 1e-12f)) + bias;
-    if (!(lod > 0.0f)) return 0;
-    return std::min(uint32_t(lod), mesh.mipCount - 1);
-}
-
 // How far the view of a carried-over chunk may turn before its specular visibly lags
 // (GpuShadelObject::viewDriftCos holds its cosine, checked per chunk: shadel.glsl chunkViewTurned).
 // Specular and Fresnel follow the view direction, and a specular lobe is about roughness^2 radians
@@ -580,24 +575,6 @@ static float viewDriftLimitFor(float roughness, float metallic) {
     float lobeWidth = std::clamp(roughness * roughness, 0.01f, 0.4f);
     float specularShare = glm::mix(2.0f * 0.04f, 1.0f, std::clamp(metallic, 0.0f, 1.0f));
     return lobeWidth * std::min(1.0f / specularShare, SPECULAR_SHARE_MAX_GAIN);
-}
-
-static bool boxVisible(const std::array<glm::vec4, 6>& planes, glm::vec3 bmin, glm::vec3 bmax) {
-    for (const glm::vec4& p : planes) {
-        glm::vec3 v{p.x >= 0 ? bmax.x : bmin.x, p.y >= 0 ? bmax.y : bmin.y,
-                    p.z >= 0 ? bmax.z : bmin.z};
-        if (glm::dot(glm::vec3(p), v) + p.w < 0) return false;
-    }
-    return true;
-}
-
-// Projected diameter in pixels of a world-space sphere (for the hybrid forward policy).
-static float projectedDiameter(const CameraView& camera, float viewportHeight, glm::vec3 center,
-                               float radius) {
-    float distance = glm::length(center - camera.position);
-    if (distance <= radius) return 1e9f; // the camera is inside: treat as huge
-    float focal = 0.5f * viewportHeight * std::abs(camera.proj[1][1]);
-    return 2.0f * radius * focal / std::sqrt(distance * distance - radius * radius);
 }
 
 // A slot for an instance that has none: a fresh ObjectSlot (no rects) and a zero GPU entry, as
@@ -632,12 +609,23 @@ static void prefetchLines(const void* p, size_t bytes, int write) {
         write ? __builtin_prefetch(c + o, 1) : __builtin_prefetch(c + o, 0);
 }
 
-static void prefetchInstance(const DecoupledState& d, const GpuScene& scene, uint32_t i) {
+static void prefetchInstance(const DecoupledState& d, const GpuScene& scene, uint32_t i,
+                             bool readsInstance) {
     __builtin_prefetch(&d.instances[i]);
+    if (!readsInstance) return;
     const auto* inst = reinterpret_cast<const char*>(&scene.instanceInfo[i]);
     __builtin_prefetch(inst);                                        // model
     __builtin_prefetch(inst + offsetof(gpu::GpuInstance, worldMin)); // bounds, mesh, material
     __builtin_prefetch(inst + sizeof(gpu::GpuInstance) - 1);
+}
+
+static bool holdsSlot(const DecoupledState& d, uint32_t i) {
+    return (d.holdsSlot[i >> 6] >> (i & 63)) & 1u;
+}
+
+static void setHoldsSlot(DecoupledState& d, uint32_t i, bool holds) {
+    uint64_t bit = uint64_t(1) << (i & 63);
+    d.holdsSlot[i >> 6] = holds ? d.holdsSlot[i >> 6] | bit : d.holdsSlot[i >> 6] & ~bit;
 }
 
 static void prefetchSlot(const DecoupledState& d, uint32_t i) {
@@ -645,6 +633,72 @@ static void prefetchSlot(const DecoupledState& d, uint32_t i) {
     if (s == kNoSlot) return;
     prefetchLines(&d.slots[s], kSlotHotBytes, 0);
     prefetchLines(&d.slotObjects[s], sizeof(gpu::GpuShadelObject), 1); // rewritten
+}
+
+static double msBetween(std::chrono::steady_clock::time_point a,
+                        std::chrono::steady_clock::time_point b) {
+    return std::chrono::duration<double, std::milli>(b - a).count();
+}
+
+void prefetchCoarseVisit(Renderer& r, const GpuScene& scene, const CameraView& nextCamera,
+                         bool sceneMoves) {
+    if (!r.decoupled) return;
+    DecoupledState& d = *r.decoupled;
+    // --occlusion on: after its first frame, a frame visits the GPU's visible set of the frame
+    // before it, read back when that frame finishes; nothing to run ahead.
+    if (r.settings.occlusion) return;
+    if (sceneMoves) { // the next frame's bounds are known once its pose is written
+        d.visitStats.skippedPlayback++;
+        return;
+    }
+    uint64_t frame = d.frameNumber + 1; // (this frame finishes after this call)
+    DecoupledState::PendingVisit& pending = d.pendingVisit;
+    pending.frame = frame;
+    // The grid and the scene's instances are not written while it runs: the grid is rebuilt
+    // only for animated playback (sceneMoves), the scene only between frames by the playback.
+    pending.visit = std::async(std::launch::async,
+                               [policy = d.visitPolicy, &scene, &grid = d.grid, camera = nextCamera,
+                                out = std::move(d.spareVisit)]() mutable {
+                                   out.start = std::chrono::steady_clock::now();
+                                   double cpuStart = threadCpuMs();
+                                   visitCoarse(policy, scene, grid, camera, out);
+                                   out.cpuMs = threadCpuMs() - cpuStart;
+                                   out.end = std::chrono::steady_clock::now();
+                                   return std::move(out);
+                               });
+}
+
+// This frame's grid visit: the one the frontend worker computed beside the last frame's backend
+// when it is for this camera and the scene did not move, else computed here (the same function
+// on the same inputs: the same result).
+static const CoarseVisit& takeCoarseVisit(Renderer& r, const GpuScene& scene,
+                                          const CameraView& camera) {
+    DecoupledState& d = *r.decoupled;
+    // Animated playback moved instances (render/animation): the grid follows their bounds.
+    bool moved = std::find(r.reposedInstances.begin(), r.reposedInstances.end(), 1) !=
+                 r.reposedInstances.end();
+    if (moved) d.grid.build(scene.instanceInfo);
+    DecoupledState::PendingVisit& pending = d.pendingVisit;
+    if (pending.visit.valid() && pending.frame == d.frameNumber) {
+        auto waitStart = std::chrono::steady_clock::now();
+        CoarseVisit taken = pending.visit.get();
+        d.visitStats.waitMs += msBetween(waitStart, std::chrono::steady_clock::now());
+        if (!moved && sameVisitCamera(taken.camera, camera)) {
+            d.visitStats.prefetched++;
+            d.visitStats.workerCpuMs += taken.cpuMs;
+            r.frontendTaken.push_back({"coarse visit", msBetween(r.createdAt, taken.start),
+                                       msBetween(taken.start, taken.end), taken.cpuMs});
+            d.spareVisit = std::move(d.coarseVisit);
+            d.coarseVisit = std::move(taken);
+            return d.coarseVisit;
+        }
+        d.visitStats.discarded++;
+        d.spareVisit = std::move(taken);
+    }
+    auto timer = cpuScope(r, "coarse visit (inline)");
+    d.visitStats.inlineVisits++;
+    visitCoarse(d.visitPolicy, scene, d.grid, camera, d.coarseVisit);
+    return d.coarseVisit;
 }
 
 void prepareDecoupledFrame(Renderer& r, const GpuScene& scene, const CameraView& camera,
@@ -668,65 +722,68 @@ void prepareDecoupledFrame(Renderer& r, const GpuScene& scene, const CameraView&
                     d.changes.size() * sizeof(ChangedVolume));
     // Instances near the frustum's bounds, and last frame's (to free or clear what they held):
     // every other instance stays unwanted, with its zero entry and no rects.
-    d.visit.clear();
-    Aabb frustumBox;
-    glm::mat4 invViewProj = glm::inverse(constants.viewProj);
-    for (int c = 0; c < 8; ++c) {
-        glm::vec4 p =
-            invViewProj * glm::vec4((c & 1) ? 1 : -1, (c & 2) ? 1 : -1, (c & 4) ? 1 : 0, 1);
-        frustumBox.extend(glm::vec3(p) / p.w);
-    }
     // With occlusion culling the GPU's visible set of last frame is the set to allocate for
     // (seed 004: the CPU estimator and the GPU agree on what is seen); an instance that appears
-    // is drawn forward for one frame. Otherwise every instance near the frustum.
+    // is drawn forward for one frame. Otherwise the grid's answer for the frustum (the visit's
+    // first half, coarse_visit.h: taken from the frontend worker or computed here), whose
+    // instances come with their view of the camera already computed.
+    d.visit.clear();
     const std::vector<uint32_t>* seen = visibleLastFrame(r);
     const uint32_t frameMark = uint32_t(d.frameNumber + 1); // visitedFrame, seenFrame
+    const CoarseVisit* grid = nullptr;
     if (seen) {
+        d.visitStats.readbackVisits++;
         d.visit.insert(d.visit.end(), seen->begin(), seen->end());
         for (uint32_t i : *seen) d.instances[i].seenFrame = frameMark;
     } else {
-        // Animated playback moved instances (render/animation): the grid follows their bounds.
-        if (std::find(r.reposedInstances.begin(), r.reposedInstances.end(), 1) !=
-            r.reposedInstances.end())
-            d.grid.build(scene.instanceInfo);
-        d.grid.query(frustumBox, d.visit);
+        grid = &takeCoarseVisit(r, scene, camera);
+        d.visit.insert(d.visit.end(), grid->instances.begin(), grid->instances.end());
     }
+    const size_t viewed = grid ? grid->views.size() : 0; // visit entries with their view
     d.visit.insert(d.visit.end(), d.touched.begin(), d.touched.end());
     d.touched.clear();
+    // In the grid's answer, whether the view wants the instance decoupled.
+    auto viewWants = [&](size_t v) { return grid->views[v].inFrustum && !grid->views[v].small; };
     for (size_t v = 0; v < d.visit.size(); ++v) {
-        if (v + kPrefetchAhead < d.visit.size())
-            prefetchInstance(d, scene, d.visit[v + kPrefetchAhead]);
+        if (v + kPrefetchAhead < d.visit.size()) {
+            size_t ahead = v + kPrefetchAhead;
+            // Past the grid's answer (or with occlusion) the loop reads the instance itself;
+            // in it, only where the view wants it decoupled (and its entry where it holds a slot).
+            bool readsInstance = ahead >= viewed || viewWants(ahead);
+            if (readsInstance || holdsSlot(d, d.visit[ahead]))
+                prefetchInstance(d, scene, d.visit[ahead], readsInstance);
+        }
         if (v + kPrefetchAhead / 2 < d.visit.size())
             prefetchSlot(d, d.visit[v + kPrefetchAhead / 2]);
         uint32_t i = d.visit[v];
+        // Forward this frame and holding nothing, as before: nothing to decide or undo (the grid
+        // lists an instance once, and d.touched only instances that hold a slot).
+        if (v < viewed && !viewWants(v) && !holdsSlot(d, i)) {
+            if (grid->views[v].inFrustum) d.objectsSmallForward++, d.objectsForward++;
+            continue;
+        }
         InstanceEntry& entry = d.instances[i];
         if (entry.visitedFrame == frameMark) continue;
         entry.visitedFrame = frameMark;
-        const gpu::GpuInstance& inst = scene.instanceInfo[i];
-        const ShadelMeshInfo& mesh = scene.shadelMeshes[inst.mesh];
-        glm::vec3 margin = (inst.worldMax - inst.worldMin) * d.frustumMargin;
-        // Transparent surfaces are shaded in shadel space too and reconstructed into the WBOIT
-        // targets (render/oit); the sorted reference keeps them forward. (The visibility buffer
-        // sees only the nearest surface: with it, they are marked by the raster pass below.)
-        bool blended = inst.material < scene.materialInfo.size() &&
-                       (scene.materialInfo[inst.material].flags & MATERIAL_ALPHA_BLEND) != 0u;
-        bool transparentForward = blended && r.settings.oit != OitMode::Wboit;
         // Hidden by occlusion last frame: its rects go back (it returns forward for a frame).
-        bool wanted = mesh.mipCount > 0 && !transparentForward &&
-                      (!seen || entry.seenFrame == frameMark) &&
-                      boxVisible(planes, inst.worldMin - margin, inst.worldMax + margin);
-        // Hybrid (seed: "small objects fall back to a direct only render"): an object a few
-        // pixels across would still shade whole chunks at its coarsest MIP; forward is cheaper.
-        bool small = wanted && r.settings.forwardBelowPixels > 0.0f &&
-                     projectedDiameter(camera, float(r.internalHeight),
-                                       0.5f * (inst.worldMin + inst.worldMax),
-                                       0.5f * glm::length(inst.worldMax - inst.worldMin)) <
-                         r.settings.forwardBelowPixels;
+        bool hidden = seen && entry.seenFrame != frameMark;
+        CoarseInstanceView view;
+        if (v < viewed)
+            view = grid->views[v];
+        else if (!hidden)
+            view = viewInstance(d.visitPolicy, scene, camera, planes, i);
+        // (The visibility buffer sees only the nearest surface: with it, transparent surfaces
+        // are marked by the raster pass below.)
+        bool wanted = !hidden && view.inFrustum;
+        bool small = wanted && view.small;
         if (small) d.objectsSmallForward++, d.objectsForward++;
         // Drawn forward: without a slot it holds nothing and its GPU entry is zero already (the
         // common case of the many small instances the GPU sees every frame: no slot churn).
         if ((!wanted || small) && entry.slot == kNoSlot) continue;
-        if (entry.slot == kNoSlot) entry.slot = takeSlot(d);
+        if (entry.slot == kNoSlot) {
+            entry.slot = takeSlot(d);
+            setHoldsSlot(d, i, true);
+        }
         ObjectSlot& o = d.slots[entry.slot];
         bool wasDecoupled = o.decoupledLastFrame;
         o.decoupledLastFrame = false;
@@ -736,11 +793,9 @@ void prepareDecoupledFrame(Renderer& r, const GpuScene& scene, const CameraView&
             if (o.allocated) freeObject(gpu, d, o);
             continue;
         }
-        uint32_t wantFirst =
-            r.settings.sheetAllMips
-                ? 0
-                : finestMipNeeded(camera, float(r.internalHeight), inst, mesh,
-                                  inst.worldMin - margin, inst.worldMax + margin, d.shadingBias);
+        const gpu::GpuInstance& inst = scene.instanceInfo[i];
+        const ShadelMeshInfo& mesh = scene.shadelMeshes[inst.mesh];
+        uint32_t wantFirst = finestMipFromLod(view.lodBeforeBias, d.shadingBias, mesh.mipCount);
         bool limited = false;
         // No room in the sheet: drawn forward this frame, retried next frame.
         if (!updateObjectRects(gpu, d, o, i, mesh, wantFirst, wasDecoupled, limited)) {
@@ -813,16 +868,21 @@ void prepareDecoupledFrame(Renderer& r, const GpuScene& scene, const CameraView&
         // Two stages ahead: the slot's uploaded copy, then (compared by then) the GPU entry of
         // an instance that writes it. An instance without a slot writes nothing.
         if (v + 2 * kPrefetchAhead < d.visit.size()) {
-            uint32_t s = d.instances[d.visit[v + 2 * kPrefetchAhead]].slot;
+            uint32_t j = d.visit[v + 2 * kPrefetchAhead];
+            uint32_t s = holdsSlot(d, j) ? d.instances[j].slot : kNoSlot;
             if (s != kNoSlot)
                 prefetchLines(&d.slotObjectsUploaded[s], sizeof(gpu::GpuShadelObject), 0);
         }
         if (v + kPrefetchAhead < d.visit.size()) {
-            uint32_t j = d.visit[v + kPrefetchAhead], s = d.instances[j].slot;
+            uint32_t j = d.visit[v + kPrefetchAhead];
+            uint32_t s = holdsSlot(d, j) ? d.instances[j].slot : kNoSlot;
             if (s != kNoSlot && entryChanged(s))
                 prefetchLines(&objects[j], sizeof(gpu::GpuShadelObject), 1);
         }
         uint32_t i = d.visit[v];
+        // Holding no slot: forward, its entry zero (a visitedFrame left set by the loop above
+        // is this frame's number, which no later frame matches).
+        if (!holdsSlot(d, i)) continue;
         InstanceEntry& entry = d.instances[i];
         if (entry.visitedFrame != frameMark) continue;
         entry.visitedFrame = 0;              // once per instance (visit may list it twice)
@@ -842,6 +902,7 @@ void prepareDecoupledFrame(Renderer& r, const GpuScene& scene, const CameraView&
         } else { // nothing held: the slot goes back to the pool
             d.freeSlots.push_back(entry.slot);
             entry.slot = kNoSlot;
+            setHoldsSlot(d, i, false);
         }
     }
     std::memcpy(mapped(gpu, d.rectBuffer), d.rects.data(),
@@ -1216,6 +1277,15 @@ void decoupledStats(const Renderer& r, nlohmann::json& s) {
         shadelsMarked ? double(last.counters.markedBlocks) * 96.0 / double(shadelsMarked) : 0.0;
     // The whole sheet's bookkeeping for this frame (every allocated rect block) per shadel.
     s["sheet_bits_per_shadel"] = stored ? double(last.rectBlocks) * 96.0 / double(stored) : 0.0;
+    // Frontend/backend overlap (coarse_visit.h): where the frames' grid visits came from.
+    const FrontendVisitStats& v = d.visitStats;
+    s["frontend"] = {{"prefetched_visits", v.prefetched},
+                     {"inline_visits", v.inlineVisits},
+                     {"readback_visits", v.readbackVisits},
+                     {"visits_not_prefetched_playback", v.skippedPlayback},
+                     {"visits_discarded", v.discarded},
+                     {"visit_worker_cpu_ms", v.workerCpuMs},
+                     {"wait_ms", v.waitMs}};
     s["storage_used"] =
         d.capacityChunks ? double(last.counters.chunksAllocated) / d.capacityChunks : 0.0;
 }

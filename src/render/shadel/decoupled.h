@@ -21,6 +21,13 @@ void destroyDecoupled(Renderer& r, DecoupledStatePtr& state);
 // sheet, shading bias; fills the decoupled fields of the frame constants.
 void prepareDecoupledFrame(Renderer& r, const GpuScene& scene, const CameraView& camera,
                            gpu::FrameConstants& constants);
+// Frontend/backend overlap (issue 16): starts the grid visit (coarse_visit.h) of the next frame
+// on the frontend worker, for `nextCamera`; that frame's prepareDecoupledFrame takes it. Called
+// by renderFrame after this frame's frontend (Renderer::nextFrame). Nothing with --occlusion on
+// (the visit is last frame's visible set, a readback) or when `sceneMoves` (animated playback:
+// the next frame's bounds are written only before it; counted).
+void prefetchCoarseVisit(Renderer& r, const GpuScene& scene, const CameraView& nextCamera,
+                         bool sceneMoves);
 // Marking and allocation: after them the occupancy masks say which chunks the frame reads.
 void recordDecoupledMarking(Renderer& r, FrameRecorder& rec, uint64_t frame);
 // Work queues, carry-over, shading, reconstruction.
