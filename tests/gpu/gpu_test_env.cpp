@@ -6,6 +6,8 @@
 #include <filesystem>
 #include <fstream>
 
+#include <glm/gtc/quaternion.hpp>
+
 namespace shadel::test {
 
 namespace {
@@ -142,6 +144,11 @@ nlohmann::json gltfAccessor(int bufferView, int componentType, int count, const 
             {"componentType", componentType},
             {"count", count},
             {"type", type}};
+}
+
+nlohmann::json gltfRotationTowards(glm::vec3 direction) {
+    glm::quat q = glm::quatLookAtRH(glm::normalize(direction), glm::vec3(0, 1, 0));
+    return {q.x, q.y, q.z, q.w};
 }
 
 ReuseRuns renderReuseOnAndOff(RenderOptions o) {

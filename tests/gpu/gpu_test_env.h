@@ -3,6 +3,7 @@
 // Every test checks afterwards that no validation error and no shader assert happened.
 #include <gtest/gtest.h>
 
+#include <glm/glm.hpp>
 #include <nlohmann/json.hpp>
 
 #include "app/commands.h"
@@ -51,5 +52,8 @@ std::string writeGltf(const std::string& name, nlohmann::json doc, const std::ve
                       const std::vector<uint16_t>& indices);
 nlohmann::json gltfBufferView(size_t byteOffset, size_t byteLength); // of buffer 0
 nlohmann::json gltfAccessor(int bufferView, int componentType, int count, const char* type);
+// A node rotation (quaternion x, y, z, w) turning -Z onto `direction`, +Y up: a camera or a
+// light looking along it.
+nlohmann::json gltfRotationTowards(glm::vec3 direction);
 
 } // namespace shadel::test

@@ -2,8 +2,6 @@
 // every shadow map test the mask, in both paths. Scenes without masked materials draw those
 // passes with the test compiled out (Renderer::alphaMasked), so the test here is what keeps the
 // masked path honest.
-#include <glm/gtc/quaternion.hpp>
-
 #include "gpu_test_env.h"
 
 using namespace shadel;
@@ -30,10 +28,7 @@ std::string maskedWallScene(const std::string& name, Wall wall, float wallAlpha)
     using nlohmann::json;
     auto view = gltfBufferView;
     auto accessor = gltfAccessor;
-    auto rotationTowards = [](glm::vec3 direction) { // -Z onto `direction`, +Y up
-        glm::quat q = glm::quatLookAtRH(glm::normalize(direction), glm::vec3(0, 1, 0));
-        return json{q.x, q.y, q.z, q.w};
-    };
+    auto rotationTowards = gltfRotationTowards;
     const size_t positionBytes = 3 * 24 * 3 * 4, ib = f.size() * 4;
     json doc;
     doc["asset"] = {{"version", "2.0"}};

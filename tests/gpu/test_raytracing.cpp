@@ -435,10 +435,7 @@ std::string thinPostScene(const std::string& name, float floorSize) {
     using nlohmann::json;
     auto view = gltfBufferView;
     auto accessor = gltfAccessor;
-    auto rotationTowards = [](glm::vec3 direction) { // -Z onto `direction`, +Y up
-        glm::quat q = glm::quatLookAtRH(glm::normalize(direction), glm::vec3(0, 1, 0));
-        return json{q.x, q.y, q.z, q.w};
-    };
+    auto rotationTowards = gltfRotationTowards;
     size_t ib = f.size() * 4;
     json doc;
     doc["asset"] = {{"version", "2.0"}};
