@@ -26,9 +26,6 @@ std::string maskedWallScene(const std::string& name, Wall wall, float wallAlpha)
     // Each box is its own mesh: positions of all three, then their normals, then indices.
     f.insert(f.end(), normals.begin(), normals.end());
     using nlohmann::json;
-    auto view = gltfBufferView;
-    auto accessor = gltfAccessor;
-    auto rotationTowards = gltfRotationTowards;
     const size_t positionBytes = 3 * 24 * 3 * 4, ib = f.size() * 4;
     json doc;
     doc["asset"] = {{"version", "2.0"}};
@@ -44,23 +41,23 @@ std::string maskedWallScene(const std::string& name, Wall wall, float wallAlpha)
                     {{"mesh", 1}, {"name", "red box"}},
                     {{"mesh", 2}, {"name", "wall"}},
                     {{"name", "sun"},
-                     {"rotation", rotationTowards(glm::vec3(0.3f, -0.7f, -0.6f))},
+                     {"rotation", gltfRotationTowards(glm::vec3(0.3f, -0.7f, -0.6f))},
                      {"extensions", {{"KHR_lights_punctual", {{"light", 0}}}}}},
                     {{"name", "camera"},
                      {"camera", 0},
                      {"translation", {eye.x, eye.y, eye.z}},
-                     {"rotation", rotationTowards(target - eye)}}};
+                     {"rotation", gltfRotationTowards(target - eye)}}};
     doc["cameras"] = {{{"type", "perspective"},
                        {"perspective", {{"yfov", 0.8}, {"znear", 0.05}, {"zfar", 100.0}}}}};
     json views, accessors;
     const int f32 = 5126, u16 = 5123;
     for (int m = 0; m < 3; ++m) {
-        views.push_back(view(size_t(m) * 288, 288));                 // positions
-        views.push_back(view(positionBytes + size_t(m) * 288, 288)); // normals
-        views.push_back(view(ib + size_t(m) * 72, 72));              // indices
-        accessors.push_back(accessor(3 * m, f32, 24, "VEC3"));
-        accessors.push_back(accessor(3 * m + 1, f32, 24, "VEC3"));
-        accessors.push_back(accessor(3 * m + 2, u16, 36, "SCALAR"));
+        views.push_back(gltfBufferView(size_t(m) * 288, 288));                 // positions
+        views.push_back(gltfBufferView(positionBytes + size_t(m) * 288, 288)); // normals
+        views.push_back(gltfBufferView(ib + size_t(m) * 72, 72));              // indices
+        accessors.push_back(gltfAccessor(3 * m, f32, 24, "VEC3"));
+        accessors.push_back(gltfAccessor(3 * m + 1, f32, 24, "VEC3"));
+        accessors.push_back(gltfAccessor(3 * m + 2, u16, 36, "SCALAR"));
         const float* c = m == 0 ? floorCentre : m == 1 ? boxCentre : wallCentre;
         const float* h = m == 0 ? floorHalf : m == 1 ? boxHalf : wallHalf;
         accessors[3 * m]["min"] = {c[0] - h[0], c[1] - h[1], c[2] - h[2]};
