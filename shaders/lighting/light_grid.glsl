@@ -3,7 +3,7 @@
 // big list and the buckets of the at most 2x2x2 cells the box meets) are tested exactly as
 // without the grid, kept ones set in a shared bit set (a light listed in several buckets
 // counts once), and the bit set is compacted in light order, so the list is the one the loop
-// over every light would have built. Needs light_cull.glsl (orderedAppend's shared state) and
+// over every light would have built. Needs light_cull.glsl (orderedAppend's subgroup counts) and
 // GL_KHR_shader_subgroup_arithmetic; the includer defines LIGHT_GRID_LIST and
 // LIGHT_GRID_LIST_MAX (the shared list the compaction fills). Call in uniform control flow.
 #ifndef SHADEL_LIGHT_GRID_GLSL
@@ -12,12 +12,6 @@
 
 shared uint sGridMask[LIGHT_GRID_MASK_LIGHTS / 32u];
 shared uint sGridCandidates;
-
-// orderedAppend for n entries per invocation: each invocation's first slot, in invocation
-// order after those already placed.
-uint orderedAppendCount(uint n) {
-    return orderedAppendSubgroupBase(subgroupAdd(n)) + subgroupExclusiveAdd(n);
-}
 
 // A box's grid query: its level and cells. Sources: 0 the global list, 1 the level's big
 // list, 2.. the cells (x fastest).
@@ -97,36 +91,60 @@ uint lightGridCandidateEntry(LightGridCandidates c, uint k) {
     return 0u; // not reached for k < c.total
 }
 
-void lightGridMaskClear(uint lightCount, uint threads) {
+// Clears the bit set; the caller's next barrier makes it visible (a chunk's shading clears it
+// before the barrier of its box, so culling costs no barrier of its own for it).
+void lightGridMaskClearUnsynced(uint lightCount, uint threads) {
     for (uint w = gl_LocalInvocationIndex; w < (lightCount + 31u) / 32u; w += threads) sGridMask[w] = 0u;
     if (gl_LocalInvocationIndex == 0u) sGridCandidates = 0u;
+}
+
+void lightGridMaskClear(uint lightCount, uint threads) {
+    lightGridMaskClearUnsynced(lightCount, threads);
     barrier();
 }
 
-// The kept lights of the bit set appended in light order (orderedAppend's sAppendCount) to
-// LIGHT_GRID_LIST (a shared uvec2 array of LIGHT_GRID_LIST_MAX entries the includer names).
-void lightGridMaskCompact(uint lightCount, uint threads) {
+// The kept lights of the bit set, in light order, into LIGHT_GRID_LIST (a shared uvec2 array of
+// LIGHT_GRID_LIST_MAX entries the includer names) from its start; returns how many there are
+// (the same in every invocation; entries past the array's end are counted, not written). One
+// barrier per `threads` x 32 lights (orderedAppend takes three): barriers are what a
+// workgroup's culling spends most on where invocations run in turn (lavapipe). Entries are
+// written by other invocations than the ones that read them: barrier before reading. Call
+// after a barrier that follows any earlier orderedAppend (it reuses its subgroup counts).
+uint lightGridMaskCompact(uint lightCount, uint threads) {
     uint words = (lightCount + 31u) / 32u;
     uint tid = gl_LocalInvocationIndex;
+    uint placed = 0u;
     for (uint base = 0u; base < words; base += threads) {
         uint word = base + tid < words ? sGridMask[base + tid] : 0u;
-        uint slot = orderedAppendCount(bitCount(word));
+        uint n = bitCount(word);
+        uint inSubgroup = subgroupAdd(n);
+        uint slot = placed + subgroupExclusiveAdd(n);
+        if (subgroupElect()) sSubgroupCounts[gl_SubgroupID] = inSubgroup;
+        barrier();
+        for (uint s = 0u; s < gl_NumSubgroups; ++s) {
+            uint count = sSubgroupCounts[s];
+            slot += s < gl_SubgroupID ? count : 0u;
+            placed += count;
+        }
         while (word != 0u) {
             uint bit = uint(findLSB(word));
             if (slot < LIGHT_GRID_LIST_MAX) LIGHT_GRID_LIST[slot] = uvec2((base + tid) * 32u + bit, 0u);
             slot++;
             word &= word - 1u;
         }
+        if (base + threads < words) barrier(); // before the next round rewrites the counts
     }
+    return placed;
 }
 
 // A shadel chunk's lights: those chunkKeepsLight keeps, as the loop over every light in
-// shade.comp tests them.
+// shade.comp tests them; `appended`: how many (lightGridMaskCompact). The caller cleared the bit
+// set (lightGridMaskClearUnsynced, then a barrier) and barriers before reading the list.
 bool gridChunkLights(FrameConstants f, uint64_t gridAddress, vec3 boxMin, vec3 boxMax,
-                     vec3 corners[8], uint threads) {
+                     vec3 corners[8], uint threads, out uint appended) {
+    appended = 0u;
     LightGridQuery q;
     if (!lightGridQuery(f, gridAddress, boxMin, boxMax, q)) return false;
-    lightGridMaskClear(f.lightCount, threads);
     LightBuffer lights = LightBuffer(f.lights);
     UintBuffer entries = UintBuffer(q.g.entries);
     uint tested = 0u;
@@ -138,7 +156,7 @@ bool gridChunkLights(FrameConstants f, uint64_t gridAddress, vec3 boxMin, vec3 b
     }
     if (tested != 0u) atomicAdd(sGridCandidates, tested);
     barrier();
-    lightGridMaskCompact(f.lightCount, threads);
+    appended = lightGridMaskCompact(f.lightCount, threads);
     return true;
 }
 

@@ -130,6 +130,7 @@ void main() {
     LightBuffer lights = LightBuffer(f.lights);
     UintBuffer frustumLights = UintBuffer(lf.frustumLights);
     LightGridQuery grid;
+    uint appended; // lights kept, before the list's capacity
     if (lightGridQuery(f, lf.lightGrid, boxMin, boxMax, grid)) {
         lightGridMaskClear(f.lightCount, THREADS);
         UintBuffer entries = UintBuffer(grid.g.entries);
@@ -141,7 +142,7 @@ void main() {
                 atomicOr(sGridMask[index >> 5], 1u << (index & 31u));
         }
         barrier();
-        lightGridMaskCompact(f.lightCount, THREADS);
+        appended = lightGridMaskCompact(f.lightCount, THREADS);
     } else {
         for (uint base = 0u; base < lf.frustumLightCount; base += THREADS) {
             uint index = base + tid < lf.frustumLightCount ? frustumLights.v[base + tid] : LIGHT_INVALID;
@@ -150,9 +151,10 @@ void main() {
             uint slot = orderedAppend(keep);
             if (slot < LIGHT_TILE_MAX_LIGHTS) sList[slot] = uvec2(index, 0u);
         }
+        appended = sAppendCount;
     }
-    uint candidates = min(sAppendCount, LIGHT_TILE_MAX_LIGHTS);
-    if (tid == 0u && sAppendCount > LIGHT_TILE_MAX_LIGHTS)
+    uint candidates = min(appended, LIGHT_TILE_MAX_LIGHTS);
+    if (tid == 0u && appended > LIGHT_TILE_MAX_LIGHTS)
         atomicAdd(LightingCountersRef(lf.counters).c.tilesOverflowed, 1u);
     barrier();
 

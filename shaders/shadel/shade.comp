@@ -150,6 +150,10 @@ bool chunkBox(bool shading, vec3 p, out vec3 boxMin, out vec3 boxMax) {
 void cullChunkLights(FrameConstants f, bool shading, vec3 p) {
     LightingFrame lf = LightingFrameRef(f.lighting).l;
     uint tid = gl_LocalInvocationIndex;
+    const uint threads = SHADEL_CHUNK * SHADEL_CHUNK;
+    // The light grid's bit set is cleared under the box's barrier (no barrier of its own).
+    if (lf.lightGrid != 0ul && f.lightCount <= LIGHT_GRID_MASK_LIGHTS)
+        lightGridMaskClearUnsynced(f.lightCount, threads);
     vec3 boxMin, boxMax;
     gChunkHasBox = chunkBox(shading, p, boxMin, boxMax);
     gChunkBoxMin = boxMin, gChunkBoxMax = boxMax;
@@ -165,11 +169,11 @@ void cullChunkLights(FrameConstants f, bool shading, vec3 p) {
         corners[i] = vec3((i & 1) != 0 ? boxMax.x : boxMin.x, (i & 2) != 0 ? boxMax.y : boxMin.y,
                           (i & 4) != 0 ? boxMax.z : boxMin.z);
     LightBuffer lights = LightBuffer(f.lights);
-    const uint threads = SHADEL_CHUNK * SHADEL_CHUNK;
     // The lights near the box from the light grid; without it (or for a box larger than the
     // grid's cells), every light. The same list either way.
-    bool gridded = gridChunkLights(f, lf.lightGrid, boxMin, boxMax, corners, threads);
-    if (!gridded)
+    uint appended; // lights kept, before the list's capacity
+    bool gridded = gridChunkLights(f, lf.lightGrid, boxMin, boxMax, corners, threads, appended);
+    if (!gridded) {
         for (uint base = 0u; base < f.lightCount; base += threads) {
             uint index = base + tid;
             bool keep = false;
@@ -179,8 +183,11 @@ void cullChunkLights(FrameConstants f, bool shading, vec3 p) {
             uint slot = orderedAppend(keep);
             if (slot < LIGHT_CHUNK_MAX_LIGHTS) sLightList[slot] = uvec2(index, 0u);
         }
-    uint count = min(sAppendCount, LIGHT_CHUNK_MAX_LIGHTS);
+        appended = sAppendCount;
+    }
+    uint count = min(appended, LIGHT_CHUNK_MAX_LIGHTS);
     if (tid == 0u) sLightListCount = count;
+    barrier(); // the list's entries were written by other invocations
     for (uint i = tid; i < count; i += threads) {
         uint mask = lightBlockerMask(lf, lights.l[sLightList[i].x], corners, boxMin, boxMax);
         sLightList[i] = mask == LIGHT_INVALID ? uvec2(LIGHT_INVALID, 0u) : uvec2(sLightList[i].x, mask);
@@ -200,7 +207,7 @@ void cullChunkLights(FrameConstants f, bool shading, vec3 p) {
         atomicAdd(counters.c.lightGridCandidates, gridded ? sGridCandidates : f.lightCount);
         atomicAdd(counters.c.lightsCulledByBlockers, count - kept);
         if (perPixel) atomicAdd(counters.c.perPixelBlockerChunks, 1u);
-        if (sAppendCount > LIGHT_CHUNK_MAX_LIGHTS) atomicAdd(counters.c.chunksOverflowed, 1u);
+        if (appended > LIGHT_CHUNK_MAX_LIGHTS) atomicAdd(counters.c.chunksOverflowed, 1u);
     }
 }
 
