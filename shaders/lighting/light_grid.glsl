@@ -104,45 +104,32 @@ void lightGridMaskClear(uint lightCount, uint threads) {
 }
 
 // The kept lights of the bit set, in light order, into LIGHT_GRID_LIST (a shared uvec2 array of
-// LIGHT_GRID_LIST_MAX entries the includer names) from its start; returns how many there are
-// (the same in every invocation; entries past the array's end are counted, not written). One
-// barrier per `threads` x 32 lights (orderedAppend takes three): barriers are what a
-// workgroup's culling spends most on where invocations run in turn (lavapipe). Entries are
-// written by other invocations than the ones that read them: barrier before reading. Call
-// after a barrier that follows any earlier orderedAppend (it reuses its subgroup counts).
-uint lightGridMaskCompact(uint lightCount, uint threads) {
-    uint words = (lightCount + 31u) / 32u;
-    uint tid = gl_LocalInvocationIndex;
+// LIGHT_GRID_LIST_MAX entries the includer names) from its start; their count (entries past the
+// array's end are counted, not written) goes to orderedAppend's sAppendCount. One invocation
+// walks the set: a box keeps a few of its candidates (~7 of ~100 per chunk on builtin:lights)
+// and walking lightCount / 32 words costs less than a parallel compaction's subgroup scans and
+// barriers (on lavapipe, where a workgroup's invocations run in turn, 2.4 us a chunk). Barrier
+// before reading the list or the count.
+void lightGridMaskCompact(uint lightCount) {
+    if (gl_LocalInvocationIndex != 0u) return;
     uint placed = 0u;
-    for (uint base = 0u; base < words; base += threads) {
-        uint word = base + tid < words ? sGridMask[base + tid] : 0u;
-        uint n = bitCount(word);
-        uint inSubgroup = subgroupAdd(n);
-        uint slot = placed + subgroupExclusiveAdd(n);
-        if (subgroupElect()) sSubgroupCounts[gl_SubgroupID] = inSubgroup;
-        barrier();
-        for (uint s = 0u; s < gl_NumSubgroups; ++s) {
-            uint count = sSubgroupCounts[s];
-            slot += s < gl_SubgroupID ? count : 0u;
-            placed += count;
-        }
+    for (uint w = 0u; w < (lightCount + 31u) / 32u; ++w) {
+        uint word = sGridMask[w];
         while (word != 0u) {
             uint bit = uint(findLSB(word));
-            if (slot < LIGHT_GRID_LIST_MAX) LIGHT_GRID_LIST[slot] = uvec2((base + tid) * 32u + bit, 0u);
-            slot++;
+            if (placed < LIGHT_GRID_LIST_MAX) LIGHT_GRID_LIST[placed] = uvec2(w * 32u + bit, 0u);
+            placed++;
             word &= word - 1u;
         }
-        if (base + threads < words) barrier(); // before the next round rewrites the counts
     }
-    return placed;
+    sAppendCount = placed;
 }
 
 // A shadel chunk's lights: those chunkKeepsLight keeps, as the loop over every light in
-// shade.comp tests them; `appended`: how many (lightGridMaskCompact). The caller cleared the bit
-// set (lightGridMaskClearUnsynced, then a barrier) and barriers before reading the list.
+// shade.comp tests them. The caller cleared the bit set (lightGridMaskClearUnsynced, then a
+// barrier) and barriers before reading the list and its count (sAppendCount).
 bool gridChunkLights(FrameConstants f, uint64_t gridAddress, vec3 boxMin, vec3 boxMax,
-                     vec3 corners[8], uint threads, out uint appended) {
-    appended = 0u;
+                     vec3 corners[8], uint threads) {
     LightGridQuery q;
     if (!lightGridQuery(f, gridAddress, boxMin, boxMax, q)) return false;
     LightBuffer lights = LightBuffer(f.lights);
@@ -156,7 +143,7 @@ bool gridChunkLights(FrameConstants f, uint64_t gridAddress, vec3 boxMin, vec3 b
     }
     if (tested != 0u) atomicAdd(sGridCandidates, tested);
     barrier();
-    appended = lightGridMaskCompact(f.lightCount, threads);
+    lightGridMaskCompact(f.lightCount);
     return true;
 }
 

@@ -130,7 +130,6 @@ void main() {
     LightBuffer lights = LightBuffer(f.lights);
     UintBuffer frustumLights = UintBuffer(lf.frustumLights);
     LightGridQuery grid;
-    uint appended; // lights kept, before the list's capacity
     if (lightGridQuery(f, lf.lightGrid, boxMin, boxMax, grid)) {
         lightGridMaskClear(f.lightCount, THREADS);
         UintBuffer entries = UintBuffer(grid.g.entries);
@@ -142,7 +141,7 @@ void main() {
                 atomicOr(sGridMask[index >> 5], 1u << (index & 31u));
         }
         barrier();
-        appended = lightGridMaskCompact(f.lightCount, THREADS);
+        lightGridMaskCompact(f.lightCount);
     } else {
         for (uint base = 0u; base < lf.frustumLightCount; base += THREADS) {
             uint index = base + tid < lf.frustumLightCount ? frustumLights.v[base + tid] : LIGHT_INVALID;
@@ -151,12 +150,11 @@ void main() {
             uint slot = orderedAppend(keep);
             if (slot < LIGHT_TILE_MAX_LIGHTS) sList[slot] = uvec2(index, 0u);
         }
-        appended = sAppendCount;
     }
-    uint candidates = min(appended, LIGHT_TILE_MAX_LIGHTS);
-    if (tid == 0u && appended > LIGHT_TILE_MAX_LIGHTS)
+    barrier(); // the list and its count were written by other invocations
+    uint candidates = min(sAppendCount, LIGHT_TILE_MAX_LIGHTS);
+    if (tid == 0u && sAppendCount > LIGHT_TILE_MAX_LIGHTS)
         atomicAdd(LightingCountersRef(lf.counters).c.tilesOverflowed, 1u);
-    barrier();
 
     // Blockers: remove the lights a blocker hides from the whole tile, mark the partial ones.
     uint kept = 0u;

@@ -171,8 +171,7 @@ void cullChunkLights(FrameConstants f, bool shading, vec3 p) {
     LightBuffer lights = LightBuffer(f.lights);
     // The lights near the box from the light grid; without it (or for a box larger than the
     // grid's cells), every light. The same list either way.
-    uint appended; // lights kept, before the list's capacity
-    bool gridded = gridChunkLights(f, lf.lightGrid, boxMin, boxMax, corners, threads, appended);
+    bool gridded = gridChunkLights(f, lf.lightGrid, boxMin, boxMax, corners, threads);
     if (!gridded) {
         for (uint base = 0u; base < f.lightCount; base += threads) {
             uint index = base + tid;
@@ -183,11 +182,11 @@ void cullChunkLights(FrameConstants f, bool shading, vec3 p) {
             uint slot = orderedAppend(keep);
             if (slot < LIGHT_CHUNK_MAX_LIGHTS) sLightList[slot] = uvec2(index, 0u);
         }
-        appended = sAppendCount;
     }
+    barrier(); // the list and its count were written by other invocations
+    uint appended = sAppendCount; // lights kept, before the list's capacity
     uint count = min(appended, LIGHT_CHUNK_MAX_LIGHTS);
     if (tid == 0u) sLightListCount = count;
-    barrier(); // the list's entries were written by other invocations
     for (uint i = tid; i < count; i += threads) {
         uint mask = lightBlockerMask(lf, lights.l[sLightList[i].x], corners, boxMin, boxMax);
         sLightList[i] = mask == LIGHT_INVALID ? uvec2(LIGHT_INVALID, 0u) : uvec2(sLightList[i].x, mask);
