@@ -91,16 +91,11 @@ uint lightGridCandidateEntry(LightGridCandidates c, uint k) {
     return 0u; // not reached for k < c.total
 }
 
-// Clears the bit set; the caller's next barrier makes it visible (a chunk's shading clears it
-// before the barrier of its box, so culling costs no barrier of its own for it).
+// Clears the bit set; the caller's next barrier makes it visible (tile culling and a chunk's
+// shading clear it under a barrier they need anyway).
 void lightGridMaskClearUnsynced(uint lightCount, uint threads) {
     for (uint w = gl_LocalInvocationIndex; w < (lightCount + 31u) / 32u; w += threads) sGridMask[w] = 0u;
     if (gl_LocalInvocationIndex == 0u) sGridCandidates = 0u;
-}
-
-void lightGridMaskClear(uint lightCount, uint threads) {
-    lightGridMaskClearUnsynced(lightCount, threads);
-    barrier();
 }
 
 // The kept lights of the bit set, in light order, into LIGHT_GRID_LIST (a shared uvec2 array of

@@ -6,7 +6,9 @@
 // with blockers, each blocker's shadow volume from the light: a blocker that covers the whole
 // tile removes the light, one that covers part of it is kept as a (light, blocker) pair for the
 // per-pixel test. Lists keep the lights' order (ordered compaction), so tiled shading sums in
-// the same order as shading without culling.
+// the same order as shading without culling. Barriers are few (four on the grid's path): where
+// a workgroup's invocations run in turn (lavapipe) they are most of a tile's cost; the small
+// serial steps (compaction of the grid's bit set, the copy of the kept lights) run on one.
 #define LIGHT_CULL_ORDERED_APPEND
 #include "lighting/light_cull.glsl"
 #include "lighting/spectra.glsl"
@@ -21,9 +23,7 @@ layout(push_constant, scalar) uniform Push {
 #define THREADS 256u
 shared uint sDepthMin, sDepthMax;
 shared uvec2 sList[LIGHT_TILE_MAX_LIGHTS];
-shared bool sAnyPerPixel;
-shared uint sKept, sPoolBase;
-shared uint sFeatures; // SPECTRUM_* the tile's list needs (feature spectra)
+shared uint sKept;
 #define LIGHT_GRID_LIST sList
 #define LIGHT_GRID_LIST_MAX LIGHT_TILE_MAX_LIGHTS
 #include "lighting/light_grid.glsl"
@@ -66,20 +66,23 @@ void main() {
         sDepthMin = 0xFFFFFFFFu;
         sDepthMax = 0u;
         sAppendCount = 0u;
-        sAnyPerPixel = false;
         sKept = 0u;
-        sFeatures = 0u;
     }
+    // The light grid's bit set, cleared under the same barrier.
+    if (lf.lightGrid != 0ul && f.lightCount <= LIGHT_GRID_MASK_LIGHTS)
+        lightGridMaskClearUnsynced(f.lightCount, THREADS);
     barrier();
-    // Depth bounds of the tile's covered pixels (reversed Z: 0 is the far plane, the sky).
+    // Depth bounds of the tile's covered pixels (reversed Z: 0 is the far plane, the sky):
+    // reduced over the subgroup first, one shared atomic per subgroup.
     ivec2 pixel = ivec2(gl_GlobalInvocationID.xy);
     ivec2 size = ivec2(f.viewportSize);
-    if (all(lessThan(pixel, size))) {
-        float d = fetchTextureUniform(pc.depthSlot, pixel, 0).r;
-        if (d > 0.0) {
-            atomicMin(sDepthMin, floatBitsToUint(d));
-            atomicMax(sDepthMax, floatBitsToUint(d));
-        }
+    float d = all(lessThan(pixel, size)) ? fetchTextureUniform(pc.depthSlot, pixel, 0).r : 0.0;
+    bool covered = d > 0.0;
+    uint depthMin = subgroupMin(covered ? floatBitsToUint(d) : 0xFFFFFFFFu);
+    uint depthMax = subgroupMax(covered ? floatBitsToUint(d) : 0u);
+    if (subgroupElect() && depthMax != 0u) {
+        atomicMin(sDepthMin, depthMin);
+        atomicMax(sDepthMax, depthMax);
     }
     barrier();
     if (sDepthMax == 0u) { // nothing but sky
@@ -130,8 +133,7 @@ void main() {
     LightBuffer lights = LightBuffer(f.lights);
     UintBuffer frustumLights = UintBuffer(lf.frustumLights);
     LightGridQuery grid;
-    if (lightGridQuery(f, lf.lightGrid, boxMin, boxMax, grid)) {
-        lightGridMaskClear(f.lightCount, THREADS);
+    if (lightGridQuery(f, lf.lightGrid, boxMin, boxMax, grid)) { // (its bit set is cleared)
         UintBuffer entries = UintBuffer(grid.g.entries);
         LightGridCandidates candidates = lightGridCandidates(grid);
         for (uint k = tid; k < candidates.total; k += THREADS) {
@@ -167,37 +169,31 @@ void main() {
     }
     atomicAdd(sKept, kept);
     barrier();
-    // The tile's place in the shared pool (lists take what they need, not a worst case each).
+    // The tile's place in the shared pool (lists take what they need, not a worst case each),
+    // and its kept lights copied there in order by one invocation: a tile keeps tens of lights,
+    // and a walk over them costs less than a parallel ordered append's barriers.
+    if (tid != 0u) return;
     LightingCountersRef counters = LightingCountersRef(lf.counters);
-    if (tid == 0u) {
-        atomicAdd(counters.c.lightsCulledByBlockers, candidates - sKept);
-        uint base = atomicAdd(counters.c.tileListEntries, sKept);
-        uint room = base < lf.poolCapacity ? lf.poolCapacity - base : 0u;
-        if (room < sKept) atomicAdd(counters.c.tilesOverflowed, 1u);
-        sPoolBase = base;
-        sKept = min(sKept, room);
-        LightListBuffer(lf.tileRanges).e[tile] = uvec2(base, sKept);
-        atomicAdd(counters.c.lightTilePairs, sKept);
-        sAppendCount = 0u;
-    }
-    barrier();
-    LightListBuffer outList = LightListBuffer(lf.tileLights + uint64_t(sPoolBase) * 8ul);
-    uint room = sKept;
+    uint keptLights = sKept;
+    atomicAdd(counters.c.lightsCulledByBlockers, candidates - keptLights);
+    uint poolBase = atomicAdd(counters.c.tileListEntries, keptLights);
+    uint room = poolBase < lf.poolCapacity ? lf.poolCapacity - poolBase : 0u;
+    if (room < keptLights) atomicAdd(counters.c.tilesOverflowed, 1u);
+    keptLights = min(keptLights, room);
+    LightListBuffer(lf.tileRanges).e[tile] = uvec2(poolBase, keptLights);
+    atomicAdd(counters.c.lightTilePairs, keptLights);
+    LightListBuffer outList = LightListBuffer(lf.tileLights + uint64_t(poolBase) * 8ul);
     uint features = 0u;
-    for (uint base = 0u; base < candidates; base += THREADS) {
-        uint i = base + tid;
-        uvec2 entry = i < candidates ? sList[i] : uvec2(LIGHT_INVALID);
-        bool keep = entry.x != LIGHT_INVALID;
-        uint slot = orderedAppend(keep);
-        if (keep && slot < room) {
-            outList.e[slot] = entry;
-            if (entry.y != 0u) sAnyPerPixel = true;
-            atomicOr(UintBuffer(lf.visibleLights).v[entry.x >> 5], 1u << (entry.x & 31u));
-            if (lf.spectra != 0ul) features |= entryFeatures(lf, lights.l[entry.x], entry.y, corners);
-        }
+    bool anyPerPixel = false;
+    uint written = 0u;
+    for (uint i = 0u; i < candidates && written < keptLights; ++i) {
+        uvec2 entry = sList[i];
+        if (entry.x == LIGHT_INVALID) continue;
+        outList.e[written++] = entry;
+        anyPerPixel = anyPerPixel || entry.y != 0u;
+        atomicOr(UintBuffer(lf.visibleLights).v[entry.x >> 5], 1u << (entry.x & 31u));
+        if (lf.spectra != 0ul) features |= entryFeatures(lf, lights.l[entry.x], entry.y, corners);
     }
-    if (features != 0u) atomicOr(sFeatures, features);
-    barrier();
-    if (tid == 0u && sAnyPerPixel) atomicAdd(counters.c.perPixelBlockerTiles, 1u);
-    if (tid == 0u) binTileSpectrum(lf, tile, sFeatures | frameFeatures(f, lf));
+    if (anyPerPixel) atomicAdd(counters.c.perPixelBlockerTiles, 1u);
+    binTileSpectrum(lf, tile, features | frameFeatures(f, lf));
 }
