@@ -182,32 +182,37 @@ void cullChunkLights(FrameConstants f, bool shading, vec3 p) {
             uint slot = orderedAppend(keep);
             if (slot < LIGHT_CHUNK_MAX_LIGHTS) sLightList[slot] = uvec2(index, 0u);
         }
+        barrier(); // the entries were written by other invocations
     }
-    barrier(); // the list and its count were written by other invocations
-    uint appended = sAppendCount; // lights kept, before the list's capacity
-    uint count = min(appended, LIGHT_CHUNK_MAX_LIGHTS);
-    if (tid == 0u) sLightListCount = count;
-    for (uint i = tid; i < count; i += threads) {
-        uint mask = lightBlockerMask(lf, lights.l[sLightList[i].x], corners, boxMin, boxMax);
-        sLightList[i] = mask == LIGHT_INVALID ? uvec2(LIGHT_INVALID, 0u) : uvec2(sLightList[i].x, mask);
-    }
-    barrier();
-    if (tid == 0u && kChunkSpectraPhase != CHUNK_SPECTRA_SHADE) { // counted once per chunk
+    // One invocation finishes the list (the grid's compaction ran on it too): each light's
+    // blockers against the box, and the counts. A chunk keeps a few lights; walking them costs
+    // less than the barrier a parallel pass needs (lavapipe runs invocations in turn).
+    if (tid == 0u) {
+        uint appended = sAppendCount; // lights kept, before the list's capacity
+        uint count = min(appended, LIGHT_CHUNK_MAX_LIGHTS);
+        sLightListCount = count;
+        bool counting = kChunkSpectraPhase != CHUNK_SPECTRA_SHADE; // once per chunk
         uint kept = 0u;
         bool perPixel = false;
         for (uint i = 0u; i < count; ++i) {
-            if (sLightList[i].x == LIGHT_INVALID) continue;
+            uint light = sLightList[i].x;
+            uint mask = lightBlockerMask(lf, lights.l[light], corners, boxMin, boxMax);
+            sLightList[i] = mask == LIGHT_INVALID ? uvec2(LIGHT_INVALID, 0u) : uvec2(light, mask);
+            if (mask == LIGHT_INVALID) continue;
             kept++;
-            perPixel = perPixel || sLightList[i].y != 0u;
-            atomicOr(UintBuffer(lf.visibleLights).v[sLightList[i].x >> 5], 1u << (sLightList[i].x & 31u));
+            perPixel = perPixel || mask != 0u;
+            if (counting) atomicOr(UintBuffer(lf.visibleLights).v[light >> 5], 1u << (light & 31u));
         }
-        LightingCountersRef counters = LightingCountersRef(lf.counters);
-        atomicAdd(counters.c.lightChunkPairs, kept);
-        atomicAdd(counters.c.lightGridCandidates, gridded ? sGridCandidates : f.lightCount);
-        atomicAdd(counters.c.lightsCulledByBlockers, count - kept);
-        if (perPixel) atomicAdd(counters.c.perPixelBlockerChunks, 1u);
-        if (appended > LIGHT_CHUNK_MAX_LIGHTS) atomicAdd(counters.c.chunksOverflowed, 1u);
+        if (counting) {
+            LightingCountersRef counters = LightingCountersRef(lf.counters);
+            atomicAdd(counters.c.lightChunkPairs, kept);
+            atomicAdd(counters.c.lightGridCandidates, gridded ? sGridCandidates : f.lightCount);
+            atomicAdd(counters.c.lightsCulledByBlockers, count - kept);
+            if (perPixel) atomicAdd(counters.c.perPixelBlockerChunks, 1u);
+            if (appended > LIGHT_CHUNK_MAX_LIGHTS) atomicAdd(counters.c.chunksOverflowed, 1u);
+        }
     }
+    barrier();
 }
 
 #include "lighting/chunk_spectra_classify.glsl" // --spectra: binning chunks by features
