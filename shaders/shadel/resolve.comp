@@ -7,6 +7,7 @@
 // instead (shadel/vis_shadel.glsl, the same samples as the marking): misses and overflow are
 // shaded forward here from the rebuilt attributes. Every other pixel gets the sky: forward
 // (hybrid) instances are drawn over it by the raster pass that follows.
+#extension GL_KHR_shader_subgroup_arithmetic : require
 #include "shadel/resolve.glsl"
 #include "shadel/resolve_address.glsl"
 #include "shadel/vis_shadel.glsl"
@@ -51,8 +52,6 @@ vec3 forwardShade(FrameConstants f, GpuInstance inst, VisTriangle tri, VisBary b
     return color;
 }
 
-// The frame's counters summed per workgroup first: one global atomic per group and counter.
-shared uint sMagnified, sSampled, sMisses, sOverflow;
 
 // The filter over the footprints marking addressed; missing/overflowed count the lookups that
 // found no storage (the pixel is then rebuilt and shaded forward).
@@ -141,23 +140,19 @@ void resolveQuad(FrameConstants f, ShadelFrame s, ivec2 origin, inout uvec4 coun
 }
 
 void main() {
-    if (gl_LocalInvocationIndex == 0u) sMagnified = sSampled = sMisses = sOverflow = 0u;
-    barrier();
     ivec2 origin = ivec2(gl_GlobalInvocationID.xy) * 2;
     FrameConstants f = FrameConstantsRef(pc.frame).f;
     ShadelFrame s = ShadelFrameRef(f.shadel).s;
     uvec4 counts = uvec4(0u);
     if (origin.x < int(pc.width) && origin.y < int(pc.height)) resolveQuad(f, s, origin, counts);
-    if (counts.x != 0u) atomicAdd(sMagnified, counts.x);
-    if (counts.y != 0u) atomicAdd(sSampled, counts.y);
-    if (counts.z != 0u) atomicAdd(sMisses, counts.z);
-    if (counts.w != 0u) atomicAdd(sOverflow, counts.w);
-    barrier();
-    if (gl_LocalInvocationIndex == 0u) {
+    // The counts summed over the subgroup, one atomic each (no shared sums: their barriers cost
+    // more than the atomics where a workgroup's invocations run in turn, lavapipe).
+    counts = subgroupAdd(counts);
+    if (subgroupElect()) {
         ShadelCountersRef counters = ShadelCountersRef(s.counters);
-        if (sMagnified != 0u) atomicAdd(counters.c.magnifiedPixels, sMagnified);
-        if (sSampled != 0u) atomicAdd(counters.c.reconstructedPixels, sSampled);
-        if (sMisses != 0u) atomicAdd(counters.c.reconstructionMisses, sMisses);
-        if (sOverflow != 0u) atomicAdd(counters.c.overflowSamples, sOverflow);
+        if (counts.x != 0u) atomicAdd(counters.c.magnifiedPixels, counts.x);
+        if (counts.y != 0u) atomicAdd(counters.c.reconstructedPixels, counts.y);
+        if (counts.z != 0u) atomicAdd(counters.c.reconstructionMisses, counts.z);
+        if (counts.w != 0u) atomicAdd(counters.c.overflowSamples, counts.w);
     }
 }
