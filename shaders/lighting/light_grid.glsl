@@ -3,9 +3,9 @@
 // big list and the buckets of the at most 2x2x2 cells the box meets) are tested exactly as
 // without the grid, kept ones set in a shared bit set (a light listed in several buckets
 // counts once), and the bit set is compacted in light order, so the list is the one the loop
-// over every light would have built. Needs light_cull.glsl (orderedAppend's subgroup counts) and
-// GL_KHR_shader_subgroup_arithmetic; the includer defines LIGHT_GRID_LIST and
-// LIGHT_GRID_LIST_MAX (the shared list the compaction fills). Call in uniform control flow.
+// over every light would have built. Needs light_cull.glsl (orderedAppend's sAppendCount, which
+// the compaction sets); the includer defines LIGHT_GRID_LIST and LIGHT_GRID_LIST_MAX (the shared
+// list the compaction fills). Call in uniform control flow.
 #ifndef SHADEL_LIGHT_GRID_GLSL
 #define SHADEL_LIGHT_GRID_GLSL
 
@@ -22,11 +22,16 @@ struct LightGridQuery {
     ivec3 cells;
 };
 
-// False when the grid cannot answer: no grid, the box is larger than its coarsest cell, or
-// there are more lights than the bit set holds (the caller then tests every light).
+// Whether the grid can answer at all: there is one, and the bit set holds every light.
+bool lightGridUsable(FrameConstants f, uint64_t gridAddress) {
+    return gridAddress != 0ul && f.lightCount <= LIGHT_GRID_MASK_LIGHTS;
+}
+
+// False when the grid cannot answer: not usable, or the box is larger than its coarsest cell
+// (the caller then tests every light).
 bool lightGridQuery(FrameConstants f, uint64_t gridAddress, vec3 boxMin, vec3 boxMax,
                     out LightGridQuery q) {
-    if (gridAddress == 0ul || f.lightCount > LIGHT_GRID_MASK_LIGHTS) return false;
+    if (!lightGridUsable(f, gridAddress)) return false;
     q.g = LightGridRef(gridAddress).g;
     vec3 size = boxMax - boxMin;
     float extent = max(size.x, max(size.y, size.z));
@@ -91,10 +96,11 @@ uint lightGridCandidateEntry(LightGridCandidates c, uint k) {
     return 0u; // not reached for k < c.total
 }
 
-// Clears the bit set; the caller's next barrier makes it visible (tile culling and a chunk's
-// shading clear it under a barrier they need anyway).
-void lightGridMaskClearUnsynced(uint lightCount, uint threads) {
-    for (uint w = gl_LocalInvocationIndex; w < (lightCount + 31u) / 32u; w += threads) sGridMask[w] = 0u;
+// Clears the bit set when the grid is usable; the caller's next barrier makes it visible (tile
+// culling and a chunk's shading clear it under a barrier they need anyway).
+void lightGridMaskClearUnsynced(FrameConstants f, uint64_t gridAddress, uint threads) {
+    if (!lightGridUsable(f, gridAddress)) return;
+    for (uint w = gl_LocalInvocationIndex; w < (f.lightCount + 31u) / 32u; w += threads) sGridMask[w] = 0u;
     if (gl_LocalInvocationIndex == 0u) sGridCandidates = 0u;
 }
 

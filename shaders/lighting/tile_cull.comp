@@ -6,7 +6,7 @@
 // with blockers, each blocker's shadow volume from the light: a blocker that covers the whole
 // tile removes the light, one that covers part of it is kept as a (light, blocker) pair for the
 // per-pixel test. Lists keep the lights' order (ordered compaction), so tiled shading sums in
-// the same order as shading without culling. Barriers are few (four on the grid's path): where
+// the same order as shading without culling. Barriers are few (five on the grid's path): where
 // a workgroup's invocations run in turn (lavapipe) they are most of a tile's cost; the small
 // serial steps (compaction of the grid's bit set, the copy of the kept lights) run on one.
 #define LIGHT_CULL_ORDERED_APPEND
@@ -69,8 +69,7 @@ void main() {
         sKept = 0u;
     }
     // The light grid's bit set, cleared under the same barrier.
-    if (lf.lightGrid != 0ul && f.lightCount <= LIGHT_GRID_MASK_LIGHTS)
-        lightGridMaskClearUnsynced(f.lightCount, THREADS);
+    lightGridMaskClearUnsynced(f, lf.lightGrid, THREADS);
     barrier();
     // Depth bounds of the tile's covered pixels (reversed Z: 0 is the far plane, the sky):
     // reduced over the subgroup first, one shared atomic per subgroup.

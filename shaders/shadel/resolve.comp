@@ -52,7 +52,6 @@ vec3 forwardShade(FrameConstants f, GpuInstance inst, VisTriangle tri, VisBary b
     return color;
 }
 
-
 // The filter over the footprints marking addressed; missing/overflowed count the lookups that
 // found no storage (the pixel is then rebuilt and shaded forward).
 vec3 resolveAddressed(ShadelFrame s, ResolveAddress a, uint layerSlot, inout uint missing,

@@ -152,8 +152,7 @@ void cullChunkLights(FrameConstants f, bool shading, vec3 p) {
     uint tid = gl_LocalInvocationIndex;
     const uint threads = SHADEL_CHUNK * SHADEL_CHUNK;
     // The light grid's bit set is cleared under the box's barrier (no barrier of its own).
-    if (lf.lightGrid != 0ul && f.lightCount <= LIGHT_GRID_MASK_LIGHTS)
-        lightGridMaskClearUnsynced(f.lightCount, threads);
+    lightGridMaskClearUnsynced(f, lf.lightGrid, threads);
     vec3 boxMin, boxMax;
     gChunkHasBox = chunkBox(shading, p, boxMin, boxMax);
     gChunkBoxMin = boxMin, gChunkBoxMax = boxMax;

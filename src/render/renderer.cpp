@@ -371,8 +371,7 @@ FrameResult renderFrame(Renderer& r, const GpuScene& scene, const CameraView& ca
     uint64_t frame = address(gpu, r.frameConstants);
     double prepareMs = msSince(cpuStart);
     if (r.nextFrame) { // the next frame's frontend beside this frame's backend
-        if (r.decoupled)
-            prefetchCoarseVisit(r, scene, r.nextFrame->camera, r.nextFrame->sceneMoves);
+        prefetchCoarseVisit(r, scene, r.nextFrame->camera, r.nextFrame->sceneMoves);
         r.nextFrame.reset();
     }
 

@@ -1,5 +1,4 @@
 #include "rhi/gpu.h"
-#include <algorithm>
 
 #include "rhi/shader_reload.h"
 
