@@ -623,6 +623,9 @@ struct GpuShadelCounters {
     // Sampled reconstructed pixels read from a coarser level than they wanted because that
     // level's window (last frame's marks + margin) did not hold them yet.
     uint windowFallbackPixels;
+    // ... of those, the ones whose window lagged so far that they were shaded forward
+    // (SHADEL_MAX_WINDOW_FALLBACK, shaders/shadel/shadel.glsl).
+    uint windowForwardPixels;
     // Chunks queued for shading, by why they could not be carried over (SHADEL_SHADED_*).
     uint shadedBecause[SHADEL_SHADED_REASONS];
     uvec4 fillDispatch;  // x, y, z, marked blocks in the list: indirect args of the queue fill

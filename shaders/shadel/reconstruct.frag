@@ -56,9 +56,10 @@ void main() {
         beginInspect(f, inInstance, uint(gl_PrimitiveID), gl_FragCoord);
         inspectShadels(f, s, o, r, inShadelUv, texelDx, texelDy);
     }
-    if (r.missing + r.overflowed != 0u || inspect) {
+    bool shadeForward = r.missing + r.overflowed != 0u || r.forward;
+    if (shadeForward || inspect) {
         vec3 forward = forwardShade(f); // also prints the surface under --inspect
-        if (r.missing + r.overflowed != 0u) color = forward;
+        if (shadeForward) color = forward;
     }
     if (inspect) shaderPrintF3(f, PRINT_OUTPUT, color);
     outColor = vec4(visualizeReconstruction(f, o, r, color, inShadelUv, texelDx, texelDy), 1.0);

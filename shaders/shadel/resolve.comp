@@ -87,7 +87,10 @@ vec4 resolveRebuilt(FrameConstants f, ShadelFrame s, ivec2 origin, int i, ivec2 
                     r.overflowed != 0u ? 1u : 0u);
     if (r.sampled && r.windowFallback) // rare: only where a window lags the view
         atomicAdd(ShadelCountersRef(s.counters).c.windowFallbackPixels, 1u);
+    if (r.sampled && r.forward) // rarer: lagging by more than a level (a camera cut)
+        atomicAdd(ShadelCountersRef(s.counters).c.windowForwardPixels, 1u);
     vec3 c = r.color;
+    bool shadeForward = r.missing + r.overflowed != 0u || r.forward;
     bool inspect = inspecting(f, uvec2(pixel));
     if (inspect) {
         vec4 clip = f.viewProj * vec4(visInterpolate(v.bary.center,
@@ -97,10 +100,10 @@ vec4 resolveRebuilt(FrameConstants f, ShadelFrame s, ivec2 origin, int i, ivec2 
         beginInspect(f, vis.x, vis.y, vec4(vec2(pixel) + 0.5, clip.z / clip.w, 1.0));
         inspectShadels(f, s, o, r, v.shadelUv, v.texelDx, v.texelDy);
     }
-    if (r.missing + r.overflowed != 0u || inspect) {
+    if (shadeForward || inspect) {
         useTileDecalList(f, vec2(pixel) + 0.5); // decals, as forward shading applies them
         vec3 forward = forwardShade(f, inst, q.tri, v.bary, vis, pixel, inspect);
-        if (r.missing + r.overflowed != 0u) c = forward;
+        if (shadeForward) c = forward;
     }
     if (inspect) shaderPrintF3(f, PRINT_OUTPUT, c);
     return vec4(visualizeReconstruction(f, o, r, c, v.shadelUv, v.texelDx, v.texelDy), 1.0);

@@ -16,7 +16,7 @@
 
 #define RESOLVE_ADDRESS_NONE 0u    // no decoupled surface: the sky (hybrid objects drawn over it)
 #define RESOLVE_ADDRESS_READY 1u   // the footprints below
-#define RESOLVE_ADDRESS_REBUILD 2u // the resolve rebuilds the sample (more than one tap)
+#define RESOLVE_ADDRESS_REBUILD 2u // the resolve rebuilds the sample (more taps, or forward)
 
 // Laid out by 2x2 quads, the unit both passes walk: a quad's four pixels are 64 bytes together.
 layout(buffer_reference, scalar) buffer ResolveAddressBuffer { uvec4 v[]; };
@@ -61,7 +61,8 @@ uvec4 resolveAddressNone() { return uvec4(0u); } // kind RESOLVE_ADDRESS_NONE
 
 // magnified: the MIP-0 shadel is larger than the pixel (the resolve's statistics).
 uvec4 packResolveAddress(MarkedSample m, bool magnified) {
-    if (m.taps != 1u) return uvec4(RESOLVE_ADDRESS_REBUILD << kAddressExtraBit, 0u, 0u, 0u);
+    if (m.taps != 1u || m.forward) // rare: the resolve rebuilds it
+        return uvec4(RESOLVE_ADDRESS_REBUILD << kAddressExtraBit, 0u, 0u, 0u);
     uint blend = m.levels.two ? uint(m.levels.blend * 255.0 + 0.5) : 0u;
     uint extraX = RESOLVE_ADDRESS_READY | (m.levels.two ? 4u : 0u) | (m.windowFallback ? 8u : 0u);
     LevelFootprint a = m.footprint0, b = m.footprint1;

@@ -140,6 +140,17 @@ uint fitLevelsToWindows(ShadelObjectRef o, vec2 uv, inout ShadelLevels l) {
     return unheld;
 }
 
+// A sample whose wanted level's window lags by more than one level (a camera cut: last frame's
+// marks were elsewhere) is shaded forward instead of read that much coarser: from two levels
+// up, charts bleed into each other's shadels (bake.h: only levels <= log2(gutter) are clean)
+// and the blur shows. Marking marks nothing for it and the resolve shades it from its surface,
+// as a miss (counted apart: window_forward_pixel_fraction). One level up stays a read.
+const uint SHADEL_MAX_WINDOW_FALLBACK = 1u;
+
+bool windowFallbackTooDeep(ShadelLevels wanted, ShadelLevels fitted) {
+    return fitted.mip0 > wanted.mip0 + SHADEL_MAX_WINDOW_FALLBACK;
+}
+
 // Sheet shadel coordinate of an object's level texel (clamped to the level; the level's window
 // must hold it: fitLevelsToWindows).
 uvec2 sheetShadel(ShadelObjectRef o, uint mip, ivec2 texel) {

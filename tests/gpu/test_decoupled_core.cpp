@@ -351,3 +351,31 @@ TEST(DecoupledCore, LevelWindowsFollowAnOrbitWithoutHoles) {
     EXPECT_LT(fallback, 0.05);
     EXPECT_GE(worst, 40.0);
 }
+
+// A camera cut: on a 3-frame orbit each frame jumps a third of the way round, so last frame's
+// marks (the level windows) are elsewhere. A sample whose window lags by more than a level is
+// shaded forward instead of read from a level that coarse, where charts bleed into each other
+// (lit triangles on shadowed spheres) and the ground's shadows blur away.
+TEST(DecoupledCore, CameraCutsShadeWhatTheWindowsLagForward) {
+    RenderOptions o = decoupled("builtin:many", 320, 180);
+    o.frames = 3;
+    o.cameraPath = CameraPath::Orbit;
+    RenderRun windows = renderChecked(o);
+    o.levelWindows = false; // whole levels: nothing lags, the decoupled image to match
+    RenderRun whole = renderChecked(o);
+    RenderOptions f = renderOptions("builtin:many", RenderMode::Forward, 320, 180);
+    f.frames = 3;
+    f.cameraPath = CameraPath::Orbit;
+    RenderRun forward = renderChecked(f);
+    double forwardFraction = windows.stats["window_forward_pixel_fraction"].get<double>();
+    double toWhole = psnr(windows.frames.back().rgba, whole.frames.back().rgba);
+    double toForward = psnr(windows.frames.back().rgba, forward.frames.back().rgba);
+    std::printf("[ figures ] many 320x180, cut frame: %.3f of pixels shaded forward (%.3f fell "
+                "back); PSNR %.2f dB to whole levels, %.2f dB to forward\n",
+                forwardFraction, windows.stats["window_fallback_pixel_fraction"].get<double>(),
+                toWhole, toForward);
+    EXPECT_EQ(stat(windows, "reconstruction_misses"), 0u);
+    EXPECT_GT(forwardFraction, 0.1); // the cut is one (reading them coarser gave 25.8 / 25.4 dB)
+    EXPECT_GE(toWhole, 35.0);
+    EXPECT_GE(toForward, 35.0);
+}

@@ -401,8 +401,10 @@ static glm::uvec2 levelBlocks(const ShadelMeshInfo& mesh, uint32_t k) {
 // but read coarser because the window did not hold them: marking.glsl wantLevel), plus a
 // margin for the view's motion; a level nothing wanted holds no blocks at all (most levels of
 // builtin:many's 4000 small objects). A sample outside the window reads the next coarser level
-// for a frame (counted: window_fallback_pixel_fraction), never a hole. The coarsest level and
-// levels with no feedback yet (just placed) are held whole.
+// for a frame (counted: window_fallback_pixel_fraction), never a hole; one lagging by more than
+// a level (a camera cut) is shaded forward instead (window_forward_pixel_fraction, shadel.glsl
+// windowFallbackTooDeep). The coarsest level and levels with no feedback yet (just placed) are
+// held whole.
 
 static LevelWindow wholeLevel(const ShadelMeshInfo& mesh, uint32_t k) {
     return {glm::uvec2(0), levelBlocks(mesh, k)};
@@ -1268,6 +1270,11 @@ void decoupledStats(const Renderer& r, nlohmann::json& s) {
     s["window_fallback_pixel_fraction"] =
         last.counters.reconstructedPixels
             ? double(last.counters.windowFallbackPixels) / double(last.counters.reconstructedPixels)
+            : 0.0;
+    // Of all pixels, those whose window lagged more than a level: shaded forward (camera cuts).
+    s["window_forward_pixel_fraction"] =
+        last.counters.reconstructedPixels
+            ? double(last.counters.windowForwardPixels) / double(last.counters.reconstructedPixels)
             : 0.0;
     s["sheet_shadels"] = uint64_t(d.sheetBlocks) * SHADEL_BLOCK;
     // The seed's measure (~1.5 bits per shadel): the 64-bit occupancy mask + 32-bit offset of
