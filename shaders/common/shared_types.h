@@ -645,15 +645,17 @@ struct ShadelFrame {
     uint64_t copyQueue;    // GpuShadelWork[capacityChunks]: chunks carried over (chunk = old slot)
     uint64_t idMaps;       // uint16 triangle ids, packed in uints
     uint64_t shadelUvs;    // vec2 per vertex of the unified geometry buffer
-    uint sheetBlocks;      // blocks per side of the virtual sheet
+    // The shade storage's layers, chunk-linear buffers (shaders/shadel/shadel.glsl storageIndex:
+    // shadel (x, y) of the chunk in slot s is element s * 64 + y * 8 + x): radiance uvec2 (RGBA16F
+    // halves), material uint (RGBA8 unorm). This frame's, and last frame's for preserved layers.
+    uint64_t layers[SHADEL_LAYERS];
+    uint64_t prevLayers[SHADEL_LAYERS];
+    uint sheetBlocks; // blocks per side of the virtual sheet
     uint rectCount;
     uint rectBlockCount;
-    uint storageReadSlot;                  // bindless sampled view of this frame's radiance layer
-    uint layerWriteSlot[SHADEL_LAYERS];    // this frame's layers (storage images)
-    uint layerReadSlot[SHADEL_LAYERS];     // this frame's layers (sampled)
-    uint prevLayerReadSlot[SHADEL_LAYERS]; // last frame's layers (sampled): preserved layers
-    uint64_t prevOccupancy;                // last frame's occupancy masks
-    uint64_t prevOffsetMap;                // last frame's offset map
+    uint pad0;              // the 64-bit fields below stay 8-byte aligned in C++ and GLSL
+    uint64_t prevOccupancy; // last frame's occupancy masks
+    uint64_t prevOffsetMap; // last frame's offset map
     // Reuse: per storage slot, where its chunk was seen from when shaded (carried over with it):
     // uvec4 {centre of the chunk's world box (float bits), the unit direction from the centre to
     // the camera (octahedral, packSnorm2x16)}; x = SHADEL_CHUNK_VIEW_NONE: nothing shaded in it.
@@ -670,7 +672,6 @@ struct ShadelFrame {
     uint frameNumber;   // frames rendered by this renderer (refresh phase)
     uint reuse;         // 0: reshade everything (--reuse off)
     uint refreshPeriod; // frames a carried-over chunk may go unshaded (--reuse-refresh)
-    uint storageChunksPerRow;
     uint capacityChunks;
     uint markedCapacity;     // entries of markedBlocks (= capacityChunks: a block needs >= 1 chunk)
     uint allocationCounters; // hashed counters in use (SHADEL_COUNTERS; fewer only for tests)

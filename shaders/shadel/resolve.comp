@@ -53,13 +53,15 @@ vec3 forwardShade(FrameConstants f, GpuInstance inst, VisTriangle tri, VisBary b
 }
 
 // The filter over the footprints marking addressed; missing/overflowed count the lookups that
-// found no storage (the pixel is then rebuilt and shaded forward).
-vec3 resolveAddressed(ShadelFrame s, ResolveAddress a, uint layerSlot, inout uint missing,
-                      inout uint overflowed) {
+// found no storage (the pixel is then rebuilt and shaded forward). Always the radiance layer:
+// the debug views (--visualize layer:material among them) take the rebuilt path, so the taps'
+// layer is a constant here.
+vec3 resolveAddressed(ShadelFrame s, ResolveAddress a, inout uint missing, inout uint overflowed) {
+    const uint layer = SHADEL_LAYER_RADIANCE;
     uint64_t mask;
-    vec3 c = sampleFootprint(s, a.footprint0, layerSlot, missing, overflowed, mask);
+    vec3 c = sampleFootprint(s, a.footprint0, layer, missing, overflowed, mask);
     if (a.two)
-        c = mix(c, sampleFootprint(s, a.footprint1, layerSlot, missing, overflowed, mask), a.blend);
+        c = mix(c, sampleFootprint(s, a.footprint1, layer, missing, overflowed, mask), a.blend);
     return c;
 }
 
@@ -114,7 +116,6 @@ void resolveQuad(FrameConstants f, ShadelFrame s, ivec2 origin, inout uvec4 coun
     VisQuad q;
     ShadelObjectRef o;
     GpuInstance inst;
-    uint layerSlot = reconstructionLayer(f, s);
     for (int i = 0; i < 4; ++i) {
         ivec2 pixel = origin + ivec2(i & 1, i >> 1);
         if (pixel.x >= int(pc.width) || pixel.y >= int(pc.height)) continue;
@@ -125,7 +126,7 @@ void resolveQuad(FrameConstants f, ShadelFrame s, ivec2 origin, inout uvec4 coun
                        inspecting(f, uvec2(pixel));
         if (a.kind == RESOLVE_ADDRESS_READY && !rebuild) {
             uint missing = 0u, overflowed = 0u;
-            vec3 c = resolveAddressed(s, a, layerSlot, missing, overflowed);
+            vec3 c = resolveAddressed(s, a, missing, overflowed);
             if (missing + overflowed == 0u) {
                 bool sampled = all(equal(pixel & 1, ivec2(0))); // as reconstructSample samples
                 counts += uvec4(sampled && a.magnified ? 1u : 0u, sampled ? 1u : 0u, 0u, 0u);

@@ -21,14 +21,15 @@ int chunkSlotAt(ShadelFrame s, uvec2 sheet, inout uint missing, inout uint overf
     return int(chunkSlot(mask, base, bit));
 }
 
-// The stored value of a sheet shadel whose chunk has storage slot `slot` (black for -1).
-vec3 storageTap(ShadelFrame s, uint layerSlot, int slot, uvec2 sheet) {
+// The stored value of a sheet shadel whose chunk has storage slot `slot` (black for -1), from
+// storage layer `layer` (SHADEL_LAYER_*; the material layer shows its RGB, the base colour).
+vec3 storageTap(ShadelFrame s, uint layer, int slot, uvec2 sheet) {
     if (slot < 0) return vec3(0.0);
-    return fetchTextureUniform(layerSlot, storageTexel(s, uint(slot), sheet % SHADEL_CHUNK), 0).rgb;
+    return loadLayer(s, layer, storageIndex(uint(slot), sheet % SHADEL_CHUNK)).rgb;
 }
 
 // The bilinear filter over a level footprint (levelFootprint).
-vec3 sampleFootprint(ShadelFrame s, LevelFootprint fp, uint layerSlot, inout uint missing,
+vec3 sampleFootprint(ShadelFrame s, LevelFootprint fp, uint layer, inout uint missing,
                      inout uint overflowed, out uint64_t firstMask) {
     // The footprint's two columns and two rows in the sheet (clamped to the level). Each of its
     // four taps reads the chunk holding it; one chunk lookup serves all four unless the
@@ -47,16 +48,16 @@ vec3 sampleFootprint(ShadelFrame s, LevelFootprint fp, uint layerSlot, inout uin
     int s11 = cross.x && cross.y ? chunkSlotAt(s, hi, missing, overflowed, mask)
               : cross.x          ? s10
                                  : s01;
-    vec3 c00 = storageTap(s, layerSlot, s00, lo);
-    vec3 c10 = storageTap(s, layerSlot, s10, uvec2(hi.x, lo.y));
-    vec3 c01 = storageTap(s, layerSlot, s01, uvec2(lo.x, hi.y));
-    vec3 c11 = storageTap(s, layerSlot, s11, hi);
+    vec3 c00 = storageTap(s, layer, s00, lo);
+    vec3 c10 = storageTap(s, layer, s10, uvec2(hi.x, lo.y));
+    vec3 c01 = storageTap(s, layer, s01, uvec2(lo.x, hi.y));
+    vec3 c11 = storageTap(s, layer, s11, hi);
     return mix(mix(c00, c10, w.x), mix(c01, c11, w.x), w.y);
 }
 
-vec3 sampleLevel(ShadelFrame s, ShadelObjectRef o, uint mip, vec2 uv, uint layerSlot,
+vec3 sampleLevel(ShadelFrame s, ShadelObjectRef o, uint mip, vec2 uv, uint layer,
                  inout uint missing, inout uint overflowed, out uint64_t firstMask) {
-    return sampleFootprint(s, levelFootprint(o, mip, uv), layerSlot, missing, overflowed,
+    return sampleFootprint(s, levelFootprint(o, mip, uv), layer, missing, overflowed,
                            firstMask);
 }
 
@@ -75,9 +76,9 @@ struct Reconstruction {
 
 // texelDx/Dy: screen derivatives of the MIP-0 shadel coordinate; pixel: for the sampled
 // statistics (one pixel of every 2x2). The caller counts (countReconstruction or its own sums).
-// layerSlot: the storage layer to read (the radiance layer, or another for --visualize layer:X).
+// layer: the storage layer to read (SHADEL_LAYER_RADIANCE, or another for --visualize layer:X).
 Reconstruction reconstructSample(ShadelFrame s, ShadelObjectRef o, vec2 shadelUv, vec2 texelDx,
-                                 vec2 texelDy, ivec2 pixel, uint layerSlot) {
+                                 vec2 texelDy, ivec2 pixel, uint layer) {
     ShadelLevels wanted = shadelLevels(o, texelDx, texelDy, s.shadingBias, s.trilinearBand);
     Reconstruction r;
     r.missing = 0u;
@@ -100,13 +101,13 @@ Reconstruction reconstructSample(ShadelFrame s, ShadelObjectRef o, vec2 shadelUv
             }
             continue;
         }
-        vec3 c = sampleLevel(s, o, l.mip0, uv, layerSlot, r.missing, r.overflowed, tapMask);
+        vec3 c = sampleLevel(s, o, l.mip0, uv, layer, r.missing, r.overflowed, tapMask);
         if (i == 0u) {
             r.mask0 = tapMask;
             r.mip0 = l.mip0;
             r.lod = float(l.mip0) + l.blend;
         }
-        if (l.two) c = mix(c, sampleLevel(s, o, l.mip1, uv, layerSlot, r.missing, r.overflowed, mask1), l.blend);
+        if (l.two) c = mix(c, sampleLevel(s, o, l.mip1, uv, layer, r.missing, r.overflowed, mask1), l.blend);
         r.color += c;
     }
     r.color /= float(a.taps);
@@ -118,11 +119,10 @@ Reconstruction reconstructSample(ShadelFrame s, ShadelObjectRef o, vec2 shadelUv
     return r;
 }
 
-// The storage layer the reconstruction shows: radiance, or the material layer for
-// --visualize layer:material.
+// The storage layer the reconstruction shows (SHADEL_LAYER_*): radiance, or the material layer
+// for --visualize layer:material.
 uint reconstructionLayer(FrameConstants f, ShadelFrame s) {
-    return f.visualize == VISUALIZE_LAYER_MATERIAL ? s.layerReadSlot[SHADEL_LAYER_MATERIAL]
-                                                   : s.storageReadSlot;
+    return f.visualize == VISUALIZE_LAYER_MATERIAL ? SHADEL_LAYER_MATERIAL : SHADEL_LAYER_RADIANCE;
 }
 
 // The frame's counters, one pixel at a time (raster reconstruction).

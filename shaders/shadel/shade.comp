@@ -23,9 +23,9 @@
 layout(local_size_x = 8, local_size_y = 8) in;
 layout(push_constant, scalar) uniform Push { uint64_t frame; } pc;
 
-void storeLayers(ShadelFrame s, ivec2 texel, vec4 radiance, vec4 material) {
-    imageStore(gImagesRgba16f[s.layerWriteSlot[SHADEL_LAYER_RADIANCE]], texel, radiance);
-    imageStore(gImagesRgba8[s.layerWriteSlot[SHADEL_LAYER_MATERIAL]], texel, material);
+void storeLayers(ShadelFrame s, uint index, vec4 radiance, vec4 material) {
+    storeRadiance(s.layers[SHADEL_LAYER_RADIANCE], index, radiance);
+    storeMaterial(s.layers[SHADEL_LAYER_MATERIAL], index, material);
 }
 
 uint triangleId(ShadelFrame s, uint offset) {
@@ -53,12 +53,13 @@ int carrySource(ShadelFrame s, ShadelObjectRef o, GpuShadelWork work, vec3 camer
     return chunkViewTurned(s, o, slot, camera) ? -1 : int(slot);
 }
 
-void carryOver(ShadelFrame s, uint fromSlot, uint toSlot, ivec2 outTexel) {
-    ivec2 from = storageTexel(s, fromSlot, gl_LocalInvocationID.xy);
-    imageStore(gImagesRgba16f[s.layerWriteSlot[SHADEL_LAYER_RADIANCE]], outTexel,
-               fetchTexture(s.prevLayerReadSlot[SHADEL_LAYER_RADIANCE], from, 0));
-    imageStore(gImagesRgba8[s.layerWriteSlot[SHADEL_LAYER_MATERIAL]], outTexel,
-               fetchTexture(s.prevLayerReadSlot[SHADEL_LAYER_MATERIAL], from, 0));
+// Copies the packed words as they are (no unpack and repack).
+void carryOver(ShadelFrame s, uint fromSlot, uint toSlot, uint outIndex) {
+    uint from = storageIndex(fromSlot, gl_LocalInvocationID.xy);
+    ShadeRadianceLayer(s.layers[SHADEL_LAYER_RADIANCE]).v[outIndex] =
+        ShadeRadianceLayer(s.prevLayers[SHADEL_LAYER_RADIANCE]).v[from];
+    ShadeMaterialLayer(s.layers[SHADEL_LAYER_MATERIAL]).v[outIndex] =
+        ShadeMaterialLayer(s.prevLayers[SHADEL_LAYER_MATERIAL]).v[from];
     if (gl_LocalInvocationIndex == 0u) {
         Uvec4Buffer(s.chunkViews).v[toSlot] = Uvec4Buffer(s.prevChunkViews).v[fromSlot];
         atomicAdd(ShadelCountersRef(s.counters).c.chunksReused, 1u);
@@ -260,7 +261,7 @@ void main() {
     GpuShadelWork work = ShadelWorkBuffer(s.queue).w[workIndex];
     ShadelObjectRef o = shadelObject(s, work.object);
     uvec2 local = gl_LocalInvocationID.xy;
-    ivec2 outTexel = storageTexel(s, work.slot, local);
+    uint outIndex = storageIndex(work.slot, local);
     // Chunks of objects a changed region meets come here even when reusable (the fill pass
     // cannot tell which of their shadels the change reaches): carry over those it does not.
     // (With spectra the classify phase decided: a binned chunk is shaded.)
@@ -270,7 +271,7 @@ void main() {
                         : -1;
     if (carrySlot >= 0 && chunkTouchesChange(f, s, o, work)) carrySlot = -1;
     if (carrySlot >= 0) {
-        carryOver(s, uint(carrySlot), work.slot, outTexel);
+        carryOver(s, uint(carrySlot), work.slot, outIndex);
         return;
     }
 
@@ -323,7 +324,7 @@ void main() {
     if (debugLinesOn(f, DEBUG_LINES_CHUNKS))
         debugWorkgroupBox(f, shading, si.position, debugLevelColour(work.mip));
     if (!shading) {
-        storeLayers(s, outTexel, vec4(0.0), vec4(0.0));
+        storeLayers(s, outIndex, vec4(0.0), vec4(0.0));
         return;
     }
     // No rasterizer here: a surface faces the viewer when its normal points at the camera.
@@ -346,5 +347,5 @@ void main() {
                                   s.materialSamples, uvec3(shadel, work.object * 16u + work.mip),
                                   material);
     color = visualizeChunkSpectrum(f, visualizeLighting(f, color));
-    storeLayers(s, outTexel, vec4(color, 1.0), material);
+    storeLayers(s, outIndex, vec4(color, 1.0), material);
 }

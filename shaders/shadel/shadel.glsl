@@ -258,8 +258,38 @@ bool chunkViewTurned(ShadelFrame s, ShadelObjectRef o, uint prevSlot, vec3 camer
     return dot(then, toCamera / len) < o.v.viewDriftCos; // cosines: no acos per chunk
 }
 
-ivec2 storageTexel(ShadelFrame s, uint slot, uvec2 inChunk) {
-    uvec2 c = uvec2(slot % s.storageChunksPerRow, slot / s.storageChunksPerRow);
-    return ivec2(c * SHADEL_CHUNK + inChunk);
+// The shade storage (ShadelFrame::layers): one buffer per layer, chunk-linear, so a chunk's
+// shadels are contiguous (a carried-over chunk is one block copy) and a tap is a buffer load (a
+// bindless texelFetch costs far more on CPU devices). Callers go through the load/store pairs
+// below and never pack by hand.
+layout(buffer_reference, scalar, buffer_reference_align = 8) buffer ShadeRadianceLayer { uvec2 v[]; };
+layout(buffer_reference, scalar, buffer_reference_align = 4) buffer ShadeMaterialLayer { uint v[]; };
+
+// Element of shadel `inChunk` (0..7 each) of the chunk in storage slot `slot`.
+uint storageIndex(uint slot, uvec2 inChunk) {
+    return slot * (SHADEL_CHUNK * SHADEL_CHUNK) + inChunk.y * SHADEL_CHUNK + inChunk.x;
+}
+
+// Radiance: RGBA16F as two packHalf2x16 words.
+vec4 loadRadiance(uint64_t layer, uint index) {
+    uvec2 v = ShadeRadianceLayer(layer).v[index];
+    return vec4(unpackHalf2x16(v.x), unpackHalf2x16(v.y));
+}
+void storeRadiance(uint64_t layer, uint index, vec4 radiance) {
+    ShadeRadianceLayer(layer).v[index] = uvec2(packHalf2x16(radiance.rg), packHalf2x16(radiance.ba));
+}
+
+// Material: base colour + roughness, RGBA8 unorm (packUnorm4x8 clamps to [0, 1]).
+vec4 loadMaterial(uint64_t layer, uint index) {
+    return unpackUnorm4x8(ShadeMaterialLayer(layer).v[index]);
+}
+void storeMaterial(uint64_t layer, uint index, vec4 material) {
+    ShadeMaterialLayer(layer).v[index] = packUnorm4x8(material);
+}
+
+// Either layer by its index (SHADEL_LAYER_*), as the reconstruction's debug views choose it.
+vec4 loadLayer(ShadelFrame s, uint layer, uint index) {
+    return layer == SHADEL_LAYER_MATERIAL ? loadMaterial(s.layers[SHADEL_LAYER_MATERIAL], index)
+                                          : loadRadiance(s.layers[SHADEL_LAYER_RADIANCE], index);
 }
 #endif

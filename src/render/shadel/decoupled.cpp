@@ -201,14 +201,16 @@ static BufferHandle need(BufferHandle b, const char* what) {
 static void registerDecoupledCaptures(Renderer& r, DecoupledState& d) {
     Gpu& gpu = *r.gpu;
     auto done = [&d] { return uint32_t((d.frameNumber + 1) & 1); }; // frameNumber moved on
-    auto layer = [&d, done](uint32_t l) { return d.storage.frames[done()][l].texture; };
-    registerTextureCapture(
-        r.captures, gpu, "storage.radiance", "shade storage: lit radiance (EXR)", CaptureKind::Hdr,
-        [=] { return layer(SHADEL_LAYER_RADIANCE); }, VK_IMAGE_LAYOUT_GENERAL);
-    registerTextureCapture(
-        r.captures, gpu, "storage.material", "shade storage: base colour, roughness in alpha (PNG)",
-        CaptureKind::Display, [=] { return layer(SHADEL_LAYER_MATERIAL); },
-        VK_IMAGE_LAYOUT_GENERAL);
+    // The chunk-linear buffers laid out as the 2-D atlas their slots tile.
+    registerCapture(r.captures, "storage.radiance", "shade storage: lit radiance (EXR)",
+                    CaptureKind::Hdr, [&gpu, &d, done] {
+                        return readShadeLayerAtlas(gpu, d.storage, done(), SHADEL_LAYER_RADIANCE);
+                    });
+    registerCapture(r.captures, "storage.material",
+                    "shade storage: base colour, roughness in alpha (PNG)", CaptureKind::Display,
+                    [&gpu, &d, done] {
+                        return readShadeLayerAtlas(gpu, d.storage, done(), SHADEL_LAYER_MATERIAL);
+                    });
     registerCapture(r.captures, "occupancy", "chunks marked per sheet block, 0..64 (heat PNG)",
                     CaptureKind::Mask, [&gpu, &d, done] {
                         return readMaskGrid(gpu, d.occupancy[done()], d.sheetBlocks);
@@ -931,18 +933,15 @@ void prepareDecoupledFrame(Renderer& r, const GpuScene& scene, const CameraView&
     s.rectCount = uint32_t(d.rects.size());
     s.rectBlockCount = d.rectBlockCount;
     for (uint32_t l = 0; l < SHADEL_LAYERS; ++l) {
-        s.layerWriteSlot[l] = slot(gpu, d.storage.frames[now][l].write).value;
-        s.layerReadSlot[l] = slot(gpu, d.storage.frames[now][l].read).value;
-        s.prevLayerReadSlot[l] = slot(gpu, d.storage.frames[prev][l].read).value;
+        s.layers[l] = address(gpu, d.storage.frames[now][l]);
+        s.prevLayers[l] = address(gpu, d.storage.frames[prev][l]);
     }
-    s.storageReadSlot = s.layerReadSlot[SHADEL_LAYER_RADIANCE];
     s.changedVolumes = address(gpu, d.changedVolumes);
     s.levelWants = address(gpu, d.levelWants);
     s.changedVolumeCount = d.changesOverflow ? 0u : uint32_t(d.changes.size());
     s.frameNumber = uint32_t(d.frameNumber);
     s.reuse = d.reuse ? 1u : 0u;
     s.refreshPeriod = d.refreshPeriod;
-    s.storageChunksPerRow = d.storageSize / SHADEL_CHUNK;
     s.capacityChunks = d.capacityChunks;
     s.markedCapacity = d.capacityChunks;
     s.allocationCounters = std::clamp(r.settings.allocationCounters, 1u, SHADEL_COUNTERS);
@@ -1060,11 +1059,15 @@ void recordDecoupledShading(Renderer& r, FrameRecorder& rec, uint64_t frame, con
 
     // Preserved layers: chunks whose inputs did not change copy last frame's shadels.
     pass(rec, "carryOver", [&, frame](VkCommandBuffer cmd) {
-        // Reconstruction two frames ago read this storage: order this pass's writes and the
-        // shading pass's after it.
-        memoryBarrier(cmd, VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT,
-                      VK_ACCESS_2_SHADER_SAMPLED_READ_BIT, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
-                      VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT);
+        // The shade storage's buffers: reconstruction two frames ago (raster or compute
+        // resolve) read this frame's, so this pass's writes and the shading pass's after it
+        // wait for those reads; last frame's shading and carry-over wrote last frame's, which
+        // both passes read.
+        memoryBarrier(
+            cmd, VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT | VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
+            VK_ACCESS_2_SHADER_STORAGE_READ_BIT | VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT,
+            VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
+            VK_ACCESS_2_SHADER_STORAGE_READ_BIT | VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT);
         bind(gpu, cmd, d.carryOver);
         pushConstants(gpu, cmd, FramePush{frame});
         vkCmdDispatchIndirect(cmd, vkBuffer(gpu, d.counters),
@@ -1086,9 +1089,12 @@ void recordDecoupledShading(Renderer& r, FrameRecorder& rec, uint64_t frame, con
             vkCmdDispatchIndirect(cmd, vkBuffer(gpu, d.counters),
                                   offsetof(gpu::GpuShadelCounters, shadeDispatch));
         }
-        memoryBarrier(cmd, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
-                      VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT, VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT,
-                      VK_ACCESS_2_SHADER_SAMPLED_READ_BIT);
+        // The shade storage this pass and carry-over wrote, read by reconstruction (raster:
+        // fragment; --marking visibility: the compute resolve) and the transparency passes.
+        memoryBarrier(
+            cmd, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT,
+            VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT | VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
+            VK_ACCESS_2_SHADER_STORAGE_READ_BIT);
     });
 
     if (r.visibility) { // compute resolve, then forward (hybrid) objects rastered over it
