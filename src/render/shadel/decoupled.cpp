@@ -567,18 +567,37 @@ static bool updateObjectRects(Gpu& gpu, DecoupledState& d, ObjectSlot& o, uint32
 // Fresnel's rise towards grazing angles), so a rough dielectric is carried over far longer than a
 // polished metal. Roughness textures only lower the factor's roughness, so glossier texels than the
 // factor can lag somewhat more.
-// Cap of the specular-share gain (below), with the round-robin refresh period. builtin:default
-// 320x180, 24-frame orbit, reuse on vs off (reuse fraction, worst frame): gain 1, period 16:
-// 0.736, 47.5 dB; 1, 32: 0.755, 46.6 dB; 2, 16: 0.774, 45.5 dB; 2, 32: 0.796, 43.7 dB; 3, 32:
-// 0.807, 41.3 dB. (Checked per object, at the nearest point of its box against the last step's
-// turn, gain 3 and period 8 reused 0.712 at 45.9 dB: the near end of a large object set the pace of
-// all its chunks.)
+// The specular share is measured against the darkest albedo channel: a saturated base colour
+// lets a coloured light's specular dominate the channels it barely reflects (builtin:many's
+// green trees under the pink street light: its red and blue are mostly specular, so a carried
+// chunk's stale highlight showed as 8x8-shadel patches on the spheres). Share = the GGX peak's
+// specular (F0 = 4%, D = 1 / (pi alpha^2), over 4) against that channel's Lambert diffuse.
+// The turn allowed, in lobe widths, is SPECULAR_SHARE_TOLERANCE / share within [1,
+// SPECULAR_SHARE_MAX_GAIN]: a rough light-coloured dielectric (share ~8%) keeps the cap, a
+// metal, a glossy or a saturated dark dielectric about one lobe (the trees: 0.25, 1.2 lobes).
+// Tolerance, 1280x720 24-frame orbit, reuse fraction / worst frame against reuse off, default
+// and many: grey share for every dielectric (before) 0.793 / 45.4 dB, 0.489 / 29.2 dB; 0.1:
+// 0.753 / 49.5, 0.381 / 49.4; 0.2: 0.765 / 49.1, 0.480 / 49.4; 0.3: 0.775 / 49.1, 0.487 / 49.4;
+// 0.5: 0.784 / 49.0, 0.489 / 27.2 (the trees back at the cap).
+// Cap of the gain, with the round-robin refresh period. builtin:default 320x180, 24-frame orbit,
+// reuse on vs off (reuse fraction, worst frame): gain 1, period 16: 0.736, 47.5 dB; 1, 32:
+// 0.755, 46.6 dB; 2, 16: 0.774, 45.5 dB; 2, 32: 0.796, 43.7 dB; 3, 32: 0.807, 41.3 dB. (Checked
+// per object, at the nearest point of its box against the last step's turn, gain 3 and period 8
+// reused 0.712 at 45.9 dB: the near end of a large object set the pace of all its chunks.)
 constexpr float SPECULAR_SHARE_MAX_GAIN = 2.0f;
+constexpr float SPECULAR_SHARE_TOLERANCE = 0.3f;
 
-static float viewDriftLimitFor(float roughness, float metallic) {
+static float viewDriftLimitFor(float roughness, float metallic, glm::vec3 baseColor) {
+    constexpr float kPi = 3.14159265f;
     float lobeWidth = std::clamp(roughness * roughness, 0.01f, 0.4f);
-    float specularShare = glm::mix(2.0f * 0.04f, 1.0f, std::clamp(metallic, 0.0f, 1.0f));
-    return lobeWidth * std::min(1.0f / specularShare, SPECULAR_SHARE_MAX_GAIN);
+    float specularPeak = 0.04f / (4.0f * kPi * lobeWidth * lobeWidth);
+    float darkest = std::min({baseColor.r, baseColor.g, baseColor.b});
+    float darkestDiffuse = std::max(darkest, 0.0f) * 0.96f / kPi;
+    float dielectricShare = specularPeak / (specularPeak + darkestDiffuse);
+    float specularShare = glm::mix(dielectricShare, 1.0f, std::clamp(metallic, 0.0f, 1.0f));
+    float gain =
+        std::clamp(SPECULAR_SHARE_TOLERANCE / specularShare, 1.0f, SPECULAR_SHARE_MAX_GAIN);
+    return lobeWidth * gain;
 }
 
 // A slot for an instance that has none: a fresh ObjectSlot (no rects) and a zero GPU entry, as
@@ -837,7 +856,9 @@ void prepareDecoupledFrame(Renderer& r, const GpuScene& scene, const CameraView&
         bool known = inst.material < scene.materialInfo.size();
         float roughness = known ? scene.materialInfo[inst.material].roughnessFactor : 1.0f;
         float metallic = known ? scene.materialInfo[inst.material].metallicFactor : 1.0f;
-        g.viewDriftCos = std::cos(viewDriftLimitFor(roughness, metallic));
+        glm::vec3 baseColor =
+            known ? glm::vec3(scene.materialInfo[inst.material].baseColorFactor) : glm::vec3(0.0f);
+        g.viewDriftCos = std::cos(viewDriftLimitFor(roughness, metallic, baseColor));
         d.objectsReusable += g.reuseLevels != 0;
         d.firstMipHistogram[o.firstMip]++;
         g.mip0Size = mesh.mip0Size;
