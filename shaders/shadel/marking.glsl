@@ -65,7 +65,7 @@ struct MarkedSample {
     LevelFootprint footprint0; // at levels.mip0
     LevelFootprint footprint1; // at levels.mip1 (when levels.two)
     bool windowFallback;       // a wanted level's window did not hold the tap
-    bool forward; // a tap's window fell back too far: nothing marked, shaded forward
+    bool forward; // its window fell back too far: the resolve shades it forward
     uint taps;
 };
 
@@ -76,17 +76,12 @@ MarkedSample markSample(ShadelFrame s, ShadelObjectRef o, vec2 shadelUv, vec2 te
     ShadelAniso a = shadelAniso(texelDx, texelDy);
     MarkedSample m;
     m.taps = a.taps;
-    m.forward = false;
     for (uint i = 0u; i < a.taps; ++i) { // the same taps reconstruction reads
         vec2 uv = shadelTapUv(o.v.mip0Size, shadelUv, a, i);
         ShadelLevels l = wanted;
         uint unheld = fitLevelsToWindows(o, uv, l);
         for (uint k = wanted.mip0; (unheld >> k) != 0u; ++k)
             if (((unheld >> k) & 1u) != 0u) wantLevel(s, o, k, uv);
-        if (windowFallbackTooDeep(wanted, l)) {
-            m.forward = true;
-            continue;
-        }
         LevelFootprint fp0 = levelFootprint(o, l.mip0, uv);
         markFootprint(s, fp0);
         LevelFootprint fp1 = fp0;
@@ -99,6 +94,7 @@ MarkedSample markSample(ShadelFrame s, ShadelObjectRef o, vec2 shadelUv, vec2 te
             m.footprint0 = fp0;
             m.footprint1 = fp1;
             m.windowFallback = unheld != 0u;
+            m.forward = windowFallbackTooDeep(wanted, l);
         }
     }
     return m;

@@ -69,7 +69,7 @@ struct Reconstruction {
     float lod;       // of the first tap, after fitting to the level windows
     uint mip0;
     bool windowFallback; // a level the sample wanted was outside its window: read coarser
-    bool forward; // ... so far outside that nothing was read: the caller shades it forward
+    bool forward; // ... so far outside that the caller shades it forward instead
     bool sampled;   // a pixel of the statistics sample (one of every 2x2)
     bool magnified; // ... whose MIP-0 shadel is larger than the pixel
 };
@@ -85,7 +85,6 @@ Reconstruction reconstructSample(ShadelFrame s, ShadelObjectRef o, vec2 shadelUv
     r.overflowed = 0u;
     r.mask0 = 0ul;
     r.windowFallback = false;
-    r.forward = false;
     uint64_t mask1, tapMask;
     ShadelAniso a = shadelAniso(texelDx, texelDy);
     r.color = vec3(0.0);
@@ -93,19 +92,12 @@ Reconstruction reconstructSample(ShadelFrame s, ShadelObjectRef o, vec2 shadelUv
         vec2 uv = shadelTapUv(o.v.mip0Size, shadelUv, a, i);
         ShadelLevels l = wanted;
         r.windowFallback = r.windowFallback || fitLevelsToWindows(o, uv, l) != 0u;
-        if (windowFallbackTooDeep(wanted, l)) { // as marking decided: nothing marked to read
-            r.forward = true;
-            if (i == 0u) {
-                r.mip0 = l.mip0;
-                r.lod = float(l.mip0);
-            }
-            continue;
-        }
         vec3 c = sampleLevel(s, o, l.mip0, uv, layer, r.missing, r.overflowed, tapMask);
         if (i == 0u) {
             r.mask0 = tapMask;
             r.mip0 = l.mip0;
             r.lod = float(l.mip0) + l.blend;
+            r.forward = windowFallbackTooDeep(wanted, l); // as marking decided
         }
         if (l.two) c = mix(c, sampleLevel(s, o, l.mip1, uv, layer, r.missing, r.overflowed, mask1), l.blend);
         r.color += c;

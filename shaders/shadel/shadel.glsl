@@ -143,8 +143,10 @@ uint fitLevelsToWindows(ShadelObjectRef o, vec2 uv, inout ShadelLevels l) {
 // A sample whose wanted level's window lags by more than one level (a camera cut: last frame's
 // marks were elsewhere) is shaded forward instead of read that much coarser: from two levels
 // up, charts bleed into each other's shadels (bake.h: only levels <= log2(gutter) are clean)
-// and the blur shows. Marking marks nothing for it and the resolve shades it from its surface,
-// as a miss (counted apart: window_forward_pixel_fraction). One level up stays a read.
+// and the blur shows. The resolve shades it from its surface, as a miss (counted apart:
+// window_forward_pixel_fraction). Marking still marks what it would have read (checking per
+// tap cost the marking pass 2 ms at 1280x720; a cut frame's coarse chunks are few). One level
+// up stays a read.
 const uint SHADEL_MAX_WINDOW_FALLBACK = 1u;
 
 bool windowFallbackTooDeep(ShadelLevels wanted, ShadelLevels fitted) {
