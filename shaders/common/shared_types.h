@@ -91,6 +91,9 @@ using uint = uint32_t;
 // them the test and its discard are compiled out, so the depth test runs before the fragment
 // shader (early Z) instead of after it for every covered fragment.
 #define ALPHA_MASK_CONSTANT_ID 144
+// Whether the compute resolve rebuilds its rare pixels inline (debug views, --inspect) or lists
+// them for its rebuild pass (shaders/shadel/resolve.comp).
+#define RESOLVE_REBUILD_INLINE_CONSTANT_ID 146
 // Specialization constant of shaders/common/lighting.glsl: 1 compiles the distance-field far
 // shadows and AO in (render/distance_fields; forward and shadel shading with --distance-fields).
 #define DISTANCE_FIELD_LIGHTING_CONSTANT_ID 142

@@ -15,7 +15,13 @@ struct VisibilityState {
     // "reconstructionAddress" (decoupled only): 16 bytes per pixel, the levels' footprints the
     // compute marking marked, read by the resolve (shaders/shadel/resolve_address.glsl).
     BufferHandle address;
-    Pipeline prepass, mark, resolve;
+    // "resolveRebuildList" (decoupled only): the pixels the resolve leaves to its rebuild pass
+    // (misses, overflow, camera cuts) and that pass's indirect arguments
+    // (shaders/shadel/resolve_pixel.glsl ResolveRebuildList).
+    BufferHandle rebuildList;
+    // resolveInline rebuilds its rare pixels itself (debug views, --inspect); resolve lists them
+    // for resolveRebuild, sized by resolveRebuildArgs.
+    Pipeline prepass, mark, resolve, resolveInline, resolveRebuild, resolveRebuildArgs;
 };
 
 void VisibilityStateDeleter::operator()(VisibilityState* state) const {
@@ -30,6 +36,7 @@ struct ComputePush {
     uint32_t height;
     uint32_t hdrSlot;
     uint64_t address;
+    uint64_t rebuildList;
 };
 
 ComputePush computePush(Renderer& r, uint64_t frame) {
@@ -40,7 +47,8 @@ ComputePush computePush(Renderer& r, uint64_t frame) {
             r.internalWidth,
             r.internalHeight,
             slot(gpu, v.hdrWrite).value,
-            v.address ? address(gpu, v.address) : 0u};
+            v.address ? address(gpu, v.address) : 0u,
+            v.rebuildList ? address(gpu, v.rebuildList) : 0u};
 }
 
 void dispatchPixels(Renderer& r, VkCommandBuffer cmd) {
@@ -73,6 +81,12 @@ VisibilityStatePtr createVisibility(Renderer& r) {
         VkDeviceSize quads = VkDeviceSize((r.internalWidth + 1) / 2) * ((r.internalHeight + 1) / 2);
         v.address = createBuffer(gpu, {"reconstructionAddress", quads * 4 * 16});
         if (!v.address) throw DeviceError("out of GPU memory for the reconstruction addresses");
+        // 32 bytes of header, then at most every pixel once.
+        VkDeviceSize pixels = VkDeviceSize(r.internalWidth) * r.internalHeight;
+        v.rebuildList = createBuffer(
+            gpu, {"resolveRebuildList", 32 + pixels * 4,
+                  VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT});
+        if (!v.rebuildList) throw DeviceError("out of GPU memory for the resolve's rebuild list");
     }
 
     GraphicsPipelineDesc prepass;
@@ -85,8 +99,19 @@ VisibilityStatePtr createVisibility(Renderer& r) {
     prepass.cullMode = VK_CULL_MODE_NONE; // as the depth prepass
     v.prepass = createGraphicsPipeline(gpu, prepass);
     v.mark = createComputePipeline(gpu, "shadelMarkVisibility", "shadel_mark_visibility.comp.spv");
-    v.resolve = createComputePipeline(gpu, "shadelResolve", "shadel_resolve.comp.spv",
-                                      shaderPrintSpecialization(r.settings.inspectX >= 0));
+    std::vector<std::pair<uint32_t, uint32_t>> inlineRebuild =
+        shaderPrintSpecialization(r.settings.inspectX >= 0);
+    inlineRebuild.push_back({RESOLVE_REBUILD_INLINE_CONSTANT_ID, 1u});
+    v.resolveInline = createComputePipeline(gpu, "shadelResolveInlineRebuild",
+                                            "shadel_resolve.comp.spv", inlineRebuild);
+    if (v.rebuildList) {
+        v.resolve = createComputePipeline(gpu, "shadelResolve", "shadel_resolve.comp.spv",
+                                          {{RESOLVE_REBUILD_INLINE_CONSTANT_ID, 0u}});
+        v.resolveRebuild =
+            createComputePipeline(gpu, "shadelResolveRebuild", "shadel_resolve_rebuild.comp.spv");
+        v.resolveRebuildArgs = createComputePipeline(gpu, "shadelResolveRebuildArgs",
+                                                     "shadel_resolve_rebuild_args.comp.spv");
+    }
     registerTextureCapture(
         r.captures, gpu, "visibility", "visibility buffer: instance, triangle (PNG)",
         CaptureKind::Ids, [&v] { return v.ids; }, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL);
@@ -97,9 +122,12 @@ void destroyVisibility(Renderer& r, VisibilityStatePtr& state) {
     if (!state) return;
     Gpu& gpu = *r.gpu;
     VisibilityState& v = *state;
-    for (Pipeline* p : {&v.prepass, &v.mark, &v.resolve}) destroy(gpu, *p);
+    for (Pipeline* p : {&v.prepass, &v.mark, &v.resolve, &v.resolveInline, &v.resolveRebuild,
+                        &v.resolveRebuildArgs})
+        destroy(gpu, *p);
     destroy(gpu, v.hdrWrite);
     if (v.address) destroy(gpu, v.address);
+    if (v.rebuildList) destroy(gpu, v.rebuildList);
     destroy(gpu, v.idsRead);
     destroy(gpu, v.idsTarget);
     destroy(gpu, v.ids);
@@ -179,9 +207,42 @@ void recordResolveCompute(Renderer& r, VkCommandBuffer cmd, uint64_t frame) {
     imageBarrier(cmd, vkImage(gpu, r.hdr), VK_IMAGE_ASPECT_COLOR_BIT, VK_IMAGE_LAYOUT_UNDEFINED,
                  VK_IMAGE_LAYOUT_GENERAL, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, 0,
                  VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT);
-    bind(gpu, cmd, r.visibility->resolve);
-    pushConstants(gpu, cmd, computePush(r, frame));
+    VisibilityState& v = *r.visibility;
+    ComputePush push = computePush(r, frame);
+    // Debug views and --inspect rebuild every decoupled pixel: the resolve does it inline.
+    bool inlineRebuild =
+        !v.rebuildList || r.settings.visualize != Visualize::None || r.settings.inspectX >= 0;
+    if (inlineRebuild) {
+        bind(gpu, cmd, v.resolveInline);
+        pushConstants(gpu, cmd, push);
+        dispatchPixels(r, cmd);
+        return;
+    }
+    // The resolve lists its rare pixels (misses, overflow, camera cuts); the rebuild pass
+    // shades them, by indirect dispatch (last frame's rebuild pass read the list: cleared after).
+    memoryBarrier(cmd,
+                  VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_2_DRAW_INDIRECT_BIT,
+                  VK_ACCESS_2_SHADER_STORAGE_READ_BIT | VK_ACCESS_2_INDIRECT_COMMAND_READ_BIT,
+                  VK_PIPELINE_STAGE_2_CLEAR_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT);
+    vkCmdFillBuffer(cmd, vkBuffer(gpu, v.rebuildList), 0, 32, 0);
+    memoryBarrier(cmd, VK_PIPELINE_STAGE_2_CLEAR_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT,
+                  VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
+                  VK_ACCESS_2_SHADER_STORAGE_READ_BIT | VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT);
+    bind(gpu, cmd, v.resolve);
+    pushConstants(gpu, cmd, push);
     dispatchPixels(r, cmd);
+    memoryBarrier(cmd, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT,
+                  VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
+                  VK_ACCESS_2_SHADER_STORAGE_READ_BIT | VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT);
+    bind(gpu, cmd, v.resolveRebuildArgs);
+    pushConstants(gpu, cmd, push);
+    vkCmdDispatch(cmd, 1, 1, 1);
+    memoryBarrier(cmd, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT,
+                  VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_2_DRAW_INDIRECT_BIT,
+                  VK_ACCESS_2_SHADER_STORAGE_READ_BIT | VK_ACCESS_2_INDIRECT_COMMAND_READ_BIT);
+    bind(gpu, cmd, v.resolveRebuild);
+    pushConstants(gpu, cmd, push);
+    vkCmdDispatchIndirect(cmd, vkBuffer(gpu, v.rebuildList), 0);
 }
 
 void recordHybridForward(Renderer& r, VkCommandBuffer cmd, uint64_t frame) {
