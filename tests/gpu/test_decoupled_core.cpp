@@ -16,6 +16,13 @@ RenderOptions decoupled(const std::string& scene, uint32_t w, uint32_t h) {
     return renderOptions(scene, RenderMode::Decoupled, w, h);
 }
 
+// The options on the orbit camera path over `frames` frames.
+RenderOptions onOrbit(RenderOptions o, uint32_t frames) {
+    o.frames = frames;
+    o.cameraPath = CameraPath::Orbit;
+    return o;
+}
+
 uint64_t stat(const RenderRun& run, const char* name) {
     return run.stats[name].get<uint64_t>();
 }
@@ -202,9 +209,7 @@ TEST(DecoupledCore, MagnificationFollowsDensity) {
 // where they reach.
 TEST(DecoupledCore, ReuseChangesNothingVisibleOnAnOrbit) {
     for (bool animateLights : {false, true}) {
-        RenderOptions o = decoupled("builtin:default", 320, 180);
-        o.frames = 24;
-        o.cameraPath = CameraPath::Orbit;
+        RenderOptions o = onOrbit(decoupled("builtin:default", 320, 180), 24);
         o.animateLights = animateLights;
         o.reuse = false;
         RenderRun off = renderChecked(o);
@@ -230,12 +235,10 @@ TEST(DecoupledCore, ReuseChangesNothingVisibleOnAnOrbit) {
 
 // The view tolerance follows a material's specular share against its darkest albedo channel:
 // builtin:many's saturated green trees under the pink street light are mostly specular in red
-// and blue, and with the share of a grey dielectric their stale highlights showed as 8x8-shadel
-// patches (worst frame 37.5 dB at 320x180, 29.2 dB at 1280x720).
+// and blue, and with the share of a grey dielectric their carried chunks lagged the view far
+// enough to fail the bar (worst frame 37.5 dB at 320x180, 29.2 dB at 1280x720).
 TEST(DecoupledCore, ReuseKeepsSaturatedMaterialsUnderColouredLights) {
-    RenderOptions o = decoupled("builtin:many", 320, 180);
-    o.frames = 24;
-    o.cameraPath = CameraPath::Orbit;
+    RenderOptions o = onOrbit(decoupled("builtin:many", 320, 180), 24);
     auto [on, off] = renderReuseOnAndOff(o);
     double worst = worstFramePsnr(on, off);
     double fraction = on.stats["reuse_fraction"].get<double>();
@@ -253,9 +256,7 @@ TEST(DecoupledCore, ReuseKeepsSaturatedMaterialsUnderColouredLights) {
 // (--reuse-refresh 1024), an orbit still matches the frames shaded from scratch (without the
 // view check: 36.2 dB), and a still camera reshades nothing for its view.
 TEST(DecoupledCore, ReuseReshadesChunksWhoseViewTurned) {
-    RenderOptions o = decoupled("builtin:default", 320, 180);
-    o.frames = 24;
-    o.cameraPath = CameraPath::Orbit;
+    RenderOptions o = onOrbit(decoupled("builtin:default", 320, 180), 24);
     o.reuseRefreshPeriod = 1024;
     auto [on, off] = renderReuseOnAndOff(o);
     double worst = worstFramePsnr(on, off);
@@ -281,9 +282,7 @@ TEST(DecoupledCore, ReuseReshadesChunksWhoseViewTurned) {
 // the stored chunks at 640x360 when a move made the whole level unreusable), and the frames
 // still match the frames shaded from scratch.
 TEST(DecoupledCore, ReuseCarriesShadelsAcrossLevelWindowMoves) {
-    RenderOptions o = decoupled("builtin:default", 640, 360);
-    o.frames = 24;
-    o.cameraPath = CameraPath::Orbit;
+    RenderOptions o = onOrbit(decoupled("builtin:default", 640, 360), 24);
     auto [on, off] = renderReuseOnAndOff(o);
     double worst = worstFramePsnr(on, off);
     double notReusable = on.stats["shaded_because"]["not_reusable"].get<double>();
@@ -352,9 +351,7 @@ TEST(DecoupledCore, LevelWindowsAtLeastHalveTheSheet) {
 // On a moving camera the windows follow the marks: a sample the window does not hold yet reads
 // a coarser level for a frame (never a hole), and every frame stays close to whole levels.
 TEST(DecoupledCore, LevelWindowsFollowAnOrbitWithoutHoles) {
-    RenderOptions o = decoupled("builtin:default", 320, 180);
-    o.frames = 12;
-    o.cameraPath = CameraPath::Orbit;
+    RenderOptions o = onOrbit(decoupled("builtin:default", 320, 180), 12);
     o.levelWindows = false;
     RenderRun whole = renderChecked(o);
     o.levelWindows = true;
@@ -376,15 +373,11 @@ TEST(DecoupledCore, LevelWindowsFollowAnOrbitWithoutHoles) {
 // shaded forward instead of read from a level that coarse, where charts bleed into each other
 // (lit triangles on shadowed spheres) and the ground's shadows blur away.
 TEST(DecoupledCore, CameraCutsShadeWhatTheWindowsLagForward) {
-    RenderOptions o = decoupled("builtin:many", 320, 180);
-    o.frames = 3;
-    o.cameraPath = CameraPath::Orbit;
+    RenderOptions o = onOrbit(decoupled("builtin:many", 320, 180), 3);
     RenderRun windows = renderChecked(o);
     o.levelWindows = false; // whole levels: nothing lags, the decoupled image to match
     RenderRun whole = renderChecked(o);
-    RenderOptions f = renderOptions("builtin:many", RenderMode::Forward, 320, 180);
-    f.frames = 3;
-    f.cameraPath = CameraPath::Orbit;
+    RenderOptions f = onOrbit(renderOptions("builtin:many", RenderMode::Forward, 320, 180), 3);
     RenderRun forward = renderChecked(f);
     double forwardFraction = windows.stats["window_forward_pixel_fraction"].get<double>();
     double toWhole = psnr(windows.frames.back().rgba, whole.frames.back().rgba);

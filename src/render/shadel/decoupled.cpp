@@ -569,10 +569,10 @@ static bool updateObjectRects(Gpu& gpu, DecoupledState& d, ObjectSlot& o, uint32
 // factor can lag somewhat more.
 // The specular share is measured against the darkest albedo channel: a saturated base colour
 // lets a coloured light's specular dominate the channels it barely reflects (builtin:many's
-// green trees under the pink street light: its red and blue are mostly specular, so a carried
-// chunk's stale highlight showed as 8x8-shadel patches on the spheres). Share = the GGX peak's
-// specular (F0 = 4%, D = 1 / (pi alpha^2), over 4) against that channel's Lambert diffuse.
-// The turn allowed, in lobe widths, is SPECULAR_SHARE_TOLERANCE / share within [1,
+// green trees under the pink street light: its red and blue are mostly specular, and their
+// carried chunks lagged the view far enough to drop a frame to 29 dB against reuse off). Share =
+// the GGX peak's specular (F0 = 4%, D = 1 / (pi alpha^2), over 4) against that channel's Lambert
+// diffuse. The turn allowed, in lobe widths, is SPECULAR_SHARE_TOLERANCE / share within [1,
 // SPECULAR_SHARE_MAX_GAIN]: a rough light-coloured dielectric (share ~8%) keeps the cap, a
 // metal, a glossy or a saturated dark dielectric about one lobe (the trees: 0.25, 1.2 lobes).
 // Tolerance, 1280x720 24-frame orbit, reuse fraction / worst frame against reuse off, default
