@@ -411,6 +411,7 @@ Scene makeMany(uint32_t instances) {
 
     constexpr uint32_t kPerBlock = 16; // 4 buildings + 12 props
     constexpr float kPitch = 40.0f;    // 30 m blocks, 10 m streets
+    constexpr float kBuildingSink = 0.1f;
     uint32_t rest = instances > 0 ? instances - 1 : 0;
     uint32_t blocks = (rest + kPerBlock - 1) / kPerBlock;
     uint32_t side = std::max(1u, uint32_t(std::ceil(std::sqrt(double(blocks)))));
@@ -425,7 +426,10 @@ Scene makeMany(uint32_t instances) {
             if (j < 4) { // a 2 x 2 lot of buildings, 1 m passages between them
                 glm::vec3 lot((j & 1) ? 7.0f : -7.0f, 0.0f, (j & 2) ? 7.0f : -7.0f);
                 int kind = rng.range(0, 2);
-                b.place("", buildings[kind], centre + lot + glm::vec3(0, height[kind] * 0.5f, 0),
+                // Sunk 10 cm into the ground: a bottom face on the ground's plane z-fights
+                // with it and shadows it with acne (seen when a camera path enters a building).
+                b.place("", buildings[kind],
+                        centre + lot + glm::vec3(0, height[kind] * 0.5f - kBuildingSink, 0),
                         rng.range(0, 3) * 1.5707964f);
                 continue;
             }
