@@ -1,7 +1,9 @@
 #include "gpu_test_env.h"
 #include <unistd.h>
 
+#include <array>
 #include <cmath>
+#include <cstdlib>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -93,6 +95,24 @@ double worstFramePsnr(const RenderRun& a, const RenderRun& b) {
     double worst = 1e9;
     for (size_t i = 0; i < a.frames.size() && i < b.frames.size(); ++i)
         worst = std::min(worst, psnr(a.frames[i].rgba, b.frames[i].rgba));
+    return worst;
+}
+
+int worstFrameErrorQuantile(const RenderRun& a, const RenderRun& b, double quantile) {
+    int worst = 0;
+    for (size_t f = 0; f < a.frames.size() && f < b.frames.size(); ++f) {
+        const std::vector<uint8_t>& x = a.frames[f].rgba;
+        const std::vector<uint8_t>& y = b.frames[f].rgba;
+        EXPECT_EQ(x.size(), y.size());
+        std::array<size_t, 256> histogram{};
+        size_t n = 0;
+        for (size_t i = 0; i + 3 < x.size() && i + 3 < y.size(); i += 4)
+            for (int c = 0; c < 3; ++c, ++n) histogram[std::abs(int(x[i + c]) - int(y[i + c]))]++;
+        size_t below = 0, rank = size_t(quantile * double(n));
+        int level = 0;
+        while (level < 255 && below + histogram[level] <= rank) below += histogram[level++];
+        worst = std::max(worst, level);
+    }
     return worst;
 }
 

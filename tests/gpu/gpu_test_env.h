@@ -34,6 +34,10 @@ nlohmann::json takeJsonFile(const std::string& path);
 
 // The lowest PSNR between the runs' frames of the same index (the runs have as many frames).
 double worstFramePsnr(const RenderRun& a, const RenderRun& b);
+// The largest, over the frames of the same index, of the `quantile` (0..1) of the per-channel
+// absolute differences (RGB, 8-bit levels): what the worst frame's worst pixels are off by,
+// which an average such as PSNR hides when few pixels differ much.
+int worstFrameErrorQuantile(const RenderRun& a, const RenderRun& b, double quantile);
 
 // The same decoupled run with --reuse on and off (checked as renderChecked checks them).
 struct ReuseRuns {

@@ -572,20 +572,29 @@ static bool updateObjectRects(Gpu& gpu, DecoupledState& d, ObjectSlot& o, uint32
 // green trees under the pink street light: its red and blue are mostly specular, and their
 // carried chunks lagged the view far enough to drop a frame to 29 dB against reuse off). Share =
 // the GGX peak's specular (F0 = 4%, D = 1 / (pi alpha^2), over 4) against that channel's Lambert
-// diffuse. The turn allowed, in lobe widths, is SPECULAR_SHARE_TOLERANCE / share within [1,
-// SPECULAR_SHARE_MAX_GAIN]: a rough light-coloured dielectric (share ~8%) keeps the cap, a
-// metal, a glossy or a saturated dark dielectric about one lobe (the trees: 0.25, 1.2 lobes).
+// diffuse. The turn allowed, in lobe widths, is SPECULAR_SHARE_TOLERANCE / share within
+// [SPECULAR_SHARE_MIN_GAIN, SPECULAR_SHARE_MAX_GAIN]: the lag a turn leaves is about share x
+// turn / lobe, so the tolerance is roughly the error allowed in the darkest channel. A rough
+// light-coloured dielectric (share ~8%) keeps the cap, the trees (share 0.25) 0.6 lobes.
 // Tolerance, 1280x720 24-frame orbit, reuse fraction / worst frame against reuse off, default
 // and many: grey share for every dielectric (before) 0.793 / 45.4 dB, 0.489 / 29.2 dB; 0.1:
 // 0.753 / 49.5, 0.381 / 49.4; 0.2: 0.765 / 49.1, 0.480 / 49.4; 0.3: 0.775 / 49.1, 0.487 / 49.4;
-// 0.5: 0.784 / 49.0, 0.489 / 27.2 (the trees back at the cap).
+// 0.5: 0.784 / 49.0, 0.489 / 27.2 (the trees back at the cap). Those runs kept at least one
+// lobe, and the trees' carried chunks, 25% off in red and blue, showed as 8x8 patches beside the
+// chunks refreshed that frame (99.9th percentile channel error of the worst frame: 12 levels
+// at 640x360). Tolerance / least gain, 640x360, reuse fraction / worst frame / that error,
+// many then default: 0.3 / 1: 0.474 / 49.3 dB / 12, 0.767 / 48.4 / 10; 0.2 / 0.5: 0.465 / 49.3 /
+// 11, 0.734 / 49.5 / 8; 0.15 / 0.5: 0.416 / 55.3 / 5, 0.715 / 49.6 / 8; 0.1 / 0.5: 0.357 / 55.7
+// / 5, 0.689 / 50.0 / 8. (Reshading a block's chunks past half the tolerance once one of them
+// passed it, to keep neighbours' ages together, gave 12 and 9 at 0.3 / 1: the lag itself shows.)
 // Cap of the gain, with the round-robin refresh period. builtin:default 320x180, 24-frame orbit,
 // reuse on vs off (reuse fraction, worst frame): gain 1, period 16: 0.736, 47.5 dB; 1, 32:
 // 0.755, 46.6 dB; 2, 16: 0.774, 45.5 dB; 2, 32: 0.796, 43.7 dB; 3, 32: 0.807, 41.3 dB. (Checked
 // per object, at the nearest point of its box against the last step's turn, gain 3 and period 8
 // reused 0.712 at 45.9 dB: the near end of a large object set the pace of all its chunks.)
+constexpr float SPECULAR_SHARE_MIN_GAIN = 0.5f;
 constexpr float SPECULAR_SHARE_MAX_GAIN = 2.0f;
-constexpr float SPECULAR_SHARE_TOLERANCE = 0.3f;
+constexpr float SPECULAR_SHARE_TOLERANCE = 0.15f;
 
 static float viewDriftLimitFor(float roughness, float metallic, glm::vec3 baseColor) {
     constexpr float kPi = 3.14159265f;
@@ -595,8 +604,8 @@ static float viewDriftLimitFor(float roughness, float metallic, glm::vec3 baseCo
     float darkestDiffuse = std::max(darkest, 0.0f) * 0.96f / kPi;
     float dielectricShare = specularPeak / (specularPeak + darkestDiffuse);
     float specularShare = glm::mix(dielectricShare, 1.0f, std::clamp(metallic, 0.0f, 1.0f));
-    float gain =
-        std::clamp(SPECULAR_SHARE_TOLERANCE / specularShare, 1.0f, SPECULAR_SHARE_MAX_GAIN);
+    float gain = std::clamp(SPECULAR_SHARE_TOLERANCE / specularShare, SPECULAR_SHARE_MIN_GAIN,
+                            SPECULAR_SHARE_MAX_GAIN);
     return lobeWidth * gain;
 }
 
