@@ -94,6 +94,13 @@ using uint = uint32_t;
 // Whether the compute resolve rebuilds its rare pixels inline (debug views, --inspect) or lists
 // them for its rebuild pass (shaders/shadel/resolve.comp).
 #define RESOLVE_REBUILD_INLINE_CONSTANT_ID 146
+// Which queued chunks a shadel shading pipeline shades (shaders/shadel/shade.comp): all of them
+// (the spectra permutations), those of objects shaded with one material sample per shadel (the
+// material supersampling compiled out), or those of supersampled objects (their own list).
+#define SHADE_QUEUE_CONSTANT_ID 147
+#define SHADE_QUEUE_ALL 0u
+#define SHADE_QUEUE_SINGLE_SAMPLE 1u
+#define SHADE_QUEUE_SUPERSAMPLED 2u
 // Specialization constant of shaders/common/lighting.glsl: 1 compiles the distance-field far
 // shadows and AO in (render/distance_fields; forward and shadel shading with --distance-fields).
 #define DISTANCE_FIELD_LIGHTING_CONSTANT_ID 142
@@ -512,6 +519,9 @@ struct ShaderMessage {
 #define SHADEL_OBJECT_DECOUPLED 1u // allocated in the sheet this frame: drawn decoupled
 // Its bounds meet a light that changed this frame: carried-over chunks check their shadels.
 #define SHADEL_OBJECT_NEAR_CHANGE 2u
+// Its material is a point-function procedural and --material-samples > 1: its shadels
+// supersample the material (shaders/shadel/prefilter.glsl), in a shading pipeline of their own.
+#define SHADEL_OBJECT_SUPERSAMPLED 4u
 #define SHADEL_MAX_CHANGED_VOLUMES 256u
 #define SHADEL_CHUNK_VIEW_NONE 0xFFFFFFFFu // ShadelFrame::chunkViews: a NaN centre
 // Material layers of the shade storage (seed: "layers of different bit depths"): every layer
@@ -620,6 +630,7 @@ struct GpuShadelCounters {
     uint chunksReused;                 // chunks carried over from last frame's storage (preserved)
     uint shadeCount;                   // entries in the shading queue
     uint copyCount;                    // entries in the carry-over queue
+    uint supersampledCount;            // entries in the supersampled list
     uint magnifiedPixels;     // sampled reconstructed pixels whose MIP-0 shadel spans > 1 pixel
     uint reconstructedPixels; // sampled (even x and y) pixels the reconstruction drew
     uint chunksPerMip[SHADEL_MAX_MIPS]; // allocated chunks by MIP level
@@ -634,6 +645,7 @@ struct GpuShadelCounters {
     uvec4 fillDispatch;  // x, y, z, marked blocks in the list: indirect args of the queue fill
     uvec4 shadeDispatch; // x, y, z, queue length: indirect args of the shading pass
     uvec4 copyDispatch;  // x, y, z, queue length: indirect args of the carry-over pass
+    uvec4 supersampledDispatch; // x, y, z, list length: the supersampled objects' shading
 };
 
 struct ShadelFrame {
@@ -646,6 +658,8 @@ struct ShadelFrame {
     uint64_t markedBlocks; // uvec4 {block, place in its counter, object, mip | counter << 8}
     uint64_t queue;        // GpuShadelWork[capacityChunks]: chunks to shade
     uint64_t copyQueue;    // GpuShadelWork[capacityChunks]: chunks carried over (chunk = old slot)
+    // uint[capacityChunks]: the shading queue's entries of SHADEL_OBJECT_SUPERSAMPLED objects.
+    uint64_t supersampledQueue;
     uint64_t idMaps;       // uint16 triangle ids, packed in uints
     uint64_t shadelUvs;    // vec2 per vertex of the unified geometry buffer
     // The shade storage's layers, chunk-linear buffers (shaders/shadel/shadel.glsl storageIndex:

@@ -74,7 +74,10 @@ void main() {
             ShadelWorkBuffer(s.copyQueue).w[atomicAdd(counters.c.copyCount, 1u)] = w;
             continue;
         }
-        ShadelWorkBuffer(s.queue).w[atomicAdd(counters.c.shadeCount, 1u)] = w;
+        uint queued = atomicAdd(counters.c.shadeCount, 1u);
+        ShadelWorkBuffer(s.queue).w[queued] = w;
+        if ((o.v.flags & SHADEL_OBJECT_SUPERSAMPLED) != 0u)
+            UintBuffer(s.supersampledQueue).v[atomicAdd(counters.c.supersampledCount, 1u)] = queued;
         uint reason = !levelReusable ? SHADEL_SHADED_NOT_REUSABLE
                       : nearChange   ? SHADEL_SHADED_NEAR_CHANGE
                       : refresh      ? SHADEL_SHADED_REFRESH

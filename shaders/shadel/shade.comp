@@ -15,7 +15,12 @@
 #include "lighting/light_debug.glsl"
 #include "lighting/chunk_spectra.glsl"
 #include "common/shadel_bary.h"
-#include "shadel/prefilter.glsl"
+// The plain shading pass runs two pipelines (render/shadel/decoupled.cpp): one over the whole
+// queue that leaves supersampled objects' chunks alone and has the material supersampling
+// compiled out, one over those chunks' list. On CPU devices a SIMD group runs the code of a
+// branch none of its lanes takes, so the supersampling cost every chunk ~17% of the pass.
+layout(constant_id = SHADE_QUEUE_CONSTANT_ID) const uint kShadeQueue = SHADE_QUEUE_ALL;
+#include "shadel/prefilter.glsl" // reads kShadeQueue
 #define DEBUG_LINES_WORKGROUP_BOX
 #include "debug/debug_lines.glsl"
 #include "raytracing/rt_apply.glsl"
@@ -256,10 +261,19 @@ void main() {
     FrameConstants f = FrameConstantsRef(pc.frame).f;
     gTextureFeedback = f.textureFeedback; // texture streaming: the MIPs the shadels want
     ShadelFrame s = ShadelFrameRef(f.shadel).s;
-    uint workIndex = chunkSpectraWorkIndex(f, gl_WorkGroupID.y * 32768u + gl_WorkGroupID.x);
-    if (workIndex >= ShadelCountersRef(s.counters).c.shadeDispatch.w) return;
+    uint group = gl_WorkGroupID.y * 32768u + gl_WorkGroupID.x;
+    uint workIndex;
+    if (kShadeQueue == SHADE_QUEUE_SUPERSAMPLED) {
+        if (group >= ShadelCountersRef(s.counters).c.supersampledDispatch.w) return;
+        workIndex = UintBuffer(s.supersampledQueue).v[group];
+    } else {
+        workIndex = chunkSpectraWorkIndex(f, group);
+        if (workIndex >= ShadelCountersRef(s.counters).c.shadeDispatch.w) return;
+    }
     GpuShadelWork work = ShadelWorkBuffer(s.queue).w[workIndex];
     ShadelObjectRef o = shadelObject(s, work.object);
+    if (kShadeQueue == SHADE_QUEUE_SINGLE_SAMPLE && (o.v.flags & SHADEL_OBJECT_SUPERSAMPLED) != 0u)
+        return; // the supersampled pipeline's
     uvec2 local = gl_LocalInvocationID.xy;
     uint outIndex = storageIndex(work.slot, local);
     // Chunks of objects a changed region meets come here even when reusable (the fill pass

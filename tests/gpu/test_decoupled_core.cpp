@@ -125,6 +125,13 @@ TEST(DecoupledCore, OccupancyAndShadelsPerPixelAreInRange) {
     EXPECT_LE(perPixel, 6.0);
     EXPECT_LE(stat(run, "sheet_blocks_touched"), stat(run, "sheet_blocks_allocated"));
     EXPECT_EQ(stat(run, "chunks_shaded") * 64, stat(run, "shadels_shaded"));
+    // The plaza checker and the bricks are point-function procedurals: their chunks, and only
+    // theirs, go to the supersampled shading pipeline; without material supersampling none do.
+    EXPECT_GT(stat(run, "chunks_supersampled"), 0u);
+    EXPECT_LT(stat(run, "chunks_supersampled"), stat(run, "chunks_shaded"));
+    RenderOptions one = decoupled("builtin:default", 320, 180);
+    one.materialSamples = 1;
+    EXPECT_EQ(stat(renderChecked(one), "chunks_supersampled"), 0u);
 }
 
 // Capacity control: with storage far too small for the view, the controller raises the shading

@@ -173,17 +173,20 @@ struct DecoupledState {
     bool reuse = true;
     uint32_t refreshPeriod = 16; // --reuse-refresh
     uint32_t objectsReusable = 0;
-    BufferHandle allocId;        // uint per block (upload: written by the CPU allocator)
-    BufferHandle counters;       // GpuShadelCounters (readback, also indirect args)
-    BufferHandle markedBlocks;   // uvec4 per marked block, capacityChunks of them
-    BufferHandle queue;          // GpuShadelWork[capacity]: chunks to shade
-    BufferHandle copyQueue;      // GpuShadelWork[capacity]: chunks carried over from last frame
-    BufferHandle changedVolumes; // ChangedVolume[SHADEL_MAX_CHANGED_VOLUMES] (upload)
+    BufferHandle allocId;           // uint per block (upload: written by the CPU allocator)
+    BufferHandle counters;          // GpuShadelCounters (readback, also indirect args)
+    BufferHandle markedBlocks;      // uvec4 per marked block, capacityChunks of them
+    BufferHandle queue;             // GpuShadelWork[capacity]: chunks to shade
+    BufferHandle copyQueue;         // GpuShadelWork[capacity]: chunks carried over from last frame
+    BufferHandle supersampledQueue; // uint[capacity]: queue entries of supersampled objects
+    BufferHandle changedVolumes;    // ChangedVolume[SHADEL_MAX_CHANGED_VOLUMES] (upload)
     std::vector<ChangedVolume> changes; // this frame's (render/shadel/reuse_invalidation.h)
     bool changesOverflow = false;       // more than the buffer holds: everything changed
     ShadeStorage storage;
-    Pipeline clear, allocate, queueSetup, fillQueue, dispatchSetup, carryOver, shade, sheetView,
-        mark, markTransparent, reconstruct;
+    // shade: every queued chunk but supersampled objects' (their material supersampling compiled
+    // out); shadeSupersampled: those (ShadelFrame::supersampledQueue).
+    Pipeline clear, allocate, queueSetup, fillQueue, dispatchSetup, carryOver, shade,
+        shadeSupersampled, sheetView, mark, markTransparent, reconstruct;
     std::vector<FrameCounters> history;
 };
 
@@ -317,6 +320,8 @@ DecoupledStatePtr createDecoupled(Renderer& r, const GpuScene& scene) {
         device("shadel.workQueue", VkDeviceSize(d.capacityChunks) * sizeof(gpu::GpuShadelWork));
     d.copyQueue = device("shadel.carryOverQueue",
                          VkDeviceSize(d.capacityChunks) * sizeof(gpu::GpuShadelWork));
+    d.supersampledQueue =
+        device("shadel.supersampledQueue", VkDeviceSize(d.capacityChunks) * sizeof(uint32_t));
     d.chunkViews = {device("shadel.chunkViews.frame0", VkDeviceSize(d.capacityChunks) * 16),
                     device("shadel.chunkViews.frame1", VkDeviceSize(d.capacityChunks) * 16)};
 
@@ -330,7 +335,11 @@ DecoupledStatePtr createDecoupled(Renderer& r, const GpuScene& scene) {
     std::vector<std::pair<uint32_t, uint32_t>> shadeConstants;
     if (r.settings.distanceFieldLighting) // render/distance_fields: far shadows + AO per shadel
         shadeConstants.push_back({DISTANCE_FIELD_LIGHTING_CONSTANT_ID, 1u});
+    shadeConstants.push_back({SHADE_QUEUE_CONSTANT_ID, SHADE_QUEUE_SINGLE_SAMPLE});
     d.shade = createComputePipeline(gpu, "shadelShade", "shadel_shade.comp.spv", shadeConstants);
+    shadeConstants.back().second = SHADE_QUEUE_SUPERSAMPLED;
+    d.shadeSupersampled = createComputePipeline(gpu, "shadelShadeSupersampled",
+                                                "shadel_shade.comp.spv", shadeConstants);
     d.sheetView = createComputePipeline(gpu, "shadelSheetView", "shadel_sheet_view.comp.spv");
     GraphicsPipelineDesc mark;
     mark.name = "shadelMark";
@@ -359,15 +368,15 @@ void destroyDecoupled(Renderer& r, DecoupledStatePtr& state) {
     if (!state) return;
     Gpu& gpu = *r.gpu;
     DecoupledState& d = *state;
-    for (Pipeline* p :
-         {&d.clear, &d.allocate, &d.queueSetup, &d.fillQueue, &d.dispatchSetup, &d.carryOver,
-          &d.shade, &d.sheetView, &d.mark, &d.markTransparent, &d.reconstruct})
+    for (Pipeline* p : {&d.clear, &d.allocate, &d.queueSetup, &d.fillQueue, &d.dispatchSetup,
+                        &d.carryOver, &d.shade, &d.shadeSupersampled, &d.sheetView, &d.mark,
+                        &d.markTransparent, &d.reconstruct})
         destroy(gpu, *p);
     destroyShadeStorage(gpu, d.storage);
     for (BufferHandle b :
          {d.frameInfo, d.changedVolumes, d.objectBuffer, d.rectBuffer, d.levelWants, d.occupancy[0],
           d.occupancy[1], d.offsetMap[0], d.offsetMap[1], d.allocId, d.counters, d.markedBlocks,
-          d.queue, d.copyQueue, d.chunkViews[0], d.chunkViews[1]})
+          d.queue, d.copyQueue, d.supersampledQueue, d.chunkViews[0], d.chunkViews[1]})
         destroy(gpu, b);
     state.reset();
 }
@@ -874,6 +883,11 @@ void prepareDecoupledFrame(Renderer& r, const GpuScene& scene, const CameraView&
         g.mipCount = mesh.mipCount;
         g.firstMip = o.firstMip;
         g.flags |= SHADEL_OBJECT_DECOUPLED;
+        // Only point-function procedurals are supersampled (shaders/shadel/prefilter.glsl).
+        uint32_t procedural = known ? scene.materialInfo[inst.material].procedural : 0u;
+        if ((procedural == PROCEDURAL_TEXEL_CHECKER || procedural == PROCEDURAL_BRICKS) &&
+            r.settings.materialSamples >= 4) // 2 x 2 samples at least
+            g.flags |= SHADEL_OBJECT_SUPERSAMPLED;
         g.firstRect = uint32_t(d.rects.size());
         for (uint32_t k = o.firstMip; k < mesh.mipCount; ++k) {
             g.idMapOffset[k] = mesh.idMapOffset[k];
@@ -957,6 +971,7 @@ void prepareDecoupledFrame(Renderer& r, const GpuScene& scene, const CameraView&
     s.markedBlocks = address(gpu, d.markedBlocks);
     s.queue = address(gpu, d.queue);
     s.copyQueue = address(gpu, d.copyQueue);
+    s.supersampledQueue = address(gpu, d.supersampledQueue);
     s.idMaps = address(gpu, scene.idMaps);
     s.shadelUvs = address(gpu, scene.shadelUvs);
     s.sheetBlocks = d.sheetBlocks;
@@ -1118,6 +1133,12 @@ void recordDecoupledShading(Renderer& r, FrameRecorder& rec, uint64_t frame, con
             pushConstants(gpu, cmd, FramePush{frame});
             vkCmdDispatchIndirect(cmd, vkBuffer(gpu, d.counters),
                                   offsetof(gpu::GpuShadelCounters, shadeDispatch));
+            // Chunks of supersampled objects (point-function procedurals): no barrier between,
+            // the two pipelines write disjoint chunks.
+            bind(gpu, cmd, d.shadeSupersampled);
+            pushConstants(gpu, cmd, FramePush{frame});
+            vkCmdDispatchIndirect(cmd, vkBuffer(gpu, d.counters),
+                                  offsetof(gpu::GpuShadelCounters, supersampledDispatch));
         }
         // The shade storage this pass and carry-over wrote, read by reconstruction (raster:
         // fragment; --marking visibility: the compute resolve) and the transparency passes.
@@ -1281,6 +1302,9 @@ void decoupledStats(const Renderer& r, nlohmann::json& s) {
     s["overflow_samples"] = overflowSamples;
     s["marked_blocks"] = last.counters.markedBlocks;
     s["chunks_shaded"] = chunksShaded;
+    // Of the queued chunks, those of point-function procedurals, shaded with material
+    // supersampling by a pipeline of their own (shade.comp SHADE_QUEUE_SUPERSAMPLED).
+    s["chunks_supersampled"] = last.counters.supersampledCount;
     nlohmann::json perMip = nlohmann::json::array();
     for (uint32_t k = 0; k < SHADEL_MAX_MIPS; ++k) perMip.push_back(last.counters.chunksPerMip[k]);
     s["chunks_per_mip"] = perMip;
