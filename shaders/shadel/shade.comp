@@ -20,6 +20,8 @@
 // compiled out, one over those chunks' list. On CPU devices a SIMD group runs the code of a
 // branch none of its lanes takes, so the supersampling cost every chunk ~17% of the pass.
 layout(constant_id = SHADE_QUEUE_CONSTANT_ID) const uint kShadeQueue = SHADE_QUEUE_ALL;
+layout(constant_id = SHADE_OPTIONAL_CONSTANT_ID) const uint kShadeOptional = SHADE_OPTIONAL_ALL;
+#define SHADE_HAS(feature) ((kShadeOptional & (feature)) != 0u)
 #include "shadel/prefilter.glsl" // reads kShadeQueue
 #define DEBUG_LINES_WORKGROUP_BOX
 #include "debug/debug_lines.glsl"
@@ -335,7 +337,7 @@ void main() {
     }
     recordChunkView(f, s, work.slot, shading, si.position);
     // --debug-lines chunks: this chunk's world box, coloured by MIP (uniform over the workgroup).
-    if (debugLinesOn(f, DEBUG_LINES_CHUNKS))
+    if (SHADE_HAS(SHADE_OPTIONAL_DEBUG_LINES) && debugLinesOn(f, DEBUG_LINES_CHUNKS))
         debugWorkgroupBox(f, shading, si.position, debugLevelColour(work.mip));
     if (!shading) {
         storeLayers(s, outIndex, vec4(0.0), vec4(0.0));
@@ -346,14 +348,16 @@ void main() {
                                      cross(v1.position - v0.position, v2.position - v0.position));
     si.frontFacing = dot(geometricNormal, f.cameraPosition - si.position) >= 0.0;
     GpuMaterial mat = MaterialBuffer(f.materials).m[inst.material];
-    useRayTracedShadelTerms(f, work.object, shadelCenterUv(shadel, size)); // --rt-* (RT cache)
+    if (SHADE_HAS(SHADE_OPTIONAL_RT)) // --rt-* (RT cache)
+        useRayTracedShadelTerms(f, work.object, shadelCenterUv(shadel, size));
     // Decals: the object's list (render/decals) narrowed to this shadel's point, applied inside
     // evaluateMaterial, so each shadel takes them once and every pixel reading it reuses them.
     // Opaque surfaces only, as in forward shading.
-    uint decalPairs = (mat.flags & MATERIAL_ALPHA_BLEND) == 0u
+    uint decalPairs = SHADE_HAS(SHADE_OPTIONAL_DECALS) && (mat.flags & MATERIAL_ALPHA_BLEND) == 0u
                           ? useShadelDecalList(f, work.object, si.position)
                           : 0u;
-    if (f.decals != 0ul) countShadelDecals(f, work.object, decalPairs);
+    if (SHADE_HAS(SHADE_OPTIONAL_DECALS) && f.decals != 0ul)
+        countShadelDecals(f, work.object, decalPairs);
     // The shadel's whole footprint, not its centre (prefilter.glsl; --material-samples caps it).
     vec4 material;
     vec3 color = prefilteredShade(f, mat, si, shadelCenterUv(shadel, size), vec2(1.0) / vec2(size),

@@ -335,6 +335,13 @@ DecoupledStatePtr createDecoupled(Renderer& r, const GpuScene& scene) {
     std::vector<std::pair<uint32_t, uint32_t>> shadeConstants;
     if (r.settings.distanceFieldLighting) // render/distance_fields: far shadows + AO per shadel
         shadeConstants.push_back({DISTANCE_FIELD_LIGHTING_CONSTANT_ID, 1u});
+    // What this renderer can use (render/renderer.cpp creates the decal, ray tracing and debug
+    // line states from the same settings and scene).
+    uint32_t optional = 0u;
+    if (r.settings.rt.enabled()) optional |= SHADE_OPTIONAL_RT;
+    if (r.settings.decals && !scene.decals.empty()) optional |= SHADE_OPTIONAL_DECALS;
+    if (r.settings.debugLines & DEBUG_LINES_CHUNKS) optional |= SHADE_OPTIONAL_DEBUG_LINES;
+    shadeConstants.push_back({SHADE_OPTIONAL_CONSTANT_ID, optional});
     shadeConstants.push_back({SHADE_QUEUE_CONSTANT_ID, SHADE_QUEUE_SINGLE_SAMPLE});
     d.shade = createComputePipeline(gpu, "shadelShade", "shadel_shade.comp.spv", shadeConstants);
     shadeConstants.back().second = SHADE_QUEUE_SUPERSAMPLED;
