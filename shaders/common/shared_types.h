@@ -101,14 +101,16 @@ using uint = uint32_t;
 #define SHADE_QUEUE_ALL 0u
 #define SHADE_QUEUE_SINGLE_SAMPLE 1u
 #define SHADE_QUEUE_SUPERSAMPLED 2u
-// The optional inputs a shadel shading pipeline has compiled in: ray-traced terms (--rt-*),
-// the scene's decals, --debug-lines chunks. The plain shading pass leaves out what the renderer
+// The optional parts a shadel shading pipeline has compiled in: ray-traced terms (--rt-*),
+// the scene's decals, --debug-lines chunks, preserved layers (--reuse: carrying chunks near a
+// change over, recording each chunk's view). The plain shading pass leaves out what the renderer
 // was created without (on CPU devices an unused feature's code still runs, masked).
 #define SHADE_OPTIONAL_CONSTANT_ID 148
 #define SHADE_OPTIONAL_RT 1u
 #define SHADE_OPTIONAL_DECALS 2u
 #define SHADE_OPTIONAL_DEBUG_LINES 4u
-#define SHADE_OPTIONAL_ALL 7u
+#define SHADE_OPTIONAL_REUSE 8u
+#define SHADE_OPTIONAL_ALL 15u
 // Specialization constant of shaders/common/lighting.glsl: 1 compiles the distance-field far
 // shadows and AO in (render/distance_fields; forward and shadel shading with --distance-fields).
 #define DISTANCE_FIELD_LIGHTING_CONSTANT_ID 142

@@ -281,7 +281,7 @@ void main() {
     // Chunks of objects a changed region meets come here even when reusable (the fill pass
     // cannot tell which of their shadels the change reaches): carry over those it does not.
     // (With spectra the classify phase decided: a binned chunk is shaded.)
-    int carrySlot = kChunkSpectraPhase != CHUNK_SPECTRA_SHADE &&
+    int carrySlot = SHADE_HAS(SHADE_OPTIONAL_REUSE) && kChunkSpectraPhase != CHUNK_SPECTRA_SHADE &&
                             (o.v.flags & SHADEL_OBJECT_NEAR_CHANGE) != 0u
                         ? carrySource(s, o, work, f.cameraPosition)
                         : -1;
@@ -335,7 +335,7 @@ void main() {
         classifyChunkSpectrum(f, workIndex);
         return;
     }
-    recordChunkView(f, s, work.slot, shading, si.position);
+    if (SHADE_HAS(SHADE_OPTIONAL_REUSE)) recordChunkView(f, s, work.slot, shading, si.position);
     // --debug-lines chunks: this chunk's world box, coloured by MIP (uniform over the workgroup).
     if (SHADE_HAS(SHADE_OPTIONAL_DEBUG_LINES) && debugLinesOn(f, DEBUG_LINES_CHUNKS))
         debugWorkgroupBox(f, shading, si.position, debugLevelColour(work.mip));

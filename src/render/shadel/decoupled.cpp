@@ -341,6 +341,7 @@ DecoupledStatePtr createDecoupled(Renderer& r, const GpuScene& scene) {
     if (r.settings.rt.enabled()) optional |= SHADE_OPTIONAL_RT;
     if (r.settings.decals && !scene.decals.empty()) optional |= SHADE_OPTIONAL_DECALS;
     if (r.settings.debugLines & DEBUG_LINES_CHUNKS) optional |= SHADE_OPTIONAL_DEBUG_LINES;
+    if (d.reuse) optional |= SHADE_OPTIONAL_REUSE;
     shadeConstants.push_back({SHADE_OPTIONAL_CONSTANT_ID, optional});
     shadeConstants.push_back({SHADE_QUEUE_CONSTANT_ID, SHADE_QUEUE_SINGLE_SAMPLE});
     d.shade = createComputePipeline(gpu, "shadelShade", "shadel_shade.comp.spv", shadeConstants);
