@@ -155,7 +155,8 @@ float distributionCharlie(float nh, float alpha) {
 // normal; what it reflects does not reach the layers below).
 vec3 brdf(MaterialSample m, vec3 n, vec3 v, vec3 l, vec3 radiance) {
     float nl = dot(n, l);
-    float coatNl = m.clearcoat > 0.0 ? dot(m.clearcoatNormal, l) : 0.0;
+    bool coat = MATERIAL_HAS(MATERIAL_FEATURE_CLEARCOAT) && m.clearcoat > 0.0;
+    float coatNl = coat ? dot(m.clearcoatNormal, l) : 0.0;
     if (nl <= 0.0 && coatNl <= 0.0) return vec3(0.0);
     vec3 h = normalize(v + l);
     float vh = max(dot(v, h), 0.0);
@@ -172,7 +173,7 @@ vec3 brdf(MaterialSample m, vec3 n, vec3 v, vec3 l, vec3 radiance) {
         vec3 diffuse = (1.0 - f) * (1.0 - m.metallic) * m.baseColor / PI;
         color = diffuse + specular;
         float sheenMax = max(m.sheenColor.r, max(m.sheenColor.g, m.sheenColor.b));
-        if (sheenMax > 0.0) {
+        if (MATERIAL_HAS(MATERIAL_FEATURE_SHEEN) && sheenMax > 0.0) {
             float alpha = m.sheenRoughness * m.sheenRoughness;
             vec3 sheen = m.sheenColor * distributionCharlie(nh, alpha) /
                          (4.0 * (nl + nv - nl * nv));
@@ -180,7 +181,7 @@ vec3 brdf(MaterialSample m, vec3 n, vec3 v, vec3 l, vec3 radiance) {
         }
         color *= nl;
     }
-    if (m.clearcoat > 0.0) {
+    if (coat) {
         vec3 cn = m.clearcoatNormal;
         float cnv = max(dot(cn, v), 1e-4);
         float fcView = 0.04 + 0.96 * pow(1.0 - cnv, 5.0);
@@ -516,7 +517,7 @@ vec3 shadeSurface(FrameConstants f, MaterialSample m, vec3 worldPos, vec3 geomet
     float up = n.y * 0.5 + 0.5;
     vec3 ambient = mix(f.ambientColor * 0.5, f.ambientColor + f.skyColor * 0.15, up);
     vec3 ambientLit = ambient * m.baseColor * (1.0 - m.metallic * 0.5) * m.occlusion;
-    if (m.clearcoat > 0.0) {
+    if (MATERIAL_HAS(MATERIAL_FEATURE_CLEARCOAT) && m.clearcoat > 0.0) {
         // The coat mirrors the same hemisphere (sky above, ground below) by its Fresnel; what it
         // reflects does not reach the base.
         float fc = m.clearcoat * (0.04 + 0.96 * pow(1.0 - max(dot(m.clearcoatNormal, v), 0.0), 5.0));

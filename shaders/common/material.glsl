@@ -91,21 +91,28 @@ vec3 applyNormalMap(GpuMaterial m, uint slot, uint tex, float scale, SurfaceInpu
     return normalize(t * tn.x + b * tn.y + n * max(tn.z, 1e-3));
 }
 
+// The material features this shader evaluates (MATERIAL_FEATURE_*): all of them, except in the
+// shadel shading pipeline of plain materials (shaders/shadel/shade.comp), whose objects use
+// none. On CPU devices a SIMD group runs the code of a branch none of its lanes takes, so each
+// absent texture's sample still cost every shadel.
+layout(constant_id = MATERIAL_FEATURES_CONSTANT_ID) const uint kMaterialFeatures = MATERIAL_FEATURES_ALL;
+#define MATERIAL_HAS(feature) ((kMaterialFeatures & (feature)) != 0u)
+
 MaterialSample evaluateMaterial(GpuMaterial m, SurfaceInput s) {
     MaterialSample o;
     vec4 base = m.baseColorFactor;
-    if (m.baseColorTexture != NO_TEXTURE)
+    if (m.baseColorTexture != NO_TEXTURE && MATERIAL_HAS(MATERIAL_FEATURE_TEXTURES))
         base *= sampleMaterialTexture(m, TEXTURE_SLOT_BASE_COLOR, m.baseColorTexture, s);
-    if (m.procedural == PROCEDURAL_TEXEL_CHECKER)
+    if (MATERIAL_HAS(MATERIAL_FEATURE_PROCEDURAL) && m.procedural == PROCEDURAL_TEXEL_CHECKER)
         base.rgb *= mix(0.08, 1.0, texelChecker(s.uv, m.proceduralScale));
-    else if (m.procedural == PROCEDURAL_BRICKS)
+    else if (MATERIAL_HAS(MATERIAL_FEATURE_PROCEDURAL) && m.procedural == PROCEDURAL_BRICKS)
         base.rgb *= bricks(s.uv, m.proceduralScale);
     o.baseColor = base.rgb;
     o.alpha = base.a;
 
     o.metallic = m.metallicFactor;
     o.roughness = m.roughnessFactor;
-    if (m.metallicRoughnessTexture != NO_TEXTURE) {
+    if (m.metallicRoughnessTexture != NO_TEXTURE && MATERIAL_HAS(MATERIAL_FEATURE_TEXTURES)) {
         vec4 mr = sampleMaterialTexture(m, TEXTURE_SLOT_METALLIC_ROUGHNESS, m.metallicRoughnessTexture, s);
         o.roughness *= mr.g;
         o.metallic *= mr.b;
@@ -114,36 +121,38 @@ MaterialSample evaluateMaterial(GpuMaterial m, SurfaceInput s) {
     o.metallic = clamp(o.metallic, 0.0, 1.0);
 
     o.occlusion = 1.0;
-    if (m.occlusionTexture != NO_TEXTURE) {
+    if (m.occlusionTexture != NO_TEXTURE && MATERIAL_HAS(MATERIAL_FEATURE_TEXTURES)) {
         float ao = sampleMaterialTexture(m, TEXTURE_SLOT_OCCLUSION, m.occlusionTexture, s).r;
         o.occlusion = mix(1.0, ao, m.occlusionStrength);
     }
 
     o.emissive = m.emissiveFactor;
-    if (m.emissiveTexture != NO_TEXTURE)
+    if (m.emissiveTexture != NO_TEXTURE && MATERIAL_HAS(MATERIAL_FEATURE_TEXTURES))
         o.emissive *= sampleMaterialTexture(m, TEXTURE_SLOT_EMISSIVE, m.emissiveTexture, s).rgb;
 
     vec3 n = normalize(s.normal);
     if ((m.flags & MATERIAL_DOUBLE_SIDED) != 0u && !s.frontFacing) n = -n;
-    o.normal = applyNormalMap(m, TEXTURE_SLOT_NORMAL, m.normalTexture, m.normalScale, s, n, o.roughness);
+    o.normal = n;
+    if (MATERIAL_HAS(MATERIAL_FEATURE_TEXTURES))
+        o.normal = applyNormalMap(m, TEXTURE_SLOT_NORMAL, m.normalTexture, m.normalScale, s, n, o.roughness);
 
     // KHR_materials_specular: strength in the specular texture's A, the F0 tint in the colour
     // texture's RGB (sRGB), both multiplying their factors.
     float specularStrength = 1.0;
     vec3 specularTint = m.specularColorFactor;
-    if (m.specularTexture != NO_TEXTURE)
+    if (m.specularTexture != NO_TEXTURE && MATERIAL_HAS(MATERIAL_FEATURE_TEXTURES))
         specularStrength = sampleMaterialTexture(m, TEXTURE_SLOT_SPECULAR, m.specularTexture, s).a;
-    if (m.specularColorTexture != NO_TEXTURE)
+    if (m.specularColorTexture != NO_TEXTURE && MATERIAL_HAS(MATERIAL_FEATURE_TEXTURES))
         specularTint *= sampleMaterialTexture(m, TEXTURE_SLOT_SPECULAR_COLOR, m.specularColorTexture, s).rgb;
     o.specularF0 = min(m.dielectricF0Scalar * specularTint, vec3(1.0)) * specularStrength;
     o.specularF90 = m.specularFactor * specularStrength;
-    o.clearcoat = m.clearcoatFactor;
+    o.clearcoat = MATERIAL_HAS(MATERIAL_FEATURE_CLEARCOAT) ? m.clearcoatFactor : 0.0;
     o.clearcoatRoughness = m.clearcoatRoughnessFactor;
     o.clearcoatNormal = n; // the coat follows the geometry, not the base layer's normal map
     if (o.clearcoat > 0.0) {
-        if (m.clearcoatTexture != NO_TEXTURE)
+        if (m.clearcoatTexture != NO_TEXTURE && MATERIAL_HAS(MATERIAL_FEATURE_TEXTURES))
             o.clearcoat *= sampleMaterialTexture(m, TEXTURE_SLOT_CLEARCOAT, m.clearcoatTexture, s).r;
-        if (m.clearcoatRoughnessTexture != NO_TEXTURE)
+        if (m.clearcoatRoughnessTexture != NO_TEXTURE && MATERIAL_HAS(MATERIAL_FEATURE_TEXTURES))
             o.clearcoatRoughness *= sampleMaterialTexture(m, TEXTURE_SLOT_CLEARCOAT_ROUGHNESS,
                                                           m.clearcoatRoughnessTexture, s).g;
         o.clearcoatRoughness = clamp(o.clearcoatRoughness, 0.04, 1.0);
@@ -152,12 +161,12 @@ MaterialSample evaluateMaterial(GpuMaterial m, SurfaceInput s) {
     }
     // KHR_materials_sheen: colour in the colour texture's RGB (sRGB), roughness in the
     // roughness texture's A, both multiplying their factors.
-    o.sheenColor = m.sheenColorFactor;
+    o.sheenColor = MATERIAL_HAS(MATERIAL_FEATURE_SHEEN) ? m.sheenColorFactor : vec3(0.0);
     float sheenRoughness = m.sheenRoughnessFactor;
     if (any(greaterThan(o.sheenColor, vec3(0.0)))) {
-        if (m.sheenColorTexture != NO_TEXTURE)
+        if (m.sheenColorTexture != NO_TEXTURE && MATERIAL_HAS(MATERIAL_FEATURE_TEXTURES))
             o.sheenColor *= sampleMaterialTexture(m, TEXTURE_SLOT_SHEEN_COLOR, m.sheenColorTexture, s).rgb;
-        if (m.sheenRoughnessTexture != NO_TEXTURE)
+        if (m.sheenRoughnessTexture != NO_TEXTURE && MATERIAL_HAS(MATERIAL_FEATURE_TEXTURES))
             sheenRoughness *= sampleMaterialTexture(m, TEXTURE_SLOT_SHEEN_ROUGHNESS,
                                                     m.sheenRoughnessTexture, s).a;
     }

@@ -95,12 +95,23 @@ using uint = uint32_t;
 // them for its rebuild pass (shaders/shadel/resolve.comp).
 #define RESOLVE_REBUILD_INLINE_CONSTANT_ID 146
 // Which queued chunks a shadel shading pipeline shades (shaders/shadel/shade.comp): all of them
-// (the spectra permutations), those of objects shaded with one material sample per shadel (the
-// material supersampling compiled out), or those of supersampled objects (their own list).
+// (the spectra permutations, everything compiled in), or one shading class's list. The classes
+// (SHADEL_OBJECT_* flags, per object from its material): plain (no texture, procedural, clear
+// coat or sheen: those compiled out, one material sample), featured (one material sample), and
+// supersampled (point-function procedurals).
 #define SHADE_QUEUE_CONSTANT_ID 147
 #define SHADE_QUEUE_ALL 0u
-#define SHADE_QUEUE_SINGLE_SAMPLE 1u
-#define SHADE_QUEUE_SUPERSAMPLED 2u
+#define SHADE_QUEUE_PLAIN 1u
+#define SHADE_QUEUE_FEATURED 2u
+#define SHADE_QUEUE_SUPERSAMPLED 3u
+#define SHADE_CLASSES 3u // the class lists: SHADE_QUEUE_* - 1
+// The material features a shader evaluates (shaders/common/material.glsl: kMaterialFeatures).
+#define MATERIAL_FEATURES_CONSTANT_ID 149
+#define MATERIAL_FEATURE_TEXTURES 1u   // any texture slot
+#define MATERIAL_FEATURE_PROCEDURAL 2u // point-function procedurals (checker, bricks)
+#define MATERIAL_FEATURE_CLEARCOAT 4u
+#define MATERIAL_FEATURE_SHEEN 8u
+#define MATERIAL_FEATURES_ALL 15u
 // The optional parts a shadel shading pipeline has compiled in: ray-traced terms (--rt-*),
 // the scene's decals, --debug-lines chunks, preserved layers (--reuse: carrying chunks near a
 // change over, recording each chunk's view). The plain shading pass leaves out what the renderer
@@ -532,6 +543,8 @@ struct ShaderMessage {
 // Its material is a point-function procedural and --material-samples > 1: its shadels
 // supersample the material (shaders/shadel/prefilter.glsl), in a shading pipeline of their own.
 #define SHADEL_OBJECT_SUPERSAMPLED 4u
+// Its material uses any MATERIAL_FEATURE_* (else it is shaded by the plain pipeline).
+#define SHADEL_OBJECT_FEATURED_MATERIAL 8u
 #define SHADEL_MAX_CHANGED_VOLUMES 256u
 #define SHADEL_CHUNK_VIEW_NONE 0xFFFFFFFFu // ShadelFrame::chunkViews: a NaN centre
 // Material layers of the shade storage (seed: "layers of different bit depths"): every layer
@@ -640,7 +653,7 @@ struct GpuShadelCounters {
     uint chunksReused;                 // chunks carried over from last frame's storage (preserved)
     uint shadeCount;                   // entries in the shading queue
     uint copyCount;                    // entries in the carry-over queue
-    uint supersampledCount;            // entries in the supersampled list
+    uint classCount[SHADE_CLASSES];    // entries in each shading class's list
     uint magnifiedPixels;     // sampled reconstructed pixels whose MIP-0 shadel spans > 1 pixel
     uint reconstructedPixels; // sampled (even x and y) pixels the reconstruction drew
     uint chunksPerMip[SHADEL_MAX_MIPS]; // allocated chunks by MIP level
@@ -655,7 +668,7 @@ struct GpuShadelCounters {
     uvec4 fillDispatch;  // x, y, z, marked blocks in the list: indirect args of the queue fill
     uvec4 shadeDispatch; // x, y, z, queue length: indirect args of the shading pass
     uvec4 copyDispatch;  // x, y, z, queue length: indirect args of the carry-over pass
-    uvec4 supersampledDispatch; // x, y, z, list length: the supersampled objects' shading
+    uvec4 classDispatch[SHADE_CLASSES]; // x, y, z, list length: each class's shading
 };
 
 struct ShadelFrame {
@@ -668,8 +681,8 @@ struct ShadelFrame {
     uint64_t markedBlocks; // uvec4 {block, place in its counter, object, mip | counter << 8}
     uint64_t queue;        // GpuShadelWork[capacityChunks]: chunks to shade
     uint64_t copyQueue;    // GpuShadelWork[capacityChunks]: chunks carried over (chunk = old slot)
-    // uint[capacityChunks]: the shading queue's entries of SHADEL_OBJECT_SUPERSAMPLED objects.
-    uint64_t supersampledQueue;
+    // uint[SHADE_CLASSES][capacityChunks]: the shading queue's entries by shading class.
+    uint64_t classQueues;
     uint64_t idMaps;       // uint16 triangle ids, packed in uints
     uint64_t shadelUvs;    // vec2 per vertex of the unified geometry buffer
     // The shade storage's layers, chunk-linear buffers (shaders/shadel/shadel.glsl storageIndex:

@@ -14,7 +14,8 @@ void main() {
     ShadelFrame s = ShadelFrameRef(FrameConstantsRef(pc.frame).f.shadel).s;
     ShadelCountersRef counters = ShadelCountersRef(s.counters);
     counters.c.shadeDispatch = chunkDispatch(counters.c.shadeCount);
-    counters.c.supersampledDispatch = chunkDispatch(counters.c.supersampledCount);
+    for (uint c = 0u; c < SHADE_CLASSES; ++c)
+        counters.c.classDispatch[c] = chunkDispatch(counters.c.classCount[c]);
     // Carry-over copies 8 chunks per workgroup (carry_over.comp).
     uint copyGroups = (counters.c.copyCount + 7u) / 8u;
     counters.c.copyDispatch = chunkDispatch(copyGroups);

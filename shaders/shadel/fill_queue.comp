@@ -76,8 +76,9 @@ void main() {
         }
         uint queued = atomicAdd(counters.c.shadeCount, 1u);
         ShadelWorkBuffer(s.queue).w[queued] = w;
-        if ((o.v.flags & SHADEL_OBJECT_SUPERSAMPLED) != 0u)
-            UintBuffer(s.supersampledQueue).v[atomicAdd(counters.c.supersampledCount, 1u)] = queued;
+        uint shadeClass = shadeClassOf(o);
+        uint place = atomicAdd(counters.c.classCount[shadeClass], 1u);
+        UintBuffer(s.classQueues).v[shadeClass * s.capacityChunks + place] = queued;
         uint reason = !levelReusable ? SHADEL_SHADED_NOT_REUSABLE
                       : nearChange   ? SHADEL_SHADED_NEAR_CHANGE
                       : refresh      ? SHADEL_SHADED_REFRESH

@@ -15,10 +15,10 @@
 #include "lighting/light_debug.glsl"
 #include "lighting/chunk_spectra.glsl"
 #include "common/shadel_bary.h"
-// The plain shading pass runs two pipelines (render/shadel/decoupled.cpp): one over the whole
-// queue that leaves supersampled objects' chunks alone and has the material supersampling
-// compiled out, one over those chunks' list. On CPU devices a SIMD group runs the code of a
-// branch none of its lanes takes, so the supersampling cost every chunk ~17% of the pass.
+// Without spectra the shading pass runs one pipeline per shading class (shadeClassOf), each
+// over its class's list, with what its class does not use compiled out (kMaterialFeatures,
+// common/material.glsl; the supersampling, prefilter.glsl). On CPU devices a SIMD group runs
+// the code of a branch none of its lanes takes, so unused material features cost every shadel.
 layout(constant_id = SHADE_QUEUE_CONSTANT_ID) const uint kShadeQueue = SHADE_QUEUE_ALL;
 layout(constant_id = SHADE_OPTIONAL_CONSTANT_ID) const uint kShadeOptional = SHADE_OPTIONAL_ALL;
 #define SHADE_HAS(feature) ((kShadeOptional & (feature)) != 0u)
@@ -265,17 +265,16 @@ void main() {
     ShadelFrame s = ShadelFrameRef(f.shadel).s;
     uint group = gl_WorkGroupID.y * 32768u + gl_WorkGroupID.x;
     uint workIndex;
-    if (kShadeQueue == SHADE_QUEUE_SUPERSAMPLED) {
-        if (group >= ShadelCountersRef(s.counters).c.supersampledDispatch.w) return;
-        workIndex = UintBuffer(s.supersampledQueue).v[group];
+    if (kShadeQueue != SHADE_QUEUE_ALL) {
+        uint shadeClass = kShadeQueue - 1u;
+        if (group >= ShadelCountersRef(s.counters).c.classDispatch[shadeClass].w) return;
+        workIndex = UintBuffer(s.classQueues).v[shadeClass * s.capacityChunks + group];
     } else {
         workIndex = chunkSpectraWorkIndex(f, group);
         if (workIndex >= ShadelCountersRef(s.counters).c.shadeDispatch.w) return;
     }
     GpuShadelWork work = ShadelWorkBuffer(s.queue).w[workIndex];
     ShadelObjectRef o = shadelObject(s, work.object);
-    if (kShadeQueue == SHADE_QUEUE_SINGLE_SAMPLE && (o.v.flags & SHADEL_OBJECT_SUPERSAMPLED) != 0u)
-        return; // the supersampled pipeline's
     uvec2 local = gl_LocalInvocationID.xy;
     uint outIndex = storageIndex(work.slot, local);
     // Chunks of objects a changed region meets come here even when reusable (the fill pass

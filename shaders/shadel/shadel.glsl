@@ -221,6 +221,13 @@ bool shadelRefreshDue(ShadelFrame s, uint chunk) {
     return (((chunk * 2654435761u) >> 20) + s.frameNumber) % max(s.refreshPeriod, 1u) == 0u;
 }
 
+// The shading class of an object (its chunks' list, SHADE_QUEUE_* - 1).
+uint shadeClassOf(ShadelObjectRef o) {
+    if ((o.v.flags & SHADEL_OBJECT_SUPERSAMPLED) != 0u) return SHADE_QUEUE_SUPERSAMPLED - 1u;
+    if ((o.v.flags & SHADEL_OBJECT_FEATURED_MATERIAL) != 0u) return SHADE_QUEUE_FEATURED - 1u;
+    return SHADE_QUEUE_PLAIN - 1u;
+}
+
 // Octahedral mapping of a unit vector to [-1, 1]^2 and back (chunk view directions).
 vec2 shadelOctEncode(vec3 n) {
     n /= abs(n.x) + abs(n.y) + abs(n.z);

@@ -362,6 +362,22 @@ void destroyScene(Gpu& gpu, GpuScene& s) {
     s = GpuScene{};
 }
 
+uint32_t materialFeatures(const gpu::GpuMaterial& m) {
+    uint32_t features = 0u;
+    for (uint32_t texture :
+         {m.baseColorTexture, m.metallicRoughnessTexture, m.normalTexture, m.emissiveTexture,
+          m.occlusionTexture, m.clearcoatTexture, m.clearcoatRoughnessTexture,
+          m.clearcoatNormalTexture, m.specularTexture, m.specularColorTexture, m.sheenColorTexture,
+          m.sheenRoughnessTexture})
+        if (texture != NO_TEXTURE) features |= MATERIAL_FEATURE_TEXTURES;
+    if (m.procedural == PROCEDURAL_TEXEL_CHECKER || m.procedural == PROCEDURAL_BRICKS)
+        features |= MATERIAL_FEATURE_PROCEDURAL;
+    if (m.clearcoatFactor > 0.0f) features |= MATERIAL_FEATURE_CLEARCOAT;
+    if (glm::any(glm::greaterThan(m.sheenColorFactor, glm::vec3(0.0f))))
+        features |= MATERIAL_FEATURE_SHEEN;
+    return features;
+}
+
 bool hasAlphaMaskedMaterials(const GpuScene& scene) {
     for (const gpu::GpuMaterial& m : scene.materialInfo)
         if (m.flags & MATERIAL_ALPHA_MASK) return true;

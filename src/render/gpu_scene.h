@@ -78,4 +78,8 @@ void destroyScene(Gpu& gpu, GpuScene& scene);
 // Whether any material is alpha-masked (glTF alphaMode MASK).
 bool hasAlphaMaskedMaterials(const GpuScene& scene);
 
+// The MATERIAL_FEATURE_* the material uses: what shaders/common/material.glsl must evaluate for
+// it (a shader compiled without them, kMaterialFeatures, shades it the same).
+uint32_t materialFeatures(const gpu::GpuMaterial& m);
+
 } // namespace shadel

@@ -125,13 +125,25 @@ TEST(DecoupledCore, OccupancyAndShadelsPerPixelAreInRange) {
     EXPECT_LE(perPixel, 6.0);
     EXPECT_LE(stat(run, "sheet_blocks_touched"), stat(run, "sheet_blocks_allocated"));
     EXPECT_EQ(stat(run, "chunks_shaded") * 64, stat(run, "shadels_shaded"));
-    // The plaza checker and the bricks are point-function procedurals: their chunks, and only
-    // theirs, go to the supersampled shading pipeline; without material supersampling none do.
-    EXPECT_GT(stat(run, "chunks_supersampled"), 0u);
-    EXPECT_LT(stat(run, "chunks_supersampled"), stat(run, "chunks_shaded"));
+    // Shading classes (one pipeline each): the plaza checker and the bricks are point-function
+    // procedurals, supersampled; the untextured rest is plain (every material feature compiled
+    // out); every shaded chunk is in one class. Without material supersampling no chunk is
+    // supersampled, and textured materials are featured.
+    const auto& classes = run.stats["chunks_by_shading_class"];
+    uint64_t plain = classes["plain"].get<uint64_t>();
+    uint64_t featured = classes["featured"].get<uint64_t>();
+    uint64_t supersampled = classes["supersampled"].get<uint64_t>();
+    EXPECT_GT(supersampled, 0u);
+    EXPECT_GT(plain, 0u);
+    EXPECT_EQ(supersampled, stat(run, "chunks_supersampled"));
+    EXPECT_EQ(plain + featured + supersampled, stat(run, "chunks_shaded"));
     RenderOptions one = decoupled("builtin:default", 320, 180);
     one.materialSamples = 1;
-    EXPECT_EQ(stat(renderChecked(one), "chunks_supersampled"), 0u);
+    RenderRun single = renderChecked(one);
+    EXPECT_EQ(stat(single, "chunks_supersampled"), 0u);
+    EXPECT_GT(single.stats["chunks_by_shading_class"]["featured"].get<uint64_t>(), 0u);
+    RenderRun textured = renderChecked(decoupled("builtin:textures", 320, 180));
+    EXPECT_GT(textured.stats["chunks_by_shading_class"]["featured"].get<uint64_t>(), 0u);
 }
 
 // Capacity control: with storage far too small for the view, the controller raises the shading

@@ -173,20 +173,20 @@ struct DecoupledState {
     bool reuse = true;
     uint32_t refreshPeriod = 16; // --reuse-refresh
     uint32_t objectsReusable = 0;
-    BufferHandle allocId;           // uint per block (upload: written by the CPU allocator)
-    BufferHandle counters;          // GpuShadelCounters (readback, also indirect args)
-    BufferHandle markedBlocks;      // uvec4 per marked block, capacityChunks of them
-    BufferHandle queue;             // GpuShadelWork[capacity]: chunks to shade
-    BufferHandle copyQueue;         // GpuShadelWork[capacity]: chunks carried over from last frame
-    BufferHandle supersampledQueue; // uint[capacity]: queue entries of supersampled objects
-    BufferHandle changedVolumes;    // ChangedVolume[SHADEL_MAX_CHANGED_VOLUMES] (upload)
+    BufferHandle allocId;        // uint per block (upload: written by the CPU allocator)
+    BufferHandle counters;       // GpuShadelCounters (readback, also indirect args)
+    BufferHandle markedBlocks;   // uvec4 per marked block, capacityChunks of them
+    BufferHandle queue;          // GpuShadelWork[capacity]: chunks to shade
+    BufferHandle copyQueue;      // GpuShadelWork[capacity]: chunks carried over from last frame
+    BufferHandle classQueues;    // uint[SHADE_CLASSES][capacity]: queue entries by shading class
+    BufferHandle changedVolumes; // ChangedVolume[SHADEL_MAX_CHANGED_VOLUMES] (upload)
     std::vector<ChangedVolume> changes; // this frame's (render/shadel/reuse_invalidation.h)
     bool changesOverflow = false;       // more than the buffer holds: everything changed
     ShadeStorage storage;
-    // shade: every queued chunk but supersampled objects' (their material supersampling compiled
-    // out); shadeSupersampled: those (ShadelFrame::supersampledQueue).
-    Pipeline clear, allocate, queueSetup, fillQueue, dispatchSetup, carryOver, shade,
-        shadeSupersampled, sheetView, mark, markTransparent, reconstruct;
+    // shade: one pipeline per shading class (SHADE_QUEUE_* - 1), each over its class's list.
+    Pipeline clear, allocate, queueSetup, fillQueue, dispatchSetup, carryOver, sheetView, mark,
+        markTransparent, reconstruct;
+    std::array<Pipeline, SHADE_CLASSES> shade;
     std::vector<FrameCounters> history;
 };
 
@@ -320,8 +320,8 @@ DecoupledStatePtr createDecoupled(Renderer& r, const GpuScene& scene) {
         device("shadel.workQueue", VkDeviceSize(d.capacityChunks) * sizeof(gpu::GpuShadelWork));
     d.copyQueue = device("shadel.carryOverQueue",
                          VkDeviceSize(d.capacityChunks) * sizeof(gpu::GpuShadelWork));
-    d.supersampledQueue =
-        device("shadel.supersampledQueue", VkDeviceSize(d.capacityChunks) * sizeof(uint32_t));
+    d.classQueues = device("shadel.shadeClassQueues",
+                           VkDeviceSize(d.capacityChunks) * SHADE_CLASSES * sizeof(uint32_t));
     d.chunkViews = {device("shadel.chunkViews.frame0", VkDeviceSize(d.capacityChunks) * 16),
                     device("shadel.chunkViews.frame1", VkDeviceSize(d.capacityChunks) * 16)};
 
@@ -343,11 +343,16 @@ DecoupledStatePtr createDecoupled(Renderer& r, const GpuScene& scene) {
     if (r.settings.debugLines & DEBUG_LINES_CHUNKS) optional |= SHADE_OPTIONAL_DEBUG_LINES;
     if (d.reuse) optional |= SHADE_OPTIONAL_REUSE;
     shadeConstants.push_back({SHADE_OPTIONAL_CONSTANT_ID, optional});
-    shadeConstants.push_back({SHADE_QUEUE_CONSTANT_ID, SHADE_QUEUE_SINGLE_SAMPLE});
-    d.shade = createComputePipeline(gpu, "shadelShade", "shadel_shade.comp.spv", shadeConstants);
-    shadeConstants.back().second = SHADE_QUEUE_SUPERSAMPLED;
-    d.shadeSupersampled = createComputePipeline(gpu, "shadelShadeSupersampled",
-                                                "shadel_shade.comp.spv", shadeConstants);
+    // The shading classes (SHADEL_OBJECT_* flags set per object below): plain materials with
+    // every material feature compiled out, featured ones, supersampled procedurals.
+    const char* const classNames[SHADE_CLASSES] = {"shadelShadePlain", "shadelShadeFeatured",
+                                                   "shadelShadeSupersampled"};
+    for (uint32_t c = 0; c < SHADE_CLASSES; ++c) {
+        auto constants = shadeConstants;
+        constants.push_back({SHADE_QUEUE_CONSTANT_ID, SHADE_QUEUE_PLAIN + c});
+        if (c == SHADE_QUEUE_PLAIN - 1) constants.push_back({MATERIAL_FEATURES_CONSTANT_ID, 0u});
+        d.shade[c] = createComputePipeline(gpu, classNames[c], "shadel_shade.comp.spv", constants);
+    }
     d.sheetView = createComputePipeline(gpu, "shadelSheetView", "shadel_sheet_view.comp.spv");
     GraphicsPipelineDesc mark;
     mark.name = "shadelMark";
@@ -377,14 +382,15 @@ void destroyDecoupled(Renderer& r, DecoupledStatePtr& state) {
     Gpu& gpu = *r.gpu;
     DecoupledState& d = *state;
     for (Pipeline* p : {&d.clear, &d.allocate, &d.queueSetup, &d.fillQueue, &d.dispatchSetup,
-                        &d.carryOver, &d.shade, &d.shadeSupersampled, &d.sheetView, &d.mark,
+                        &d.carryOver, &d.shade[0], &d.shade[1], &d.shade[2], &d.sheetView, &d.mark,
                         &d.markTransparent, &d.reconstruct})
         destroy(gpu, *p);
+    static_assert(SHADE_CLASSES == 3);
     destroyShadeStorage(gpu, d.storage);
     for (BufferHandle b :
          {d.frameInfo, d.changedVolumes, d.objectBuffer, d.rectBuffer, d.levelWants, d.occupancy[0],
           d.occupancy[1], d.offsetMap[0], d.offsetMap[1], d.allocId, d.counters, d.markedBlocks,
-          d.queue, d.copyQueue, d.supersampledQueue, d.chunkViews[0], d.chunkViews[1]})
+          d.queue, d.copyQueue, d.classQueues, d.chunkViews[0], d.chunkViews[1]})
         destroy(gpu, b);
     state.reset();
 }
@@ -891,11 +897,13 @@ void prepareDecoupledFrame(Renderer& r, const GpuScene& scene, const CameraView&
         g.mipCount = mesh.mipCount;
         g.firstMip = o.firstMip;
         g.flags |= SHADEL_OBJECT_DECOUPLED;
+        // Its shading class (the pipeline that shades its chunks, shaders/shadel/shade.comp).
+        uint32_t features =
+            known ? materialFeatures(scene.materialInfo[inst.material]) : MATERIAL_FEATURES_ALL;
+        if (features != 0u) g.flags |= SHADEL_OBJECT_FEATURED_MATERIAL;
         // Only point-function procedurals are supersampled (shaders/shadel/prefilter.glsl).
-        uint32_t procedural = known ? scene.materialInfo[inst.material].procedural : 0u;
-        if ((procedural == PROCEDURAL_TEXEL_CHECKER || procedural == PROCEDURAL_BRICKS) &&
-            r.settings.materialSamples >= 4) // 2 x 2 samples at least
-            g.flags |= SHADEL_OBJECT_SUPERSAMPLED;
+        if ((features & MATERIAL_FEATURE_PROCEDURAL) && r.settings.materialSamples >= 4)
+            g.flags |= SHADEL_OBJECT_SUPERSAMPLED; // 2 x 2 samples at least
         g.firstRect = uint32_t(d.rects.size());
         for (uint32_t k = o.firstMip; k < mesh.mipCount; ++k) {
             g.idMapOffset[k] = mesh.idMapOffset[k];
@@ -979,7 +987,7 @@ void prepareDecoupledFrame(Renderer& r, const GpuScene& scene, const CameraView&
     s.markedBlocks = address(gpu, d.markedBlocks);
     s.queue = address(gpu, d.queue);
     s.copyQueue = address(gpu, d.copyQueue);
-    s.supersampledQueue = address(gpu, d.supersampledQueue);
+    s.classQueues = address(gpu, d.classQueues);
     s.idMaps = address(gpu, scene.idMaps);
     s.shadelUvs = address(gpu, scene.shadelUvs);
     s.sheetBlocks = d.sheetBlocks;
@@ -1137,16 +1145,15 @@ void recordDecoupledShading(Renderer& r, FrameRecorder& rec, uint64_t frame, con
         if (usesChunkSpectra(r)) { // one permutation per spectrum (render/lighting)
             recordChunkSpectraShading(r, cmd, frame);
         } else {
-            bind(gpu, cmd, d.shade);
-            pushConstants(gpu, cmd, FramePush{frame});
-            vkCmdDispatchIndirect(cmd, vkBuffer(gpu, d.counters),
-                                  offsetof(gpu::GpuShadelCounters, shadeDispatch));
-            // Chunks of supersampled objects (point-function procedurals): no barrier between,
-            // the two pipelines write disjoint chunks.
-            bind(gpu, cmd, d.shadeSupersampled);
-            pushConstants(gpu, cmd, FramePush{frame});
-            vkCmdDispatchIndirect(cmd, vkBuffer(gpu, d.counters),
-                                  offsetof(gpu::GpuShadelCounters, supersampledDispatch));
+            // One pipeline per shading class, each over its list; no barrier between: the
+            // classes' chunks are disjoint.
+            for (uint32_t c = 0; c < SHADE_CLASSES; ++c) {
+                bind(gpu, cmd, d.shade[c]);
+                pushConstants(gpu, cmd, FramePush{frame});
+                vkCmdDispatchIndirect(cmd, vkBuffer(gpu, d.counters),
+                                      offsetof(gpu::GpuShadelCounters, classDispatch) +
+                                          c * sizeof(glm::uvec4));
+            }
         }
         // The shade storage this pass and carry-over wrote, read by reconstruction (raster:
         // fragment; --marking visibility: the compute resolve) and the transparency passes.
@@ -1311,8 +1318,13 @@ void decoupledStats(const Renderer& r, nlohmann::json& s) {
     s["marked_blocks"] = last.counters.markedBlocks;
     s["chunks_shaded"] = chunksShaded;
     // Of the queued chunks, those of point-function procedurals, shaded with material
-    // supersampling by a pipeline of their own (shade.comp SHADE_QUEUE_SUPERSAMPLED).
-    s["chunks_supersampled"] = last.counters.supersampledCount;
+    // supersampling by a pipeline of their own (shade.comp SHADE_QUEUE_SUPERSAMPLED); and the
+    // chunks of each shading class (plain materials have every material feature compiled out).
+    s["chunks_supersampled"] = last.counters.classCount[SHADE_QUEUE_SUPERSAMPLED - 1];
+    s["chunks_by_shading_class"] = {
+        {"plain", last.counters.classCount[SHADE_QUEUE_PLAIN - 1]},
+        {"featured", last.counters.classCount[SHADE_QUEUE_FEATURED - 1]},
+        {"supersampled", last.counters.classCount[SHADE_QUEUE_SUPERSAMPLED - 1]}};
     nlohmann::json perMip = nlohmann::json::array();
     for (uint32_t k = 0; k < SHADEL_MAX_MIPS; ++k) perMip.push_back(last.counters.chunksPerMip[k]);
     s["chunks_per_mip"] = perMip;
