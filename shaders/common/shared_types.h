@@ -683,8 +683,8 @@ struct ShadelFrame {
     uint64_t copyQueue;    // GpuShadelWork[capacityChunks]: chunks carried over (chunk = old slot)
     // uint[SHADE_CLASSES][capacityChunks]: the shading queue's entries by shading class.
     uint64_t classQueues;
-    uint64_t idMaps;       // uint16 triangle ids, packed in uints
-    uint64_t shadelUvs;    // vec2 per vertex of the unified geometry buffer
+    uint64_t idMaps;    // uint16 triangle ids, packed in uints
+    uint64_t shadelUvs; // vec2 per vertex of the unified geometry buffer
     // The shade storage's layers, chunk-linear buffers (shaders/shadel/shadel.glsl storageIndex:
     // shadel (x, y) of the chunk in slot s is element s * 64 + y * 8 + x): radiance uvec2 (RGBA16F
     // halves), material uint (RGBA8 unorm). This frame's, and last frame's for preserved layers.
