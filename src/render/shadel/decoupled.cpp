@@ -382,10 +382,9 @@ void destroyDecoupled(Renderer& r, DecoupledStatePtr& state) {
     Gpu& gpu = *r.gpu;
     DecoupledState& d = *state;
     for (Pipeline* p : {&d.clear, &d.allocate, &d.queueSetup, &d.fillQueue, &d.dispatchSetup,
-                        &d.carryOver, &d.shade[0], &d.shade[1], &d.shade[2], &d.sheetView, &d.mark,
-                        &d.markTransparent, &d.reconstruct})
+                        &d.carryOver, &d.sheetView, &d.mark, &d.markTransparent, &d.reconstruct})
         destroy(gpu, *p);
-    static_assert(SHADE_CLASSES == 3);
+    for (Pipeline& p : d.shade) destroy(gpu, p);
     destroyShadeStorage(gpu, d.storage);
     for (BufferHandle b :
          {d.frameInfo, d.changedVolumes, d.objectBuffer, d.rectBuffer, d.levelWants, d.occupancy[0],
@@ -1317,10 +1316,8 @@ void decoupledStats(const Renderer& r, nlohmann::json& s) {
     s["overflow_samples"] = overflowSamples;
     s["marked_blocks"] = last.counters.markedBlocks;
     s["chunks_shaded"] = chunksShaded;
-    // Of the queued chunks, those of point-function procedurals, shaded with material
-    // supersampling by a pipeline of their own (shade.comp SHADE_QUEUE_SUPERSAMPLED); and the
-    // chunks of each shading class (plain materials have every material feature compiled out).
-    s["chunks_supersampled"] = last.counters.classCount[SHADE_QUEUE_SUPERSAMPLED - 1];
+    // The queued chunks of each shading class (shade.comp): plain materials have every material
+    // feature compiled out; only supersampled ones (point-function procedurals) supersample.
     s["chunks_by_shading_class"] = {
         {"plain", last.counters.classCount[SHADE_QUEUE_PLAIN - 1]},
         {"featured", last.counters.classCount[SHADE_QUEUE_FEATURED - 1]},
