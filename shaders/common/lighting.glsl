@@ -7,8 +7,10 @@
 // Which lights a surface loops over is chosen by the caller before shadeSurface (render/lighting):
 // every light (LIGHT_LIST_ALL), a screen tile's list in memory (forward, useTileLightList), the
 // light grid's candidates at one point (forward pixels of a frame without screen tiles:
-// decoupled frames, whose shadel chunks cull against the grid themselves) or the workgroup's
-// list in shared memory (shadel chunks; the shader defines SHADEL_LIGHT_LIST_SHARED).
+// decoupled frames, whose shadel chunks cull against the grid themselves), the workgroup's
+// list in shared memory (shadel chunks; the shader defines SHADEL_LIGHT_LIST_SHARED) or, with
+// few lights, a bit set the subgroup culled for itself (LIGHT_LIST_SUBGROUP, forward pixels and
+// shadel chunks alike: lighting/light_cull.glsl useSubgroupLightList).
 // A list entry is (light, mask): bit k of the mask asks for the per-pixel test of the light's
 // k-th blocker; culling has already removed lights a blocker hides from the whole tile.
 #ifndef SHADEL_LIGHTING_GLSL
@@ -31,6 +33,7 @@ layout(buffer_reference, scalar) readonly buffer LightGridEntries { uint v[]; };
 #define LIGHT_LIST_BUFFER 1u
 #define LIGHT_LIST_SHARED 2u
 #define LIGHT_LIST_GRID 3u
+#define LIGHT_LIST_SUBGROUP 4u
 #define LIGHT_TILE_MAX_LIGHTS 1024u // lights a tile's list can hold (shared memory while culling)
 #define LIGHT_CHUNK_MAX_LIGHTS 512u // entries of a shadel chunk's list (shared memory)
 #define LIGHT_INVALID 0xFFFFFFFFu   // an entry culling removed in place
@@ -53,6 +56,10 @@ uint64_t gLightListAddress = 0ul;
 uint gLightListCount = 0u;
 uvec2 gGridLists[3]; // LIGHT_LIST_GRID: global, big and bucket lists (first entry, count)
 uint gGridBlockerMask = 0u;
+// LIGHT_LIST_SUBGROUP (light_cull.glsl, useSubgroupLightList): the lights kept for the subgroup,
+// a bit per light (uniform over the subgroup), and the blocker mask every kept light takes.
+uvec2 gSubgroupLights = uvec2(0u);
+uint gSubgroupBlockerMask = 0u;
 
 #ifdef SHADEL_LIGHT_LIST_SHARED
 shared uvec2 sLightList[LIGHT_CHUNK_MAX_LIGHTS];
@@ -104,6 +111,8 @@ uint lightListLength(FrameConstants f) {
 #ifdef SHADEL_LIGHT_LIST_SHARED
     if (gLightListMode == LIGHT_LIST_SHARED) return min(sLightListCount, LIGHT_CHUNK_MAX_LIGHTS);
 #endif
+    if (gLightListMode == LIGHT_LIST_SUBGROUP)
+        return uint(bitCount(gSubgroupLights.x) + bitCount(gSubgroupLights.y));
     return f.lightCount;
 }
 
@@ -120,6 +129,12 @@ uvec2 lightListEntry(FrameConstants f, uint i) {
 #ifdef SHADEL_LIGHT_LIST_SHARED
     if (gLightListMode == LIGHT_LIST_SHARED) return sLightList[i];
 #endif
+    if (gLightListMode == LIGHT_LIST_SUBGROUP) { // the i-th set bit
+        uint low = uint(bitCount(gSubgroupLights.x));
+        uint word = i < low ? gSubgroupLights.x : gSubgroupLights.y;
+        for (uint k = i < low ? i : i - low; k > 0u; --k) word &= word - 1u;
+        return uvec2(uint(findLSB(word)) + (i < low ? 0u : 32u), gSubgroupBlockerMask);
+    }
     // Every light: no culling happened, so every blocker a light lists is tested per pixel.
     bool blockers = f.lighting != 0ul && LightingFrameRef(f.lighting).l.blockersOn != 0u;
     return uvec2(i, blockers ? 0xFFFFFFFFu : 0u);

@@ -270,6 +270,9 @@ struct LightingCounters {
     uint lightsCulledByBlockers; // (light, tile) pairs a blocker removed whole
     uint tileListEntries;        // entries taken from the tile list pool (may exceed it)
     uint lightGridCandidates;    // lights the shadel chunks tested (taken from the light grid)
+    // Lists the shadel path culled per subgroup (LightingFrame::subgroupLists); the chunk
+    // counts above (pairs, candidates, per-pixel blocker) then count those lists.
+    uint lightSubgroupLists;
 };
 
 // The light grid (render/lighting/light_grid.h): lights bucketed in world space so a shadel
@@ -302,6 +305,9 @@ struct GpuLightGrid {
 };
 
 // What the tiled-lighting passes share with shading (FrameConstants::lighting).
+// LightingFrame::subgroupLists: culling per subgroup into a bit set of the scene's lights.
+#define LIGHT_SUBGROUP_MAX_LIGHTS 64u
+
 struct LightingFrame {
     uint64_t tileLights;    // pool of uvec2 entries: light index, mask of its blockers to test
     uint64_t tileRanges;    // uvec2 per tile: first entry in the pool, entries
@@ -337,6 +343,10 @@ struct LightingFrame {
     uint64_t sunCascades;
     // The light grid the shadel chunks' culling queries (GpuLightGrid), 0: test every light.
     uint64_t lightGrid;
+    // 1: few lights (at most LIGHT_SUBGROUP_MAX_LIGHTS); shading culls them per subgroup
+    // (lighting/light_cull.glsl useSubgroupLightList): every forward pixel and shadel, with no
+    // tile pass and no chunk culling (`tiled` is then 0).
+    uint subgroupLists;
 };
 
 #define SUN_MAX_CASCADES 4u

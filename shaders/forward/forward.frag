@@ -1,6 +1,7 @@
 #version 460
 // Forward shading: the shared material + lighting code evaluated per pixel.
 #include "common/lighting.glsl"
+#include "lighting/light_cull.glsl" // useSubgroupLightList
 #include "lighting/light_debug.glsl"
 #include "debug/inspect.glsl"
 #include "raytracing/rt_apply.glsl"
@@ -44,6 +45,7 @@ void main() {
     // Opaque pixels lie on the prepass depth the tile's bounds came from; blended ones need not.
     if ((mat.flags & MATERIAL_ALPHA_BLEND) == 0u) {
         useLightListAt(f, gl_FragCoord.xy, inPosition);
+        useSubgroupLightList(f, true, inPosition); // only with few lights (LightingFrame)
         useRayTracedPixelTerms(f, gl_FragCoord.xy); // --rt-*: this pixel's traced terms
     }
     vec3 color = shadeSurface(f, m, inPosition, s.normal);

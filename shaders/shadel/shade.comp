@@ -7,6 +7,7 @@
 #extension GL_KHR_shader_subgroup_arithmetic : require
 #define SHADEL_LIGHT_LIST_SHARED
 #define LIGHT_CULL_ORDERED_APPEND
+#define LIGHT_CULL_SUBGROUP_COUNTS_CHUNKS // useSubgroupLightList counts into the chunk statistics
 #include "common/lighting.glsl"
 #include "lighting/light_cull.glsl"
 #define LIGHT_GRID_LIST sLightList
@@ -326,9 +327,12 @@ void main() {
     si.uv = uv;
     si.uvDx = uvDx;
     si.uvDy = uvDy;
-    // A spectrum's permutation reads the list its chunk's classify phase culled.
-    if (f.lighting != 0ul && LightingFrameRef(f.lighting).l.tiled != 0u &&
-        !(kChunkSpectraPhase == CHUNK_SPECTRA_SHADE && loadChunkLightList(f, workIndex)))
+    // With few lights each subgroup culls them for its own shadels (no barrier); else the
+    // chunk culls them (a spectrum's permutation reads the list its classify phase culled).
+    if (f.lighting != 0ul && LightingFrameRef(f.lighting).l.subgroupLists != 0u)
+        useSubgroupLightList(f, shading, si.position);
+    else if (f.lighting != 0ul && LightingFrameRef(f.lighting).l.tiled != 0u &&
+             !(kChunkSpectraPhase == CHUNK_SPECTRA_SHADE && loadChunkLightList(f, workIndex)))
         cullChunkLights(f, shading, si.position);
     if (kChunkSpectraPhase == CHUNK_SPECTRA_CLASSIFY) {
         classifyChunkSpectrum(f, workIndex);

@@ -196,6 +196,20 @@ static std::optional<std::string> missingRequiredFeature(VkPhysicalDevice pd) {
         if (!r.have) return std::string(r.name);
     if (!props.limits.timestampComputeAndGraphics)
         return std::string("timestampComputeAndGraphics");
+    // Subgroup operations in compute and fragment shaders: the shadel passes reduce over
+    // subgroups, and forward pixels cull few lights per subgroup (light_cull.glsl).
+    VkPhysicalDeviceSubgroupProperties subgroup{
+        VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_SUBGROUP_PROPERTIES};
+    VkPhysicalDeviceProperties2 props2{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PROPERTIES_2, &subgroup};
+    vkGetPhysicalDeviceProperties2(pd, &props2);
+    const VkShaderStageFlags stages = VK_SHADER_STAGE_COMPUTE_BIT | VK_SHADER_STAGE_FRAGMENT_BIT;
+    const VkSubgroupFeatureFlags ops =
+        VK_SUBGROUP_FEATURE_BASIC_BIT | VK_SUBGROUP_FEATURE_VOTE_BIT |
+        VK_SUBGROUP_FEATURE_ARITHMETIC_BIT | VK_SUBGROUP_FEATURE_BALLOT_BIT;
+    if ((subgroup.supportedStages & stages) != stages)
+        return std::string("subgroup operations in compute and fragment shaders");
+    if ((subgroup.supportedOperations & ops) != ops)
+        return std::string("subgroup basic, vote, arithmetic and ballot operations");
     return std::nullopt;
 }
 
@@ -526,7 +540,7 @@ std::string describeDevice(const Device& device) {
                   VK_API_VERSION_PATCH(device.properties.apiVersion));
     out += "required: dynamicRendering synchronization2 timelineSemaphore descriptorIndexing "
            "bufferDeviceAddress shaderInt64 shaderBufferInt64Atomics fragmentStoresAndAtomics "
-           "multiDrawIndirect drawIndirectCount timestamps: all present\n";
+           "multiDrawIndirect drawIndirectCount timestamps subgroups: all present\n";
     out +=
         format("optional: meshShader=%s rayQuery=%s computeDerivatives=%s sparseResidency=%s\n",
                device.optional.meshShader ? "yes" : "no", device.optional.rayQuery ? "yes" : "no",

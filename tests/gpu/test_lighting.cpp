@@ -40,6 +40,9 @@ void expectCullingChangesNothing(RenderMode mode) {
     EXPECT_EQ(none.stats["lights_visible"].get<uint64_t>() + 1,
               none.stats["lights"].get<uint64_t>())
         << "without culling every light but the moon is considered everywhere";
+    if (mode == RenderMode::Decoupled) {
+        EXPECT_EQ(s["light_chunk_unit"], "chunk") << "thousands of lights: whole chunks cull";
+    }
     double p = psnr(none.frames[0].rgba, tiled.frames[0].rgba);
     EXPECT_GE(p, 45.0) << "culling must not change the image";
     // Not a trivially equal pair: the scene is lit by the culled lights (not black, not flat).
@@ -72,6 +75,44 @@ TEST(Lighting, TiledCullingChangesNothingForward) {
 
 TEST(Lighting, ChunkCullingChangesNothingDecoupled) {
     expectCullingChangesNothing(RenderMode::Decoupled);
+}
+
+// With few lights every subgroup culls them for its own pixels or shadels (no tile pass, no
+// chunk culling: light_cull.glsl useSubgroupLightList); the sum is the one over every light.
+void expectSubgroupCullingChangesNothing(RenderMode mode) {
+    RenderOptions o = renderOptions("builtin:default", mode, 320, 180);
+    o.lightCulling = LightCulling::None;
+    RenderRun none = renderChecked(o);
+    o.lightCulling = LightCulling::Tiled;
+    RenderRun culled = renderChecked(o);
+    const auto& s = culled.stats;
+    ASSERT_LT(s["lights"].get<uint64_t>(), 16u) << "below the screen tiles' threshold";
+    EXPECT_EQ(s["light_culling"], "subgroups (few lights)");
+    EXPECT_EQ(none.stats["light_culling"], "none");
+    EXPECT_FALSE(s["light_screen_tiles"].get<bool>()) << "no tile pass";
+    for (const auto& p : s["passes"]) EXPECT_NE(p["name"], "lightCulling") << "no tile pass";
+    uint64_t visible = s["lights_visible"].get<uint64_t>();
+    EXPECT_GT(visible, 0u) << "the street lamps light some pixels";
+    EXPECT_LT(visible, s["lights"].get<uint64_t>()) << "some lamps reach no shaded subgroup";
+    if (mode == RenderMode::Decoupled) {
+        EXPECT_EQ(s["light_chunk_unit"], "subgroup");
+        uint64_t pairs = s["light_chunk_pairs"].get<uint64_t>();
+        uint64_t tested = s["light_chunk_candidates"].get<uint64_t>();
+        EXPECT_GT(s["light_subgroup_lists"].get<uint64_t>(), s["chunks_shaded"].get<uint64_t>())
+            << "several subgroups per chunk";
+        EXPECT_GT(pairs, 0u);
+        EXPECT_LT(pairs * 2, tested) << "most (light, subgroup) pairs are culled";
+    }
+    EXPECT_GE(psnr(none.frames[0].rgba, culled.frames[0].rgba), 60.0)
+        << "the same sum: culled lights add nothing";
+}
+
+TEST(Lighting, FewLightsAreCulledPerSubgroupForward) {
+    expectSubgroupCullingChangesNothing(RenderMode::Forward);
+}
+
+TEST(Lighting, FewLightsAreCulledPerSubgroupInTheShadelPath) {
+    expectSubgroupCullingChangesNothing(RenderMode::Decoupled);
 }
 
 TEST(Lighting, TiledCullingCountsPairsAndCullsMostOfThem) {
