@@ -542,18 +542,43 @@ nlohmann::json runBench(Gpu& gpu, const BenchOptions& b) {
     out["camera_path"] = pathNames[int(b.cameraPath)];
     out["animate_lights"] = b.animateLights;
     out["shading_bias"] = b.shadingBias;
-    for (const Mode& m : modes) {
-        std::fprintf(stderr, "bench: %s, %u frames at %ux%u (%s camera)\n", m.name, b.frames,
-                     b.width, b.height, pathNames[int(b.cameraPath)]);
-        o.mode = m.mode;
-        o.reuse = m.reuse;
-        out["modes"][m.name] = runRender(gpu, o).stats;
+    // With --rounds N every round runs the three modes, in opposite order each round, so the
+    // machine's drift over a run (a shared machine's neighbours, warm-up) hits every mode
+    // alike; each ratio is the median of the rounds' ratios (forward of the same round as the
+    // denominator), and modes.<name> keeps the last round's stats plus every round's median
+    // frame (frame_ms_rounds).
+    const uint32_t modeCount = uint32_t(std::size(modes));
+    std::vector<std::vector<double>> roundMs(modeCount);
+    for (uint32_t round = 0; round < b.modeRounds; ++round)
+        for (uint32_t k = 0; k < modeCount; ++k) {
+            uint32_t index = round % 2 == 0 ? k : modeCount - 1 - k;
+            const Mode& m = modes[index];
+            std::fprintf(stderr, "bench: %s, %u frames at %ux%u (%s camera)", m.name, b.frames,
+                         b.width, b.height, pathNames[int(b.cameraPath)]);
+            if (b.modeRounds > 1) std::fprintf(stderr, ", round %u of %u", round + 1, b.modeRounds);
+            std::fprintf(stderr, "\n");
+            o.mode = m.mode;
+            o.reuse = m.reuse;
+            out["modes"][m.name] = runRender(gpu, o).stats;
+            roundMs[index].push_back(out["modes"][m.name]["frame_ms"]["median"].get<double>());
+        }
+    auto median = [](std::vector<double> v) {
+        std::sort(v.begin(), v.end());
+        size_t n = v.size();
+        return n == 0 ? 0.0 : n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+    };
+    out["rounds"] = b.modeRounds;
+    for (uint32_t k = 0; k < modeCount; ++k) {
+        out["modes"][modes[k].name]["frame_ms_rounds"] = roundMs[k];
+        out["modes"][modes[k].name]["frame_ms_median_of_rounds"] = median(roundMs[k]);
     }
     const nlohmann::json& forward = out["modes"]["forward"];
-    double fwd = forward["frame_ms"]["median"];
-    for (const char* name : {"decoupled", "reuse"}) {
-        double ms = out["modes"][name]["frame_ms"]["median"];
-        out["ratios"][name] = fwd > 0 ? ms / fwd : 0.0;
+    for (uint32_t k = 1; k < modeCount; ++k) {
+        std::vector<double> ratios;
+        for (uint32_t r = 0; r < b.modeRounds; ++r)
+            ratios.push_back(roundMs[0][r] > 0 ? roundMs[k][r] / roundMs[0][r] : 0.0);
+        out["ratios"][modes[k].name] = median(ratios);
+        out["ratios_by_round"][modes[k].name] = ratios;
     }
 
     if (b.compareLightCulling) {
@@ -692,20 +717,26 @@ nlohmann::json runBench(Gpu& gpu, const BenchOptions& b) {
         o.threads = b.threads;
     }
 
-    std::printf("shadel bench: %s at %ux%u on %s, %u frames, %s camera, medians (timing: %s)\n",
+    std::printf("shadel bench: %s at %ux%u on %s, %u frames, %s camera, medians (timing: %s)%s\n",
                 b.scene.c_str(), b.width, b.height, gpu.device.name.c_str(), b.frames,
-                pathNames[int(b.cameraPath)], forward["timing"].get<std::string>().c_str());
+                pathNames[int(b.cameraPath)], forward["timing"].get<std::string>().c_str(),
+                b.modeRounds > 1 ? format(", %u rounds", b.modeRounds).c_str() : "");
     std::printf("%-28s %12s %12s %12s\n", "", "forward", "decoupled", "reuse");
     auto row = [&](const char* label, auto value) {
         std::printf("%-28s", label);
         for (const Mode& m : modes) std::printf(" %12s", value(out["modes"][m.name]).c_str());
         std::printf("\n");
     };
+    // With rounds: the median over the rounds of each round's median frame, and the median
+    // of the rounds' ratios (what --json's ratios hold); the passes below are the last round's.
     row("frame ms", [](const nlohmann::json& s) {
-        return format("%.3f", s["frame_ms"]["median"].get<double>());
+        return format("%.3f", s["frame_ms_median_of_rounds"].get<double>());
     });
     row("ratio to forward", [&](const nlohmann::json& s) {
-        return format("%.3f", fwd > 0 ? s["frame_ms"]["median"].get<double>() / fwd : 0.0);
+        for (const Mode& m : modes)
+            if (&out["modes"][m.name] == &s && out["ratios"].contains(m.name))
+                return format("%.3f", out["ratios"][m.name].get<double>());
+        return std::string("1.000");
     });
     row("cpu frame ms",
         [](const nlohmann::json& s) { return format("%.3f", s["cpu_frame_ms"].get<double>()); });

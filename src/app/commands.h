@@ -197,6 +197,9 @@ struct BenchOptions {
     double textureBudgetMiB = 128.0; // --texture-budget (streaming compare)
     uint32_t galleryTextureSize = 0; // --gallery-texture-size (builtin:textures; 0 = 2048)
     uint32_t rounds = 3;             // --rounds (streaming compare, instance scaling)
+    // The forward / decoupled / reuse comparison's rounds: 1, or --rounds when given (each round
+    // runs the three modes, in alternating order; ratios are the median of the rounds').
+    uint32_t modeRounds = 1;
     // --instance-scaling N,N,...: builtin:many at each count (--lod on), --rounds rounds
     // interleaved; cpu_frame_ms per count and ratios cpu(N) / cpu(first N) (app/bench_command.cpp).
     std::vector<uint32_t> instanceScaling;

@@ -460,11 +460,13 @@ int main(int argc, char** argv) {
         ->check(finiteInRange(kTextureBudgetRange));
     bench->add_option("--gallery-texture-size", bo.galleryTextureSize,
                       "builtin:textures: side of each texture (power of two, default 2048)");
-    bench
-        ->add_option("--rounds", bo.rounds,
-                     "--streaming-compare, --instance-scaling: rounds, each running every "
-                     "residency or instance count once")
-        ->capture_default_str();
+    auto* benchRoundsFlag =
+        bench
+            ->add_option("--rounds", bo.rounds,
+                         "rounds, each running every mode once (the forward / decoupled / reuse "
+                         "comparison: 1 unless given, ratios are the median of the rounds'), "
+                         "residency (--streaming-compare) or instance count (--instance-scaling)")
+            ->capture_default_str();
     std::string benchInstanceScaling, benchScalingMode = "both", benchScalingOcclusion = "on";
     auto* benchInstanceScalingFlag = bench->add_option(
         "--instance-scaling", benchInstanceScaling,
@@ -761,6 +763,7 @@ int main(int argc, char** argv) {
             bo.sunCascades = parseSunCascades(benchSunCascades);
             if (bo.rounds < 1 || bo.rounds > 100)
                 throw InputError(format("--rounds %u: expected 1..100", bo.rounds));
+            bo.modeRounds = benchRoundsFlag->count() ? bo.rounds : 1;
             if (bo.compareStreaming && !(bo.textureBudgetMiB > 0.0))
                 throw InputError("--streaming-compare: needs a --texture-budget above 0 MiB");
             if (*benchInstancesFlag && bo.instances == 0)

@@ -1,6 +1,7 @@
 // `shadel bench --plot FILE.png` (app/bench_plot.h): bars proportional to each mode's GPU ms.
 #include "gpu_test_env.h"
 
+#include <algorithm>
 #include <filesystem>
 
 #include "app/bench_plot.h"
@@ -61,4 +62,32 @@ TEST(BenchPlot, BenchWritesThePlot) {
     for (int m = 0; m < 3; ++m) EXPECT_GT(pixelsOf(img, kPlotModeColours[m]), 0u) << m;
     EXPECT_EQ(validationErrors(), 0u);
     std::filesystem::remove(path);
+}
+
+// --rounds N: every round runs the three modes (in opposite order each round); each ratio is
+// the median of the rounds' ratios, each over forward's frame of the same round.
+TEST(BenchPlot, BenchRoundsReportTheMedianOfTheRoundsRatios) {
+    BenchOptions b;
+    b.scene = "builtin:smooth";
+    b.width = 64;
+    b.height = 36;
+    b.frames = 1;
+    b.modeRounds = 3;
+    nlohmann::json result = runBench(sharedGpu(), b);
+    EXPECT_EQ(result["rounds"].get<uint32_t>(), 3u);
+    std::vector<double> fwd = result["modes"]["forward"]["frame_ms_rounds"];
+    ASSERT_EQ(fwd.size(), 3u);
+    for (const char* mode : {"decoupled", "reuse"}) {
+        std::vector<double> ms = result["modes"][mode]["frame_ms_rounds"];
+        std::vector<double> ratios = result["ratios_by_round"][mode];
+        ASSERT_EQ(ms.size(), 3u) << mode;
+        ASSERT_EQ(ratios.size(), 3u) << mode;
+        for (size_t r = 0; r < 3; ++r) {
+            ASSERT_GT(fwd[r], 0.0);
+            EXPECT_NEAR(ratios[r], ms[r] / fwd[r], 1e-9) << mode << " round " << r;
+        }
+        std::sort(ratios.begin(), ratios.end());
+        EXPECT_NEAR(result["ratios"][mode].get<double>(), ratios[1], 1e-12) << mode;
+    }
+    EXPECT_EQ(validationErrors(), 0u);
 }
