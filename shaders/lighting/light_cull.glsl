@@ -165,7 +165,9 @@ uint lightBlockerMask(LightingFrame lf, GpuLight light, vec3 corners[8], vec3 bo
 void useSubgroupLightList(FrameConstants f, bool shading, vec3 p) {
     if (f.lighting == 0ul) return;
     LightingFrame lf = LightingFrameRef(f.lighting).l;
-    if (lf.subgroupLists == 0u) return;
+    // The CPU chose it for at most that many lights; more would not fit the bit set (then the
+    // loop over every light stays: the same sum).
+    if (lf.subgroupLists == 0u || f.lightCount > LIGHT_SUBGROUP_MAX_LIGHTS) return;
     uvec3 bits = uvec3(orderedFloatBits(p.x), orderedFloatBits(p.y), orderedFloatBits(p.z));
     uvec3 lo = subgroupMin(shading ? bits : uvec3(0xFFFFFFFFu));
     uvec3 hi = subgroupMax(shading ? bits : uvec3(0u));
@@ -180,7 +182,7 @@ void useSubgroupLightList(FrameConstants f, bool shading, vec3 p) {
         corners[i] = vec3((i & 1) != 0 ? boxMax.x : boxMin.x, (i & 2) != 0 ? boxMax.y : boxMin.y,
                           (i & 4) != 0 ? boxMax.z : boxMin.z);
     LightBuffer lights = LightBuffer(f.lights);
-    uint lightCount = min(f.lightCount, LIGHT_SUBGROUP_MAX_LIGHTS);
+    uint lightCount = f.lightCount;
     uint culledByBlockers = 0u;
     bool perPixel = false;
     // Each present invocation tests one light a round; the kept ones land on their bits

@@ -409,7 +409,7 @@ FrameResult renderFrame(Renderer& r, const GpuScene& scene, const CameraView& ca
     else
         pass(rec, "depthPrepass", [&](VkCommandBuffer cmd) { recordDepthPrepass(r, cmd, frame); });
     if (r.settings.occlusion) recordOcclusionPasses(r, rec, frame, scene);
-    if (lightTilesThisFrame(r)) // depth bounds per tile: after the occlusion passes' second phase
+    if (lightCullingThisFrame(r)) // depth bounds per tile: after the occlusion passes' 2nd phase
         pass(rec, "lightCulling", [&](VkCommandBuffer cmd) { recordLightCulling(r, cmd, frame); });
     recordThinGBufferPass(r, rec, frame);               // --screen-space on (render/screenspace)
     if (r.rt && r.settings.mode == RenderMode::Forward) // sun visibility, AO, GI per pixel

@@ -18,10 +18,10 @@ TEST(Forward, RendersDefaultSceneWithCoverageAndTimings) {
     EXPECT_LE(s["pixels_covered"].get<uint64_t>(), 160u * 90u);
     std::vector<std::string> passes;
     for (auto& p : s["passes"]) passes.push_back(p["name"]);
-    // No lightCulling pass: the default scene's few lights are culled per subgroup in shading
-    // (render/lighting/light_culling.cpp, subgroupListsFit; builtin:lights has the pass).
+    // The default scene's few lights are culled per subgroup in shading (render/lighting/
+    // light_culling.cpp, subgroupListsFit): lightCulling only clears the counters.
     EXPECT_EQ(passes, (std::vector<std::string>{"instanceCull", "shadowMap", "depthPrepass",
-                                                "forwardShading", "tonemap"}));
+                                                "lightCulling", "forwardShading", "tonemap"}));
     for (auto& p : s["passes"]) EXPECT_GE(p["gpu_ms"].get<double>(), 0.0);
     // The image is not flat: sky and lit geometry differ.
     const auto& px = run.frames[0].rgba;

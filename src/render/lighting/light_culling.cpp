@@ -188,8 +188,9 @@ void recordLightCulling(Renderer& r, VkCommandBuffer cmd, uint64_t frame) {
                   VK_ACCESS_2_SHADER_STORAGE_READ_BIT | VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT);
 }
 
-bool lightTilesThisFrame(const Renderer& r) {
-    return r.lightCulling && r.lightCulling->tiledThisFrame;
+bool lightCullingThisFrame(const Renderer& r) {
+    return r.lightCulling &&
+           (r.lightCulling->tiledThisFrame || r.lightCulling->subgroupListsThisFrame);
 }
 
 void readLightCullingStats(Renderer& r) {

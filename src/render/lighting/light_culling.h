@@ -39,10 +39,12 @@ uint64_t prepareLightCulling(Renderer& r, const GpuScene& scene,
 // plus a tube's half length or an area light's half diagonal; infinite without a range (and for
 // directional lights). The CPU's side of lightSphere (shaders/lighting/light_cull.glsl).
 float lightReach(const gpu::GpuLight& light);
-// Whether this frame builds tile lists: --light-culling tiled and enough lights in view (or
-// blockers to classify); otherwise shading loops over the lights directly.
-bool lightTilesThisFrame(const Renderer& r);
-// The culling pass (tiled mode); with --light-culling none it records nothing.
+// Whether this frame culls lights (and so records the culling pass): tile lists
+// (--light-culling tiled and enough lights in view, or blockers to classify) or, with few
+// lights, per-subgroup lists in shading; otherwise shading loops over the lights directly.
+bool lightCullingThisFrame(const Renderer& r);
+// The culling pass: clears the counters shading's culling adds to, then (screen tiles only)
+// the tile pass; with --light-culling none it records nothing.
 void recordLightCulling(Renderer& r, VkCommandBuffer cmd, uint64_t frame);
 // After the frame: counters into the stats (lights, lights_visible, light_tile_pairs, ...).
 void readLightCullingStats(Renderer& r);
