@@ -329,7 +329,9 @@ void main() {
     si.uvDy = uvDy;
     // With few lights each subgroup culls them for its own shadels (no barrier); else the
     // chunk culls them (a spectrum's permutation reads the list its classify phase culled).
-    if (f.lighting != 0ul && LightingFrameRef(f.lighting).l.subgroupLists != 0u)
+    // Spectra never cull per subgroup: their permutations do not compile it in.
+    if (kChunkSpectraPhase == CHUNK_SPECTRA_OFF && f.lighting != 0ul &&
+        LightingFrameRef(f.lighting).l.subgroupLists != 0u)
         useSubgroupLightList(f, shading, si.position);
     else if (f.lighting != 0ul && LightingFrameRef(f.lighting).l.tiled != 0u &&
              !(kChunkSpectraPhase == CHUNK_SPECTRA_SHADE && loadChunkLightList(f, workIndex)))

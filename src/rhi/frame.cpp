@@ -5,6 +5,7 @@
 
 #include "core/assert.h"
 #include "core/cpu_scope.h"
+#include "core/log.h"
 #include "core/worker_pool.h"
 #include "rhi/gpu.h"
 
@@ -117,13 +118,19 @@ static void submitAndWait(FrameRecorder& r, const VkCommandBuffer* cmds, uint32_
     // A CPU device's submit can block on its queue thread (lavapipe: up to 16 ms at 1M instances
     // with ~0.01 ms of this thread's CPU): the blocked part is waiting for the GPU too.
     r.gpuWaitMs += std::max(0.0, submitWallMs - submitCpuMs);
+    // A hang detector, not a budget. A CPU device (lavapipe) compiles each pipeline's shader
+    // on its first dispatch inside the queue, so a first frame with many permutations (the
+    // shadel path's spectra: every mode of shade.comp) waits minutes on a loaded machine.
+    const bool cpuDevice = r.gpu->device.properties.deviceType == VK_PHYSICAL_DEVICE_TYPE_CPU;
+    const uint64_t timeoutSeconds = cpuDevice ? 600 : 120;
     VkResult res =
-        vkWaitForFences(r.gpu->device.device, 1, &r.fence, VK_TRUE, 120ull * 1000000000ull);
+        vkWaitForFences(r.gpu->device.device, 1, &r.fence, VK_TRUE, timeoutSeconds * 1000000000ull);
     r.gpuWaitMs +=
         std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - waitStart)
             .count();
     if (res == VK_TIMEOUT)
-        throw DeviceError("GPU frame did not finish within 120 s (device hang?)");
+        throw DeviceError(format("GPU frame did not finish within %llu s (device hang?)",
+                                 (unsigned long long)timeoutSeconds));
     VK_CHECK(res);
 }
 
