@@ -18,6 +18,16 @@ uint64_t pixelsOf(const PlotImage& img, const uint8_t c[3]) {
     return n;
 }
 
+// One frame of a small smooth scene: the three modes in seconds.
+BenchOptions smallBench() {
+    BenchOptions b;
+    b.scene = "builtin:smooth";
+    b.width = 64;
+    b.height = 36;
+    b.frames = 1;
+    return b;
+}
+
 } // namespace
 
 // A synthetic bench result: each mode's bar area follows its summed pass times.
@@ -46,11 +56,7 @@ TEST(BenchPlot, BenchWritesThePlot) {
     std::string path = (std::filesystem::temp_directory_path() /
                         ("shadel-bench-plot-" + std::to_string(::getpid()) + ".png"))
                            .string();
-    BenchOptions b;
-    b.scene = "builtin:smooth";
-    b.width = 64;
-    b.height = 36;
-    b.frames = 1;
+    BenchOptions b = smallBench();
     b.plot = path;
     nlohmann::json result = runBench(sharedGpu(), b);
     ASSERT_TRUE(std::filesystem::exists(path));
@@ -67,11 +73,7 @@ TEST(BenchPlot, BenchWritesThePlot) {
 // --rounds N: every round runs the three modes (in opposite order each round); each ratio is
 // the median of the rounds' ratios, each over forward's frame of the same round.
 TEST(BenchPlot, BenchRoundsReportTheMedianOfTheRoundsRatios) {
-    BenchOptions b;
-    b.scene = "builtin:smooth";
-    b.width = 64;
-    b.height = 36;
-    b.frames = 1;
+    BenchOptions b = smallBench();
     b.modeRounds = 3;
     nlohmann::json result = runBench(sharedGpu(), b);
     EXPECT_EQ(result["rounds"].get<uint32_t>(), 3u);
