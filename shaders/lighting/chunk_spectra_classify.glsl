@@ -59,9 +59,7 @@ void classifyChunkSpectrum(FrameConstants f, uint workIndex) {
     if (culled && anyShadel) {
         vec3 boxMin = gChunkBoxMin, boxMax = gChunkBoxMax;
         vec3 corners[8];
-        for (int i = 0; i < 8; ++i)
-            corners[i] = vec3((i & 1) != 0 ? boxMax.x : boxMin.x, (i & 2) != 0 ? boxMax.y : boxMin.y,
-                              (i & 4) != 0 ? boxMax.z : boxMin.z);
+        for (int i = 0; i < 8; ++i) corners[i] = boxCorner(boxMin, boxMax, i);
         LightBuffer lights = LightBuffer(f.lights);
         uint count = min(sLightListCount, LIGHT_CHUNK_MAX_LIGHTS);
         uint mine = 0u;

@@ -15,6 +15,11 @@
 #define SHADOW_PARTIAL 1u // part of the volume: test per pixel
 #define SHADOW_COVERS 2u  // all of it, through no portal: the light is culled
 
+// Corner i (bit 0: x, bit 1: y, bit 2: z; set: the high side) of the box lo..hi.
+vec3 boxCorner(vec3 lo, vec3 hi, int i) {
+    return vec3((i & 1) != 0 ? hi.x : lo.x, (i & 2) != 0 ? hi.y : lo.y, (i & 4) != 0 ? hi.z : lo.z);
+}
+
 // xyz centre, w radius; w < 0 for lights without a finite range (never culled by distance).
 vec4 lightSphere(GpuLight l) {
     if (l.type == LIGHT_DIRECTIONAL || l.range <= 0.0) return vec4(l.position, -1.0);
@@ -125,9 +130,7 @@ uint lightBlockerMask(LightingFrame lf, GpuLight light, vec3 corners[8], vec3 bo
     vec3 inRange[8] = corners;
     if (sphere.w >= 0.0) {
         vec3 lo = max(boxMin, sphere.xyz - sphere.w), hi = min(boxMax, sphere.xyz + sphere.w);
-        for (int i = 0; i < 8; ++i)
-            inRange[i] = vec3((i & 1) != 0 ? hi.x : lo.x, (i & 2) != 0 ? hi.y : lo.y,
-                              (i & 4) != 0 ? hi.z : lo.z);
+        for (int i = 0; i < 8; ++i) inRange[i] = boxCorner(lo, hi, i);
     }
     LightBlockerBuffer blockers = LightBlockerBuffer(lf.blockers);
     LightPortalBuffer portals = LightPortalBuffer(lf.portals);
@@ -149,6 +152,14 @@ uint lightBlockerMask(LightingFrame lf, GpuLight light, vec3 corners[8], vec3 bo
 
 #include "common/ordered_float.glsl"
 
+// The box of the positions of the subgroup's invocations with `inBox`, as order-preserving bits
+// (hi.x == 0: none). Call where every invocation that needs the box is present.
+void subgroupBoxBits(bool inBox, vec3 p, out uvec3 lo, out uvec3 hi) {
+    uvec3 bits = orderedFloatBits(p);
+    lo = subgroupMin(inBox ? bits : uvec3(0xFFFFFFFFu));
+    hi = subgroupMax(inBox ? bits : uvec3(0u));
+}
+
 // With few lights (LightingFrame::subgroupLists: at most LIGHT_SUBGROUP_MAX_LIGHTS) each
 // subgroup culls them for its own invocations, with no tile pass and no barrier: the box of the
 // positions of its `shading` invocations against every light, kept in a bit set
@@ -169,19 +180,15 @@ void useSubgroupLightList(FrameConstants f, bool shading, vec3 p) {
     // The CPU chose it for at most that many lights; more would not fit the bit set (then the
     // loop over every light stays: the same sum).
     if (lf.subgroupLists == 0u || f.lightCount > LIGHT_SUBGROUP_MAX_LIGHTS) return;
-    uvec3 bits = uvec3(orderedFloatBits(p.x), orderedFloatBits(p.y), orderedFloatBits(p.z));
-    uvec3 lo = subgroupMin(shading ? bits : uvec3(0xFFFFFFFFu));
-    uvec3 hi = subgroupMax(shading ? bits : uvec3(0u));
-    vec3 boxMin = vec3(orderedBitsFloat(lo.x), orderedBitsFloat(lo.y), orderedBitsFloat(lo.z));
-    vec3 boxMax = vec3(orderedBitsFloat(hi.x), orderedBitsFloat(hi.y), orderedBitsFloat(hi.z));
+    uvec3 lo, hi;
+    subgroupBoxBits(shading, p, lo, hi);
+    vec3 boxMin = orderedBitsFloat(lo), boxMax = orderedBitsFloat(hi);
     gLightListMode = LIGHT_LIST_SUBGROUP;
     gSubgroupLights = uvec2(0u);
     gSubgroupBlockerMask = lf.blockersOn != 0u ? 0xFFFFFFFFu : 0u;
     if (hi.x == 0u) return; // nothing to shade
     vec3 corners[8];
-    for (int i = 0; i < 8; ++i)
-        corners[i] = vec3((i & 1) != 0 ? boxMax.x : boxMin.x, (i & 2) != 0 ? boxMax.y : boxMin.y,
-                          (i & 4) != 0 ? boxMax.z : boxMin.z);
+    for (int i = 0; i < 8; ++i) corners[i] = boxCorner(boxMin, boxMax, i);
     LightBuffer lights = LightBuffer(f.lights);
     uint lightCount = f.lightCount;
     uint culledByBlockers = 0u;

@@ -127,9 +127,8 @@ bool gChunkHasBox = false, gChunkBoxKnown = false;
 shared uvec3 sSubgroupBoxMin[SHADEL_CHUNK * SHADEL_CHUNK];
 shared uvec3 sSubgroupBoxMax[SHADEL_CHUNK * SHADEL_CHUNK];
 bool chunkBox(bool shading, vec3 p, out vec3 boxMin, out vec3 boxMax) {
-    uvec3 bits = uvec3(orderedFloatBits(p.x), orderedFloatBits(p.y), orderedFloatBits(p.z));
-    uvec3 lo = subgroupMin(shading ? bits : uvec3(0xFFFFFFFFu));
-    uvec3 hi = subgroupMax(shading ? bits : uvec3(0u));
+    uvec3 lo, hi;
+    subgroupBoxBits(shading, p, lo, hi);
     if (subgroupElect()) {
         sSubgroupBoxMin[gl_SubgroupID] = lo;
         sSubgroupBoxMax[gl_SubgroupID] = hi;
@@ -140,8 +139,8 @@ bool chunkBox(bool shading, vec3 p, out vec3 boxMin, out vec3 boxMax) {
         lo = min(lo, sSubgroupBoxMin[g]);
         hi = max(hi, sSubgroupBoxMax[g]);
     }
-    boxMin = vec3(orderedBitsFloat(lo.x), orderedBitsFloat(lo.y), orderedBitsFloat(lo.z));
-    boxMax = vec3(orderedBitsFloat(hi.x), orderedBitsFloat(hi.y), orderedBitsFloat(hi.z));
+    boxMin = orderedBitsFloat(lo);
+    boxMax = orderedBitsFloat(hi);
     return hi.x != 0u;
 }
 
@@ -173,9 +172,7 @@ void cullChunkLights(FrameConstants f, bool shading, vec3 p) {
         return;
     }
     vec3 corners[8];
-    for (int i = 0; i < 8; ++i)
-        corners[i] = vec3((i & 1) != 0 ? boxMax.x : boxMin.x, (i & 2) != 0 ? boxMax.y : boxMin.y,
-                          (i & 4) != 0 ? boxMax.z : boxMin.z);
+    for (int i = 0; i < 8; ++i) corners[i] = boxCorner(boxMin, boxMax, i);
     LightBuffer lights = LightBuffer(f.lights);
     // The lights near the box from the light grid; without it (or for a box larger than the
     // grid's cells), every light. The same list either way.
