@@ -64,9 +64,10 @@ using uint = uint32_t;
 // Light blockers (render/lighting): a light lists up to this many blockers.
 #define LIGHT_MAX_BLOCKERS_PER_LIGHT 32u
 #define LIGHT_TILE_SIZE 16u // pixels per side of a forward light culling tile
-// Feature spectra (seed 001, render/lighting/feature_spectra.h): the lighting features a tile
-// needs, recorded by the tile pass; each shading permutation compiles in only its set
-// (specialization constant SPECTRUM_FEATURES_CONSTANT_ID of shaders/common/lighting.glsl).
+// Feature spectra (seed 001, render/lighting/feature_spectra.h): the features a tile needs,
+// recorded by the tile pass; each shading permutation compiles in only its set (specialization
+// constant SPECTRUM_FEATURES_CONSTANT_ID of shaders/common/lighting.glsl; SPECTRUM_MATERIAL sets
+// MATERIAL_FEATURES_CONSTANT_ID of shaders/common/material.glsl).
 #define SPECTRUM_OMNI 0x1u           // point lights
 #define SPECTRUM_SPOT 0x2u           // round-cone spots
 #define SPECTRUM_SQUARE_SPOT 0x4u    // square-cone spots
@@ -80,8 +81,9 @@ using uint = uint32_t;
 #define SPECTRUM_SOFT_SHADOWS 0x400u // variable penumbra (PCSS): the sun's or a spot's
 #define SPECTRUM_PROJECTED 0x800u    // spots projecting a texture (gobos)
 #define SPECTRUM_AREA 0x1000u        // textured rectangular area lights
-#define SPECTRUM_FEATURE_COUNT 13u
-#define SPECTRUM_ALL 0x1FFFu
+#define SPECTRUM_MATERIAL 0x2000u    // a material with any MATERIAL_FEATURE_* (textures, ...)
+#define SPECTRUM_FEATURE_COUNT 14u
+#define SPECTRUM_ALL 0x3FFFu
 #define SPECTRUM_MAX_MODES 16u
 #define SPECTRUM_FEATURES_CONSTANT_ID 140
 #define SPECTRUM_MODE_CONSTANT_ID 141 // the mode (bin) a tile / chunk shading permutation runs

@@ -9,19 +9,24 @@
 // the same order as shading without culling. Barriers are few (five on the grid's path): where
 // a workgroup's invocations run in turn (lavapipe) they are most of a tile's cost; the small
 // serial steps (compaction of the grid's bit set, the copy of the kept lights) run on one.
+// With feature spectra the tile also records whether any of its pixels' materials uses a
+// material feature (SPECTRUM_MATERIAL), read from the visibility buffer.
 #define LIGHT_CULL_ORDERED_APPEND
 #include "lighting/light_cull.glsl"
 #include "lighting/spectra.glsl"
+#include "common/visibility.glsl"
 #extension GL_KHR_shader_subgroup_arithmetic : require
 
 layout(local_size_x = 16, local_size_y = 16) in;
 layout(push_constant, scalar) uniform Push {
     uint64_t frame;
     uint depthSlot;
+    uint visibilitySlot; // NO_TEXTURE without feature spectra
 } pc;
 
 #define THREADS 256u
 shared uint sDepthMin, sDepthMax;
+shared uint sMaterialFeatures; // SPECTRUM_MATERIAL when a pixel's material uses any feature
 shared uvec2 sList[LIGHT_TILE_MAX_LIGHTS];
 shared uint sKept;
 #define LIGHT_GRID_LIST sList
@@ -67,6 +72,7 @@ void main() {
         sDepthMax = 0u;
         sAppendCount = 0u;
         sKept = 0u;
+        sMaterialFeatures = 0u;
     }
     // The light grid's bit set, cleared under the same barrier.
     lightGridMaskClearUnsynced(f, lf.lightGrid, THREADS);
@@ -82,6 +88,15 @@ void main() {
     if (subgroupElect() && depthMax != 0u) {
         atomicMin(sDepthMin, depthMin);
         atomicMax(sDepthMax, depthMax);
+    }
+    if (pc.visibilitySlot != NO_TEXTURE) { // (uniform)
+        uint instance = covered ? loadVisibility(pc.visibilitySlot, pixel).x : VISIBILITY_NONE;
+        bool featured = false;
+        if (instance != VISIBILITY_NONE) {
+            uint material = InstanceBuffer(f.instances).i[instance].material;
+            featured = materialFeaturesOf(MaterialBuffer(f.materials).m[material]) != 0u;
+        }
+        if (subgroupAny(featured) && subgroupElect()) atomicOr(sMaterialFeatures, SPECTRUM_MATERIAL);
     }
     barrier();
     if (sDepthMax == 0u) { // nothing but sky
@@ -194,5 +209,5 @@ void main() {
         if (lf.spectra != 0ul) features |= entryFeatures(lf, lights.l[entry.x], entry.y, corners);
     }
     if (anyPerPixel) atomicAdd(counters.c.perPixelBlockerTiles, 1u);
-    binTileSpectrum(lf, tile, features | frameFeatures(f, lf));
+    binTileSpectrum(lf, tile, features | frameFeatures(f, lf) | sMaterialFeatures);
 }

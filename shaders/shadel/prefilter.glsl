@@ -61,8 +61,10 @@ vec3 prefilteredShade(FrameConstants f, GpuMaterial mat, SurfaceInput si, vec2 c
     uint cap = uint(floor(sqrt(float(max(maxSamples, 1u)) + 1e-3)));
     uint n = uint(clamp(ceil(2.0 * cells), 1.0, float(cap)));
     // kShadeQueue (shade.comp): only the supersampled class (and the spectra's all-in-one
-    // permutations) have the supersampling compiled in.
-    if (n <= 1u || (kShadeQueue != SHADE_QUEUE_SUPERSAMPLED && kShadeQueue != SHADE_QUEUE_ALL)) {
+    // permutations) have the supersampling compiled in, and only with procedurals (the spectra's
+    // permutations without material features have none: n is 1).
+    if (n <= 1u || (kShadeQueue != SHADE_QUEUE_SUPERSAMPLED && kShadeQueue != SHADE_QUEUE_ALL) ||
+        !MATERIAL_HAS(MATERIAL_FEATURE_PROCEDURAL)) {
         MaterialSample one = evaluateMaterial(mat, si);
         material = vec4(clamp(one.baseColor, 0.0, 1.0), one.roughness);
         return shadeSurface(f, one, si.position, si.normal);

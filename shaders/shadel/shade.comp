@@ -334,7 +334,8 @@ void main() {
              !(kChunkSpectraPhase == CHUNK_SPECTRA_SHADE && loadChunkLightList(f, workIndex)))
         cullChunkLights(f, shading, si.position);
     if (kChunkSpectraPhase == CHUNK_SPECTRA_CLASSIFY) {
-        classifyChunkSpectrum(f, workIndex);
+        classifyChunkSpectrum(f, workIndex,
+                              materialFeaturesOf(MaterialBuffer(f.materials).m[inst.material]));
         return;
     }
     if (SHADE_HAS(SHADE_OPTIONAL_REUSE)) recordChunkView(f, s, work.slot, shading, si.position);

@@ -31,6 +31,26 @@ uint64_t sumValues(const nlohmann::json& object) {
     return sum;
 }
 
+// Material features (textures, procedurals, clear coat, sheen) are a spectrum feature too: a
+// tile (chunk) whose materials use none runs a permutation without them. Every mode with them
+// follows the same mode without them, so no tile runs them needlessly, and the tiles in those
+// modes are exactly the tiles that need them; the one all-features permutation runs them
+// needlessly in every other tile. A few of the street's surfaces are textured.
+void expectMaterialSpectra(const nlohmann::json& on, const nlohmann::json& single,
+                           uint64_t binned) {
+    uint64_t materialTiles = on["tile_features"]["material"].get<uint64_t>();
+    EXPECT_GT(materialTiles, 0u);
+    EXPECT_LT(materialTiles, binned / 2);
+    uint64_t inMaterialModes = 0;
+    for (const auto& [name, value] : on["spectra"].items())
+        if (name == "all" || name.ends_with("+material")) inMaterialModes += value.get<uint64_t>();
+    EXPECT_EQ(inMaterialModes, materialTiles) << on["spectra"].dump();
+    for (const auto& [mode, features] : on["spectra_superfluous"].items())
+        EXPECT_FALSE(features.contains("material")) << mode << ": " << features.dump();
+    EXPECT_EQ(single["spectra_superfluous"]["all"].value("material", uint64_t(0)),
+              binned - single["tile_features"]["material"].get<uint64_t>());
+}
+
 } // namespace
 
 TEST(Spectra, PermutationsMatchTheAllFeaturesShaders) {
@@ -74,6 +94,7 @@ TEST(Spectra, PermutationsMatchTheAllFeaturesShaders) {
     EXPECT_EQ(one["spectra"]["all"].get<uint64_t>(), tiles);
     EXPECT_LT(s["spectra_superfluous_total"].get<uint64_t>(),
               one["spectra_superfluous_total"].get<uint64_t>() / 2);
+    expectMaterialSpectra(s, one, tiles);
 }
 
 // The shadel path ("the same for chunk queues"): queued chunks are binned by the features of
@@ -116,6 +137,7 @@ TEST(Spectra, ShadelChunkPermutationsMatchTheAllFeaturesShading) {
     EXPECT_EQ(single.stats["spectra"]["all"].get<uint64_t>(), chunks);
     EXPECT_LT(s["spectra_superfluous_total"].get<uint64_t>(),
               single.stats["spectra_superfluous_total"].get<uint64_t>() / 2);
+    expectMaterialSpectra(s, single.stats, chunks);
 }
 
 TEST(Spectra, VisualizeSpectraColoursTilesByMode) {

@@ -2,10 +2,11 @@
 // Feature spectra (seed 001, "Lighting Compute Optimization"): a shader with every lighting
 // feature compiled in pays for all of them everywhere (registers, occupancy, code). The tile
 // pass (shaders/lighting/tile_cull.comp) records the features each 16x16 tile needs (light
-// kinds, darks, clip planes, per-pixel blockers, portals, shadows) and bins the tile into the
+// kinds, darks, clip planes, per-pixel blockers, portals, shadows, and whether any of its
+// pixels' materials uses textures, procedurals, clear coat or sheen) and bins the tile into the
 // first of a few shading modes, cheapest first, whose features cover them; each mode is a
 // permutation of the tile shading compute (shaders/lighting/tile_shade.comp) compiled with only
-// its features (a specialization constant), run over its bin by an indirect dispatch.
+// its features (specialization constants), run over its bin by an indirect dispatch.
 //
 // Forward mode only. The forward path shades in a raster pass, where a permutation cannot be
 // chosen per screen tile without drawing the scene once per mode; so with --spectra on|single

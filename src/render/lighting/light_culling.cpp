@@ -8,8 +8,10 @@
 
 #include "render/camera.h"
 #include "render/forward/forward_passes.h"
+#include "render/lighting/feature_spectra.h"
 #include "render/lighting/light_grid.h"
 #include "render/renderer.h"
+#include "render/shadel/visibility.h"
 
 namespace shadel {
 
@@ -56,6 +58,7 @@ namespace {
 struct CullPush {
     uint64_t frame;
     uint32_t depthSlot;
+    uint32_t visibilitySlot; // feature spectra: the pixels' materials (SPECTRUM_MATERIAL)
 };
 } // namespace
 
@@ -181,7 +184,8 @@ void recordLightCulling(Renderer& r, VkCommandBuffer cmd, uint64_t frame) {
     // after this one test against.
     sceneDepthToSampled(r, cmd, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT);
     bind(gpu, cmd, s.tileCull);
-    pushConstants(gpu, cmd, CullPush{frame, slot(gpu, r.depthRead).value});
+    uint32_t visibilitySlot = usesTileShading(r) ? visibilityBufferSlot(r) : NO_TEXTURE;
+    pushConstants(gpu, cmd, CullPush{frame, slot(gpu, r.depthRead).value, visibilitySlot});
     vkCmdDispatch(cmd, s.tilesX, s.tilesY, 1);
     sceneDepthToAttachment(r, cmd, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT);
     memoryBarrier(cmd, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT,
