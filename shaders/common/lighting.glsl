@@ -45,6 +45,14 @@ layout(buffer_reference, scalar) readonly buffer LightGridEntries { uint v[]; };
 // result is the same.
 layout(constant_id = SPECTRUM_FEATURES_CONSTANT_ID) const uint kSpectrumFeatures = SPECTRUM_ALL;
 #define SPECTRUM_HAS(features) ((kSpectrumFeatures & (features)) != 0u)
+// Spectra per light: the first gLightListPlainCount entries of the list read no texture
+// (SPECTRUM_SAMPLING_LIGHTS), and a permutation with kSpectrumLightSplit shades them in a loop
+// compiled without those features (forward tiles, whose list is in memory: on lavapipe the code
+// of the features compiled in costs every light there whether it uses them or not;
+// builtin:lights 1280x720, tile shading with every light that reads a texture skipped: 239 ms
+// without their code, 305 with it).
+layout(constant_id = SPECTRUM_LIGHT_SPLIT_CONSTANT_ID) const uint kSpectrumLightSplit = 0u;
+uint gLightListPlainCount = 0u;
 
 // Distance-field far shadows and AO (render/distance_fields): compiled in only by the pipelines
 // that set the constant (forward and shadel shading with --distance-fields on), so other scenes
@@ -470,8 +478,9 @@ vec3 areaLight(GpuLight light, MaterialSample m, vec3 n, vec3 v, vec3 p) {
     return color;
 }
 
-// One light of the buffer at surface point p (not counting blockers).
-vec3 evaluateLight(GpuLight light, MaterialSample m, vec3 n, vec3 v, vec3 p) {
+// One light of the buffer at surface point p (not counting blockers), with the SPECTRUM_*
+// `features` compiled in (a constant after inlining).
+vec3 evaluateLightWith(GpuLight light, MaterialSample m, vec3 n, vec3 v, vec3 p, uint features) {
     if (SPECTRUM_HAS(SPECTRUM_CLIP_PLANES) && (light.flags & LIGHT_FLAG_CLIP_PLANE) != 0u &&
         dot(light.clipPlane.xyz, p) + light.clipPlane.w < 0.0)
         return vec3(0.0);
@@ -479,7 +488,7 @@ vec3 evaluateLight(GpuLight light, MaterialSample m, vec3 n, vec3 v, vec3 p) {
     if (light.type == LIGHT_TUBE)
         return SPECTRUM_HAS(SPECTRUM_TUBE) ? tubeLight(light, m, n, v, p) : vec3(0.0);
     if (light.type == LIGHT_AREA)
-        return SPECTRUM_HAS(SPECTRUM_AREA) ? areaLight(light, m, n, v, p) : vec3(0.0);
+        return (features & SPECTRUM_AREA) != 0u ? areaLight(light, m, n, v, p) : vec3(0.0);
     if (!SPECTRUM_HAS(SPECTRUM_OMNI | SPECTRUM_SPOT | SPECTRUM_SQUARE_SPOT)) return vec3(0.0);
     vec3 toLight = light.position - p;
     float dist = length(toLight);
@@ -488,10 +497,14 @@ vec3 evaluateLight(GpuLight light, MaterialSample m, vec3 n, vec3 v, vec3 p) {
     // Beyond its range or outside its cone a light adds nothing: skip the BRDF (without light
     // culling, e.g. few lights on screen, every surface loops over every light).
     if (all(equal(radiance, vec3(0.0)))) return vec3(0.0);
-    if (SPECTRUM_HAS(SPECTRUM_PROJECTED) && (light.flags & LIGHT_FLAG_PROJECTED) != 0u &&
+    if ((features & SPECTRUM_PROJECTED) != 0u && (light.flags & LIGHT_FLAG_PROJECTED) != 0u &&
         any(notEqual(radiance, vec3(0.0))))
         radiance *= goboColor(light, dir, dist);
     return brdf(m, n, v, dir, radiance);
+}
+
+vec3 evaluateLight(GpuLight light, MaterialSample m, vec3 n, vec3 v, vec3 p) {
+    return evaluateLightWith(light, m, n, v, p, kSpectrumFeatures);
 }
 
 // Ray-traced terms (render/raytracing, shaders/raytracing): the caller sets them before
@@ -513,6 +526,24 @@ float gSunVisibilityUsed = 1.0;
 
 float rtSpotVisibility(uvec4 packed, uint shadowIndex) {
     return float((packed[shadowIndex >> 2u] >> ((shadowIndex & 3u) * 8u)) & 0xFFu) / 255.0;
+}
+
+// Entry i of the light list at worldPos, with the SPECTRUM_* `features` compiled in (a constant
+// after inlining): its blockers per pixel, the light, its spot shadow.
+vec3 listedLight(FrameConstants f, LightingFrame lf, bool haveLighting, uint i, MaterialSample m,
+                 vec3 n, vec3 v, vec3 worldPos, vec3 geometricNormal, uint features) {
+    uvec2 entry = lightListEntry(f, i);
+    if (entry.x == LIGHT_INVALID) return vec3(0.0);
+    GpuLight light = LightBuffer(f.lights).l[entry.x];
+    if (SPECTRUM_HAS(SPECTRUM_BLOCKERS) && lightBlockedAt(f, light, entry.y, worldPos))
+        return vec3(0.0);
+    vec3 c = evaluateLightWith(light, m, n, v, worldPos, features);
+    bool spotShadows = (features & SPECTRUM_SPOT_SHADOWS) != 0u && haveLighting &&
+                       lf.spotShadowAtlas != NO_TEXTURE;
+    if (spotShadows && light.shadowIndex != LIGHT_NO_SHADOW && any(notEqual(c, vec3(0.0))))
+        c *= gRtSpots ? rtSpotVisibility(gRtSpotVisibility, light.shadowIndex)
+                      : spotShadow(lf, light, worldPos, geometricNormal);
+    return c;
 }
 
 // Everything that lights a surface point, evaluated for a viewer at f.cameraPosition.
@@ -577,26 +608,19 @@ vec3 shadeSurface(FrameConstants f, MaterialSample m, vec3 worldPos, vec3 geomet
         color += brdf(m, n, v, l, f.sunColor * shadow);
         gSunVisibilityUsed = shadow;
     }
-    bool spotShadows = SPECTRUM_HAS(SPECTRUM_SPOT_SHADOWS) && haveLighting &&
-                       lf.spotShadowAtlas != NO_TEXTURE;
     // A pixel's width at this point (the gobos' MIP): view distance times the pixel's angle.
     gLightFootprint = length(worldPos - f.cameraPosition) * 2.0 / (f.proj[1][1] * f.viewportSize.y);
 
-    LightBuffer lights = LightBuffer(f.lights);
     vec3 direct = vec3(0.0);
     uint count = lightListLength(f);
-    for (uint i = 0u; i < count; ++i) {
-        uvec2 entry = lightListEntry(f, i);
-        if (entry.x == LIGHT_INVALID) continue;
-        GpuLight light = lights.l[entry.x];
-        if (SPECTRUM_HAS(SPECTRUM_BLOCKERS) && lightBlockedAt(f, light, entry.y, worldPos))
-            continue;
-        vec3 c = evaluateLight(light, m, n, v, worldPos);
-        if (spotShadows && light.shadowIndex != LIGHT_NO_SHADOW && any(notEqual(c, vec3(0.0))))
-            c *= gRtSpots ? rtSpotVisibility(gRtSpotVisibility, light.shadowIndex)
-                          : spotShadow(lf, light, worldPos, geometricNormal);
-        direct += c;
-    }
+    // Spectra per light: the leading lights that read no texture, in a loop without that code.
+    uint plain = kSpectrumLightSplit != 0u ? min(gLightListPlainCount, count) : 0u;
+    for (uint i = 0u; i < plain; ++i)
+        direct += listedLight(f, lf, haveLighting, i, m, n, v, worldPos, geometricNormal,
+                              kSpectrumFeatures & ~SPECTRUM_SAMPLING_LIGHTS);
+    for (uint i = plain; i < count; ++i)
+        direct += listedLight(f, lf, haveLighting, i, m, n, v, worldPos, geometricNormal,
+                              kSpectrumFeatures);
     // Darks subtract light; they never make a surface emit negative light.
     // Without darks the sum is not negative and the clamp changes nothing.
     if (!SPECTRUM_HAS(SPECTRUM_DARK)) return color + direct * m.occlusion;

@@ -87,6 +87,14 @@ using uint = uint32_t;
 #define SPECTRUM_MAX_MODES 16u
 #define SPECTRUM_FEATURES_CONSTANT_ID 140
 #define SPECTRUM_MODE_CONSTANT_ID 141 // the mode (bin) a tile / chunk shading permutation runs
+// Spectra per light (--spectra on, forward tiles): the features only some lights of a list
+// bring, each a texture read per light (a spot's shadow map, PCSS, a gobo, an area light's
+// emitter). A tile's list holds the lights without them first (SpectraFrame::lightSplits), and
+// a permutation with SPECTRUM_LIGHT_SPLIT_CONSTANT_ID set shades those in a loop compiled
+// without them (shaders/common/lighting.glsl, shadeSurface).
+#define SPECTRUM_SAMPLING_LIGHTS                                                                   \
+    (SPECTRUM_SPOT_SHADOWS | SPECTRUM_SOFT_SHADOWS | SPECTRUM_PROJECTED | SPECTRUM_AREA)
+#define SPECTRUM_LIGHT_SPLIT_CONSTANT_ID 150
 // Shadel shading's phase: off, classify or shade (chunk_spectra.glsl).
 #define CHUNK_SPECTRA_PHASE_CONSTANT_ID 143
 // Whether the scene has alpha-masked materials (the visibility prepass's alpha test): without
@@ -392,6 +400,9 @@ struct SpectraFrame {
     uint64_t chunkRanges;    // uvec2 per shading-queue index: (first entry, count); count
                              // CHUNK_LIST_NONE when the pool was full (the chunk is culled again)
     uint64_t chunkListCount; // uint[2]: pool entries taken this frame, chunks culled again
+    // uint per screen tile: its list's leading entries whose lights read no texture
+    // (SPECTRUM_SAMPLING_LIGHTS); the rest of the list follows them (0 for shadel chunks).
+    uint64_t lightSplits;
     uint modeCount;
     uint binCapacity;       // tiles (each mode's list can hold every tile)
     uint chunkListCapacity; // entries of the chunkLists pool

@@ -42,6 +42,13 @@ uint entryFeatures(LightingFrame lf, GpuLight light, uint blockerMask, vec3 corn
     return features;
 }
 
+// Whether the light brings any SPECTRUM_SAMPLING_LIGHTS feature (entryFeatures' texture
+// reads): it goes after the lights that do not in a spectra list (shadeSurface's split).
+bool lightSamplesTextures(LightingFrame lf, GpuLight light) {
+    return light.type == LIGHT_AREA || (light.flags & LIGHT_FLAG_PROJECTED) != 0u ||
+           (light.shadowIndex != LIGHT_NO_SHADOW && lf.spotShadowAtlas != NO_TEXTURE);
+}
+
 // Features every covered pixel of the frame needs (not per light): the sun's shadow map.
 uint frameFeatures(FrameConstants f, LightingFrame lf) {
     bool sunShadow = f.sunShadowSlot != NO_TEXTURE && dot(f.sunColor, f.sunColor) > 0.0;

@@ -200,14 +200,24 @@ void main() {
     uint features = 0u;
     bool anyPerPixel = false;
     uint written = 0u;
-    for (uint i = 0u; i < candidates && written < keptLights; ++i) {
-        uvec2 entry = sList[i];
-        if (entry.x == LIGHT_INVALID) continue;
-        outList.e[written++] = entry;
-        anyPerPixel = anyPerPixel || entry.y != 0u;
-        atomicOr(UintBuffer(lf.visibleLights).v[entry.x >> 5], 1u << (entry.x & 31u));
-        if (lf.spectra != 0ul) features |= entryFeatures(lf, lights.l[entry.x], entry.y, corners);
+    // With spectra the lights that read no texture come first, each part in light order
+    // (spectra per light: SpectraFrame::lightSplits).
+    bool split = lf.spectra != 0ul;
+    uint plain = 0u;
+    for (uint part = 0u; part < (split ? 2u : 1u); ++part) {
+        for (uint i = 0u; i < candidates && written < keptLights; ++i) {
+            uvec2 entry = sList[i];
+            if (entry.x == LIGHT_INVALID) continue;
+            GpuLight light = lights.l[entry.x];
+            if (split && lightSamplesTextures(lf, light) != (part == 1u)) continue;
+            outList.e[written++] = entry;
+            anyPerPixel = anyPerPixel || entry.y != 0u;
+            atomicOr(UintBuffer(lf.visibleLights).v[entry.x >> 5], 1u << (entry.x & 31u));
+            if (split) features |= entryFeatures(lf, light, entry.y, corners);
+        }
+        if (part == 0u) plain = written;
     }
+    if (split) UintBuffer(SpectraFrameRef(lf.spectra).s.lightSplits).v[tile] = plain;
     if (anyPerPixel) atomicAdd(counters.c.perPixelBlockerTiles, 1u);
     binTileSpectrum(lf, tile, features | frameFeatures(f, lf) | sMaterialFeatures);
 }

@@ -600,10 +600,11 @@ nlohmann::json runBench(Gpu& gpu, const BenchOptions& b) {
 
     if (b.compareSpectra) {
         // Tile-shaded forward and decoupled (reuse off), by spectra and by one all-features
-        // permutation (the same classify + bin passes, one bin). On and single run in two rounds
-        // of opposite order (on first, then single first), as the threads comparison does: a
-        // single pair on this shared machine swung on / single between 0.93 and 1.08. Each
-        // figure is the mean of its two runs' medians; modes.<name> keeps the second run's stats.
+        // permutation (the same classify + bin passes, one bin). On and single run in rounds
+        // (--rounds, at least 2) of alternating order (on first, then single first): a single
+        // pair on this shared machine swung on / single between 0.80 and 1.10. Each ratio is the
+        // median of the rounds' ratios (each round's on over the same round's single), each
+        // time the median of the rounds' medians; modes.<name> keeps the last run's stats.
         struct SpectraPath {
             const char* path;
             RenderMode mode;
@@ -626,14 +627,15 @@ nlohmann::json runBench(Gpu& gpu, const BenchOptions& b) {
              "shadelChunkSpectra + shadelShading",
              {std::begin(kDecoupledSpectraPasses), std::end(kDecoupledSpectraPasses)}}};
         auto ratio = [](double a, double b) { return b > 0 ? a / b : 0.0; };
+        uint32_t spectraRounds = std::max(2u, b.modeRounds);
         for (const SpectraPath& path : paths) {
-            double frameMs[2] = {0, 0}, shadingMs[2] = {0, 0}; // [on, single]
+            std::vector<double> frameRounds[2], shadingRounds[2]; // [on, single] per round
             nlohmann::json runs = nlohmann::json::array();
-            for (int round = 0; round < 2; ++round)
+            for (uint32_t round = 0; round < spectraRounds; ++round)
                 for (int k = 0; k < 2; ++k) {
-                    bool on = (k == 0) == (round == 0); // on, single, then single, on
-                    std::fprintf(stderr, "bench: %s, --spectra %s (round %d)\n", path.path,
-                                 on ? "on" : "single", round + 1);
+                    bool on = (k == 0) == (round % 2 == 0); // on, single, then single, on
+                    std::fprintf(stderr, "bench: %s, --spectra %s (round %u of %u)\n", path.path,
+                                 on ? "on" : "single", round + 1, spectraRounds);
                     o.mode = path.mode;
                     o.reuse = false;
                     o.lightCulling = b.lightCulling;
@@ -642,8 +644,8 @@ nlohmann::json runBench(Gpu& gpu, const BenchOptions& b) {
                     double frame = st["frame_ms"]["median"].get<double>();
                     double shading = 0.0;
                     for (const char* name : path.passes) shading += passMs(st, name);
-                    frameMs[on ? 0 : 1] += 0.5 * frame;
-                    shadingMs[on ? 0 : 1] += 0.5 * shading;
+                    frameRounds[on ? 0 : 1].push_back(frame);
+                    shadingRounds[on ? 0 : 1].push_back(shading);
                     runs.push_back({{"spectra", on ? "on" : "single"},
                                     {"round", round + 1},
                                     {"frame_ms", frame},
@@ -653,8 +655,18 @@ nlohmann::json runBench(Gpu& gpu, const BenchOptions& b) {
             o.spectra = Spectra::Off;
             bool forwardPath = path.mode == RenderMode::Forward;
             std::string key = std::string("spectra_") + path.path;
-            out["ratios"][key] = ratio(frameMs[0], frameMs[1]);
-            out["ratios"][key + "_shading"] = ratio(shadingMs[0], shadingMs[1]);
+            std::vector<double> frameRatios, shadingRatios;
+            for (uint32_t round = 0; round < spectraRounds; ++round) {
+                frameRatios.push_back(ratio(frameRounds[0][round], frameRounds[1][round]));
+                shadingRatios.push_back(ratio(shadingRounds[0][round], shadingRounds[1][round]));
+            }
+            double frameMs[2] = {median(frameRounds[0]), median(frameRounds[1])};
+            double shadingMs[2] = {median(shadingRounds[0]), median(shadingRounds[1])};
+            double frameRatio = median(frameRatios), shadingRatio = median(shadingRatios);
+            out["ratios"][key] = frameRatio;
+            out["ratios"][key + "_shading"] = shadingRatio;
+            out["ratios_by_round"][key] = frameRatios;
+            out["ratios_by_round"][key + "_shading"] = shadingRatios;
             out["spectra_frame_ms"][path.path] = {{"on", frameMs[0]}, {"single", frameMs[1]}};
             out["spectra_shading_ms"][path.path] = {{"on", shadingMs[0]}, {"single", shadingMs[1]}};
             out["spectra_runs"][path.path] = runs;
@@ -663,14 +675,13 @@ nlohmann::json runBench(Gpu& gpu, const BenchOptions& b) {
             const char* otherName = forwardPath ? "raster" : "off";
             out["ratios"][key + (forwardPath ? "_vs_raster" : "_vs_off")] =
                 ratio(frameMs[0], other);
-            std::printf("spectra (%s): on %.3f ms, single %.3f ms, %s %.3f ms; on / single %.3f, "
-                        "on / %s %.3f\n",
-                        path.path, frameMs[0], frameMs[1], otherName, other,
-                        ratio(frameMs[0], frameMs[1]), otherName, ratio(frameMs[0], other));
+            std::printf("spectra (%s, %u rounds): on %.3f ms, single %.3f ms, %s %.3f ms; on / "
+                        "single %.3f (median of the rounds'), on / %s %.3f\n",
+                        path.path, spectraRounds, frameMs[0], frameMs[1], otherName, other,
+                        frameRatio, otherName, ratio(frameMs[0], other));
             std::printf("spectra (%s) shading passes (%s): on %.3f ms, single %.3f ms; on / "
                         "single %.3f\n",
-                        path.path, path.passNames, shadingMs[0], shadingMs[1],
-                        ratio(shadingMs[0], shadingMs[1]));
+                        path.path, path.passNames, shadingMs[0], shadingMs[1], shadingRatio);
         }
     }
 

@@ -464,8 +464,9 @@ int main(int argc, char** argv) {
         bench
             ->add_option("--rounds", bo.rounds,
                          "rounds, each running every mode once (the forward / decoupled / reuse "
-                         "comparison: 1 unless given, ratios are the median of the rounds'), "
-                         "residency (--streaming-compare) or instance count (--instance-scaling)")
+                         "comparison: 1 unless given, ratios are the median of the rounds'; "
+                         "--spectra compare: on and single, at least 2), residency "
+                         "(--streaming-compare) or instance count (--instance-scaling)")
             ->capture_default_str();
     std::string benchInstanceScaling, benchScalingMode = "both", benchScalingOcclusion = "on";
     auto* benchInstanceScalingFlag = bench->add_option(
@@ -518,8 +519,10 @@ int main(int argc, char** argv) {
     bench
         ->add_option("--spectra", benchSpectra,
                      "off | compare: compare also renders forward and decoupled with --spectra "
-                     "on and single and reports on / single and on / off frame-time ratios, and "
-                     "on / single of the shading passes (with spectra's classify + bin)")
+                     "on and single (--rounds rounds of alternating order, 2 unless given) and "
+                     "reports on / single (the median of the rounds' ratios) and on / off "
+                     "frame-time ratios, and on / single of the shading passes (with spectra's "
+                     "classify + bin)")
         ->capture_default_str();
     bench
         ->add_option("--reuse-refresh", bo.reuseRefreshPeriod,

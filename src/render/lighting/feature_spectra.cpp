@@ -100,6 +100,17 @@ uint32_t materialFeaturesOf(uint32_t mode) {
     return (mode & SPECTRUM_MATERIAL) ? MATERIAL_FEATURES_ALL : 0u;
 }
 
+// Whether a forward tile mode's permutation shades its list's lights that read no texture in a
+// loop of their own (spectra per light, SPECTRUM_LIGHT_SPLIT_CONSTANT_ID): with --spectra on,
+// where the mode has such features at all. --spectra single stays the one all-features loop it
+// is measured as. Not in the shadel path: its chunk lists are in shared memory, read at an
+// index uniform over the workgroup, and there the split changed nothing measurable
+// (builtin:lights 1280x720, shadelShading on 318-362 ms against 332-354 without it) while
+// doubling the light loop each permutation compiles.
+uint32_t lightSplitOf(const Renderer& r, uint32_t mode) {
+    return r.settings.spectra == Spectra::On && (mode & SPECTRUM_SAMPLING_LIGHTS) != 0u;
+}
+
 struct TileShadePush {
     uint64_t frame;
     uint32_t visibilitySlot;
@@ -118,6 +129,7 @@ struct SpectraState {
     BufferHandle tileBins;     // modes x tiles (or chunks of the shading queue)
     BufferHandle superfluous;  // modes x features (readback)
     BufferHandle featureTiles; // features (readback)
+    BufferHandle lightSplits;  // per tile: its list's lights that read no texture (forward)
     // Chunks: the classify phase's light lists (pool, per-chunk ranges, the pool's counter).
     BufferHandle chunkLists, chunkRanges, chunkListCount;
     uint32_t chunkListCapacity = 0;
@@ -208,12 +220,14 @@ SpectraStatePtr createFeatureSpectra(Renderer& r) {
         }
         return s;
     }
+    s->lightSplits = need(createBuffer(gpu, {"spectra.lightSplits", uint64_t(s->tiles) * 4}));
     for (uint32_t m = 0; m < modes; ++m)
         s->shading.push_back(createComputePipeline(
             gpu, "tileShading." + modeName(s->modes[m]), "lighting_tile_shade.comp.spv",
             {{SPECTRUM_FEATURES_CONSTANT_ID, s->modes[m]},
              {SPECTRUM_MODE_CONSTANT_ID, m},
-             {MATERIAL_FEATURES_CONSTANT_ID, materialFeaturesOf(s->modes[m])}}));
+             {MATERIAL_FEATURES_CONSTANT_ID, materialFeaturesOf(s->modes[m])},
+             {SPECTRUM_LIGHT_SPLIT_CONSTANT_ID, lightSplitOf(r, s->modes[m])}}));
     return s;
 }
 
@@ -227,6 +241,7 @@ void destroyFeatureSpectra(Renderer& r, SpectraStatePtr& state) {
         for (BufferHandle b : {state->chunkLists, state->chunkRanges, state->chunkListCount})
             destroy(gpu, b);
     }
+    if (state->lightSplits) destroy(gpu, state->lightSplits);
     for (BufferHandle b :
          {state->frame, state->dispatch, state->tileBins, state->superfluous, state->featureTiles})
         destroy(gpu, b);
@@ -242,6 +257,7 @@ uint64_t prepareFeatureSpectra(Renderer& r, uint32_t tilesX, uint32_t tilesY) {
     f.tileBins = address(gpu, s.tileBins);
     f.superfluous = address(gpu, s.superfluous);
     f.featureTiles = address(gpu, s.featureTiles);
+    if (s.lightSplits) f.lightSplits = address(gpu, s.lightSplits);
     f.modeCount = uint32_t(s.modes.size());
     f.binCapacity = s.chunks ? s.tiles : tilesX * tilesY;
     if (s.chunks) {
