@@ -208,12 +208,14 @@ void main() {
         for (uint i = 0u; i < candidates && written < keptLights; ++i) {
             uvec2 entry = sList[i];
             if (entry.x == LIGHT_INVALID) continue;
-            GpuLight light = lights.l[entry.x];
-            if (split && lightSamplesTextures(lf, light) != (part == 1u)) continue;
+            if (split) {
+                GpuLight light = lights.l[entry.x];
+                if (lightSamplesTextures(lf, light) != (part == 1u)) continue;
+                features |= entryFeatures(lf, light, entry.y, corners);
+            }
             outList.e[written++] = entry;
             anyPerPixel = anyPerPixel || entry.y != 0u;
             atomicOr(UintBuffer(lf.visibleLights).v[entry.x >> 5], 1u << (entry.x & 31u));
-            if (split) features |= entryFeatures(lf, light, entry.y, corners);
         }
         if (part == 0u) plain = written;
     }
