@@ -98,24 +98,6 @@ vec3 applyNormalMap(GpuMaterial m, uint slot, uint tex, float scale, SurfaceInpu
 layout(constant_id = MATERIAL_FEATURES_CONSTANT_ID) const uint kMaterialFeatures = MATERIAL_FEATURES_ALL;
 #define MATERIAL_HAS(feature) ((kMaterialFeatures & (feature)) != 0u)
 
-// The MATERIAL_FEATURE_* the material uses: a shader compiled without the others shades it the
-// same. The GPU twin of materialFeatures (render/gpu_scene.h); the feature spectra's tile pass
-// reads it per pixel (a texture that streams in changes it from one frame to the next).
-uint materialFeaturesOf(GpuMaterial m) {
-    uint features = 0u;
-    uint textures[12] = uint[12](m.baseColorTexture, m.metallicRoughnessTexture, m.normalTexture,
-                                 m.emissiveTexture, m.occlusionTexture, m.clearcoatTexture,
-                                 m.clearcoatRoughnessTexture, m.clearcoatNormalTexture,
-                                 m.specularTexture, m.specularColorTexture, m.sheenColorTexture,
-                                 m.sheenRoughnessTexture);
-    for (int i = 0; i < 12; ++i)
-        if (textures[i] != NO_TEXTURE) features |= MATERIAL_FEATURE_TEXTURES;
-    if (m.procedural == PROCEDURAL_TEXEL_CHECKER || m.procedural == PROCEDURAL_BRICKS)
-        features |= MATERIAL_FEATURE_PROCEDURAL;
-    if (m.clearcoatFactor > 0.0) features |= MATERIAL_FEATURE_CLEARCOAT;
-    if (any(greaterThan(m.sheenColorFactor, vec3(0.0)))) features |= MATERIAL_FEATURE_SHEEN;
-    return features;
-}
 
 MaterialSample evaluateMaterial(GpuMaterial m, SurfaceInput s) {
     MaterialSample o;

@@ -22,6 +22,9 @@ using uint = uint32_t;
 #define MATERIAL_ALPHA_BLEND 2u
 #define MATERIAL_DOUBLE_SIDED 4u
 #define MATERIAL_UNLIT 8u
+// It uses a MATERIAL_FEATURE_* (texture, procedural, clear coat, sheen): set at upload from
+// materialFeatures (render/gpu_scene.h), read where a shader chooses what to compile in.
+#define MATERIAL_FEATURED 16u
 // Bits 8..10: the surface class (scene.h SurfaceClass; render/screenspace's thin G-buffer).
 #define MATERIAL_CLASS_SHIFT 8u
 #define MATERIAL_CLASS_MASK 7u
@@ -403,6 +406,7 @@ struct SpectraFrame {
     // uint per screen tile: its list's leading entries whose lights read no texture
     // (SPECTRUM_SAMPLING_LIGHTS); the rest of the list follows them (0 for shadel chunks).
     uint64_t lightSplits;
+    uint64_t plainLightPairs; // uint: the sum of lightSplits this frame (readback)
     uint modeCount;
     uint binCapacity;       // tiles (each mode's list can hold every tile)
     uint chunkListCapacity; // entries of the chunkLists pool

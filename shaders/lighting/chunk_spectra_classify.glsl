@@ -49,8 +49,8 @@ bool loadChunkLightList(FrameConstants f, uint workIndex) {
 }
 
 // CLASSIFY: after cullChunkLights, bins the chunk by the features of its list and of its
-// object's material (materialFeatures: MATERIAL_FEATURE_*). Uniform flow.
-void classifyChunkSpectrum(FrameConstants f, uint workIndex, uint materialFeatures) {
+// object's material (featuredMaterial: it uses a MATERIAL_FEATURE_*). Uniform flow.
+void classifyChunkSpectrum(FrameConstants f, uint workIndex, bool featuredMaterial) {
     LightingFrame lf = LightingFrameRef(f.lighting).l;
     uint tid = gl_LocalInvocationIndex;
     if (tid == 0u) sChunkFeatures = 0u;
@@ -74,7 +74,7 @@ void classifyChunkSpectrum(FrameConstants f, uint workIndex, uint materialFeatur
     if (culled) storeChunkLightList(SpectraFrameRef(lf.chunkSpectra).s, workIndex);
     if (tid != 0u) return;
     // Without a culled list (no tiled culling this frame) every light may reach it.
-    uint material = materialFeatures != 0u ? SPECTRUM_MATERIAL : 0u;
+    uint material = featuredMaterial ? SPECTRUM_MATERIAL : 0u;
     uint features = !culled      ? SPECTRUM_ALL
                     : anyShadel ? sChunkFeatures | frameFeatures(f, lf) | material
                                 : 0u;

@@ -94,7 +94,7 @@ void main() {
         bool featured = false;
         if (instance != VISIBILITY_NONE) {
             uint material = InstanceBuffer(f.instances).i[instance].material;
-            featured = materialFeaturesOf(MaterialBuffer(f.materials).m[material]) != 0u;
+            featured = (MaterialBuffer(f.materials).m[material].flags & MATERIAL_FEATURED) != 0u;
         }
         if (subgroupAny(featured) && subgroupElect()) atomicOr(sMaterialFeatures, SPECTRUM_MATERIAL);
     }
@@ -219,7 +219,11 @@ void main() {
         }
         if (part == 0u) plain = written;
     }
-    if (split) UintBuffer(SpectraFrameRef(lf.spectra).s.lightSplits).v[tile] = plain;
+    if (split) {
+        SpectraFrame sf = SpectraFrameRef(lf.spectra).s;
+        UintBuffer(sf.lightSplits).v[tile] = plain;
+        atomicAdd(UintBuffer(sf.plainLightPairs).v[0], plain);
+    }
     if (anyPerPixel) atomicAdd(counters.c.perPixelBlockerTiles, 1u);
     binTileSpectrum(lf, tile, features | frameFeatures(f, lf) | sMaterialFeatures);
 }

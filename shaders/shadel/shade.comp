@@ -334,8 +334,7 @@ void main() {
              !(kChunkSpectraPhase == CHUNK_SPECTRA_SHADE && loadChunkLightList(f, workIndex)))
         cullChunkLights(f, shading, si.position);
     if (kChunkSpectraPhase == CHUNK_SPECTRA_CLASSIFY) {
-        classifyChunkSpectrum(f, workIndex,
-                              materialFeaturesOf(MaterialBuffer(f.materials).m[inst.material]));
+        classifyChunkSpectrum(f, workIndex, (o.v.flags & SHADEL_OBJECT_FEATURED_MATERIAL) != 0u);
         return;
     }
     if (SHADE_HAS(SHADE_OPTIONAL_REUSE)) recordChunkView(f, s, work.slot, shading, si.position);

@@ -193,6 +193,8 @@ void uploadScene(Gpu& gpu, const Scene& scene, GpuScene& out, const std::vector<
         setMaterialExtensions(g, Material{}, [](int32_t) { return NO_TEXTURE; });
         materials.push_back(g);
     }
+    for (gpu::GpuMaterial& g : materials)
+        if (materialFeatures(g) != 0u) g.flags |= MATERIAL_FEATURED;
 
     // Unified geometry.
     std::vector<gpu::GpuVertex> vertices;

@@ -79,8 +79,8 @@ void destroyScene(Gpu& gpu, GpuScene& scene);
 bool hasAlphaMaskedMaterials(const GpuScene& scene);
 
 // The MATERIAL_FEATURE_* the material uses: what shaders/common/material.glsl must evaluate for
-// it (a shader compiled without them, kMaterialFeatures, shades it the same). Its GPU twin is
-// materialFeaturesOf in that file: keep the two the same.
+// it (a shader compiled without them, kMaterialFeatures, shades it the same). Uploaded
+// materials carry MATERIAL_FEATURED when it is not 0.
 uint32_t materialFeatures(const gpu::GpuMaterial& m);
 
 } // namespace shadel

@@ -95,6 +95,11 @@ TEST(Spectra, PermutationsMatchTheAllFeaturesShaders) {
     EXPECT_LT(s["spectra_superfluous_total"].get<uint64_t>(),
               one["spectra_superfluous_total"].get<uint64_t>() / 2);
     expectMaterialSpectra(s, one, tiles);
+    // Spectra per light: the tiles' lists hold lights that read no texture first, and some
+    // that do after them.
+    uint64_t plainPairs = s["spectra_plain_light_pairs"].get<uint64_t>();
+    EXPECT_GT(plainPairs, 0u);
+    EXPECT_LT(plainPairs, s["light_tile_pairs"].get<uint64_t>());
 }
 
 // The shadel path ("the same for chunk queues"): queued chunks are binned by the features of

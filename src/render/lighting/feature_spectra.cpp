@@ -96,7 +96,7 @@ std::string modeName(uint32_t features) {
 
 // The material features a mode's permutation compiles in (kMaterialFeatures of
 // shaders/common/material.glsl): all of them with SPECTRUM_MATERIAL, else none.
-uint32_t materialFeaturesOf(uint32_t mode) {
+uint32_t modeMaterialFeatures(uint32_t mode) {
     return (mode & SPECTRUM_MATERIAL) ? MATERIAL_FEATURES_ALL : 0u;
 }
 
@@ -125,18 +125,19 @@ struct SpectraState {
     Pipeline classify, setup;      // chunks: the classify permutation, the dispatch sizes
     BufferHandle frame;            // gpu::SpectraFrame (upload)
     // Per mode: tiles, a VkDispatchIndirectCommand (x counts); chunks, a uvec4 (w counts).
-    BufferHandle dispatch;     // (read back for stats)
-    BufferHandle tileBins;     // modes x tiles (or chunks of the shading queue)
-    BufferHandle superfluous;  // modes x features (readback)
-    BufferHandle featureTiles; // features (readback)
-    BufferHandle lightSplits;  // per tile: its list's lights that read no texture (forward)
+    BufferHandle dispatch;        // (read back for stats)
+    BufferHandle tileBins;        // modes x tiles (or chunks of the shading queue)
+    BufferHandle superfluous;     // modes x features (readback)
+    BufferHandle featureTiles;    // features (readback)
+    BufferHandle lightSplits;     // per tile: its list's lights that read no texture (forward)
+    BufferHandle plainLightPairs; // their sum (readback)
     // Chunks: the classify phase's light lists (pool, per-chunk ranges, the pool's counter).
     BufferHandle chunkLists, chunkRanges, chunkListCount;
     uint32_t chunkListCapacity = 0;
     uint32_t tiles = 0;
     // Last frame's counts.
     std::vector<uint32_t> binned, lastSuperfluous, lastFeatureTiles;
-    uint32_t lastChunkListEntries = 0, lastChunksCulledAgain = 0;
+    uint32_t lastChunkListEntries = 0, lastChunksCulledAgain = 0, lastPlainLightPairs = 0;
 };
 
 void SpectraStateDeleter::operator()(SpectraState* state) const {
@@ -214,19 +215,21 @@ SpectraStatePtr createFeatureSpectra(Renderer& r) {
             constants.push_back({CHUNK_SPECTRA_PHASE_CONSTANT_ID, 2u});
             constants.push_back({SPECTRUM_FEATURES_CONSTANT_ID, s->modes[m]});
             constants.push_back({SPECTRUM_MODE_CONSTANT_ID, m});
-            constants.push_back({MATERIAL_FEATURES_CONSTANT_ID, materialFeaturesOf(s->modes[m])});
+            constants.push_back({MATERIAL_FEATURES_CONSTANT_ID, modeMaterialFeatures(s->modes[m])});
             s->shading.push_back(createComputePipeline(
                 gpu, "shadelShading." + modeName(s->modes[m]), "shadel_shade.comp.spv", constants));
         }
         return s;
     }
     s->lightSplits = need(createBuffer(gpu, {"spectra.lightSplits", uint64_t(s->tiles) * 4}));
+    s->plainLightPairs =
+        need(createBuffer(gpu, {"spectra.plainLightPairs", 4, 0, MemoryKind::Readback}));
     for (uint32_t m = 0; m < modes; ++m)
         s->shading.push_back(createComputePipeline(
             gpu, "tileShading." + modeName(s->modes[m]), "lighting_tile_shade.comp.spv",
             {{SPECTRUM_FEATURES_CONSTANT_ID, s->modes[m]},
              {SPECTRUM_MODE_CONSTANT_ID, m},
-             {MATERIAL_FEATURES_CONSTANT_ID, materialFeaturesOf(s->modes[m])},
+             {MATERIAL_FEATURES_CONSTANT_ID, modeMaterialFeatures(s->modes[m])},
              {SPECTRUM_LIGHT_SPLIT_CONSTANT_ID, lightSplitOf(r, s->modes[m])}}));
     return s;
 }
@@ -241,7 +244,8 @@ void destroyFeatureSpectra(Renderer& r, SpectraStatePtr& state) {
         for (BufferHandle b : {state->chunkLists, state->chunkRanges, state->chunkListCount})
             destroy(gpu, b);
     }
-    if (state->lightSplits) destroy(gpu, state->lightSplits);
+    for (BufferHandle b : {state->lightSplits, state->plainLightPairs})
+        if (b) destroy(gpu, b);
     for (BufferHandle b :
          {state->frame, state->dispatch, state->tileBins, state->superfluous, state->featureTiles})
         destroy(gpu, b);
@@ -257,7 +261,10 @@ uint64_t prepareFeatureSpectra(Renderer& r, uint32_t tilesX, uint32_t tilesY) {
     f.tileBins = address(gpu, s.tileBins);
     f.superfluous = address(gpu, s.superfluous);
     f.featureTiles = address(gpu, s.featureTiles);
-    if (s.lightSplits) f.lightSplits = address(gpu, s.lightSplits);
+    if (s.lightSplits) {
+        f.lightSplits = address(gpu, s.lightSplits);
+        f.plainLightPairs = address(gpu, s.plainLightPairs);
+    }
     f.modeCount = uint32_t(s.modes.size());
     f.binCapacity = s.chunks ? s.tiles : tilesX * tilesY;
     if (s.chunks) {
@@ -285,6 +292,8 @@ void recordSpectraReset(Renderer& r, VkCommandBuffer cmd) {
     vkCmdFillBuffer(cmd, vkBuffer(gpu, s.superfluous), 0, VK_WHOLE_SIZE, 0);
     vkCmdFillBuffer(cmd, vkBuffer(gpu, s.featureTiles), 0, VK_WHOLE_SIZE, 0);
     if (s.chunks) vkCmdFillBuffer(cmd, vkBuffer(gpu, s.chunkListCount), 0, VK_WHOLE_SIZE, 0);
+    if (s.plainLightPairs)
+        vkCmdFillBuffer(cmd, vkBuffer(gpu, s.plainLightPairs), 0, VK_WHOLE_SIZE, 0);
     // Before the tile pass's atomics (vkCmdUpdateBuffer counts as a transfer: ALL_TRANSFER).
     memoryBarrier(cmd, VK_PIPELINE_STAGE_2_ALL_TRANSFER_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT,
                   VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
@@ -367,6 +376,8 @@ void readFeatureSpectraStats(Renderer& r) {
         s.lastChunkListEntries = lists[0];
         s.lastChunksCulledAgain = lists[1];
     }
+    if (s.plainLightPairs)
+        s.lastPlainLightPairs = *static_cast<const uint32_t*>(mapped(gpu, s.plainLightPairs));
 }
 
 void featureSpectraStats(const Renderer& r, nlohmann::json& stats) {
@@ -411,6 +422,10 @@ void featureSpectraStats(const Renderer& r, nlohmann::json& stats) {
         stats["spectra_chunk_list_entries"] = s.lastChunkListEntries;
         stats["spectra_chunk_list_capacity"] = s.chunkListCapacity;
         stats["spectra_chunks_culled_again"] = s.lastChunksCulledAgain;
+    } else {
+        // Spectra per light: the tiles' list entries that read no texture, listed first; with
+        // --spectra on the permutations shade them without the texture-reading code.
+        stats["spectra_plain_light_pairs"] = s.lastPlainLightPairs;
     }
 }
 
