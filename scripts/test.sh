@@ -12,7 +12,11 @@ bash scripts/build.sh
 
 echo "== tests: unit + GPU (Release, Khronos validation on)"
 export SHADEL_CACHE_DIR="$PWD/build/test-cache"
-ctest --test-dir build --output-on-failure -j1 --timeout 900
+# One test per core: a GPU test on lavapipe spends most of its time in one thread (pipeline
+# compiles, the validation layer, readbacks), so two at once nearly halve the suite on two
+# cores. Every test's temp files carry its pid and every cache write is atomic, so tests may
+# share the machine; none asserts on timing.
+ctest --test-dir build --output-on-failure -j"$jobs" --timeout 900
 
 echo "== tests: unit under AddressSanitizer + UBSan"
 cmake -S . -B build-asan -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DSHADEL_CPU_ONLY=ON \
