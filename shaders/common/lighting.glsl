@@ -45,12 +45,13 @@ layout(buffer_reference, scalar) readonly buffer LightGridEntries { uint v[]; };
 // result is the same.
 layout(constant_id = SPECTRUM_FEATURES_CONSTANT_ID) const uint kSpectrumFeatures = SPECTRUM_ALL;
 #define SPECTRUM_HAS(features) ((kSpectrumFeatures & (features)) != 0u)
-// Spectra per light: the first gLightListPlainCount entries of the list read no texture
-// (SPECTRUM_SAMPLING_LIGHTS), and a permutation with kSpectrumLightSplit shades them in a loop
-// compiled without those features (forward tiles, whose list is in memory: on lavapipe the code
-// of the features compiled in costs every light there whether it uses them or not;
-// builtin:lights 1280x720, tile shading with every light that reads a texture skipped: 239 ms
-// without their code, 305 with it).
+// Spectra per light: the first gLightListPlainCount entries of a tile's list read no texture
+// (SPECTRUM_SAMPLING_LIGHTS), and a pipeline with kSpectrumLightSplit shades them in a loop
+// compiled without those features: the raster forward pass and the spectra permutations that
+// have them (forward tiles, whose list is in memory: on lavapipe the code of the features
+// compiled in costs every light there whether it uses them or not; builtin:lights 1280x720,
+// tile shading with every light that reads a texture skipped: 239 ms without their code, 305
+// with it). Other lists (grid, subgroup, chunk) leave the count 0: one loop with every feature.
 layout(constant_id = SPECTRUM_LIGHT_SPLIT_CONSTANT_ID) const uint kSpectrumLightSplit = 0u;
 uint gLightListPlainCount = 0u;
 
@@ -74,6 +75,10 @@ shared uvec2 sLightList[LIGHT_CHUNK_MAX_LIGHTS];
 shared uint sLightListCount;
 #endif
 
+// A tile's range (first entry, packTileListLength): its entries, and how many of the leading
+// ones read no texture (the tile pass lists those first; gLightListPlainCount).
+uint packTileListLength(uint count, uint plain) { return count | (plain << 16); }
+
 // Forward shading: the list of the 16x16 tile holding this pixel, when tiled culling ran.
 void useTileLightList(FrameConstants f, vec2 fragCoord) {
     if (f.lighting == 0ul) return;
@@ -84,7 +89,8 @@ void useTileLightList(FrameConstants f, vec2 fragCoord) {
     uvec2 range = LightListBuffer(lf.tileRanges).e[index];
     gLightListMode = LIGHT_LIST_BUFFER;
     gLightListAddress = lf.tileLights + uint64_t(range.x) * 8ul;
-    gLightListCount = range.y;
+    gLightListCount = range.y & 0xFFFFu;
+    gLightListPlainCount = range.y >> 16;
 }
 
 // A forward pixel at `position`: its tile's list when screen tiles were culled this frame,

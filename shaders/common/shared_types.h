@@ -90,11 +90,12 @@ using uint = uint32_t;
 #define SPECTRUM_MAX_MODES 16u
 #define SPECTRUM_FEATURES_CONSTANT_ID 140
 #define SPECTRUM_MODE_CONSTANT_ID 141 // the mode (bin) a tile / chunk shading permutation runs
-// Spectra per light (--spectra on, forward tiles): the features only some lights of a list
-// bring, each a texture read per light (a spot's shadow map, PCSS, a gobo, an area light's
-// emitter). A tile's list holds the lights without them first (SpectraFrame::lightSplits), and
-// a permutation with SPECTRUM_LIGHT_SPLIT_CONSTANT_ID set shades those in a loop compiled
-// without them (shaders/common/lighting.glsl, shadeSurface).
+// Spectra per light (forward tiles): the features only some lights of a list bring, each a
+// texture read per light (a spot's shadow map, PCSS, a gobo, an area light's emitter). A
+// tile's list holds the lights without them first (LightingFrame::tileRanges), and a pipeline
+// with SPECTRUM_LIGHT_SPLIT_CONSTANT_ID set shades those in a loop compiled without them
+// (shaders/common/lighting.glsl, shadeSurface): the raster forward pass, and the --spectra on
+// permutations that have them.
 #define SPECTRUM_SAMPLING_LIGHTS                                                                   \
     (SPECTRUM_SPOT_SHADOWS | SPECTRUM_SOFT_SHADOWS | SPECTRUM_PROJECTED | SPECTRUM_AREA)
 #define SPECTRUM_LIGHT_SPLIT_CONSTANT_ID 150
@@ -286,6 +287,9 @@ struct LightingCounters {
     // Lists the shadel path culled per subgroup (LightingFrame::subgroupLists); the chunk
     // counts above (pairs, candidates, per-pixel blocker) then count those lists.
     uint lightSubgroupLists;
+    // Of lightTilePairs, those whose light reads no texture: each tile lists them first (spectra
+    // per light, SPECTRUM_LIGHT_SPLIT_CONSTANT_ID).
+    uint lightTilePlainPairs;
 };
 
 // The light grid (render/lighting/light_grid.h): lights bucketed in world space so a shadel
@@ -403,10 +407,6 @@ struct SpectraFrame {
     uint64_t chunkRanges;    // uvec2 per shading-queue index: (first entry, count); count
                              // CHUNK_LIST_NONE when the pool was full (the chunk is culled again)
     uint64_t chunkListCount; // uint[2]: pool entries taken this frame, chunks culled again
-    // uint per screen tile: its list's leading entries whose lights read no texture
-    // (SPECTRUM_SAMPLING_LIGHTS); the rest of the list follows them (0 for shadel chunks).
-    uint64_t lightSplits;
-    uint64_t plainLightPairs; // uint: the sum of lightSplits this frame (readback)
     uint modeCount;
     uint binCapacity;       // tiles (each mode's list can hold every tile)
     uint chunkListCapacity; // entries of the chunkLists pool

@@ -29,6 +29,9 @@ shared uint sDepthMin, sDepthMax;
 shared uint sMaterialFeatures; // SPECTRUM_MATERIAL when a pixel's material uses any feature
 shared uvec2 sList[LIGHT_TILE_MAX_LIGHTS];
 shared uint sKept;
+// A bit per entry of sList: the light reads a texture (lightSamplesTextures), so it is listed
+// after those that do not.
+shared uint sSamplesTextures[LIGHT_TILE_MAX_LIGHTS / 32u];
 #define LIGHT_GRID_LIST sList
 #define LIGHT_GRID_LIST_MAX LIGHT_TILE_MAX_LIGHTS
 #include "lighting/light_grid.glsl"
@@ -74,6 +77,7 @@ void main() {
         sKept = 0u;
         sMaterialFeatures = 0u;
     }
+    for (uint i = tid; i < LIGHT_TILE_MAX_LIGHTS / 32u; i += THREADS) sSamplesTextures[i] = 0u;
     // The light grid's bit set, cleared under the same barrier.
     lightGridMaskClearUnsynced(f, lf.lightGrid, THREADS);
     barrier();
@@ -180,6 +184,8 @@ void main() {
         sList[i].y = mask;
         if (mask == LIGHT_INVALID) sList[i].x = LIGHT_INVALID;
         kept += mask == LIGHT_INVALID ? 0u : 1u;
+        if (mask != LIGHT_INVALID && lightSamplesTextures(lf, light))
+            atomicOr(sSamplesTextures[i >> 5], 1u << (i & 31u));
     }
     atomicAdd(sKept, kept);
     barrier();
@@ -194,36 +200,30 @@ void main() {
     uint room = poolBase < lf.poolCapacity ? lf.poolCapacity - poolBase : 0u;
     if (room < keptLights) atomicAdd(counters.c.tilesOverflowed, 1u);
     keptLights = min(keptLights, room);
-    LightListBuffer(lf.tileRanges).e[tile] = uvec2(poolBase, keptLights);
     atomicAdd(counters.c.lightTilePairs, keptLights);
     LightListBuffer outList = LightListBuffer(lf.tileLights + uint64_t(poolBase) * 8ul);
     uint features = 0u;
     bool anyPerPixel = false;
     uint written = 0u;
-    // With spectra the lights that read no texture come first, each part in light order
-    // (spectra per light: SpectraFrame::lightSplits).
-    bool split = lf.spectra != 0ul;
+    // The lights that read no texture come first, each part in light order: shadeSurface runs
+    // them in a loop compiled without that code (lighting.glsl, kSpectrumLightSplit), and the
+    // tile's range carries where the parts meet.
+    bool spectra = lf.spectra != 0ul;
     uint plain = 0u;
-    for (uint part = 0u; part < (split ? 2u : 1u); ++part) {
+    for (uint part = 0u; part < 2u; ++part) {
         for (uint i = 0u; i < candidates && written < keptLights; ++i) {
             uvec2 entry = sList[i];
             if (entry.x == LIGHT_INVALID) continue;
-            if (split) {
-                GpuLight light = lights.l[entry.x];
-                if (lightSamplesTextures(lf, light) != (part == 1u)) continue;
-                features |= entryFeatures(lf, light, entry.y, corners);
-            }
+            if (((sSamplesTextures[i >> 5] >> (i & 31u)) & 1u) != part) continue;
+            if (spectra) features |= entryFeatures(lf, lights.l[entry.x], entry.y, corners);
             outList.e[written++] = entry;
             anyPerPixel = anyPerPixel || entry.y != 0u;
             atomicOr(UintBuffer(lf.visibleLights).v[entry.x >> 5], 1u << (entry.x & 31u));
         }
         if (part == 0u) plain = written;
     }
-    if (split) {
-        SpectraFrame sf = SpectraFrameRef(lf.spectra).s;
-        UintBuffer(sf.lightSplits).v[tile] = plain;
-        atomicAdd(UintBuffer(sf.plainLightPairs).v[0], plain);
-    }
+    LightListBuffer(lf.tileRanges).e[tile] = uvec2(poolBase, packTileListLength(keptLights, plain));
+    atomicAdd(counters.c.lightTilePlainPairs, plain);
     if (anyPerPixel) atomicAdd(counters.c.perPixelBlockerTiles, 1u);
     binTileSpectrum(lf, tile, features | frameFeatures(f, lf) | sMaterialFeatures);
 }

@@ -53,7 +53,6 @@ void main() {
         useTileDecalList(f, vec2(pixel) + 0.5); // decals (render/decals)
         MaterialSample m = evaluateMaterial(mat, s);
         useTileLightList(f, vec2(pixel) + 0.5);
-        if (kSpectrumLightSplit != 0u) gLightListPlainCount = UintBuffer(sf.lightSplits).v[tile];
         vec3 shaded = visualizeLighting(f, shadeSurface(f, m, s.position, s.normal));
         if (f.visualize == VISUALIZE_SPECTRA) {
             float l = dot(shaded, vec3(0.2126, 0.7152, 0.0722));

@@ -136,7 +136,7 @@ void initRenderer(Renderer& r, Gpu& gpu, const RenderSettings& requested, const 
                            MemoryKind::Readback});
     if (!r.draws || !r.shadowDraws || !r.drawCounts || !r.frameConstants || !r.pixels)
         throw DeviceError("out of GPU memory for the renderer's frame buffers");
-    createForwardPipelines(r);
+    createForwardPipelines(r, forwardSplitsTileLights(r, scene));
     createTonemapPipeline(r);
     initShaderMessages(gpu, r.messages);
     initFrameRecorder(gpu, r.recorder, settings.timing, std::max(1u, settings.recordingThreads));

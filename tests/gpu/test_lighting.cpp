@@ -90,6 +90,7 @@ void expectSubgroupCullingChangesNothing(RenderMode mode) {
     EXPECT_EQ(s["light_culling"], "subgroups (few lights)");
     EXPECT_EQ(none.stats["light_culling"], "none");
     EXPECT_FALSE(s["light_screen_tiles"].get<bool>()) << "no tile pass";
+    EXPECT_FALSE(s["light_tile_split"].get<bool>()) << "no second light loop without tile lists";
     uint64_t visible = s["lights_visible"].get<uint64_t>();
     EXPECT_GT(visible, 0u) << "the street lamps light some pixels";
     EXPECT_LT(visible, s["lights"].get<uint64_t>()) << "some lamps reach no shaded subgroup";
@@ -137,6 +138,11 @@ TEST(Lighting, TiledCullingCountsPairsAndCullsMostOfThem) {
         << "tiles away from the rooms need no per-pixel blocker test";
     EXPECT_GT(s["lights_culled_by_blockers"].get<uint64_t>(), 0u)
         << "tiles wholly behind a wall drop its lamps";
+    // Spectra per light: the street's shadowed spots, gobos and area lights read textures, most
+    // of its lamps do not; the forward pass shades those first without the texture code.
+    EXPECT_TRUE(s["light_tile_split"].get<bool>());
+    EXPECT_GT(s["light_tile_plain_pairs"].get<uint64_t>(), pairs / 2);
+    EXPECT_LT(s["light_tile_plain_pairs"].get<uint64_t>(), pairs);
 }
 
 // builtin:blockers: a roofless room with a lamp; seen from straight above, pixels map to the

@@ -97,7 +97,7 @@ TEST(Spectra, PermutationsMatchTheAllFeaturesShaders) {
     expectMaterialSpectra(s, one, tiles);
     // Spectra per light: the tiles' lists hold lights that read no texture first, and some
     // that do after them.
-    uint64_t plainPairs = s["spectra_plain_light_pairs"].get<uint64_t>();
+    uint64_t plainPairs = s["light_tile_plain_pairs"].get<uint64_t>();
     EXPECT_GT(plainPairs, 0u);
     EXPECT_LT(plainPairs, s["light_tile_pairs"].get<uint64_t>());
 }

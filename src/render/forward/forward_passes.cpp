@@ -24,7 +24,7 @@ void drawList(Renderer& r, VkCommandBuffer cmd, BufferHandle draws, VkDeviceSize
 }
 } // namespace
 
-void createForwardPipelines(Renderer& r) {
+void createForwardPipelines(Renderer& r, bool splitTileLights) {
     Gpu& gpu = *r.gpu;
     r.instanceCull = createComputePipeline(gpu, "instanceCull", "forward_instance_cull.comp.spv");
     GraphicsPipelineDesc depth;
@@ -47,6 +47,9 @@ void createForwardPipelines(Renderer& r) {
     opaque.specialization = shaderPrintSpecialization(r.settings.inspectX >= 0);
     if (r.settings.distanceFieldLighting)
         opaque.specialization.push_back({DISTANCE_FIELD_LIGHTING_CONSTANT_ID, 1u});
+    // A screen tile's lights that read no texture run in a loop without that code (spectra per
+    // light, shaders/common/lighting.glsl); other lists leave that loop empty.
+    if (splitTileLights) opaque.specialization.push_back({SPECTRUM_LIGHT_SPLIT_CONSTANT_ID, 1u});
     r.forwardOpaque = createGraphicsPipeline(gpu, opaque);
 }
 

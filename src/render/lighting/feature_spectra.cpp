@@ -101,9 +101,9 @@ uint32_t modeMaterialFeatures(uint32_t mode) {
 }
 
 // Whether a forward tile mode's permutation shades its list's lights that read no texture in a
-// loop of their own (spectra per light, SPECTRUM_LIGHT_SPLIT_CONSTANT_ID): with --spectra on,
-// where the mode has such features at all. --spectra single stays the one all-features loop it
-// is measured as. Not in the shadel path: its chunk lists are in shared memory, read at an
+// loop of their own (spectra per light, SPECTRUM_LIGHT_SPLIT_CONSTANT_ID; the raster forward
+// pass always does): with --spectra on, where the mode has such features at all. --spectra
+// single stays the one all-features loop it is measured as. Not in the shadel path: its chunk lists are in shared memory, read at an
 // index uniform over the workgroup, and there the split changed nothing measurable
 // (builtin:lights 1280x720, shadelShading on 318-362 ms against 332-354 without it) while
 // doubling the light loop each permutation compiles.
@@ -129,15 +129,13 @@ struct SpectraState {
     BufferHandle tileBins;        // modes x tiles (or chunks of the shading queue)
     BufferHandle superfluous;     // modes x features (readback)
     BufferHandle featureTiles;    // features (readback)
-    BufferHandle lightSplits;     // per tile: its list's lights that read no texture (forward)
-    BufferHandle plainLightPairs; // their sum (readback)
     // Chunks: the classify phase's light lists (pool, per-chunk ranges, the pool's counter).
     BufferHandle chunkLists, chunkRanges, chunkListCount;
     uint32_t chunkListCapacity = 0;
     uint32_t tiles = 0;
     // Last frame's counts.
     std::vector<uint32_t> binned, lastSuperfluous, lastFeatureTiles;
-    uint32_t lastChunkListEntries = 0, lastChunksCulledAgain = 0, lastPlainLightPairs = 0;
+    uint32_t lastChunkListEntries = 0, lastChunksCulledAgain = 0;
 };
 
 void SpectraStateDeleter::operator()(SpectraState* state) const {
@@ -221,9 +219,6 @@ SpectraStatePtr createFeatureSpectra(Renderer& r) {
         }
         return s;
     }
-    s->lightSplits = need(createBuffer(gpu, {"spectra.lightSplits", uint64_t(s->tiles) * 4}));
-    s->plainLightPairs =
-        need(createBuffer(gpu, {"spectra.plainLightPairs", 4, 0, MemoryKind::Readback}));
     for (uint32_t m = 0; m < modes; ++m)
         s->shading.push_back(createComputePipeline(
             gpu, "tileShading." + modeName(s->modes[m]), "lighting_tile_shade.comp.spv",
@@ -244,8 +239,6 @@ void destroyFeatureSpectra(Renderer& r, SpectraStatePtr& state) {
         for (BufferHandle b : {state->chunkLists, state->chunkRanges, state->chunkListCount})
             destroy(gpu, b);
     }
-    for (BufferHandle b : {state->lightSplits, state->plainLightPairs})
-        if (b) destroy(gpu, b);
     for (BufferHandle b :
          {state->frame, state->dispatch, state->tileBins, state->superfluous, state->featureTiles})
         destroy(gpu, b);
@@ -261,10 +254,6 @@ uint64_t prepareFeatureSpectra(Renderer& r, uint32_t tilesX, uint32_t tilesY) {
     f.tileBins = address(gpu, s.tileBins);
     f.superfluous = address(gpu, s.superfluous);
     f.featureTiles = address(gpu, s.featureTiles);
-    if (s.lightSplits) {
-        f.lightSplits = address(gpu, s.lightSplits);
-        f.plainLightPairs = address(gpu, s.plainLightPairs);
-    }
     f.modeCount = uint32_t(s.modes.size());
     f.binCapacity = s.chunks ? s.tiles : tilesX * tilesY;
     if (s.chunks) {
@@ -292,8 +281,6 @@ void recordSpectraReset(Renderer& r, VkCommandBuffer cmd) {
     vkCmdFillBuffer(cmd, vkBuffer(gpu, s.superfluous), 0, VK_WHOLE_SIZE, 0);
     vkCmdFillBuffer(cmd, vkBuffer(gpu, s.featureTiles), 0, VK_WHOLE_SIZE, 0);
     if (s.chunks) vkCmdFillBuffer(cmd, vkBuffer(gpu, s.chunkListCount), 0, VK_WHOLE_SIZE, 0);
-    if (s.plainLightPairs)
-        vkCmdFillBuffer(cmd, vkBuffer(gpu, s.plainLightPairs), 0, VK_WHOLE_SIZE, 0);
     // Before the tile pass's atomics (vkCmdUpdateBuffer counts as a transfer: ALL_TRANSFER).
     memoryBarrier(cmd, VK_PIPELINE_STAGE_2_ALL_TRANSFER_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT,
                   VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
@@ -376,8 +363,6 @@ void readFeatureSpectraStats(Renderer& r) {
         s.lastChunkListEntries = lists[0];
         s.lastChunksCulledAgain = lists[1];
     }
-    if (s.plainLightPairs)
-        s.lastPlainLightPairs = *static_cast<const uint32_t*>(mapped(gpu, s.plainLightPairs));
 }
 
 void featureSpectraStats(const Renderer& r, nlohmann::json& stats) {
@@ -422,10 +407,6 @@ void featureSpectraStats(const Renderer& r, nlohmann::json& stats) {
         stats["spectra_chunk_list_entries"] = s.lastChunkListEntries;
         stats["spectra_chunk_list_capacity"] = s.chunkListCapacity;
         stats["spectra_chunks_culled_again"] = s.lastChunksCulledAgain;
-    } else {
-        // Spectra per light: the tiles' list entries that read no texture, listed first; with
-        // --spectra on the permutations shade them without the texture-reading code.
-        stats["spectra_plain_light_pairs"] = s.lastPlainLightPairs;
     }
 }
 

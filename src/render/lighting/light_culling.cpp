@@ -50,6 +50,17 @@ static bool subgroupListsFit(const Renderer& r, uint32_t lightCount, bool blocke
            lightCount <= LIGHT_SUBGROUP_MAX_LIGHTS && !r.spectra && (r.decoupled || !blockersOn);
 }
 
+bool forwardSplitsTileLights(const Renderer& r, const GpuScene& scene) {
+    if (r.settings.lightCulling != LightCulling::Tiled ||
+        scene.lightInfo.size() <= LIGHT_SUBGROUP_MAX_LIGHTS)
+        return false;
+    for (const gpu::GpuLight& light : scene.lightInfo) // as lightSamplesTextures (spectra.glsl)
+        if (light.type == LIGHT_AREA || (light.flags & LIGHT_FLAG_PROJECTED) != 0 ||
+            (light.shadowIndex != LIGHT_NO_SHADOW && r.settings.spotShadows))
+            return true;
+    return false;
+}
+
 void LightCullingStateDeleter::operator()(LightCullingState* state) const {
     delete state;
 }
@@ -227,6 +238,11 @@ void lightCullingStats(const Renderer& r, const GpuScene& scene, nlohmann::json&
     // Without culling every light is considered everywhere.
     stats["lights_visible"] = tiled ? s.lightsVisible : scene.lightCount;
     stats["light_tile_pairs"] = s.tiledThisFrame ? s.last.lightTilePairs : 0u;
+    // Spectra per light: of those pairs, the lights that read no texture (each tile lists them
+    // first), and whether the raster forward pass shades them in a loop without that code.
+    stats["light_tile_plain_pairs"] = s.tiledThisFrame ? s.last.lightTilePlainPairs : 0u;
+    stats["light_tile_split"] =
+        r.settings.mode == RenderMode::Forward && forwardSplitsTileLights(r, scene);
     stats["light_tiles"] = s.tilesX * s.tilesY;
     stats["light_screen_tiles"] = s.screenTilesThisFrame; // false: decoupled, chunks + grid
     stats["per_pixel_blocker_tiles"] = s.last.perPixelBlockerTiles;
