@@ -103,10 +103,10 @@ uint32_t modeMaterialFeatures(uint32_t mode) {
 // Whether a forward tile mode's permutation shades its list's lights that read no texture in a
 // loop of their own (spectra per light, SPECTRUM_LIGHT_SPLIT_CONSTANT_ID; the raster forward
 // pass always does): with --spectra on, where the mode has such features at all. --spectra
-// single stays the one all-features loop it is measured as. Not in the shadel path: its chunk lists are in shared memory, read at an
-// index uniform over the workgroup, and there the split changed nothing measurable
-// (builtin:lights 1280x720, shadelShading on 318-362 ms against 332-354 without it) while
-// doubling the light loop each permutation compiles.
+// single stays the one all-features loop it is measured as. Not in the shadel path: its chunk lists
+// are in shared memory, read at an index uniform over the workgroup, and there the split changed
+// nothing measurable (builtin:lights 1280x720, shadelShading on 318-362 ms against 332-354 without
+// it) while doubling the light loop each permutation compiles.
 uint32_t lightSplitOf(const Renderer& r, uint32_t mode) {
     return r.settings.spectra == Spectra::On && (mode & SPECTRUM_SAMPLING_LIGHTS) != 0u;
 }
@@ -125,10 +125,10 @@ struct SpectraState {
     Pipeline classify, setup;      // chunks: the classify permutation, the dispatch sizes
     BufferHandle frame;            // gpu::SpectraFrame (upload)
     // Per mode: tiles, a VkDispatchIndirectCommand (x counts); chunks, a uvec4 (w counts).
-    BufferHandle dispatch;        // (read back for stats)
-    BufferHandle tileBins;        // modes x tiles (or chunks of the shading queue)
-    BufferHandle superfluous;     // modes x features (readback)
-    BufferHandle featureTiles;    // features (readback)
+    BufferHandle dispatch;     // (read back for stats)
+    BufferHandle tileBins;     // modes x tiles (or chunks of the shading queue)
+    BufferHandle superfluous;  // modes x features (readback)
+    BufferHandle featureTiles; // features (readback)
     // Chunks: the classify phase's light lists (pool, per-chunk ranges, the pool's counter).
     BufferHandle chunkLists, chunkRanges, chunkListCount;
     uint32_t chunkListCapacity = 0;
