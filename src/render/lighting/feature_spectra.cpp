@@ -102,11 +102,12 @@ uint32_t modeMaterialFeatures(uint32_t mode) {
 
 // Whether a forward tile mode's permutation shades its list's lights that read no texture in a
 // loop of their own (spectra per light, SPECTRUM_LIGHT_SPLIT_CONSTANT_ID; the raster forward
-// pass always does): with --spectra on, where the mode has such features at all. --spectra
-// single stays the one all-features loop it is measured as. Not in the shadel path: its chunk lists
-// are in shared memory, read at an index uniform over the workgroup, and there the split changed
-// nothing measurable (builtin:lights 1280x720, shadelShading on 318-362 ms against 332-354 without
-// it) while doubling the light loop each permutation compiles.
+// pass does where forwardSplitsTileLights): with --spectra on, where the mode has such features
+// at all. --spectra single stays the one all-features loop it is measured as. Not in the shadel
+// path: its chunk lists are in shared memory, read at an index uniform over the workgroup, and
+// there the split changed nothing measurable (builtin:lights 1280x720, shadelShading on
+// 318-362 ms against 332-354 without it) while doubling the light loop each permutation
+// compiles.
 uint32_t lightSplitOf(const Renderer& r, uint32_t mode) {
     return r.settings.spectra == Spectra::On && (mode & SPECTRUM_SAMPLING_LIGHTS) != 0u;
 }
