@@ -136,7 +136,6 @@ void initRenderer(Renderer& r, Gpu& gpu, const RenderSettings& requested, const 
                            MemoryKind::Readback});
     if (!r.draws || !r.shadowDraws || !r.drawCounts || !r.frameConstants || !r.pixels)
         throw DeviceError("out of GPU memory for the renderer's frame buffers");
-    createForwardPipelines(r, forwardSplitsTileLights(r, scene));
     createTonemapPipeline(r);
     initShaderMessages(gpu, r.messages);
     initFrameRecorder(gpu, r.recorder, settings.timing, std::max(1u, settings.recordingThreads));
@@ -149,6 +148,10 @@ void initRenderer(Renderer& r, Gpu& gpu, const RenderSettings& requested, const 
     r.spotShadows = createSpotShadows(r, scene);
     r.sunCascades = createSunCascades(r, scene);
     if (usesTileShading(r) || usesChunkSpectra(r)) r.spectra = createFeatureSpectra(r);
+    // After the decoupled and spectra states: whether forward pixels read tile lists depends on
+    // them (forwardSplitsTileLights).
+    r.forwardSplitsTileLights = forwardSplitsTileLights(r, scene);
+    createForwardPipelines(r);
     if (settings.gi == GiMode::Lpv) r.gi = createGi(r, scene);
     r.culling = createCulling(r, scene);
     r.decals = createDecals(r, scene); // after the decoupled state (its queue's capacity)

@@ -244,6 +244,9 @@ struct Renderer {
     // visibility prepass run their alpha test. Without them they are depth-only / have the test
     // compiled out, so the depth test runs before any fragment shading (early Z).
     bool alphaMasked = true;
+    // The raster forward pass shades a tile's lights that read no texture in a loop of their own
+    // (forwardSplitsTileLights, render/lighting/light_culling.h): chosen once, for its pipeline.
+    bool forwardSplitsTileLights = false;
     ShaderMessageChannel messages;
     FrameRecorder recorder;
     DecoupledStatePtr decoupled;

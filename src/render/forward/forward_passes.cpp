@@ -24,7 +24,7 @@ void drawList(Renderer& r, VkCommandBuffer cmd, BufferHandle draws, VkDeviceSize
 }
 } // namespace
 
-void createForwardPipelines(Renderer& r, bool splitTileLights) {
+void createForwardPipelines(Renderer& r) {
     Gpu& gpu = *r.gpu;
     r.instanceCull = createComputePipeline(gpu, "instanceCull", "forward_instance_cull.comp.spv");
     GraphicsPipelineDesc depth;
@@ -49,7 +49,8 @@ void createForwardPipelines(Renderer& r, bool splitTileLights) {
         opaque.specialization.push_back({DISTANCE_FIELD_LIGHTING_CONSTANT_ID, 1u});
     // A screen tile's lights that read no texture run in a loop without that code (spectra per
     // light, shaders/common/lighting.glsl); other lists leave that loop empty.
-    if (splitTileLights) opaque.specialization.push_back({SPECTRUM_LIGHT_SPLIT_CONSTANT_ID, 1u});
+    if (r.forwardSplitsTileLights)
+        opaque.specialization.push_back({SPECTRUM_LIGHT_SPLIT_CONSTANT_ID, 1u});
     r.forwardOpaque = createGraphicsPipeline(gpu, opaque);
 }
 

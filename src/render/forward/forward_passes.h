@@ -15,8 +15,7 @@ struct RasterPush { // push constants of every raster pass (shaders/forward/forw
 struct Renderer;
 struct GpuScene;
 
-// splitTileLights: forwardSplitsTileLights (render/lighting/light_culling.h).
-void createForwardPipelines(Renderer& r, bool splitTileLights);
+void createForwardPipelines(Renderer& r);
 void destroyForwardPipelines(Renderer& r);
 
 // Culls every instance on the GPU, in one dispatch, against the camera frustum, the sun's

@@ -51,9 +51,13 @@ static bool subgroupListsFit(const Renderer& r, uint32_t lightCount, bool blocke
 }
 
 bool forwardSplitsTileLights(const Renderer& r, const GpuScene& scene) {
+    bool blockersOn = r.settings.lightBlockers && scene.blockerCount > 0; // as prepareLightCulling
     if (r.settings.lightCulling != LightCulling::Tiled ||
-        scene.lightInfo.size() <= LIGHT_SUBGROUP_MAX_LIGHTS)
+        subgroupListsFit(r, uint32_t(scene.lightInfo.size()), blockersOn))
         return false;
+    // Decoupled frames with the grid have no screen tiles: forward (hybrid) pixels take the
+    // grid's candidates (screenTilesThisFrame).
+    if (r.decoupled && r.settings.lightGrid) return false;
     for (const gpu::GpuLight& light : scene.lightInfo) // as lightSamplesTextures (spectra.glsl)
         if (light.type == LIGHT_AREA || (light.flags & LIGHT_FLAG_PROJECTED) != 0 ||
             (light.shadowIndex != LIGHT_NO_SHADOW && r.settings.spotShadows))
@@ -241,8 +245,7 @@ void lightCullingStats(const Renderer& r, const GpuScene& scene, nlohmann::json&
     // Spectra per light: of those pairs, the lights that read no texture (each tile lists them
     // first), and whether the raster forward pass shades them in a loop without that code.
     stats["light_tile_plain_pairs"] = s.tiledThisFrame ? s.last.lightTilePlainPairs : 0u;
-    stats["light_tile_split"] =
-        r.settings.mode == RenderMode::Forward && forwardSplitsTileLights(r, scene);
+    stats["light_tile_split"] = r.forwardSplitsTileLights;
     stats["light_tiles"] = s.tilesX * s.tilesY;
     stats["light_screen_tiles"] = s.screenTilesThisFrame; // false: decoupled, chunks + grid
     stats["per_pixel_blocker_tiles"] = s.last.perPixelBlockerTiles;

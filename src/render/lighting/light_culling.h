@@ -40,11 +40,11 @@ uint64_t prepareLightCulling(Renderer& r, const GpuScene& scene,
 // directional lights). The CPU's side of lightSphere (shaders/lighting/light_cull.glsl).
 float lightReach(const gpu::GpuLight& light);
 // Whether the raster forward pass should shade a screen tile's lights that read no texture in a
-// loop of their own (spectra per light, SPECTRUM_LIGHT_SPLIT_CONSTANT_ID): the scene has more
-// lights than per-subgroup lists take, so its forward pixels read tile lists, and some read a
-// texture. Chosen once, for the pipeline: the second loop costs the scenes that never fill it
-// (builtin:default forward shading 130 -> 139 ms), and a scene edit that changes either only
-// costs speed, never the image.
+// loop of their own (spectra per light, SPECTRUM_LIGHT_SPLIT_CONSTANT_ID): its pixels read tile
+// lists (not per-subgroup lists: too many lights, or blockers in a forward frame), and some
+// light reads a texture. Chosen once, for the pipeline (Renderer::forwardSplitsTileLights): the
+// second loop costs the scenes that never fill it (builtin:default forward shading 130 -> 139 ms),
+// and a scene edit that changes either only costs speed, never the image.
 bool forwardSplitsTileLights(const Renderer& r, const GpuScene& scene);
 // Whether this frame culls lights (and so records the culling pass): tile lists
 // (--light-culling tiled and enough lights in view, or blockers to classify) or, with few
