@@ -24,6 +24,7 @@
 #include "render/screenspace/screen_space.h"
 #include "render/shadel/decoupled.h"
 #include "render/view_density.h"
+#include "rhi/pipeline.h"
 #include "scene/load.h"
 
 namespace shadel {
@@ -462,6 +463,7 @@ RenderRun runRender(Gpu& gpu, const RenderOptions& o) {
     settings.recordingThreads = o.threads ? o.threads : defaultRecordingThreads();
     Renderer renderer;
     RenderRun run;
+    const PipelineLibraryCounters pipelinesBefore = pipelineLibraryCounters(gpu);
     try {
         initRenderer(renderer, gpu, settings, gpuScene);
         if (o.distanceFields)
@@ -621,6 +623,12 @@ RenderRun runRender(Gpu& gpu, const RenderOptions& o) {
     s["reconstruction_misses"] = 0;
     s["shader_asserts"] = asserts;
     s["validation_errors"] = gpu.device.validationErrors.load();
+    // This run's pipelines: compiled, or found already built on the device by an earlier run.
+    const PipelineLibraryCounters pipelines = pipelineLibraryCounters(gpu);
+    s["pipelines"] = {
+        {"created", pipelines.created - pipelinesBefore.created},
+        {"shared", pipelines.shared - pipelinesBefore.shared},
+        {"create_ms", (pipelines.createSeconds - pipelinesBefore.createSeconds) * 1000.0}};
     s["instances"] = gpuScene.instanceCount;
     s["triangles"] = scene.triangleCount();
     s["lights"] = scene.lights.size();

@@ -1,5 +1,6 @@
 #include "rhi/gpu.h"
 
+#include "rhi/pipeline.h"
 #include "rhi/shader_reload.h"
 
 #include <algorithm>
@@ -21,12 +22,14 @@ void createGpu(Gpu& gpu, const DeviceDesc& desc) {
     VK_CHECK(vkCreateCommandPool(gpu.device.device, &ci, nullptr, &gpu.transientPool));
     setName(gpu.device, gpu.transientPool, VK_OBJECT_TYPE_COMMAND_POOL, "transientPool");
     initBindless(gpu);
+    initPipelineLibrary(gpu);
 }
 
 void destroyGpu(Gpu& gpu) {
     if (!gpu.device.device) return;
     vkDeviceWaitIdle(gpu.device.device);
     disableShaderHotReload(gpu);
+    destroyPipelineLibrary(gpu);
     destroyBindless(gpu);
     for (uint32_t i = 0; i < gpu.readViews.items.size(); ++i)
         if (gpu.readViews.contains(i)) destroy(gpu, TextureReadView{i});

@@ -55,6 +55,8 @@ struct Gpu {
     uint64_t frameIndex = 0;
     uint64_t failedAllocations = 0;
     std::shared_ptr<struct ShaderHotReload> hotReload; // rhi/shader_reload.h, when enabled
+    // Every pipeline built on this device, shared by the renderers created on it (rhi/pipeline.h).
+    std::shared_ptr<struct PipelineLibrary> pipelineLibrary;
 };
 
 void createGpu(Gpu& gpu, const DeviceDesc& desc);

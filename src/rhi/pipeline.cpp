@@ -1,8 +1,15 @@
 #include "rhi/pipeline.h"
 
+#include <chrono>
 #include <cstdlib>
+#include <cstring>
 #include <fstream>
+#include <mutex>
+#include <string_view>
+#include <unordered_map>
+#include <unordered_set>
 
+#include "core/assert.h"
 #include "core/log.h"
 #include "rhi/gpu.h"
 #include "rhi/shader_reload.h"
@@ -31,9 +38,14 @@ std::vector<uint32_t> loadSpirv(const std::string& fileName) {
     return code;
 }
 
-static VkShaderModule createModule(Gpu& gpu, const std::string& file) {
-    const std::vector<uint32_t>* reloaded = reloadedSpirv(gpu, file); // hot reload's newest
-    std::vector<uint32_t> code = reloaded ? *reloaded : loadSpirv(file);
+// The SPIR-V a stage is built from: hot reload's newest, else the compiled file.
+static std::vector<uint32_t> stageSpirv(const Gpu& gpu, const std::string& file) {
+    const std::vector<uint32_t>* reloaded = reloadedSpirv(gpu, file);
+    return reloaded ? *reloaded : loadSpirv(file);
+}
+
+static VkShaderModule createModule(Gpu& gpu, const std::string& file,
+                                   const std::vector<uint32_t>& code) {
     VkShaderModuleCreateInfo ci{VK_STRUCTURE_TYPE_SHADER_MODULE_CREATE_INFO};
     ci.codeSize = code.size() * 4;
     ci.pCode = code.data();
@@ -41,6 +53,127 @@ static VkShaderModule createModule(Gpu& gpu, const std::string& file) {
     VK_CHECK(vkCreateShaderModule(gpu.device.device, &ci, nullptr, &module));
     setName(gpu.device, module, VK_OBJECT_TYPE_SHADER_MODULE, file);
     return module;
+}
+
+struct PipelineLibrary {
+    std::mutex mutex;
+    std::unordered_map<std::string, VkPipeline> byKey;
+    std::unordered_set<VkPipeline> owned;
+    PipelineLibraryCounters counters;
+};
+
+// A pipeline's identity as bytes: every input vkCreate*Pipelines sees.
+struct KeyWriter {
+    std::string bytes;
+    template <typename T>
+    void pod(const T& v) {
+        static_assert(std::is_trivially_copyable_v<T>);
+        bytes.append(reinterpret_cast<const char*>(&v), sizeof(T));
+    }
+    void text(const std::string& t) {
+        pod(t.size());
+        bytes += t;
+    }
+    void spirv(const std::vector<uint32_t>& code) {
+        pod(code.size());
+        pod(std::hash<std::string_view>{}(std::string_view(
+            reinterpret_cast<const char*>(code.data()), code.size() * sizeof(uint32_t))));
+    }
+    void specialization(const std::vector<std::pair<uint32_t, uint32_t>>& constants) {
+        pod(constants.size());
+        for (auto& [id, value] : constants) pod(id), pod(value);
+    }
+};
+
+#if defined(__GLIBCXX__) && defined(__x86_64__)
+// A field added to GraphicsPipelineDesc must be added to graphicsKey too (then update the size).
+static_assert(sizeof(GraphicsPipelineDesc) == 232, "GraphicsPipelineDesc changed: see graphicsKey");
+#endif
+
+static std::string graphicsKey(const GraphicsPipelineDesc& d, const std::vector<uint32_t>& vs,
+                               const std::vector<uint32_t>* fs) {
+    KeyWriter k;
+    k.text("graphics");
+    k.text(d.name);
+    k.text(d.vertexShader);
+    k.spirv(vs);
+    k.text(d.fragmentShader);
+    if (fs) k.spirv(*fs);
+    k.pod(d.colorFormats.size());
+    for (VkFormat f : d.colorFormats) k.pod(f);
+    k.pod(d.depthFormat);
+    k.pod(d.depthTest), k.pod(d.depthWrite), k.pod(d.depthCompare), k.pod(d.cullMode);
+    k.pod(d.topology), k.pod(d.depthClamp), k.pod(d.depthBias), k.pod(d.blend);
+    k.pod(d.attachmentBlends.size());
+    for (const VkPipelineColorBlendAttachmentState& b : d.attachmentBlends) k.pod(b);
+    k.specialization(d.specialization);
+    k.pod(d.stencilTest);
+    k.pod(d.stencil);
+    return std::move(k.bytes);
+}
+
+static std::string computeKey(const std::string& name, const std::string& shader,
+                              const std::vector<uint32_t>& cs,
+                              const std::vector<std::pair<uint32_t, uint32_t>>& specialization) {
+    KeyWriter k;
+    k.text("compute");
+    k.text(name);
+    k.text(shader);
+    k.spirv(cs);
+    k.specialization(specialization);
+    return std::move(k.bytes);
+}
+
+// The library's pipeline for `key`, or null (then build it and call keepPipeline). Null while
+// hot reload is on: its pipelines are built per owner.
+static VkPipeline sharedPipeline(Gpu& gpu, const std::string& key) {
+    if (gpu.hotReload) return VK_NULL_HANDLE;
+    SHADEL_ASSERT(gpu.pipelineLibrary, "createGpu makes the pipeline library");
+    PipelineLibrary& l = *gpu.pipelineLibrary;
+    std::lock_guard lock(l.mutex);
+    auto it = l.byKey.find(key);
+    if (it == l.byKey.end()) return VK_NULL_HANDLE;
+    ++l.counters.shared;
+    return it->second;
+}
+
+// Counts a pipeline built in `seconds` and, outside hot reload, keeps it for later requests.
+// Two threads that built the same pipeline at once keep the first; the second is destroyed.
+static VkPipeline keepPipeline(Gpu& gpu, const std::string& key, VkPipeline built, double seconds) {
+    SHADEL_ASSERT(gpu.pipelineLibrary, "createGpu makes the pipeline library");
+    PipelineLibrary& l = *gpu.pipelineLibrary;
+    std::lock_guard lock(l.mutex);
+    ++l.counters.created;
+    l.counters.createSeconds += seconds;
+    if (gpu.hotReload) return built;
+    auto [it, inserted] = l.byKey.emplace(key, built);
+    if (!inserted) {
+        vkDestroyPipeline(gpu.device.device, built, nullptr);
+        return it->second;
+    }
+    l.owned.insert(built);
+    return built;
+}
+
+void initPipelineLibrary(Gpu& gpu) {
+    gpu.pipelineLibrary = std::make_shared<PipelineLibrary>();
+}
+
+PipelineLibraryCounters pipelineLibraryCounters(const Gpu& gpu) {
+    if (!gpu.pipelineLibrary) return {};
+    std::lock_guard lock(gpu.pipelineLibrary->mutex);
+    return gpu.pipelineLibrary->counters;
+}
+
+void destroyPipelineLibrary(Gpu& gpu) {
+    if (!gpu.pipelineLibrary) return;
+    for (VkPipeline p : gpu.pipelineLibrary->owned)
+        vkDestroyPipeline(gpu.device.device, p, nullptr);
+    gpu.pipelineLibrary.reset();
+}
+
+static double secondsSince(std::chrono::steady_clock::time_point start) {
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
 
 struct Specialization {
@@ -61,10 +194,19 @@ struct Specialization {
 };
 
 Pipeline createGraphicsPipeline(Gpu& gpu, const GraphicsPipelineDesc& desc) {
+    Pipeline out;
+    out.name = desc.name;
+    out.bindPoint = VK_PIPELINE_BIND_POINT_GRAPHICS;
+    std::vector<uint32_t> vsCode = stageSpirv(gpu, desc.vertexShader), fsCode;
+    if (!desc.fragmentShader.empty()) fsCode = stageSpirv(gpu, desc.fragmentShader);
+    std::string key = graphicsKey(desc, vsCode, desc.fragmentShader.empty() ? nullptr : &fsCode);
+    if ((out.pipeline = sharedPipeline(gpu, key))) return out;
+
     Specialization spec(desc.specialization);
-    VkShaderModule vs = createModule(gpu, desc.vertexShader);
-    VkShaderModule fs =
-        desc.fragmentShader.empty() ? VK_NULL_HANDLE : createModule(gpu, desc.fragmentShader);
+    VkShaderModule vs = createModule(gpu, desc.vertexShader, vsCode);
+    VkShaderModule fs = desc.fragmentShader.empty()
+                            ? VK_NULL_HANDLE
+                            : createModule(gpu, desc.fragmentShader, fsCode);
     VkPipelineShaderStageCreateInfo stages[2]{};
     stages[0] = {VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO};
     stages[0].stage = VK_SHADER_STAGE_VERTEX_BIT;
@@ -158,22 +300,30 @@ Pipeline createGraphicsPipeline(Gpu& gpu, const GraphicsPipelineDesc& desc) {
     ci.pColorBlendState = &blend;
     ci.pDynamicState = &dynamic;
     ci.layout = gpu.bindless.pipelineLayout;
-    Pipeline out;
-    out.name = desc.name;
-    out.bindPoint = VK_PIPELINE_BIND_POINT_GRAPHICS;
-    VK_CHECK(vkCreateGraphicsPipelines(gpu.device.device, VK_NULL_HANDLE, 1, &ci, nullptr,
-                                       &out.pipeline));
-    setName(gpu.device, out.pipeline, VK_OBJECT_TYPE_PIPELINE, desc.name);
+    auto start = std::chrono::steady_clock::now();
+    VkPipeline built = VK_NULL_HANDLE;
+    VkResult result =
+        vkCreateGraphicsPipelines(gpu.device.device, VK_NULL_HANDLE, 1, &ci, nullptr, &built);
     vkDestroyShaderModule(gpu.device.device, vs, nullptr);
     if (fs) vkDestroyShaderModule(gpu.device.device, fs, nullptr);
+    VK_CHECK(result);
+    setName(gpu.device, built, VK_OBJECT_TYPE_PIPELINE, desc.name);
+    out.pipeline = keepPipeline(gpu, key, built, secondsSince(start));
     recordPipeline(gpu, out, &desc, "", desc.specialization);
     return out;
 }
 
 Pipeline createComputePipeline(Gpu& gpu, const std::string& name, const std::string& shader,
                                const std::vector<std::pair<uint32_t, uint32_t>>& specialization) {
+    Pipeline out;
+    out.name = name;
+    out.bindPoint = VK_PIPELINE_BIND_POINT_COMPUTE;
+    std::vector<uint32_t> code = stageSpirv(gpu, shader);
+    std::string key = computeKey(name, shader, code, specialization);
+    if ((out.pipeline = sharedPipeline(gpu, key))) return out;
+
     Specialization spec(specialization);
-    VkShaderModule cs = createModule(gpu, shader);
+    VkShaderModule cs = createModule(gpu, shader, code);
     VkComputePipelineCreateInfo ci{VK_STRUCTURE_TYPE_COMPUTE_PIPELINE_CREATE_INFO};
     ci.stage = {VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO};
     ci.stage.stage = VK_SHADER_STAGE_COMPUTE_BIT;
@@ -181,18 +331,26 @@ Pipeline createComputePipeline(Gpu& gpu, const std::string& name, const std::str
     ci.stage.pName = "main";
     ci.stage.pSpecializationInfo = spec.get();
     ci.layout = gpu.bindless.pipelineLayout;
-    Pipeline out;
-    out.name = name;
-    out.bindPoint = VK_PIPELINE_BIND_POINT_COMPUTE;
-    VK_CHECK(vkCreateComputePipelines(gpu.device.device, VK_NULL_HANDLE, 1, &ci, nullptr,
-                                      &out.pipeline));
-    setName(gpu.device, out.pipeline, VK_OBJECT_TYPE_PIPELINE, name);
+    auto start = std::chrono::steady_clock::now();
+    VkPipeline built = VK_NULL_HANDLE;
+    VkResult result =
+        vkCreateComputePipelines(gpu.device.device, VK_NULL_HANDLE, 1, &ci, nullptr, &built);
     vkDestroyShaderModule(gpu.device.device, cs, nullptr);
+    VK_CHECK(result);
+    setName(gpu.device, built, VK_OBJECT_TYPE_PIPELINE, name);
+    out.pipeline = keepPipeline(gpu, key, built, secondsSince(start));
     recordPipeline(gpu, out, nullptr, shader, specialization);
     return out;
 }
 
 void destroy(Gpu& gpu, Pipeline& pipeline) {
+    if (gpu.pipelineLibrary) {
+        std::lock_guard lock(gpu.pipelineLibrary->mutex);
+        if (gpu.pipelineLibrary->owned.count(pipeline.pipeline)) {
+            pipeline.pipeline = VK_NULL_HANDLE; // the device's library keeps it (destroyGpu)
+            return;
+        }
+    }
     forgetPipeline(gpu, pipeline.pipeline); // and its hot-reload replacement
     if (pipeline.pipeline) vkDestroyPipeline(gpu.device.device, pipeline.pipeline, nullptr);
     pipeline.pipeline = VK_NULL_HANDLE;

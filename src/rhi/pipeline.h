@@ -11,6 +11,8 @@ namespace shadel {
 
 struct Gpu;
 
+// Every field is part of the pipeline's key in the device's library (graphicsKey in
+// pipeline.cpp, which a static_assert on this struct's size keeps in step).
 struct GraphicsPipelineDesc {
     std::string name;
     std::string vertexShader;   // file name of the .spv in the shader directory
@@ -40,6 +42,21 @@ struct Pipeline {
     VkPipelineBindPoint bindPoint = VK_PIPELINE_BIND_POINT_GRAPHICS;
     std::string name;
 };
+
+// Pipelines are kept per device and shared: asking again for a pipeline with the same name,
+// SPIR-V, specialization and state returns the one already built instead of compiling it again,
+// so renderers created one after another on one device (the bench's modes, scene reloads, a
+// test's runs) pay for each pipeline once. destroy() gives the caller's use back; the device
+// destroys them (destroyGpu). While shader hot reload is on, every pipeline is built and destroyed
+// on its own (the reload swaps pipelines one owner at a time).
+struct PipelineLibraryCounters {
+    uint64_t created = 0;       // pipelines compiled
+    uint64_t shared = 0;        // requests answered with one compiled before
+    double createSeconds = 0.0; // spent in vkCreate*Pipelines
+};
+void initPipelineLibrary(Gpu& gpu); // createGpu
+PipelineLibraryCounters pipelineLibraryCounters(const Gpu& gpu);
+void destroyPipelineLibrary(Gpu& gpu); // destroyGpu
 
 std::string shaderDirectory();
 std::vector<uint32_t> loadSpirv(const std::string& fileName);

@@ -3,6 +3,7 @@
 #include "gpu_test_env.h"
 
 #include <cstring>
+#include <unistd.h>
 
 #include "common/shared_types.h"
 #include "rhi/frame.h"
@@ -138,4 +139,74 @@ TEST(Memory, HeapsSubAllocateFromPoolsAndFailureIsAValue) {
     BufferHandle huge =
         createBuffer(gpu, {"test.huge", gpu.memory.poolSize * (gpu.memory.maxPoolsPerHeap + 1)});
     EXPECT_FALSE(huge.valid());
+}
+
+// The device's pipeline library (rhi/pipeline.h): the same request answers with the pipeline
+// already built; a different name, specialization or state builds another; destroy() gives the
+// caller's use back while the pipeline stays usable for the others.
+TEST(PipelineLibrary, TheSameRequestSharesOnePipelineAndAnyDifferenceBuildsAnother) {
+    Gpu& gpu = sharedGpu();
+    // A name no other test uses, so the first request below always compiles.
+    const std::string name = "test.library." + std::to_string(::getpid());
+    PipelineLibraryCounters before = pipelineLibraryCounters(gpu);
+    Pipeline a = createComputePipeline(gpu, name, "tests_probe.comp.spv");
+    PipelineLibraryCounters afterFirst = pipelineLibraryCounters(gpu);
+    EXPECT_EQ(afterFirst.created, before.created + 1);
+    EXPECT_GT(afterFirst.createSeconds, before.createSeconds);
+    Pipeline again = createComputePipeline(gpu, name, "tests_probe.comp.spv");
+    EXPECT_EQ(again.pipeline, a.pipeline);
+    EXPECT_EQ(pipelineLibraryCounters(gpu).shared, afterFirst.shared + 1);
+    EXPECT_EQ(pipelineLibraryCounters(gpu).created, afterFirst.created);
+
+    Pipeline specialized = createComputePipeline(gpu, name, "tests_probe.comp.spv", {{0, 1}});
+    Pipeline renamed = createComputePipeline(gpu, name + ".other", "tests_probe.comp.spv");
+    EXPECT_NE(specialized.pipeline, a.pipeline);
+    EXPECT_NE(renamed.pipeline, a.pipeline);
+    EXPECT_EQ(pipelineLibraryCounters(gpu).created, afterFirst.created + 2);
+
+    GraphicsPipelineDesc d;
+    d.name = name + ".depth";
+    d.vertexShader = "forward_forward.vert.spv";
+    d.depthFormat = VK_FORMAT_D32_SFLOAT;
+    Pipeline depth = createGraphicsPipeline(gpu, d);
+    d.depthCompare = VK_COMPARE_OP_EQUAL; // state is part of the key
+    Pipeline equal = createGraphicsPipeline(gpu, d);
+    EXPECT_NE(equal.pipeline, depth.pipeline);
+    d.depthCompare = VK_COMPARE_OP_GREATER_OR_EQUAL;
+    Pipeline depthAgain = createGraphicsPipeline(gpu, d);
+    EXPECT_EQ(depthAgain.pipeline, depth.pipeline);
+    EXPECT_EQ(pipelineLibraryCounters(gpu).created, afterFirst.created + 4);
+
+    destroy(gpu, again); // the caller's use only: `a` still runs (validation would flag it)
+    EXPECT_EQ(again.pipeline, VK_NULL_HANDLE);
+    EXPECT_EQ(createComputePipeline(gpu, name, "tests_probe.comp.spv").pipeline, a.pipeline);
+    uint32_t errors = validationErrors();
+    Probe probe;
+    destroy(gpu, probe.pipeline);
+    probe.pipeline = a;
+    TextureHandle red = solidTexture(gpu, 255, 0, 0);
+    TextureReadView view = createReadView(gpu, red);
+    EXPECT_NEAR(probe.read(slot(gpu, view).value).r, 1.0f, 1e-3);
+    EXPECT_EQ(validationErrors(), errors);
+    destroy(gpu, view);
+    destroy(gpu, red);
+    for (Pipeline* p : {&specialized, &renamed, &depth, &equal, &depthAgain}) destroy(gpu, *p);
+}
+
+// Renderers created one after another on one device (the bench's modes, a test's runs) compile
+// each pipeline once: the second run of the same options builds none and draws the same bytes.
+TEST(PipelineLibrary, ASecondRunOfTheSameOptionsCompilesNothing) {
+    RenderOptions o = renderOptions("builtin:default", RenderMode::Decoupled, 128, 72);
+    o.frames = 2;
+    RenderRun first = renderChecked(o);
+    RenderRun second = renderChecked(o);
+    const nlohmann::json &a = first.stats["pipelines"], &b = second.stats["pipelines"];
+    EXPECT_GT(a["created"].get<uint64_t>() + a["shared"].get<uint64_t>(), 10u);
+    EXPECT_EQ(b["created"].get<uint64_t>(), 0u);
+    EXPECT_EQ(b["shared"].get<uint64_t>(),
+              a["created"].get<uint64_t>() + a["shared"].get<uint64_t>());
+    EXPECT_EQ(b["create_ms"].get<double>(), 0.0);
+    ASSERT_EQ(first.frames.size(), second.frames.size());
+    for (size_t f = 0; f < first.frames.size(); ++f)
+        EXPECT_EQ(first.frames[f].rgba, second.frames[f].rgba) << "frame " << f;
 }
