@@ -4,8 +4,10 @@
 #include <cstdlib>
 #include <cstring>
 #include <fstream>
+#include <future>
 #include <mutex>
 #include <string_view>
+#include <thread>
 #include <unordered_map>
 #include <unordered_set>
 
@@ -315,15 +317,19 @@ Pipeline createGraphicsPipeline(Gpu& gpu, const GraphicsPipelineDesc& desc) {
 
 Pipeline createComputePipeline(Gpu& gpu, const std::string& name, const std::string& shader,
                                const std::vector<std::pair<uint32_t, uint32_t>>& specialization) {
-    Pipeline out;
-    out.name = name;
-    out.bindPoint = VK_PIPELINE_BIND_POINT_COMPUTE;
-    std::vector<uint32_t> code = stageSpirv(gpu, shader);
-    std::string key = computeKey(name, shader, code, specialization);
-    if ((out.pipeline = sharedPipeline(gpu, key))) return out;
+    return createComputePipelines(gpu, {{name, shader, specialization}}).front();
+}
 
-    Specialization spec(specialization);
-    VkShaderModule cs = createModule(gpu, shader, code);
+// One compute pipeline compiled (no library or hot-reload bookkeeping: the caller's thread does
+// that). Thread-safe: vkCreateComputePipelines without a cache synchronizes nothing external.
+struct BuiltPipeline {
+    VkPipeline pipeline = VK_NULL_HANDLE;
+    VkResult result = VK_SUCCESS;
+    double seconds = 0.0;
+};
+static BuiltPipeline buildComputePipeline(const Gpu& gpu, const ComputePipelineDesc& desc,
+                                          VkShaderModule cs) {
+    Specialization spec(desc.specialization);
     VkComputePipelineCreateInfo ci{VK_STRUCTURE_TYPE_COMPUTE_PIPELINE_CREATE_INFO};
     ci.stage = {VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO};
     ci.stage.stage = VK_SHADER_STAGE_COMPUTE_BIT;
@@ -332,14 +338,57 @@ Pipeline createComputePipeline(Gpu& gpu, const std::string& name, const std::str
     ci.stage.pSpecializationInfo = spec.get();
     ci.layout = gpu.bindless.pipelineLayout;
     auto start = std::chrono::steady_clock::now();
-    VkPipeline built = VK_NULL_HANDLE;
-    VkResult result =
-        vkCreateComputePipelines(gpu.device.device, VK_NULL_HANDLE, 1, &ci, nullptr, &built);
-    vkDestroyShaderModule(gpu.device.device, cs, nullptr);
-    VK_CHECK(result);
-    setName(gpu.device, built, VK_OBJECT_TYPE_PIPELINE, name);
-    out.pipeline = keepPipeline(gpu, key, built, secondsSince(start));
-    recordPipeline(gpu, out, nullptr, shader, specialization);
+    BuiltPipeline b;
+    b.result =
+        vkCreateComputePipelines(gpu.device.device, VK_NULL_HANDLE, 1, &ci, nullptr, &b.pipeline);
+    b.seconds = secondsSince(start);
+    return b;
+}
+
+std::vector<Pipeline> createComputePipelines(Gpu& gpu,
+                                             const std::vector<ComputePipelineDesc>& descs) {
+    std::vector<Pipeline> out(descs.size());
+    std::vector<std::string> keys(descs.size());
+    std::vector<size_t> missing; // not in the library: to compile
+    std::vector<VkShaderModule> modules(descs.size(), VK_NULL_HANDLE);
+    for (size_t i = 0; i < descs.size(); ++i) {
+        out[i].name = descs[i].name;
+        out[i].bindPoint = VK_PIPELINE_BIND_POINT_COMPUTE;
+        std::vector<uint32_t> code = stageSpirv(gpu, descs[i].shader);
+        keys[i] = computeKey(descs[i].name, descs[i].shader, code, descs[i].specialization);
+        if ((out[i].pipeline = sharedPipeline(gpu, keys[i]))) continue;
+        missing.push_back(i);
+        modules[i] = createModule(gpu, descs[i].shader, code);
+    }
+    // The driver compiles a pipeline on the calling thread: the missing ones go to as many
+    // threads as the machine has (the first on this one), a batch costing about its largest.
+    std::vector<BuiltPipeline> built(descs.size());
+    size_t threads = std::max<size_t>(1, std::thread::hardware_concurrency());
+    for (size_t first = 0; first < missing.size(); first += threads) {
+        size_t last = std::min(missing.size(), first + threads);
+        std::vector<std::future<BuiltPipeline>> others;
+        for (size_t m = first + 1; m < last; ++m)
+            others.push_back(std::async(std::launch::async, buildComputePipeline, std::cref(gpu),
+                                        std::cref(descs[missing[m]]), modules[missing[m]]));
+        built[missing[first]] =
+            buildComputePipeline(gpu, descs[missing[first]], modules[missing[first]]);
+        for (size_t m = first + 1; m < last; ++m) built[missing[m]] = others[m - first - 1].get();
+    }
+    for (size_t i : missing) vkDestroyShaderModule(gpu.device.device, modules[i], nullptr);
+    VkResult failed = VK_SUCCESS;
+    for (size_t i : missing) {
+        if (built[i].result != VK_SUCCESS) {
+            failed = built[i].result;
+            continue;
+        }
+        setName(gpu.device, built[i].pipeline, VK_OBJECT_TYPE_PIPELINE, descs[i].name);
+        out[i].pipeline = keepPipeline(gpu, keys[i], built[i].pipeline, built[i].seconds);
+        recordPipeline(gpu, out[i], nullptr, descs[i].shader, descs[i].specialization);
+    }
+    if (failed != VK_SUCCESS) {
+        for (Pipeline& p : out) destroy(gpu, p);
+        VK_CHECK(failed);
+    }
     return out;
 }
 

@@ -52,7 +52,7 @@ struct Pipeline {
 struct PipelineLibraryCounters {
     uint64_t created = 0;       // pipelines compiled
     uint64_t shared = 0;        // requests answered with one compiled before
-    double createSeconds = 0.0; // spent in vkCreate*Pipelines
+    double createSeconds = 0.0; // spent in vkCreate*Pipelines (summed over threads)
 };
 void initPipelineLibrary(Gpu& gpu); // createGpu
 PipelineLibraryCounters pipelineLibraryCounters(const Gpu& gpu);
@@ -64,6 +64,15 @@ Pipeline createGraphicsPipeline(Gpu& gpu, const GraphicsPipelineDesc& desc);
 Pipeline
 createComputePipeline(Gpu& gpu, const std::string& name, const std::string& shader,
                       const std::vector<std::pair<uint32_t, uint32_t>>& specialization = {});
+struct ComputePipelineDesc {
+    std::string name;
+    std::string shader; // file name of the .spv in the shader directory
+    std::vector<std::pair<uint32_t, uint32_t>> specialization;
+};
+// Several at once: those not yet in the device's library are compiled in parallel (drivers
+// compile on the calling thread; lavapipe takes up to a second for a large shader).
+std::vector<Pipeline> createComputePipelines(Gpu& gpu,
+                                             const std::vector<ComputePipelineDesc>& descs);
 void destroy(Gpu& gpu, Pipeline& pipeline);
 
 // Binds the pipeline and the current bindless set.

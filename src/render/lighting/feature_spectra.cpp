@@ -203,30 +203,36 @@ SpectraStatePtr createFeatureSpectra(Renderer& r) {
         std::vector<std::pair<uint32_t, uint32_t>> base;
         if (r.settings.distanceFieldLighting)
             base.push_back({DISTANCE_FIELD_LIGHTING_CONSTANT_ID, 1u});
+        // Every permutation at once: compiled side by side (rhi/pipeline.h).
+        std::vector<ComputePipelineDesc> descs;
         auto constants = base;
         constants.push_back({CHUNK_SPECTRA_PHASE_CONSTANT_ID, 1u});
-        s->classify = createComputePipeline(gpu, "shadelChunkSpectra.classify",
-                                            "shadel_shade.comp.spv", constants);
-        s->setup = createComputePipeline(gpu, "shadelChunkSpectra.setup",
-                                         "lighting_chunk_spectra_setup.comp.spv");
+        descs.push_back({"shadelChunkSpectra.classify", "shadel_shade.comp.spv", constants});
+        descs.push_back({"shadelChunkSpectra.setup", "lighting_chunk_spectra_setup.comp.spv", {}});
         for (uint32_t m = 0; m < modes; ++m) {
             constants = base;
             constants.push_back({CHUNK_SPECTRA_PHASE_CONSTANT_ID, 2u});
             constants.push_back({SPECTRUM_FEATURES_CONSTANT_ID, s->modes[m]});
             constants.push_back({SPECTRUM_MODE_CONSTANT_ID, m});
             constants.push_back({MATERIAL_FEATURES_CONSTANT_ID, modeMaterialFeatures(s->modes[m])});
-            s->shading.push_back(createComputePipeline(
-                gpu, "shadelShading." + modeName(s->modes[m]), "shadel_shade.comp.spv", constants));
+            descs.push_back(
+                {"shadelShading." + modeName(s->modes[m]), "shadel_shade.comp.spv", constants});
         }
+        std::vector<Pipeline> built = createComputePipelines(gpu, descs);
+        s->classify = built[0];
+        s->setup = built[1];
+        s->shading.assign(built.begin() + 2, built.end());
         return s;
     }
+    std::vector<ComputePipelineDesc> descs;
     for (uint32_t m = 0; m < modes; ++m)
-        s->shading.push_back(createComputePipeline(
-            gpu, "tileShading." + modeName(s->modes[m]), "lighting_tile_shade.comp.spv",
-            {{SPECTRUM_FEATURES_CONSTANT_ID, s->modes[m]},
-             {SPECTRUM_MODE_CONSTANT_ID, m},
-             {MATERIAL_FEATURES_CONSTANT_ID, modeMaterialFeatures(s->modes[m])},
-             {SPECTRUM_LIGHT_SPLIT_CONSTANT_ID, lightSplitOf(r, s->modes[m])}}));
+        descs.push_back({"tileShading." + modeName(s->modes[m]),
+                         "lighting_tile_shade.comp.spv",
+                         {{SPECTRUM_FEATURES_CONSTANT_ID, s->modes[m]},
+                          {SPECTRUM_MODE_CONSTANT_ID, m},
+                          {MATERIAL_FEATURES_CONSTANT_ID, modeMaterialFeatures(s->modes[m])},
+                          {SPECTRUM_LIGHT_SPLIT_CONSTANT_ID, lightSplitOf(r, s->modes[m])}}});
+    s->shading = createComputePipelines(gpu, descs);
     return s;
 }
 

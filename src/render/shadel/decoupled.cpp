@@ -347,12 +347,16 @@ DecoupledStatePtr createDecoupled(Renderer& r, const GpuScene& scene) {
     // every material feature compiled out, featured ones, supersampled procedurals.
     const char* const classNames[SHADE_CLASSES] = {"shadelShadePlain", "shadelShadeFeatured",
                                                    "shadelShadeSupersampled"};
+    std::vector<ComputePipelineDesc> classes;
     for (uint32_t c = 0; c < SHADE_CLASSES; ++c) {
         auto constants = shadeConstants;
         constants.push_back({SHADE_QUEUE_CONSTANT_ID, SHADE_QUEUE_PLAIN + c});
         if (c == SHADE_QUEUE_PLAIN - 1) constants.push_back({MATERIAL_FEATURES_CONSTANT_ID, 0u});
-        d.shade[c] = createComputePipeline(gpu, classNames[c], "shadel_shade.comp.spv", constants);
+        classes.push_back({classNames[c], "shadel_shade.comp.spv", constants});
     }
+    // Compiled side by side: the three are the renderer's largest pipelines.
+    std::vector<Pipeline> shade = createComputePipelines(gpu, classes);
+    for (uint32_t c = 0; c < SHADE_CLASSES; ++c) d.shade[c] = shade[c];
     d.sheetView = createComputePipeline(gpu, "shadelSheetView", "shadel_sheet_view.comp.spv");
     GraphicsPipelineDesc mark;
     mark.name = "shadelMark";

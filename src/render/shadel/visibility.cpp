@@ -98,19 +98,26 @@ VisibilityStatePtr createVisibility(Renderer& r) {
     prepass.depthFormat = VK_FORMAT_D32_SFLOAT;
     prepass.cullMode = VK_CULL_MODE_NONE; // as the depth prepass
     v.prepass = createGraphicsPipeline(gpu, prepass);
-    v.mark = createComputePipeline(gpu, "shadelMarkVisibility", "shadel_mark_visibility.comp.spv");
     std::vector<std::pair<uint32_t, uint32_t>> inlineRebuild =
         shaderPrintSpecialization(r.settings.inspectX >= 0);
     inlineRebuild.push_back({RESOLVE_REBUILD_INLINE_CONSTANT_ID, 1u});
-    v.resolveInline = createComputePipeline(gpu, "shadelResolveInlineRebuild",
-                                            "shadel_resolve.comp.spv", inlineRebuild);
+    std::vector<ComputePipelineDesc> descs = {
+        {"shadelMarkVisibility", "shadel_mark_visibility.comp.spv", {}},
+        {"shadelResolveInlineRebuild", "shadel_resolve.comp.spv", inlineRebuild}};
     if (v.rebuildList) {
-        v.resolve = createComputePipeline(gpu, "shadelResolve", "shadel_resolve.comp.spv",
-                                          {{RESOLVE_REBUILD_INLINE_CONSTANT_ID, 0u}});
-        v.resolveRebuild =
-            createComputePipeline(gpu, "shadelResolveRebuild", "shadel_resolve_rebuild.comp.spv");
-        v.resolveRebuildArgs = createComputePipeline(gpu, "shadelResolveRebuildArgs",
-                                                     "shadel_resolve_rebuild_args.comp.spv");
+        descs.push_back({"shadelResolve",
+                         "shadel_resolve.comp.spv",
+                         {{RESOLVE_REBUILD_INLINE_CONSTANT_ID, 0u}}});
+        descs.push_back({"shadelResolveRebuild", "shadel_resolve_rebuild.comp.spv", {}});
+        descs.push_back({"shadelResolveRebuildArgs", "shadel_resolve_rebuild_args.comp.spv", {}});
+    }
+    std::vector<Pipeline> built = createComputePipelines(gpu, descs); // side by side
+    v.mark = built[0];
+    v.resolveInline = built[1];
+    if (v.rebuildList) {
+        v.resolve = built[2];
+        v.resolveRebuild = built[3];
+        v.resolveRebuildArgs = built[4];
     }
     registerTextureCapture(
         r.captures, gpu, "visibility", "visibility buffer: instance, triangle (PNG)",
