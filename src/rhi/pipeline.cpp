@@ -1,5 +1,6 @@
 #include "rhi/pipeline.h"
 
+#include <atomic>
 #include <chrono>
 #include <cstdlib>
 #include <cstring>
@@ -351,29 +352,37 @@ std::vector<Pipeline> createComputePipelines(Gpu& gpu,
     std::vector<std::string> keys(descs.size());
     std::vector<size_t> missing; // not in the library: to compile
     std::vector<VkShaderModule> modules(descs.size(), VK_NULL_HANDLE);
-    for (size_t i = 0; i < descs.size(); ++i) {
-        out[i].name = descs[i].name;
-        out[i].bindPoint = VK_PIPELINE_BIND_POINT_COMPUTE;
-        std::vector<uint32_t> code = stageSpirv(gpu, descs[i].shader);
-        keys[i] = computeKey(descs[i].name, descs[i].shader, code, descs[i].specialization);
-        if ((out[i].pipeline = sharedPipeline(gpu, keys[i]))) continue;
-        missing.push_back(i);
-        modules[i] = createModule(gpu, descs[i].shader, code);
+    try {
+        for (size_t i = 0; i < descs.size(); ++i) {
+            out[i].name = descs[i].name;
+            out[i].bindPoint = VK_PIPELINE_BIND_POINT_COMPUTE;
+            std::vector<uint32_t> code = stageSpirv(gpu, descs[i].shader);
+            keys[i] = computeKey(descs[i].name, descs[i].shader, code, descs[i].specialization);
+            if ((out[i].pipeline = sharedPipeline(gpu, keys[i]))) continue;
+            missing.push_back(i);
+            modules[i] = createModule(gpu, descs[i].shader, code);
+        }
+    } catch (...) { // a missing or malformed .spv: no module outlives the error
+        for (VkShaderModule m : modules)
+            if (m) vkDestroyShaderModule(gpu.device.device, m, nullptr);
+        throw;
     }
-    // The driver compiles a pipeline on the calling thread: the missing ones go to as many
-    // threads as the machine has (the first on this one), a batch costing about its largest.
+    // The driver compiles a pipeline on the calling thread: the missing ones are taken in turn
+    // by as many threads as the machine has (this one included), so a batch costs about its
+    // largest pipeline or its share of the machine, whichever is more.
     std::vector<BuiltPipeline> built(descs.size());
-    size_t threads = std::max<size_t>(1, std::thread::hardware_concurrency());
-    for (size_t first = 0; first < missing.size(); first += threads) {
-        size_t last = std::min(missing.size(), first + threads);
-        std::vector<std::future<BuiltPipeline>> others;
-        for (size_t m = first + 1; m < last; ++m)
-            others.push_back(std::async(std::launch::async, buildComputePipeline, std::cref(gpu),
-                                        std::cref(descs[missing[m]]), modules[missing[m]]));
-        built[missing[first]] =
-            buildComputePipeline(gpu, descs[missing[first]], modules[missing[first]]);
-        for (size_t m = first + 1; m < last; ++m) built[missing[m]] = others[m - first - 1].get();
-    }
+    std::atomic<size_t> next{0};
+    auto work = [&] {
+        for (size_t m; (m = next.fetch_add(1)) < missing.size();)
+            built[missing[m]] = buildComputePipeline(gpu, descs[missing[m]], modules[missing[m]]);
+    };
+    size_t threads =
+        std::min<size_t>(missing.size(), std::max(1u, std::thread::hardware_concurrency()));
+    size_t helpers = threads > 1 ? threads - 1 : 0;
+    std::vector<std::future<void>> others;
+    for (size_t t = 0; t < helpers; ++t) others.push_back(std::async(std::launch::async, work));
+    work();
+    for (std::future<void>& f : others) f.get();
     for (size_t i : missing) vkDestroyShaderModule(gpu.device.device, modules[i], nullptr);
     VkResult failed = VK_SUCCESS;
     for (size_t i : missing) {

@@ -210,3 +210,38 @@ TEST(PipelineLibrary, ASecondRunOfTheSameOptionsCompilesNothing) {
     for (size_t f = 0; f < first.frames.size(); ++f)
         EXPECT_EQ(first.frames[f].rgba, second.frames[f].rgba) << "frame " << f;
 }
+
+// A batch compiles what the library lacks side by side and answers the rest from it; the same
+// request twice in one batch is one pipeline.
+TEST(PipelineLibrary, ABatchCompilesOnlyWhatTheLibraryLacks) {
+    Gpu& gpu = sharedGpu();
+    const std::string name = "test.batch." + std::to_string(::getpid());
+    uint32_t errors = validationErrors();
+    Pipeline known = createComputePipeline(gpu, name + ".known", "tests_probe.comp.spv");
+    PipelineLibraryCounters before = pipelineLibraryCounters(gpu);
+    std::vector<Pipeline> batch =
+        createComputePipelines(gpu, {{name + ".known", "tests_probe.comp.spv", {}},
+                                     {name + ".a", "tests_probe.comp.spv", {}},
+                                     {name + ".b", "tests_probe.comp.spv", {{0, 7}}},
+                                     {name + ".a", "tests_probe.comp.spv", {}}});
+    ASSERT_EQ(batch.size(), 4u);
+    EXPECT_EQ(batch[0].pipeline, known.pipeline);
+    EXPECT_EQ(batch[3].pipeline, batch[1].pipeline);
+    EXPECT_NE(batch[1].pipeline, batch[2].pipeline);
+    for (const Pipeline& p : batch) {
+        EXPECT_NE(p.pipeline, VK_NULL_HANDLE);
+        EXPECT_EQ(p.bindPoint, VK_PIPELINE_BIND_POINT_COMPUTE);
+    }
+    EXPECT_EQ(batch[2].name, name + ".b");
+    PipelineLibraryCounters after = pipelineLibraryCounters(gpu);
+    EXPECT_EQ(after.shared, before.shared + 1);
+    // .a twice in one batch: both compiled side by side, the library keeps the first.
+    EXPECT_EQ(after.created, before.created + 3);
+    // A stage that does not exist is one clear error, and nothing of the batch leaks.
+    EXPECT_THROW(createComputePipelines(gpu, {{name + ".c", "tests_probe.comp.spv", {}},
+                                              {name + ".d", "no_such_stage.comp.spv", {}}}),
+                 DeviceError);
+    EXPECT_EQ(validationErrors(), errors);
+    destroy(gpu, known);
+    for (Pipeline& p : batch) destroy(gpu, p);
+}
