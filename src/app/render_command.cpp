@@ -464,6 +464,10 @@ RenderRun runRender(Gpu& gpu, const RenderOptions& o) {
     Renderer renderer;
     RenderRun run;
     const PipelineLibraryCounters pipelinesBefore = pipelineLibraryCounters(gpu);
+    const bool tty = isatty(STDERR_FILENO);
+    // Building the renderer compiles its pipelines: seconds on a CPU device, so say so.
+    if (o.progress && tty) std::fprintf(stderr, "render: building the renderer's pipelines...");
+    auto renderStart = std::chrono::steady_clock::now();
     try {
         initRenderer(renderer, gpu, settings, gpuScene);
         if (o.distanceFields)
@@ -483,7 +487,23 @@ RenderRun runRender(Gpu& gpu, const RenderOptions& o) {
             return run;
         }
         requireCapturesExist(renderer.captures, o.captures); // before minutes of rendering
-        bool tty = isatty(STDERR_FILENO);
+        {
+            PipelineLibraryCounters p = pipelineLibraryCounters(gpu);
+            double seconds =
+                std::chrono::duration<double>(std::chrono::steady_clock::now() - renderStart)
+                    .count();
+            SHADEL_DEBUG("renderer built in %.2f s: %llu pipelines compiled (%.2f s of compile "
+                         "time), %llu shared with earlier renderers",
+                         seconds, (unsigned long long)(p.created - pipelinesBefore.created),
+                         p.createSeconds - pipelinesBefore.createSeconds,
+                         (unsigned long long)(p.shared - pipelinesBefore.shared));
+            if (o.progress && tty)
+                std::fprintf(stderr,
+                             "\rrender: renderer built in %.1f s (%llu pipelines compiled, "
+                             "%llu shared)\n",
+                             seconds, (unsigned long long)(p.created - pipelinesBefore.created),
+                             (unsigned long long)(p.shared - pipelinesBefore.shared));
+        }
         auto viewOfFrame = [&](uint32_t i) {
             glm::vec2 jitter = o.jitter ? subpixelJitter(i) : glm::vec2(0.0f);
             const Camera& start = cutCamera && i >= o.cutFrame ? *cutCamera : camera;
