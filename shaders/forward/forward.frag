@@ -1,6 +1,7 @@
 #version 460
 // Forward shading: the shared material + lighting code evaluated per pixel.
 #include "common/lighting.glsl"
+#define LIGHT_CULL_FRAGMENT // helper invocations write nothing (light_cull.glsl)
 #include "lighting/light_cull.glsl" // useSubgroupLightList
 #include "lighting/light_debug.glsl"
 #include "debug/inspect.glsl"

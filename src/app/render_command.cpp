@@ -466,7 +466,8 @@ RenderRun runRender(Gpu& gpu, const RenderOptions& o) {
     const PipelineLibraryCounters pipelinesBefore = pipelineLibraryCounters(gpu);
     const bool tty = isatty(STDERR_FILENO);
     // Building the renderer compiles its pipelines: seconds on a CPU device, so say so.
-    if (o.progress && tty) std::fprintf(stderr, "render: building the renderer's pipelines...");
+    bool buildingLine = o.progress && tty; // open until the renderer is built
+    if (buildingLine) std::fprintf(stderr, "render: building the renderer's pipelines...");
     auto renderStart = std::chrono::steady_clock::now();
     try {
         initRenderer(renderer, gpu, settings, gpuScene);
@@ -479,6 +480,22 @@ RenderRun runRender(Gpu& gpu, const RenderOptions& o) {
         renderer.streaming = streaming.get();
         if (o.gpuSkinning) renderer.skinning = createSkinning(renderer, scene, gpuScene);
         renderer.pointsLines = createPointsLines(renderer, scene);
+        {
+            PipelineLibraryCounters p = pipelineLibraryCountersSince(gpu, pipelinesBefore);
+            double seconds =
+                std::chrono::duration<double>(std::chrono::steady_clock::now() - renderStart)
+                    .count();
+            SHADEL_DEBUG("renderer built in %.2f s: %llu pipelines compiled (%.2f s of compile "
+                         "time), %llu shared with earlier renderers",
+                         seconds, (unsigned long long)p.created, p.createSeconds,
+                         (unsigned long long)p.shared);
+            if (buildingLine)
+                std::fprintf(stderr,
+                             "\rrender: renderer built in %.1f s (%llu pipelines compiled, "
+                             "%llu shared)\n",
+                             seconds, (unsigned long long)p.created, (unsigned long long)p.shared);
+            buildingLine = false;
+        }
         if (listCaptures) {
             std::printf("%s", captureListing(renderer.captures).c_str());
             run.listedCaptures = true;
@@ -487,23 +504,6 @@ RenderRun runRender(Gpu& gpu, const RenderOptions& o) {
             return run;
         }
         requireCapturesExist(renderer.captures, o.captures); // before minutes of rendering
-        {
-            PipelineLibraryCounters p = pipelineLibraryCounters(gpu);
-            double seconds =
-                std::chrono::duration<double>(std::chrono::steady_clock::now() - renderStart)
-                    .count();
-            SHADEL_DEBUG("renderer built in %.2f s: %llu pipelines compiled (%.2f s of compile "
-                         "time), %llu shared with earlier renderers",
-                         seconds, (unsigned long long)(p.created - pipelinesBefore.created),
-                         p.createSeconds - pipelinesBefore.createSeconds,
-                         (unsigned long long)(p.shared - pipelinesBefore.shared));
-            if (o.progress && tty)
-                std::fprintf(stderr,
-                             "\rrender: renderer built in %.1f s (%llu pipelines compiled, "
-                             "%llu shared)\n",
-                             seconds, (unsigned long long)(p.created - pipelinesBefore.created),
-                             (unsigned long long)(p.shared - pipelinesBefore.shared));
-        }
         auto viewOfFrame = [&](uint32_t i) {
             glm::vec2 jitter = o.jitter ? subpixelJitter(i) : glm::vec2(0.0f);
             const Camera& start = cutCamera && i >= o.cutFrame ? *cutCamera : camera;
@@ -551,6 +551,7 @@ RenderRun runRender(Gpu& gpu, const RenderOptions& o) {
         }
         if (o.progress && o.frames > 1 && tty) std::fprintf(stderr, "\n");
     } catch (...) {
+        if (buildingLine) std::fprintf(stderr, "\n"); // the error gets a line of its own
         destroyRenderer(renderer);
         destroyScene(gpu, gpuScene);
         throw;
@@ -644,11 +645,10 @@ RenderRun runRender(Gpu& gpu, const RenderOptions& o) {
     s["shader_asserts"] = asserts;
     s["validation_errors"] = gpu.device.validationErrors.load();
     // This run's pipelines: compiled, or found already built on the device by an earlier run.
-    const PipelineLibraryCounters pipelines = pipelineLibraryCounters(gpu);
-    s["pipelines"] = {
-        {"created", pipelines.created - pipelinesBefore.created},
-        {"shared", pipelines.shared - pipelinesBefore.shared},
-        {"create_ms", (pipelines.createSeconds - pipelinesBefore.createSeconds) * 1000.0}};
+    const PipelineLibraryCounters pipelines = pipelineLibraryCountersSince(gpu, pipelinesBefore);
+    s["pipelines"] = {{"created", pipelines.created},
+                      {"shared", pipelines.shared},
+                      {"create_ms", pipelines.createSeconds * 1000.0}};
     s["instances"] = gpuScene.instanceCount;
     s["triangles"] = scene.triangleCount();
     s["lights"] = scene.lights.size();

@@ -168,6 +168,13 @@ PipelineLibraryCounters pipelineLibraryCounters(const Gpu& gpu) {
     return gpu.pipelineLibrary->counters;
 }
 
+PipelineLibraryCounters pipelineLibraryCountersSince(const Gpu& gpu,
+                                                     const PipelineLibraryCounters& before) {
+    PipelineLibraryCounters now = pipelineLibraryCounters(gpu);
+    return {now.created - before.created, now.shared - before.shared,
+            now.createSeconds - before.createSeconds};
+}
+
 void destroyPipelineLibrary(Gpu& gpu) {
     if (!gpu.pipelineLibrary) return;
     for (VkPipeline p : gpu.pipelineLibrary->owned)

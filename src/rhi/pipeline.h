@@ -56,6 +56,9 @@ struct PipelineLibraryCounters {
 };
 void initPipelineLibrary(Gpu& gpu); // createGpu
 PipelineLibraryCounters pipelineLibraryCounters(const Gpu& gpu);
+// What happened since `before` (an earlier pipelineLibraryCounters): one run's pipelines.
+PipelineLibraryCounters pipelineLibraryCountersSince(const Gpu& gpu,
+                                                     const PipelineLibraryCounters& before);
 void destroyPipelineLibrary(Gpu& gpu); // destroyGpu
 
 std::string shaderDirectory();
