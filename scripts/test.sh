@@ -19,9 +19,10 @@ export SHADEL_CACHE_DIR="$PWD/build/test-cache"
 ctest --test-dir build --output-on-failure -j"$jobs" --timeout 900
 
 echo "== tests: unit under AddressSanitizer + UBSan"
-# -O1 -g1 (line tables) without NDEBUG: the CPU asserts are on, the traces still name file and
-# line, and the build takes half the time of -O2 -g (gltf_import.cpp, tinygltf inside: 55 s
-# against 112 s on 2 cores).
+# -O1 -g1 (line tables) without NDEBUG: the traces still name file and line, the libraries'
+# header asserts (nlohmann/json's, glm's) are on as well (SHADEL_ASSERT is on in every build),
+# and the build takes half the time of -O2 -g (gltf_import.cpp, tinygltf inside: 55 s against
+# 112 s on 2 cores).
 cmake -S . -B build-asan -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo \
       "-DCMAKE_CXX_FLAGS_RELWITHDEBINFO=-O1 -g1" "-DCMAKE_C_FLAGS_RELWITHDEBINFO=-O1 -g1" \
       -DSHADEL_CPU_ONLY=ON -DSHADEL_BENCH=OFF -DSHADEL_SANITIZE=ON >/dev/null
