@@ -52,14 +52,15 @@ allocators=$!
     >build-fuzz/gltf_import.log 2>&1 &
 gltf=$!
 fuzz_failed=0
-for fuzzer in allocators:$allocators gltf_import:$gltf; do
-  log="build-fuzz/${fuzzer%%:*}.log"
-  if wait "${fuzzer##*:}"; then
-    echo "-- ${fuzzer%%:*}:"; tail -3 "$log"
+finish_fuzzer() { # name pid: its log's tail, or its last 60 lines when it failed
+  if wait "$2"; then
+    echo "-- $1:"; tail -3 "build-fuzz/$1.log"
   else
-    echo "-- ${fuzzer%%:*} FAILED:"; tail -60 "$log"; fuzz_failed=1
+    echo "-- $1 FAILED:"; tail -60 "build-fuzz/$1.log"; fuzz_failed=1
   fi
-done
+}
+finish_fuzzer allocators "$allocators"
+finish_fuzzer gltf_import "$gltf"
 if [ "$fuzz_failed" -ne 0 ]; then
   echo "test: a fuzzer found a failure (its log is above and in build-fuzz/)" >&2
   exit 1
