@@ -295,6 +295,11 @@ void finishCullingFrame(Renderer& r) {
         const uint32_t* list = static_cast<const uint32_t*>(mapped(*r.gpu, c.visibleList));
         uint32_t count = std::min(list[0], c.instances);
         c.visibleLastFrame.assign(list + 1, list + 1 + count);
+        // The GPU appends in whatever order its invocations ran. The decoupled allocation
+        // visits this list in order, and the order decides where each object's chunks are
+        // stored (and so which chunks take their refresh turn): sorted, a frame's storage
+        // layout and stats depend on the scene and camera alone, not on the device's scheduling.
+        std::sort(c.visibleLastFrame.begin(), c.visibleLastFrame.end());
         c.haveVisible = true;
     }
 }
