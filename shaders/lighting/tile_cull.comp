@@ -1,7 +1,7 @@
 #version 460
 // Tiled light culling (seed 001): one workgroup per 16x16-pixel screen tile, 8x8 invocations
-// reading four of its pixels each (see THREADS). The tile's depth bounds come from the
-// prepass depth; every light's sphere is tested against the tile's
+// reading four of its pixels each (common/tile_frustum.glsl, TILE_CULL_THREADS). The tile's
+// depth bounds come from the prepass depth; every light's sphere is tested against the tile's
 // depth-bounded frustum (its clip plane and an area light's back side against the frustum's
 // corners, a spot's cone against the frustum's bounding sphere); then, for lights
 // with blockers, each blocker's shadow volume from the light: a blocker that covers the whole
@@ -16,22 +16,17 @@
 #include "lighting/light_cull.glsl"
 #include "lighting/spectra.glsl"
 #include "common/visibility.glsl"
+#include "common/tile_frustum.glsl"
 #extension GL_KHR_shader_subgroup_arithmetic : require
 
-layout(local_size_x = 8, local_size_y = 8) in;
+layout(local_size_x = TILE_CULL_SIZE_X, local_size_y = TILE_CULL_SIZE_Y) in;
 layout(push_constant, scalar) uniform Push {
     uint64_t frame;
     uint depthSlot;
     uint visibilitySlot; // NO_TEXTURE without feature spectra
 } pc;
 
-// 64 invocations per tile, not one per pixel: everything a tile does but read its pixels (its
-// frustum, the grid query, the barriers) is the same for each invocation or each subgroup, and
-// where a workgroup's subgroups run in turn (lavapipe: 8 lanes each) it was paid 32 times per
-// tile. Measured on builtin:lights 1280x720 (forward, spectra on, lavapipe): lightCulling
-// 84-108 ms with 256 invocations, 38-53 with 64, 31-32 with 32; 64 keeps a whole subgroup or
-// two per tile on GPUs (32 or 64 lanes) and the candidate loop a few rounds deep.
-#define THREADS 64u
+#define THREADS TILE_CULL_THREADS
 shared uint sDepthMin, sDepthMax;
 shared uint sMaterialFeatures; // SPECTRUM_MATERIAL when a pixel's material uses any feature
 shared uvec2 sList[LIGHT_TILE_MAX_LIGHTS];
@@ -88,24 +83,17 @@ void main() {
     // The light grid's bit set, cleared under the same barrier.
     lightGridMaskClearUnsynced(f, lf.lightGrid, THREADS);
     barrier();
-    // Depth bounds of the tile's covered pixels (reversed Z: 0 is the far plane, the sky):
-    // reduced over the subgroup first, one shared atomic per subgroup.
-    // Each invocation reads the pixels at its place in the tile's four 8x8 quarters (neighbours
-    // read neighbours, as one invocation per pixel did), then each subgroup reduces and one of
-    // its invocations takes the shared atomics.
+    // Depth bounds of the tile's covered pixels (reversed Z: 0 is the far plane, the sky), and
+    // whether any of their materials has a feature (with spectra): reduced over the subgroup
+    // first, one shared atomic per subgroup.
     ivec2 size = ivec2(f.viewportSize);
-    ivec2 corner = ivec2(gl_WorkGroupID.xy * LIGHT_TILE_SIZE + gl_LocalInvocationID.xy);
     uint depthMin = 0xFFFFFFFFu, depthMax = 0u;
     bool featured = false;
-    for (int q = 0; q < 4; ++q) {
-        ivec2 pixel = corner + ivec2(q & 1, q >> 1) * 8;
+    for (uint q = 0u; q < 4u; ++q) {
+        ivec2 pixel = tileCullPixel(q);
         float d = all(lessThan(pixel, size)) ? fetchTextureUniform(pc.depthSlot, pixel, 0).r : 0.0;
-        bool covered = d > 0.0;
-        if (covered) {
-            depthMin = min(depthMin, floatBitsToUint(d));
-            depthMax = max(depthMax, floatBitsToUint(d));
-        }
-        if (covered && pc.visibilitySlot != NO_TEXTURE) {
+        tileDepthBoundsAdd(d, depthMin, depthMax);
+        if (d > 0.0 && pc.visibilitySlot != NO_TEXTURE) {
             uint instance = loadVisibility(pc.visibilitySlot, pixel).x;
             if (instance != VISIBILITY_NONE) {
                 uint material = InstanceBuffer(f.instances).i[instance].material;
@@ -129,40 +117,12 @@ void main() {
         }
         return;
     }
-    // The tile's frustum between its depth bounds: 8 world-space corners.
-    vec2 lo = vec2(gl_WorkGroupID.xy * LIGHT_TILE_SIZE) * f.invViewportSize * 2.0 - 1.0;
-    vec2 hi = min(vec2((gl_WorkGroupID.xy + 1u) * LIGHT_TILE_SIZE) * f.invViewportSize, vec2(1.0)) * 2.0 - 1.0;
-    float dNear = uintBitsToFloat(sDepthMax), dFar = uintBitsToFloat(sDepthMin);
-    vec3 corners[8];
-    for (int i = 0; i < 8; ++i) {
-        vec4 clip = vec4((i & 1) != 0 ? hi.x : lo.x, (i & 2) != 0 ? hi.y : lo.y,
-                         (i & 4) != 0 ? dFar : dNear, 1.0);
-        vec4 w = f.invViewProj * clip;
-        corners[i] = w.xyz / w.w;
-    }
-    // Planes of that volume, facing inward: four sides through the eye, near and far.
-    vec3 eye = f.cameraPosition;
-    vec3 centre = vec3(0.0);
-    for (int i = 0; i < 8; ++i) centre += corners[i] * 0.125;
-    vec4 planes[6];
-    const ivec2 edges[4] = ivec2[4](ivec2(0, 1), ivec2(1, 3), ivec2(3, 2), ivec2(2, 0));
-    for (int e = 0; e < 4; ++e) {
-        vec3 n = normalize(cross(corners[edges[e].x + 4] - eye, corners[edges[e].y + 4] - eye));
-        if (dot(n, centre - eye) < 0.0) n = -n;
-        planes[e] = vec4(n, -dot(n, eye));
-    }
-    vec3 forward = normalize(-vec3(f.view[0][2], f.view[1][2], f.view[2][2]));
-    float zMin = 1e30, zMax = -1e30;
-    for (int i = 0; i < 8; ++i) {
-        float z = dot(corners[i] - eye, forward);
-        zMin = min(zMin, z), zMax = max(zMax, z);
-    }
-    planes[4] = vec4(forward, -dot(forward, eye) - zMin);
-    planes[5] = vec4(-forward, dot(forward, eye) + zMax);
-    vec3 boxMin = corners[0], boxMax = corners[0];
-    for (int i = 1; i < 8; ++i) boxMin = min(boxMin, corners[i]), boxMax = max(boxMax, corners[i]);
-    float radius = 0.0; // the volume's bounding sphere about `centre` (spot cones)
-    for (int i = 0; i < 8; ++i) radius = max(radius, distance(corners[i], centre));
+    // The tile's frustum between its depth bounds.
+    TileFrustum t = tileFrustum(f, gl_WorkGroupID.xy, uintBitsToFloat(sDepthMax), uintBitsToFloat(sDepthMin));
+    vec3 corners[8] = t.corners;
+    vec4 planes[6] = t.planes;
+    vec3 boxMin = t.boxMin, boxMax = t.boxMax, centre = t.centre;
+    float radius = t.radius;
 
     // Lights against the tile, kept in light order: the frustum's lights near the tile's box
     // from the light grid (render/lighting/light_grid.h), or, where the grid cannot answer
