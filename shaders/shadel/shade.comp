@@ -116,6 +116,9 @@ bool chunkTouchesChange(FrameConstants f, ShadelFrame s, ShadelObjectRef o, GpuS
 // and the chunk's view record (recordChunkView).
 vec3 gChunkBoxMin = vec3(0.0), gChunkBoxMax = vec3(0.0);
 bool gChunkHasBox = false, gChunkBoxKnown = false;
+// Invocation 0 of a CLASSIFY workgroup: the features of the chunk's kept lights (entryFeatures),
+// gathered as it walks them.
+uint gChunkListFeatures = 0u;
 
 // The chunk's world box from its shading invocations' positions, with one barrier: each
 // subgroup reduces its lanes (subgroupMin/Max of the order-preserving bits, so the box is the
@@ -168,7 +171,7 @@ void cullChunkLights(FrameConstants f, bool shading, vec3 p) {
     gLightListMode = LIGHT_LIST_SHARED;
     if (!gChunkHasBox) { // no shadel to shade
         if (tid == 0u) sLightListCount = 0u;
-        barrier();
+        if (kChunkSpectraPhase != CHUNK_SPECTRA_CLASSIFY) barrier(); // (as at the end)
         return;
     }
     vec3 corners[8];
@@ -201,11 +204,14 @@ void cullChunkLights(FrameConstants f, bool shading, vec3 p) {
         bool perPixel = false;
         for (uint i = 0u; i < count; ++i) {
             uint light = sLightList[i].x;
-            uint mask = lightBlockerMask(lf, lights.l[light], corners, boxMin, boxMax);
+            GpuLight l = lights.l[light];
+            uint mask = lightBlockerMask(lf, l, corners, boxMin, boxMax);
             sLightList[i] = mask == LIGHT_INVALID ? uvec2(LIGHT_INVALID, 0u) : uvec2(light, mask);
             if (mask == LIGHT_INVALID) continue;
             kept++;
             perPixel = perPixel || mask != 0u;
+            if (kChunkSpectraPhase == CHUNK_SPECTRA_CLASSIFY)
+                gChunkListFeatures |= entryFeatures(lf, l, mask, corners);
             if (counting) atomicOr(UintBuffer(lf.visibleLights).v[light >> 5], 1u << (light & 31u));
         }
         if (counting) {
@@ -217,7 +223,9 @@ void cullChunkLights(FrameConstants f, bool shading, vec3 p) {
             if (appended > LIGHT_CHUNK_MAX_LIGHTS) atomicAdd(counters.c.chunksOverflowed, 1u);
         }
     }
-    barrier();
+    // The shading reads the list with every invocation; the classify phase only with this one
+    // (classifyChunkSpectrum), which wrote it.
+    if (kChunkSpectraPhase != CHUNK_SPECTRA_CLASSIFY) barrier();
 }
 
 #include "lighting/chunk_spectra_classify.glsl" // --spectra: binning chunks by features

@@ -409,7 +409,7 @@ void featureSpectraStats(const Renderer& r, nlohmann::json& stats) {
     stats["spectra_superfluous_total"] = superfluousTotal; // (tile, feature) pairs
     stats["tile_features"] = features;                     // feature -> tiles needing it
     if (s.chunks) {
-        // The classify phase's lists the permutations read (entries, blocked lights included),
+        // The classify phase's lists the permutations read (their kept lights' entries),
         // and the chunks whose list did not fit the pool, culled again by their permutation.
         stats["spectra_chunk_list_entries"] = s.lastChunkListEntries;
         stats["spectra_chunk_list_capacity"] = s.chunkListCapacity;
