@@ -26,11 +26,11 @@
 // mode's permutation of the same shader shades its bin by indirect dispatch
 // (shaders/lighting/chunk_spectra.glsl). Stats "spectra" then count chunks, not tiles.
 // Cost: the classify phase rebuilds every queued shadel's position and culls its chunk's lights,
-// which the plain shading (--spectra off) does once, inside the shading. On lavapipe that costs
-// more than the permutations save: builtin:lights at 1280x720, decoupled frame 683 ms with
-// spectra against 531 ms without (bench --spectra compare, 5 rounds; classify ~125 ms: ~60 the
-// positions and boxes, ~65 the culling). Forward tile shading with spectra is 0.90x the raster
-// forward pass there.
+// which the plain shading (--spectra off) does once, inside the shading. On lavapipe that mostly
+// costs more than the permutations save: builtin:lights at 1280x720, decoupled frame with
+// spectra 1.08x and 1.17x the frame without in two benches, 0.84x in a third (bench --spectra
+// compare, 3 rounds each; classify 120-130 ms: ~60 the positions and boxes, the rest the
+// culling).
 #include <memory>
 
 #include <nlohmann/json.hpp>
