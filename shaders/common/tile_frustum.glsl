@@ -3,6 +3,7 @@
 // which pixels each of a tile's TILE_CULL_THREADS invocations reads for its depth bounds.
 #ifndef COMMON_TILE_FRUSTUM_GLSL
 #define COMMON_TILE_FRUSTUM_GLSL
+#include "common/bindless.glsl" // FrameConstants, LIGHT_TILE_SIZE
 
 // 64 invocations per tile, not one per pixel: everything a tile does but read its pixels (its
 // frustum, the light grid's query, the barriers) is the same for each invocation or each
