@@ -7,22 +7,18 @@
 
 layout(buffer_reference, scalar) buffer ChunkListBuffer { uvec2 e[]; };
 
-// CLASSIFY, invocation 0: keeps the chunk's culled list (the entries cullChunkLights kept, in
-// order) in the pool, so that its permutation need not cull it again; a chunk the pool has no
+// CLASSIFY, invocation 0: keeps the chunk's culled list (cullChunkLights left only the lights
+// it keeps, in order) in the pool, so that its permutation need not cull it again; a chunk the pool has no
 // room for is marked CHUNK_LIST_NONE and culled again there. One invocation copies the list
 // (a chunk keeps a few lights): no barrier, as the screen tiles' copy (tile_cull.comp).
 void storeChunkLightList(SpectraFrame sf, uint workIndex) {
     uint count = min(sLightListCount, LIGHT_CHUNK_MAX_LIGHTS);
-    uint kept = 0u;
-    for (uint i = 0u; i < count; ++i) kept += sLightList[i].x != LIGHT_INVALID ? 1u : 0u;
-    uint base = kept == 0u ? 0u : atomicAdd(UintBuffer(sf.chunkListCount).v[0], kept);
-    bool fits = base <= sf.chunkListCapacity && kept <= sf.chunkListCapacity - base;
-    ChunkListBuffer(sf.chunkRanges).e[workIndex] = uvec2(base, fits ? kept : CHUNK_LIST_NONE);
+    uint base = count == 0u ? 0u : atomicAdd(UintBuffer(sf.chunkListCount).v[0], count);
+    bool fits = base <= sf.chunkListCapacity && count <= sf.chunkListCapacity - base;
+    ChunkListBuffer(sf.chunkRanges).e[workIndex] = uvec2(base, fits ? count : CHUNK_LIST_NONE);
     if (!fits) return;
     ChunkListBuffer pool = ChunkListBuffer(sf.chunkLists);
-    uint written = 0u;
-    for (uint i = 0u; i < count; ++i)
-        if (sLightList[i].x != LIGHT_INVALID) pool.e[base + written++] = sLightList[i];
+    for (uint i = 0u; i < count; ++i) pool.e[base + i] = sLightList[i];
 }
 
 // SHADE: the chunk's list as its classify phase culled it, into the shared list. False (and

@@ -193,12 +193,12 @@ void cullChunkLights(FrameConstants f, bool shading, vec3 p) {
         barrier(); // the entries were written by other invocations
     }
     // One invocation finishes the list (the grid's compaction ran on it too): each light's
-    // blockers against the box, and the counts. A chunk keeps a few lights; walking them costs
-    // less than the barrier a parallel pass needs (lavapipe runs invocations in turn).
+    // blockers against the box, the lights they hide from the whole chunk dropped (the rest
+    // moved up in order), and the counts. A chunk keeps a few lights; walking them costs less
+    // than the barrier a parallel pass needs (lavapipe runs invocations in turn).
     if (tid == 0u) {
         uint appended = sAppendCount; // lights kept, before the list's capacity
         uint count = min(appended, LIGHT_CHUNK_MAX_LIGHTS);
-        sLightListCount = count;
         bool counting = kChunkSpectraPhase != CHUNK_SPECTRA_SHADE; // once per chunk
         uint kept = 0u;
         bool perPixel = false;
@@ -206,14 +206,14 @@ void cullChunkLights(FrameConstants f, bool shading, vec3 p) {
             uint light = sLightList[i].x;
             GpuLight l = lights.l[light];
             uint mask = lightBlockerMask(lf, l, corners, boxMin, boxMax);
-            sLightList[i] = mask == LIGHT_INVALID ? uvec2(LIGHT_INVALID, 0u) : uvec2(light, mask);
             if (mask == LIGHT_INVALID) continue;
-            kept++;
+            sLightList[kept++] = uvec2(light, mask); // (kept <= i)
             perPixel = perPixel || mask != 0u;
             if (kChunkSpectraPhase == CHUNK_SPECTRA_CLASSIFY)
                 gChunkListFeatures |= entryFeatures(lf, l, mask, corners);
             if (counting) atomicOr(UintBuffer(lf.visibleLights).v[light >> 5], 1u << (light & 31u));
         }
+        sLightListCount = kept;
         if (counting) {
             LightingCountersRef counters = LightingCountersRef(lf.counters);
             atomicAdd(counters.c.lightChunkPairs, kept);
