@@ -9,17 +9,16 @@
 // frustum, the light grid's query, the barriers) is the same for each invocation or each
 // subgroup, and where a workgroup's subgroups run in turn (lavapipe: 8 lanes each) it was paid
 // 32 times per tile. Measured on builtin:lights 1280x720 (forward, spectra on, lavapipe): light
-// culling 84-108 ms with 256 invocations, 38-53 with 64, 31-32 with 32; 64 keeps a whole
+// culling 81-116 ms with 256 invocations, 37-54 with 64, 31-32 with 32; 64 keeps a whole
 // subgroup or two per tile on GPUs (32 or 64 lanes) and the candidate loops a few rounds deep.
-#define TILE_CULL_THREADS 64u
-#define TILE_CULL_SIZE_X 8
-#define TILE_CULL_SIZE_Y 8
+#define TILE_CULL_SIDE 8 // invocations per side of the workgroup: half the tile's
+#define TILE_CULL_THREADS uint(TILE_CULL_SIDE * TILE_CULL_SIDE)
 
-// The q-th (0..3) pixel this invocation reads: its place in each of the tile's four 8x8
-// quarters, so neighbouring invocations read neighbouring pixels.
+// The q-th (0..3) pixel this invocation reads: its place in each of the tile's four quarters,
+// so neighbouring invocations read neighbouring pixels.
 ivec2 tileCullPixel(uint q) {
     return ivec2(gl_WorkGroupID.xy * LIGHT_TILE_SIZE + gl_LocalInvocationID.xy) +
-           ivec2(q & 1u, q >> 1u) * 8;
+           ivec2(q & 1u, q >> 1u) * TILE_CULL_SIDE;
 }
 
 // Reversed Z: depth 0 is the sky. Folds one pixel's depth into the running bounds (the bits of

@@ -6,7 +6,7 @@
 #include "common/tile_frustum.glsl"
 #extension GL_KHR_shader_subgroup_arithmetic : require
 
-layout(local_size_x = TILE_CULL_SIZE_X, local_size_y = TILE_CULL_SIZE_Y) in;
+layout(local_size_x = TILE_CULL_SIDE, local_size_y = TILE_CULL_SIDE) in;
 layout(push_constant, scalar) uniform Push {
     uint64_t frame;
     uint depthSlot;
