@@ -148,7 +148,11 @@ using uint = uint32_t;
 #define DRAW_LIST_DECOUPLED 2u // opaque instances shaded in shadel space this frame
 // Blended instances shaded in shadel space this frame (reconstructed into the OIT targets).
 #define DRAW_LIST_DECOUPLED_BLEND 3u
-#define DRAW_LIST_COUNT 4u
+// Forward-shaded opaque instances whose material uses a MATERIAL_FEATURE_* (MATERIAL_FEATURED):
+// the forward shading draws DRAW_LIST_OPAQUE with those features compiled out and this list
+// with all of them (render/forward). Every other pass draws the two as one (drawCameraList).
+#define DRAW_LIST_OPAQUE_FEATURED 4u
+#define DRAW_LIST_COUNT 5u
 
 // Debug views (--visualize).
 #define VISUALIZE_NONE 0u

@@ -47,6 +47,9 @@ uint cameraListOf(FrameConstants f, GpuMaterial mat, uint id) {
     if (f.shadel != 0ul && (ShadelObjectBuffer(ShadelFrameRef(f.shadel).s.objects).o[id].flags &
                             SHADEL_OBJECT_DECOUPLED) != 0u)
         list = list == DRAW_LIST_OPAQUE ? DRAW_LIST_DECOUPLED : DRAW_LIST_DECOUPLED_BLEND;
+    // Forward opaque surfaces by the pipeline their material needs (render/forward).
+    if (list == DRAW_LIST_OPAQUE && (mat.flags & MATERIAL_FEATURED) != 0u)
+        list = DRAW_LIST_OPAQUE_FEATURED;
     return list;
 }
 

@@ -239,7 +239,10 @@ struct Renderer {
     uint32_t maxDraws = 0;
     BufferHandle sceneIndices; // the unified index buffer of the scene being drawn
     glm::vec3 skyColor{0.5f};
-    Pipeline instanceCull, depthPrepass, forwardOpaque, tonemap;
+    Pipeline instanceCull, depthPrepass, tonemap;
+    // Forward shading of opaque surfaces: plain materials (DRAW_LIST_OPAQUE, material features
+    // compiled out) and materials using them (DRAW_LIST_OPAQUE_FEATURED).
+    Pipeline forwardOpaque, forwardOpaqueFeatured;
     // The scene has alpha-masked materials: the depth-only passes (prepass, shadow maps) and the
     // visibility prepass run their alpha test. Without them they are depth-only / have the test
     // compiled out, so the depth test runs before any fragment shading (early Z).

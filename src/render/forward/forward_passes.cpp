@@ -22,6 +22,15 @@ void drawList(Renderer& r, VkCommandBuffer cmd, BufferHandle draws, VkDeviceSize
                                   vkBuffer(gpu, r.drawCounts), countOffset + list * 4, r.maxDraws,
                                   sizeof(gpu::DrawIndexedCommand));
 }
+
+// One camera list exactly (drawCameraList draws the two opaque lists as one).
+void drawOneCameraList(Renderer& r, VkCommandBuffer cmd, uint32_t list) {
+    Gpu& gpu = *r.gpu;
+    setViewport(cmd, r.internalWidth, r.internalHeight);
+    vkCmdBindIndexBuffer(cmd, vkBuffer(gpu, r.sceneIndices), 0, VK_INDEX_TYPE_UINT32);
+    drawList(r, cmd, r.draws, 0, list);
+    drawPhase2List(r, cmd, list); // occlusion culling's second phase (render/culling)
+}
 } // namespace
 
 void createForwardPipelines(Renderer& r) {
@@ -36,7 +45,7 @@ void createForwardPipelines(Renderer& r) {
     r.depthPrepass = createGraphicsPipeline(gpu, depth);
 
     GraphicsPipelineDesc opaque;
-    opaque.name = "forwardOpaque";
+    opaque.name = "forwardOpaqueFeatured";
     opaque.vertexShader = "forward_forward.vert.spv";
     opaque.fragmentShader = "forward_forward.frag.spv";
     opaque.colorFormats = {VK_FORMAT_R16G16B16A16_SFLOAT};
@@ -51,11 +60,19 @@ void createForwardPipelines(Renderer& r) {
     // light, shaders/common/lighting.glsl); other lists leave that loop empty.
     if (r.forwardSplitsTileLights)
         opaque.specialization.push_back({SPECTRUM_LIGHT_SPLIT_CONSTANT_ID, 1u});
+    r.forwardOpaqueFeatured = createGraphicsPipeline(gpu, opaque);
+    // Plain materials (no MATERIAL_FEATURE_*: DRAW_LIST_OPAQUE) with the material features
+    // compiled out, as the shadel path's plain class: a CPU device's SIMD group runs the code of
+    // a branch none of its lanes takes, so compiled-in features cost every pixel.
+    opaque.name = "forwardOpaque";
+    opaque.specialization.push_back({MATERIAL_FEATURES_CONSTANT_ID, 0u});
     r.forwardOpaque = createGraphicsPipeline(gpu, opaque);
 }
 
 void destroyForwardPipelines(Renderer& r) {
-    for (Pipeline* p : {&r.instanceCull, &r.depthPrepass, &r.forwardOpaque}) destroy(*r.gpu, *p);
+    for (Pipeline* p :
+         {&r.instanceCull, &r.depthPrepass, &r.forwardOpaque, &r.forwardOpaqueFeatured})
+        destroy(*r.gpu, *p);
 }
 
 void recordInstanceCull(Renderer& r, VkCommandBuffer cmd, uint64_t frame, const GpuScene& scene) {
@@ -94,11 +111,10 @@ void drawSunShadowList(Renderer& r, VkCommandBuffer cmd) {
 }
 
 void drawCameraList(Renderer& r, VkCommandBuffer cmd, uint32_t list) {
-    Gpu& gpu = *r.gpu;
-    setViewport(cmd, r.internalWidth, r.internalHeight);
-    vkCmdBindIndexBuffer(cmd, vkBuffer(gpu, r.sceneIndices), 0, VK_INDEX_TYPE_UINT32);
-    drawList(r, cmd, r.draws, 0, list);
-    drawPhase2List(r, cmd, list); // occlusion culling's second phase (render/culling)
+    drawOneCameraList(r, cmd, list);
+    // The forward opaque surfaces are two lists by material class (DRAW_LIST_OPAQUE_FEATURED);
+    // only the forward shading tells them apart.
+    if (list == DRAW_LIST_OPAQUE) drawOneCameraList(r, cmd, DRAW_LIST_OPAQUE_FEATURED);
 }
 
 void sceneDepthToSampled(Renderer& r, VkCommandBuffer cmd, VkPipelineStageFlags2 readers) {
@@ -192,9 +208,13 @@ void beginSceneColorPass(Renderer& r, VkCommandBuffer cmd, bool clear) {
 
 void drawForwardLists(Renderer& r, VkCommandBuffer cmd, uint64_t frame) {
     Gpu& gpu = *r.gpu;
+    // Plain materials, then those using material features, each by its own pipeline.
     bind(gpu, cmd, r.forwardOpaque);
     pushConstants(gpu, cmd, RasterPush{frame, 0});
-    drawCameraList(r, cmd, DRAW_LIST_OPAQUE);
+    drawOneCameraList(r, cmd, DRAW_LIST_OPAQUE);
+    bind(gpu, cmd, r.forwardOpaqueFeatured);
+    pushConstants(gpu, cmd, RasterPush{frame, 0});
+    drawOneCameraList(r, cmd, DRAW_LIST_OPAQUE_FEATURED);
     // The blended instances (DRAW_LIST_BLEND) are drawn after every opaque surface by the
     // transparency passes (render/oit), from a CPU list that can be shuffled or sorted.
 }
