@@ -51,8 +51,13 @@ void editMaterial(Renderer& r, const GpuScene& scene, uint32_t index,
                                                  MemoryKind::Upload});
         if (!e.materialBuffer) throw DeviceError("out of GPU memory for the edited materials");
     }
-    if (std::memcmp(&e.materials[index], &material, sizeof(material)) == 0) return;
-    e.materials[index] = material;
+    gpu::GpuMaterial m = material;
+    // The flag the forward draw lists follow (DRAW_LIST_OPAQUE_FEATURED: the pipeline with the
+    // material features): an edit that adds a clear coat or a sheen moves the material's
+    // instances to the all-features pipeline, one that removes them back.
+    m.flags = (m.flags & ~MATERIAL_FEATURED) | (materialFeatures(m) ? MATERIAL_FEATURED : 0u);
+    if (std::memcmp(&e.materials[index], &m, sizeof(m)) == 0) return;
+    e.materials[index] = m;
     e.materialsChanged[index] = 1;
 }
 

@@ -80,11 +80,13 @@ EditFrames renderEdit(RenderMode mode, const Edit& edit) {
     return out;
 }
 
-// The instance with the largest world box: its material is one the camera sees widely.
-uint32_t largestMaterial(const GpuScene& gs) {
+// The instance with the largest world box: its material is one the camera sees widely. With
+// `plainOnly`, among materials that use no MATERIAL_FEATURE_*.
+uint32_t largestMaterial(const GpuScene& gs, bool plainOnly = false) {
     uint32_t best = 0;
     float area = -1.0f;
     for (const gpu::GpuInstance& inst : gs.instanceInfo) {
+        if (plainOnly && materialFeatures(gs.materialInfo[inst.material]) != 0u) continue;
         glm::vec3 e = inst.worldMax - inst.worldMin;
         float a = e.x * e.z + e.x * e.y + e.y * e.z;
         if (a > area) area = a, best = inst.material;
@@ -115,6 +117,25 @@ TEST(SceneEdits, MaterialEditShowsInTheNextFrameBothPaths) {
     };
     for (RenderMode mode : {RenderMode::Forward, RenderMode::Decoupled})
         expectEditShows("material", mode, recolour);
+}
+
+// A plain material given a clear coat and a sheen: its surfaces leave the pipelines compiled
+// without material features (forward: DRAW_LIST_OPAQUE's; shadel path: the plain class) for the
+// all-features ones, else the edit would not show.
+TEST(SceneEdits, MaterialEditAddingFeaturesShowsBothPaths) {
+    Edit coat = [](Renderer& r, const GpuScene& gs) {
+        uint32_t index = largestMaterial(gs, true);
+        gpu::GpuMaterial m = currentMaterial(r, gs, index);
+        ASSERT_EQ(materialFeatures(m), 0u);
+        m.clearcoatFactor = 1.0f;
+        m.clearcoatRoughnessFactor = 0.05f;
+        m.sheenColorFactor = glm::vec3(1.0f, 0.1f, 0.9f);
+        m.sheenRoughnessFactor = 0.4f;
+        editMaterial(r, gs, index, m);
+        EXPECT_NE(currentMaterial(r, gs, index).flags & MATERIAL_FEATURED, 0u);
+    };
+    for (RenderMode mode : {RenderMode::Forward, RenderMode::Decoupled})
+        expectEditShows("material features", mode, coat);
 }
 
 TEST(SceneEdits, LightAndSunEditsShowInTheNextFrameBothPaths) {

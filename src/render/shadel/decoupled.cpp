@@ -888,11 +888,15 @@ void prepareDecoupledFrame(Renderer& r, const GpuScene& scene, const CameraView&
         for (uint32_t k = o.firstMip; k < mesh.mipCount && inputsUnchanged; ++k)
             if (o.levelSince[k] < d.frameNumber || o.movedAt[k] == d.frameNumber)
                 g.reuseLevels |= 1u << k;
+        // The material as this frame shades it (edited or as loaded: render/scene_edits).
         bool known = inst.material < scene.materialInfo.size();
-        float roughness = known ? scene.materialInfo[inst.material].roughnessFactor : 1.0f;
-        float metallic = known ? scene.materialInfo[inst.material].metallicFactor : 1.0f;
-        glm::vec3 baseColor =
-            known ? glm::vec3(scene.materialInfo[inst.material].baseColorFactor) : glm::vec3(0.0f);
+        const gpu::GpuMaterial* material = !known ? nullptr
+                                           : r.edits.materials.empty()
+                                               ? &scene.materialInfo[inst.material]
+                                               : &r.edits.materials[inst.material];
+        float roughness = known ? material->roughnessFactor : 1.0f;
+        float metallic = known ? material->metallicFactor : 1.0f;
+        glm::vec3 baseColor = known ? glm::vec3(material->baseColorFactor) : glm::vec3(0.0f);
         g.viewDriftCos = std::cos(viewDriftLimitFor(roughness, metallic, baseColor));
         d.objectsReusable += g.reuseLevels != 0;
         d.firstMipHistogram[o.firstMip]++;
@@ -901,8 +905,7 @@ void prepareDecoupledFrame(Renderer& r, const GpuScene& scene, const CameraView&
         g.firstMip = o.firstMip;
         g.flags |= SHADEL_OBJECT_DECOUPLED;
         // Its shading class (the pipeline that shades its chunks, shaders/shadel/shade.comp).
-        uint32_t features =
-            known ? materialFeatures(scene.materialInfo[inst.material]) : MATERIAL_FEATURES_ALL;
+        uint32_t features = known ? materialFeatures(*material) : MATERIAL_FEATURES_ALL;
         if (features != 0u) g.flags |= SHADEL_OBJECT_FEATURED_MATERIAL;
         // Only point-function procedurals are supersampled (shaders/shadel/prefilter.glsl).
         if ((features & MATERIAL_FEATURE_PROCEDURAL) && r.settings.materialSamples >= 4)
