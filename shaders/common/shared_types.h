@@ -25,6 +25,8 @@ using uint = uint32_t;
 // It uses a MATERIAL_FEATURE_* (texture, procedural, clear coat, sheen): set at upload from
 // materialFeatures (render/gpu_scene.h), read where a shader chooses what to compile in.
 #define MATERIAL_FEATURED 16u
+// Which MATERIAL_FEATURE_* it uses (bits 12..15, with MATERIAL_FEATURED: setMaterialFeatureFlags).
+#define MATERIAL_FEATURES_SHIFT 12u
 // Bits 8..10: the surface class (scene.h SurfaceClass; render/screenspace's thin G-buffer).
 #define MATERIAL_CLASS_SHIFT 8u
 #define MATERIAL_CLASS_MASK 7u
@@ -148,11 +150,13 @@ using uint = uint32_t;
 #define DRAW_LIST_DECOUPLED 2u // opaque instances shaded in shadel space this frame
 // Blended instances shaded in shadel space this frame (reconstructed into the OIT targets).
 #define DRAW_LIST_DECOUPLED_BLEND 3u
-// Forward-shaded opaque instances whose material uses a MATERIAL_FEATURE_* (MATERIAL_FEATURED):
-// the forward shading draws DRAW_LIST_OPAQUE with those features compiled out and this list
-// with all of them (render/forward). Every other pass draws the two as one (drawCameraList).
+// Forward-shaded opaque instances by the material features their material uses: textures and
+// nothing else, or any other MATERIAL_FEATURE_* (procedurals, clear coat, sheen). The forward
+// shading draws DRAW_LIST_OPAQUE (no feature) and these with only what they need compiled in
+// (render/forward); every other pass draws the three as one (drawCameraList).
 #define DRAW_LIST_OPAQUE_FEATURED 4u
-#define DRAW_LIST_COUNT 5u
+#define DRAW_LIST_OPAQUE_TEXTURED 5u
+#define DRAW_LIST_COUNT 6u
 
 // Debug views (--visualize).
 #define VISUALIZE_NONE 0u

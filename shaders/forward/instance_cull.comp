@@ -48,8 +48,10 @@ uint cameraListOf(FrameConstants f, GpuMaterial mat, uint id) {
                             SHADEL_OBJECT_DECOUPLED) != 0u)
         list = list == DRAW_LIST_OPAQUE ? DRAW_LIST_DECOUPLED : DRAW_LIST_DECOUPLED_BLEND;
     // Forward opaque surfaces by the pipeline their material needs (render/forward).
-    if (list == DRAW_LIST_OPAQUE && (mat.flags & MATERIAL_FEATURED) != 0u)
-        list = DRAW_LIST_OPAQUE_FEATURED;
+    uint features = (mat.flags >> MATERIAL_FEATURES_SHIFT) & MATERIAL_FEATURES_ALL;
+    if (list == DRAW_LIST_OPAQUE && features != 0u)
+        list = features == MATERIAL_FEATURE_TEXTURES ? DRAW_LIST_OPAQUE_TEXTURED
+                                                     : DRAW_LIST_OPAQUE_FEATURED;
     return list;
 }
 

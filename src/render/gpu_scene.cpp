@@ -193,8 +193,7 @@ void uploadScene(Gpu& gpu, const Scene& scene, GpuScene& out, const std::vector<
         setMaterialExtensions(g, Material{}, [](int32_t) { return NO_TEXTURE; });
         materials.push_back(g);
     }
-    for (gpu::GpuMaterial& g : materials)
-        if (materialFeatures(g) != 0u) g.flags |= MATERIAL_FEATURED;
+    for (gpu::GpuMaterial& g : materials) setMaterialFeatureFlags(g);
 
     // Unified geometry.
     std::vector<gpu::GpuVertex> vertices;
@@ -362,6 +361,12 @@ void destroyScene(Gpu& gpu, GpuScene& s) {
           s.lights, s.idMaps, s.blockers, s.portals, s.lightBlockerLists})
         destroy(gpu, b);
     s = GpuScene{};
+}
+
+void setMaterialFeatureFlags(gpu::GpuMaterial& m) {
+    uint32_t features = materialFeatures(m);
+    m.flags &= ~(MATERIAL_FEATURED | (MATERIAL_FEATURES_ALL << MATERIAL_FEATURES_SHIFT));
+    m.flags |= (features ? MATERIAL_FEATURED : 0u) | (features << MATERIAL_FEATURES_SHIFT);
 }
 
 uint32_t materialFeatures(const gpu::GpuMaterial& m) {

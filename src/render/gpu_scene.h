@@ -82,5 +82,8 @@ bool hasAlphaMaskedMaterials(const GpuScene& scene);
 // it (a shader compiled without them, kMaterialFeatures, shades it the same). Uploaded
 // materials carry MATERIAL_FEATURED when it is not 0.
 uint32_t materialFeatures(const gpu::GpuMaterial& m);
+// Sets MATERIAL_FEATURED and the feature bits (MATERIAL_FEATURES_SHIFT) from materialFeatures:
+// the forward draw lists and the tile pass read them.
+void setMaterialFeatureFlags(gpu::GpuMaterial& m);
 
 } // namespace shadel

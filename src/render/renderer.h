@@ -1,6 +1,7 @@
 #pragma once
 // The renderer: owns render targets, pipelines and per-frame buffers, and renders one frame
 // as a list of passes (renderFrame in renderer.cpp reads top to bottom).
+#include <array>
 #include <memory>
 #include <optional>
 #include <string>
@@ -31,6 +32,9 @@
 #include "rhi/shader_messages.h"
 
 namespace shadel {
+
+// Forward opaque material classes: plain, textures only, other features (render/forward).
+constexpr uint32_t kForwardClassCount = 3;
 
 enum class RenderMode { Forward, Decoupled };
 // Decoupled marking + reconstruction: raster passes over the objects, or compute passes over
@@ -240,9 +244,10 @@ struct Renderer {
     BufferHandle sceneIndices; // the unified index buffer of the scene being drawn
     glm::vec3 skyColor{0.5f};
     Pipeline instanceCull, depthPrepass, tonemap;
-    // Forward shading of opaque surfaces: plain materials (DRAW_LIST_OPAQUE, material features
-    // compiled out) and materials using them (DRAW_LIST_OPAQUE_FEATURED).
-    Pipeline forwardOpaque, forwardOpaqueFeatured;
+    // Forward shading of opaque surfaces, one pipeline per material class (render/forward):
+    // plain materials (DRAW_LIST_OPAQUE, material features compiled out), textures only
+    // (DRAW_LIST_OPAQUE_TEXTURED), any other feature (DRAW_LIST_OPAQUE_FEATURED, all of them).
+    std::array<Pipeline, kForwardClassCount> forwardOpaque;
     // The scene has alpha-masked materials: the depth-only passes (prepass, shadow maps) and the
     // visibility prepass run their alpha test. Without them they are depth-only / have the test
     // compiled out, so the depth test runs before any fragment shading (early Z).

@@ -52,10 +52,10 @@ void editMaterial(Renderer& r, const GpuScene& scene, uint32_t index,
         if (!e.materialBuffer) throw DeviceError("out of GPU memory for the edited materials");
     }
     gpu::GpuMaterial m = material;
-    // The flag the forward draw lists follow (DRAW_LIST_OPAQUE_FEATURED: the pipeline with the
-    // material features): an edit that adds a clear coat or a sheen moves the material's
-    // instances to the all-features pipeline, one that removes them back.
-    m.flags = (m.flags & ~MATERIAL_FEATURED) | (materialFeatures(m) ? MATERIAL_FEATURED : 0u);
+    // The flags the forward draw lists follow (a pipeline per material class, render/forward):
+    // an edit that adds a clear coat or a sheen moves the material's instances to the
+    // all-features pipeline, one that removes them back.
+    setMaterialFeatureFlags(m);
     if (std::memcmp(&e.materials[index], &m, sizeof(m)) == 0) return;
     e.materials[index] = m;
     e.materialsChanged[index] = 1;

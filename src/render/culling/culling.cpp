@@ -251,7 +251,8 @@ void recordOcclusionPasses(Renderer& r, FrameRecorder& rec, uint64_t frame, cons
         vkCmdSetViewport(cmd, 0, 1, &vp);
         vkCmdSetScissor(cmd, 0, 1, &scissor);
         pushConstants(gpu, cmd, RasterPush{frame, 0});
-        for (uint32_t list : {DRAW_LIST_OPAQUE, DRAW_LIST_OPAQUE_FEATURED, DRAW_LIST_DECOUPLED}) {
+        for (uint32_t list : {DRAW_LIST_OPAQUE, DRAW_LIST_OPAQUE_TEXTURED,
+                              DRAW_LIST_OPAQUE_FEATURED, DRAW_LIST_DECOUPLED}) {
             vkCmdBindIndexBuffer(cmd, vkBuffer(gpu, r.sceneIndices), 0, VK_INDEX_TYPE_UINT32);
             drawPhase2List(r, cmd, list);
         }

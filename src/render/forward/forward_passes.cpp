@@ -23,7 +23,19 @@ void drawList(Renderer& r, VkCommandBuffer cmd, BufferHandle draws, VkDeviceSize
                                   sizeof(gpu::DrawIndexedCommand));
 }
 
-// One camera list exactly (drawCameraList draws the two opaque lists as one).
+// The forward opaque lists by material class, each shaded by a pipeline with only the class's
+// material features compiled in (Renderer::forwardOpaque[k]).
+struct ForwardClass {
+    uint32_t list;
+    uint32_t materialFeatures; // kMaterialFeatures of its pipeline
+    const char* pipelineName;
+};
+constexpr ForwardClass kForwardClasses[kForwardClassCount] = {
+    {DRAW_LIST_OPAQUE, 0u, "forwardOpaque"},
+    {DRAW_LIST_OPAQUE_TEXTURED, MATERIAL_FEATURE_TEXTURES, "forwardOpaqueTextured"},
+    {DRAW_LIST_OPAQUE_FEATURED, MATERIAL_FEATURES_ALL, "forwardOpaqueFeatured"}};
+
+// One camera list exactly (drawCameraList draws the opaque lists as one).
 void drawOneCameraList(Renderer& r, VkCommandBuffer cmd, uint32_t list) {
     Gpu& gpu = *r.gpu;
     setViewport(cmd, r.internalWidth, r.internalHeight);
@@ -45,7 +57,6 @@ void createForwardPipelines(Renderer& r) {
     r.depthPrepass = createGraphicsPipeline(gpu, depth);
 
     GraphicsPipelineDesc opaque;
-    opaque.name = "forwardOpaqueFeatured";
     opaque.vertexShader = "forward_forward.vert.spv";
     opaque.fragmentShader = "forward_forward.frag.spv";
     opaque.colorFormats = {VK_FORMAT_R16G16B16A16_SFLOAT};
@@ -60,19 +71,21 @@ void createForwardPipelines(Renderer& r) {
     // light, shaders/common/lighting.glsl); other lists leave that loop empty.
     if (r.forwardSplitsTileLights)
         opaque.specialization.push_back({SPECTRUM_LIGHT_SPLIT_CONSTANT_ID, 1u});
-    r.forwardOpaqueFeatured = createGraphicsPipeline(gpu, opaque);
-    // Plain materials (no MATERIAL_FEATURE_*: DRAW_LIST_OPAQUE) with the material features
-    // compiled out, as the shadel path's plain class: a CPU device's SIMD group runs the code of
-    // a branch none of its lanes takes, so compiled-in features cost every pixel.
-    opaque.name = "forwardOpaque";
-    opaque.specialization.push_back({MATERIAL_FEATURES_CONSTANT_ID, 0u});
-    r.forwardOpaque = createGraphicsPipeline(gpu, opaque);
+    // One pipeline per material class, with only the class's material features compiled in (as
+    // the shadel path's shading classes): a CPU device's SIMD group runs the code of a branch
+    // none of its lanes takes, so compiled-in features cost every pixel.
+    for (uint32_t k = 0; k < kForwardClassCount; ++k) {
+        GraphicsPipelineDesc c = opaque;
+        c.name = kForwardClasses[k].pipelineName;
+        c.specialization.push_back(
+            {MATERIAL_FEATURES_CONSTANT_ID, kForwardClasses[k].materialFeatures});
+        r.forwardOpaque[k] = createGraphicsPipeline(gpu, c);
+    }
 }
 
 void destroyForwardPipelines(Renderer& r) {
-    for (Pipeline* p :
-         {&r.instanceCull, &r.depthPrepass, &r.forwardOpaque, &r.forwardOpaqueFeatured})
-        destroy(*r.gpu, *p);
+    for (Pipeline* p : {&r.instanceCull, &r.depthPrepass}) destroy(*r.gpu, *p);
+    for (Pipeline& p : r.forwardOpaque) destroy(*r.gpu, p);
 }
 
 void recordInstanceCull(Renderer& r, VkCommandBuffer cmd, uint64_t frame, const GpuScene& scene) {
@@ -111,10 +124,10 @@ void drawSunShadowList(Renderer& r, VkCommandBuffer cmd) {
 }
 
 void drawCameraList(Renderer& r, VkCommandBuffer cmd, uint32_t list) {
-    drawOneCameraList(r, cmd, list);
-    // The forward opaque surfaces are two lists by material class (DRAW_LIST_OPAQUE_FEATURED);
-    // only the forward shading tells them apart.
-    if (list == DRAW_LIST_OPAQUE) drawOneCameraList(r, cmd, DRAW_LIST_OPAQUE_FEATURED);
+    if (list != DRAW_LIST_OPAQUE) return drawOneCameraList(r, cmd, list);
+    // The forward opaque surfaces are a list per material class (kForwardClasses); only the
+    // forward shading tells them apart.
+    for (const ForwardClass& c : kForwardClasses) drawOneCameraList(r, cmd, c.list);
 }
 
 void sceneDepthToSampled(Renderer& r, VkCommandBuffer cmd, VkPipelineStageFlags2 readers) {
@@ -208,13 +221,12 @@ void beginSceneColorPass(Renderer& r, VkCommandBuffer cmd, bool clear) {
 
 void drawForwardLists(Renderer& r, VkCommandBuffer cmd, uint64_t frame) {
     Gpu& gpu = *r.gpu;
-    // Plain materials, then those using material features, each by its own pipeline.
-    bind(gpu, cmd, r.forwardOpaque);
-    pushConstants(gpu, cmd, RasterPush{frame, 0});
-    drawOneCameraList(r, cmd, DRAW_LIST_OPAQUE);
-    bind(gpu, cmd, r.forwardOpaqueFeatured);
-    pushConstants(gpu, cmd, RasterPush{frame, 0});
-    drawOneCameraList(r, cmd, DRAW_LIST_OPAQUE_FEATURED);
+    // Each material class's list by its own pipeline.
+    for (uint32_t k = 0; k < kForwardClassCount; ++k) {
+        bind(gpu, cmd, r.forwardOpaque[k]);
+        pushConstants(gpu, cmd, RasterPush{frame, 0});
+        drawOneCameraList(r, cmd, kForwardClasses[k].list);
+    }
     // The blended instances (DRAW_LIST_BLEND) are drawn after every opaque surface by the
     // transparency passes (render/oit), from a CPU list that can be shuffled or sorted.
 }
