@@ -120,8 +120,7 @@ using uint = uint32_t;
 #define SHADE_QUEUE_PLAIN 1u
 #define SHADE_QUEUE_FEATURED 2u
 #define SHADE_QUEUE_SUPERSAMPLED 3u
-#define SHADE_QUEUE_TEXTURED 4u // textures and no other material feature
-#define SHADE_CLASSES 4u // the class lists: SHADE_QUEUE_* - 1
+#define SHADE_CLASSES 3u // the class lists: SHADE_QUEUE_* - 1
 // The material features a shader evaluates (shaders/common/material.glsl: kMaterialFeatures).
 #define MATERIAL_FEATURES_CONSTANT_ID 149
 #define MATERIAL_FEATURE_TEXTURES 1u   // any texture slot
@@ -581,8 +580,6 @@ struct ShaderMessage {
 #define SHADEL_OBJECT_SUPERSAMPLED 4u
 // Its material uses any MATERIAL_FEATURE_* (else it is shaded by the plain pipeline).
 #define SHADEL_OBJECT_FEATURED_MATERIAL 8u
-// ... textures and no other (shaded by the pipeline with only textures compiled in).
-#define SHADEL_OBJECT_TEXTURED_MATERIAL 16u
 #define SHADEL_MAX_CHANGED_VOLUMES 256u
 #define SHADEL_CHUNK_VIEW_NONE 0xFFFFFFFFu // ShadelFrame::chunkViews: a NaN centre
 // Material layers of the shade storage (seed: "layers of different bit depths"): every layer

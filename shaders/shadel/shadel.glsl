@@ -224,7 +224,6 @@ bool shadelRefreshDue(ShadelFrame s, uint chunk) {
 // The shading class of an object (its chunks' list, SHADE_QUEUE_* - 1).
 uint shadeClassOf(ShadelObjectRef o) {
     if ((o.v.flags & SHADEL_OBJECT_SUPERSAMPLED) != 0u) return SHADE_QUEUE_SUPERSAMPLED - 1u;
-    if ((o.v.flags & SHADEL_OBJECT_TEXTURED_MATERIAL) != 0u) return SHADE_QUEUE_TEXTURED - 1u;
     if ((o.v.flags & SHADEL_OBJECT_FEATURED_MATERIAL) != 0u) return SHADE_QUEUE_FEATURED - 1u;
     return SHADE_QUEUE_PLAIN - 1u;
 }

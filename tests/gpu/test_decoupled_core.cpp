@@ -128,32 +128,21 @@ TEST(DecoupledCore, OccupancyAndShadelsPerPixelAreInRange) {
     // Shading classes (one pipeline each): the plaza checker and the bricks are point-function
     // procedurals, supersampled; the untextured rest is plain (every material feature compiled
     // out); every shaded chunk is in one class. Without material supersampling no chunk is
-    // supersampled (the procedurals are featured), and materials with textures and no other
-    // feature are textured (only textures compiled in).
+    // supersampled, and textured materials are featured.
     const auto& classes = run.stats["chunks_by_shading_class"];
     uint64_t plain = classes["plain"].get<uint64_t>();
     uint64_t featured = classes["featured"].get<uint64_t>();
     uint64_t supersampled = classes["supersampled"].get<uint64_t>();
-    uint64_t texturedOnly = classes["textured"].get<uint64_t>();
     EXPECT_GT(supersampled, 0u);
     EXPECT_GT(plain, 0u);
-    EXPECT_EQ(plain + featured + supersampled + texturedOnly, stat(run, "chunks_shaded"));
+    EXPECT_EQ(plain + featured + supersampled, stat(run, "chunks_shaded"));
     RenderOptions one = decoupled("builtin:default", 320, 180);
     one.materialSamples = 1;
     RenderRun single = renderChecked(one);
     EXPECT_EQ(single.stats["chunks_by_shading_class"]["supersampled"].get<uint64_t>(), 0u);
     EXPECT_GT(single.stats["chunks_by_shading_class"]["featured"].get<uint64_t>(), 0u);
     RenderRun textured = renderChecked(decoupled("builtin:textures", 320, 180));
-    const auto& texturedClasses = textured.stats["chunks_by_shading_class"];
-    EXPECT_GT(texturedClasses["textured"].get<uint64_t>(), 0u) << texturedClasses.dump();
-    uint64_t sum = 0;
-    for (const auto& [name, n] : texturedClasses.items()) sum += n.get<uint64_t>();
-    EXPECT_EQ(sum, stat(textured, "chunks_shaded"));
-    // Shaded with their textures: against forward 32.5 dB as measured (textures filtered in
-    // shadel space); the textured class with its textures compiled out falls far below.
-    RenderOptions forward = decoupled("builtin:textures", 320, 180);
-    forward.mode = RenderMode::Forward;
-    EXPECT_GE(psnr(renderChecked(forward).frames[0].rgba, textured.frames[0].rgba), 28.0);
+    EXPECT_GT(textured.stats["chunks_by_shading_class"]["featured"].get<uint64_t>(), 0u);
 }
 
 // Capacity control: with storage far too small for the view, the controller raises the shading

@@ -344,21 +344,17 @@ DecoupledStatePtr createDecoupled(Renderer& r, const GpuScene& scene) {
     if (d.reuse) optional |= SHADE_OPTIONAL_REUSE;
     shadeConstants.push_back({SHADE_OPTIONAL_CONSTANT_ID, optional});
     // The shading classes (SHADEL_OBJECT_* flags set per object below): plain materials with
-    // every material feature compiled out, featured ones, supersampled procedurals, and
-    // textured materials with only textures compiled in.
+    // every material feature compiled out, featured ones, supersampled procedurals.
     const char* const classNames[SHADE_CLASSES] = {"shadelShadePlain", "shadelShadeFeatured",
-                                                   "shadelShadeSupersampled",
-                                                   "shadelShadeTextured"};
+                                                   "shadelShadeSupersampled"};
     std::vector<ComputePipelineDesc> classes;
     for (uint32_t c = 0; c < SHADE_CLASSES; ++c) {
         auto constants = shadeConstants;
         constants.push_back({SHADE_QUEUE_CONSTANT_ID, SHADE_QUEUE_PLAIN + c});
         if (c == SHADE_QUEUE_PLAIN - 1) constants.push_back({MATERIAL_FEATURES_CONSTANT_ID, 0u});
-        if (c == SHADE_QUEUE_TEXTURED - 1)
-            constants.push_back({MATERIAL_FEATURES_CONSTANT_ID, MATERIAL_FEATURE_TEXTURES});
         classes.push_back({classNames[c], "shadel_shade.comp.spv", constants});
     }
-    // Compiled side by side: the classes are the renderer's largest pipelines.
+    // Compiled side by side: the three are the renderer's largest pipelines.
     std::vector<Pipeline> shade = createComputePipelines(gpu, classes);
     for (uint32_t c = 0; c < SHADE_CLASSES; ++c) d.shade[c] = shade[c];
     d.sheetView = createComputePipeline(gpu, "shadelSheetView", "shadel_sheet_view.comp.spv");
@@ -911,7 +907,6 @@ void prepareDecoupledFrame(Renderer& r, const GpuScene& scene, const CameraView&
         // Its shading class (the pipeline that shades its chunks, shaders/shadel/shade.comp).
         uint32_t features = known ? materialFeatures(*material) : MATERIAL_FEATURES_ALL;
         if (features != 0u) g.flags |= SHADEL_OBJECT_FEATURED_MATERIAL;
-        if (features == MATERIAL_FEATURE_TEXTURES) g.flags |= SHADEL_OBJECT_TEXTURED_MATERIAL;
         // Only point-function procedurals are supersampled (shaders/shadel/prefilter.glsl).
         if ((features & MATERIAL_FEATURE_PROCEDURAL) && r.settings.materialSamples >= 4)
             g.flags |= SHADEL_OBJECT_SUPERSAMPLED; // 2 x 2 samples at least
@@ -1333,8 +1328,7 @@ void decoupledStats(const Renderer& r, nlohmann::json& s) {
     s["chunks_by_shading_class"] = {
         {"plain", last.counters.classCount[SHADE_QUEUE_PLAIN - 1]},
         {"featured", last.counters.classCount[SHADE_QUEUE_FEATURED - 1]},
-        {"supersampled", last.counters.classCount[SHADE_QUEUE_SUPERSAMPLED - 1]},
-        {"textured", last.counters.classCount[SHADE_QUEUE_TEXTURED - 1]}};
+        {"supersampled", last.counters.classCount[SHADE_QUEUE_SUPERSAMPLED - 1]}};
     nlohmann::json perMip = nlohmann::json::array();
     for (uint32_t k = 0; k < SHADEL_MAX_MIPS; ++k) perMip.push_back(last.counters.chunksPerMip[k]);
     s["chunks_per_mip"] = perMip;
