@@ -22,11 +22,11 @@ using uint = uint32_t;
 #define MATERIAL_ALPHA_BLEND 2u
 #define MATERIAL_DOUBLE_SIDED 4u
 #define MATERIAL_UNLIT 8u
-// It uses a MATERIAL_FEATURE_* (texture, procedural, clear coat, sheen): set at upload from
-// materialFeatures (render/gpu_scene.h), read where a shader chooses what to compile in.
-#define MATERIAL_FEATURED 16u
-// Which MATERIAL_FEATURE_* it uses (bits 12..15, with MATERIAL_FEATURED: setMaterialFeatureFlags).
+// Bits 12..15: the MATERIAL_FEATURE_* it uses (texture, procedural, clear coat, sheen), set at
+// upload and on edits from materialFeatures (setMaterialFeatureFlags, render/gpu_scene.h), read
+// where a shader or the cull chooses what to compile in. MATERIAL_FEATURED: any of them.
 #define MATERIAL_FEATURES_SHIFT 12u
+#define MATERIAL_FEATURED (MATERIAL_FEATURES_ALL << MATERIAL_FEATURES_SHIFT)
 // Bits 8..10: the surface class (scene.h SurfaceClass; render/screenspace's thin G-buffer).
 #define MATERIAL_CLASS_SHIFT 8u
 #define MATERIAL_CLASS_MASK 7u

@@ -364,9 +364,7 @@ void destroyScene(Gpu& gpu, GpuScene& s) {
 }
 
 void setMaterialFeatureFlags(gpu::GpuMaterial& m) {
-    uint32_t features = materialFeatures(m);
-    m.flags &= ~(MATERIAL_FEATURED | (MATERIAL_FEATURES_ALL << MATERIAL_FEATURES_SHIFT));
-    m.flags |= (features ? MATERIAL_FEATURED : 0u) | (features << MATERIAL_FEATURES_SHIFT);
+    m.flags = (m.flags & ~MATERIAL_FEATURED) | (materialFeatures(m) << MATERIAL_FEATURES_SHIFT);
 }
 
 uint32_t materialFeatures(const gpu::GpuMaterial& m) {

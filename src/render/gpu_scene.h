@@ -79,11 +79,10 @@ void destroyScene(Gpu& gpu, GpuScene& scene);
 bool hasAlphaMaskedMaterials(const GpuScene& scene);
 
 // The MATERIAL_FEATURE_* the material uses: what shaders/common/material.glsl must evaluate for
-// it (a shader compiled without them, kMaterialFeatures, shades it the same). Uploaded
-// materials carry MATERIAL_FEATURED when it is not 0.
+// it (a shader compiled without them, kMaterialFeatures, shades it the same).
 uint32_t materialFeatures(const gpu::GpuMaterial& m);
-// Sets MATERIAL_FEATURED and the feature bits (MATERIAL_FEATURES_SHIFT) from materialFeatures:
-// the forward draw lists and the tile pass read them.
+// Writes materialFeatures into the material's flags (MATERIAL_FEATURES_SHIFT): the forward draw
+// lists and the tile pass read them. Uploaded and edited materials carry them.
 void setMaterialFeatureFlags(gpu::GpuMaterial& m);
 
 } // namespace shadel

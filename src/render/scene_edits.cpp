@@ -16,7 +16,7 @@ gpu::GpuLight currentLight(const Renderer& r, const GpuScene& scene, uint32_t in
     return r.edits.lights.empty() ? scene.lightInfo[index] : r.edits.lights[index];
 }
 
-gpu::GpuMaterial currentMaterial(const Renderer& r, const GpuScene& scene, uint32_t index) {
+const gpu::GpuMaterial& currentMaterial(const Renderer& r, const GpuScene& scene, uint32_t index) {
     if (index >= scene.materialInfo.size())
         throw InputError(
             format("material %u: the scene has %zu materials", index, scene.materialInfo.size()));

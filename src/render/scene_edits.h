@@ -36,7 +36,8 @@ struct SceneEdits {
 
 // The light's, sun's or material's current value (edited or as loaded).
 gpu::GpuLight currentLight(const Renderer& r, const GpuScene& scene, uint32_t index);
-gpu::GpuMaterial currentMaterial(const Renderer& r, const GpuScene& scene, uint32_t index);
+// (The material by reference, valid until the next edit: read per instance every frame.)
+const gpu::GpuMaterial& currentMaterial(const Renderer& r, const GpuScene& scene, uint32_t index);
 SunEdit currentSun(const Renderer& r, const GpuScene& scene);
 
 // Replace one light / material / the sun from the next frame on. An index out of range throws

@@ -890,10 +890,8 @@ void prepareDecoupledFrame(Renderer& r, const GpuScene& scene, const CameraView&
                 g.reuseLevels |= 1u << k;
         // The material as this frame shades it (edited or as loaded: render/scene_edits).
         bool known = inst.material < scene.materialInfo.size();
-        const gpu::GpuMaterial* material = !known ? nullptr
-                                           : r.edits.materials.empty()
-                                               ? &scene.materialInfo[inst.material]
-                                               : &r.edits.materials[inst.material];
+        const gpu::GpuMaterial* material =
+            known ? &currentMaterial(r, scene, inst.material) : nullptr;
         float roughness = known ? material->roughnessFactor : 1.0f;
         float metallic = known ? material->metallicFactor : 1.0f;
         glm::vec3 baseColor = known ? glm::vec3(material->baseColorFactor) : glm::vec3(0.0f);
