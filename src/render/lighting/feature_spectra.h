@@ -29,8 +29,16 @@
 // which the plain shading (--spectra off) does once, inside the shading. On lavapipe that mostly
 // costs more than the permutations save: builtin:lights at 1280x720, decoupled frame with
 // spectra 1.08x and 1.17x the frame without in two benches, 0.84x in a third (bench --spectra
-// compare, 3 rounds each; classify 120-130 ms: ~60 the positions and boxes, the rest the
-// culling).
+// compare, 3 rounds each; 6 rounds later: on 558, single 635, off 492 ms, on / single 0.876).
+// Where classify's 110-150 ms go (same place, variants swapped in, alternating runs): not the
+// positions: the chunk boxes baked per mesh and level (object space, transformed per instance;
+// tried, not kept) took it from 124-148 to 118-132 ms. Dropping the light tests too (no light
+// kept) left 59-70 ms: the cost of a 64-invocation workgroup per queued chunk (barriers, the
+// bit set's clear and compaction, the grid query in every invocation, the bin append), ~16,000
+// chunks a frame. The light tests cost ~45 ms and the blocker tests of the kept lights ~15.
+// A classify with baked boxes needs no invocation per shadel: one subgroup per chunk would
+// drop most of that fixed cost (not built). Both on and single pay it, so on / single moves
+// little: with classify free, (558 - 120) / (635 - 120) = 0.85.
 // Where the permutations' gain comes from (same place, builtin:lights 1280x720, reuse off, the
 // light lists emptied after classify as a measure only): shadelShading on 318 / single 383 ms
 // with the lights, 87 / 141 ms without them. The light loops cost about the same in both
