@@ -20,20 +20,9 @@ vec3 boxCorner(vec3 lo, vec3 hi, int i) {
     return vec3((i & 1) != 0 ? hi.x : lo.x, (i & 2) != 0 ? hi.y : lo.y, (i & 4) != 0 ? hi.z : lo.z);
 }
 
-// xyz centre, w radius; w < 0 for lights without a finite range (never culled by distance).
-vec4 lightSphere(GpuLight l) {
-    if (l.type == LIGHT_DIRECTIONAL || l.range <= 0.0) return vec4(l.position, -1.0);
-    float extra = l.type == LIGHT_TUBE ? l.halfLength : 0.0;
-    if (l.type == LIGHT_AREA) extra = length(vec2(l.halfLength, l.radius)); // corner to centre
-    return vec4(l.position, l.range + extra);
-}
-
-// Whether a sphere (a tile's or chunk's bounds) lies wholly outside a spot's outer cone (the
-// square cone's circumscribed round one), or behind its apex: the closest point of the cone's
-// surface to the centre is farther than the radius (Wronski's cone test). Gobos are spots.
-bool spotConeMisses(GpuLight l, vec3 centre, float radius) {
-    if (l.type != LIGHT_SPOT && l.type != LIGHT_SPOT_SQUARE) return false;
-    float c, s; // cosine and sine of the cone's half angle
+// The cosine and sine of a spot's outer half angle (a square spot's: of the round cone around
+// its square one). Gobos are spots.
+void spotCone(GpuLight l, out float c, out float s) {
     if (l.type == LIGHT_SPOT) {
         c = clamp(-l.spotOffset / l.spotScale, -1.0, 1.0);
         s = sqrt(1.0 - c * c);
@@ -42,6 +31,41 @@ bool spotConeMisses(GpuLight l, vec3 centre, float radius) {
         c = inversesqrt(1.0 + t * t);
         s = t * c;
     }
+}
+
+// The sphere around everything the light reaches: xyz centre, w radius; w < 0 for lights
+// without a finite range (never culled by distance). A spot lights only the part of its range
+// sphere inside its cone, whose smallest enclosing sphere is far smaller for the usual narrow
+// cones (Wronski, "Cull that cone"): radius range / (2 cos a) on the axis up to 45 degrees,
+// range sin a beyond. Every culling test and the light grid (light_grid.cpp
+// lightBoundingSphere, the same formula) use it. On builtin:lights at 1280x720 (decoupled,
+// spectra on) a chunk's grid candidates fell from 166 to 109 and its kept lights by 0.2%, the
+// image unchanged; on lavapipe the culling passes' times did not move measurably (the tests
+// are a small part of them). Padded by 1e-4 of the range: the sector's rim lies on the sphere.
+vec4 lightSphere(GpuLight l) {
+    if (l.type == LIGHT_DIRECTIONAL || l.range <= 0.0) return vec4(l.position, -1.0);
+    float extra = l.type == LIGHT_TUBE ? l.halfLength : 0.0;
+    if (l.type == LIGHT_AREA) extra = length(vec2(l.halfLength, l.radius)); // corner to centre
+    float reach = l.range + extra;
+    if (l.type == LIGHT_SPOT || l.type == LIGHT_SPOT_SQUARE) {
+        float c, s;
+        spotCone(l, c, s);
+        if (c >= 0.70710678) {
+            float t = reach / (2.0 * c);
+            return vec4(l.position + l.direction * t, t + reach * 1e-4);
+        }
+        if (c > 0.0) return vec4(l.position + l.direction * (reach * c), reach * s + reach * 1e-4);
+    }
+    return vec4(l.position, reach);
+}
+
+// Whether a sphere (a tile's or chunk's bounds) lies wholly outside a spot's outer cone (the
+// square cone's circumscribed round one), or behind its apex: the closest point of the cone's
+// surface to the centre is farther than the radius (Wronski's cone test). Gobos are spots.
+bool spotConeMisses(GpuLight l, vec3 centre, float radius) {
+    if (l.type != LIGHT_SPOT && l.type != LIGHT_SPOT_SQUARE) return false;
+    float c, s; // cosine and sine of the cone's half angle
+    spotCone(l, c, s);
     if (c <= 0.0) return false; // 90 degrees or wider: no cone to cull by
     vec3 v = centre - l.position;
     float along = dot(v, l.direction);
@@ -64,11 +88,19 @@ bool lightPlanesCull(GpuLight l, vec3 corners[8]) {
     return true;
 }
 
+// Whether the light's sphere meets the box. A spot's sphere (lightSphere) reaches past its range
+// on the axis: the box must meet the range sphere around the apex too.
+bool lightSphereMeetsBox(GpuLight light, vec4 sphere, vec3 boxMin, vec3 boxMax) {
+    if (sphere.w < 0.0) return true;
+    if (distance(clamp(sphere.xyz, boxMin, boxMax), sphere.xyz) > sphere.w) return false;
+    if (light.type != LIGHT_SPOT && light.type != LIGHT_SPOT_SQUARE) return true;
+    return distance(clamp(light.position, boxMin, boxMax), light.position) <= light.range;
+}
+
 // A shadel chunk's test of one light against its world box: the light's sphere meets the box,
 // no bounding plane leaves every corner unlit, and a spot's cone meets the box's sphere.
 bool chunkKeepsLight(GpuLight light, vec3 boxMin, vec3 boxMax, vec3 corners[8]) {
-    vec4 sphere = lightSphere(light);
-    bool keep = sphere.w < 0.0 || distance(clamp(sphere.xyz, boxMin, boxMax), sphere.xyz) <= sphere.w;
+    bool keep = lightSphereMeetsBox(light, lightSphere(light), boxMin, boxMax);
     return keep && !lightPlanesCull(light, corners) &&
            !spotConeMisses(light, (boxMin + boxMax) * 0.5, 0.5 * distance(boxMin, boxMax));
 }

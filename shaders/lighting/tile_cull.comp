@@ -48,8 +48,7 @@ bool tileKeepsLight(GpuLight light, vec4 planes[6], vec3 boxMin, vec3 boxMax, ve
     if (sphere.w >= 0.0) {
         for (int p = 0; p < 6; ++p)
             keep = keep && dot(planes[p].xyz, sphere.xyz) + planes[p].w >= -sphere.w;
-        vec3 nearest = clamp(sphere.xyz, boxMin, boxMax);
-        keep = keep && distance(nearest, sphere.xyz) <= sphere.w;
+        keep = keep && lightSphereMeetsBox(light, sphere, boxMin, boxMax);
     }
     return keep && !lightPlanesCull(light, corners) && !spotConeMisses(light, centre, radius);
 }

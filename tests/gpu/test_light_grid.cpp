@@ -9,6 +9,7 @@
 #include <random>
 #include <set>
 
+#include "render/gpu_scene.h"
 #include "render/lighting/light_grid.h"
 
 using namespace shadel;
@@ -110,6 +111,81 @@ TEST(LightGrid, CandidatesHoldEveryLightThatMeetsTheBoxAndFewOthers) {
     // A box larger than the coarsest cell is not answered (the chunk tests every light).
     float coarsest = grid.header.cellSize * float(1u << (LIGHT_GRID_LEVELS - 1));
     EXPECT_FALSE(lightGridCandidates(grid, glm::vec3(0), glm::vec3(coarsest * 1.5f)).has_value());
+}
+
+// A spot's culling sphere (lightSphere in lighting/light_cull.glsl, lightBoundingSphere here)
+// is the sphere around its lit sector, not its range sphere: it must hold every point the spot
+// lights (within its range and its outer cone, a square spot's square pyramid), and be smaller
+// than the range for the usual narrow cones, which is what makes the grid list it in fewer cells.
+TEST(LightGrid, SpotSphereHoldsItsLitSectorAndNarrowConesGetSmallerOnes) {
+    std::mt19937 rng(11);
+    std::uniform_real_distribution<float> coord(-1.0f, 1.0f);
+    for (LightType type : {LightType::Spot, LightType::SquareSpot})
+        for (float degrees : {3.0f, 20.0f, 44.0f, 45.0f, 46.0f, 70.0f, 89.0f, 120.0f}) {
+            SCOPED_TRACE(std::string(type == LightType::Spot ? "round" : "square") + " spot, " +
+                         std::to_string(degrees) + " degrees");
+            Light light;
+            light.type = type;
+            light.position = {3.0f, 4.0f, -2.0f};
+            light.direction = glm::normalize(glm::vec3(0.3f, -1.0f, 0.2f));
+            light.range = 7.5f;
+            light.outerConeAngle = glm::radians(degrees);
+            light.innerConeAngle = 0.5f * light.outerConeAngle;
+            std::vector<uint32_t> blockerLists;
+            gpu::GpuLight g = gpuLight(light, blockerLists);
+            glm::vec4 sphere = lightBoundingSphere(g);
+            ASSERT_GT(sphere.w, 0.0f);
+            // (A round spot's axis is not made orthogonal to its direction: it has no use.)
+            glm::vec3 d = g.direction;
+            glm::vec3 u = glm::normalize(g.axis - d * glm::dot(g.axis, d)), v = glm::cross(d, u);
+            // What the spot lights (its cone as the shading evaluates it: common/lighting.glsl).
+            float tanOuter = std::tan(std::min(light.outerConeAngle, 1.5f));
+            auto lit = [&](glm::vec3 p) {
+                if (glm::length(p) > light.range) return false;
+                if (type == LightType::Spot)
+                    return glm::dot(p, d) >= std::cos(light.outerConeAngle) * glm::length(p);
+                float along = glm::dot(p, d);
+                return along > 0.0f && std::abs(glm::dot(p, u)) <= along * tanOuter &&
+                       std::abs(glm::dot(p, v)) <= along * tanOuter;
+            };
+            auto inside = [&](glm::vec3 p) {
+                return glm::distance(light.position + p, glm::vec3(sphere)) <= sphere.w;
+            };
+            uint32_t litPoints = 0;
+            for (int i = 0; i < 20000; ++i) {
+                glm::vec3 p = glm::vec3(coord(rng), coord(rng), coord(rng)) * light.range;
+                if (!lit(p)) continue;
+                litPoints++;
+                ASSERT_TRUE(inside(p)) << "lit point " << i << " outside the sphere";
+            }
+            EXPECT_GT(litPoints, 0u);
+            // The extremes: the apex, the far end of the axis, the rim (round: the cone's edge
+            // at full range; square: the pyramid's corner edges), a hair inside the range (a
+            // wide cone's sphere is the range sphere, unpadded: nothing is lit at the range).
+            float reach = light.range * 0.99999f;
+            EXPECT_TRUE(inside(glm::vec3(0.0f)));
+            EXPECT_TRUE(inside(d * reach));
+            if (type == LightType::Spot) {
+                for (int k = 0; k < 16; ++k) {
+                    float phi = 6.2831853f * float(k) / 16.0f;
+                    glm::vec3 side = std::cos(phi) * u + std::sin(phi) * v;
+                    float a = light.outerConeAngle;
+                    glm::vec3 rim = (std::cos(a) * d + std::sin(a) * side) * reach;
+                    EXPECT_TRUE(inside(rim)) << "rim " << k;
+                }
+            } else {
+                for (glm::vec3 corner : {u + v, u - v, -u + v, -u - v}) {
+                    glm::vec3 edge = glm::normalize(d + corner * tanOuter) * reach;
+                    EXPECT_TRUE(inside(edge));
+                }
+            }
+            if (type == LightType::Spot && degrees <= 45.0f) {
+                EXPECT_LE(sphere.w, 0.7073f * light.range) << "narrow: at most range / sqrt 2";
+            }
+            if (degrees <= 20.0f) {
+                EXPECT_LT(sphere.w, 0.6f * light.range);
+            }
+        }
 }
 
 TEST(LightGrid, NoFiniteLightsGivesAnEmptyGrid) {

@@ -139,9 +139,9 @@ uint64_t prepareLightCulling(Renderer& r, const GpuScene& scene,
     for (uint32_t i = 0; i < lights.size(); ++i) {
         const gpu::GpuLight& l = lights[i];
         bool in = true;
-        if (float radius = lightReach(l); std::isfinite(radius)) {
+        if (glm::vec4 sphere = lightBoundingSphere(l); sphere.w >= 0.0f) {
             for (const glm::vec4& p : planes)
-                in = in && glm::dot(glm::vec3(p), l.position) + p.w >= -radius;
+                in = in && glm::dot(glm::vec3(p), glm::vec3(sphere)) + p.w >= -sphere.w;
         }
         if (in) visible[count++] = i;
     }
