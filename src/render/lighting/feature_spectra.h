@@ -30,15 +30,20 @@
 // costs more than the permutations save: builtin:lights at 1280x720, decoupled frame with
 // spectra 1.08x and 1.17x the frame without in two benches, 0.84x in a third (bench --spectra
 // compare, 3 rounds each; 6 rounds later: on 558, single 635, off 492 ms, on / single 0.876).
-// Where classify's 110-150 ms go (same place, variants swapped in, alternating runs): not the
-// positions: the chunk boxes baked per mesh and level (object space, transformed per instance;
-// tried, not kept) took it from 124-148 to 118-132 ms. Dropping the light tests too (no light
-// kept) left 59-70 ms: the cost of a 64-invocation workgroup per queued chunk (barriers, the
-// bit set's clear and compaction, the grid query in every invocation, the bin append), ~16,000
-// chunks a frame. The light tests cost ~45 ms and the blocker tests of the kept lights ~15.
-// A classify with baked boxes needs no invocation per shadel: one subgroup per chunk would
-// drop most of that fixed cost (not built). Both on and single pay it, so on / single moves
-// little: with classify free, (558 - 120) / (635 - 120) = 0.85.
+// Where classify's 105-150 ms go (same place, variants swapped in, alternating runs; each
+// figure moved 10-20% between runs):
+//  - not the positions: chunk boxes baked per mesh and level (object space, transformed per
+//    instance; tried, not kept) took it from 124-148 to 110-132 ms;
+//  - 29 ms is the 64-invocation workgroup per queued chunk itself (~16,000 a frame: a variant
+//    that bins each chunk with an empty list), ~30 more the grid query in every invocation, the
+//    bit set's clear and compaction and their barriers (a variant that tests no candidate);
+//  - the blocker tests of the kept lights, walked by one invocation, ~20-25 ms (a variant
+//    without them: 86-92 against 105-117 ms); the light tests ~25 ms, and testing a third
+//    fewer candidates (spots culled by their cone's sphere, light_cull.glsl) did not move it.
+// A classify on baked boxes needs no invocation per shadel: a workgroup of 8 chunks, and the
+// blocker tests one kept light per invocation, would cut most of that (not built). Both on and
+// single pay it, so on / single moves little: with classify free, (558 - 120) / (635 - 120) =
+// 0.85.
 // Where the permutations' gain comes from (same place, builtin:lights 1280x720, reuse off, the
 // light lists emptied after classify as a measure only): shadelShading on 318 / single 383 ms
 // with the lights, 87 / 141 ms without them. The light loops cost about the same in both
