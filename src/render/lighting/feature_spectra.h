@@ -40,10 +40,12 @@
 //  - the blocker tests of the kept lights, walked by one invocation, ~20-25 ms (a variant
 //    without them: 86-92 against 105-117 ms); the light tests ~25 ms, and testing a third
 //    fewer candidates (spots culled by their cone's sphere, light_cull.glsl) did not move it.
-// A classify on baked boxes needs no invocation per shadel: a workgroup of 8 chunks, and the
-// blocker tests one kept light per invocation, would cut most of that (not built). Both on and
-// single pay it, so on / single moves little: with classify free, (558 - 120) / (635 - 120) =
-// 0.85.
+// Also measured: a barrier costs ~1.5 ms a frame there (16,000 chunks; the bare workgroup that
+// only bins, 13-17 ms), and the blocker tests one kept light per invocation (two barriers more)
+// gave the same lists and no measurable gain (classify 114-125 against 117-139 ms; tried, not
+// kept). A classify on baked boxes needs no invocation per shadel (a workgroup of 8 chunks;
+// not built). Both on and single pay classify, so on / single moves little: with classify
+// free, (558 - 120) / (635 - 120) = 0.85.
 // Where the permutations' gain comes from (same place, builtin:lights 1280x720, reuse off, the
 // light lists emptied after classify as a measure only): shadelShading on 318 / single 383 ms
 // with the lights, 87 / 141 ms without them. The light loops cost about the same in both
