@@ -7,6 +7,7 @@
 #ifndef SHADEL_LIGHT_CULL_GLSL
 #define SHADEL_LIGHT_CULL_GLSL
 #include "common/lighting.glsl"
+#include "common/spot_bounds.h"
 #extension GL_KHR_shader_subgroup_arithmetic : require
 #extension GL_KHR_shader_subgroup_ballot : require
 #extension GL_KHR_shader_subgroup_vote : require
@@ -20,42 +21,22 @@ vec3 boxCorner(vec3 lo, vec3 hi, int i) {
     return vec3((i & 1) != 0 ? hi.x : lo.x, (i & 2) != 0 ? hi.y : lo.y, (i & 4) != 0 ? hi.z : lo.z);
 }
 
-// The cosine and sine of a spot's outer half angle (a square spot's: of the round cone around
-// its square one). Gobos are spots.
-void spotCone(GpuLight l, out float c, out float s) {
-    if (l.type == LIGHT_SPOT) {
-        c = clamp(-l.spotOffset / l.spotScale, -1.0, 1.0);
-        s = sqrt(1.0 - c * c);
-    } else {
-        float t = max(l.spotOffset / l.spotScale, 0.0) * sqrt(2.0);
-        c = inversesqrt(1.0 + t * t);
-        s = t * c;
-    }
-}
-
 // The sphere around everything the light reaches: xyz centre, w radius; w < 0 for lights
-// without a finite range (never culled by distance). A spot lights only the part of its range
-// sphere inside its cone, whose smallest enclosing sphere is far smaller for the usual narrow
-// cones (Wronski, "Cull that cone"): radius range / (2 cos a) on the axis up to 45 degrees,
-// range sin a beyond. Every culling test and the light grid (light_grid.cpp
-// lightBoundingSphere, the same formula) use it. On builtin:lights at 1280x720 (decoupled,
+// without a finite range (never culled by distance). A spot's is the sphere around its lit
+// sector (common/spot_bounds.h), far smaller than its range sphere for the usual narrow
+// cones. Every culling test and the light grid (light_grid.cpp lightBoundingSphere, the same
+// header) use it. On builtin:lights at 1280x720 (decoupled,
 // spectra on) a chunk's grid candidates fell from 166 to 109 and its kept lights by 0.2%, the
 // image unchanged; on lavapipe the culling passes' times did not move measurably (the tests
-// are a small part of them). Padded by 1e-4 of the range: the sector's rim lies on the sphere.
+// are a small part of them).
 vec4 lightSphere(GpuLight l) {
     if (l.type == LIGHT_DIRECTIONAL || l.range <= 0.0) return vec4(l.position, -1.0);
     float extra = l.type == LIGHT_TUBE ? l.halfLength : 0.0;
     if (l.type == LIGHT_AREA) extra = length(vec2(l.halfLength, l.radius)); // corner to centre
     float reach = l.range + extra;
-    if (l.type == LIGHT_SPOT || l.type == LIGHT_SPOT_SQUARE) {
-        float c, s;
-        spotCone(l, c, s);
-        if (c >= 0.70710678) {
-            float t = reach / (2.0 * c);
-            return vec4(l.position + l.direction * t, t + reach * 1e-4);
-        }
-        if (c > 0.0) return vec4(l.position + l.direction * (reach * c), reach * s + reach * 1e-4);
-    }
+    if (l.type == LIGHT_SPOT || l.type == LIGHT_SPOT_SQUARE)
+        return spotSectorSphere(l.position, l.direction, reach,
+                                spotConeCosSin(l.type, l.spotOffset, l.spotScale));
     return vec4(l.position, reach);
 }
 
@@ -64,8 +45,8 @@ vec4 lightSphere(GpuLight l) {
 // surface to the centre is farther than the radius (Wronski's cone test). Gobos are spots.
 bool spotConeMisses(GpuLight l, vec3 centre, float radius) {
     if (l.type != LIGHT_SPOT && l.type != LIGHT_SPOT_SQUARE) return false;
-    float c, s; // cosine and sine of the cone's half angle
-    spotCone(l, c, s);
+    vec2 cone = spotConeCosSin(l.type, l.spotOffset, l.spotScale);
+    float c = cone.x, s = cone.y; // cosine and sine of the cone's half angle
     if (c <= 0.0) return false; // 90 degrees or wider: no cone to cull by
     vec3 v = centre - l.position;
     float along = dot(v, l.direction);

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstring>
 
+#include "common/spot_bounds.h"
 #include "core/error.h"
 #include "render/lighting/light_culling.h"
 #include "rhi/resources.h"
@@ -41,24 +42,9 @@ uint32_t bucketOf(glm::ivec3 cell) {
 glm::vec4 lightBoundingSphere(const gpu::GpuLight& l) {
     float reach = lightReach(l);
     if (!(std::isfinite(reach) && reach > 0.0f)) return glm::vec4(l.position, -1.0f);
-    if (l.type == LIGHT_SPOT || l.type == LIGHT_SPOT_SQUARE) {
-        // The sphere around the spot's lit sector (lightSphere in lighting/light_cull.glsl).
-        float c, s;
-        if (l.type == LIGHT_SPOT) {
-            c = std::clamp(-l.spotOffset / l.spotScale, -1.0f, 1.0f);
-            s = std::sqrt(1.0f - c * c);
-        } else {
-            float t = std::max(l.spotOffset / l.spotScale, 0.0f) * std::sqrt(2.0f);
-            c = 1.0f / std::sqrt(1.0f + t * t);
-            s = t * c;
-        }
-        if (c >= 0.70710678f) {
-            float t = reach / (2.0f * c);
-            return glm::vec4(l.position + l.direction * t, t + reach * 1e-4f);
-        }
-        if (c > 0.0f)
-            return glm::vec4(l.position + l.direction * (reach * c), reach * s + reach * 1e-4f);
-    }
+    if (l.type == LIGHT_SPOT || l.type == LIGHT_SPOT_SQUARE) // as lightSphere (light_cull.glsl)
+        return shader::spotSectorSphere(l.position, l.direction, reach,
+                                        shader::spotConeCosSin(l.type, l.spotOffset, l.spotScale));
     return glm::vec4(l.position, reach);
 }
 
