@@ -402,7 +402,9 @@ struct GpuSpotShadow {
 
 // Feature spectra (render/lighting/feature_spectra.h): the tile pass bins every tile into the
 // first mode (cheapest first) whose features cover what the tile needs.
-#define CHUNK_LIST_NONE 0xFFFFFFFFu // SpectraFrame::chunkRanges: no stored list
+#define CHUNK_LIST_NONE 0xFFFFFFFFu // SpectraFrame::chunkRanges .y: no stored list
+// ... and .x: the classify pass did not count the chunk's lights either (its permutation does)
+#define CHUNK_LIST_UNCOUNTED 0xFFFFFFFFu
 
 struct SpectraFrame {
     uint64_t dispatch;     // VkDispatchIndirectCommand per mode: x = tiles binned to it
@@ -413,8 +415,11 @@ struct SpectraFrame {
     // shading permutations read it instead of culling the chunk again (0 for screen tiles).
     uint64_t chunkLists;     // uvec2 entries (light, blocker mask), a pool
     uint64_t chunkRanges;    // uvec2 per shading-queue index: (first entry, count); count
-                             // CHUNK_LIST_NONE when the pool was full (the chunk is culled again)
-    uint64_t chunkListCount; // uint[2]: pool entries taken this frame, chunks culled again
+                             // CHUNK_LIST_NONE when the pool was full or the chunk has more
+                             // lights than classify keeps (the chunk is culled again)
+    // uint[3]: pool entries taken this frame; chunks culled again because the pool was full,
+    // and because they have more lights than classify keeps
+    uint64_t chunkListCount;
     uint modeCount;
     uint binCapacity;       // tiles (each mode's list can hold every tile)
     uint chunkListCapacity; // entries of the chunkLists pool
@@ -704,6 +709,9 @@ struct GpuShadelCounters {
     uvec4 shadeDispatch; // x, y, z, queue length: indirect args of the shading pass
     uvec4 copyDispatch;  // x, y, z, queue length: indirect args of the carry-over pass
     uvec4 classDispatch[SHADE_CLASSES]; // x, y, z, list length: each class's shading
+    // x, y, z, queue length: one invocation per queued chunk, 64 a workgroup (passes that take a
+    // chunk in one invocation: the spectra's chunk classify)
+    uvec4 invocationDispatch;
 };
 
 struct ShadelFrame {

@@ -1,19 +1,19 @@
 // Feature spectra of the shadel path (seed 001's spectra, "the same for chunk queues"; see
-// render/lighting/feature_spectra.h). shade.comp is compiled three ways by kChunkSpectraPhase:
+// render/lighting/feature_spectra.h). Two passes:
+//   classify (chunk_classify.comp, one invocation per queued chunk): the carry-over decision,
+//             the chunk's light culling against its world box, the features its list needs (the
+//             entryFeatures of a screen tile) and an append to the bin of the first mode
+//             covering them; the list is kept for the shading;
+// and shade.comp, compiled two ways by kChunkSpectraPhase:
 //   OFF:      one pass over the whole shading queue with every feature (--spectra off);
-//   CLASSIFY: per queued chunk, the carry-over decision, then the chunk's light culling, the
-//             features its list needs (the entryFeatures of a screen tile, against the chunk's
-//             box) and an append to the bin of the first mode covering them; nothing is shaded;
 //   SHADE:    one permutation per mode (kSpectrumFeatures holds only its features) over its
-//             bin, by indirect dispatch: the chunk is culled again (the same list, so the same
-//             features) and shaded.
-// Included by shade.comp; the classify phase's function is chunk_spectra_classify.glsl.
+//             bin, by indirect dispatch: the chunk's list as classify culled it, and shading.
+// Included by shade.comp.
 #ifndef SHADEL_CHUNK_SPECTRA_GLSL
 #define SHADEL_CHUNK_SPECTRA_GLSL
 #include "lighting/spectra.glsl"
 
 #define CHUNK_SPECTRA_OFF 0u
-#define CHUNK_SPECTRA_CLASSIFY 1u
 #define CHUNK_SPECTRA_SHADE 2u
 layout(constant_id = CHUNK_SPECTRA_PHASE_CONSTANT_ID) const uint kChunkSpectraPhase = CHUNK_SPECTRA_OFF;
 layout(constant_id = SPECTRUM_MODE_CONSTANT_ID) const uint kChunkSpectrumMode = 0u;
@@ -25,6 +25,32 @@ uint chunkSpectraWorkIndex(FrameConstants f, uint group) {
     SpectraFrame sf = SpectraFrameRef(LightingFrameRef(f.lighting).l.chunkSpectra).s;
     if (group >= UintBuffer(sf.dispatch).v[kChunkSpectrumMode * 4u + 3u]) return 0xFFFFFFFFu;
     return UintBuffer(sf.tileBins).v[kChunkSpectrumMode * sf.binCapacity + group];
+}
+
+layout(buffer_reference, scalar) buffer ChunkListBuffer { uvec2 e[]; };
+
+// Whether this chunk's lights are counted in the light statistics by the shading: its classify
+// left it uncounted (more lights than it keeps, chunk_classify.comp).
+bool gChunkUncounted = false;
+
+// SHADE: the chunk's list as the classify pass culled it, into the shared list. False (and
+// nothing read) when the classify pass did not keep it: the caller culls the chunk. Uniform
+// flow.
+bool loadChunkLightList(FrameConstants f, uint workIndex) {
+    SpectraFrame sf = SpectraFrameRef(LightingFrameRef(f.lighting).l.chunkSpectra).s;
+    uvec2 range = ChunkListBuffer(sf.chunkRanges).e[workIndex];
+    uint tid = gl_LocalInvocationIndex;
+    if (range.y == CHUNK_LIST_NONE) {
+        gChunkUncounted = range.x == CHUNK_LIST_UNCOUNTED;
+        if (tid == 0u) atomicAdd(UintBuffer(sf.chunkListCount).v[gChunkUncounted ? 2 : 1], 1u);
+        return false;
+    }
+    ChunkListBuffer pool = ChunkListBuffer(sf.chunkLists);
+    for (uint i = tid; i < range.y; i += SHADEL_CHUNK * SHADEL_CHUNK) sLightList[i] = pool.e[range.x + i];
+    if (tid == 0u) sLightListCount = range.y;
+    gLightListMode = LIGHT_LIST_SHARED;
+    barrier();
+    return true;
 }
 
 // --visualize spectra: the shadels of a chunk take its mode's colour.

@@ -5,13 +5,10 @@
 // counts once), and the bit set is compacted in light order, so the list is the one the loop
 // over every light would have built. Needs light_cull.glsl (orderedAppend's sAppendCount, which
 // the compaction sets); the includer defines LIGHT_GRID_LIST and LIGHT_GRID_LIST_MAX (the shared
-// list the compaction fills). Call in uniform control flow.
+// list the compaction fills). Call in uniform control flow. Without LIGHT_GRID_LIST only the
+// query (per invocation, no shared memory: lighting/chunk_classify.comp).
 #ifndef SHADEL_LIGHT_GRID_GLSL
 #define SHADEL_LIGHT_GRID_GLSL
-
-
-shared uint sGridMask[LIGHT_GRID_MASK_LIGHTS / 32u];
-shared uint sGridCandidates;
 
 // A box's grid query: its level and cells. Sources: 0 the global list, 1 the level's big
 // list, 2.. the cells (x fastest).
@@ -96,6 +93,10 @@ uint lightGridCandidateEntry(LightGridCandidates c, uint k) {
     return 0u; // not reached for k < c.total
 }
 
+#ifdef LIGHT_GRID_LIST // a workgroup's query, through a shared bit set
+shared uint sGridMask[LIGHT_GRID_MASK_LIGHTS / 32u];
+shared uint sGridCandidates;
+
 // Clears the bit set when the grid is usable; the caller's next barrier makes it visible (tile
 // culling and a chunk's shading clear it under a barrier they need anyway).
 void lightGridMaskClearUnsynced(FrameConstants f, uint64_t gridAddress, uint threads) {
@@ -147,5 +148,7 @@ bool gridChunkLights(FrameConstants f, uint64_t gridAddress, vec3 boxMin, vec3 b
     lightGridMaskCompact(f.lightCount);
     return true;
 }
+
+#endif // LIGHT_GRID_LIST
 
 #endif

@@ -16,6 +16,8 @@ void main() {
     counters.c.shadeDispatch = chunkDispatch(counters.c.shadeCount);
     for (uint c = 0u; c < SHADE_CLASSES; ++c)
         counters.c.classDispatch[c] = chunkDispatch(counters.c.classCount[c]);
+    counters.c.invocationDispatch = chunkDispatch((counters.c.shadeCount + 63u) / 64u);
+    counters.c.invocationDispatch.w = counters.c.shadeCount;
     // Carry-over copies 8 chunks per workgroup (carry_over.comp).
     uint copyGroups = (counters.c.copyCount + 7u) / 8u;
     counters.c.copyDispatch = chunkDispatch(copyGroups);

@@ -4,6 +4,7 @@
 // with clamped barycentrics (and the barycentrics one shadel right and down, for derivatives),
 // then runs the same material and lighting code as the forward path.
 #include "shadel/shadel.glsl"
+#include "shadel/shade_chunk.glsl"
 #extension GL_KHR_shader_subgroup_arithmetic : require
 #define SHADEL_LIGHT_LIST_SHARED
 #define LIGHT_CULL_ORDERED_APPEND
@@ -36,31 +37,6 @@ void storeLayers(ShadelFrame s, uint index, vec4 radiance, vec4 material) {
     storeMaterial(s.layers[SHADEL_LAYER_MATERIAL], index, material);
 }
 
-uint triangleId(ShadelFrame s, uint offset) {
-    uint word = UintBuffer(s.idMaps).v[offset >> 1];
-    return (word >> ((offset & 1u) * 16u)) & 0xFFFFu;
-}
-
-// Preserved layers (seed: "GetIndexPrevSampleVirtualCoords ... if it was computed last frame
-// it's there"). Where last frame stored this chunk, returns its storage slot then; -1 when the
-// chunk must be shaded: reuse off, the object's level changed (reuseLevels, decided on the
-// CPU), this chunk's turn to be refreshed (each chunk is reshaded once per refresh period, at
-// its own phase), or its view turned past what its specular tolerates (chunkViewTurned).
-// Uniform over the workgroup.
-int carrySource(ShadelFrame s, ShadelObjectRef o, GpuShadelWork work, vec3 camera) {
-    if (s.reuse == 0u || ((o.v.reuseLevels >> work.mip) & 1u) == 0u) return -1;
-    if (shadelRefreshDue(s, work.chunk)) return -1;
-    uvec2 sheet = uvec2(work.chunk & 0xFFFFu, work.chunk >> 16) * SHADEL_CHUNK;
-    uint block = prevBlockIndex(s, o, work.mip, blockIndex(s, sheet));
-    if (block == SHADEL_INVALID) return -1;
-    uint bit = chunkBit(sheet);
-    uint64_t prevMask = Uint64Buffer(s.prevOccupancy).v[block];
-    uint prevBase = UintBuffer(s.prevOffsetMap).v[block];
-    if ((prevMask & (1ul << bit)) == 0ul || prevBase == SHADEL_INVALID) return -1;
-    uint slot = chunkSlot(prevMask, prevBase, bit);
-    return chunkViewTurned(s, o, slot, camera) ? -1 : int(slot);
-}
-
 // Copies the packed words as they are (no unpack and repack).
 void carryOver(ShadelFrame s, uint fromSlot, uint toSlot, uint outIndex) {
     uint from = storageIndex(fromSlot, gl_LocalInvocationID.xy);
@@ -91,34 +67,16 @@ bool chunkTouchesChange(FrameConstants f, ShadelFrame s, ShadelObjectRef o, GpuS
     if (tri != 0xFFFFu) {
         GpuInstance inst = InstanceBuffer(f.instances).i[work.object];
         GpuMesh mesh = MeshBuffer(f.meshes).m[inst.mesh];
-        IndexBuffer indices = IndexBuffer(f.indices);
-        uint i0 = indices.i[mesh.firstIndex + tri * 3u] + uint(mesh.vertexOffset);
-        uint i1 = indices.i[mesh.firstIndex + tri * 3u + 1u] + uint(mesh.vertexOffset);
-        uint i2 = indices.i[mesh.firstIndex + tri * 3u + 2u] + uint(mesh.vertexOffset);
-        Vec2Buffer uvs = Vec2Buffer(s.shadelUvs);
-        vec3 b = shadelBarycentrics(shadelCenterUv(shadel, size), uvs.v[i0], uvs.v[i1], uvs.v[i2]);
-        VertexBuffer vb = VertexBuffer(f.vertices);
-        vec3 p = shadelInterpolate(b, vb.v[i0].position, vb.v[i1].position, vb.v[i2].position);
-        vec3 world = (inst.model * vec4(p, 1.0)).xyz;
-        Vec4Buffer volumes = Vec4Buffer(s.changedVolumes);
-        for (uint i = 0u; i < s.changedVolumeCount; ++i) {
-            vec4 a = volumes.v[2u * i];
-            vec3 ab = volumes.v[2u * i + 1u].xyz - a.xyz; // capsule a-b, radius a.w
-            float t = clamp(dot(world - a.xyz, ab) / max(dot(ab, ab), 1e-12), 0.0, 1.0);
-            if (isinf(a.w) || distance(world, a.xyz + t * ab) <= a.w) chunkNearChange = true;
-        }
+        if (inChangedRegion(s, shadelWorldPosition(f, s, inst, mesh, tri, shadel, size)))
+            chunkNearChange = true;
     }
     barrier();
     return chunkNearChange;
 }
 
-// cullChunkLights keeps the box for the spectra's classify phase (chunk_spectra_classify.glsl)
-// and the chunk's view record (recordChunkView).
+// cullChunkLights keeps the box for the chunk's view record (recordChunkView).
 vec3 gChunkBoxMin = vec3(0.0), gChunkBoxMax = vec3(0.0);
 bool gChunkHasBox = false, gChunkBoxKnown = false;
-// Invocation 0 of a CLASSIFY workgroup: the features of the chunk's kept lights (entryFeatures),
-// gathered as it walks them.
-uint gChunkListFeatures = 0u;
 
 // The chunk's world box from its shading invocations' positions, with one barrier: each
 // subgroup reduces its lanes (subgroupMin/Max of the order-preserving bits, so the box is the
@@ -171,7 +129,7 @@ void cullChunkLights(FrameConstants f, bool shading, vec3 p) {
     gLightListMode = LIGHT_LIST_SHARED;
     if (!gChunkHasBox) { // no shadel to shade
         if (tid == 0u) sLightListCount = 0u;
-        if (kChunkSpectraPhase != CHUNK_SPECTRA_CLASSIFY) barrier(); // (as at the end)
+        barrier(); // (as at the end)
         return;
     }
     vec3 corners[8];
@@ -199,7 +157,8 @@ void cullChunkLights(FrameConstants f, bool shading, vec3 p) {
     if (tid == 0u) {
         uint appended = sAppendCount; // lights kept, before the list's capacity
         uint count = min(appended, LIGHT_CHUNK_MAX_LIGHTS);
-        bool counting = kChunkSpectraPhase != CHUNK_SPECTRA_SHADE; // once per chunk
+        // Once per chunk: a spectrum's permutation counts only the chunks the classify did not.
+        bool counting = kChunkSpectraPhase != CHUNK_SPECTRA_SHADE || gChunkUncounted;
         uint kept = 0u;
         bool perPixel = false;
         for (uint i = 0u; i < count; ++i) {
@@ -209,8 +168,6 @@ void cullChunkLights(FrameConstants f, bool shading, vec3 p) {
             if (mask == LIGHT_INVALID) continue;
             sLightList[kept++] = uvec2(light, mask); // (kept <= i)
             perPixel = perPixel || mask != 0u;
-            if (kChunkSpectraPhase == CHUNK_SPECTRA_CLASSIFY)
-                gChunkListFeatures |= entryFeatures(lf, l, mask, corners);
             if (counting) atomicOr(UintBuffer(lf.visibleLights).v[light >> 5], 1u << (light & 31u));
         }
         sLightListCount = kept;
@@ -223,12 +180,8 @@ void cullChunkLights(FrameConstants f, bool shading, vec3 p) {
             if (appended > LIGHT_CHUNK_MAX_LIGHTS) atomicAdd(counters.c.chunksOverflowed, 1u);
         }
     }
-    // The shading reads the list with every invocation; the classify phase only with this one
-    // (classifyChunkSpectrum), which wrote it.
-    if (kChunkSpectraPhase != CHUNK_SPECTRA_CLASSIFY) barrier();
+    barrier(); // the shading reads the list with every invocation
 }
-
-#include "lighting/chunk_spectra_classify.glsl" // --spectra: binning chunks by features
 
 // Reuse: records where the chunk is seen from as it is shaded (its world box's centre and the
 // direction to the camera), so fill_queue.comp reshades it once the view turned too far for its
@@ -285,7 +238,7 @@ void main() {
     uint outIndex = storageIndex(work.slot, local);
     // Chunks of objects a changed region meets come here even when reusable (the fill pass
     // cannot tell which of their shadels the change reaches): carry over those it does not.
-    // (With spectra the classify phase decided: a binned chunk is shaded.)
+    // (With spectra the classify pass decided: a binned chunk is shaded.)
     int carrySlot = SHADE_HAS(SHADE_OPTIONAL_REUSE) && kChunkSpectraPhase != CHUNK_SPECTRA_SHADE &&
                             (o.v.flags & SHADEL_OBJECT_NEAR_CHANGE) != 0u
                         ? carrySource(s, o, work, f.cameraPosition)
@@ -341,10 +294,6 @@ void main() {
     else if (f.lighting != 0ul && LightingFrameRef(f.lighting).l.tiled != 0u &&
              !(kChunkSpectraPhase == CHUNK_SPECTRA_SHADE && loadChunkLightList(f, workIndex)))
         cullChunkLights(f, shading, si.position);
-    if (kChunkSpectraPhase == CHUNK_SPECTRA_CLASSIFY) {
-        classifyChunkSpectrum(f, workIndex, (o.v.flags & SHADEL_OBJECT_FEATURED_MATERIAL) != 0u);
-        return;
-    }
     if (SHADE_HAS(SHADE_OPTIONAL_REUSE)) recordChunkView(f, s, work.slot, shading, si.position);
     // --debug-lines chunks: this chunk's world box, coloured by MIP (uniform over the workgroup).
     if (SHADE_HAS(SHADE_OPTIONAL_DEBUG_LINES) && debugLinesOn(f, DEBUG_LINES_CHUNKS))

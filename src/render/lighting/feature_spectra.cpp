@@ -123,20 +123,20 @@ struct SpectraState {
     bool chunks = false;           // the shadel path's chunk queue (else forward screen tiles)
     std::vector<uint32_t> modes;   // feature sets, cheapest first
     std::vector<Pipeline> shading; // one permutation per mode
-    Pipeline classify, setup;      // chunks: the classify permutation, the dispatch sizes
+    Pipeline classify, setup;      // chunks: the classify pass, the dispatch sizes
     BufferHandle frame;            // gpu::SpectraFrame (upload)
     // Per mode: tiles, a VkDispatchIndirectCommand (x counts); chunks, a uvec4 (w counts).
     BufferHandle dispatch;     // (read back for stats)
     BufferHandle tileBins;     // modes x tiles (or chunks of the shading queue)
     BufferHandle superfluous;  // modes x features (readback)
     BufferHandle featureTiles; // features (readback)
-    // Chunks: the classify phase's light lists (pool, per-chunk ranges, the pool's counter).
+    // Chunks: the classify pass's light lists (pool, per-chunk ranges, the pool's counter).
     BufferHandle chunkLists, chunkRanges, chunkListCount;
     uint32_t chunkListCapacity = 0;
     uint32_t tiles = 0;
     // Last frame's counts.
     std::vector<uint32_t> binned, lastSuperfluous, lastFeatureTiles;
-    uint32_t lastChunkListEntries = 0, lastChunksCulledAgain = 0;
+    uint32_t lastChunkListEntries = 0, lastChunksCulledAgain = 0, lastChunksLongLists = 0;
 };
 
 void SpectraStateDeleter::operator()(SpectraState* state) const {
@@ -187,7 +187,7 @@ SpectraStatePtr createFeatureSpectra(Renderer& r) {
         createBuffer(gpu, {"spectra.featureTiles", (SPECTRUM_FEATURE_COUNT + SPECTRUM_ALL + 1) * 4,
                            0, MemoryKind::Readback}));
     if (s->chunks) {
-        // The classify phase culls each chunk's lights; the shading permutations read its list
+        // The classify pass culls each chunk's lights; the shading permutations read its list
         // back instead of culling again (on builtin:lights at 1280x720 that culling was a third
         // of the classify pass). 8 entries per queue slot: 13.7 (light, chunk) pairs per shaded
         // chunk there, and the queue holds far more chunks than a frame shades; a chunk whose
@@ -198,19 +198,17 @@ SpectraStatePtr createFeatureSpectra(Renderer& r) {
         s->chunkRanges =
             need(createBuffer(gpu, {"spectra.chunkRanges", uint64_t(s->tiles) * 8, 0}));
         s->chunkListCount = need(createBuffer(
-            gpu, {"spectra.chunkListCount", 8, 0, MemoryKind::Readback})); // entries, culled again
+            gpu, {"spectra.chunkListCount", 12, 0, MemoryKind::Readback})); // SpectraFrame
         // Permutations of the shadel shading itself (shade.comp), with its other constants.
         std::vector<std::pair<uint32_t, uint32_t>> base;
         if (r.settings.distanceFieldLighting)
             base.push_back({DISTANCE_FIELD_LIGHTING_CONSTANT_ID, 1u});
         // Every permutation at once: compiled side by side (rhi/pipeline.h).
         std::vector<ComputePipelineDesc> descs;
-        auto constants = base;
-        constants.push_back({CHUNK_SPECTRA_PHASE_CONSTANT_ID, 1u});
-        descs.push_back({"shadelChunkSpectra.classify", "shadel_shade.comp.spv", constants});
+        descs.push_back({"shadelChunkSpectra.classify", "lighting_chunk_classify.comp.spv", {}});
         descs.push_back({"shadelChunkSpectra.setup", "lighting_chunk_spectra_setup.comp.spv", {}});
         for (uint32_t m = 0; m < modes; ++m) {
-            constants = base;
+            auto constants = base;
             constants.push_back({CHUNK_SPECTRA_PHASE_CONSTANT_ID, 2u});
             constants.push_back({SPECTRUM_FEATURES_CONSTANT_ID, s->modes[m]});
             constants.push_back({SPECTRUM_MODE_CONSTANT_ID, m});
@@ -330,7 +328,7 @@ void recordChunkSpectraClassify(Renderer& r, VkCommandBuffer cmd, uint64_t frame
     ShadelShadingQueue queue = shadelShadingQueue(r);
     bind(gpu, cmd, s.classify);
     pushConstants(gpu, cmd, frame);
-    vkCmdDispatchIndirect(cmd, vkBuffer(gpu, queue.counters), queue.dispatchOffset);
+    vkCmdDispatchIndirect(cmd, vkBuffer(gpu, queue.counters), queue.invocationDispatchOffset);
     memoryBarrier(cmd, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT,
                   VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
                   VK_ACCESS_2_SHADER_STORAGE_READ_BIT | VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT);
@@ -369,6 +367,7 @@ void readFeatureSpectraStats(Renderer& r) {
         const uint32_t* lists = static_cast<const uint32_t*>(mapped(gpu, s.chunkListCount));
         s.lastChunkListEntries = lists[0];
         s.lastChunksCulledAgain = lists[1];
+        s.lastChunksLongLists = lists[2];
     }
 }
 
@@ -409,11 +408,13 @@ void featureSpectraStats(const Renderer& r, nlohmann::json& stats) {
     stats["spectra_superfluous_total"] = superfluousTotal; // (tile, feature) pairs
     stats["tile_features"] = features;                     // feature -> tiles needing it
     if (s.chunks) {
-        // The classify phase's lists the permutations read (their kept lights' entries),
-        // and the chunks whose list did not fit the pool, culled again by their permutation.
+        // The classify pass's lists the permutations read (their kept lights' entries), and the
+        // chunks culled again by their permutation: those whose list did not fit the pool, and
+        // those with more lights than classify keeps (binned to every feature).
         stats["spectra_chunk_list_entries"] = s.lastChunkListEntries;
         stats["spectra_chunk_list_capacity"] = s.chunkListCapacity;
         stats["spectra_chunks_culled_again"] = s.lastChunksCulledAgain;
+        stats["spectra_chunks_long_lists"] = s.lastChunksLongLists;
     }
 }
 

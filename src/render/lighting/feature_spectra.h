@@ -21,31 +21,25 @@
 //
 // Decoupled mode ("the same for chunk queues"): shading is per 8x8-shadel chunk of the shading
 // queue, culled against the chunk's world box (shaders/shadel/shade.comp). With --spectra
-// on|single a classify permutation of the shadel shading runs over the queue first (carry-over
-// decision, chunk light culling, the chunk's features, append to its mode's bin), then each
-// mode's permutation of the same shader shades its bin by indirect dispatch
-// (shaders/lighting/chunk_spectra.glsl). Stats "spectra" then count chunks, not tiles.
-// Cost: the classify phase rebuilds every queued shadel's position and culls its chunk's lights,
-// which the plain shading (--spectra off) does once, inside the shading. On lavapipe that mostly
-// costs more than the permutations save: builtin:lights at 1280x720, decoupled frame with
-// spectra 1.08x and 1.17x the frame without in two benches, 0.84x in a third (bench --spectra
-// compare, 3 rounds each; 6 rounds later: on 558, single 635, off 492 ms, on / single 0.876).
-// Where classify's 105-150 ms go (same place, variants swapped in, alternating runs; each
-// figure moved 10-20% between runs):
-//  - not the positions: chunk boxes baked per mesh and level (object space, transformed per
-//    instance; tried, not kept) took it from 124-148 to 110-132 ms;
-//  - 29 ms is the 64-invocation workgroup per queued chunk itself (~16,000 a frame: a variant
-//    that bins each chunk with an empty list), ~30 more the grid query in every invocation, the
-//    bit set's clear and compaction and their barriers (a variant that tests no candidate);
-//  - the blocker tests of the kept lights, walked by one invocation, ~20-25 ms (a variant
-//    without them: 86-92 against 105-117 ms); the light tests ~25 ms, and testing a third
-//    fewer candidates (spots culled by their cone's sphere, light_cull.glsl) did not move it.
-// Also measured: a barrier costs ~1.5 ms a frame there (16,000 chunks; the bare workgroup that
-// only bins, 13-17 ms), and the blocker tests one kept light per invocation (two barriers more)
-// gave the same lists and no measurable gain (classify 114-125 against 117-139 ms; tried, not
-// kept). A classify on baked boxes needs no invocation per shadel (a workgroup of 8 chunks;
-// not built). Both on and single pay classify, so on / single moves little: with classify
-// free, (558 - 120) / (635 - 120) = 0.85.
+// on|single a classify pass runs over the queue first, one invocation per chunk
+// (shaders/lighting/chunk_classify.comp: carry-over decision, the chunk's box from its 64
+// positions, light culling, the chunk's features, append to its mode's bin, its list kept for
+// the shading), then each mode's permutation of the shadel shading shades its bin by indirect
+// dispatch, reading that list (shaders/lighting/chunk_spectra.glsl). Stats "spectra" then count
+// chunks, not tiles.
+// Classify was first a permutation of the shading itself: an 8x8 workgroup per chunk whose 64
+// invocations each rebuilt a position and shared the culling through shared memory and
+// barriers. On builtin:lights at 1280x720 (lavapipe) that took 105-150 ms of a ~600 ms frame,
+// and variants showed where: not the positions (chunk boxes baked per mesh and level took it to
+// 110-132 ms), but ~29 ms for the bare workgroup per chunk (~16,000 a frame), ~30 the grid's
+// shared bit set, its compaction and their barriers (a barrier there cost ~1.5 ms a frame),
+// ~20-25 the blocker tests walked by one invocation, ~25 the light tests. One invocation per
+// chunk pays none of the workgroup's costs: each walks its chunk's 64 positions, its ~100 grid
+// candidates (a light listed in several cells kept once, by a sorted insert) and its ~14 kept
+// lights' blockers beside 63 other chunks. Alternating runs against the workgroup classify
+// (same command, reuse off, spectra on): classify 31.4 / 33.0 ms against 93.3 / 88.7, the same
+// (light, chunk) pairs (220,533) and image; 42 of the 16,174 chunks keep more than 64 lights
+// (coarse levels' large chunks) and are culled again by their permutation.
 // Where the permutations' gain comes from (same place, builtin:lights 1280x720, reuse off, the
 // light lists emptied after classify as a measure only): shadelShading on 318 / single 383 ms
 // with the lights, 87 / 141 ms without them. The light loops cost about the same in both
@@ -88,8 +82,8 @@ uint64_t prepareFeatureSpectra(Renderer& r, uint32_t tilesX, uint32_t tilesY);
 void recordSpectraReset(Renderer& r, VkCommandBuffer cmd);
 // "tileShading": every mode's permutation over its bin (indirect), into the HDR target.
 void recordTileShading(Renderer& r, VkCommandBuffer cmd, uint64_t frame);
-// "shadelChunkSpectra" (decoupled, before shadelShading): the classify permutation over the
-// shading queue, then the bins' dispatch sizes.
+// "shadelChunkSpectra" (decoupled, before shadelShading): the classify pass over the shading
+// queue (an invocation per chunk), then the bins' dispatch sizes.
 void recordChunkSpectraClassify(Renderer& r, VkCommandBuffer cmd, uint64_t frame);
 // Inside "shadelShading": every mode's shadel shading permutation over its bin (indirect).
 void recordChunkSpectraShading(Renderer& r, VkCommandBuffer cmd, uint64_t frame);

@@ -1034,7 +1034,8 @@ void computeToCompute(VkCommandBuffer cmd) {
 
 ShadelShadingQueue shadelShadingQueue(const Renderer& r) {
     const DecoupledState& d = *r.decoupled;
-    return {d.counters, offsetof(gpu::GpuShadelCounters, shadeDispatch), d.capacityChunks};
+    return {d.counters, offsetof(gpu::GpuShadelCounters, shadeDispatch),
+            offsetof(gpu::GpuShadelCounters, invocationDispatch), d.capacityChunks};
 }
 
 void recordDecoupledMarking(Renderer& r, FrameRecorder& rec, uint64_t frame) {

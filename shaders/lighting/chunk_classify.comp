@@ -1,0 +1,223 @@
+#version 460
+// The classify pass of the shadel path's feature spectra (chunk_spectra.glsl,
+// render/lighting/feature_spectra.h): one invocation per queued chunk, 64 chunks a workgroup.
+// Each invocation carries the chunk over when it can, else builds the chunk's world box from
+// the positions its shadels are lit at (as the shading rebuilds them), culls the lights
+// against it (the light grid's candidates, then the blockers), keeps the list in light order
+// for the shading permutations, and bins the chunk by the features the list and its material
+// need.
+// Why one invocation per chunk: it was a permutation of the shading itself (one 8x8 workgroup
+// per chunk, the culling shared by its 64 invocations through shared memory and barriers),
+// and on builtin:lights at 1280x720 that took 105-150 ms of a ~600 ms frame on lavapipe, where a
+// workgroup per chunk and each barrier cost far more than the tests: 29 ms was the bare
+// workgroup per chunk (~16,000 a frame), ~30 the shared bit set and its barriers. Here nothing
+// is shared, no barrier is needed, and a chunk's serial walk (its 64 positions, ~100 candidate
+// lights, ~14 kept) runs beside 63 others'.
+#include "shadel/shade_chunk.glsl"
+#include "common/lighting.glsl"
+#include "lighting/light_cull.glsl"
+#include "lighting/light_grid.glsl" // the query only (no LIGHT_GRID_LIST)
+#include "lighting/spectra.glsl"
+#include "common/ordered_float.glsl"
+
+layout(local_size_x = 64) in;
+layout(push_constant, scalar) uniform Push { uint64_t frame; } pc;
+layout(buffer_reference, scalar) buffer ClassifyListBuffer { uvec2 e[]; };
+
+// The lights a chunk keeps here, in light order; a chunk with more (rare: a large box among many
+// lights) is left to its permutation, which culls it with the whole workgroup (shade.comp
+// cullChunkLights, the same list).
+#define CLASSIFY_MAX_LIGHTS 64u
+uint gLights[CLASSIFY_MAX_LIGHTS];
+uint gMasks[CLASSIFY_MAX_LIGHTS];
+
+// Inserts `light` into the first n entries of gLights (sorted) unless it is there already: a
+// light listed in several of the query's cells is kept once. False when the list is full. The
+// grid lists each source in light order, so the search from the end is short.
+bool insertLight(inout uint n, uint light) {
+    uint at = n;
+    while (at > 0u && gLights[at - 1u] > light) at--;
+    if (at > 0u && gLights[at - 1u] == light) return true;
+    if (n == CLASSIFY_MAX_LIGHTS) return false;
+    for (uint i = n; i > at; --i) gLights[i] = gLights[i - 1u];
+    gLights[at] = light;
+    n++;
+    return true;
+}
+
+// The lights chunkKeepsLight keeps for the box, into gLights: the light grid's candidates, or
+// every light when the grid cannot answer (as shade.comp's cullChunkLights). `tested`: the
+// candidates tested. False when they do not fit.
+bool cullChunk(FrameConstants f, LightingFrame lf, vec3 boxMin, vec3 boxMax, vec3 corners[8],
+               out uint count, out uint tested) {
+    LightBuffer lights = LightBuffer(f.lights);
+    count = 0u;
+    LightGridQuery q;
+    if (lightGridQuery(f, lf.lightGrid, boxMin, boxMax, q)) {
+        UintBuffer entries = UintBuffer(q.g.entries);
+        LightGridCandidates c = lightGridCandidates(q);
+        tested = c.total;
+        for (uint s = 0u; s < c.sources; ++s)
+            for (uint k = 0u; k < c.lists[s].y; ++k) {
+                uint light = entries.v[c.lists[s].x + k];
+                if (chunkKeepsLight(lights.l[light], boxMin, boxMax, corners) && !insertLight(count, light))
+                    return false;
+            }
+        return true;
+    }
+    tested = f.lightCount;
+    for (uint light = 0u; light < f.lightCount; ++light) {
+        if (!chunkKeepsLight(lights.l[light], boxMin, boxMax, corners)) continue;
+        if (count == CLASSIFY_MAX_LIGHTS) return false;
+        gLights[count++] = light;
+    }
+    return true;
+}
+
+// A chunk with more lights than the list holds: the features of every light it keeps (after
+// its blockers), walked as cullChunk walks them, a light listed twice adding nothing.
+uint longListFeatures(FrameConstants f, LightingFrame lf, vec3 boxMin, vec3 boxMax, vec3 corners[8]) {
+    LightBuffer lights = LightBuffer(f.lights);
+    uint features = 0u;
+    LightGridQuery q;
+    bool gridded = lightGridQuery(f, lf.lightGrid, boxMin, boxMax, q);
+    LightGridCandidates c;
+    if (gridded) c = lightGridCandidates(q);
+    UintBuffer entries = UintBuffer(q.g.entries);
+    uint total = gridded ? c.total : f.lightCount;
+    for (uint k = 0u, s = 0u, inSource = 0u; k < total; ++k, ++inSource) {
+        uint light = k;
+        if (gridded) {
+            while (inSource >= c.lists[s].y) s++, inSource = 0u;
+            light = entries.v[c.lists[s].x + inSource];
+        }
+        GpuLight l = lights.l[light];
+        if (!chunkKeepsLight(l, boxMin, boxMax, corners)) continue;
+        uint mask = lightBlockerMask(lf, l, corners, boxMin, boxMax);
+        if (mask != LIGHT_INVALID) features |= entryFeatures(lf, l, mask, corners);
+    }
+    return features;
+}
+
+// Copies last frame's shadels of the chunk (slot `fromSlot` then) to its slot now, the packed
+// words as they are, as carry_over.comp does for the chunks the fill pass carried.
+void carryOverChunk(ShadelFrame s, uint fromSlot, uint toSlot) {
+    const uint radianceUvec4s = SHADEL_CHUNK * SHADEL_CHUNK / 2u; // uvec2 per shadel
+    const uint materialUvec4s = SHADEL_CHUNK * SHADEL_CHUNK / 4u; // uint per shadel
+    Uvec4Buffer radianceIn = Uvec4Buffer(s.prevLayers[SHADEL_LAYER_RADIANCE]);
+    Uvec4Buffer radianceOut = Uvec4Buffer(s.layers[SHADEL_LAYER_RADIANCE]);
+    for (uint i = 0u; i < radianceUvec4s; ++i)
+        radianceOut.v[toSlot * radianceUvec4s + i] = radianceIn.v[fromSlot * radianceUvec4s + i];
+    Uvec4Buffer materialIn = Uvec4Buffer(s.prevLayers[SHADEL_LAYER_MATERIAL]);
+    Uvec4Buffer materialOut = Uvec4Buffer(s.layers[SHADEL_LAYER_MATERIAL]);
+    for (uint i = 0u; i < materialUvec4s; ++i)
+        materialOut.v[toSlot * materialUvec4s + i] = materialIn.v[fromSlot * materialUvec4s + i];
+    Uvec4Buffer(s.chunkViews).v[toSlot] = Uvec4Buffer(s.prevChunkViews).v[fromSlot];
+    atomicAdd(ShadelCountersRef(s.counters).c.chunksReused, 1u);
+}
+
+void main() {
+    FrameConstants f = FrameConstantsRef(pc.frame).f;
+    ShadelFrame s = ShadelFrameRef(f.shadel).s;
+    ShadelCountersRef counters = ShadelCountersRef(s.counters);
+    uint group = gl_WorkGroupID.y * 32768u + gl_WorkGroupID.x;
+    uint workIndex = group * gl_WorkGroupSize.x + gl_LocalInvocationIndex;
+    if (workIndex >= counters.c.shadeDispatch.w) return;
+    GpuShadelWork work = ShadelWorkBuffer(s.queue).w[workIndex];
+    ShadelObjectRef o = shadelObject(s, work.object);
+    // Chunks of objects a changed region meets come to the queue even when reusable (the fill
+    // pass cannot tell which of their shadels the change reaches): carried over unless one of
+    // their shadels lies in it.
+    int carrySlot = (o.v.flags & SHADEL_OBJECT_NEAR_CHANGE) != 0u
+                        ? carrySource(s, o, work, f.cameraPosition)
+                        : -1;
+
+    // The box of the positions the chunk's shadels are lit at (order-preserving bits, so it is
+    // the box the shading's subgroup reduction builds).
+    GpuInstance inst = InstanceBuffer(f.instances).i[work.object];
+    GpuMesh mesh = MeshBuffer(f.meshes).m[inst.mesh];
+    uvec2 size = levelSize(o, work.mip);
+    uvec2 sheet = uvec2(work.chunk & 0xFFFFu, work.chunk >> 16) * SHADEL_CHUNK;
+    uvec3 lo = uvec3(0xFFFFFFFFu), hi = uvec3(0u);
+    bool nearChange = false;
+    for (uint i = 0u; i < SHADEL_CHUNK * SHADEL_CHUNK; ++i) {
+        uvec2 shadel = levelShadel(o, work.mip, sheet + uvec2(i % SHADEL_CHUNK, i / SHADEL_CHUNK));
+        if (any(greaterThanEqual(shadel, size))) continue;
+        uint tri = triangleId(s, o.v.idMapOffset[work.mip] + shadel.y * size.x + shadel.x);
+        if (tri == 0xFFFFu) continue;
+        SHADEL_ASSERT(f, tri * 3u < mesh.indexCount, ASSERT_TRIANGLE_ID, tri, mesh.indexCount);
+        if (tri * 3u >= mesh.indexCount) continue;
+        vec3 world = shadelWorldPosition(f, s, inst, mesh, tri, shadel, size);
+        uvec3 bits = orderedFloatBits(world);
+        lo = min(lo, bits);
+        hi = max(hi, bits);
+        if (carrySlot >= 0 && !nearChange) nearChange = inChangedRegion(s, world);
+    }
+    if (carrySlot >= 0 && !nearChange) {
+        carryOverChunk(s, uint(carrySlot), work.slot);
+        return;
+    }
+
+    // Spectra need the lighting frame (feature_spectra.h: they exist only with it).
+    LightingFrame lf = LightingFrameRef(f.lighting).l;
+    SpectraFrame sf = SpectraFrameRef(lf.chunkSpectra).s;
+    ClassifyListBuffer ranges = ClassifyListBuffer(sf.chunkRanges);
+    // Without tiled culling every light may reach the chunk (its permutation loops over all).
+    if (lf.tiled == 0u) {
+        binChunkSpectrum(lf, workIndex, SPECTRUM_ALL);
+        return;
+    }
+    if (hi.x == 0u) { // no shadel to shade: the cheapest mode writes its zeros
+        ranges.e[workIndex] = uvec2(0u);
+        binChunkSpectrum(lf, workIndex, 0u);
+        return;
+    }
+    vec3 boxMin = orderedBitsFloat(lo), boxMax = orderedBitsFloat(hi);
+    vec3 corners[8];
+    for (int i = 0; i < 8; ++i) corners[i] = boxCorner(boxMin, boxMax, i);
+    uint features = frameFeatures(f, lf);
+    if ((o.v.flags & SHADEL_OBJECT_FEATURED_MATERIAL) != 0u) features |= SPECTRUM_MATERIAL;
+    uint count, tested;
+    if (!cullChunk(f, lf, boxMin, boxMax, corners, count, tested)) {
+        // Its permutation culls it (the same list) and counts its lights.
+        ranges.e[workIndex] = uvec2(CHUNK_LIST_UNCOUNTED, CHUNK_LIST_NONE);
+        binChunkSpectrum(lf, workIndex, features | longListFeatures(f, lf, boxMin, boxMax, corners));
+        return;
+    }
+
+    // Each kept light's blockers against the box: the lights one hides from the whole chunk
+    // dropped, the others' masks of blockers to test per shadel; the list's features.
+    LightBuffer lights = LightBuffer(f.lights);
+    UintBuffer visible = UintBuffer(lf.visibleLights);
+    uint kept = 0u;
+    bool perPixel = false;
+    for (uint i = 0u; i < count; ++i) {
+        uint light = gLights[i];
+        GpuLight l = lights.l[light];
+        uint mask = lightBlockerMask(lf, l, corners, boxMin, boxMax);
+        if (mask == LIGHT_INVALID) continue;
+        gLights[kept] = light;
+        gMasks[kept++] = mask;
+        perPixel = perPixel || mask != 0u;
+        features |= entryFeatures(lf, l, mask, corners);
+        uint bit = 1u << (light & 31u); // lights_visible: most are marked already
+        if ((visible.v[light >> 5] & bit) == 0u) atomicOr(visible.v[light >> 5], bit);
+    }
+
+    // The list, for the chunk's permutation; one that does not fit the pool is culled again
+    // there (the same list).
+    uint base = kept == 0u ? 0u : atomicAdd(UintBuffer(sf.chunkListCount).v[0], kept);
+    bool fits = base <= sf.chunkListCapacity && kept <= sf.chunkListCapacity - base;
+    ranges.e[workIndex] = fits ? uvec2(base, kept) : uvec2(0u, CHUNK_LIST_NONE);
+    if (fits) {
+        ClassifyListBuffer pool = ClassifyListBuffer(sf.chunkLists);
+        for (uint i = 0u; i < kept; ++i) pool.e[base + i] = uvec2(gLights[i], gMasks[i]);
+    }
+
+    LightingCountersRef lc = LightingCountersRef(lf.counters);
+    if (kept != 0u) atomicAdd(lc.c.lightChunkPairs, kept);
+    atomicAdd(lc.c.lightGridCandidates, tested);
+    if (count != kept) atomicAdd(lc.c.lightsCulledByBlockers, count - kept);
+    if (perPixel) atomicAdd(lc.c.perPixelBlockerChunks, 1u);
+    binChunkSpectrum(lf, workIndex, features);
+}
