@@ -39,7 +39,14 @@
 // lights' blockers beside 63 other chunks. Alternating runs against the workgroup classify
 // (same command, reuse off, spectra on): classify 31.4 / 33.0 ms against 93.3 / 88.7, the same
 // (light, chunk) pairs (220,533) and image; 42 of the 16,174 chunks keep more than 64 lights
-// (coarse levels' large chunks) and are culled again by their permutation.
+// (coarse levels' large chunks) and are culled again by their permutation. bench --spectra
+// compare (1280x720, 4 frames, timing submit), the old build's 3 rounds then this one's 6, the
+// host in the same state: decoupled frame on 397.9 -> 340.6 ms, single 428.2 -> 382.2, off
+// 364.4 / 375.6; on / single 0.930 -> 0.896, on / off 1.092 -> 0.907 (spectra now cost less
+// than no spectra). The permutations' own gain is what is left: 37 ms of shading.
+// Tried, not kept: the lists with the lights that read no texture first and a permutation
+// looping over those without that code (kSpectrumLightSplit, as forward tiles): shadelShading
+// 236-237 ms against 236-243 without (alternating runs), no gain.
 // Where the permutations' gain comes from (same place, builtin:lights 1280x720, reuse off, the
 // light lists emptied after classify as a measure only): shadelShading on 318 / single 383 ms
 // with the lights, 87 / 141 ms without them. The light loops cost about the same in both
