@@ -14,6 +14,7 @@
 // is shared, no barrier is needed, and a chunk's serial walk (its 64 positions, ~100 candidate
 // lights, ~14 kept) runs beside 63 others'.
 #include "shadel/shade_chunk.glsl"
+#include "common/dispatch_2d.h"
 #include "common/lighting.glsl"
 #include "lighting/light_cull.glsl"
 #include "lighting/light_grid.glsl" // the query only (no LIGHT_GRID_LIST)
@@ -120,7 +121,7 @@ void main() {
     FrameConstants f = FrameConstantsRef(pc.frame).f;
     ShadelFrame s = ShadelFrameRef(f.shadel).s;
     ShadelCountersRef counters = ShadelCountersRef(s.counters);
-    uint group = gl_WorkGroupID.y * 32768u + gl_WorkGroupID.x;
+    uint group = dispatch2dGroup();
     uint workIndex = group * gl_WorkGroupSize.x + gl_LocalInvocationIndex;
     if (workIndex >= counters.c.shadeDispatch.w) return;
     GpuShadelWork work = ShadelWorkBuffer(s.queue).w[workIndex];

@@ -3,6 +3,7 @@
 // becomes its 2-D indirect dispatch size, x kept under every device's maxComputeWorkGroupCount[0]
 // as for the shading queue (shaders/shadel/dispatch_setup.comp).
 #include "common/bindless.glsl"
+#include "common/dispatch_2d.h"
 
 layout(local_size_x = SPECTRUM_MAX_MODES) in;
 layout(buffer_reference, scalar) readonly buffer SetupSpectraFrameRef { SpectraFrame s; };
@@ -14,7 +15,8 @@ void main() {
     if (mode >= sf.modeCount) return;
     UintBuffer args = UintBuffer(sf.dispatch);
     uint n = args.v[mode * 4u + 3u];
-    args.v[mode * 4u] = min(n, 32768u);
-    args.v[mode * 4u + 1u] = n == 0u ? 0u : (n + 32767u) / 32768u;
+    uvec2 groups = dispatch2d(n);
+    args.v[mode * 4u] = groups.x;
+    args.v[mode * 4u + 1u] = groups.y;
     args.v[mode * 4u + 2u] = 1u;
 }

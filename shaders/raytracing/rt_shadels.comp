@@ -10,6 +10,7 @@
 #include "raytracing/rt_effects.glsl"
 #include "common/shadel_bary.h"
 #include "shadel/shadel.glsl"
+#include "common/dispatch_2d.h"
 
 layout(local_size_x = 8, local_size_y = 8) in;
 layout(push_constant, scalar) uniform Push { uint64_t frame; } pc;
@@ -111,7 +112,7 @@ void main() {
     FrameConstants f = FrameConstantsRef(pc.frame).f;
     RtFrame rt = RtFrameRef(f.rt).r;
     ShadelFrame s = ShadelFrameRef(f.shadel).s;
-    uint tileIndex = gl_WorkGroupID.y * 32768u + gl_WorkGroupID.x;
+    uint tileIndex = dispatch2dGroup();
     if (tileIndex >= rt.shadelTileCount) return;
     RtShadelTile tile = RtShadelTiles(rt.shadelTiles).t[tileIndex];
     RtShadelObject o = RtShadelObjectRefs(rt.shadelObjects).o[tile.object];

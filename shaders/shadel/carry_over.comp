@@ -7,6 +7,7 @@
 // 2 uvec4s); a workgroup copies eight chunks (per-workgroup overhead dominates a copy on CPU
 // devices).
 #include "shadel/shadel.glsl"
+#include "common/dispatch_2d.h"
 
 #define CHUNKS_PER_GROUP 8u
 #define RADIANCE_ROW_UVEC4S 4u // SHADEL_CHUNK shadels x uvec2
@@ -17,7 +18,7 @@ layout(push_constant, scalar) uniform Push { uint64_t frame; } pc;
 void main() {
     ShadelFrameRef frame = ShadelFrameRef(FrameConstantsRef(pc.frame).f.shadel);
     ShadelCountersRef counters = ShadelCountersRef(frame.s.counters);
-    uint group = gl_WorkGroupID.y * 32768u + gl_WorkGroupID.x;
+    uint group = dispatch2dGroup();
     uint workIndex = group * CHUNKS_PER_GROUP + gl_LocalInvocationIndex / SHADEL_CHUNK;
     uint row = gl_LocalInvocationIndex % SHADEL_CHUNK;
     if (workIndex >= counters.c.copyCount) return;

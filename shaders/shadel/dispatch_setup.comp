@@ -1,13 +1,15 @@
 #version 460
 // Indirect arguments of the shading and carry-over passes, from the queue lengths the fill
-// pass counted. 2-D dispatches keep x under every device's maxComputeWorkGroupCount[0].
+// pass counted. 2-D dispatches keep x under every device's maxComputeWorkGroupCount[0]
+// (common/dispatch_2d.h).
 #include "shadel/shadel.glsl"
+#include "common/dispatch_2d.h"
 
 layout(local_size_x = 1) in;
 layout(push_constant, scalar) uniform Push { uint64_t frame; } pc;
 
 uvec4 chunkDispatch(uint n) {
-    return uvec4(min(n, 32768u), n == 0u ? 0u : (n + 32767u) / 32768u, 1u, n);
+    return uvec4(dispatch2d(n), 1u, n);
 }
 
 void main() {

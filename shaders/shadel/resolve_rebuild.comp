@@ -2,8 +2,9 @@
 // The resolve's rebuild pass (see resolve.comp): one invocation per pixel the resolve listed
 // (misses, overflow, camera-cut samples: rare), rebuilt from the visibility buffer and shaded
 // as the inline rebuild would (shadel/resolve_pixel.glsl resolveRebuilt). Indirect dispatch
-// (resolve_rebuild_args.comp), 2-D past 32768 groups.
+// (resolve_rebuild_args.comp), 2-D past 65535 groups (common/dispatch_2d.h).
 #include "shadel/resolve_pixel.glsl"
+#include "common/dispatch_2d.h"
 
 layout(local_size_x = 64) in;
 
@@ -11,7 +12,7 @@ void main() {
     FrameConstants f = FrameConstantsRef(pc.frame).f;
     ShadelFrame s = ShadelFrameRef(f.shadel).s;
     ResolveRebuildList list = ResolveRebuildList(pc.rebuildList);
-    uint index = (gl_WorkGroupID.y * 32768u + gl_WorkGroupID.x) * 64u + gl_LocalInvocationIndex;
+    uint index = dispatch2dGroup() * 64u + gl_LocalInvocationIndex;
     uvec4 counts = uvec4(0u);
     if (index < list.count) {
         uint packed = list.pixels[index];

@@ -5,6 +5,7 @@
 // then runs the same material and lighting code as the forward path.
 #include "shadel/shadel.glsl"
 #include "shadel/shade_chunk.glsl"
+#include "common/dispatch_2d.h"
 #extension GL_KHR_shader_subgroup_arithmetic : require
 #define SHADEL_LIGHT_LIST_SHARED
 #define LIGHT_CULL_ORDERED_APPEND
@@ -222,7 +223,7 @@ void main() {
     FrameConstants f = FrameConstantsRef(pc.frame).f;
     gTextureFeedback = f.textureFeedback; // texture streaming: the MIPs the shadels want
     ShadelFrame s = ShadelFrameRef(f.shadel).s;
-    uint group = gl_WorkGroupID.y * 32768u + gl_WorkGroupID.x;
+    uint group = dispatch2dGroup();
     uint workIndex;
     if (kShadeQueue != SHADE_QUEUE_ALL) {
         uint shadeClass = kShadeQueue - 1u;

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstring>
 
+#include "common/dispatch_2d.h"
 #include "core/log.h"
 #include "render/renderer.h"
 #include "render/shadel/decoupled.h"
@@ -214,8 +215,8 @@ void recordRtShadelTrace(Renderer& r, VkCommandBuffer cmd, uint64_t frame, RtSha
     if (c.tileCount) {
         bind(gpu, cmd, c.trace);
         pushConstants(gpu, cmd, RtShadelPush{frame});
-        uint32_t x = std::min(c.tileCount, 32768u);
-        vkCmdDispatch(cmd, x, (c.tileCount + 32767) / 32768, 1);
+        shader::Dispatch2d groups = shader::dispatch2d(c.tileCount);
+        vkCmdDispatch(cmd, groups.x, groups.y, 1);
     }
     memoryBarrier(cmd, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT,
                   VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT,
