@@ -7,7 +7,8 @@
 // queued chunks: a full row and a row of 2,786 chunks and 29,982 groups that return at once)
 // ran the first row on one thread: the all-features shadel shading took 1046 ms, and 587 ms as
 // 17,777 x 2 groups, the image the same. (The groups that return cost little: a variant
-// returning every group at that check took 47 ms.)
+// returning every group at that check took 47 ms.) builtin:default at 1920x1080 on the orbit
+// (40,950 chunks) had the same: decoupled / forward 2.495 -> 1.876 (bench, 12 frames, 2 rounds).
 #ifndef SHADEL_DISPATCH_2D_H
 #define SHADEL_DISPATCH_2D_H
 
