@@ -2,10 +2,11 @@
 // 65535 groups in x): n groups as x * y with y = ceil(n / 65535) and x = ceil(n / y), rows of
 // nearly equal length, at most y - 1 groups past the end. Written once for C++ (vkCmdDispatch
 // sizes) and GLSL (indirect arguments built on the GPU, and a group's index).
-// Why rows of equal length: this was x = min(n, 32768), y = ceil(n / 32768), and on lavapipe,
-// which hands each of its threads whole rows of the grid, builtin:lights at 1920x1080 (35,554
-// queued chunks: a full row and a row of 2,786 chunks and 29,982 groups that return at once)
-// ran the first row on one thread: the all-features shadel shading took 1046 ms, and 587 ms as
+// Why rows of equal length: this was x = min(n, 32768), y = ceil(n / 32768), and lavapipe
+// splits a dispatch's groups, in order, into one contiguous range per thread (its compute
+// thread pool's iter_per_thread), so builtin:lights at 1920x1080 (35,554 queued chunks: a full
+// row, then a row of 2,786 chunks and 29,982 groups that return at once) ran the first row on
+// one thread and little on the other: the all-features shadel shading took 1046 ms, and 587 ms as
 // 17,777 x 2 groups, the image the same. (The groups that return cost little: a variant
 // returning every group at that check took 47 ms.) builtin:default at 1920x1080 on the orbit
 // (40,950 chunks) had the same: decoupled / forward 2.495 -> 1.876 (bench, 12 frames, 2 rounds).

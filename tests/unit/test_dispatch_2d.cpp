@@ -1,7 +1,8 @@
 // The 2-D workgroup counts of common/dispatch_2d.h (the shadel queues' indirect dispatches are
 // built on the GPU with the same function): every group count n is covered, x stays within the
-// 65535 every device allows, rows are as few as x allows and nearly equal (lavapipe hands
-// whole rows to its threads), and fewer than y groups run past the end.
+// 65535 every device allows, rows are as few as x allows and nearly equal, and fewer than y
+// groups run past the end (lavapipe gives each thread one contiguous range of the groups: a
+// full row beside a nearly empty one put almost all the work on one thread).
 #include <vector>
 
 #include <gtest/gtest.h>
