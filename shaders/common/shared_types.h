@@ -413,10 +413,10 @@ struct SpectraFrame {
     uint64_t featureTiles; // uint per feature bit: tiles that needed it; then per feature set
     // Shadel chunks: the light list the classify phase culled for each queued chunk, so the
     // shading permutations read it instead of culling the chunk again (0 for screen tiles).
-    uint64_t chunkLists;     // uvec2 entries (light, blocker mask), a pool
-    uint64_t chunkRanges;    // uvec2 per shading-queue index: (first entry, count); count
-                             // CHUNK_LIST_NONE when the pool was full or the chunk has more
-                             // lights than classify keeps (the chunk is culled again)
+    uint64_t chunkLists;  // uvec2 entries (light, blocker mask), a pool
+    uint64_t chunkRanges; // uvec2 per shading-queue index: (first entry, count); count
+                          // CHUNK_LIST_NONE when the pool was full or the chunk has more
+                          // lights than classify keeps (the chunk is culled again)
     // uint[3]: pool entries taken this frame; chunks culled again because the pool was full,
     // and because they have more lights than classify keeps
     uint64_t chunkListCount;

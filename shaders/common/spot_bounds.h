@@ -7,6 +7,7 @@
 
 #ifdef __cplusplus
 #include <glm/glm.hpp>
+
 #include "common/shared_types.h"
 #ifndef SHADEL_INLINE
 #define SHADEL_INLINE inline

@@ -23,7 +23,6 @@
 
 layout(local_size_x = 64) in;
 layout(push_constant, scalar) uniform Push { uint64_t frame; } pc;
-layout(buffer_reference, scalar) buffer ClassifyListBuffer { uvec2 e[]; };
 
 // The lights a chunk keeps here, in light order; a chunk with more (rare: a large box among many
 // lights) is left to its permutation, which culls it with the whole workgroup (shade.comp
@@ -46,75 +45,45 @@ bool insertLight(inout uint n, uint light) {
     return true;
 }
 
-// The lights chunkKeepsLight keeps for the box, into gLights: the light grid's candidates, or
-// every light when the grid cannot answer (as shade.comp's cullChunkLights). `tested`: the
-// candidates tested. False when they do not fit.
-bool cullChunk(FrameConstants f, LightingFrame lf, vec3 boxMin, vec3 boxMax, vec3 corners[8],
-               out uint count, out uint tested) {
-    LightBuffer lights = LightBuffer(f.lights);
-    count = 0u;
-    LightGridQuery q;
-    if (lightGridQuery(f, lf.lightGrid, boxMin, boxMax, q)) {
-        UintBuffer entries = UintBuffer(q.g.entries);
-        LightGridCandidates c = lightGridCandidates(q);
-        tested = c.total;
-        for (uint s = 0u; s < c.sources; ++s)
-            for (uint k = 0u; k < c.lists[s].y; ++k) {
-                uint light = entries.v[c.lists[s].x + k];
-                if (chunkKeepsLight(lights.l[light], boxMin, boxMax, corners) && !insertLight(count, light))
-                    return false;
-            }
-        return true;
-    }
-    tested = f.lightCount;
-    for (uint light = 0u; light < f.lightCount; ++light) {
-        if (!chunkKeepsLight(lights.l[light], boxMin, boxMax, corners)) continue;
-        if (count == CLASSIFY_MAX_LIGHTS) return false;
-        gLights[count++] = light;
-    }
-    return true;
+// The features a kept light brings after its blockers (none when one hides it from the box).
+uint keptLightFeatures(LightingFrame lf, GpuLight l, vec3 boxMin, vec3 boxMax, vec3 corners[8]) {
+    uint mask = lightBlockerMask(lf, l, corners, boxMin, boxMax);
+    return mask == LIGHT_INVALID ? 0u : entryFeatures(lf, l, mask, corners);
 }
 
-// A chunk with more lights than the list holds: the features of every light it keeps (after
-// its blockers), walked as cullChunk walks them, a light listed twice adding nothing.
-uint longListFeatures(FrameConstants f, LightingFrame lf, vec3 boxMin, vec3 boxMax, vec3 corners[8]) {
+// The lights chunkKeepsLight keeps for the box, into gLights: the light grid's candidates, or
+// every light when the grid cannot answer (as shade.comp's cullChunkLights). `tested`: the
+// candidates tested. False when they do not fit: the walk then goes on for `features`, which
+// gains those of every light the chunk keeps (a light listed twice adds nothing).
+bool cullChunk(FrameConstants f, LightingFrame lf, vec3 boxMin, vec3 boxMax, vec3 corners[8],
+               out uint count, out uint tested, inout uint features) {
     LightBuffer lights = LightBuffer(f.lights);
-    uint features = 0u;
     LightGridQuery q;
     bool gridded = lightGridQuery(f, lf.lightGrid, boxMin, boxMax, q);
     LightGridCandidates c;
-    if (gridded) c = lightGridCandidates(q);
-    UintBuffer entries = UintBuffer(q.g.entries);
-    uint total = gridded ? c.total : f.lightCount;
-    for (uint k = 0u, s = 0u, inSource = 0u; k < total; ++k, ++inSource) {
-        uint light = k;
-        if (gridded) {
-            while (inSource >= c.lists[s].y) s++, inSource = 0u;
-            light = entries.v[c.lists[s].x + inSource];
-        }
-        GpuLight l = lights.l[light];
-        if (!chunkKeepsLight(l, boxMin, boxMax, corners)) continue;
-        uint mask = lightBlockerMask(lf, l, corners, boxMin, boxMax);
-        if (mask != LIGHT_INVALID) features |= entryFeatures(lf, l, mask, corners);
+    if (gridded) {
+        c = lightGridCandidates(q);
+    } else { // every light, as one source
+        c.sources = 1u;
+        c.lists[0] = uvec2(0u, f.lightCount);
+        c.total = f.lightCount;
     }
-    return features;
-}
-
-// Copies last frame's shadels of the chunk (slot `fromSlot` then) to its slot now, the packed
-// words as they are, as carry_over.comp does for the chunks the fill pass carried.
-void carryOverChunk(ShadelFrame s, uint fromSlot, uint toSlot) {
-    const uint radianceUvec4s = SHADEL_CHUNK * SHADEL_CHUNK / 2u; // uvec2 per shadel
-    const uint materialUvec4s = SHADEL_CHUNK * SHADEL_CHUNK / 4u; // uint per shadel
-    Uvec4Buffer radianceIn = Uvec4Buffer(s.prevLayers[SHADEL_LAYER_RADIANCE]);
-    Uvec4Buffer radianceOut = Uvec4Buffer(s.layers[SHADEL_LAYER_RADIANCE]);
-    for (uint i = 0u; i < radianceUvec4s; ++i)
-        radianceOut.v[toSlot * radianceUvec4s + i] = radianceIn.v[fromSlot * radianceUvec4s + i];
-    Uvec4Buffer materialIn = Uvec4Buffer(s.prevLayers[SHADEL_LAYER_MATERIAL]);
-    Uvec4Buffer materialOut = Uvec4Buffer(s.layers[SHADEL_LAYER_MATERIAL]);
-    for (uint i = 0u; i < materialUvec4s; ++i)
-        materialOut.v[toSlot * materialUvec4s + i] = materialIn.v[fromSlot * materialUvec4s + i];
-    Uvec4Buffer(s.chunkViews).v[toSlot] = Uvec4Buffer(s.prevChunkViews).v[fromSlot];
-    atomicAdd(ShadelCountersRef(s.counters).c.chunksReused, 1u);
+    UintBuffer entries = UintBuffer(q.g.entries);
+    tested = c.total;
+    count = 0u;
+    bool fits = true;
+    for (uint s = 0u; s < c.sources; ++s)
+        for (uint k = 0u; k < c.lists[s].y; ++k) {
+            uint light = gridded ? entries.v[c.lists[s].x + k] : k;
+            GpuLight l = lights.l[light];
+            if (!chunkKeepsLight(l, boxMin, boxMax, corners)) continue;
+            fits = fits && insertLight(count, light);
+            if (!fits) features |= keptLightFeatures(lf, l, boxMin, boxMax, corners);
+        }
+    if (!fits)
+        for (uint i = 0u; i < count; ++i)
+            features |= keptLightFeatures(lf, lights.l[gLights[i]], boxMin, boxMax, corners);
+    return fits;
 }
 
 void main() {
@@ -154,15 +123,16 @@ void main() {
         hi = max(hi, bits);
         if (carrySlot >= 0 && !nearChange) nearChange = inChangedRegion(s, world);
     }
-    if (carrySlot >= 0 && !nearChange) {
-        carryOverChunk(s, uint(carrySlot), work.slot);
+    if (carrySlot >= 0 && !nearChange) { // as carry_over.comp, one invocation for the chunk
+        for (uint row = 0u; row < SHADEL_CHUNK; ++row) carryChunkRow(s, uint(carrySlot), work.slot, row);
+        carryChunkRecord(s, uint(carrySlot), work.slot);
         return;
     }
 
     // Spectra need the lighting frame (feature_spectra.h: they exist only with it).
     LightingFrame lf = LightingFrameRef(f.lighting).l;
     SpectraFrame sf = SpectraFrameRef(lf.chunkSpectra).s;
-    ClassifyListBuffer ranges = ClassifyListBuffer(sf.chunkRanges);
+    ChunkListBuffer ranges = ChunkListBuffer(sf.chunkRanges);
     // Without tiled culling every light may reach the chunk (its permutation loops over all).
     if (lf.tiled == 0u) {
         binChunkSpectrum(lf, workIndex, SPECTRUM_ALL);
@@ -179,10 +149,10 @@ void main() {
     uint features = frameFeatures(f, lf);
     if ((o.v.flags & SHADEL_OBJECT_FEATURED_MATERIAL) != 0u) features |= SPECTRUM_MATERIAL;
     uint count, tested;
-    if (!cullChunk(f, lf, boxMin, boxMax, corners, count, tested)) {
+    if (!cullChunk(f, lf, boxMin, boxMax, corners, count, tested, features)) {
         // Its permutation culls it (the same list) and counts its lights.
         ranges.e[workIndex] = uvec2(CHUNK_LIST_UNCOUNTED, CHUNK_LIST_NONE);
-        binChunkSpectrum(lf, workIndex, features | longListFeatures(f, lf, boxMin, boxMax, corners));
+        binChunkSpectrum(lf, workIndex, features);
         return;
     }
 
@@ -211,7 +181,7 @@ void main() {
     bool fits = base <= sf.chunkListCapacity && kept <= sf.chunkListCapacity - base;
     ranges.e[workIndex] = fits ? uvec2(base, kept) : uvec2(0u, CHUNK_LIST_NONE);
     if (fits) {
-        ClassifyListBuffer pool = ClassifyListBuffer(sf.chunkLists);
+        ChunkListBuffer pool = ChunkListBuffer(sf.chunkLists);
         for (uint i = 0u; i < kept; ++i) pool.e[base + i] = uvec2(gLights[i], gMasks[i]);
     }
 

@@ -27,8 +27,6 @@ uint chunkSpectraWorkIndex(FrameConstants f, uint group) {
     return UintBuffer(sf.tileBins).v[kChunkSpectrumMode * sf.binCapacity + group];
 }
 
-layout(buffer_reference, scalar) buffer ChunkListBuffer { uvec2 e[]; };
-
 // Whether this chunk's lights are counted in the light statistics by the shading: its classify
 // left it uncounted (more lights than it keeps, chunk_classify.comp).
 bool gChunkUncounted = false;

@@ -7,6 +7,8 @@
 #include "common/lighting.glsl"
 
 layout(buffer_reference, scalar) readonly buffer SpectraFrameRef { SpectraFrame s; };
+// SpectraFrame::chunkLists entries and ::chunkRanges (the shadel path's classified lists).
+layout(buffer_reference, scalar) buffer ChunkListBuffer { uvec2 e[]; };
 
 // The features one (light, blocker mask) entry of a tile's list asks for. `corners`: the
 // tile's volume (a clip plane that leaves all of it lit needs no per-pixel test).

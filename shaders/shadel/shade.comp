@@ -45,10 +45,7 @@ void carryOver(ShadelFrame s, uint fromSlot, uint toSlot, uint outIndex) {
         ShadeRadianceLayer(s.prevLayers[SHADEL_LAYER_RADIANCE]).v[from];
     ShadeMaterialLayer(s.layers[SHADEL_LAYER_MATERIAL]).v[outIndex] =
         ShadeMaterialLayer(s.prevLayers[SHADEL_LAYER_MATERIAL]).v[from];
-    if (gl_LocalInvocationIndex == 0u) {
-        Uvec4Buffer(s.chunkViews).v[toSlot] = Uvec4Buffer(s.prevChunkViews).v[fromSlot];
-        atomicAdd(ShadelCountersRef(s.counters).c.chunksReused, 1u);
-    }
+    if (gl_LocalInvocationIndex == 0u) carryChunkRecord(s, fromSlot, toSlot);
 }
 
 shared bool chunkNearChange;

@@ -301,4 +301,28 @@ vec4 loadLayer(ShadelFrame s, uint layer, uint index) {
     return layer == SHADEL_LAYER_MATERIAL ? loadMaterial(s.layers[SHADEL_LAYER_MATERIAL], index)
                                           : loadRadiance(s.layers[SHADEL_LAYER_RADIANCE], index);
 }
+
+// Carry-over (preserved layers): row `row` (0..7) of the chunk last frame stored in slot
+// `fromSlot`, every layer, into slot `toSlot`, the packed words as they are. A chunk row is
+// contiguous in each layer (storageIndex): radiance 8 shadels x uvec2 = 4 uvec4s, material
+// 8 x uint = 2 uvec4s.
+void carryChunkRow(ShadelFrame s, uint fromSlot, uint toSlot, uint row) {
+    const uint radianceRow = SHADEL_CHUNK / 2u, materialRow = SHADEL_CHUNK / 4u; // uvec4s
+    uint from = fromSlot * SHADEL_CHUNK + row, to = toSlot * SHADEL_CHUNK + row;
+    Uvec4Buffer radianceIn = Uvec4Buffer(s.prevLayers[SHADEL_LAYER_RADIANCE]);
+    Uvec4Buffer radianceOut = Uvec4Buffer(s.layers[SHADEL_LAYER_RADIANCE]);
+    for (uint i = 0u; i < radianceRow; ++i)
+        radianceOut.v[to * radianceRow + i] = radianceIn.v[from * radianceRow + i];
+    Uvec4Buffer materialIn = Uvec4Buffer(s.prevLayers[SHADEL_LAYER_MATERIAL]);
+    Uvec4Buffer materialOut = Uvec4Buffer(s.layers[SHADEL_LAYER_MATERIAL]);
+    for (uint i = 0u; i < materialRow; ++i)
+        materialOut.v[to * materialRow + i] = materialIn.v[from * materialRow + i];
+}
+
+// What travels with a carried chunk besides its shadels, once per chunk: where it was seen from
+// when shaded (chunkViews), and the count.
+void carryChunkRecord(ShadelFrame s, uint fromSlot, uint toSlot) {
+    Uvec4Buffer(s.chunkViews).v[toSlot] = Uvec4Buffer(s.prevChunkViews).v[fromSlot];
+    atomicAdd(ShadelCountersRef(s.counters).c.chunksReused, 1u);
+}
 #endif

@@ -198,7 +198,7 @@ SpectraStatePtr createFeatureSpectra(Renderer& r) {
         s->chunkRanges =
             need(createBuffer(gpu, {"spectra.chunkRanges", uint64_t(s->tiles) * 8, 0}));
         s->chunkListCount = need(createBuffer(
-            gpu, {"spectra.chunkListCount", 12, 0, MemoryKind::Readback})); // SpectraFrame
+            gpu, {"spectra.chunkListCount", 12, 0, MemoryKind::Readback})); // uint[3]: SpectraFrame
         // Permutations of the shadel shading itself (shade.comp), with its other constants.
         std::vector<std::pair<uint32_t, uint32_t>> base;
         if (r.settings.distanceFieldLighting)

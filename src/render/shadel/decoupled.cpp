@@ -1034,8 +1034,7 @@ void computeToCompute(VkCommandBuffer cmd) {
 
 ShadelShadingQueue shadelShadingQueue(const Renderer& r) {
     const DecoupledState& d = *r.decoupled;
-    return {d.counters, offsetof(gpu::GpuShadelCounters, shadeDispatch),
-            offsetof(gpu::GpuShadelCounters, invocationDispatch), d.capacityChunks};
+    return {d.counters, offsetof(gpu::GpuShadelCounters, invocationDispatch), d.capacityChunks};
 }
 
 void recordDecoupledMarking(Renderer& r, FrameRecorder& rec, uint64_t frame) {

@@ -38,13 +38,12 @@ void recordDecoupledPostPasses(Renderer& r, FrameRecorder& rec, uint64_t frame);
 bool drawnDecoupled(const Renderer& r, uint32_t instance);
 // Reads back the frame's counters (after the GPU finished).
 void finishDecoupledFrame(Renderer& r);
-// The shading queue, for passes that run once per queued chunk before shading (render/decals,
-// the spectra's chunk classify): the buffer holding its indirect dispatch arguments
-// (GpuShadelCounters::shadeDispatch, a workgroup per chunk as shading, and ::invocationDispatch,
-// an invocation per chunk in workgroups of 64) and the entries it can hold.
+// The shading queue, for passes that run once per queued chunk before shading (the spectra's
+// chunk classify): the buffer holding its indirect dispatch arguments
+// (GpuShadelCounters::invocationDispatch, an invocation per chunk in workgroups of 64) and the
+// entries it can hold.
 struct ShadelShadingQueue {
     BufferHandle counters;
-    VkDeviceSize dispatchOffset = 0;
     VkDeviceSize invocationDispatchOffset = 0;
     uint32_t capacity = 0;
 };
