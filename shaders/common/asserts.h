@@ -8,5 +8,6 @@
 #define ASSERT_NON_FINITE 4u     // non-finite shading result
 #define ASSERT_SHADEL_SLOT 5u    // shadel storage slot out of range
 #define ASSERT_TRIANGLE_ID 6u    // triangle id out of range
+#define ASSERT_SHADE_PIPELINE 7u // a shading pipeline without a part this frame uses
 #define ASSERT_TEST 100u         // used by the tests to prove the channel works
 #endif

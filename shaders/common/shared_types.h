@@ -121,6 +121,10 @@ using uint = uint32_t;
 #define SHADE_QUEUE_FEATURED 2u
 #define SHADE_QUEUE_SUPERSAMPLED 3u
 #define SHADE_CLASSES 3u // the class lists: SHADE_QUEUE_* - 1
+// After the class lists, ShadelFrame::classQueues holds one more: the near-change list, chunks
+// that could be carried over but lie on an object a changed region meets (fill_queue.comp);
+// near_change.comp carries each over or appends it to its class's list.
+#define SHADE_NEAR_CHANGE_LIST SHADE_CLASSES
 // The material features a shader evaluates (shaders/common/material.glsl: kMaterialFeatures).
 #define MATERIAL_FEATURES_CONSTANT_ID 149
 #define MATERIAL_FEATURE_TEXTURES 1u   // any texture slot
@@ -130,14 +134,17 @@ using uint = uint32_t;
 #define MATERIAL_FEATURES_ALL 15u
 // The optional parts a shadel shading pipeline has compiled in: ray-traced terms (--rt-*),
 // the scene's decals, --debug-lines chunks, preserved layers (--reuse: carrying chunks near a
-// change over, recording each chunk's view). The plain shading pass leaves out what the renderer
-// was created without (on CPU devices an unused feature's code still runs, masked).
+// change over, recording each chunk's view), and the chunk's light culling in shared memory
+// (tiled culling with more lights than per-subgroup lists take). The plain shading pass leaves
+// out what the renderer was created without (on CPU devices an unused feature's code still runs,
+// masked; and lavapipe runs a shader with any barrier in it as coroutines, one per SIMD group).
 #define SHADE_OPTIONAL_CONSTANT_ID 148
 #define SHADE_OPTIONAL_RT 1u
 #define SHADE_OPTIONAL_DECALS 2u
 #define SHADE_OPTIONAL_DEBUG_LINES 4u
 #define SHADE_OPTIONAL_REUSE 8u
-#define SHADE_OPTIONAL_ALL 15u
+#define SHADE_OPTIONAL_CHUNK_LIGHTS 16u
+#define SHADE_OPTIONAL_ALL 31u
 // Specialization constant of shaders/common/lighting.glsl: 1 compiles the distance-field far
 // shadows and AO in (render/distance_fields; forward and shadel shading with --distance-fields).
 #define DISTANCE_FIELD_LIGHTING_CONSTANT_ID 142
@@ -694,6 +701,7 @@ struct GpuShadelCounters {
     uint shadeCount;                   // entries in the shading queue
     uint copyCount;                    // entries in the carry-over queue
     uint classCount[SHADE_CLASSES];    // entries in each shading class's list
+    uint nearChangeCount;              // entries in the near-change list (SHADE_NEAR_CHANGE_LIST)
     uint magnifiedPixels;     // sampled reconstructed pixels whose MIP-0 shadel spans > 1 pixel
     uint reconstructedPixels; // sampled (even x and y) pixels the reconstruction drew
     uint chunksPerMip[SHADEL_MAX_MIPS]; // allocated chunks by MIP level
@@ -709,6 +717,8 @@ struct GpuShadelCounters {
     uvec4 shadeDispatch; // x, y, z, queue length: indirect args of the shading pass
     uvec4 copyDispatch;  // x, y, z, queue length: indirect args of the carry-over pass
     uvec4 classDispatch[SHADE_CLASSES]; // x, y, z, list length: each class's shading
+    // x, y, z, list length: the near-change pass, one invocation per entry, 64 a workgroup
+    uvec4 nearChangeDispatch;
     // x, y, z, queue length: one invocation per queued chunk, 64 a workgroup (passes that take a
     // chunk in one invocation: the spectra's chunk classify)
     uvec4 invocationDispatch;
@@ -724,7 +734,8 @@ struct ShadelFrame {
     uint64_t markedBlocks; // uvec4 {block, place in its counter, object, mip | counter << 8}
     uint64_t queue;        // GpuShadelWork[capacityChunks]: chunks to shade
     uint64_t copyQueue;    // GpuShadelWork[capacityChunks]: chunks carried over (chunk = old slot)
-    // uint[SHADE_CLASSES][capacityChunks]: the shading queue's entries by shading class.
+    // uint[SHADE_CLASSES + 1][capacityChunks]: the shading queue's entries by shading class,
+    // then the near-change list (SHADE_NEAR_CHANGE_LIST).
     uint64_t classQueues;
     uint64_t idMaps;    // uint16 triangle ids, packed in uints
     uint64_t shadelUvs; // vec2 per vertex of the unified geometry buffer
@@ -740,8 +751,9 @@ struct ShadelFrame {
     uint64_t prevOccupancy; // last frame's occupancy masks
     uint64_t prevOffsetMap; // last frame's offset map
     // Reuse: per storage slot, where its chunk was seen from when shaded (carried over with it):
-    // uvec4 {centre of the chunk's world box (float bits), the unit direction from the centre to
-    // the camera (octahedral, packSnorm2x16)}; x = SHADEL_CHUNK_VIEW_NONE: nothing shaded in it.
+    // uvec4 {a point of the chunk's surface (float bits; shaders/shadel/shade_chunk.glsl
+    // chunkSurfacePoint), the unit direction from it to the camera (octahedral,
+    // packSnorm2x16)}; x = SHADEL_CHUNK_VIEW_NONE: no shadel of it is covered.
     uint64_t chunkViews;
     uint64_t prevChunkViews; // last frame's
     // Regions whose lighting changed since last frame (render/shadel/reuse_invalidation.h):

@@ -1,6 +1,7 @@
 #version 460
 // Indirect arguments of the shading and carry-over passes, from the queue lengths the fill
-// pass counted. 2-D dispatches keep x under every device's maxComputeWorkGroupCount[0]
+// pass counted. Run again after the near-change pass (near_change.comp), which appends to the
+// class lists. 2-D dispatches keep x under every device's maxComputeWorkGroupCount[0]
 // (common/dispatch_2d.h).
 #include "shadel/shadel.glsl"
 #include "common/dispatch_2d.h"
@@ -20,6 +21,8 @@ void main() {
         counters.c.classDispatch[c] = chunkDispatch(counters.c.classCount[c]);
     counters.c.invocationDispatch = chunkDispatch((counters.c.shadeCount + 63u) / 64u);
     counters.c.invocationDispatch.w = counters.c.shadeCount;
+    counters.c.nearChangeDispatch = chunkDispatch((counters.c.nearChangeCount + 63u) / 64u);
+    counters.c.nearChangeDispatch.w = counters.c.nearChangeCount;
     // Carry-over copies 8 chunks per workgroup (carry_over.comp).
     uint copyGroups = (counters.c.copyCount + 7u) / 8u;
     counters.c.copyDispatch = chunkDispatch(copyGroups);

@@ -3,9 +3,11 @@
 // place in the counter) and publishes it in the offset map. Each of its marked chunks then goes
 // to one of two queues: carried over from last frame's storage (preserved layers: the object's
 // level is unchanged, last frame stored the chunk, it is not the chunk's turn to be refreshed,
-// and the view did not turn past what its specular tolerates) or shaded. Chunks of objects a
-// changed region meets (a light or a caster that changed) are queued for shading, which checks
-// their shadels against the regions and may still carry them over (shade.comp). With ray-traced
+// and the view did not turn past what its specular tolerates) or shaded, in the list of its
+// shading class (the pipeline that shades it, shade.comp). Chunks that could be carried over but
+// lie on an object a changed region meets (a light or a caster that changed) go to the
+// near-change list, whose pass checks their shadels against the regions and carries them over
+// or appends them to their class's list (near_change.comp). With ray-traced
 // terms, a chunk is also reshaded when the RT cache under it gained a factor of sqrt 2 in rays
 // (raytracing/rt_history.glsl).
 #include "shadel/shadel.glsl"
@@ -38,8 +40,7 @@ void main() {
     ShadelObjectRef o = shadelObject(s, entry.z);
     bool levelReusable = s.reuse != 0u && ((o.v.reuseLevels >> mip) & 1u) != 0u;
     bool nearChange = (o.v.flags & SHADEL_OBJECT_NEAR_CHANGE) != 0u;
-    bool copyable = levelReusable && !nearChange;
-    uint prevBlock = copyable ? prevBlockIndex(s, o, mip, block) : SHADEL_INVALID;
+    uint prevBlock = levelReusable ? prevBlockIndex(s, o, mip, block) : SHADEL_INVALID;
     uint64_t prevMask = prevBlock != SHADEL_INVALID ? Uint64Buffer(s.prevOccupancy).v[prevBlock] : 0ul;
     uint prevBase = prevBlock != SHADEL_INVALID ? UintBuffer(s.prevOffsetMap).v[prevBlock] : SHADEL_INVALID;
     uvec2 blockXy = uvec2(block % s.sheetBlocks, block / s.sheetBlocks);
@@ -69,16 +70,18 @@ void main() {
             }
             rtHistory = rtHistoryStepped(f, entry.z, uvs, w.chunk);
         }
-        if (stored && !refresh && !viewTurned && !rtHistory) {
+        bool carryable = stored && !refresh && !viewTurned && !rtHistory;
+        if (carryable && !nearChange) {
             w.chunk = prevSlot; // where last frame stored it
             ShadelWorkBuffer(s.copyQueue).w[atomicAdd(counters.c.copyCount, 1u)] = w;
             continue;
         }
         uint queued = atomicAdd(counters.c.shadeCount, 1u);
         ShadelWorkBuffer(s.queue).w[queued] = w;
-        uint shadeClass = shadeClassOf(o);
-        uint place = atomicAdd(counters.c.classCount[shadeClass], 1u);
-        UintBuffer(s.classQueues).v[shadeClass * s.capacityChunks + place] = queued;
+        uint list = carryable ? SHADE_NEAR_CHANGE_LIST : shadeClassOf(o);
+        uint place = carryable ? atomicAdd(counters.c.nearChangeCount, 1u)
+                               : atomicAdd(counters.c.classCount[list], 1u);
+        UintBuffer(s.classQueues).v[list * s.capacityChunks + place] = queued;
         uint reason = !levelReusable ? SHADEL_SHADED_NOT_REUSABLE
                       : nearChange   ? SHADEL_SHADED_NEAR_CHANGE
                       : refresh      ? SHADEL_SHADED_REFRESH

@@ -2,7 +2,10 @@
 // Shading (seed: "Shadel Shader"): one 8x8 workgroup per queued chunk. Each shadel finds its
 // triangle in the object's triangle-ID map, rebuilds the surface from the triangle's vertices
 // with clamped barycentrics (and the barycentrics one shadel right and down, for derivatives),
-// then runs the same material and lighting code as the forward path.
+// then runs the same material and lighting code as the forward path. Every queued chunk that
+// reaches a pipeline is shaded: carry-over decisions were taken before (fill_queue.comp,
+// near_change.comp, or the spectra's classify), so no barrier is needed here beyond the chunk
+// light culling's (only in pipelines that have it, SHADE_OPTIONAL_CHUNK_LIGHTS).
 #include "shadel/shadel.glsl"
 #include "shadel/shade_chunk.glsl"
 #include "common/dispatch_2d.h"
@@ -18,7 +21,7 @@
 #include "lighting/light_debug.glsl"
 #include "lighting/chunk_spectra.glsl"
 #include "common/shadel_bary.h"
-// Without spectra the shading pass runs one pipeline per shading class (shadeClassOf), each
+// Without spectra the shading pass runs one pipeline per shading class (fill_queue.comp), each
 // over its class's list, with what its class does not use compiled out (kMaterialFeatures,
 // common/material.glsl; the supersampling, prefilter.glsl). On CPU devices a SIMD group runs
 // the code of a branch none of its lanes takes, so unused material features cost every shadel.
@@ -37,44 +40,6 @@ void storeLayers(ShadelFrame s, uint index, vec4 radiance, vec4 material) {
     storeRadiance(s.layers[SHADEL_LAYER_RADIANCE], index, radiance);
     storeMaterial(s.layers[SHADEL_LAYER_MATERIAL], index, material);
 }
-
-// Copies the packed words as they are (no unpack and repack).
-void carryOver(ShadelFrame s, uint fromSlot, uint toSlot, uint outIndex) {
-    uint from = storageIndex(fromSlot, gl_LocalInvocationID.xy);
-    ShadeRadianceLayer(s.layers[SHADEL_LAYER_RADIANCE]).v[outIndex] =
-        ShadeRadianceLayer(s.prevLayers[SHADEL_LAYER_RADIANCE]).v[from];
-    ShadeMaterialLayer(s.layers[SHADEL_LAYER_MATERIAL]).v[outIndex] =
-        ShadeMaterialLayer(s.prevLayers[SHADEL_LAYER_MATERIAL]).v[from];
-    if (gl_LocalInvocationIndex == 0u) carryChunkRecord(s, fromSlot, toSlot);
-}
-
-shared bool chunkNearChange;
-
-// Whether any shadel of the chunk lies in a region whose lighting changed this frame (a light
-// or a caster that changed: render/shadel/reuse_invalidation.h; the object's bounds meet one,
-// or this is not called). Only positions are rebuilt. Call in uniform control flow.
-bool chunkTouchesChange(FrameConstants f, ShadelFrame s, ShadelObjectRef o, GpuShadelWork work) {
-    if (gl_LocalInvocationIndex == 0u) chunkNearChange = false;
-    barrier();
-    uvec2 size = levelSize(o, work.mip);
-    uvec2 shadel = levelShadel(o, work.mip, uvec2(work.chunk & 0xFFFFu, work.chunk >> 16) *
-                                                SHADEL_CHUNK + gl_LocalInvocationID.xy);
-    uint tri = all(lessThan(shadel, size))
-                   ? triangleId(s, o.v.idMapOffset[work.mip] + shadel.y * size.x + shadel.x)
-                   : 0xFFFFu;
-    if (tri != 0xFFFFu) {
-        GpuInstance inst = InstanceBuffer(f.instances).i[work.object];
-        GpuMesh mesh = MeshBuffer(f.meshes).m[inst.mesh];
-        if (inChangedRegion(s, shadelWorldPosition(f, s, inst, mesh, tri, shadel, size)))
-            chunkNearChange = true;
-    }
-    barrier();
-    return chunkNearChange;
-}
-
-// cullChunkLights keeps the box for the chunk's view record (recordChunkView).
-vec3 gChunkBoxMin = vec3(0.0), gChunkBoxMax = vec3(0.0);
-bool gChunkHasBox = false, gChunkBoxKnown = false;
 
 // The chunk's world box from its shading invocations' positions, with one barrier: each
 // subgroup reduces its lanes (subgroupMin/Max of the order-preserving bits, so the box is the
@@ -121,11 +86,9 @@ void cullChunkLights(FrameConstants f, bool shading, vec3 p) {
     // The light grid's bit set is cleared under the box's barrier (no barrier of its own).
     lightGridMaskClearUnsynced(f, lf.lightGrid, threads);
     vec3 boxMin, boxMax;
-    gChunkHasBox = chunkBox(shading, p, boxMin, boxMax);
-    gChunkBoxMin = boxMin, gChunkBoxMax = boxMax;
-    gChunkBoxKnown = true;
+    bool hasBox = chunkBox(shading, p, boxMin, boxMax);
     gLightListMode = LIGHT_LIST_SHARED;
-    if (!gChunkHasBox) { // no shadel to shade
+    if (!hasBox) { // no shadel to shade
         if (tid == 0u) sLightListCount = 0u;
         barrier(); // (as at the end)
         return;
@@ -181,19 +144,17 @@ void cullChunkLights(FrameConstants f, bool shading, vec3 p) {
     barrier(); // the shading reads the list with every invocation
 }
 
-// Reuse: records where the chunk is seen from as it is shaded (its world box's centre and the
+// Reuse: records where the chunk is seen from as it is shaded (a point of its surface and the
 // direction to the camera), so fill_queue.comp reshades it once the view turned too far for its
-// specular (chunkViewTurned). The box is light culling's when that ran, else built here (one
-// barrier). Call in uniform control flow.
-void recordChunkView(FrameConstants f, ShadelFrame s, uint slot, bool shading, vec3 p) {
-    if (s.reuse == 0u) return;
-    if (!gChunkBoxKnown) {
-        gChunkHasBox = chunkBox(shading, p, gChunkBoxMin, gChunkBoxMax);
-        gChunkBoxKnown = true;
-    }
-    if (gl_LocalInvocationIndex == 0u)
-        Uvec4Buffer(s.chunkViews).v[slot] =
-            chunkViewRecord(gChunkHasBox, gChunkBoxMin, gChunkBoxMax, f.cameraPosition);
+// specular (chunkViewTurned). One invocation finds the point itself (chunkSurfacePoint): a box
+// of the chunk's shadels would take the workgroup's barrier, and on lavapipe a shader with any
+// barrier runs each SIMD group as a coroutine, which cost builtin:default's shading (1280x720,
+// reuse on) a quarter of its time. Any control flow.
+void recordChunkView(FrameConstants f, ShadelFrame s, GpuShadelWork work) {
+    if (s.reuse == 0u || gl_LocalInvocationIndex != 0u) return;
+    vec3 point;
+    bool seen = chunkSurfacePoint(f, s, work, point);
+    Uvec4Buffer(s.chunkViews).v[work.slot] = chunkViewRecord(seen, point, f.cameraPosition);
 }
 
 // The decal stats of this shadel's list (useShadelDecalList): (decal, shadel) pairs, and the
@@ -234,19 +195,6 @@ void main() {
     ShadelObjectRef o = shadelObject(s, work.object);
     uvec2 local = gl_LocalInvocationID.xy;
     uint outIndex = storageIndex(work.slot, local);
-    // Chunks of objects a changed region meets come here even when reusable (the fill pass
-    // cannot tell which of their shadels the change reaches): carry over those it does not.
-    // (With spectra the classify pass decided: a binned chunk is shaded.)
-    int carrySlot = SHADE_HAS(SHADE_OPTIONAL_REUSE) && kChunkSpectraPhase != CHUNK_SPECTRA_SHADE &&
-                            (o.v.flags & SHADEL_OBJECT_NEAR_CHANGE) != 0u
-                        ? carrySource(s, o, work, f.cameraPosition)
-                        : -1;
-    if (carrySlot >= 0 && chunkTouchesChange(f, s, o, work)) carrySlot = -1;
-    if (carrySlot >= 0) {
-        carryOver(s, uint(carrySlot), work.slot, outIndex);
-        return;
-    }
-
     uvec2 sheetShadel = uvec2(work.chunk & 0xFFFFu, work.chunk >> 16) * SHADEL_CHUNK + local;
     uvec2 size = levelSize(o, work.mip);
     uvec2 shadel = levelShadel(o, work.mip, sheetShadel);
@@ -285,14 +233,20 @@ void main() {
     si.uvDy = uvDy;
     // With few lights each subgroup culls them for its own shadels (no barrier); else the
     // chunk culls them (a spectrum's permutation reads the list its classify phase culled).
-    // Spectra never cull per subgroup: their permutations do not compile it in.
+    // Spectra never cull per subgroup: their permutations do not compile it in. Pipelines of
+    // renderers that never cull per chunk leave that culling out, with its barriers: on
+    // lavapipe a shader with a barrier runs each SIMD group as a coroutine, which cost
+    // builtin:default's shading (1280x720) a fifth of its time.
     if (kChunkSpectraPhase == CHUNK_SPECTRA_OFF && f.lighting != 0ul &&
         LightingFrameRef(f.lighting).l.subgroupLists != 0u)
         useSubgroupLightList(f, shading, si.position);
     else if (f.lighting != 0ul && LightingFrameRef(f.lighting).l.tiled != 0u &&
-             !(kChunkSpectraPhase == CHUNK_SPECTRA_SHADE && loadChunkLightList(f, workIndex)))
-        cullChunkLights(f, shading, si.position);
-    if (SHADE_HAS(SHADE_OPTIONAL_REUSE)) recordChunkView(f, s, work.slot, shading, si.position);
+             !(kChunkSpectraPhase == CHUNK_SPECTRA_SHADE && loadChunkLightList(f, workIndex))) {
+        SHADEL_ASSERT(f, SHADE_HAS(SHADE_OPTIONAL_CHUNK_LIGHTS), ASSERT_SHADE_PIPELINE,
+                      SHADE_OPTIONAL_CHUNK_LIGHTS, kShadeOptional);
+        if (SHADE_HAS(SHADE_OPTIONAL_CHUNK_LIGHTS)) cullChunkLights(f, shading, si.position);
+    }
+    if (SHADE_HAS(SHADE_OPTIONAL_REUSE)) recordChunkView(f, s, work);
     // --debug-lines chunks: this chunk's world box, coloured by MIP (uniform over the workgroup).
     if (SHADE_HAS(SHADE_OPTIONAL_DEBUG_LINES) && debugLinesOn(f, DEBUG_LINES_CHUNKS))
         debugWorkgroupBox(f, shading, si.position, debugLevelColour(work.mip));

@@ -27,6 +27,29 @@ vec3 shadelWorldPosition(FrameConstants f, ShadelFrame s, GpuInstance inst, GpuM
     return (inst.model * vec4(p, 1.0)).xyz;
 }
 
+// A point of a queued chunk's surface, the same whichever pass asks: the world position its
+// centre shadel is lit at or, when no triangle covers that one, its first covered shadel's (row
+// order). False when none is covered. The chunk's view record (chunkViewRecord) is taken from it
+// by one invocation, so shading needs no box of the chunk, and no barrier, to record it.
+bool chunkSurfacePoint(FrameConstants f, ShadelFrame s, GpuShadelWork work, out vec3 p) {
+    ShadelObjectRef o = shadelObject(s, work.object);
+    uvec2 size = levelSize(o, work.mip);
+    uvec2 first = uvec2(work.chunk & 0xFFFFu, work.chunk >> 16) * SHADEL_CHUNK;
+    uint offset = o.v.idMapOffset[work.mip];
+    for (uint i = 0u; i <= SHADEL_CHUNK * SHADEL_CHUNK; ++i) {
+        uint at = i == 0u ? (SHADEL_CHUNK / 2u) * (SHADEL_CHUNK + 1u) : i - 1u; // centre first
+        uvec2 shadel = levelShadel(o, work.mip, first + uvec2(at % SHADEL_CHUNK, at / SHADEL_CHUNK));
+        if (any(greaterThanEqual(shadel, size))) continue;
+        uint tri = triangleId(s, offset + shadel.y * size.x + shadel.x);
+        if (tri == 0xFFFFu) continue;
+        GpuInstance inst = InstanceBuffer(f.instances).i[work.object];
+        p = shadelWorldPosition(f, s, inst, MeshBuffer(f.meshes).m[inst.mesh], tri, shadel, size);
+        return true;
+    }
+    p = vec3(0.0);
+    return false;
+}
+
 // Whether a world point lies in a region whose lighting changed this frame (a light or a
 // caster that changed: render/shadel/reuse_invalidation.h), capsules a-b of radius a.w.
 bool inChangedRegion(ShadelFrame s, vec3 world) {
@@ -36,6 +59,25 @@ bool inChangedRegion(ShadelFrame s, vec3 world) {
         vec3 ab = volumes.v[2u * i + 1u].xyz - a.xyz;
         float t = clamp(dot(world - a.xyz, ab) / max(dot(ab, ab), 1e-12), 0.0, 1.0);
         if (isinf(a.w) || distance(world, a.xyz + t * ab) <= a.w) return true;
+    }
+    return false;
+}
+
+// Whether a position one of the chunk's shadels is lit at lies in a changed region: a chunk that
+// could be carried over but whose object a changed region meets is shaded only then. One
+// invocation walks the chunk's shadels (near_change.comp).
+bool chunkTouchesChangedRegion(FrameConstants f, ShadelFrame s, GpuShadelWork work) {
+    ShadelObjectRef o = shadelObject(s, work.object);
+    GpuInstance inst = InstanceBuffer(f.instances).i[work.object];
+    GpuMesh mesh = MeshBuffer(f.meshes).m[inst.mesh];
+    uvec2 size = levelSize(o, work.mip);
+    uvec2 sheet = uvec2(work.chunk & 0xFFFFu, work.chunk >> 16) * SHADEL_CHUNK;
+    for (uint i = 0u; i < SHADEL_CHUNK * SHADEL_CHUNK; ++i) {
+        uvec2 shadel = levelShadel(o, work.mip, sheet + uvec2(i % SHADEL_CHUNK, i / SHADEL_CHUNK));
+        if (any(greaterThanEqual(shadel, size))) continue;
+        uint tri = triangleId(s, o.v.idMapOffset[work.mip] + shadel.y * size.x + shadel.x);
+        if (tri == 0xFFFFu || tri * 3u >= mesh.indexCount) continue;
+        if (inChangedRegion(s, shadelWorldPosition(f, s, inst, mesh, tri, shadel, size))) return true;
     }
     return false;
 }

@@ -242,10 +242,10 @@ vec3 shadelOctDecode(vec2 e) {
 }
 
 // Preserved layers: what a chunk's record holds (ShadelFrame::chunkViews) when it was shaded
-// with its world box [lo, hi] seen from `camera`; none when no shadel of it was shaded.
-uvec4 chunkViewRecord(bool shaded, vec3 lo, vec3 hi, vec3 camera) {
-    if (!shaded) return uvec4(SHADEL_CHUNK_VIEW_NONE);
-    vec3 centre = 0.5 * (lo + hi);
+// seen from `camera`, `centre` a point of its surface (chunkSurfacePoint); none when no shadel
+// of it is covered.
+uvec4 chunkViewRecord(bool seen, vec3 centre, vec3 camera) {
+    if (!seen) return uvec4(SHADEL_CHUNK_VIEW_NONE);
     vec3 toCamera = camera - centre;
     float len = length(toCamera);
     vec3 dir = len > 0.0 ? toCamera / len : vec3(0.0, 0.0, 1.0);

@@ -39,6 +39,8 @@ const char* assertMessage(uint32_t id) {
         return "shadel storage slot out of range";
     case ASSERT_TRIANGLE_ID:
         return "triangle id out of range";
+    case ASSERT_SHADE_PIPELINE:
+        return "a shading pipeline without a part this frame uses";
     case ASSERT_TEST:
         return "test assert";
     default:

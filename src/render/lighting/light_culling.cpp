@@ -50,6 +50,15 @@ static bool subgroupListsFit(const Renderer& r, uint32_t lightCount, bool blocke
            lightCount <= LIGHT_SUBGROUP_MAX_LIGHTS && !r.spectra && (r.decoupled || !blockersOn);
 }
 
+bool shadelsCullLightsPerChunk(const Renderer& r, const GpuScene& scene) {
+    // As subgroupListsFit in a decoupled frame, where r.spectra exists exactly with
+    // --spectra on|single (usesChunkSpectra).
+    uint32_t count = uint32_t(scene.lightInfo.size());
+    bool subgroupLists = r.settings.lightCulling == LightCulling::Tiled && count > 0 &&
+                         count <= LIGHT_SUBGROUP_MAX_LIGHTS && r.settings.spectra == Spectra::Off;
+    return r.settings.lightCulling == LightCulling::Tiled && !subgroupLists;
+}
+
 bool forwardSplitsTileLights(const Renderer& r, const GpuScene& scene) {
     bool blockersOn = r.settings.lightBlockers && scene.blockerCount > 0; // as prepareLightCulling
     if (r.settings.lightCulling != LightCulling::Tiled ||

@@ -46,6 +46,11 @@ float lightReach(const gpu::GpuLight& light);
 // second loop costs the scenes that never fill it (builtin:default forward shading 130 -> 139 ms),
 // and a scene edit that changes either only costs speed, never the image.
 bool forwardSplitsTileLights(const Renderer& r, const GpuScene& scene);
+// Whether decoupled shading may cull a chunk's lights in shared memory (tiled culling with more
+// lights than per-subgroup lists take): otherwise its pipelines leave that culling and its
+// barriers out (SHADE_OPTIONAL_CHUNK_LIGHTS). From the settings and the scene, so the decoupled
+// state can ask before the culling state exists; a frame's choice always agrees.
+bool shadelsCullLightsPerChunk(const Renderer& r, const GpuScene& scene);
 // Whether this frame culls lights (and so records the culling pass): tile lists
 // (--light-culling tiled and enough lights in view, or blockers to classify) or, with few
 // lights, per-subgroup lists in shading; otherwise shading loops over the lights directly.

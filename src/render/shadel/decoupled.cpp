@@ -173,19 +173,21 @@ struct DecoupledState {
     bool reuse = true;
     uint32_t refreshPeriod = 16; // --reuse-refresh
     uint32_t objectsReusable = 0;
-    BufferHandle allocId;        // uint per block (upload: written by the CPU allocator)
-    BufferHandle counters;       // GpuShadelCounters (readback, also indirect args)
-    BufferHandle markedBlocks;   // uvec4 per marked block, capacityChunks of them
-    BufferHandle queue;          // GpuShadelWork[capacity]: chunks to shade
-    BufferHandle copyQueue;      // GpuShadelWork[capacity]: chunks carried over from last frame
-    BufferHandle classQueues;    // uint[SHADE_CLASSES][capacity]: queue entries by shading class
-    BufferHandle changedVolumes; // ChangedVolume[SHADEL_MAX_CHANGED_VOLUMES] (upload)
+    BufferHandle allocId;      // uint per block (upload: written by the CPU allocator)
+    BufferHandle counters;     // GpuShadelCounters (readback, also indirect args)
+    BufferHandle markedBlocks; // uvec4 per marked block, capacityChunks of them
+    BufferHandle queue;        // GpuShadelWork[capacity]: chunks to shade
+    BufferHandle copyQueue;    // GpuShadelWork[capacity]: chunks carried over from last frame
+    // uint[SHADE_CLASSES + 1][capacity]: queue entries by shading class, then near change
+    BufferHandle classQueues;
+    BufferHandle changedVolumes;        // ChangedVolume[SHADEL_MAX_CHANGED_VOLUMES] (upload)
     std::vector<ChangedVolume> changes; // this frame's (render/shadel/reuse_invalidation.h)
     bool changesOverflow = false;       // more than the buffer holds: everything changed
     ShadeStorage storage;
     // shade: one pipeline per shading class (SHADE_QUEUE_* - 1), each over its class's list.
-    Pipeline clear, allocate, queueSetup, fillQueue, dispatchSetup, carryOver, sheetView, mark,
-        markTransparent, reconstruct;
+    // nearChange: --reuse only (shaders/shadel/near_change.comp).
+    Pipeline clear, allocate, queueSetup, fillQueue, dispatchSetup, carryOver, nearChange,
+        sheetView, mark, markTransparent, reconstruct;
     std::array<Pipeline, SHADE_CLASSES> shade;
     std::vector<FrameCounters> history;
 };
@@ -321,7 +323,7 @@ DecoupledStatePtr createDecoupled(Renderer& r, const GpuScene& scene) {
     d.copyQueue = device("shadel.carryOverQueue",
                          VkDeviceSize(d.capacityChunks) * sizeof(gpu::GpuShadelWork));
     d.classQueues = device("shadel.shadeClassQueues",
-                           VkDeviceSize(d.capacityChunks) * SHADE_CLASSES * sizeof(uint32_t));
+                           VkDeviceSize(d.capacityChunks) * (SHADE_CLASSES + 1) * sizeof(uint32_t));
     d.chunkViews = {device("shadel.chunkViews.frame0", VkDeviceSize(d.capacityChunks) * 16),
                     device("shadel.chunkViews.frame1", VkDeviceSize(d.capacityChunks) * 16)};
 
@@ -332,6 +334,9 @@ DecoupledStatePtr createDecoupled(Renderer& r, const GpuScene& scene) {
     d.dispatchSetup =
         createComputePipeline(gpu, "shadelDispatchSetup", "shadel_dispatch_setup.comp.spv");
     d.carryOver = createComputePipeline(gpu, "shadelCarryOver", "shadel_carry_over.comp.spv");
+    if (d.reuse)
+        d.nearChange =
+            createComputePipeline(gpu, "shadelNearChange", "shadel_near_change.comp.spv");
     std::vector<std::pair<uint32_t, uint32_t>> shadeConstants;
     if (r.settings.distanceFieldLighting) // render/distance_fields: far shadows + AO per shadel
         shadeConstants.push_back({DISTANCE_FIELD_LIGHTING_CONSTANT_ID, 1u});
@@ -342,6 +347,7 @@ DecoupledStatePtr createDecoupled(Renderer& r, const GpuScene& scene) {
     if (r.settings.decals && !scene.decals.empty()) optional |= SHADE_OPTIONAL_DECALS;
     if (r.settings.debugLines & DEBUG_LINES_CHUNKS) optional |= SHADE_OPTIONAL_DEBUG_LINES;
     if (d.reuse) optional |= SHADE_OPTIONAL_REUSE;
+    if (shadelsCullLightsPerChunk(r, scene)) optional |= SHADE_OPTIONAL_CHUNK_LIGHTS;
     shadeConstants.push_back({SHADE_OPTIONAL_CONSTANT_ID, optional});
     // The shading classes (SHADEL_OBJECT_* flags set per object below): plain materials with
     // every material feature compiled out, featured ones, supersampled procedurals.
@@ -385,8 +391,9 @@ void destroyDecoupled(Renderer& r, DecoupledStatePtr& state) {
     if (!state) return;
     Gpu& gpu = *r.gpu;
     DecoupledState& d = *state;
-    for (Pipeline* p : {&d.clear, &d.allocate, &d.queueSetup, &d.fillQueue, &d.dispatchSetup,
-                        &d.carryOver, &d.sheetView, &d.mark, &d.markTransparent, &d.reconstruct})
+    for (Pipeline* p :
+         {&d.clear, &d.allocate, &d.queueSetup, &d.fillQueue, &d.dispatchSetup, &d.carryOver,
+          &d.nearChange, &d.sheetView, &d.mark, &d.markTransparent, &d.reconstruct})
         destroy(gpu, *p);
     for (Pipeline& p : d.shade) destroy(gpu, p);
     destroyShadeStorage(gpu, d.storage);
@@ -1137,6 +1144,20 @@ void recordDecoupledShading(Renderer& r, FrameRecorder& rec, uint64_t frame, con
         pushConstants(gpu, cmd, FramePush{frame});
         vkCmdDispatchIndirect(cmd, vkBuffer(gpu, d.counters),
                               offsetof(gpu::GpuShadelCounters, copyDispatch));
+        // Chunks on objects a changed region meets: carried over here unless one of their
+        // shadels lies in a region, else appended to their class's list, whose dispatch sizes
+        // are then set again. (Spectra's classify decides for its whole queue instead.)
+        if (d.nearChange.pipeline && !usesChunkSpectra(r)) {
+            bind(gpu, cmd, d.nearChange);
+            pushConstants(gpu, cmd, FramePush{frame});
+            vkCmdDispatchIndirect(cmd, vkBuffer(gpu, d.counters),
+                                  offsetof(gpu::GpuShadelCounters, nearChangeDispatch));
+            computeToCompute(cmd);
+            bind(gpu, cmd, d.dispatchSetup);
+            pushConstants(gpu, cmd, FramePush{frame});
+            vkCmdDispatch(cmd, 1, 1, 1);
+            computeToCompute(cmd);
+        }
     });
 
     recordDecalCulling(r, rec, frame); // the decal lists of screen tiles and queued chunks

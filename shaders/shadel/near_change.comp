@@ -1,0 +1,38 @@
+#version 460
+// Near-change carry-over (preserved layers, --reuse, without spectra): the chunks that could be
+// carried over but lie on an object a changed region meets (a light or a caster that changed:
+// render/shadel/reuse_invalidation.h), listed by fill_queue.comp, which cannot tell which of
+// their shadels the change reaches. One invocation per chunk rebuilds the positions its shadels
+// are lit at: none in a changed region, it is carried over (as carry_over.comp, one invocation
+// for the chunk); else it goes to its shading class's list. The spectra's classify takes the
+// same decision for its queue (lighting/chunk_classify.comp).
+// The check used to run in the shading itself, a workgroup per chunk sharing its answer through
+// shared memory: the barrier that took made every shading pipeline run as coroutines on
+// lavapipe, near change or not, and the chunks it then shaded paid the all-features pipeline.
+#include "shadel/shade_chunk.glsl"
+#include "common/dispatch_2d.h"
+
+layout(local_size_x = 64) in;
+layout(push_constant, scalar) uniform Push { uint64_t frame; } pc;
+
+void main() {
+    FrameConstants f = FrameConstantsRef(pc.frame).f;
+    ShadelFrame s = ShadelFrameRef(f.shadel).s;
+    ShadelCountersRef counters = ShadelCountersRef(s.counters);
+    uint index = dispatch2dGroup() * gl_WorkGroupSize.x + gl_LocalInvocationIndex;
+    if (index >= counters.c.nearChangeDispatch.w) return;
+    uint queued = UintBuffer(s.classQueues).v[SHADE_NEAR_CHANGE_LIST * s.capacityChunks + index];
+    GpuShadelWork work = ShadelWorkBuffer(s.queue).w[queued];
+    ShadelObjectRef o = shadelObject(s, work.object);
+    // The fill pass found where last frame stored it; the same function says where.
+    int carrySlot = carrySource(s, o, work, f.cameraPosition);
+    if (carrySlot >= 0 && !chunkTouchesChangedRegion(f, s, work)) {
+        for (uint row = 0u; row < SHADEL_CHUNK; ++row)
+            carryChunkRow(s, uint(carrySlot), work.slot, row);
+        carryChunkRecord(s, uint(carrySlot), work.slot);
+        return;
+    }
+    uint shadeClass = shadeClassOf(o);
+    uint place = atomicAdd(counters.c.classCount[shadeClass], 1u);
+    UintBuffer(s.classQueues).v[shadeClass * s.capacityChunks + place] = queued;
+}
