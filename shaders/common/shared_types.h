@@ -89,6 +89,7 @@ using uint = uint32_t;
 #define SPECTRUM_MATERIAL 0x2000u    // a material with any MATERIAL_FEATURE_* (textures, ...)
 #define SPECTRUM_FEATURE_COUNT 14u
 #define SPECTRUM_ALL 0x3FFFu
+#define SPECTRUM_ALL_LIGHTING (SPECTRUM_ALL & ~SPECTRUM_MATERIAL) // every light may reach it
 #define SPECTRUM_MAX_MODES 16u
 #define SPECTRUM_FEATURES_CONSTANT_ID 140
 #define SPECTRUM_MODE_CONSTANT_ID 141 // the mode (bin) a tile / chunk shading permutation runs
@@ -410,8 +411,11 @@ struct GpuSpotShadow {
 // Feature spectra (render/lighting/feature_spectra.h): the tile pass bins every tile into the
 // first mode (cheapest first) whose features cover what the tile needs.
 #define CHUNK_LIST_NONE 0xFFFFFFFFu // SpectraFrame::chunkRanges .y: no stored list
-// ... and .x: the classify pass did not count the chunk's lights either (its permutation does)
-#define CHUNK_LIST_UNCOUNTED 0xFFFFFFFFu
+// SpectraFrame::chunkListCount[SPECTRA_LONG_LIST_DISPATCH..+3]: the long-list pass's indirect
+// dispatch (x, y, z, chunks).
+#define SPECTRA_LONG_LIST_DISPATCH 4u
+#define SPECTRA_CHUNK_LIST_COUNTS 8u // uints in SpectraFrame::chunkListCount
+#define SPECTRA_LONG_LIST_GROUP 8u   // chunk_long_lists.comp's workgroup
 
 struct SpectraFrame {
     uint64_t dispatch;     // VkDispatchIndirectCommand per mode: x = tiles binned to it
@@ -422,11 +426,14 @@ struct SpectraFrame {
     // shading permutations read it instead of culling the chunk again (0 for screen tiles).
     uint64_t chunkLists;  // uvec2 entries (light, blocker mask), a pool
     uint64_t chunkRanges; // uvec2 per shading-queue index: (first entry, count); count
-                          // CHUNK_LIST_NONE when the pool was full or the chunk has more
-                          // lights than classify keeps (the chunk is culled again)
-    // uint[3]: pool entries taken this frame; chunks culled again because the pool was full,
-    // and because they have more lights than classify keeps
+                          // CHUNK_LIST_NONE when the pool was full (the chunk's permutation
+                          // takes every light)
+    // uint[SPECTRA_CHUNK_LIST_COUNTS]: pool entries requested this frame; chunks whose list did
+    // not fit the pool; chunks with more lights than classify keeps in its private list (their
+    // lists written by chunk_long_lists.comp); unused; that pass's indirect dispatch
     uint64_t chunkListCount;
+    // uvec4 pairs per long-list chunk: (shading-queue index, box min), (box max, 0) (floats)
+    uint64_t longChunks;
     uint modeCount;
     uint binCapacity;       // tiles (each mode's list can hold every tile)
     uint chunkListCapacity; // entries of the chunkLists pool

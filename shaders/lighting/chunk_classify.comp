@@ -25,8 +25,9 @@ layout(local_size_x = 64) in;
 layout(push_constant, scalar) uniform Push { uint64_t frame; } pc;
 
 // The lights a chunk keeps here, in light order; a chunk with more (rare: a large box among many
-// lights) is left to its permutation, which culls it with the whole workgroup (shade.comp
-// cullChunkLights, the same list).
+// lights) has its list written by a pass of its own (chunk_long_lists.comp, the same list: its
+// walks would cost every chunk here, ~5 ms at 1280x720 on builtin:lights, as code the SIMD
+// groups carry).
 #define CLASSIFY_MAX_LIGHTS 64u
 uint gLights[CLASSIFY_MAX_LIGHTS];
 uint gMasks[CLASSIFY_MAX_LIGHTS];
@@ -149,10 +150,17 @@ void main() {
     uint features = frameFeatures(f, lf);
     if ((o.v.flags & SHADEL_OBJECT_FEATURED_MATERIAL) != 0u) features |= SPECTRUM_MATERIAL;
     uint count, tested;
+    LightingCountersRef lc = LightingCountersRef(lf.counters);
     if (!cullChunk(f, lf, boxMin, boxMax, corners, count, tested, features)) {
-        // Its permutation culls it (the same list) and counts its lights.
-        ranges.e[workIndex] = uvec2(CHUNK_LIST_UNCOUNTED, CHUNK_LIST_NONE);
-        binChunkSpectrum(lf, workIndex, features);
+        // Left to the long-list pass with its box; binned to every lighting feature (counted
+        // with the ones it needs), so that it is shaded right even if its list then overflows
+        // the pool and it takes every light (a few dozen chunks a frame).
+        uint slot = atomicAdd(UintBuffer(sf.chunkListCount).v[2], 1u);
+        Uvec4Buffer(sf.longChunks).v[2u * slot] = uvec4(workIndex, floatBitsToUint(boxMin));
+        Uvec4Buffer(sf.longChunks).v[2u * slot + 1u] = uvec4(floatBitsToUint(boxMax), 0u);
+        ranges.e[workIndex] = uvec2(0u, CHUNK_LIST_NONE); // until that pass writes it
+        atomicAdd(lc.c.lightGridCandidates, tested);
+        binChunkSpectrumAs(lf, workIndex, SPECTRUM_ALL_LIGHTING, features);
         return;
     }
 
@@ -175,20 +183,21 @@ void main() {
         if ((visible.v[light >> 5] & bit) == 0u) atomicOr(visible.v[light >> 5], bit);
     }
 
-    // The list, for the chunk's permutation; one that does not fit the pool is culled again
-    // there (the same list).
+    // The list, for the chunk's permutation; one that does not fit the pool leaves the chunk to
+    // every light there (chunk_spectra.glsl loadChunkLightList: the same sum, counted).
     uint base = kept == 0u ? 0u : atomicAdd(UintBuffer(sf.chunkListCount).v[0], kept);
     bool fits = base <= sf.chunkListCapacity && kept <= sf.chunkListCapacity - base;
     ranges.e[workIndex] = fits ? uvec2(base, kept) : uvec2(0u, CHUNK_LIST_NONE);
     if (fits) {
         ChunkListBuffer pool = ChunkListBuffer(sf.chunkLists);
         for (uint i = 0u; i < kept; ++i) pool.e[base + i] = uvec2(gLights[i], gMasks[i]);
+    } else {
+        atomicAdd(UintBuffer(sf.chunkListCount).v[1], 1u);
     }
 
-    LightingCountersRef lc = LightingCountersRef(lf.counters);
     if (kept != 0u) atomicAdd(lc.c.lightChunkPairs, kept);
     atomicAdd(lc.c.lightGridCandidates, tested);
     if (count != kept) atomicAdd(lc.c.lightsCulledByBlockers, count - kept);
     if (perPixel) atomicAdd(lc.c.perPixelBlockerChunks, 1u);
-    binChunkSpectrum(lf, workIndex, features);
+    binChunkSpectrumAs(lf, workIndex, fits ? features : SPECTRUM_ALL_LIGHTING, features);
 }

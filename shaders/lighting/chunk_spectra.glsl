@@ -27,28 +27,21 @@ uint chunkSpectraWorkIndex(FrameConstants f, uint group) {
     return UintBuffer(sf.tileBins).v[kChunkSpectrumMode * sf.binCapacity + group];
 }
 
-// Whether this chunk's lights are counted in the light statistics by the shading: its classify
-// left it uncounted (more lights than it keeps, chunk_classify.comp).
-bool gChunkUncounted = false;
-
-// SHADE: the chunk's list as the classify pass culled it, into the shared list. False (and
-// nothing read) when the classify pass did not keep it: the caller culls the chunk. Uniform
-// flow.
-bool loadChunkLightList(FrameConstants f, uint workIndex) {
+// SHADE: the chunk's list as the classify pass culled it, read from its pool where it lies (no
+// copy to shared memory: no barrier, so the permutations run without coroutines on lavapipe).
+// A chunk whose list did not fit the pool takes every light, each blocker tested per shadel (the
+// same sum, slower; classify binned it to every feature and counted it). Any control flow.
+void loadChunkLightList(FrameConstants f, uint workIndex) {
     SpectraFrame sf = SpectraFrameRef(LightingFrameRef(f.lighting).l.chunkSpectra).s;
     uvec2 range = ChunkListBuffer(sf.chunkRanges).e[workIndex];
-    uint tid = gl_LocalInvocationIndex;
     if (range.y == CHUNK_LIST_NONE) {
-        gChunkUncounted = range.x == CHUNK_LIST_UNCOUNTED;
-        if (tid == 0u) atomicAdd(UintBuffer(sf.chunkListCount).v[gChunkUncounted ? 2 : 1], 1u);
-        return false;
+        gLightListMode = LIGHT_LIST_ALL;
+        return;
     }
-    ChunkListBuffer pool = ChunkListBuffer(sf.chunkLists);
-    for (uint i = tid; i < range.y; i += SHADEL_CHUNK * SHADEL_CHUNK) sLightList[i] = pool.e[range.x + i];
-    if (tid == 0u) sLightListCount = range.y;
-    gLightListMode = LIGHT_LIST_SHARED;
-    barrier();
-    return true;
+    gLightListMode = LIGHT_LIST_BUFFER;
+    gLightListAddress = sf.chunkLists + uint64_t(range.x) * 8ul;
+    gLightListCount = range.y;
+    gLightListPlainCount = 0u;
 }
 
 // --visualize spectra: the shadels of a chunk take its mode's colour.

@@ -118,8 +118,6 @@ void cullChunkLights(FrameConstants f, bool shading, vec3 p) {
     if (tid == 0u) {
         uint appended = sAppendCount; // lights kept, before the list's capacity
         uint count = min(appended, LIGHT_CHUNK_MAX_LIGHTS);
-        // Once per chunk: a spectrum's permutation counts only the chunks the classify did not.
-        bool counting = kChunkSpectraPhase != CHUNK_SPECTRA_SHADE || gChunkUncounted;
         uint kept = 0u;
         bool perPixel = false;
         for (uint i = 0u; i < count; ++i) {
@@ -129,17 +127,15 @@ void cullChunkLights(FrameConstants f, bool shading, vec3 p) {
             if (mask == LIGHT_INVALID) continue;
             sLightList[kept++] = uvec2(light, mask); // (kept <= i)
             perPixel = perPixel || mask != 0u;
-            if (counting) atomicOr(UintBuffer(lf.visibleLights).v[light >> 5], 1u << (light & 31u));
+            atomicOr(UintBuffer(lf.visibleLights).v[light >> 5], 1u << (light & 31u));
         }
         sLightListCount = kept;
-        if (counting) {
-            LightingCountersRef counters = LightingCountersRef(lf.counters);
-            atomicAdd(counters.c.lightChunkPairs, kept);
-            atomicAdd(counters.c.lightGridCandidates, gridded ? sGridCandidates : f.lightCount);
-            atomicAdd(counters.c.lightsCulledByBlockers, count - kept);
-            if (perPixel) atomicAdd(counters.c.perPixelBlockerChunks, 1u);
-            if (appended > LIGHT_CHUNK_MAX_LIGHTS) atomicAdd(counters.c.chunksOverflowed, 1u);
-        }
+        LightingCountersRef counters = LightingCountersRef(lf.counters);
+        atomicAdd(counters.c.lightChunkPairs, kept);
+        atomicAdd(counters.c.lightGridCandidates, gridded ? sGridCandidates : f.lightCount);
+        atomicAdd(counters.c.lightsCulledByBlockers, count - kept);
+        if (perPixel) atomicAdd(counters.c.perPixelBlockerChunks, 1u);
+        if (appended > LIGHT_CHUNK_MAX_LIGHTS) atomicAdd(counters.c.chunksOverflowed, 1u);
     }
     barrier(); // the shading reads the list with every invocation
 }
@@ -232,16 +228,19 @@ void main() {
     si.uvDx = uvDx;
     si.uvDy = uvDy;
     // With few lights each subgroup culls them for its own shadels (no barrier); else the
-    // chunk culls them (a spectrum's permutation reads the list its classify phase culled).
-    // Spectra never cull per subgroup: their permutations do not compile it in. Pipelines of
-    // renderers that never cull per chunk leave that culling out, with its barriers: on
-    // lavapipe a shader with a barrier runs each SIMD group as a coroutine, which cost
-    // builtin:default's shading (1280x720) a fifth of its time.
+    // chunk culls them, or a spectrum's permutation reads the list its classify pass culled.
+    // Spectra never cull per subgroup nor per chunk: their permutations compile neither in.
+    // Pipelines of renderers that never cull per chunk leave that culling out, with its
+    // barriers: on lavapipe a shader with a barrier runs each SIMD group as a coroutine, which
+    // cost builtin:default's shading (1280x720) a fifth of its time.
     if (kChunkSpectraPhase == CHUNK_SPECTRA_OFF && f.lighting != 0ul &&
         LightingFrameRef(f.lighting).l.subgroupLists != 0u)
         useSubgroupLightList(f, shading, si.position);
-    else if (f.lighting != 0ul && LightingFrameRef(f.lighting).l.tiled != 0u &&
-             !(kChunkSpectraPhase == CHUNK_SPECTRA_SHADE && loadChunkLightList(f, workIndex))) {
+    else if (kChunkSpectraPhase == CHUNK_SPECTRA_SHADE && f.lighting != 0ul &&
+             LightingFrameRef(f.lighting).l.tiled != 0u)
+        loadChunkLightList(f, workIndex);
+    else if (kChunkSpectraPhase == CHUNK_SPECTRA_OFF && f.lighting != 0ul &&
+             LightingFrameRef(f.lighting).l.tiled != 0u) {
         SHADEL_ASSERT(f, SHADE_HAS(SHADE_OPTIONAL_CHUNK_LIGHTS), ASSERT_SHADE_PIPELINE,
                       SHADE_OPTIONAL_CHUNK_LIGHTS, kShadeOptional);
         if (SHADE_HAS(SHADE_OPTIONAL_CHUNK_LIGHTS)) cullChunkLights(f, shading, si.position);

@@ -73,7 +73,7 @@ const uint32_t kSpectrumModes[] = {
     kShadowedStreet,                             // and PCSS
     kShadowedStreet | kTextured,                 // and gobos, textured area lights
     kStreet | kTextured | kBlocked,              // blockers and portals, no spot shadows
-    SPECTRUM_ALL & ~SPECTRUM_MATERIAL,           // every lighting feature
+    SPECTRUM_ALL_LIGHTING,                       // every lighting feature
     SPECTRUM_ALL,                                // and material features
 };
 
@@ -84,7 +84,7 @@ const char* const kFeatureNames[SPECTRUM_FEATURE_COUNT] = {
 std::string modeName(uint32_t features) {
     if (features == 0u) return "nothing_special";
     if (features == SPECTRUM_ALL) return "all";
-    if (features == (SPECTRUM_ALL & ~SPECTRUM_MATERIAL)) return "all_but_material";
+    if (features == SPECTRUM_ALL_LIGHTING) return "all_but_material";
     std::string name;
     for (uint32_t bit = 0; bit < SPECTRUM_FEATURE_COUNT; ++bit)
         if (features & (1u << bit)) {
@@ -124,6 +124,7 @@ struct SpectraState {
     std::vector<uint32_t> modes;   // feature sets, cheapest first
     std::vector<Pipeline> shading; // one permutation per mode
     Pipeline classify, setup;      // chunks: the classify pass, the dispatch sizes
+    Pipeline longLists;            // chunks: the lists classify leaves (chunk_long_lists.comp)
     BufferHandle frame;            // gpu::SpectraFrame (upload)
     // Per mode: tiles, a VkDispatchIndirectCommand (x counts); chunks, a uvec4 (w counts).
     BufferHandle dispatch;     // (read back for stats)
@@ -132,11 +133,12 @@ struct SpectraState {
     BufferHandle featureTiles; // features (readback)
     // Chunks: the classify pass's light lists (pool, per-chunk ranges, the pool's counter).
     BufferHandle chunkLists, chunkRanges, chunkListCount;
+    BufferHandle longChunks; // the long-list pass's chunks and boxes
     uint32_t chunkListCapacity = 0;
     uint32_t tiles = 0;
     // Last frame's counts.
     std::vector<uint32_t> binned, lastSuperfluous, lastFeatureTiles;
-    uint32_t lastChunkListEntries = 0, lastChunksCulledAgain = 0, lastChunksLongLists = 0;
+    uint32_t lastChunkListEntries = 0, lastChunksPoolOverflow = 0, lastChunksLongLists = 0;
 };
 
 void SpectraStateDeleter::operator()(SpectraState* state) const {
@@ -191,22 +193,30 @@ SpectraStatePtr createFeatureSpectra(Renderer& r) {
         // back instead of culling again (on builtin:lights at 1280x720 that culling was a third
         // of the classify pass). 8 entries per queue slot: 13.7 (light, chunk) pairs per shaded
         // chunk there, and the queue holds far more chunks than a frame shades; a chunk whose
-        // list does not fit is culled again by its permutation (the same list either way).
+        // list does not fit takes every light in its permutation (the same sum, slower).
         s->chunkListCapacity = s->tiles * 8u;
         s->chunkLists =
             need(createBuffer(gpu, {"spectra.chunkLists", uint64_t(s->chunkListCapacity) * 8, 0}));
         s->chunkRanges =
             need(createBuffer(gpu, {"spectra.chunkRanges", uint64_t(s->tiles) * 8, 0}));
         s->chunkListCount = need(createBuffer(
-            gpu, {"spectra.chunkListCount", 12, 0, MemoryKind::Readback})); // uint[3]: SpectraFrame
+            gpu, {"spectra.chunkListCount", SPECTRA_CHUNK_LIST_COUNTS * 4,
+                  VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT, MemoryKind::Readback})); // SpectraFrame
+        s->longChunks = need(createBuffer(gpu, {"spectra.longChunks", uint64_t(s->tiles) * 32, 0}));
         // Permutations of the shadel shading itself (shade.comp), with its other constants.
         std::vector<std::pair<uint32_t, uint32_t>> base;
         if (r.settings.distanceFieldLighting)
             base.push_back({DISTANCE_FIELD_LIGHTING_CONSTANT_ID, 1u});
+        // The renderer's optional parts, less the chunk culling: a permutation reads its
+        // chunk's list from classify's pool. (A part's barriers, compiled in, would make
+        // lavapipe run every permutation as coroutines.)
+        base.push_back({SHADE_OPTIONAL_CONSTANT_ID,
+                        shadelShadingQueue(r).shadeOptional & ~SHADE_OPTIONAL_CHUNK_LIGHTS});
         // Every permutation at once: compiled side by side (rhi/pipeline.h).
         std::vector<ComputePipelineDesc> descs;
         descs.push_back({"shadelChunkSpectra.classify", "lighting_chunk_classify.comp.spv", {}});
         descs.push_back({"shadelChunkSpectra.setup", "lighting_chunk_spectra_setup.comp.spv", {}});
+        descs.push_back({"shadelChunkSpectra.longLists", "lighting_chunk_long_lists.comp.spv", {}});
         for (uint32_t m = 0; m < modes; ++m) {
             auto constants = base;
             constants.push_back({CHUNK_SPECTRA_PHASE_CONSTANT_ID, 2u});
@@ -219,7 +229,8 @@ SpectraStatePtr createFeatureSpectra(Renderer& r) {
         std::vector<Pipeline> built = createComputePipelines(gpu, descs);
         s->classify = built[0];
         s->setup = built[1];
-        s->shading.assign(built.begin() + 2, built.end());
+        s->longLists = built[2];
+        s->shading.assign(built.begin() + 3, built.end());
         return s;
     }
     std::vector<ComputePipelineDesc> descs;
@@ -241,7 +252,9 @@ void destroyFeatureSpectra(Renderer& r, SpectraStatePtr& state) {
     if (state->chunks) {
         destroy(gpu, state->classify);
         destroy(gpu, state->setup);
-        for (BufferHandle b : {state->chunkLists, state->chunkRanges, state->chunkListCount})
+        destroy(gpu, state->longLists);
+        for (BufferHandle b :
+             {state->chunkLists, state->chunkRanges, state->chunkListCount, state->longChunks})
             destroy(gpu, b);
     }
     for (BufferHandle b :
@@ -265,6 +278,7 @@ uint64_t prepareFeatureSpectra(Renderer& r, uint32_t tilesX, uint32_t tilesY) {
         f.chunkLists = address(gpu, s.chunkLists);
         f.chunkRanges = address(gpu, s.chunkRanges);
         f.chunkListCount = address(gpu, s.chunkListCount);
+        f.longChunks = address(gpu, s.longChunks);
         f.chunkListCapacity = s.chunkListCapacity;
     }
     for (size_t m = 0; m < s.modes.size(); ++m) f.modeFeatures[m] = s.modes[m];
@@ -335,10 +349,19 @@ void recordChunkSpectraClassify(Renderer& r, VkCommandBuffer cmd, uint64_t frame
     bind(gpu, cmd, s.setup);
     pushConstants(gpu, cmd, ChunkSpectraSetupPush{address(gpu, s.frame)});
     vkCmdDispatch(cmd, 1, 1, 1);
-    // The bins and their dispatch sizes, for the per-spectrum shading.
+    // The bins and their dispatch sizes, for the long lists and the per-spectrum shading.
     memoryBarrier(cmd, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT,
                   VK_PIPELINE_STAGE_2_DRAW_INDIRECT_BIT | VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
                   VK_ACCESS_2_INDIRECT_COMMAND_READ_BIT | VK_ACCESS_2_SHADER_STORAGE_READ_BIT);
+    // The lists classify left to their own pass (more lights than it keeps), before shading
+    // reads them.
+    bind(gpu, cmd, s.longLists);
+    pushConstants(gpu, cmd, frame);
+    vkCmdDispatchIndirect(cmd, vkBuffer(gpu, s.chunkListCount),
+                          SPECTRA_LONG_LIST_DISPATCH * sizeof(uint32_t));
+    memoryBarrier(cmd, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT,
+                  VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
+                  VK_ACCESS_2_SHADER_STORAGE_READ_BIT | VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT);
 }
 
 void recordChunkSpectraShading(Renderer& r, VkCommandBuffer cmd, uint64_t frame) {
@@ -366,7 +389,7 @@ void readFeatureSpectraStats(Renderer& r) {
     if (s.chunks) {
         const uint32_t* lists = static_cast<const uint32_t*>(mapped(gpu, s.chunkListCount));
         s.lastChunkListEntries = lists[0];
-        s.lastChunksCulledAgain = lists[1];
+        s.lastChunksPoolOverflow = lists[1];
         s.lastChunksLongLists = lists[2];
     }
 }
@@ -408,12 +431,13 @@ void featureSpectraStats(const Renderer& r, nlohmann::json& stats) {
     stats["spectra_superfluous_total"] = superfluousTotal; // (tile, feature) pairs
     stats["tile_features"] = features;                     // feature -> tiles needing it
     if (s.chunks) {
-        // The classify pass's lists the permutations read (their kept lights' entries), and the
-        // chunks culled again by their permutation: those whose list did not fit the pool, and
-        // those with more lights than classify keeps (binned to every feature).
+        // The classify pass's lists the permutations read (their kept lights' entries); the
+        // chunks whose list did not fit the pool (their permutation takes every light, each
+        // blocker per shadel: the same sum, slower; binned to every feature); the chunks with
+        // more lights than classify keeps in its private list (written by two walks instead).
         stats["spectra_chunk_list_entries"] = s.lastChunkListEntries;
         stats["spectra_chunk_list_capacity"] = s.chunkListCapacity;
-        stats["spectra_chunks_culled_again"] = s.lastChunksCulledAgain;
+        stats["spectra_chunks_pool_overflow"] = s.lastChunksPoolOverflow;
         stats["spectra_chunks_long_lists"] = s.lastChunksLongLists;
     }
 }

@@ -173,11 +173,12 @@ struct DecoupledState {
     bool reuse = true;
     uint32_t refreshPeriod = 16; // --reuse-refresh
     uint32_t objectsReusable = 0;
-    BufferHandle allocId;      // uint per block (upload: written by the CPU allocator)
-    BufferHandle counters;     // GpuShadelCounters (readback, also indirect args)
-    BufferHandle markedBlocks; // uvec4 per marked block, capacityChunks of them
-    BufferHandle queue;        // GpuShadelWork[capacity]: chunks to shade
-    BufferHandle copyQueue;    // GpuShadelWork[capacity]: chunks carried over from last frame
+    uint32_t shadeOptional = 0; // SHADE_OPTIONAL_* of the shading pipelines
+    BufferHandle allocId;       // uint per block (upload: written by the CPU allocator)
+    BufferHandle counters;      // GpuShadelCounters (readback, also indirect args)
+    BufferHandle markedBlocks;  // uvec4 per marked block, capacityChunks of them
+    BufferHandle queue;         // GpuShadelWork[capacity]: chunks to shade
+    BufferHandle copyQueue;     // GpuShadelWork[capacity]: chunks carried over from last frame
     // uint[SHADE_CLASSES + 1][capacity]: queue entries by shading class, then near change
     BufferHandle classQueues;
     BufferHandle changedVolumes;        // ChangedVolume[SHADEL_MAX_CHANGED_VOLUMES] (upload)
@@ -349,6 +350,7 @@ DecoupledStatePtr createDecoupled(Renderer& r, const GpuScene& scene) {
     if (d.reuse) optional |= SHADE_OPTIONAL_REUSE;
     if (shadelsCullLightsPerChunk(r, scene)) optional |= SHADE_OPTIONAL_CHUNK_LIGHTS;
     shadeConstants.push_back({SHADE_OPTIONAL_CONSTANT_ID, optional});
+    d.shadeOptional = optional;
     // The shading classes (SHADEL_OBJECT_* flags set per object below): plain materials with
     // every material feature compiled out, featured ones, supersampled procedurals.
     const char* const classNames[SHADE_CLASSES] = {"shadelShadePlain", "shadelShadeFeatured",
@@ -1041,7 +1043,8 @@ void computeToCompute(VkCommandBuffer cmd) {
 
 ShadelShadingQueue shadelShadingQueue(const Renderer& r) {
     const DecoupledState& d = *r.decoupled;
-    return {d.counters, offsetof(gpu::GpuShadelCounters, invocationDispatch), d.capacityChunks};
+    return {d.counters, offsetof(gpu::GpuShadelCounters, invocationDispatch), d.capacityChunks,
+            d.shadeOptional};
 }
 
 void recordDecoupledMarking(Renderer& r, FrameRecorder& rec, uint64_t frame) {

@@ -46,6 +46,9 @@ struct ShadelShadingQueue {
     BufferHandle counters;
     VkDeviceSize invocationDispatchOffset = 0;
     uint32_t capacity = 0;
+    // The SHADE_OPTIONAL_* parts this renderer's shading pipelines compile in (the spectra's
+    // permutations take the same, less the chunk light culling they never run).
+    uint32_t shadeOptional = 0;
 };
 ShadelShadingQueue shadelShadingQueue(const Renderer& r);
 // Adds the decoupled fields of DESIGN §5 (medians over the frames rendered so far).
