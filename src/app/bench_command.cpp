@@ -517,6 +517,7 @@ nlohmann::json runBench(Gpu& gpu, const BenchOptions& b) {
     o.shadingBias = b.shadingBias;
     o.cacheLimitBytes = b.cacheLimitBytes;
     o.lightCulling = b.lightCulling;
+    o.spectra = b.spectra;
     o.progress = false;
     o.sunCascades = b.sunCascades;
     o.instances = b.instances;

@@ -60,7 +60,7 @@ struct RenderOptions {
     LightCulling lightCulling = LightCulling::Tiled;             // --light-culling tiled|none
     bool lightBlockers = true;                                   // --blockers on|off
     bool lightGrid = true;                                       // --light-grid on|off
-    Spectra spectra = Spectra::Off;                              // --spectra on|off|single
+    Spectra spectra = Spectra::Auto;                             // --spectra auto|on|off|single
     bool sunSoftShadows = false;                                 // --sun-shadows pcf|pcss
     bool spotShadows = true;                                     // --spot-shadows on|off
     uint32_t sunCascades = 1;                                    // --sun-cascades 1..4
@@ -184,6 +184,9 @@ struct BenchOptions {
     // ratios.spectra_forward|spectra_decoupled = on / single median frame time (the seed's
     // spectra against one all-features shader).
     bool compareSpectra = false;
+    // --spectra auto|off: the three modes' spectra (render's default, auto: on in decoupled
+    // frames with more than 64 lights).
+    Spectra spectra = Spectra::Auto;
     // --stencil-compare: forward with --screen-space on and the stencil effects, stencil-culled
     // and full-screen; ratios.stencil_outline|stencil_water = culled / full-screen pass time.
     bool compareStencil = false;

@@ -257,7 +257,7 @@ int main(int argc, char** argv) {
         ->add_option("--particle-atlas-size", ro.particleAtlasSize,
                      "texels per side of the particle lightmap atlas (128..8192)")
         ->capture_default_str();
-    std::string lightCulling = "tiled", blockers = "on", spectra = "off", sunShadows = "pcf",
+    std::string lightCulling = "tiled", blockers = "on", spectra = "auto", sunShadows = "pcf",
                 spotShadows = "on", lightGrid = "on";
     render
         ->add_option("--light-culling", lightCulling,
@@ -274,9 +274,11 @@ int main(int argc, char** argv) {
         ->capture_default_str();
     render
         ->add_option("--spectra", spectra,
-                     "on | off | single: forward shading per 16x16 tile by permutations "
-                     "compiled with only the features the tile needs (single: one "
-                     "all-features permutation; off: the raster forward pass)")
+                     "auto | on | off | single: shading by permutations compiled with only the "
+                     "features each 16x16 tile (forward) or 8x8-shadel chunk (decoupled) needs "
+                     "(single: one all-features permutation; off: the raster forward pass, the "
+                     "plain shadel shading; auto: on in decoupled frames with more than 64 "
+                     "lights, else off)")
         ->capture_default_str();
     render
         ->add_option("--sun-shadows", sunShadows,
@@ -515,14 +517,15 @@ int main(int argc, char** argv) {
             "--light-grid", benchLightGrid,
             "on | off: tiles and shadel chunks take their candidate lights from the light grid")
         ->capture_default_str();
-    std::string benchSpectra = "off";
+    std::string benchSpectra = "auto";
     bench
         ->add_option("--spectra", benchSpectra,
-                     "off | compare: compare also renders forward and decoupled with --spectra "
-                     "on and single (--rounds rounds of alternating order, 2 unless given) and "
-                     "reports on / single (the median of the rounds' ratios) and on / off "
-                     "frame-time ratios, and on / single of the shading passes (with spectra's "
-                     "classify + bin)")
+                     "auto | off | compare: the modes' spectra as render's --spectra (auto: on in "
+                     "decoupled frames with more than 64 lights); compare also renders forward "
+                     "and decoupled with --spectra on and single (--rounds rounds of "
+                     "alternating order, 2 unless given) and reports on / single (the median of "
+                     "the rounds' ratios) and on / off frame-time ratios, and on / single of the "
+                     "shading passes (with spectra's classify + bin)")
         ->capture_default_str();
     bench
         ->add_option("--reuse-refresh", bo.reuseRefreshPeriod,
@@ -796,10 +799,12 @@ int main(int argc, char** argv) {
             bo.compareLightCulling = benchLightCulling == "compare";
             if (!bo.compareLightCulling) bo.lightCulling = parseLightCulling(benchLightCulling);
             bo.compareSpectra = benchSpectra == "compare";
-            if (!bo.compareSpectra && parseSpectra(benchSpectra) != Spectra::Off)
-                throw InputError(format("bench --spectra %s: expected off or compare (the "
-                                        "decoupled runs have no spectra)",
-                                        benchSpectra.c_str()));
+            if (!bo.compareSpectra) {
+                if (benchSpectra != "auto" && benchSpectra != "off")
+                    throw InputError(format("bench --spectra %s: expected auto, off or compare",
+                                            benchSpectra.c_str()));
+                bo.spectra = parseSpectra(benchSpectra);
+            }
             runBench(g.gpu, bo);
             return 0;
         }

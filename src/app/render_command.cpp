@@ -77,7 +77,8 @@ Spectra parseSpectra(const std::string& text) {
     if (text == "off") return Spectra::Off;
     if (text == "on") return Spectra::On;
     if (text == "single") return Spectra::Single;
-    throw InputError(format("--spectra %s: expected on, off or single", text.c_str()));
+    if (text == "auto") return Spectra::Auto;
+    throw InputError(format("--spectra %s: expected auto, on, off or single", text.c_str()));
 }
 
 bool parseOnOff(const char* flag, const std::string& text) {

@@ -85,14 +85,23 @@ static void registerTargetCaptures(Renderer& r) {
 }
 
 // --marking auto: visibility, unless a feature that needs the raster prepass is on.
-static RenderSettings resolveMarking(RenderSettings s) {
+// The settings' "auto" choices, for this scene.
+static RenderSettings resolveSettings(RenderSettings s, const GpuScene& scene) {
     if (s.marking == MarkingMode::Auto)
         s.marking = s.occlusion || s.screenSpace ? MarkingMode::Raster : MarkingMode::Visibility;
+    // Spectra where they pay (render/lighting/feature_spectra.h): decoupled frames that would
+    // cull lights per chunk, i.e. tiled culling with more lights than per-subgroup lists take
+    // (render/lighting/light_culling.h); and whenever their debug view is asked for.
+    if (s.spectra == Spectra::Auto) {
+        bool perChunk = s.mode == RenderMode::Decoupled && s.lightCulling == LightCulling::Tiled &&
+                        scene.lightInfo.size() > LIGHT_SUBGROUP_MAX_LIGHTS;
+        s.spectra = perChunk || s.visualize == Visualize::Spectra ? Spectra::On : Spectra::Off;
+    }
     return s;
 }
 
 void initRenderer(Renderer& r, Gpu& gpu, const RenderSettings& requested, const GpuScene& scene) {
-    const RenderSettings settings = resolveMarking(requested);
+    const RenderSettings settings = resolveSettings(requested, scene);
     r.gpu = &gpu;
     r.settings = settings;
     r.alphaMasked = hasAlphaMaskedMaterials(scene);

@@ -149,10 +149,10 @@ struct RenderSettings {
     // Metres: only the fields of meshes with an instance this near the camera are in the atlas
     // (streamed in and out as the camera moves); 0: every field, placed at load.
     float dfResidencyDistance = 0.0f;
-    Spectra spectra = Spectra::Off; // forward: per-tile shading permutations (render/lighting)
-    bool sunSoftShadows = false;    // --sun-shadows pcss: variable penumbra (render/lighting)
-    bool spotShadows = true;        // --spot-shadows: shadow maps of shadow-casting spots
-    uint32_t sunCascades = 1;       // --sun-cascades: 1 = one map fitted to the scene
+    Spectra spectra = Spectra::Auto; // per-tile / per-chunk shading permutations (render/lighting)
+    bool sunSoftShadows = false;     // --sun-shadows pcss: variable penumbra (render/lighting)
+    bool spotShadows = true;         // --spot-shadows: shadow maps of shadow-casting spots
+    uint32_t sunCascades = 1;        // --sun-cascades: 1 = one map fitted to the scene
     bool proxyShadows =
         true;           // --proxy-shadows: shadow views draw proxy index sets (render/culling)
     bool decals = true; // --decals: the scene's projected box decals (render/decals)

@@ -219,13 +219,30 @@ TEST(Spectra, VisualizeSpectraColoursTilesByMode) {
     EXPECT_GE(hues.size(), 3u) << "several modes, each its own colour";
 }
 
+// --spectra auto (the default) turns spectra on where they pay: decoupled frames that cull lights
+// per chunk (more lights than per-subgroup lists take); not forward (the raster pass), not few
+// lights (culled per subgroup, no chunk culling to replace), and always for their debug view.
+TEST(Spectra, AutoTurnsThemOnInDecoupledFramesThatCullPerChunk) {
+    auto modeOf = [](const char* scene, RenderMode mode, Visualize visualize) {
+        RenderOptions o = renderOptions(scene, mode, 96, 54);
+        EXPECT_EQ(o.spectra, Spectra::Auto);
+        o.visualize = visualize;
+        return renderChecked(o).stats["spectra_mode"].get<std::string>();
+    };
+    EXPECT_EQ(modeOf("builtin:lights", RenderMode::Decoupled, Visualize::None), "on");
+    EXPECT_EQ(modeOf("builtin:default", RenderMode::Decoupled, Visualize::None), "off");
+    EXPECT_EQ(modeOf("builtin:lights", RenderMode::Forward, Visualize::None), "off");
+    EXPECT_EQ(modeOf("builtin:default", RenderMode::Decoupled, Visualize::Spectra), "on");
+}
+
 TEST(Spectra, BadSpectraFlagsAreOneLineErrors) {
     EXPECT_THROW(parseSpectra("maybe"), InputError);
     EXPECT_EQ(parseSpectra("single"), Spectra::Single);
+    EXPECT_EQ(parseSpectra("auto"), Spectra::Auto);
     EXPECT_EQ(parseVisualize("spectra"), Visualize::Spectra);
     std::string err = (std::filesystem::temp_directory_path() / "shadel-spectra-err.txt").string();
-    for (const char* args :
-         {"--spectra maybe", "--spectra on --light-culling none", "--visualize spectra"}) {
+    for (const char* args : {"--spectra maybe", "--spectra on --light-culling none",
+                             "--spectra off --visualize spectra"}) {
         std::string cmd = std::string("timeout 120 ") + SHADEL_BINARY +
                           " render --scene builtin:blockers --size 32x32 " + args +
                           " >/dev/null 2>" + err;

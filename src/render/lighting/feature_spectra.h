@@ -39,7 +39,7 @@
 // lights' blockers beside 63 other chunks. Alternating runs against the workgroup classify
 // (same command, reuse off, spectra on): classify 31.4 / 33.0 ms against 93.3 / 88.7, the same
 // (light, chunk) pairs (220,533) and image; 42 of the 16,174 chunks keep more than 64 lights
-// (coarse levels' large chunks) and are culled again by their permutation. bench --spectra
+// (coarse levels' large chunks; their lists now come from chunk_long_lists.comp). bench --spectra
 // compare (1280x720, 4 frames, timing submit), the old build's 3 rounds then this one's 6, the
 // host in the same state: decoupled frame on 397.9 -> 340.6 ms, single 428.2 -> 382.2, off
 // 364.4 / 375.6; on / single 0.930 -> 0.896, on / off 1.092 -> 0.907 (spectra now cost less
@@ -54,6 +54,15 @@
 // all-features permutation runs for every shadel. Modes added for the bins with superfluous
 // area lights and PCSS (blocked tiles and chunks under shadowed spots, 18 modes) changed
 // nothing measurable: tileShading 267-283 / 271-274 ms, shadelShading 312 / 316 ms.
+// The permutations carry no barrier: they read their chunk's list from the pool (no copy to
+// shared memory), never cull again (long lists have their own pass; a list that overflows the
+// pool takes every light), and leave out the optional parts the renderer lacks. On lavapipe a
+// shader with any barrier runs its SIMD groups as coroutines: alternating with the build that
+// copied the list, builtin:lights 1280x720 spectra on frame 354-358 -> 301-312 ms,
+// shadelShading 247-252 -> 193-202 ms, same pairs and image. bench --spectra compare, 6 rounds:
+// decoupled on / single 0.898, on / off 0.755 (on 304.5, single 340.2, off 403.4 ms); forward
+// on / single 0.813. The off path (the shading's own chunk culling in shared memory) costing
+// 1.3x on is why --spectra auto turns them on in decoupled frames with more than 64 lights.
 #include <memory>
 
 #include <nlohmann/json.hpp>
@@ -64,7 +73,13 @@ namespace shadel {
 
 struct Renderer;
 
-enum class Spectra { Off, On, Single };
+// Auto (the default) is resolved when the renderer is made (renderer.cpp resolveSettings): On
+// for decoupled
+// frames that cull lights per chunk (tiled culling, more lights than per-subgroup lists take),
+// where the classify pass and the permutations cost less than the shading's own chunk culling
+// (builtin:lights 1280x720, lavapipe: frame 0.80-0.88 of spectra off); Off everywhere else
+// (the raster forward pass; few lights, culled per subgroup).
+enum class Spectra { Off, On, Single, Auto };
 
 struct SpectraState;
 struct SpectraStateDeleter {
