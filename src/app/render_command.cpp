@@ -572,6 +572,10 @@ RenderRun runRender(Gpu& gpu, const RenderOptions& o) {
     s["driver"] = gpu.device.driver;
     s["scene"] = o.scene;
     s["camera"] = camera.name;
+    // Where the (first frame's) camera stood and looked: an automatic one can be reproduced with
+    // --from and --look-at.
+    s["camera_position"] = {camera.position.x, camera.position.y, camera.position.z};
+    s["camera_forward"] = {camera.forward.x, camera.forward.y, camera.forward.z};
     if (cutCamera) s["camera_cut"] = {{"camera", cutCamera->name}, {"frame", o.cutFrame}};
     s["mode"] = modeName(o.mode);
     if (o.mode == RenderMode::Decoupled)

@@ -27,7 +27,9 @@ glm::vec3 automaticViewDirection();
 // front, sides, back, top), keeping the one whose triangles cover the most of a coarse grid of
 // the image (the three-quarter view from +X +Y +Z when it covers 30%, or unless another covers
 // 25% more; the elevated views foreshorten tall models, which 16:9 images show small). Flat or
-// elongated models are then seen from the side that shows them, not edge-on.
+// elongated models are then seen from the side that shows them, not edge-on. Only the sides of
+// triangles meant to be seen count (fronts; both of double-sided materials), and a view from
+// behind (-Z: glTF assets face +Z) must cover 25% more than one from in front.
 Camera frameAutomatically(const Scene& scene, float yfov, float aspect);
 
 struct CameraOverrides {

@@ -9,10 +9,12 @@
 #include <sstream>
 #include <sys/wait.h>
 
+#include <glm/gtc/matrix_transform.hpp>
 #include <nlohmann/json.hpp>
 #include <stb/stb_image_write.h> // defined once, in scene/gltf_import.cpp
 
 #include "gpu_test_env.h"
+#include "render/camera_framing.h"
 
 using namespace shadel;
 using namespace shadel::test;
@@ -106,6 +108,47 @@ TEST(GltfFeatures, AutomaticFramingCoversAQuarterToNinetyPercent) {
         EXPECT_GE(c, 0.25) << model;
         EXPECT_LE(c, 0.90) << model;
     }
+}
+
+// Automatic framing counts only the sides meant to be seen: a one-sided square facing -Z is
+// framed from the -Z side (the preferred three-quarter view from +Z sees only its back), so is
+// a +Z-facing one under a mirroring transform (glTF: its winding turns), and a double-sided one
+// keeps the preferred view. (Before, either winding counted and all three were seen from +Z.)
+// And glTF assets face +Z: ClearCoatTest.gltf, whose backdrops are closed slabs, covers as much
+// from behind (where they hide its samples) and is framed from the front, its stats say.
+TEST(GltfFeatures, AutomaticFramingLooksAtTheFrontOfOneSidedSurfaces) {
+    {
+        RenderOptions o = renderOptions(kAssimp + "/ClearCoat-glTF/ClearCoatTest.gltf",
+                                        RenderMode::Forward, 160, 90);
+        o.camera = "auto";
+        o.progress = false;
+        RenderRun run = renderChecked(o);
+        EXPECT_GT(run.stats["camera_position"][2].get<double>(), 0.0);
+        EXPECT_LT(run.stats["camera_forward"][2].get<double>(), 0.0);
+    }
+    auto cameraZ = [](bool facingMinusZ, bool mirrored, bool doubleSided) {
+        Scene scene;
+        Mesh quad;
+        for (glm::vec2 p : {glm::vec2(-1, -1), glm::vec2(1, -1), glm::vec2(1, 1), glm::vec2(-1, 1)})
+            quad.vertices.push_back(
+                {glm::vec3(p, 0.0f), glm::vec3(0, 0, 1), glm::vec4(1, 0, 0, 1), p * 0.5f + 0.5f});
+        quad.indices = facingMinusZ ? std::vector<uint32_t>{0, 2, 1, 0, 3, 2}
+                                    : std::vector<uint32_t>{0, 1, 2, 0, 2, 3};
+        quad.bounds.extend(glm::vec3(-1, -1, 0));
+        quad.bounds.extend(glm::vec3(1, 1, 0));
+        scene.meshes.push_back(quad);
+        Material material;
+        material.doubleSided = doubleSided;
+        scene.materials.push_back(material);
+        Instance instance;
+        if (mirrored) instance.transform = glm::scale(glm::mat4(1.0f), glm::vec3(1, 1, -1));
+        scene.instances.push_back(instance);
+        return frameAutomatically(scene, glm::radians(45.0f), 16.0f / 9.0f).position.z;
+    };
+    EXPECT_GT(cameraZ(false, false, false), 0.0f) << "facing +Z: seen from +Z";
+    EXPECT_LT(cameraZ(true, false, false), 0.0f) << "facing -Z: seen from -Z";
+    EXPECT_LT(cameraZ(false, true, false), 0.0f) << "mirrored: its front faces -Z";
+    EXPECT_GT(cameraZ(true, false, true), 0.0f) << "double-sided: the preferred view";
 }
 
 TEST(GltfFeatures, AutomaticFramingDoesNotDependOnModelSize) {
