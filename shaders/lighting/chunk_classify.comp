@@ -46,45 +46,22 @@ bool insertLight(inout uint n, uint light) {
     return true;
 }
 
-// The features a kept light brings after its blockers (none when one hides it from the box).
-uint keptLightFeatures(LightingFrame lf, GpuLight l, vec3 boxMin, vec3 boxMax, vec3 corners[8]) {
-    uint mask = lightBlockerMask(lf, l, corners, boxMin, boxMax);
-    return mask == LIGHT_INVALID ? 0u : entryFeatures(lf, l, mask, corners);
-}
-
 // The lights chunkKeepsLight keeps for the box, into gLights: the light grid's candidates, or
 // every light when the grid cannot answer (as shade.comp's cullChunkLights). `tested`: the
-// candidates tested. False when they do not fit: the walk then goes on for `features`, which
-// gains those of every light the chunk keeps (a light listed twice adds nothing).
+// candidates tested. False when they do not fit (chunk_long_lists.comp then walks them).
 bool cullChunk(FrameConstants f, LightingFrame lf, vec3 boxMin, vec3 boxMax, vec3 corners[8],
-               out uint count, out uint tested, inout uint features) {
+               out uint count, out uint tested) {
     LightBuffer lights = LightBuffer(f.lights);
-    LightGridQuery q;
-    bool gridded = lightGridQuery(f, lf.lightGrid, boxMin, boxMax, q);
-    LightGridCandidates c;
-    if (gridded) {
-        c = lightGridCandidates(q);
-    } else { // every light, as one source
-        c.sources = 1u;
-        c.lists[0] = uvec2(0u, f.lightCount);
-        c.total = f.lightCount;
-    }
-    UintBuffer entries = UintBuffer(q.g.entries);
+    LightGridCandidates c = lightCandidatesNear(f, lf.lightGrid, boxMin, boxMax);
     tested = c.total;
     count = 0u;
-    bool fits = true;
     for (uint s = 0u; s < c.sources; ++s)
         for (uint k = 0u; k < c.lists[s].y; ++k) {
-            uint light = gridded ? entries.v[c.lists[s].x + k] : k;
-            GpuLight l = lights.l[light];
-            if (!chunkKeepsLight(l, boxMin, boxMax, corners)) continue;
-            fits = fits && insertLight(count, light);
-            if (!fits) features |= keptLightFeatures(lf, l, boxMin, boxMax, corners);
+            uint light = lightCandidate(c, s, k);
+            if (chunkKeepsLight(lights.l[light], boxMin, boxMax, corners) && !insertLight(count, light))
+                return false;
         }
-    if (!fits)
-        for (uint i = 0u; i < count; ++i)
-            features |= keptLightFeatures(lf, lights.l[gLights[i]], boxMin, boxMax, corners);
-    return fits;
+    return true;
 }
 
 void main() {
@@ -108,14 +85,12 @@ void main() {
     GpuInstance inst = InstanceBuffer(f.instances).i[work.object];
     GpuMesh mesh = MeshBuffer(f.meshes).m[inst.mesh];
     uvec2 size = levelSize(o, work.mip);
-    uvec2 sheet = uvec2(work.chunk & 0xFFFFu, work.chunk >> 16) * SHADEL_CHUNK;
     uvec3 lo = uvec3(0xFFFFFFFFu), hi = uvec3(0u);
     bool nearChange = false;
     for (uint i = 0u; i < SHADEL_CHUNK * SHADEL_CHUNK; ++i) {
-        uvec2 shadel = levelShadel(o, work.mip, sheet + uvec2(i % SHADEL_CHUNK, i / SHADEL_CHUNK));
-        if (any(greaterThanEqual(shadel, size))) continue;
-        uint tri = triangleId(s, o.v.idMapOffset[work.mip] + shadel.y * size.x + shadel.x);
-        if (tri == 0xFFFFu) continue;
+        uvec2 shadel;
+        uint tri;
+        if (!chunkShadel(s, o, work, i, shadel, tri)) continue;
         SHADEL_ASSERT(f, tri * 3u < mesh.indexCount, ASSERT_TRIANGLE_ID, tri, mesh.indexCount);
         if (tri * 3u >= mesh.indexCount) continue;
         vec3 world = shadelWorldPosition(f, s, inst, mesh, tri, shadel, size);
@@ -151,16 +126,17 @@ void main() {
     if ((o.v.flags & SHADEL_OBJECT_FEATURED_MATERIAL) != 0u) features |= SPECTRUM_MATERIAL;
     uint count, tested;
     LightingCountersRef lc = LightingCountersRef(lf.counters);
-    if (!cullChunk(f, lf, boxMin, boxMax, corners, count, tested, features)) {
-        // Left to the long-list pass with its box; binned to every lighting feature (counted
-        // with the ones it needs), so that it is shaded right even if its list then overflows
-        // the pool and it takes every light (a few dozen chunks a frame).
+    if (!cullChunk(f, lf, boxMin, boxMax, corners, count, tested)) {
+        // Left to the long-list pass with its box and the features known so far, which counts
+        // the features its lights need; binned here (before the bins' dispatch sizes) to every
+        // lighting feature, so that it is shaded right even if its list then overflows the pool
+        // and it takes every light (a few dozen chunks a frame).
         uint slot = atomicAdd(UintBuffer(sf.chunkListCount).v[2], 1u);
         Uvec4Buffer(sf.longChunks).v[2u * slot] = uvec4(workIndex, floatBitsToUint(boxMin));
-        Uvec4Buffer(sf.longChunks).v[2u * slot + 1u] = uvec4(floatBitsToUint(boxMax), 0u);
+        Uvec4Buffer(sf.longChunks).v[2u * slot + 1u] = uvec4(floatBitsToUint(boxMax), features);
         ranges.e[workIndex] = uvec2(0u, CHUNK_LIST_NONE); // until that pass writes it
         atomicAdd(lc.c.lightGridCandidates, tested);
-        binChunkSpectrumAs(lf, workIndex, SPECTRUM_ALL_LIGHTING, features);
+        appendChunkToBin(sf, workIndex, features | SPECTRUM_ALL_LIGHTING);
         return;
     }
 
@@ -199,5 +175,6 @@ void main() {
     atomicAdd(lc.c.lightGridCandidates, tested);
     if (count != kept) atomicAdd(lc.c.lightsCulledByBlockers, count - kept);
     if (perPixel) atomicAdd(lc.c.perPixelBlockerChunks, 1u);
-    binChunkSpectrumAs(lf, workIndex, fits ? features : SPECTRUM_ALL_LIGHTING, features);
+    uint cover = fits ? features : features | SPECTRUM_ALL_LIGHTING; // else it takes every light
+    countSpectrumFeatures(sf, appendChunkToBin(sf, workIndex, cover), features);
 }

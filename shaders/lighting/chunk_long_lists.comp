@@ -18,30 +18,17 @@
 layout(local_size_x = SPECTRA_LONG_LIST_GROUP) in;
 layout(push_constant, scalar) uniform Push { uint64_t frame; } pc;
 
-// The light of candidate k of source s (every light, in order, when the grid cannot answer).
-uint candidateLight(LightGridCandidates c, bool gridded, UintBuffer entries, uint s, uint k) {
-    return gridded ? entries.v[c.lists[s].x + k] : k;
-}
-
 // The chunk's entries straight into the pool from two walks over the candidates merged in light
-// order (each source lists its lights in order, so taking
-// the smallest head and skipping every head up to it keeps a light listed by several sources
-// once, and the list is in light order as the short ones are). The first walk counts the entries
-// and the statistics, the second writes them where the count reserved. Returns the chunk's range
-// ((0, CHUNK_LIST_NONE) when the pool is full).
+// order: each source lists its lights in order, so taking the smallest head and skipping every
+// head up to it keeps a light listed by several sources once, and the list is in light order as
+// the short ones are. The first walk counts the entries, the statistics and the features they
+// need; the second writes them where the count reserved. Returns the chunk's range ((0,
+// CHUNK_LIST_NONE) when the pool is full).
 uvec2 writeLongList(FrameConstants f, LightingFrame lf, SpectraFrame sf, vec3 boxMin, vec3 boxMax,
-                    vec3 corners[8], out uint kept, out uint culledByBlockers, out bool perPixel) {
+                    vec3 corners[8], out uint kept, out uint culledByBlockers, out bool perPixel,
+                    inout uint features) {
     LightBuffer lights = LightBuffer(f.lights);
-    LightGridQuery q;
-    bool gridded = lightGridQuery(f, lf.lightGrid, boxMin, boxMax, q);
-    LightGridCandidates c;
-    if (gridded) {
-        c = lightGridCandidates(q);
-    } else {
-        c.sources = 1u;
-        c.lists[0] = uvec2(0u, f.lightCount);
-    }
-    UintBuffer entries = UintBuffer(q.g.entries);
+    LightGridCandidates c = lightCandidatesNear(f, lf.lightGrid, boxMin, boxMax);
     UintBuffer visible = UintBuffer(lf.visibleLights);
     ChunkListBuffer pool = ChunkListBuffer(sf.chunkLists);
     uint base = 0u;
@@ -55,29 +42,27 @@ uvec2 writeLongList(FrameConstants f, LightingFrame lf, SpectraFrame sf, vec3 bo
         for (bool first = true;; first = false) {
             uint light = 0xFFFFFFFFu;
             for (uint s = 0u; s < c.sources; ++s) {
-                while (!first && at[s] < c.lists[s].y &&
-                       candidateLight(c, gridded, entries, s, at[s]) <= last)
-                    at[s]++;
-                if (at[s] < c.lists[s].y)
-                    light = min(light, candidateLight(c, gridded, entries, s, at[s]));
+                while (!first && at[s] < c.lists[s].y && lightCandidate(c, s, at[s]) <= last) at[s]++;
+                if (at[s] < c.lists[s].y) light = min(light, lightCandidate(c, s, at[s]));
             }
             if (light == 0xFFFFFFFFu) break;
             last = light;
             GpuLight l = lights.l[light];
             if (!chunkKeepsLight(l, boxMin, boxMax, corners)) continue;
             uint mask = lightBlockerMask(lf, l, corners, boxMin, boxMax);
+            if (mask == LIGHT_INVALID) {
+                culledByBlockers += walk == 0u ? 1u : 0u;
+                continue;
+            }
             if (walk == 0u) {
-                if (mask == LIGHT_INVALID) {
-                    culledByBlockers++;
-                    continue;
-                }
                 perPixel = perPixel || mask != 0u;
+                features |= entryFeatures(lf, l, mask, corners);
                 uint bit = 1u << (light & 31u);
                 if ((visible.v[light >> 5] & bit) == 0u) atomicOr(visible.v[light >> 5], bit);
-            } else if (mask != LIGHT_INVALID) {
+            } else {
                 pool.e[base + n] = uvec2(light, mask);
             }
-            if (mask != LIGHT_INVALID) n++;
+            n++;
         }
         if (walk == 0u) {
             kept = n;
@@ -100,13 +85,17 @@ void main() {
     uvec4 b = Uvec4Buffer(sf.longChunks).v[2u * index + 1u];
     uint workIndex = a.x;
     vec3 boxMin = uintBitsToFloat(a.yzw), boxMax = uintBitsToFloat(b.xyz);
+    uint features = b.w; // the frame's and the material's, from classify
     vec3 corners[8];
     for (int i = 0; i < 8; ++i) corners[i] = boxCorner(boxMin, boxMax, i);
     uint kept, culledByBlockers;
     bool perPixel;
-    uvec2 range = writeLongList(f, lf, sf, boxMin, boxMax, corners, kept, culledByBlockers, perPixel);
+    uvec2 range = writeLongList(f, lf, sf, boxMin, boxMax, corners, kept, culledByBlockers,
+                                perPixel, features);
     ChunkListBuffer(sf.chunkRanges).e[workIndex] = range;
     if (range.y == CHUNK_LIST_NONE) atomicAdd(counts.v[1], 1u);
+    // Classify binned it to the mode covering every lighting feature; counted with what it needs.
+    countSpectrumFeatures(sf, spectrumModeOf(sf, b.w | SPECTRUM_ALL_LIGHTING), features);
     LightingCountersRef lc = LightingCountersRef(lf.counters);
     if (kept != 0u) atomicAdd(lc.c.lightChunkPairs, kept);
     if (culledByBlockers != 0u) atomicAdd(lc.c.lightsCulledByBlockers, culledByBlockers);

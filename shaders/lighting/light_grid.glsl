@@ -71,6 +71,7 @@ struct LightGridCandidates {
     uvec2 lists[LIGHT_GRID_MAX_SOURCES];
     uint sources;
     uint total;
+    uint64_t entries; // the grid's entries; 0: one source holding every light (lightCandidatesNear)
 };
 
 LightGridCandidates lightGridCandidates(LightGridQuery q) {
@@ -81,7 +82,28 @@ LightGridCandidates lightGridCandidates(LightGridQuery q) {
         c.lists[s] = s < c.sources ? lightGridSource(q, s) : uvec2(0u);
         c.total += c.lists[s].y;
     }
+    c.entries = q.g.entries;
     return c;
+}
+
+// The candidates near a box, or every light as one source when the grid cannot answer (no grid,
+// or a box larger than its cells): what one invocation walks for a chunk.
+LightGridCandidates lightCandidatesNear(FrameConstants f, uint64_t gridAddress, vec3 boxMin,
+                                        vec3 boxMax) {
+    LightGridQuery q;
+    if (lightGridQuery(f, gridAddress, boxMin, boxMax, q)) return lightGridCandidates(q);
+    LightGridCandidates c;
+    for (uint s = 0u; s < LIGHT_GRID_MAX_SOURCES; ++s) c.lists[s] = uvec2(0u);
+    c.lists[0] = uvec2(0u, f.lightCount);
+    c.sources = 1u;
+    c.total = f.lightCount;
+    c.entries = 0ul;
+    return c;
+}
+
+// The light of candidate k of source s.
+uint lightCandidate(LightGridCandidates c, uint s, uint k) {
+    return c.entries != 0ul ? LightGridEntries(c.entries).v[c.lists[s].x + k] : k;
 }
 
 // Where candidate k (< c.total) sits in the grid's entries.

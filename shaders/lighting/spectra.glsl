@@ -92,19 +92,19 @@ void binTileSpectrum(LightingFrame lf, uint tile, uint features) {
 // The shadel path: appends a shading chunk (its work-queue index) to its mode's bin. The
 // dispatch entry of a mode is a uvec4 whose w counts the chunks; chunk_spectra_setup.comp turns
 // the counts into 2-D dispatch sizes (as the shading queue's, dispatch_setup.comp).
-// `binAs`: the features its mode must cover (at least `features`, the ones it needs and is
-// counted with).
-void binChunkSpectrumAs(LightingFrame lf, uint workIndex, uint binAs, uint features) {
-    if (lf.chunkSpectra == 0ul) return;
-    SpectraFrame sf = SpectraFrameRef(lf.chunkSpectra).s;
-    uint mode = spectrumModeOf(sf, binAs | features);
+// appendChunkToBin appends to the bin of the first mode covering `cover` and returns the mode;
+// binChunkSpectrum also counts the features the chunk needs.
+uint appendChunkToBin(SpectraFrame sf, uint workIndex, uint cover) {
+    uint mode = spectrumModeOf(sf, cover);
     uint slot = atomicAdd(UintBuffer(sf.dispatch).v[mode * 4u + 3u], 1u);
     UintBuffer(sf.tileBins).v[mode * sf.binCapacity + slot] = workIndex;
-    countSpectrumFeatures(sf, mode, features);
+    return mode;
 }
 
 void binChunkSpectrum(LightingFrame lf, uint workIndex, uint features) {
-    binChunkSpectrumAs(lf, workIndex, features, features);
+    if (lf.chunkSpectra == 0ul) return;
+    SpectraFrame sf = SpectraFrameRef(lf.chunkSpectra).s;
+    countSpectrumFeatures(sf, appendChunkToBin(sf, workIndex, features), features);
 }
 
 // A mode's colour in --visualize spectra.

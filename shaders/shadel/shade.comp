@@ -142,14 +142,17 @@ void cullChunkLights(FrameConstants f, bool shading, vec3 p) {
 
 // Reuse: records where the chunk is seen from as it is shaded (a point of its surface and the
 // direction to the camera), so fill_queue.comp reshades it once the view turned too far for its
-// specular (chunkViewTurned). One invocation finds the point itself (chunkSurfacePoint): a box
-// of the chunk's shadels would take the workgroup's barrier, and on lavapipe a shader with any
+// specular (chunkViewTurned). The centre shadel's invocation records it, from its own position
+// or, when it shades nothing, the chunk's first covered shadel's (chunkSurfacePoint): a box of
+// the chunk's shadels would take the workgroup's barrier, and on lavapipe a shader with any
 // barrier runs each SIMD group as a coroutine, which cost builtin:default's shading (1280x720,
-// reuse on) a quarter of its time. Any control flow.
-void recordChunkView(FrameConstants f, ShadelFrame s, GpuShadelWork work) {
-    if (s.reuse == 0u || gl_LocalInvocationIndex != 0u) return;
-    vec3 point;
-    bool seen = chunkSurfacePoint(f, s, work, point);
+// reuse on) a quarter of its time. Any control flow; `shading`: this invocation shades a shadel
+// at `position`.
+void recordChunkView(FrameConstants f, ShadelFrame s, GpuShadelWork work, bool shading,
+                     vec3 position) {
+    if (s.reuse == 0u || gl_LocalInvocationIndex != CHUNK_CENTRE_SHADEL) return;
+    vec3 point = position;
+    bool seen = shading || chunkSurfacePoint(f, s, work, point);
     Uvec4Buffer(s.chunkViews).v[work.slot] = chunkViewRecord(seen, point, f.cameraPosition);
 }
 
@@ -245,7 +248,7 @@ void main() {
                       SHADE_OPTIONAL_CHUNK_LIGHTS, kShadeOptional);
         if (SHADE_HAS(SHADE_OPTIONAL_CHUNK_LIGHTS)) cullChunkLights(f, shading, si.position);
     }
-    if (SHADE_HAS(SHADE_OPTIONAL_REUSE)) recordChunkView(f, s, work);
+    if (SHADE_HAS(SHADE_OPTIONAL_REUSE)) recordChunkView(f, s, work, shading, si.position);
     // --debug-lines chunks: this chunk's world box, coloured by MIP (uniform over the workgroup).
     if (SHADE_HAS(SHADE_OPTIONAL_DEBUG_LINES) && debugLinesOn(f, DEBUG_LINES_CHUNKS))
         debugWorkgroupBox(f, shading, si.position, debugLevelColour(work.mip));

@@ -27,23 +27,35 @@ vec3 shadelWorldPosition(FrameConstants f, ShadelFrame s, GpuInstance inst, GpuM
     return (inst.model * vec4(p, 1.0)).xyz;
 }
 
+// Shadel i (row order) of a queued chunk: its texel in the object's level and the triangle
+// covering it (0xFFFF: none). False when it lies outside the level or no triangle covers it.
+bool chunkShadel(ShadelFrame s, ShadelObjectRef o, GpuShadelWork work, uint i, out uvec2 shadel,
+                 out uint tri) {
+    uvec2 size = levelSize(o, work.mip);
+    uvec2 first = uvec2(work.chunk & 0xFFFFu, work.chunk >> 16) * SHADEL_CHUNK;
+    shadel = levelShadel(o, work.mip, first + uvec2(i % SHADEL_CHUNK, i / SHADEL_CHUNK));
+    tri = all(lessThan(shadel, size))
+              ? triangleId(s, o.v.idMapOffset[work.mip] + shadel.y * size.x + shadel.x)
+              : 0xFFFFu;
+    return tri != 0xFFFFu;
+}
+
+// The chunk's centre shadel (row order), where chunkSurfacePoint looks first.
+#define CHUNK_CENTRE_SHADEL ((SHADEL_CHUNK / 2u) * (SHADEL_CHUNK + 1u))
+
 // A point of a queued chunk's surface, the same whichever pass asks: the world position its
 // centre shadel is lit at or, when no triangle covers that one, its first covered shadel's (row
 // order). False when none is covered. The chunk's view record (chunkViewRecord) is taken from it
 // by one invocation, so shading needs no box of the chunk, and no barrier, to record it.
 bool chunkSurfacePoint(FrameConstants f, ShadelFrame s, GpuShadelWork work, out vec3 p) {
     ShadelObjectRef o = shadelObject(s, work.object);
-    uvec2 size = levelSize(o, work.mip);
-    uvec2 first = uvec2(work.chunk & 0xFFFFu, work.chunk >> 16) * SHADEL_CHUNK;
-    uint offset = o.v.idMapOffset[work.mip];
     for (uint i = 0u; i <= SHADEL_CHUNK * SHADEL_CHUNK; ++i) {
-        uint at = i == 0u ? (SHADEL_CHUNK / 2u) * (SHADEL_CHUNK + 1u) : i - 1u; // centre first
-        uvec2 shadel = levelShadel(o, work.mip, first + uvec2(at % SHADEL_CHUNK, at / SHADEL_CHUNK));
-        if (any(greaterThanEqual(shadel, size))) continue;
-        uint tri = triangleId(s, offset + shadel.y * size.x + shadel.x);
-        if (tri == 0xFFFFu) continue;
+        uvec2 shadel;
+        uint tri;
+        if (!chunkShadel(s, o, work, i == 0u ? CHUNK_CENTRE_SHADEL : i - 1u, shadel, tri)) continue;
         GpuInstance inst = InstanceBuffer(f.instances).i[work.object];
-        p = shadelWorldPosition(f, s, inst, MeshBuffer(f.meshes).m[inst.mesh], tri, shadel, size);
+        p = shadelWorldPosition(f, s, inst, MeshBuffer(f.meshes).m[inst.mesh], tri, shadel,
+                                levelSize(o, work.mip));
         return true;
     }
     p = vec3(0.0);
@@ -71,12 +83,10 @@ bool chunkTouchesChangedRegion(FrameConstants f, ShadelFrame s, GpuShadelWork wo
     GpuInstance inst = InstanceBuffer(f.instances).i[work.object];
     GpuMesh mesh = MeshBuffer(f.meshes).m[inst.mesh];
     uvec2 size = levelSize(o, work.mip);
-    uvec2 sheet = uvec2(work.chunk & 0xFFFFu, work.chunk >> 16) * SHADEL_CHUNK;
     for (uint i = 0u; i < SHADEL_CHUNK * SHADEL_CHUNK; ++i) {
-        uvec2 shadel = levelShadel(o, work.mip, sheet + uvec2(i % SHADEL_CHUNK, i / SHADEL_CHUNK));
-        if (any(greaterThanEqual(shadel, size))) continue;
-        uint tri = triangleId(s, o.v.idMapOffset[work.mip] + shadel.y * size.x + shadel.x);
-        if (tri == 0xFFFFu || tri * 3u >= mesh.indexCount) continue;
+        uvec2 shadel;
+        uint tri;
+        if (!chunkShadel(s, o, work, i, shadel, tri) || tri * 3u >= mesh.indexCount) continue;
         if (inChangedRegion(s, shadelWorldPosition(f, s, inst, mesh, tri, shadel, size))) return true;
     }
     return false;

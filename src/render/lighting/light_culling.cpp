@@ -45,18 +45,18 @@ constexpr uint32_t kMinLightsForTiles = 16;
 // come from the tile or chunk lists), nor in forward frames with blockers: there the tile pass
 // keeps each light's blockers per tile, the subgroup path tests every blocker of a kept light
 // per pixel.
+// From the settings only (spectra exist exactly when they are not off), so the decoupled state
+// can ask before the culling and spectra states exist.
 static bool subgroupListsFit(const Renderer& r, uint32_t lightCount, bool blockersOn) {
     return r.settings.lightCulling == LightCulling::Tiled && lightCount > 0 &&
-           lightCount <= LIGHT_SUBGROUP_MAX_LIGHTS && !r.spectra && (r.decoupled || !blockersOn);
+           lightCount <= LIGHT_SUBGROUP_MAX_LIGHTS && r.settings.spectra == Spectra::Off &&
+           (r.settings.mode == RenderMode::Decoupled || !blockersOn);
 }
 
 bool shadelsCullLightsPerChunk(const Renderer& r, const GpuScene& scene) {
-    // As subgroupListsFit in a decoupled frame, where r.spectra exists exactly with
-    // --spectra on|single (usesChunkSpectra).
-    uint32_t count = uint32_t(scene.lightInfo.size());
-    bool subgroupLists = r.settings.lightCulling == LightCulling::Tiled && count > 0 &&
-                         count <= LIGHT_SUBGROUP_MAX_LIGHTS && r.settings.spectra == Spectra::Off;
-    return r.settings.lightCulling == LightCulling::Tiled && !subgroupLists;
+    // (Blockers do not decide it in a decoupled frame.)
+    return r.settings.lightCulling == LightCulling::Tiled &&
+           !subgroupListsFit(r, uint32_t(scene.lightInfo.size()), false);
 }
 
 bool forwardSplitsTileLights(const Renderer& r, const GpuScene& scene) {

@@ -1039,6 +1039,21 @@ void computeToCompute(VkCommandBuffer cmd) {
                   VK_ACCESS_2_SHADER_STORAGE_READ_BIT | VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT |
                       VK_ACCESS_2_INDIRECT_COMMAND_READ_BIT);
 }
+
+// A compute pipeline of this path with the frame's constants: over `groups` workgroups, or over
+// the indirect arguments the GPU wrote into GpuShadelCounters at `argsOffset`.
+void dispatchFrame(Gpu& gpu, VkCommandBuffer cmd, const Pipeline& p, uint64_t frame,
+                   uint32_t groups) {
+    bind(gpu, cmd, p);
+    pushConstants(gpu, cmd, FramePush{frame});
+    vkCmdDispatch(cmd, groups, 1, 1);
+}
+void dispatchCounted(Gpu& gpu, VkCommandBuffer cmd, const DecoupledState& d, const Pipeline& p,
+                     uint64_t frame, VkDeviceSize argsOffset) {
+    bind(gpu, cmd, p);
+    pushConstants(gpu, cmd, FramePush{frame});
+    vkCmdDispatchIndirect(cmd, vkBuffer(gpu, d.counters), argsOffset);
+}
 } // namespace
 
 ShadelShadingQueue shadelShadingQueue(const Renderer& r) {
@@ -1056,11 +1071,7 @@ void recordDecoupledMarking(Renderer& r, FrameRecorder& rec, uint64_t frame) {
         vkCmdFillBuffer(cmd, vkBuffer(gpu, d.counters), 0, VK_WHOLE_SIZE, 0);
         if (!d.rects.empty())
             vkCmdFillBuffer(cmd, vkBuffer(gpu, d.levelWants), 0, d.rects.size() * 16, 0);
-        if (rectGroups) {
-            bind(gpu, cmd, d.clear);
-            pushConstants(gpu, cmd, FramePush{frame});
-            vkCmdDispatch(cmd, rectGroups, 1, 1);
-        }
+        if (rectGroups) dispatchFrame(gpu, cmd, d.clear, frame, rectGroups);
         memoryBarrier(cmd, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_2_CLEAR_BIT,
                       VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT | VK_ACCESS_2_TRANSFER_WRITE_BIT,
                       VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT |
@@ -1098,11 +1109,7 @@ void recordDecoupledMarking(Renderer& r, FrameRecorder& rec, uint64_t frame) {
     });
 
     pass(rec, "shadelAllocate", [&, frame, rectGroups](VkCommandBuffer cmd) {
-        if (rectGroups) {
-            bind(gpu, cmd, d.allocate);
-            pushConstants(gpu, cmd, FramePush{frame});
-            vkCmdDispatch(cmd, rectGroups, 1, 1);
-        }
+        if (rectGroups) dispatchFrame(gpu, cmd, d.allocate, frame, rectGroups);
         computeToCompute(cmd);
         // The level wants (marking and this pass) are read back after the frame.
         memoryBarrier(
@@ -1117,18 +1124,12 @@ void recordDecoupledShading(Renderer& r, FrameRecorder& rec, uint64_t frame, con
     DecoupledState& d = *r.decoupled;
 
     pass(rec, "workQueues", [&, frame](VkCommandBuffer cmd) {
-        bind(gpu, cmd, d.queueSetup);
-        pushConstants(gpu, cmd, FramePush{frame});
-        vkCmdDispatch(cmd, 1, 1, 1);
+        dispatchFrame(gpu, cmd, d.queueSetup, frame, 1);
         computeToCompute(cmd);
-        bind(gpu, cmd, d.fillQueue);
-        pushConstants(gpu, cmd, FramePush{frame});
-        vkCmdDispatchIndirect(cmd, vkBuffer(gpu, d.counters),
-                              offsetof(gpu::GpuShadelCounters, fillDispatch));
+        dispatchCounted(gpu, cmd, d, d.fillQueue, frame,
+                        offsetof(gpu::GpuShadelCounters, fillDispatch));
         computeToCompute(cmd);
-        bind(gpu, cmd, d.dispatchSetup);
-        pushConstants(gpu, cmd, FramePush{frame});
-        vkCmdDispatch(cmd, 1, 1, 1);
+        dispatchFrame(gpu, cmd, d.dispatchSetup, frame, 1);
         computeToCompute(cmd);
     });
 
@@ -1143,22 +1144,16 @@ void recordDecoupledShading(Renderer& r, FrameRecorder& rec, uint64_t frame, con
             VK_ACCESS_2_SHADER_STORAGE_READ_BIT | VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT,
             VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
             VK_ACCESS_2_SHADER_STORAGE_READ_BIT | VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT);
-        bind(gpu, cmd, d.carryOver);
-        pushConstants(gpu, cmd, FramePush{frame});
-        vkCmdDispatchIndirect(cmd, vkBuffer(gpu, d.counters),
-                              offsetof(gpu::GpuShadelCounters, copyDispatch));
+        dispatchCounted(gpu, cmd, d, d.carryOver, frame,
+                        offsetof(gpu::GpuShadelCounters, copyDispatch));
         // Chunks on objects a changed region meets: carried over here unless one of their
         // shadels lies in a region, else appended to their class's list, whose dispatch sizes
         // are then set again. (Spectra's classify decides for its whole queue instead.)
         if (d.nearChange.pipeline && !usesChunkSpectra(r)) {
-            bind(gpu, cmd, d.nearChange);
-            pushConstants(gpu, cmd, FramePush{frame});
-            vkCmdDispatchIndirect(cmd, vkBuffer(gpu, d.counters),
-                                  offsetof(gpu::GpuShadelCounters, nearChangeDispatch));
+            dispatchCounted(gpu, cmd, d, d.nearChange, frame,
+                            offsetof(gpu::GpuShadelCounters, nearChangeDispatch));
             computeToCompute(cmd);
-            bind(gpu, cmd, d.dispatchSetup);
-            pushConstants(gpu, cmd, FramePush{frame});
-            vkCmdDispatch(cmd, 1, 1, 1);
+            dispatchFrame(gpu, cmd, d.dispatchSetup, frame, 1);
             computeToCompute(cmd);
         }
     });
@@ -1175,13 +1170,10 @@ void recordDecoupledShading(Renderer& r, FrameRecorder& rec, uint64_t frame, con
         } else {
             // One pipeline per shading class, each over its list; no barrier between: the
             // classes' chunks are disjoint.
-            for (uint32_t c = 0; c < SHADE_CLASSES; ++c) {
-                bind(gpu, cmd, d.shade[c]);
-                pushConstants(gpu, cmd, FramePush{frame});
-                vkCmdDispatchIndirect(cmd, vkBuffer(gpu, d.counters),
-                                      offsetof(gpu::GpuShadelCounters, classDispatch) +
-                                          c * sizeof(glm::uvec4));
-            }
+            for (uint32_t c = 0; c < SHADE_CLASSES; ++c)
+                dispatchCounted(gpu, cmd, d, d.shade[c], frame,
+                                offsetof(gpu::GpuShadelCounters, classDispatch) +
+                                    c * sizeof(glm::uvec4));
         }
         // The shade storage this pass and carry-over wrote, read by reconstruction (raster:
         // fragment; --marking visibility: the compute resolve) and the transparency passes.
