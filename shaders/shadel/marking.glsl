@@ -79,16 +79,12 @@ MarkedSample markSample(ShadelFrame s, ShadelObjectRef o, vec2 shadelUv, vec2 te
     for (uint i = 0u; i < a.taps; ++i) { // the same taps reconstruction reads
         vec2 uv = shadelTapUv(o.v.mip0Size, shadelUv, a, i);
         ShadelLevels l = wanted;
-        uint unheld = fitLevelsToWindows(o, uv, l);
+        LevelFootprint fp0, fp1;
+        uint unheld = fitLevelFootprints(o, uv, l, fp0, fp1);
         for (uint k = wanted.mip0; (unheld >> k) != 0u; ++k)
             if (((unheld >> k) & 1u) != 0u) wantLevel(s, o, k, uv);
-        LevelFootprint fp0 = levelFootprint(o, l.mip0, uv);
         markFootprint(s, fp0);
-        LevelFootprint fp1 = fp0;
-        if (l.two) {
-            fp1 = levelFootprint(o, l.mip1, uv);
-            markFootprint(s, fp1);
-        }
+        if (l.two) markFootprint(s, fp1);
         if (i == 0u) {
             m.levels = l;
             m.footprint0 = fp0;

@@ -55,12 +55,6 @@ vec3 sampleFootprint(ShadelFrame s, LevelFootprint fp, uint layer, inout uint mi
     return mix(mix(c00, c10, w.x), mix(c01, c11, w.x), w.y);
 }
 
-vec3 sampleLevel(ShadelFrame s, ShadelObjectRef o, uint mip, vec2 uv, uint layer,
-                 inout uint missing, inout uint overflowed, out uint64_t firstMask) {
-    return sampleFootprint(s, levelFootprint(o, mip, uv), layer, missing, overflowed,
-                           firstMask);
-}
-
 struct Reconstruction {
     vec3 color;
     uint missing;    // chunk lookups that found no marked chunk
@@ -91,15 +85,16 @@ Reconstruction reconstructSample(ShadelFrame s, ShadelObjectRef o, vec2 shadelUv
     for (uint i = 0u; i < a.taps; ++i) { // the same taps and levels marking marked
         vec2 uv = shadelTapUv(o.v.mip0Size, shadelUv, a, i);
         ShadelLevels l = wanted;
-        r.windowFallback = r.windowFallback || fitLevelsToWindows(o, uv, l) != 0u;
-        vec3 c = sampleLevel(s, o, l.mip0, uv, layer, r.missing, r.overflowed, tapMask);
+        LevelFootprint fp0, fp1;
+        r.windowFallback = fitLevelFootprints(o, uv, l, fp0, fp1) != 0u || r.windowFallback;
+        vec3 c = sampleFootprint(s, fp0, layer, r.missing, r.overflowed, tapMask);
         if (i == 0u) {
             r.mask0 = tapMask;
             r.mip0 = l.mip0;
             r.lod = float(l.mip0) + l.blend;
             r.forward = windowFallbackTooDeep(wanted, l); // as marking decided
         }
-        if (l.two) c = mix(c, sampleLevel(s, o, l.mip1, uv, layer, r.missing, r.overflowed, mask1), l.blend);
+        if (l.two) c = mix(c, sampleFootprint(s, fp1, layer, r.missing, r.overflowed, mask1), l.blend);
         r.color += c;
     }
     r.color /= float(a.taps);

@@ -27,24 +27,26 @@ ShadelObjectRef shadelObject(ShadelFrame s, uint object) {
 const float SHADEL_MAX_ANISO = 1.5;
 
 struct ShadelAniso {
-    float footprint; // MIP-0 shadels a tap stands for (>= the width)
-    vec2 step;       // MIP-0 shadels between neighbouring taps
+    float footprintSq; // (MIP-0 shadels a tap stands for)^2, the footprint >= the width
+    vec2 step;         // MIP-0 shadels between neighbouring taps
     uint taps;
 };
 
 ShadelAniso shadelAniso(vec2 texelDx, vec2 texelDy) {
-    float lx = length(texelDx), ly = length(texelDy);
-    float len = max(lx, ly);
-    float width = abs(texelDx.x * texelDy.y - texelDx.y * texelDy.x) / max(len, 1e-20);
-    float aniso = clamp(len / max(width, 1e-20), 1.0, SHADEL_MAX_ANISO);
+    float lx2 = dot(texelDx, texelDx), ly2 = dot(texelDy, texelDy);
+    float len2 = max(max(lx2, ly2), 1e-30);
+    float area = texelDx.x * texelDy.y - texelDx.y * texelDy.x; // = width * length
     ShadelAniso a;
-    a.footprint = len / aniso;
+    // length / clamp(length / width, 1, SHADEL_MAX_ANISO) = max(width, length / MAX) (width <=
+    // length), squared: no square root nor division per axis (marking and reconstruction take
+    // it per pixel).
+    a.footprintSq = max(area * area / len2, len2 * (1.0 / (SHADEL_MAX_ANISO * SHADEL_MAX_ANISO)));
     // One tap: the MIP already follows the narrow side (up to SHADEL_MAX_ANISO). Measured on
     // lavapipe at 1280x720 (builtin:default, builtin:checker), a second tap along the long axis
     // cost 2-3x in marking and reconstruction and was 0.4-0.5 dB further from the 8x8 SSAA
     // checker reference; the tap loop stays for a higher anisotropy cap.
     a.taps = 1u;
-    a.step = (lx >= ly ? texelDx : texelDy) / float(a.taps);
+    a.step = (lx2 >= ly2 ? texelDx : texelDy) / float(a.taps);
     return a;
 }
 
@@ -56,7 +58,7 @@ vec2 shadelTapUv(uvec2 mip0Size, vec2 uv, ShadelAniso a, uint i) {
 // MIP selection: the same in marking and reconstruction (the seed's custom MIP calculation).
 // `texel` is the position in MIP-0 shadels; derivatives are per pixel.
 float shadelLod(vec2 texelDx, vec2 texelDy, float bias) {
-    return log2(max(shadelAniso(texelDx, texelDy).footprint, 1e-8)) + bias;
+    return 0.5 * log2(max(shadelAniso(texelDx, texelDy).footprintSq, 1e-16)) + bias;
 }
 
 uvec2 levelSize(ShadelObjectRef o, uint mip) { return max(o.v.mip0Size >> mip, uvec2(1u)); }
@@ -118,28 +120,6 @@ bool windowHolds(ShadelObjectRef o, uint mip, vec2 uv) {
            all(lessThan(hi, origin + o.v.rect[mip].zw * SHADEL_BLOCK));
 }
 
-// Level windows: a sample whose footprint a level's window does not hold reads the next
-// coarser level instead (the coarsest is always whole, so one is found); a second level of a
-// blend that does not hold it is dropped. Marking and reconstruction both call this, so they
-// agree. Returns the levels that were wanted but not held (bit per MIP): marking records them
-// so next frame's windows grow there.
-uint fitLevelsToWindows(ShadelObjectRef o, vec2 uv, inout ShadelLevels l) {
-    uint unheld = 0u;
-    while (l.mip0 + 1u < o.v.mipCount && !windowHolds(o, l.mip0, uv)) {
-        unheld |= 1u << l.mip0;
-        l.mip0++;
-        l.mip1 = l.mip0;
-        l.two = false;
-        l.blend = 0.0;
-    }
-    if (l.two && !windowHolds(o, l.mip1, uv)) {
-        unheld |= 1u << l.mip1;
-        l.two = false;
-        l.blend = 0.0;
-    }
-    return unheld;
-}
-
 // A sample whose wanted level's window lags by more than one level (a camera cut: last frame's
 // marks were elsewhere) is shaded forward instead of read that much coarser: from two levels
 // up, charts bleed into each other's shadels (bake.h: only levels <= log2(gutter) are clean)
@@ -154,7 +134,7 @@ bool windowFallbackTooDeep(ShadelLevels wanted, ShadelLevels fitted) {
 }
 
 // Sheet shadel coordinate of an object's level texel (clamped to the level; the level's window
-// must hold it: fitLevelsToWindows).
+// must hold it: fitLevelFootprints).
 uvec2 sheetShadel(ShadelObjectRef o, uint mip, ivec2 texel) {
     return o.v.rect[mip].xy * SHADEL_BLOCK + levelTexel(o, mip, texel) - windowOrigin(o, mip);
 }
@@ -175,6 +155,52 @@ LevelFootprint levelFootprint(ShadelObjectRef o, uint mip, vec2 uv) {
     fp.lo = sheetShadel(o, mip, t0);
     fp.hi = sheetShadel(o, mip, t0 + ivec2(1));
     return fp;
+}
+
+// The footprint at one level and whether the level's window holds it, from one bilinear
+// footprint: what windowHolds and levelFootprint compute apart (the same values).
+bool heldLevelFootprint(ShadelObjectRef o, uint mip, vec2 uv, out LevelFootprint fp) {
+    ivec2 t0;
+    bilinearFootprint(o, mip, uv, t0, fp.weight);
+    uvec2 lo = levelTexel(o, mip, t0), hi = levelTexel(o, mip, t0 + ivec2(1));
+    uvec4 rect = o.v.rect[mip];
+    uvec2 origin = windowOrigin(o, mip);
+    fp.lo = rect.xy * SHADEL_BLOCK + lo - origin; // sheetShadel
+    fp.hi = rect.xy * SHADEL_BLOCK + hi - origin;
+    return all(greaterThanEqual(lo, origin)) && all(lessThan(hi, origin + rect.zw * SHADEL_BLOCK));
+}
+
+// Level windows: a sample whose footprint a level's window does not hold reads the next
+// coarser level instead (the coarsest is always whole, so one is found); a second level of a
+// blend that does not hold it is dropped. Marking and reconstruction both call this, so they
+// agree. Returns the levels that were wanted but not held (bit per MIP): marking records them
+// so next frame's windows grow there. fp0/fp1: the fitted levels' footprints (fp1 = fp0 unless
+// two levels are read), each level's computed once for its window test and its taps (apart,
+// the test and the footprints cost marking ~5 ms of 26: builtin:default 1280x720, lavapipe).
+uint fitLevelFootprints(ShadelObjectRef o, vec2 uv, inout ShadelLevels l, out LevelFootprint fp0,
+                        out LevelFootprint fp1) {
+    uint unheld = 0u;
+    while (!heldLevelFootprint(o, l.mip0, uv, fp0) && l.mip0 + 1u < o.v.mipCount) {
+        unheld |= 1u << l.mip0;
+        l.mip0++;
+        l.mip1 = l.mip0;
+        l.two = false;
+        l.blend = 0.0;
+    }
+    fp1 = fp0;
+    if (l.two && !heldLevelFootprint(o, l.mip1, uv, fp1)) {
+        unheld |= 1u << l.mip1;
+        l.two = false;
+        l.blend = 0.0;
+        fp1 = fp0;
+    }
+    return unheld;
+}
+
+// The fitted levels alone (--inspect).
+uint fitLevelsToWindows(ShadelObjectRef o, vec2 uv, inout ShadelLevels l) {
+    LevelFootprint fp0, fp1;
+    return fitLevelFootprints(o, uv, l, fp0, fp1);
 }
 
 // The level texel of a sheet shadel of the object's level `mip` (the inverse of sheetShadel).
