@@ -517,7 +517,9 @@ nlohmann::json runBench(Gpu& gpu, const BenchOptions& b) {
     o.shadingBias = b.shadingBias;
     o.cacheLimitBytes = b.cacheLimitBytes;
     o.lightCulling = b.lightCulling;
-    o.spectra = b.spectra;
+    // --spectra compare reports on / off against the three modes: they run without spectra
+    // (with auto, builtin:lights' decoupled mode would be on, and on / off compare on with on).
+    o.spectra = b.compareSpectra ? Spectra::Off : b.spectra;
     o.progress = false;
     o.sunCascades = b.sunCascades;
     o.instances = b.instances;

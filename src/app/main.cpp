@@ -524,8 +524,9 @@ int main(int argc, char** argv) {
                      "decoupled frames with more than 64 lights); compare also renders forward "
                      "and decoupled with --spectra on and single (--rounds rounds of "
                      "alternating order, 2 unless given) and reports on / single (the median of "
-                     "the rounds' ratios) and on / off frame-time ratios, and on / single of the "
-                     "shading passes (with spectra's classify + bin)")
+                     "the rounds' ratios) and on / off frame-time ratios (the three modes then run "
+                     "with --spectra off), and on / single of the shading passes (with "
+                     "spectra's classify + bin)")
         ->capture_default_str();
     bench
         ->add_option("--reuse-refresh", bo.reuseRefreshPeriod,

@@ -235,6 +235,33 @@ TEST(Spectra, AutoTurnsThemOnInDecoupledFramesThatCullPerChunk) {
     EXPECT_EQ(modeOf("builtin:default", RenderMode::Decoupled, Visualize::Spectra), "on");
 }
 
+// bench --spectra compare: on / single from the spectra runs, and on / off against the three
+// modes, which then run without spectra (with the default auto, builtin:lights' decoupled mode
+// would run them, and on / off would compare on with on).
+TEST(Spectra, BenchCompareMeasuresOnAgainstSingleAndOff) {
+    BenchOptions b;
+    b.scene = "builtin:lights";
+    b.width = 96;
+    b.height = 54;
+    b.frames = 1;
+    b.compareSpectra = true;
+    b.modeRounds = 2;
+    nlohmann::json out = runBench(sharedGpu(), b);
+    EXPECT_EQ(out["modes"]["decoupled"]["spectra_mode"], "off");
+    EXPECT_EQ(out["modes"]["forward"]["spectra_mode"], "off");
+    for (const char* path : {"forward", "decoupled"}) {
+        std::string p = path;
+        EXPECT_EQ(out["modes"][p + "_spectra"]["spectra_mode"], "on") << path;
+        EXPECT_EQ(out["modes"][p + "_spectra_single"]["spectra_mode"], "single") << path;
+        EXPECT_EQ(out["ratios_by_round"]["spectra_" + p].size(), 2u) << path;
+        double on = out["spectra_frame_ms"][p]["on"].get<double>();
+        double other = out["modes"][path]["frame_ms"]["median"].get<double>();
+        std::string vs = p == "forward" ? "_vs_raster" : "_vs_off";
+        EXPECT_NEAR(out["ratios"]["spectra_" + p + vs].get<double>(), on / other, 1e-9) << path;
+    }
+    EXPECT_EQ(validationErrors(), 0u);
+}
+
 TEST(Spectra, BadSpectraFlagsAreOneLineErrors) {
     EXPECT_THROW(parseSpectra("maybe"), InputError);
     EXPECT_EQ(parseSpectra("single"), Spectra::Single);
