@@ -5,7 +5,7 @@
 #define SHADEL_PRINT_LABELS_H
 #define PRINT_INSPECT_PIXEL 1u    // the pixel under --inspect (internal resolution)
 #define PRINT_INSTANCE 2u         // instance index
-#define PRINT_TRIANGLE 3u         // triangle (gl_PrimitiveID within its draw)
+#define PRINT_TRIANGLE 3u         // triangle (within its mesh: gl_PrimitiveID of LOD 0 draws)
 #define PRINT_POSITION 4u         // world position
 #define PRINT_GEOMETRIC_NORMAL 5u // interpolated vertex normal, world
 #define PRINT_UV_LOD 6u           // log2 of the UV footprint in texels (forward MIP)

@@ -108,6 +108,9 @@ using uint = uint32_t;
 // them the test and its discard are compiled out, so the depth test runs before the fragment
 // shader (early Z) instead of after it for every covered fragment.
 #define ALPHA_MASK_CONSTANT_ID 144
+// Whether the raster vertex shader (shaders/forward/forward.vert) draws visibility vertices
+// (the visibility prepass: each triangle's provoking vertex names it, no gl_PrimitiveID).
+#define VISIBILITY_VERTICES_CONSTANT_ID 145
 // Whether the compute resolve rebuilds its rare pixels inline (debug views, --inspect) or lists
 // them for its rebuild pass (shaders/shadel/resolve.comp).
 #define RESOLVE_REBUILD_INLINE_CONSTANT_ID 146
@@ -495,6 +498,9 @@ struct FrameConstants {
     float dfShadowStart;
     uint dfPad;
     uint64_t decals; // DecalFrame (render/decals), 0 when the frame has no decals
+    // uvec2 per visibility vertex: (scene vertex, the triangle of its mesh it starts), what the
+    // visibility prepass draws (scene/visibility_vertices.h).
+    uint64_t visibilityVertices;
 };
 
 // ---- GPU-driven world (render/culling) ------------------------------------------------------
@@ -545,7 +551,6 @@ struct CullingFrame {
     uint64_t meshLods;    // GpuMeshLods[meshCount]
     uint64_t stats;       // GpuCullStats
     uint64_t visibility;  // uint per instance: 1 when visible to the camera last frame
-    uint64_t drawnLod;    // uint per instance: first index of the camera's LOD this frame
     uint64_t hiz;         // float depth pyramid, every level packed (level 0 = depth target)
     uint lod;             // 1: pick LODs by projected error; 0: always LOD 0
     float lodErrorPixels; // the coarsest LOD whose error projects below this many pixels

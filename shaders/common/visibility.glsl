@@ -23,16 +23,15 @@ struct VisTriangle {
     bool frontFacing;
 };
 
-// The triangle `primitive` (gl_PrimitiveID of its draw) of an instance's mesh. Homogeneous
-// rasterization (Olano & Greer): with M's columns the clip-space (x, y, w) of the vertices, the
-// perspective-correct barycentrics at NDC point q are adj(M) (q, 1), normalised to sum 1. No
-// division by w, so triangles crossing the camera plane are fine.
-// `instance` is the instance's id: its draw used the LOD the camera's cull chose this frame
-// (render/culling), whose first index the cull recorded.
-VisTriangle loadVisTriangle(FrameConstants f, GpuInstance inst, uint instance, uint primitive) {
+// Triangle `triangle` of an instance's mesh (the visibility buffer's: numbered from the mesh's
+// first index, whatever LOD its draw used; scene/visibility_vertices.h). Homogeneous rasterization (Olano & Greer): with M's
+// columns the clip-space (x, y, w) of the vertices, the perspective-correct barycentrics at NDC
+// point q are adj(M) (q, 1), normalised to sum 1. No division by w, so triangles crossing the
+// camera plane are fine.
+VisTriangle loadVisTriangle(FrameConstants f, GpuInstance inst, uint triangle) {
     GpuMesh mesh = MeshBuffer(f.meshes).m[inst.mesh];
     IndexBuffer indices = IndexBuffer(f.indices);
-    uint first = UintBuffer(CullingFrameRef(f.culling).c.drawnLod).v[instance] + 3u * primitive;
+    uint first = mesh.firstIndex + 3u * triangle;
     VisTriangle t;
     t.v0 = uint(int(indices.i[first + 0u]) + mesh.vertexOffset);
     t.v1 = uint(int(indices.i[first + 1u]) + mesh.vertexOffset);

@@ -1,5 +1,6 @@
 #version 460
-// Vertex shader of the depth prepass, the shadow pass and forward shading.
+// Vertex shader of the depth prepass, the shadow pass, forward shading and the visibility
+// prepass.
 #include "common/vertex.glsl"
 
 layout(push_constant, scalar) uniform Push {
@@ -13,6 +14,12 @@ layout(location = 2) out vec4 outTangent;
 layout(location = 3) out vec2 outUv;
 layout(location = 4) flat out uint outInstance;
 layout(location = 5) out vec2 outShadelUv; // object's shadel space (decoupled path only)
+layout(location = 6) flat out uint outTriangle; // the visibility prepass's triangle ID
+
+// The visibility prepass draws visibility vertices (scene/visibility_vertices.h): each names
+// the scene vertex it stands for and, as a triangle's provoking vertex, the triangle.
+layout(constant_id = VISIBILITY_VERTICES_CONSTANT_ID) const bool kVisibilityVertices = false;
+layout(buffer_reference, scalar) readonly buffer VisibilityVertexBuffer { uvec2 v[]; };
 
 invariant gl_Position; // every raster pass must produce the prepass's depth exactly
 
@@ -21,12 +28,25 @@ void main() {
     uint instanceId = gl_InstanceIndex;
     SHADEL_ASSERT(f, instanceId < f.instanceCount, ASSERT_INSTANCE_RANGE, instanceId, f.instanceCount);
     GpuInstance inst = InstanceBuffer(f.instances).i[instanceId];
-    WorldVertex v = fetchWorldVertex(f, inst, gl_VertexIndex);
+    uint vertexIndex = gl_VertexIndex;
+    outTriangle = 0u;
+    if (kVisibilityVertices) {
+        uvec2 visibilityVertex = VisibilityVertexBuffer(f.visibilityVertices).v[gl_VertexIndex];
+        vertexIndex = visibilityVertex.x;
+        outTriangle = visibilityVertex.y;
+    }
+    WorldVertex v = fetchWorldVertex(f, inst, vertexIndex);
     outPosition = v.position;
     outNormal = v.normal;
     outTangent = v.tangent;
     outUv = v.uv0;
     outInstance = instanceId;
-    outShadelUv = f.shadel != 0ul ? Vec2Buffer(ShadelFrameRef(f.shadel).s.shadelUvs).v[gl_VertexIndex] : vec2(0.0);
+    outShadelUv = f.shadel != 0ul ? Vec2Buffer(ShadelFrameRef(f.shadel).s.shadelUvs).v[vertexIndex] : vec2(0.0);
+    if (kVisibilityVertices) { // the prepass reads only these: the rest compiled out
+        outPosition = vec3(0.0);
+        outNormal = vec3(0.0);
+        outTangent = vec4(0.0);
+        outShadelUv = vec2(0.0);
+    }
     gl_Position = (pc.shadowView != 0u ? f.sunViewProj : f.viewProj) * vec4(v.position, 1.0);
 }

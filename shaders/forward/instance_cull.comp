@@ -134,9 +134,6 @@ void main() {
             haveLod = true;
             if (appendDraw(pc.draws, pc.counts, cameraListOf(f, mat, id), lod, false, mesh, id,
                            f)) {
-                // The visibility buffer rebuilds triangles from this
-                // (shaders/common/visibility.glsl).
-                UintBuffer(c.drawnLod).v[id] = lod.firstIndex;
                 drawn = true;
                 triangles = lod.indexCount / 3u;
                 vertices = lod.uniqueVertices;

@@ -36,7 +36,7 @@ void main() {
     if (vis.x != VISIBILITY_NONE) {
         GpuInstance inst = InstanceBuffer(f.instances).i[vis.x];
         GpuMaterial mat = MaterialBuffer(f.materials).m[inst.material];
-        VisTriangle tri = loadVisTriangle(f, inst, vis.x, vis.y);
+        VisTriangle tri = loadVisTriangle(f, inst, vis.y);
         VisBary bary = visBaryWithDerivatives(f, tri, pixel);
         WorldVertex a = fetchWorldVertex(f, inst, tri.v0);
         WorldVertex b = fetchWorldVertex(f, inst, tri.v1);

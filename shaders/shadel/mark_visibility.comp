@@ -36,7 +36,7 @@ void main() {
                 current = vis;
                 o = shadelObject(s, vis.x);
                 if ((o.v.flags & SHADEL_OBJECT_DECOUPLED) != 0u)
-                    visQuadSetup(f, s, InstanceBuffer(f.instances).i[vis.x], vis.x, vis.y, origin,
+                    visQuadSetup(f, s, InstanceBuffer(f.instances).i[vis.x], vis.y, origin,
                                  q);
             }
             if ((o.v.flags & SHADEL_OBJECT_DECOUPLED) != 0u) { // else a forward (hybrid) instance

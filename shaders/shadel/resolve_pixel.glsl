@@ -80,7 +80,7 @@ vec4 resolveRebuilt(FrameConstants f, ShadelFrame s, ivec2 origin, int i, ivec2 
         o = shadelObject(s, vis.x);
         if ((o.v.flags & SHADEL_OBJECT_DECOUPLED) != 0u) {
             inst = InstanceBuffer(f.instances).i[vis.x];
-            visQuadSetup(f, s, inst, vis.x, vis.y, origin, q);
+            visQuadSetup(f, s, inst, vis.y, origin, q);
         }
     }
     if ((o.v.flags & SHADEL_OBJECT_DECOUPLED) == 0u) return vec4(f.skyColor, 0.0);

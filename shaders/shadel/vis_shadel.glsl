@@ -14,9 +14,9 @@ struct VisQuad {
     vec2 uv0, uv1, uv2; // shadel UVs of the triangle's vertices
 };
 
-void visQuadSetup(FrameConstants f, ShadelFrame s, GpuInstance inst, uint instance, uint primitive,
+void visQuadSetup(FrameConstants f, ShadelFrame s, GpuInstance inst, uint triangle,
                   ivec2 quadOrigin, out VisQuad q) {
-    q.tri = loadVisTriangle(f, inst, instance, primitive);
+    q.tri = loadVisTriangle(f, inst, triangle);
     for (int i = 0; i < 4; ++i)
         q.bary[i] = visBarycentrics(q.tri, pixelNdc(f, quadOrigin + ivec2(i & 1, i >> 1)));
     Vec2Buffer uvs = Vec2Buffer(s.shadelUvs);

@@ -1,7 +1,8 @@
 #version 460
 // Visibility prepass (--marking visibility): depth plus, per pixel, the instance and the
-// triangle (gl_PrimitiveID within its draw) that won the depth test. Alpha-masked materials
-// discard as in the depth prepass.
+// triangle that won the depth test (numbered within its mesh), carried by its provoking vertex
+// (scene/visibility_vertices.h; reading gl_PrimitiveID cost lavapipe's prepass a fifth of its
+// time). Alpha-masked materials discard as in the depth prepass.
 #include "common/material.glsl"
 
 layout(push_constant, scalar) uniform Push {
@@ -11,6 +12,7 @@ layout(push_constant, scalar) uniform Push {
 
 layout(location = 3) in vec2 inUv;
 layout(location = 4) flat in uint inInstance;
+layout(location = 6) flat in uint inTriangle; // from the provoking vertex (kVisibilityVertices)
 
 layout(location = 0) out uvec2 outVisibility;
 
@@ -28,5 +30,5 @@ void main() {
             if (alpha < m.alphaCutoff) discard;
         }
     }
-    outVisibility = uvec2(inInstance, uint(gl_PrimitiveID));
+    outVisibility = uvec2(inInstance, inTriangle);
 }

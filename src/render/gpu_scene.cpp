@@ -6,6 +6,7 @@
 #include "bake/bake.h"
 #include "core/log.h"
 #include "render/culling/mesh_lods.h"
+#include "scene/visibility_vertices.h"
 
 namespace shadel {
 
@@ -329,6 +330,22 @@ void uploadScene(Gpu& gpu, const Scene& scene, GpuScene& out, const std::vector<
                                     shadelUvs.size() * sizeof(glm::vec2));
     out.indices =
         uploadArray(gpu, "scene.indices", indices.data(), indices.size() * 4, indexUsage | rtInput);
+    size_t visibilityBytes = 0;
+    {
+        std::vector<MeshIndexRange> ranges;
+        for (size_t mi = 0; mi < out.meshInfo.size(); ++mi) {
+            uint32_t first = out.meshInfo[mi].firstIndex;
+            uint32_t next = mi + 1 < out.meshInfo.size() ? out.meshInfo[mi + 1].firstIndex
+                                                         : uint32_t(indices.size());
+            ranges.push_back({first, next - first, out.meshInfo[mi].vertexOffset});
+        }
+        VisibilityGeometry vis = buildVisibilityGeometry(indices, ranges);
+        visibilityBytes = vis.indices.size() * 4 + vis.vertices.size() * sizeof(glm::uvec2);
+        out.visibilityIndices = uploadArray(gpu, "scene.visibilityIndices", vis.indices.data(),
+                                            vis.indices.size() * 4, indexUsage);
+        out.visibilityVertices = uploadArray(gpu, "scene.visibilityVertices", vis.vertices.data(),
+                                             vis.vertices.size() * sizeof(glm::uvec2));
+    }
     out.meshes = uploadArray(gpu, "scene.meshes", out.meshInfo.data(),
                              out.meshInfo.size() * sizeof(gpu::GpuMesh));
     out.meshLods = uploadArray(gpu, "scene.meshLods", out.lodInfo.data(),
@@ -350,15 +367,16 @@ void uploadScene(Gpu& gpu, const Scene& scene, GpuScene& out, const std::vector<
     out.instanceCount = uint32_t(instances.size());
     out.lightCount = uint32_t(lights.size());
     out.lightInfo = lights;
-    out.geometryBytes = vertices.size() * sizeof(gpu::GpuVertex) + indices.size() * 4;
+    out.geometryBytes =
+        vertices.size() * sizeof(gpu::GpuVertex) + indices.size() * 4 + visibilityBytes;
 }
 
 void destroyScene(Gpu& gpu, GpuScene& s) {
     for (TextureReadView v : s.textureViews) destroy(gpu, v);
     for (TextureHandle t : s.textures) destroy(gpu, t);
-    for (BufferHandle b :
-         {s.vertices, s.shadelUvs, s.indices, s.meshes, s.meshLods, s.instances, s.materials,
-          s.lights, s.idMaps, s.blockers, s.portals, s.lightBlockerLists})
+    for (BufferHandle b : {s.vertices, s.shadelUvs, s.indices, s.visibilityIndices,
+                           s.visibilityVertices, s.meshes, s.meshLods, s.instances, s.materials,
+                           s.lights, s.idMaps, s.blockers, s.portals, s.lightBlockerLists})
         destroy(gpu, b);
     s = GpuScene{};
 }

@@ -25,6 +25,11 @@ struct GpuScene {
     BufferHandle vertices;  // gpu::GpuVertex[]
     BufferHandle shadelUvs; // vec2 per vertex (decoupled path), invalid when not baked
     BufferHandle indices;   // uint32
+    // The visibility prepass's index buffer (the scene's, each triangle turned to start at a
+    // visibility vertex of its own) and its vertices (uvec2: scene vertex, triangle):
+    // scene/visibility_vertices.h.
+    BufferHandle visibilityIndices;
+    BufferHandle visibilityVertices;
     BufferHandle meshes;    // gpu::GpuMesh[]
     BufferHandle meshLods;  // gpu::GpuMeshLods[] per mesh (render/culling/mesh_lods.h)
     BufferHandle instances; // gpu::GpuInstance[]

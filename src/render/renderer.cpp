@@ -262,6 +262,7 @@ static gpu::FrameConstants makeFrameConstants(Renderer& r, const GpuScene& scene
                          (uint32_t(r.settings.inspectY) * r.settings.ssaa) << 16;
     f.vertices = address(gpu, scene.vertices);
     f.indices = address(gpu, scene.indices);
+    f.visibilityVertices = address(gpu, scene.visibilityVertices);
     f.meshes = address(gpu, scene.meshes);
     f.instances = address(gpu, scene.instances);
     f.materials = address(gpu, scene.materials);
@@ -317,6 +318,7 @@ FrameResult renderFrame(Renderer& r, const GpuScene& scene, const CameraView& ca
     r.frameCpuStart = cpuStart;
     r.recorder.timeRecording = r.settings.cpuScopes;
     r.sceneIndices = scene.indices;
+    r.sceneVisibilityIndices = scene.visibilityIndices;
     r.skyColor = scene.skyColor;
     gpu::FrameConstants constants;
     {

@@ -241,7 +241,8 @@ struct Renderer {
     BufferHandle drawCounts; // uint[DRAW_LIST_COUNT] camera, then uint[...] shadow
     BufferHandle pixels;     // readback RGBA8
     uint32_t maxDraws = 0;
-    BufferHandle sceneIndices; // the unified index buffer of the scene being drawn
+    BufferHandle sceneIndices;           // the unified index buffer of the scene being drawn
+    BufferHandle sceneVisibilityIndices; // ... and the visibility prepass's (GpuScene)
     glm::vec3 skyColor{0.5f};
     Pipeline instanceCull, depthPrepass, tonemap;
     // Forward shading of opaque surfaces, one pipeline per material class (render/forward):

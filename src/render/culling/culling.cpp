@@ -21,7 +21,6 @@ struct CullingState {
     BufferHandle frame;      // host-visible gpu::CullingFrame
     BufferHandle stats;      // gpu::GpuCullStats, read back
     BufferHandle visibility; // uint per instance (camera, last frame)
-    BufferHandle drawnLod;   // uint per instance
     // Occlusion only.
     BufferHandle pyramid;     // float, every level packed
     BufferHandle phase2Draws; // DrawIndexedCommand[DRAW_LIST_COUNT * maxDraws]
@@ -77,8 +76,7 @@ CullingStatePtr createCulling(Renderer& r, const GpuScene& scene) {
     c->stats =
         createBuffer(gpu, {"culling.stats", sizeof(gpu::GpuCullStats), 0, MemoryKind::Readback});
     c->visibility = createBuffer(gpu, {"culling.visibleLastFrame", perInstance});
-    c->drawnLod = createBuffer(gpu, {"culling.drawnLod", perInstance});
-    bool ok = c->frame && c->stats && c->visibility && c->drawnLod;
+    bool ok = c->frame && c->stats && c->visibility;
     c->cascades = sunCascadeCount(r);
     c->spots = spotShadowCount(r);
     uint32_t lists = c->cascades + c->spots;
@@ -131,8 +129,8 @@ void destroyCulling(Renderer& r, CullingStatePtr& c) {
     if (!c) return;
     Gpu& gpu = *r.gpu;
     for (BufferHandle b :
-         {c->frame, c->stats, c->visibility, c->drawnLod, c->pyramid, c->phase2Draws,
-          c->phase2Counts, c->visibleList, c->shadowViews, c->shadowViewDraws, c->shadowViewCounts})
+         {c->frame, c->stats, c->visibility, c->pyramid, c->phase2Draws, c->phase2Counts,
+          c->visibleList, c->shadowViews, c->shadowViewDraws, c->shadowViewCounts})
         if (b) destroy(gpu, b);
     if (c->hizBuild.pipeline) destroy(gpu, c->hizBuild);
     c.reset();
@@ -146,7 +144,6 @@ void prepareCullingFrame(Renderer& r, const GpuScene& scene, gpu::FrameConstants
     f.meshLods = address(gpu, scene.meshLods);
     f.stats = address(gpu, c.stats);
     f.visibility = address(gpu, c.visibility);
-    f.drawnLod = address(gpu, c.drawnLod);
     f.hiz = c.pyramid ? address(gpu, c.pyramid) : 0;
     f.lod = r.settings.lod ? 1u : 0u;
     f.lodErrorPixels = r.settings.lodErrorPixels;

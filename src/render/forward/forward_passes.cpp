@@ -36,10 +36,11 @@ constexpr ForwardClass kForwardClasses[kForwardClassCount] = {
     {DRAW_LIST_OPAQUE_FEATURED, MATERIAL_FEATURES_ALL, "forwardOpaqueFeatured"}};
 
 // One camera list exactly (drawCameraList draws the opaque lists as one).
-void drawOneCameraList(Renderer& r, VkCommandBuffer cmd, uint32_t list) {
+void drawOneCameraList(Renderer& r, VkCommandBuffer cmd, uint32_t list, BufferHandle indices) {
     Gpu& gpu = *r.gpu;
     setViewport(cmd, r.internalWidth, r.internalHeight);
-    vkCmdBindIndexBuffer(cmd, vkBuffer(gpu, r.sceneIndices), 0, VK_INDEX_TYPE_UINT32);
+    vkCmdBindIndexBuffer(cmd, vkBuffer(gpu, indices ? indices : r.sceneIndices), 0,
+                         VK_INDEX_TYPE_UINT32);
     drawList(r, cmd, r.draws, 0, list);
     drawPhase2List(r, cmd, list); // occlusion culling's second phase (render/culling)
 }
@@ -123,11 +124,11 @@ void drawSunShadowList(Renderer& r, VkCommandBuffer cmd) {
     drawList(r, cmd, r.shadowDraws, DRAW_LIST_COUNT * 4, DRAW_LIST_OPAQUE);
 }
 
-void drawCameraList(Renderer& r, VkCommandBuffer cmd, uint32_t list) {
-    if (list != DRAW_LIST_OPAQUE) return drawOneCameraList(r, cmd, list);
+void drawCameraList(Renderer& r, VkCommandBuffer cmd, uint32_t list, BufferHandle indices) {
+    if (list != DRAW_LIST_OPAQUE) return drawOneCameraList(r, cmd, list, indices);
     // The forward opaque surfaces are a list per material class (kForwardClasses); only the
     // forward shading tells them apart.
-    for (const ForwardClass& c : kForwardClasses) drawOneCameraList(r, cmd, c.list);
+    for (const ForwardClass& c : kForwardClasses) drawOneCameraList(r, cmd, c.list, indices);
 }
 
 void sceneDepthToSampled(Renderer& r, VkCommandBuffer cmd, VkPipelineStageFlags2 readers) {
@@ -176,12 +177,12 @@ void recordDepthPrepass(Renderer& r, VkCommandBuffer cmd, uint64_t frame) {
     beginSceneDepthPass(r, cmd, true);
     bind(gpu, cmd, r.depthPrepass);
     pushConstants(gpu, cmd, RasterPush{frame, 0});
-    drawPrepassListsAndEnd(r, cmd);
+    drawPrepassListsAndEnd(r, cmd, r.sceneIndices);
 }
 
-void drawPrepassListsAndEnd(Renderer& r, VkCommandBuffer cmd) {
-    drawCameraList(r, cmd, DRAW_LIST_OPAQUE);
-    drawCameraList(r, cmd, DRAW_LIST_DECOUPLED);
+void drawPrepassListsAndEnd(Renderer& r, VkCommandBuffer cmd, BufferHandle indices) {
+    drawCameraList(r, cmd, DRAW_LIST_OPAQUE, indices);
+    drawCameraList(r, cmd, DRAW_LIST_DECOUPLED, indices);
     vkCmdEndRendering(cmd);
     memoryBarrier(cmd, VK_PIPELINE_STAGE_2_LATE_FRAGMENT_TESTS_BIT,
                   VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT,
@@ -225,7 +226,7 @@ void drawForwardLists(Renderer& r, VkCommandBuffer cmd, uint64_t frame) {
     for (uint32_t k = 0; k < kForwardClassCount; ++k) {
         bind(gpu, cmd, r.forwardOpaque[k]);
         pushConstants(gpu, cmd, RasterPush{frame, 0});
-        drawOneCameraList(r, cmd, kForwardClasses[k].list);
+        drawOneCameraList(r, cmd, kForwardClasses[k].list, r.sceneIndices);
     }
     // The blended instances (DRAW_LIST_BLEND) are drawn after every opaque surface by the
     // transparency passes (render/oit), from a CPU list that can be shuffled or sorted.

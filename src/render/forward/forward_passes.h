@@ -3,6 +3,7 @@
 // map, the depth prepass and forward shading. The decoupled path reuses the first three.
 #include <cstdint>
 
+#include "rhi/handles.h"
 #include "rhi/vk.h"
 
 namespace shadel {
@@ -31,13 +32,15 @@ void drawForwardLists(Renderer& r, VkCommandBuffer cmd, uint64_t frame);
 // The sun's culled opaque casters (its whole-scene view): the sun's map, the whole-scene
 // fallback of cascades and spots, and GI's reflective shadow maps draw it.
 void drawSunShadowList(Renderer& r, VkCommandBuffer cmd);
-// Shared by every raster pass that draws the culled camera list (decoupled passes too).
-void drawCameraList(Renderer& r, VkCommandBuffer cmd, uint32_t list);
+// Shared by every raster pass that draws the culled camera list (decoupled passes too), from the
+// scene's index buffer unless `indices` names another of the same layout (the visibility
+// prepass's: GpuScene::visibilityIndices).
+void drawCameraList(Renderer& r, VkCommandBuffer cmd, uint32_t list, BufferHandle indices = {});
 // Begins depth-only rendering into the scene depth (cleared for the prepass, loaded after).
 void beginSceneDepthPass(Renderer& r, VkCommandBuffer cmd, bool clear);
-// Inside a prepass: draws the opaque and decoupled camera lists (what writes depth), ends
-// rendering, and makes the depth visible to the passes that test against it.
-void drawPrepassListsAndEnd(Renderer& r, VkCommandBuffer cmd);
+// Inside a prepass: draws the opaque and decoupled camera lists (what writes depth) from
+// `indices`, ends rendering, and makes the depth visible to the passes that test against it.
+void drawPrepassListsAndEnd(Renderer& r, VkCommandBuffer cmd, BufferHandle indices);
 // The scene depth, written by the passes before, made readable by shaders of the `readers`
 // stages (tile depth bounds, the HiZ pyramid, debug picking, soft particles) ...
 void sceneDepthToSampled(Renderer& r, VkCommandBuffer cmd, VkPipelineStageFlags2 readers);

@@ -59,9 +59,6 @@ void dispatchPixels(Renderer& r, VkCommandBuffer cmd) {
 
 VisibilityStatePtr createVisibility(Renderer& r) {
     Gpu& gpu = *r.gpu;
-    if (!gpu.device.optional.primitiveId)
-        throw DeviceError("--marking visibility needs gl_PrimitiveID in fragment shaders "
-                          "(geometryShader feature); use --marking raster on this device");
     VisibilityStatePtr state(new VisibilityState());
     VisibilityState& v = *state;
     TextureDesc ids;
@@ -93,7 +90,8 @@ VisibilityStatePtr createVisibility(Renderer& r) {
     prepass.name = "visibilityPrepass";
     prepass.vertexShader = "forward_forward.vert.spv";
     prepass.fragmentShader = "shadel_visibility.frag.spv";
-    prepass.specialization = {{ALPHA_MASK_CONSTANT_ID, r.alphaMasked ? 1u : 0u}};
+    prepass.specialization = {{ALPHA_MASK_CONSTANT_ID, r.alphaMasked ? 1u : 0u},
+                              {VISIBILITY_VERTICES_CONSTANT_ID, 1u}};
     prepass.colorFormats = {VK_FORMAT_R32G32_UINT};
     prepass.depthFormat = VK_FORMAT_D32_SFLOAT;
     prepass.cullMode = VK_CULL_MODE_NONE; // as the depth prepass
@@ -185,7 +183,7 @@ void recordVisibilityPrepass(Renderer& r, VkCommandBuffer cmd, uint64_t frame) {
     vkCmdBeginRendering(cmd, &ri);
     bind(gpu, cmd, v.prepass);
     pushConstants(gpu, cmd, RasterPush{frame, 0});
-    drawPrepassListsAndEnd(r, cmd);
+    drawPrepassListsAndEnd(r, cmd, r.sceneVisibilityIndices); // its triangles name themselves
     imageBarrier(cmd, vkImage(gpu, v.ids), VK_IMAGE_ASPECT_COLOR_BIT,
                  VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL,
                  VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT,

@@ -18,8 +18,9 @@ struct VisibilityStateDeleter {
 };
 using VisibilityStatePtr = std::unique_ptr<VisibilityState, VisibilityStateDeleter>;
 
-// Needs the renderer's targets (the HDR target must allow storage). Throws DeviceError when
-// the device cannot give fragment shaders gl_PrimitiveID.
+// Needs the renderer's targets (the HDR target must allow storage). The triangle IDs come from
+// the scene's visibility vertices (GpuScene::visibilityIndices, scene/visibility_vertices.h),
+// not gl_PrimitiveID, so no device feature is needed.
 VisibilityStatePtr createVisibility(Renderer& r);
 void destroyVisibility(Renderer& r, VisibilityStatePtr& state);
 
@@ -28,7 +29,8 @@ void destroyVisibility(Renderer& r, VisibilityStatePtr& state);
 uint32_t visibilityBufferSlot(Renderer& r);
 uint32_t visibilityHdrWriteSlot(Renderer& r);
 
-// "visibilityPrepass": reversed-Z depth + instance/triangle IDs of opaque and decoupled lists.
+// "visibilityPrepass": reversed-Z depth + instance/triangle IDs of opaque and decoupled lists
+// (triangles numbered within their mesh, LOD 0's numbering continued by its other LODs).
 void recordVisibilityPrepass(Renderer& r, VkCommandBuffer cmd, uint64_t frame);
 // "markingCompute": occupancy bits from the visibility buffer (after shadelClear), and per
 // pixel the footprints it marked ("reconstructionAddress") for the resolve.
