@@ -109,8 +109,13 @@ using uint = uint32_t;
 // shader (early Z) instead of after it for every covered fragment.
 #define ALPHA_MASK_CONSTANT_ID 144
 // Whether the raster vertex shader (shaders/forward/forward.vert) draws visibility vertices
-// (the visibility prepass: each triangle's provoking vertex names it, no gl_PrimitiveID).
+// (each triangle's provoking vertex names it, scene/visibility_vertices.h): no (the scene's
+// vertices), yes with every output (forward shading and the raster reconstruction under
+// --inspect, which prints the triangle), or yes for the visibility prepass (IDs and UVs only).
 #define VISIBILITY_VERTICES_CONSTANT_ID 145
+#define VISIBILITY_VERTICES_OFF 0u
+#define VISIBILITY_VERTICES_ALL 1u
+#define VISIBILITY_VERTICES_PREPASS 2u
 // Whether the compute resolve rebuilds its rare pixels inline (debug views, --inspect) or lists
 // them for its rebuild pass (shaders/shadel/resolve.comp).
 #define RESOLVE_REBUILD_INLINE_CONSTANT_ID 146

@@ -23,6 +23,9 @@ layout(location = 1) in vec3 inNormal;
 layout(location = 2) in vec4 inTangent;
 layout(location = 3) in vec2 inUv;
 layout(location = 4) flat in uint inInstance;
+// --inspect: the triangle, from visibility vertices (VISIBILITY_VERTICES_ALL); reading
+// gl_PrimitiveID, even only there, cost lavapipe's forward shading of builtin:many a fifth.
+layout(location = 6) flat in uint inTriangle;
 
 layout(location = 0) out vec4 outColor;
 
@@ -51,12 +54,12 @@ void main() {
     }
     vec3 color = shadeSurface(f, m, inPosition, s.normal);
     if (inspecting(f, uvec2(gl_FragCoord.xy))) {
-        beginInspect(f, inInstance, uint(gl_PrimitiveID), gl_FragCoord);
+        beginInspect(f, inInstance, inTriangle, gl_FragCoord);
         vec2 footprint = max(abs(s.uvDx), abs(s.uvDy));
         if (mat.baseColorTexture != NO_TEXTURE)
             footprint *= vec2(textureSize(gTextures[nonuniformEXT(mat.baseColorTexture)], 0));
         shaderPrintF(f, PRINT_UV_LOD, log2(max(max(footprint.x, footprint.y), 1e-8)));
-        inspectSurface(f, inInstance, uint(gl_PrimitiveID), m, inPosition, s.normal, color);
+        inspectSurface(f, inInstance, inTriangle, m, inPosition, s.normal, color);
     }
     color = visualizeLighting(f, color);
     float alpha = (mat.flags & MATERIAL_ALPHA_BLEND) != 0u ? m.alpha : 1.0;

@@ -14,11 +14,12 @@ layout(location = 2) out vec4 outTangent;
 layout(location = 3) out vec2 outUv;
 layout(location = 4) flat out uint outInstance;
 layout(location = 5) out vec2 outShadelUv; // object's shadel space (decoupled path only)
-layout(location = 6) flat out uint outTriangle; // the visibility prepass's triangle ID
+layout(location = 6) flat out uint outTriangle; // with visibility vertices, else 0
 
-// The visibility prepass draws visibility vertices (scene/visibility_vertices.h): each names
-// the scene vertex it stands for and, as a triangle's provoking vertex, the triangle.
-layout(constant_id = VISIBILITY_VERTICES_CONSTANT_ID) const bool kVisibilityVertices = false;
+// Visibility vertices (scene/visibility_vertices.h): each names the scene vertex it stands for
+// and, as a triangle's provoking vertex, the triangle (VISIBILITY_VERTICES_*).
+layout(constant_id = VISIBILITY_VERTICES_CONSTANT_ID) const uint kVisibilityVertices =
+    VISIBILITY_VERTICES_OFF;
 layout(buffer_reference, scalar) readonly buffer VisibilityVertexBuffer { uvec2 v[]; };
 
 invariant gl_Position; // every raster pass must produce the prepass's depth exactly
@@ -30,7 +31,7 @@ void main() {
     GpuInstance inst = InstanceBuffer(f.instances).i[instanceId];
     uint vertexIndex = gl_VertexIndex;
     outTriangle = 0u;
-    if (kVisibilityVertices) {
+    if (kVisibilityVertices != VISIBILITY_VERTICES_OFF) {
         uvec2 visibilityVertex = VisibilityVertexBuffer(f.visibilityVertices).v[gl_VertexIndex];
         vertexIndex = visibilityVertex.x;
         outTriangle = visibilityVertex.y;
@@ -42,7 +43,7 @@ void main() {
     outUv = v.uv0;
     outInstance = instanceId;
     outShadelUv = f.shadel != 0ul ? Vec2Buffer(ShadelFrameRef(f.shadel).s.shadelUvs).v[vertexIndex] : vec2(0.0);
-    if (kVisibilityVertices) { // the prepass reads only these: the rest compiled out
+    if (kVisibilityVertices == VISIBILITY_VERTICES_PREPASS) { // it reads only the IDs and UVs
         outPosition = vec3(0.0);
         outNormal = vec3(0.0);
         outTangent = vec4(0.0);

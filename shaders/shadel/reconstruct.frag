@@ -17,6 +17,9 @@ layout(location = 1) in vec3 inNormal;
 layout(location = 2) in vec4 inTangent;
 layout(location = 3) in vec2 inUv;
 layout(location = 4) flat in uint inInstance;
+// --inspect: the triangle, from visibility vertices (VISIBILITY_VERTICES_ALL); reading
+// gl_PrimitiveID, even only there, cost lavapipe's forward shading of builtin:many a fifth.
+layout(location = 6) flat in uint inTriangle;
 layout(location = 5) in vec2 inShadelUv;
 
 layout(location = 0) out vec4 outColor;
@@ -37,7 +40,7 @@ vec3 forwardShade(FrameConstants f) {
     useLightListAt(f, gl_FragCoord.xy, inPosition); // the lights as forward shading culls them
     vec3 color = shadeSurface(f, m, inPosition, si.normal);
     if (inspecting(f, uvec2(gl_FragCoord.xy)))
-        inspectSurface(f, inInstance, uint(gl_PrimitiveID), m, inPosition, si.normal, color);
+        inspectSurface(f, inInstance, inTriangle, m, inPosition, si.normal, color);
     return color;
 }
 
@@ -53,7 +56,7 @@ void main() {
     vec3 color = r.color;
     bool inspect = inspecting(f, uvec2(gl_FragCoord.xy));
     if (inspect) {
-        beginInspect(f, inInstance, uint(gl_PrimitiveID), gl_FragCoord);
+        beginInspect(f, inInstance, inTriangle, gl_FragCoord);
         inspectShadels(f, s, o, r, inShadelUv, texelDx, texelDy);
     }
     bool shadeForward = r.missing + r.overflowed != 0u || r.forward;

@@ -46,6 +46,14 @@ void drawOneCameraList(Renderer& r, VkCommandBuffer cmd, uint32_t list, BufferHa
 }
 } // namespace
 
+BufferHandle shadingIndices(const Renderer& r) {
+    return r.settings.inspectX >= 0 ? r.sceneVisibilityIndices : r.sceneIndices;
+}
+
+uint32_t shadingVisibilityVertices(const Renderer& r) {
+    return r.settings.inspectX >= 0 ? VISIBILITY_VERTICES_ALL : VISIBILITY_VERTICES_OFF;
+}
+
 void createForwardPipelines(Renderer& r) {
     Gpu& gpu = *r.gpu;
     r.instanceCull = createComputePipeline(gpu, "instanceCull", "forward_instance_cull.comp.spv");
@@ -66,6 +74,8 @@ void createForwardPipelines(Renderer& r) {
     opaque.depthCompare = VK_COMPARE_OP_EQUAL; // the prepass resolved visibility
     opaque.cullMode = VK_CULL_MODE_NONE;
     opaque.specialization = shaderPrintSpecialization(r.settings.inspectX >= 0);
+    opaque.specialization.push_back(
+        {VISIBILITY_VERTICES_CONSTANT_ID, shadingVisibilityVertices(r)});
     if (r.settings.distanceFieldLighting)
         opaque.specialization.push_back({DISTANCE_FIELD_LIGHTING_CONSTANT_ID, 1u});
     // A screen tile's lights that read no texture run in a loop without that code (spectra per
@@ -226,7 +236,7 @@ void drawForwardLists(Renderer& r, VkCommandBuffer cmd, uint64_t frame) {
     for (uint32_t k = 0; k < kForwardClassCount; ++k) {
         bind(gpu, cmd, r.forwardOpaque[k]);
         pushConstants(gpu, cmd, RasterPush{frame, 0});
-        drawOneCameraList(r, cmd, kForwardClasses[k].list, r.sceneIndices);
+        drawOneCameraList(r, cmd, kForwardClasses[k].list, shadingIndices(r));
     }
     // The blended instances (DRAW_LIST_BLEND) are drawn after every opaque surface by the
     // transparency passes (render/oit), from a CPU list that can be shuffled or sorted.

@@ -38,6 +38,11 @@ void drawSunShadowList(Renderer& r, VkCommandBuffer cmd);
 void drawCameraList(Renderer& r, VkCommandBuffer cmd, uint32_t list, BufferHandle indices = {});
 // Begins depth-only rendering into the scene depth (cleared for the prepass, loaded after).
 void beginSceneDepthPass(Renderer& r, VkCommandBuffer cmd, bool clear);
+// --inspect prints the triangle under the pixel: forward shading and the raster reconstruction
+// then draw the scene's visibility vertices (VISIBILITY_VERTICES_ALL), whose provoking vertex
+// names it, from these indices (the same depth: the corners keep their order).
+BufferHandle shadingIndices(const Renderer& r);
+uint32_t shadingVisibilityVertices(const Renderer& r); // the pipelines' VISIBILITY_VERTICES_*
 // Inside a prepass: draws the opaque and decoupled camera lists (what writes depth) from
 // `indices`, ends rendering, and makes the depth visible to the passes that test against it.
 void drawPrepassListsAndEnd(Renderer& r, VkCommandBuffer cmd, BufferHandle indices);

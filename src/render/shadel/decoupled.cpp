@@ -384,6 +384,7 @@ DecoupledStatePtr createDecoupled(Renderer& r, const GpuScene& scene) {
     recon.fragmentShader = "shadel_reconstruct.frag.spv";
     recon.colorFormats = {VK_FORMAT_R16G16B16A16_SFLOAT};
     recon.specialization = shaderPrintSpecialization(r.settings.inspectX >= 0);
+    recon.specialization.push_back({VISIBILITY_VERTICES_CONSTANT_ID, shadingVisibilityVertices(r)});
     d.reconstruct = createGraphicsPipeline(gpu, recon);
     registerDecoupledCaptures(r, d);
     return state;
@@ -1195,7 +1196,7 @@ void recordDecoupledShading(Renderer& r, FrameRecorder& rec, uint64_t frame, con
         beginSceneColorPass(r, cmd, true);
         bind(gpu, cmd, d.reconstruct);
         pushConstants(gpu, cmd, RasterPush{frame, 0});
-        drawCameraList(r, cmd, DRAW_LIST_DECOUPLED);
+        drawCameraList(r, cmd, DRAW_LIST_DECOUPLED, shadingIndices(r));
         drawForwardLists(r, cmd, frame);
         vkCmdEndRendering(cmd);
     });

@@ -91,7 +91,7 @@ VisibilityStatePtr createVisibility(Renderer& r) {
     prepass.vertexShader = "forward_forward.vert.spv";
     prepass.fragmentShader = "shadel_visibility.frag.spv";
     prepass.specialization = {{ALPHA_MASK_CONSTANT_ID, r.alphaMasked ? 1u : 0u},
-                              {VISIBILITY_VERTICES_CONSTANT_ID, 1u}};
+                              {VISIBILITY_VERTICES_CONSTANT_ID, VISIBILITY_VERTICES_PREPASS}};
     prepass.colorFormats = {VK_FORMAT_R32G32_UINT};
     prepass.depthFormat = VK_FORMAT_D32_SFLOAT;
     prepass.cullMode = VK_CULL_MODE_NONE; // as the depth prepass
