@@ -405,10 +405,6 @@ void createDevice(Device& device, const DeviceDesc& desc) {
         f.core.features.shaderStorageImageReadWithoutFormat;
     enable.core.features.depthClamp = VK_TRUE;
     enable.core.features.independentBlend = f.core.features.independentBlend;
-    // gl_PrimitiveID in fragment shaders (the visibility buffer's triangle IDs) needs the
-    // Geometry capability.
-    enable.core.features.geometryShader = f.core.features.geometryShader;
-    device.optional.primitiveId = f.core.features.geometryShader == VK_TRUE;
     // Sparse residency (texture streaming, --streaming sparse). SHADEL_DISABLE_SPARSE=1 leaves
     // it off, as on a device without it (tests of that error path).
     const char* noSparse = std::getenv("SHADEL_DISABLE_SPARSE");

@@ -22,7 +22,6 @@ struct DeviceFeatures { // optional features, used when present
     bool meshShader = false;
     bool rayQuery = false;
     bool computeDerivatives = false;
-    bool primitiveId = false; // fragment gl_PrimitiveID (geometryShader feature)
     // sparseBinding + sparseResidencyImage2D, on a queue with sparse binding (--streaming sparse)
     bool sparseResidency = false;
 };
