@@ -24,10 +24,10 @@ struct VisTriangle {
 };
 
 // Triangle `triangle` of an instance's mesh (the visibility buffer's: numbered from the mesh's
-// first index, whatever LOD its draw used; scene/visibility_vertices.h). Homogeneous rasterization (Olano & Greer): with M's
-// columns the clip-space (x, y, w) of the vertices, the perspective-correct barycentrics at NDC
-// point q are adj(M) (q, 1), normalised to sum 1. No division by w, so triangles crossing the
-// camera plane are fine.
+// first index, whatever LOD its draw used; scene/visibility_vertices.h). Homogeneous
+// rasterization (Olano & Greer): with M's columns the clip-space (x, y, w) of the vertices, the
+// perspective-correct barycentrics at NDC point q are adj(M) (q, 1), normalised to sum 1. No
+// division by w, so triangles crossing the camera plane are fine.
 VisTriangle loadVisTriangle(FrameConstants f, GpuInstance inst, uint triangle) {
     GpuMesh mesh = MeshBuffer(f.meshes).m[inst.mesh];
     IndexBuffer indices = IndexBuffer(f.indices);

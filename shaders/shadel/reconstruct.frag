@@ -17,10 +17,10 @@ layout(location = 1) in vec3 inNormal;
 layout(location = 2) in vec4 inTangent;
 layout(location = 3) in vec2 inUv;
 layout(location = 4) flat in uint inInstance;
+layout(location = 5) in vec2 inShadelUv;
 // --inspect: the triangle, from visibility vertices (VISIBILITY_VERTICES_ALL); reading
 // gl_PrimitiveID, even only there, cost lavapipe's forward shading of builtin:many a fifth.
 layout(location = 6) flat in uint inTriangle;
-layout(location = 5) in vec2 inShadelUv;
 
 layout(location = 0) out vec4 outColor;
 

@@ -108,18 +108,6 @@ uvec2 levelTexel(ShadelObjectRef o, uint mip, ivec2 texel) {
     return uvec2(clamp(texel, ivec2(0), ivec2(levelSize(o, mip)) - 1));
 }
 
-// Whether the level's window holds the whole 2x2 footprint at `uv` (a coarse level's window is
-// the level, so it always does).
-bool windowHolds(ShadelObjectRef o, uint mip, vec2 uv) {
-    ivec2 t0;
-    vec2 w;
-    bilinearFootprint(o, mip, uv, t0, w);
-    uvec2 lo = levelTexel(o, mip, t0), hi = levelTexel(o, mip, t0 + ivec2(1));
-    uvec2 origin = windowOrigin(o, mip);
-    return all(greaterThanEqual(lo, origin)) &&
-           all(lessThan(hi, origin + o.v.rect[mip].zw * SHADEL_BLOCK));
-}
-
 // A sample whose wanted level's window lags by more than one level (a camera cut: last frame's
 // marks were elsewhere) is shaded forward instead of read that much coarser: from two levels
 // up, charts bleed into each other's shadels (bake.h: only levels <= log2(gutter) are clean)
@@ -148,17 +136,8 @@ struct LevelFootprint {
     vec2 weight;
 };
 
-LevelFootprint levelFootprint(ShadelObjectRef o, uint mip, vec2 uv) {
-    ivec2 t0;
-    LevelFootprint fp;
-    bilinearFootprint(o, mip, uv, t0, fp.weight);
-    fp.lo = sheetShadel(o, mip, t0);
-    fp.hi = sheetShadel(o, mip, t0 + ivec2(1));
-    return fp;
-}
-
-// The footprint at one level and whether the level's window holds it, from one bilinear
-// footprint: what windowHolds and levelFootprint compute apart (the same values).
+// The footprint at one level and whether the level's window holds it (a coarse level's window
+// is the level, so it always does), from one bilinear footprint.
 bool heldLevelFootprint(ShadelObjectRef o, uint mip, vec2 uv, out LevelFootprint fp) {
     ivec2 t0;
     bilinearFootprint(o, mip, uv, t0, fp.weight);
@@ -168,6 +147,12 @@ bool heldLevelFootprint(ShadelObjectRef o, uint mip, vec2 uv, out LevelFootprint
     fp.lo = rect.xy * SHADEL_BLOCK + lo - origin; // sheetShadel
     fp.hi = rect.xy * SHADEL_BLOCK + hi - origin;
     return all(greaterThanEqual(lo, origin)) && all(lessThan(hi, origin + rect.zw * SHADEL_BLOCK));
+}
+
+// Whether the level's window holds the whole 2x2 footprint at `uv`.
+bool windowHolds(ShadelObjectRef o, uint mip, vec2 uv) {
+    LevelFootprint fp;
+    return heldLevelFootprint(o, mip, uv, fp);
 }
 
 // Level windows: a sample whose footprint a level's window does not hold reads the next
