@@ -515,6 +515,7 @@ nlohmann::json runBench(Gpu& gpu, const BenchOptions& b) {
     o.marking = b.marking;
     o.lightGrid = b.lightGrid;
     o.shadingBias = b.shadingBias;
+    o.materialRate = b.materialRate;
     o.cacheLimitBytes = b.cacheLimitBytes;
     o.lightCulling = b.lightCulling;
     // --spectra compare reports on / off against the three modes: they run without spectra
@@ -545,6 +546,7 @@ nlohmann::json runBench(Gpu& gpu, const BenchOptions& b) {
     out["camera_path"] = pathNames[int(b.cameraPath)];
     out["animate_lights"] = b.animateLights;
     out["shading_bias"] = b.shadingBias;
+    out["material_rate"] = b.materialRate;
     // With --rounds N every round runs the three modes, in opposite order each round, so the
     // machine's drift over a run (a shared machine's neighbours, warm-up) hits every mode
     // alike; each ratio is the median of the rounds' ratios (forward of the same round as the

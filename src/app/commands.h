@@ -47,6 +47,7 @@ struct RenderOptions {
     uint32_t allocationCounters = SHADEL_COUNTERS;
     bool sheetAllMips = false;
     bool levelWindows = true;
+    bool materialRate = true; // --material-rate on|off
     bool capacityControl = true;
     bool reuse = true;
     uint32_t reuseRefreshPeriod = 16;
@@ -173,6 +174,7 @@ struct BenchOptions {
     MarkingMode marking = MarkingMode::Auto; // decoupled and reuse modes
     bool lightGrid = true;                   // --light-grid on|off
     float shadingBias = 0.0f;                // decoupled and reuse modes
+    bool materialRate = true;                // --material-rate on|off: decoupled and reuse modes
     LightCulling lightCulling = LightCulling::Tiled;
     // --light-culling compare: forward and decoupled rendered again with no culling, and
     // ratios.light_culling_forward|decoupled = tiled / none median frame time.

@@ -218,6 +218,12 @@ int main(int argc, char** argv) {
                      "decoupled: on | off: a fine level's sheet rect holds only the part of the "
                      "level last frame's samples wanted, plus a margin (off: whole levels)")
         ->capture_default_str();
+    std::string materialRate = "on";
+    render
+        ->add_option("--material-rate", materialRate,
+                     "decoupled: on | off: shade plain (untextured, lighting-only) rough materials "
+                     "up to one MIP coarser (render/shadel/material_rate.h)")
+        ->capture_default_str();
     std::string reuse = "on";
     render
         ->add_option("--reuse", reuse,
@@ -508,6 +514,12 @@ int main(int argc, char** argv) {
                      "decoupled modes: fractional MIP bias (+ = fewer shadels)")
         ->capture_default_str()
         ->check(finiteInRange(kShadingBiasRange));
+    std::string benchMaterialRate = "on";
+    bench
+        ->add_option(
+            "--material-rate", benchMaterialRate,
+            "decoupled modes: on | off: plain rough materials shaded up to one MIP coarser")
+        ->capture_default_str();
     std::string benchMarking = "auto";
     bench->add_option("--marking", benchMarking, "decoupled modes: auto | raster | visibility")
         ->capture_default_str();
@@ -685,6 +697,7 @@ int main(int argc, char** argv) {
                 throw InputError(
                     format("--level-windows %s: expected on or off", levelWindows.c_str()));
             ro.levelWindows = levelWindows == "on";
+            ro.materialRate = parseOnOff("--material-rate", materialRate);
             if (reuse != "on" && reuse != "off")
                 throw InputError(format("--reuse %s: expected on or off", reuse.c_str()));
             ro.reuse = reuse == "on";
@@ -766,6 +779,7 @@ int main(int argc, char** argv) {
             bo.shadelsPerMetre = parseDensity(benchDensity);
             bo.cameraPath = parseCameraPath(benchCameraPath);
             bo.marking = parseMarking(benchMarking);
+            bo.materialRate = parseOnOff("--material-rate", benchMaterialRate);
             bo.lightGrid = parseOnOff("--light-grid", benchLightGrid);
             bo.sunCascades = parseSunCascades(benchSunCascades);
             if (bo.rounds < 1 || bo.rounds > 100)

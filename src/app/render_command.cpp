@@ -380,6 +380,7 @@ RenderRun runRender(Gpu& gpu, const RenderOptions& o) {
     settings.allocationCounters = o.allocationCounters;
     settings.sheetAllMips = o.sheetAllMips;
     settings.levelWindows = o.levelWindows;
+    settings.materialRate = o.materialRate;
     settings.capacityControl = o.capacityControl;
     settings.reuse = o.reuse;
     settings.reuseRefreshPeriod = o.reuseRefreshPeriod;

@@ -99,10 +99,11 @@ struct RenderSettings {
     uint32_t materialSamples = 4; // decoupled: material evaluations per shadel above MIP 0
     float forwardBelowPixels = 8; // decoupled: objects smaller on screen drawn forward (0 = never)
     uint32_t allocationCounters = SHADEL_COUNTERS; // decoupled: hashed counters used (tests)
-    bool sheetAllMips = false;   // decoupled: rects at every MIP (the old policy, for comparison)
-    bool levelWindows = true;    // decoupled: fine levels' rects hold only what the view wanted
-    bool capacityControl = true; // decoupled: steer the shading bias from storage use
-    bool reuse = true;           // decoupled: carry unchanged shadels over from last frame
+    bool sheetAllMips = false; // decoupled: rects at every MIP (the old policy, for comparison)
+    bool levelWindows = true;  // decoupled: fine levels' rects hold only what the view wanted
+    bool materialRate = true;  // decoupled: plain materials shaded coarser (shadel/material_rate.h)
+    bool capacityControl = true;      // decoupled: steer the shading bias from storage use
+    bool reuse = true;                // decoupled: carry unchanged shadels over from last frame
     uint32_t reuseRefreshPeriod = 16; // decoupled: reshade every carried chunk this often
     // --inspect X,Y: the output pixel whose shading is printed (shaders/debug/inspect.glsl).
     int32_t inspectX = -1, inspectY = -1;

@@ -17,6 +17,7 @@
 #include "render/renderer.h"
 #include "render/shadel/capacity_control.h"
 #include "render/shadel/coarse_visit.h"
+#include "render/shadel/material_rate.h"
 #include "render/shadel/reuse_invalidation.h"
 #include "render/shadel/shade_storage.h"
 #include "render/shadel/visibility.h"
@@ -51,6 +52,10 @@ struct ObjectSlot {
     // unchanged for two frames) and no placement failed (windowRetry), it would keep them all.
     bool wantsSettled = false;
     bool windowRetry = false; // a window's new rect did not fit: try again next frame
+    // Whether a light with sharp edges reaches the instance (material_rate.h), as of the sharp
+    // lights' version (0: not yet asked).
+    uint32_t sharpLightsVersion = 0;
+    bool sharpLit = false;
     uint32_t firstMip = 0;
     uint32_t mipCount = 0;
     uint64_t firstMipChanged = 0; // frame number firstMip last changed (levels added/dropped)
@@ -97,6 +102,8 @@ struct FrameCounters {
     uint32_t objectsForward = 0;
     uint32_t objectsSmallForward = 0;
     uint32_t objectsSheetLimited = 0;
+    uint32_t objectsRateBiased = 0; // objects whose material shades them coarser (material_rate.h)
+    float rateBiasSum = 0.0f;       // of their rate biases, over the decoupled objects
     uint64_t rectBlocks = 0;
     uint64_t wholeLevelBlocks = 0; // what the same levels would take whole (no windows)
     uint32_t windowMoves = 0;      // level rects placed again because their window changed
@@ -156,6 +163,11 @@ struct DecoupledState {
     uint32_t capacityChunks = 0;
     uint32_t objectsDecoupled = 0, objectsForward = 0, objectsSmallForward = 0;
     uint32_t objectsSheetLimited = 0; // finer levels wanted but no sheet room: clamped
+    bool materialRateOn = true;       // --material-rate
+    MaterialRate materialRate;
+    SharpLights sharpLights; // the lights that keep plain materials at the full rate
+    uint32_t objectsRateBiased = 0;
+    float rateBiasSum = 0.0f;
     std::array<uint32_t, SHADEL_MAX_MIPS> firstMipHistogram{};
 
     BufferHandle frameInfo;    // gpu::ShadelFrame (upload)
@@ -244,6 +256,7 @@ DecoupledStatePtr createDecoupled(Renderer& r, const GpuScene& scene) {
     d.baseShadingBias = rs.shadingBias;
     d.shadingBias = rs.shadingBias;
     d.capacityControl = rs.capacityControl;
+    d.materialRateOn = rs.materialRate;
     d.trilinearBand = std::clamp(rs.trilinearBand, 0.0f, 1.0f);
     d.sheetBlocks = rs.sheetShadels / SHADEL_BLOCK;
     uint32_t x = 0;
@@ -780,11 +793,21 @@ void prepareDecoupledFrame(Renderer& r, const GpuScene& scene, const CameraView&
     d.wholeLevelBlocks = 0;
     d.windowMoves = 0;
     d.objectsDecoupled = d.objectsForward = d.objectsSmallForward = d.objectsSheetLimited = 0;
+    d.objectsRateBiased = 0;
+    d.rateBiasSum = 0.0f;
     d.firstMipHistogram.fill(0);
     d.objectsReusable = 0;
     d.changes =
         changedVolumes(r, scene, constants.sunDirection, glm::length(constants.sunColor) > 0.0f);
     d.changesOverflow = d.changes.size() > SHADEL_MAX_CHANGED_VOLUMES;
+    if (d.materialRateOn) {
+        const RtSettings& rt = r.settings.rt;
+        bool sunSharp = rt.shadows || rt.ao || rt.gi || r.settings.sunCascades > 1;
+        static const std::vector<Decal> kNoDecals;
+        updateSharpLights(d.sharpLights,
+                          r.lightsLastFrame.empty() ? scene.lightInfo : r.lightsLastFrame, sunSharp,
+                          r.settings.decals ? scene.decals : kNoDecals);
+    }
     if (!d.changesOverflow && !d.changes.empty())
         std::memcpy(mapped(gpu, d.changedVolumes), d.changes.data(),
                     d.changes.size() * sizeof(ChangedVolume));
@@ -863,7 +886,27 @@ void prepareDecoupledFrame(Renderer& r, const GpuScene& scene, const CameraView&
         }
         const gpu::GpuInstance& inst = scene.instanceInfo[i];
         const ShadelMeshInfo& mesh = scene.shadelMeshes[inst.mesh];
-        uint32_t wantFirst = finestMipFromLod(view.lodBeforeBias, d.shadingBias, mesh.mipCount);
+        // The material as this frame shades it (edited or as loaded: render/scene_edits).
+        bool known = inst.material < scene.materialInfo.size();
+        const gpu::GpuMaterial* material =
+            known ? &currentMaterial(r, scene, inst.material) : nullptr;
+        float roughness = known ? material->roughnessFactor : 1.0f;
+        uint32_t features = known ? materialFeatures(*material) : MATERIAL_FEATURES_ALL;
+        // Animated playback posed it anew (moved or deformed): its shadels are shaded again.
+        bool reposed = i < r.reposedInstances.size() && r.reposedInstances[i] != 0;
+        // Its shading rate (material_rate.h): the GPU adds it to every sample's LOD, so the
+        // finest level the object can need moves by as much.
+        float rateBias =
+            d.materialRateOn ? materialRateBias(d.materialRate, features, roughness) : 0.0f;
+        if (rateBias > 0.0f) {
+            if (o.sharpLightsVersion != d.sharpLights.version || reposed) {
+                o.sharpLit = sharpLightReaches(d.sharpLights, inst.worldMin, inst.worldMax);
+                o.sharpLightsVersion = d.sharpLights.version;
+            }
+            if (o.sharpLit) rateBias = 0.0f;
+        }
+        uint32_t wantFirst =
+            finestMipFromLod(view.lodBeforeBias, d.shadingBias + rateBias, mesh.mipCount);
         bool limited = false;
         // No room in the sheet: drawn forward this frame, retried next frame.
         if (!updateObjectRects(gpu, d, o, i, mesh, wantFirst, wasDecoupled, limited)) {
@@ -891,21 +934,17 @@ void prepareDecoupledFrame(Renderer& r, const GpuScene& scene, const CameraView&
         // was edited): reshade it.
         bool restreamed =
             inst.material < r.changedMaterials.size() && r.changedMaterials[inst.material] != 0;
-        // Animated playback posed it anew (moved or deformed): its shadels are shaded again.
-        bool reposed = i < r.reposedInstances.size() && r.reposedInstances[i] != 0;
         bool inputsUnchanged =
             d.reuse && wasDecoupled && reach != ChangeReach::Everything && !restreamed && !reposed;
         for (uint32_t k = o.firstMip; k < mesh.mipCount && inputsUnchanged; ++k)
             if (o.levelSince[k] < d.frameNumber || o.movedAt[k] == d.frameNumber)
                 g.reuseLevels |= 1u << k;
-        // The material as this frame shades it (edited or as loaded: render/scene_edits).
-        bool known = inst.material < scene.materialInfo.size();
-        const gpu::GpuMaterial* material =
-            known ? &currentMaterial(r, scene, inst.material) : nullptr;
-        float roughness = known ? material->roughnessFactor : 1.0f;
         float metallic = known ? material->metallicFactor : 1.0f;
         glm::vec3 baseColor = known ? glm::vec3(material->baseColorFactor) : glm::vec3(0.0f);
         g.viewDriftCos = std::cos(viewDriftLimitFor(roughness, metallic, baseColor));
+        g.rateBias = rateBias;
+        d.objectsRateBiased += rateBias > 0.0f;
+        d.rateBiasSum += rateBias;
         d.objectsReusable += g.reuseLevels != 0;
         d.firstMipHistogram[o.firstMip]++;
         g.mip0Size = mesh.mip0Size;
@@ -913,7 +952,6 @@ void prepareDecoupledFrame(Renderer& r, const GpuScene& scene, const CameraView&
         g.firstMip = o.firstMip;
         g.flags |= SHADEL_OBJECT_DECOUPLED;
         // Its shading class (the pipeline that shades its chunks, shaders/shadel/shade.comp).
-        uint32_t features = known ? materialFeatures(*material) : MATERIAL_FEATURES_ALL;
         if (features != 0u) g.flags |= SHADEL_OBJECT_FEATURED_MATERIAL;
         // Only point-function procedurals are supersampled (shaders/shadel/prefilter.glsl).
         if ((features & MATERIAL_FEATURE_PROCEDURAL) && r.settings.materialSamples >= 4)
@@ -1242,6 +1280,8 @@ void finishDecoupledFrame(Renderer& r) {
     f.objectsForward = d.objectsForward;
     f.objectsSmallForward = d.objectsSmallForward;
     f.objectsSheetLimited = d.objectsSheetLimited;
+    f.objectsRateBiased = d.objectsRateBiased;
+    f.rateBiasSum = d.rateBiasSum;
     f.firstMipHistogram = d.firstMipHistogram;
     f.rectBlocks = d.rectBlockCount;
     f.wholeLevelBlocks = d.wholeLevelBlocks;
@@ -1358,6 +1398,12 @@ void decoupledStats(const Renderer& r, nlohmann::json& s) {
     s["objects_forward"] = last.objectsForward; // small (hybrid) + no sheet space
     s["objects_forward_small"] = last.objectsSmallForward;
     s["objects_sheet_limited"] = last.objectsSheetLimited;
+    // Material shading rate: the objects shaded coarser than their footprint asks for, and the
+    // mean bias over all decoupled objects (MIPs).
+    s["material_rate"] = d.materialRateOn;
+    s["objects_rate_biased"] = last.objectsRateBiased;
+    s["material_rate_bias_mean"] =
+        last.objectsDecoupled ? double(last.rateBiasSum) / double(last.objectsDecoupled) : 0.0;
     nlohmann::json firstMips = nlohmann::json::array();
     for (uint32_t k = 0; k < SHADEL_MAX_MIPS; ++k) firstMips.push_back(last.firstMipHistogram[k]);
     s["objects_by_first_mip"] = firstMips;
