@@ -46,6 +46,9 @@ bool inspecting(FrameConstants f, uvec2 pixel) {
 #define shaderPrintF(frame, label, v)                                                             \
     shaderPrintRecord((frame).messages, label, SHADEL_PRINT_FMT(PRINT_FLOAT, 1u),                  \
                       uvec4(floatBitsToUint(float(v)), 0u, 0u, 0u), __LINE__)
+#define shaderPrintF2(frame, label, v)                                                            \
+    shaderPrintRecord((frame).messages, label, SHADEL_PRINT_FMT(PRINT_FLOAT, 2u),                  \
+                      uvec4(floatBitsToUint(vec2(v)), 0u, 0u), __LINE__)
 #define shaderPrintF3(frame, label, v)                                                            \
     shaderPrintRecord((frame).messages, label, SHADEL_PRINT_FMT(PRINT_FLOAT, 3u),                  \
                       uvec4(floatBitsToUint(vec3(v)), 0u), __LINE__)

@@ -11,6 +11,9 @@ void inspectShadels(FrameConstants f, ShadelFrame s, ShadelObjectRef o, Reconstr
     ShadelLevels l = shadelLevels(o, texelDx, texelDy, s.shadingBias, s.trilinearBand);
     fitLevelsToWindows(o, shadelUv, l); // the levels the reconstruction read
     shaderPrintF4(f, PRINT_SHADEL_LOD, vec4(r.lod, float(l.mip0), float(l.mip1), l.blend));
+    // Why the LOD is coarser than the footprint: the frame's bias (--shading-bias + the capacity
+    // controller) and the object's material rate (render/shadel/material_rate.h).
+    shaderPrintF2(f, PRINT_SHADING_BIAS, vec2(s.shadingBias, o.v.rateBias));
     ivec2 t0;
     vec2 w;
     bilinearFootprint(o, r.mip0, shadelUv, t0, w);

@@ -95,6 +95,8 @@ const char* printLabelName(uint32_t label) {
         return "reconstructed";
     case PRINT_OUTPUT:
         return "output";
+    case PRINT_SHADING_BIAS:
+        return "shading bias (frame), material rate bias";
     case PRINT_FRAGMENT_DEPTH:
         return "fragment depth";
     case PRINT_TEST:

@@ -187,6 +187,12 @@ TEST_P(InspectDecoupled, PixelPrintsItsChunkAndAgreesWithTheCpuBrdf) {
     const ShaderPrint& lod = p.byLabel.at(PRINT_SHADEL_LOD).at(0);
     EXPECT_TRUE(std::isfinite(lod.f(0)) && lod.f(0) >= 0.0f);
     EXPECT_EQ(p.u(PRINT_SHADEL_CHUNK, 3), uint32_t(lod.f(1))); // chunk of the first MIP
+    // Why the LOD is what it is: the frame's shading bias and the object's material rate.
+    ASSERT_TRUE(p.has(PRINT_SHADING_BIAS)) << where;
+    const ShaderPrint& bias = p.byLabel.at(PRINT_SHADING_BIAS).at(0);
+    EXPECT_FLOAT_EQ(bias.f(0), run.stats["shading_bias"].get<float>());
+    EXPECT_GE(bias.f(1), 0.0f);
+    EXPECT_LE(bias.f(1), 1.0f);
     glm::vec3 shaded = checkSurface(p, scene, where);
     glm::vec3 reconstructed = p.v3(PRINT_RECONSTRUCTED);
     glm::vec3 output = p.v3(PRINT_OUTPUT);
