@@ -777,6 +777,9 @@ nlohmann::json runBench(Gpu& gpu, const BenchOptions& b) {
         };
     };
     row("shadels per covered pixel", decoupledOnly("shadels_per_pixel", "%.3f"));
+    // Material shading rate (render/shadel/material_rate.h): objects shaded coarser, mean MIPs.
+    row("objects rate-biased", decoupledOnly("objects_rate_biased", ""));
+    row("material rate bias (mean)", decoupledOnly("material_rate_bias_mean", "%.3f"));
     row("shadels shaded (last)", decoupledOnly("shadels_shaded", ""));
     row("reuse fraction", decoupledOnly("reuse_fraction", "%.3f"));
     // Why the chunks not carried over were shaded (fractions of the stored chunks).
