@@ -61,6 +61,7 @@ RenderSettings settingsFor(const ViewOptions& o, const ViewerPanel& p, const Gpu
     s.timing = defaultTimingMode(gpu);
     s.recordingThreads = o.threads ? o.threads : defaultRecordingThreads();
     s.materialSamples = 16; // as `shadel render`
+    s.materialRate = p.materialRate;
     return s;
 }
 
@@ -73,8 +74,9 @@ std::vector<std::string> statLines(const Renderer& r, const FrameResult& f) {
         nlohmann::json s = nlohmann::json::object();
         s["pixels_covered"] = f.pixelsCovered;
         decoupledStats(r, s);
-        for (const char* key : {"chunks_allocated", "chunks_capacity", "shadels_per_pixel",
-                                "shading_bias", "reconstruction_misses", "reuse_fraction"})
+        for (const char* key :
+             {"chunks_allocated", "chunks_capacity", "shadels_per_pixel", "shading_bias",
+              "objects_rate_biased", "reconstruction_misses", "reuse_fraction"})
             if (s.contains(key)) lines.push_back(format("%s: %s", key, s[key].dump().c_str()));
     }
     return lines;
@@ -297,6 +299,8 @@ int runViewer(const ViewOptions& o, DeviceDesc deviceDesc) {
                     renderer.settings.visualize = settingsFor(o, panel, gpu).visualize;
                 }
             }
+            // Read by the decoupled frontend every frame: no new renderer needed.
+            if (panel.materialRateChanged) renderer.settings.materialRate = panel.materialRate;
         }
     } catch (...) {
         cleanup();

@@ -119,6 +119,7 @@ bool uiWantsMouse(const ViewerUi& ui) {
 void buildUi(ViewerUi& ui, ViewerPanel& p, const std::function<void()>& sections) {
     (void)ui;
     p.modeChanged = p.visualizeChanged = p.cameraModeChanged = p.screenshotRequested = false;
+    p.materialRateChanged = false;
     ImGui_ImplVulkan_NewFrame();
     ImGui_ImplGlfw_NewFrame();
     ImGui::NewFrame();
@@ -127,9 +128,12 @@ void buildUi(ViewerUi& ui, ViewerPanel& p, const std::function<void()>& sections
     ImGui::Begin("shadel");
     const char* modes[] = {"forward", "decoupled"};
     p.modeChanged = ImGui::Combo("mode", &p.mode, modes, 2);
-    if (p.mode == 1)
+    if (p.mode == 1) {
         p.visualizeChanged =
             ImGui::Combo("debug view", &p.visualize, kVisualizeNames, kVisualizeCount);
+        // Plain rough materials shaded up to a MIP coarser (render/shadel/material_rate.h).
+        p.materialRateChanged = ImGui::Checkbox("material shading rate", &p.materialRate);
+    }
     p.cameraModeChanged = ImGui::Checkbox("orbit camera (Tab)", &p.orbit);
     ImGui::TextUnformatted(p.orbit ? "left drag: turn, wheel: zoom"
                                    : "WASD/QE: move, right drag: look, shift: fast");

@@ -29,8 +29,10 @@ struct ViewerPanel {
     int mode = 0;      // 0 forward, 1 decoupled
     int visualize = 0; // index into kVisualizeNames
     bool orbit = false;
+    bool materialRate = true; // decoupled: --material-rate
     // Out: events.
     bool modeChanged = false, visualizeChanged = false, cameraModeChanged = false;
+    bool materialRateChanged = false;
     bool screenshotRequested = false;
 };
 

@@ -800,6 +800,7 @@ void prepareDecoupledFrame(Renderer& r, const GpuScene& scene, const CameraView&
     d.changes =
         changedVolumes(r, scene, constants.sunDirection, glm::length(constants.sunColor) > 0.0f);
     d.changesOverflow = d.changes.size() > SHADEL_MAX_CHANGED_VOLUMES;
+    d.materialRateOn = r.settings.materialRate; // the viewer may switch it between frames
     if (d.materialRateOn) {
         const RtSettings& rt = r.settings.rt;
         bool sunSharp = rt.shadows || rt.ao || rt.gi || r.settings.sunCascades > 1;
