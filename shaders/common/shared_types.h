@@ -635,8 +635,9 @@ struct GpuShadelObject {
     float viewDriftCos;
     // MIPs coarser than the pixel footprint asks for that the object's material allows
     // (render/shadel/material_rate.h: smooth, lighting-only surfaces), added to the sample's LOD
-    // with the frame's shading bias.
+    // with the frame's shading bias, but never past rateMaxLod (where chart gutters bleed).
     float rateBias;
+    float rateMaxLod;
     uint firstRect; // index of its firstMip rect in ShadelFrame::rects (levels follow in order)
     uint idMapOffset[SHADEL_MAX_MIPS]; // in 16-bit units into ShadelFrame::idMaps
     uvec4 rect[SHADEL_MAX_MIPS];       // x, y, w, h in blocks of the virtual sheet
@@ -677,7 +678,7 @@ struct GpuDebugLines {
 
 // sizeof(GpuShadelObject) in the scalar layout: shaders address one object in place
 // (ShadelObjectRef); static_assert'ed on the C++ side.
-#define GPU_SHADEL_OBJECT_BYTES (36u + 36u * SHADEL_MAX_MIPS)
+#define GPU_SHADEL_OBJECT_BYTES (40u + 36u * SHADEL_MAX_MIPS)
 
 // One rectangle of the sheet in use this frame (the clear and allocation passes walk these).
 struct GpuShadelRect {

@@ -77,9 +77,11 @@ struct ShadelLevels {
 // texelDx/Dy: screen derivatives of the sample's MIP-0 shadel coordinate.
 ShadelLevels shadelLevels(ShadelObjectRef o, vec2 texelDx, vec2 texelDy, float bias, float band) {
     // The object has rects only from firstMip on (the CPU's lower bound of what it can need).
-    // The object's material shading rate (render/shadel/material_rate.h) on top of the frame's.
-    float lod = clamp(shadelLod(texelDx, texelDy, bias + o.v.rateBias), float(o.v.firstMip),
-                      float(o.v.mipCount - 1u));
+    // The object's material shading rate (render/shadel/material_rate.h materialRateLod) on top
+    // of the frame's bias.
+    float lod = shadelLod(texelDx, texelDy, bias);
+    lod = max(lod, min(lod + o.v.rateBias, o.v.rateMaxLod));
+    lod = clamp(lod, float(o.v.firstMip), float(o.v.mipCount - 1u));
     ShadelLevels l;
     l.mip0 = uint(floor(lod));
     l.mip1 = min(l.mip0 + 1u, o.v.mipCount - 1u);

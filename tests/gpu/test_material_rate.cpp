@@ -25,6 +25,17 @@ TEST(MaterialRate, BiasFollowsRoughnessForPlainMaterialsOnly) {
     EXPECT_EQ(materialRateBias(rate, 0u, std::numeric_limits<float>::quiet_NaN()), 0.0f);
 }
 
+// The rate coarsens a sample up to maxLod, never past it, and leaves coarser samples alone.
+TEST(MaterialRate, LodIsBoundedWhereChartGuttersBleed) {
+    EXPECT_FLOAT_EQ(materialRateLod(0.5f, 1.0f, 3.0f), 1.5f);
+    EXPECT_FLOAT_EQ(materialRateLod(2.5f, 1.0f, 3.0f), 3.0f);
+    EXPECT_FLOAT_EQ(materialRateLod(3.5f, 1.0f, 3.0f), 3.5f);
+    EXPECT_FLOAT_EQ(materialRateLod(-2.0f, 1.0f, 3.0f), -1.0f);
+    EXPECT_FLOAT_EQ(materialRateLod(1.25f, 0.0f, 3.0f), 1.25f);
+    // The default bound lies past the bake's clean levels (2^k <= gutter), not inside them.
+    EXPECT_GT(MaterialRate{}.maxLod, 1.0f);
+}
+
 TEST(MaterialRate, SharpLightsAreFoundNearTheBox) {
     gpu::GpuLight omni{};
     omni.type = LIGHT_POINT;

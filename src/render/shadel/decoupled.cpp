@@ -906,8 +906,9 @@ void prepareDecoupledFrame(Renderer& r, const GpuScene& scene, const CameraView&
             }
             if (o.sharpLit) rateBias = 0.0f;
         }
-        uint32_t wantFirst =
-            finestMipFromLod(view.lodBeforeBias, d.shadingBias + rateBias, mesh.mipCount);
+        uint32_t wantFirst = finestMipFromLod(
+            materialRateLod(view.lodBeforeBias + d.shadingBias, rateBias, d.materialRate.maxLod),
+            0.0f, mesh.mipCount);
         bool limited = false;
         // No room in the sheet: drawn forward this frame, retried next frame.
         if (!updateObjectRects(gpu, d, o, i, mesh, wantFirst, wasDecoupled, limited)) {
@@ -944,6 +945,7 @@ void prepareDecoupledFrame(Renderer& r, const GpuScene& scene, const CameraView&
         glm::vec3 baseColor = known ? glm::vec3(material->baseColorFactor) : glm::vec3(0.0f);
         g.viewDriftCos = std::cos(viewDriftLimitFor(roughness, metallic, baseColor));
         g.rateBias = rateBias;
+        g.rateMaxLod = d.materialRate.maxLod;
         d.objectsRateBiased += rateBias > 0.0f;
         d.rateBiasSum += rateBias;
         d.objectsReusable += g.reuseLevels != 0;

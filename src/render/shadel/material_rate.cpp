@@ -15,6 +15,10 @@ float materialRateBias(const MaterialRate& rate, uint32_t features, float roughn
     return rate.maxBias * std::clamp(t, 0.0f, 1.0f);
 }
 
+float materialRateLod(float lod, float rateBias, float maxLod) {
+    return std::max(lod, std::min(lod + rateBias, maxLod));
+}
+
 bool lightDrawsSharpEdges(const gpu::GpuLight& light) {
     // Round spots, omnis, tubes and darks fall off smoothly (builtin:lights' round spots blend
     // over 0.05-0.3 rad); the sun's edges are its shadow map's (see the header).
