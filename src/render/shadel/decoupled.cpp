@@ -895,8 +895,8 @@ void prepareDecoupledFrame(Renderer& r, const GpuScene& scene, const CameraView&
         uint32_t features = known ? materialFeatures(*material) : MATERIAL_FEATURES_ALL;
         // Animated playback posed it anew (moved or deformed): its shadels are shaded again.
         bool reposed = i < r.reposedInstances.size() && r.reposedInstances[i] != 0;
-        // Its shading rate (material_rate.h): the GPU adds it to every sample's LOD, so the
-        // finest level the object can need moves by as much.
+        // Its shading rate (material_rate.h): the GPU adds it to every sample's LOD up to the
+        // rate's bound (materialRateLod), so the finest level the object can need moves with it.
         float rateBias =
             d.materialRateOn ? materialRateBias(d.materialRate, features, roughness) : 0.0f;
         if (rateBias > 0.0f) {
