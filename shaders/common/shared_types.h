@@ -617,6 +617,16 @@ struct ShaderMessage {
 #define SHADEL_LAYER_MATERIAL 1u // base colour + roughness, RGBA8 (for GI injection, debugging)
 #define SHADEL_LAYERS 2u
 
+// The material shading rate (render/shadel/material_rate.h materialRateLod, shadelLevels in
+// shaders/shadel/shadel.glsl) coarsens a sample no further than this LOD (samples the view
+// already puts coarser are left as they are). Past the bake's clean levels (2^k > gutterShadels,
+// bake.h: 2 shadels, so k >= 2) a chart's border shadels read its neighbours' gutters, and the
+// rate pushing samples there showed along creases. PSNR vs 4x4 SSAA at 1280x720, full rate /
+// unbounded / bounded at 3 / at 2: 2CylinderEngine.glb 37.68 / 37.40 / 37.55 / 37.61 dB,
+// builtin:many 38.74 / 38.62 / 38.75 / 38.85; builtin:default 28.97 in all four, at 0.74
+// shadels per covered pixel unbounded and at 3 but 0.85 at 2 (shadelShading +7 ms).
+#define SHADEL_MATERIAL_RATE_MAX_LOD 3.0
+
 // Per instance: where its shadel space lives in the virtual sheet at each MIP.
 struct GpuShadelObject {
     uvec2 mip0Size; // MIP-0 shadel rect (BakedMesh::width/height)
@@ -635,9 +645,8 @@ struct GpuShadelObject {
     float viewDriftCos;
     // MIPs coarser than the pixel footprint asks for that the object's material allows
     // (render/shadel/material_rate.h: smooth, lighting-only surfaces), added to the sample's LOD
-    // with the frame's shading bias, but never past rateMaxLod (where chart gutters bleed).
+    // with the frame's shading bias, but never past SHADEL_MATERIAL_RATE_MAX_LOD.
     float rateBias;
-    float rateMaxLod;
     uint firstRect; // index of its firstMip rect in ShadelFrame::rects (levels follow in order)
     uint idMapOffset[SHADEL_MAX_MIPS]; // in 16-bit units into ShadelFrame::idMaps
     uvec4 rect[SHADEL_MAX_MIPS];       // x, y, w, h in blocks of the virtual sheet
@@ -678,7 +687,7 @@ struct GpuDebugLines {
 
 // sizeof(GpuShadelObject) in the scalar layout: shaders address one object in place
 // (ShadelObjectRef); static_assert'ed on the C++ side.
-#define GPU_SHADEL_OBJECT_BYTES (40u + 36u * SHADEL_MAX_MIPS)
+#define GPU_SHADEL_OBJECT_BYTES (36u + 36u * SHADEL_MAX_MIPS)
 
 // One rectangle of the sheet in use this frame (the clear and allocation passes walk these).
 struct GpuShadelRect {

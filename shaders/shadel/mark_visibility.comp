@@ -54,23 +54,17 @@ void main() {
     for (int i = 1; i < 4; ++i) a = a.x == VISIBILITY_NONE ? vis[i] : a;
     uvec2 b = a;
     for (int i = 3; i > 0; --i) b = vis[i].x != VISIBILITY_NONE && vis[i] != a ? vis[i] : b;
-    if (a.x == VISIBILITY_NONE) { // sky: nothing to set up (nor, in an empty scene, to read)
-        for (int i = 0; i < 4; ++i) {
-            ivec2 pixel = origin + ivec2(i & 1, i >> 1);
-            if (pixel.x < int(pc.width) && pixel.y < int(pc.height))
-                ResolveAddressBuffer(pc.addresses).v[resolveAddressIndex(pixel, pc.width)] =
-                    resolveAddressNone();
-        }
-        return;
-    }
     ShadelObjectRef oa, ob;
     VisQuad qa, qb;
-    bool decoupledA = setUpQuad(f, s, a, origin, oa, qa);
-    // A branch, but most SIMD groups take it: 1 - 0.85^8 of 8-quad groups hold a mixed quad.
-    bool decoupledB = decoupledA;
-    ob = oa;
-    qb = qa;
-    if (b != a) decoupledB = setUpQuad(f, s, b, origin, ob, qb);
+    bool decoupledA = false, decoupledB = false;
+    if (a.x != VISIBILITY_NONE) { // (a sky quad sets up nothing, nor reads, in an empty scene)
+        decoupledA = setUpQuad(f, s, a, origin, oa, qa);
+        // A branch, but most SIMD groups take it: 1 - 0.85^8 of 8-quad groups hold a mixed quad.
+        decoupledB = decoupledA;
+        ob = oa;
+        qb = qa;
+        if (b != a) decoupledB = setUpQuad(f, s, b, origin, ob, qb);
+    }
     for (int i = 0; i < 4; ++i) {
         ivec2 pixel = origin + ivec2(i & 1, i >> 1);
         if (pixel.x >= int(pc.width) || pixel.y >= int(pc.height)) continue;

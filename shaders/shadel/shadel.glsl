@@ -80,7 +80,7 @@ ShadelLevels shadelLevels(ShadelObjectRef o, vec2 texelDx, vec2 texelDy, float b
     // The object's material shading rate (render/shadel/material_rate.h materialRateLod) on top
     // of the frame's bias.
     float lod = shadelLod(texelDx, texelDy, bias);
-    lod = max(lod, min(lod + o.v.rateBias, o.v.rateMaxLod));
+    lod = max(lod, min(lod + o.v.rateBias, SHADEL_MATERIAL_RATE_MAX_LOD));
     lod = clamp(lod, float(o.v.firstMip), float(o.v.mipCount - 1u));
     ShadelLevels l;
     l.mip0 = uint(floor(lod));

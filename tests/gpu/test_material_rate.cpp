@@ -25,15 +25,16 @@ TEST(MaterialRate, BiasFollowsRoughnessForPlainMaterialsOnly) {
     EXPECT_EQ(materialRateBias(rate, 0u, std::numeric_limits<float>::quiet_NaN()), 0.0f);
 }
 
-// The rate coarsens a sample up to maxLod, never past it, and leaves coarser samples alone.
+// The rate coarsens a sample up to SHADEL_MATERIAL_RATE_MAX_LOD (3), never past it, and leaves
+// coarser samples alone.
 TEST(MaterialRate, LodIsBoundedWhereChartGuttersBleed) {
-    EXPECT_FLOAT_EQ(materialRateLod(0.5f, 1.0f, 3.0f), 1.5f);
-    EXPECT_FLOAT_EQ(materialRateLod(2.5f, 1.0f, 3.0f), 3.0f);
-    EXPECT_FLOAT_EQ(materialRateLod(3.5f, 1.0f, 3.0f), 3.5f);
-    EXPECT_FLOAT_EQ(materialRateLod(-2.0f, 1.0f, 3.0f), -1.0f);
-    EXPECT_FLOAT_EQ(materialRateLod(1.25f, 0.0f, 3.0f), 1.25f);
+    EXPECT_FLOAT_EQ(materialRateLod(0.5f, 1.0f), 1.5f);
+    EXPECT_FLOAT_EQ(materialRateLod(2.5f, 1.0f), 3.0f);
+    EXPECT_FLOAT_EQ(materialRateLod(3.5f, 1.0f), 3.5f);
+    EXPECT_FLOAT_EQ(materialRateLod(-2.0f, 1.0f), -1.0f);
+    EXPECT_FLOAT_EQ(materialRateLod(1.25f, 0.0f), 1.25f);
     // The default bound lies past the bake's clean levels (2^k <= gutter), not inside them.
-    EXPECT_GT(MaterialRate{}.maxLod, 1.0f);
+    EXPECT_GT(SHADEL_MATERIAL_RATE_MAX_LOD, 1.0);
 }
 
 TEST(MaterialRate, SharpLightsAreFoundNearTheBox) {
@@ -59,7 +60,7 @@ TEST(MaterialRate, SharpLightsAreFoundNearTheBox) {
         l.position = glm::vec3(float(i), 0.0f, 0.0f);
         lights.push_back(l);
     }
-    updateSharpLights(sharp, lights, false, {});
+    updateSharpLights(sharp, lights, false, false, {}); // the first call builds
     EXPECT_EQ(sharp.spheres.size(), 1u);
     EXPECT_TRUE(
         sharpLightReaches(sharp, glm::vec3(49.0f, -1.0f, -1.0f), glm::vec3(49.5f, 1.0f, 1.0f)));
@@ -68,10 +69,10 @@ TEST(MaterialRate, SharpLightsAreFoundNearTheBox) {
     EXPECT_FALSE(
         sharpLightReaches(sharp, glm::vec3(50.0f, 5.0f, 0.0f), glm::vec3(51.0f, 6.0f, 1.0f)));
     uint32_t version = sharp.version;
-    updateSharpLights(sharp, lights, false, {}); // unchanged: kept
+    updateSharpLights(sharp, lights, false, false, {}); // unchanged: kept
     EXPECT_EQ(sharp.version, version);
     lights[50].position.y = 10.0f;
-    updateSharpLights(sharp, lights, false, {});
+    updateSharpLights(sharp, lights, true, false, {});
     EXPECT_NE(sharp.version, version);
     EXPECT_TRUE(
         sharpLightReaches(sharp, glm::vec3(50.0f, 9.0f, 0.0f), glm::vec3(51.0f, 9.5f, 1.0f)));
@@ -128,5 +129,6 @@ TEST(MaterialRate, LightsWithSharpEdgesKeepTheFullRate) {
     std::printf("[ figures ] blockers 320x180: %llu of %llu objects biased, on vs off %.2f dB\n",
                 (unsigned long long)biased, (unsigned long long)decoupled, p);
     EXPECT_LT(biased, decoupled);
+    EXPECT_EQ(biased, 0u); // the blocked light reaches the whole room
     EXPECT_GE(p, 50.0);
 }

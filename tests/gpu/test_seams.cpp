@@ -209,22 +209,23 @@ TEST(Seams, ChartSeamsOnASmoothSphereAreBelowVisibility) {
     // makes the filter read shadels where neighbouring charts mix, and seams then stand out
     // against the inside of charts.
     o.captures.clear();
+    auto measureRun = [&](const char* what) {
+        Measured m = measure(renderChecked(o).frames[0].rgba);
+        std::printf("[ figures ] seams %s: across seams mean %.3f max %.3f, inside charts mean "
+                    "%.3f\n",
+                    what, m.seam.mean(), m.seam.max, m.inside.mean());
+        return m;
+    };
     // The default material rate shades the sphere a MIP coarser, where the filter reads shadels
     // nearer the gutters: seams add more (0.81 L* at most when this was written, a third of a
     // JND), still below half a JND and no more on average than shading inside charts adds.
     o.materialRate = true;
-    Measured rated = measure(renderChecked(o).frames[0].rgba);
-    std::printf("[ figures ] seams at the material rate: across seams mean %.3f max %.3f, inside "
-                "charts mean %.3f\n",
-                rated.seam.mean(), rated.seam.max, rated.inside.mean());
+    Measured rated = measureRun("at the material rate");
     EXPECT_LT(rated.seam.max, 0.5 * kJustNoticeableLightness);
     EXPECT_LE(rated.seam.mean(), rated.inside.mean() + 0.01 * kJustNoticeableLightness);
     o.materialRate = false;
     o.shadingBias = 2.0f;
-    Measured coarse = measure(renderChecked(o).frames[0].rgba);
-    std::printf("[ figures ] seams at --shading-bias 2: across seams mean %.3f max %.3f, inside "
-                "charts mean %.3f\n",
-                coarse.seam.mean(), coarse.seam.max, coarse.inside.mean());
+    Measured coarse = measureRun("at --shading-bias 2");
     EXPECT_GT(coarse.seam.max, 0.25 * kJustNoticeableLightness);
     EXPECT_GT(coarse.seam.mean(), coarse.inside.mean() + 0.01 * kJustNoticeableLightness);
 }

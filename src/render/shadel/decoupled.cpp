@@ -163,9 +163,8 @@ struct DecoupledState {
     uint32_t capacityChunks = 0;
     uint32_t objectsDecoupled = 0, objectsForward = 0, objectsSmallForward = 0;
     uint32_t objectsSheetLimited = 0; // finer levels wanted but no sheet room: clamped
-    bool materialRateOn = true;       // --material-rate
-    MaterialRate materialRate;
-    SharpLights sharpLights; // the lights that keep plain materials at the full rate
+    MaterialRate materialRate;        // --material-rate (RenderSettings::materialRate) tunables
+    SharpLights sharpLights;          // the lights that keep plain materials at the full rate
     uint32_t objectsRateBiased = 0;
     float rateBiasSum = 0.0f;
     std::array<uint32_t, SHADEL_MAX_MIPS> firstMipHistogram{};
@@ -256,7 +255,6 @@ DecoupledStatePtr createDecoupled(Renderer& r, const GpuScene& scene) {
     d.baseShadingBias = rs.shadingBias;
     d.shadingBias = rs.shadingBias;
     d.capacityControl = rs.capacityControl;
-    d.materialRateOn = rs.materialRate;
     d.trilinearBand = std::clamp(rs.trilinearBand, 0.0f, 1.0f);
     d.sheetBlocks = rs.sheetShadels / SHADEL_BLOCK;
     uint32_t x = 0;
@@ -800,14 +798,13 @@ void prepareDecoupledFrame(Renderer& r, const GpuScene& scene, const CameraView&
     d.changes =
         changedVolumes(r, scene, constants.sunDirection, glm::length(constants.sunColor) > 0.0f);
     d.changesOverflow = d.changes.size() > SHADEL_MAX_CHANGED_VOLUMES;
-    d.materialRateOn = r.settings.materialRate; // the viewer may switch it between frames
-    if (d.materialRateOn) {
+    if (r.settings.materialRate) { // (read every frame: the viewer switches it)
         const RtSettings& rt = r.settings.rt;
         bool sunSharp = rt.shadows || rt.ao || rt.gi || r.settings.sunCascades > 1;
         static const std::vector<Decal> kNoDecals;
-        updateSharpLights(d.sharpLights,
-                          r.lightsLastFrame.empty() ? scene.lightInfo : r.lightsLastFrame, sunSharp,
-                          r.settings.decals ? scene.decals : kNoDecals);
+        updateSharpLights(
+            d.sharpLights, r.lightsLastFrame.empty() ? scene.lightInfo : r.lightsLastFrame,
+            !r.changedLightVolumes.empty(), sunSharp, r.settings.decals ? scene.decals : kNoDecals);
     }
     if (!d.changesOverflow && !d.changes.empty())
         std::memcpy(mapped(gpu, d.changedVolumes), d.changes.data(),
@@ -898,7 +895,7 @@ void prepareDecoupledFrame(Renderer& r, const GpuScene& scene, const CameraView&
         // Its shading rate (material_rate.h): the GPU adds it to every sample's LOD up to the
         // rate's bound (materialRateLod), so the finest level the object can need moves with it.
         float rateBias =
-            d.materialRateOn ? materialRateBias(d.materialRate, features, roughness) : 0.0f;
+            r.settings.materialRate ? materialRateBias(d.materialRate, features, roughness) : 0.0f;
         if (rateBias > 0.0f) {
             if (o.sharpLightsVersion != d.sharpLights.version || reposed) {
                 o.sharpLit = sharpLightReaches(d.sharpLights, inst.worldMin, inst.worldMax);
@@ -907,8 +904,7 @@ void prepareDecoupledFrame(Renderer& r, const GpuScene& scene, const CameraView&
             if (o.sharpLit) rateBias = 0.0f;
         }
         uint32_t wantFirst = finestMipFromLod(
-            materialRateLod(view.lodBeforeBias + d.shadingBias, rateBias, d.materialRate.maxLod),
-            0.0f, mesh.mipCount);
+            materialRateLod(view.lodBeforeBias + d.shadingBias, rateBias), 0.0f, mesh.mipCount);
         bool limited = false;
         // No room in the sheet: drawn forward this frame, retried next frame.
         if (!updateObjectRects(gpu, d, o, i, mesh, wantFirst, wasDecoupled, limited)) {
@@ -945,7 +941,6 @@ void prepareDecoupledFrame(Renderer& r, const GpuScene& scene, const CameraView&
         glm::vec3 baseColor = known ? glm::vec3(material->baseColorFactor) : glm::vec3(0.0f);
         g.viewDriftCos = std::cos(viewDriftLimitFor(roughness, metallic, baseColor));
         g.rateBias = rateBias;
-        g.rateMaxLod = d.materialRate.maxLod;
         d.objectsRateBiased += rateBias > 0.0f;
         d.rateBiasSum += rateBias;
         d.objectsReusable += g.reuseLevels != 0;
@@ -1403,7 +1398,7 @@ void decoupledStats(const Renderer& r, nlohmann::json& s) {
     s["objects_sheet_limited"] = last.objectsSheetLimited;
     // Material shading rate: the objects shaded coarser than their footprint asks for, and the
     // mean bias over all decoupled objects (MIPs).
-    s["material_rate"] = d.materialRateOn;
+    s["material_rate"] = r.settings.materialRate;
     s["objects_rate_biased"] = last.objectsRateBiased;
     s["material_rate_bias_mean"] =
         last.objectsDecoupled ? double(last.rateBiasSum) / double(last.objectsDecoupled) : 0.0;

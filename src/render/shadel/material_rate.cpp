@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstring>
 #include <optional>
 
 namespace shadel {
@@ -15,8 +14,8 @@ float materialRateBias(const MaterialRate& rate, uint32_t features, float roughn
     return rate.maxBias * std::clamp(t, 0.0f, 1.0f);
 }
 
-float materialRateLod(float lod, float rateBias, float maxLod) {
-    return std::max(lod, std::min(lod + rateBias, maxLod));
+float materialRateLod(float lod, float rateBias) {
+    return std::max(lod, std::min(lod + rateBias, float(SHADEL_MATERIAL_RATE_MAX_LOD)));
 }
 
 bool lightDrawsSharpEdges(const gpu::GpuLight& light) {
@@ -28,17 +27,11 @@ bool lightDrawsSharpEdges(const gpu::GpuLight& light) {
            light.blockerCount > 0u || light.shadowIndex != LIGHT_NO_SHADOW;
 }
 
-static bool sameLights(const std::vector<gpu::GpuLight>& a, const std::vector<gpu::GpuLight>& b) {
-    return a.size() == b.size() &&
-           (a.empty() || std::memcmp(a.data(), b.data(), a.size() * sizeof(gpu::GpuLight)) == 0);
-}
-
 void updateSharpLights(SharpLights& sharp, const std::vector<gpu::GpuLight>& lights,
-                       bool sunDrawsSharpEdges, const std::vector<Decal>& decals) {
-    if (sharp.version != 0 && sharp.sunSharp == sunDrawsSharpEdges &&
-        sameLights(sharp.builtFrom, lights))
+                       bool lightsChanged, bool sunDrawsSharpEdges,
+                       const std::vector<Decal>& decals) {
+    if (sharp.version != 0 && !lightsChanged && sharp.sunSharp == sunDrawsSharpEdges)
         return; // (the decals are the scene's: they do not change)
-    sharp.builtFrom = lights;
     sharp.sunSharp = sunDrawsSharpEdges;
     sharp.spheres.clear();
     sharp.anyInfinite = sunDrawsSharpEdges;

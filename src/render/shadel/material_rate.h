@@ -7,7 +7,8 @@
 // material is shaded up to one MIP coarser (GpuShadelObject::rateBias, added to the sample's LOD
 // by shadelLevels in shaders/shadel/shadel.glsl, so marking, reconstruction and the debug views
 // agree) the broader its specular lobe is: none at roughness <= sharpRoughness, a full MIP at
-// >= broadRoughness. It keeps the full rate where a light with sharp edges reaches it (square
+// >= broadRoughness, and never past LOD SHADEL_MATERIAL_RATE_MAX_LOD (where chart gutters bleed:
+// shared_types.h). It keeps the full rate where a light with sharp edges reaches it (square
 // spots, gobos, textured area lights, clip planes, blockers, shadow-mapped spots:
 // lightDrawsSharpEdges), where a decal's box meets it (decals draw patterns on the surface),
 // and, everywhere, when the sun draws sharp edges: ray-traced terms (hard traced shadows, AO,
@@ -25,15 +26,7 @@
 namespace shadel {
 
 struct MaterialRate {
-    float maxBias = 1.0f; // MIPs coarser at most (a quarter of the shadels)
-    // The rate coarsens a sample no further than this LOD (samples the view already puts
-    // coarser are left as they are). Past the bake's clean levels (2^k > gutterShadels, bake.h:
-    // 2 shadels, so k >= 2) a chart's border shadels read its neighbours' gutters, and the rate
-    // pushing samples there showed along creases. PSNR vs 4x4 SSAA at 1280x720, full rate /
-    // unbounded / bounded at 3 / at 2: 2CylinderEngine.glb 37.68 / 37.40 / 37.55 / 37.61 dB,
-    // builtin:many 38.74 / 38.62 / 38.75 / 38.85; builtin:default 28.97 in all four, at 0.74
-    // shadels per covered pixel unbounded and at 3 but 0.85 at 2 (shadelShading +7 ms).
-    float maxLod = 3.0f;
+    float maxBias = 1.0f;         // MIPs coarser at most (a quarter of the shadels)
     float sharpRoughness = 0.25f; // at or below: highlights sharp enough to keep the full rate
     float broadRoughness = 0.55f; // at or above: the full bias
 };
@@ -43,8 +36,9 @@ struct MaterialRate {
 float materialRateBias(const MaterialRate& rate, uint32_t features, float roughness);
 
 // A sample's LOD with an object's rate bias, as shadelLevels (shaders/shadel/shadel.glsl) takes
-// it: coarser by the bias, but not past maxLod unless already there.
-float materialRateLod(float lod, float rateBias, float maxLod);
+// it: coarser by the bias, but not past SHADEL_MATERIAL_RATE_MAX_LOD (shared_types.h) unless
+// already there.
+float materialRateLod(float lod, float rateBias);
 
 // Whether a light draws edges sharper than its smooth falloff on what it lights.
 bool lightDrawsSharpEdges(const gpu::GpuLight& light);
@@ -53,7 +47,6 @@ bool lightDrawsSharpEdges(const gpu::GpuLight& light);
 // so an object's box finds the few near it. Rebuilt only when the lights change; `version`
 // counts the rebuilds, so a per-object answer can be kept until it changes.
 struct SharpLights {
-    std::vector<gpu::GpuLight> builtFrom;
     bool sunSharp = false;
     std::vector<glm::vec3> decalBoxes; // world bounds of the decals' boxes: min, max pairs
     std::vector<glm::vec4> spheres;    // of the sharp lights (lightBoundingSphere; w < 0: infinite)
@@ -62,8 +55,11 @@ struct SharpLights {
     uint32_t version = 0;
 };
 
+// lightsChanged: any light differs from last frame's (Renderer::changedLightVolumes not
+// empty); the first call always builds.
 void updateSharpLights(SharpLights& sharp, const std::vector<gpu::GpuLight>& lights,
-                       bool sunDrawsSharpEdges, const std::vector<Decal>& decals);
+                       bool lightsChanged, bool sunDrawsSharpEdges,
+                       const std::vector<Decal>& decals);
 
 // Whether any sharp light's bounding sphere or any decal's box meets the box.
 bool sharpLightReaches(const SharpLights& sharp, glm::vec3 boxMin, glm::vec3 boxMax);
