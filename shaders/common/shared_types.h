@@ -571,7 +571,9 @@ struct CullingFrame {
     uint64_t shadowViewDraws;  // DrawIndexedCommand[lists * maxDraws], one list per view
     uint64_t shadowViewCounts; // uint per list
     uint shadowViewCount;
-    uint shadowViewPad;
+    // 1: the sun's list holds every caster in its volume, not only those whose shadow can reach
+    // the camera's frustum: its map is kept across frames (render/lighting/sun_shadow_cache.h).
+    uint sunListAllCasters;
 };
 
 // A cascade's or spot's view for per-view shadow culling. Depth clamp keeps casters in front of

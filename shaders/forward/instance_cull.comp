@@ -162,14 +162,16 @@ void main() {
     uint casterTriangles = 0u, casterVertices = 0u;
     // A caster matters to the sun's views only if its shadow can reach the camera's frustum.
     bool reachesCamera = caster && !shadowCannotReachView(f, c, inst.worldMin, inst.worldMax);
-    if (reachesCamera || (caster && c.shadowViewCount != 0u)) {
+    // A kept sun map (render/lighting/sun_shadow_cache.h) holds every caster in the sun's volume.
+    bool sunCaster = c.sunListAllCasters != 0u ? caster : reachesCamera;
+    if (sunCaster || (caster && c.shadowViewCount != 0u)) {
         if (!haveLod) lod = selectLod(f, c, inst, mesh);
         casterTriangles = lod.indexCount / 3u;
         casterVertices = proxy ? lod.proxyUniqueVertices : lod.uniqueVertices;
     }
 
     // The sun's whole-scene volume.
-    inFrustum = reachesCamera;
+    inFrustum = sunCaster;
     for (int p = 0; p < 6 && inFrustum; ++p)
         if (outsidePlane(f.shadowPlanes[p], inst.worldMin, inst.worldMax)) inFrustum = false;
     drawn = inFrustum &&

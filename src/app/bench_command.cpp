@@ -98,6 +98,9 @@ nlohmann::json runShadowCullingBench(Gpu& gpu, const BenchOptions& b, RenderOpti
     out["frames"] = b.frames;
     out["sun_cascades"] = b.sunCascades;
     o.mode = RenderMode::Forward;
+    // The sun's map drawn every frame, in both: a kept map (--shadow-cache on) is drawn once,
+    // and per-view culling keeps it only because whole-scene culling cannot.
+    o.sunShadowCache = false;
     const char* shadowPasses[] = {"shadowMap", "sunCascades", "spotShadowMaps"};
     // A discarded one-frame run first: the first frame of a process pays for first-touch memory
     // (the 4096^2 spot atlas) and pipeline creation, which would land on the first mode alone.
@@ -516,6 +519,7 @@ nlohmann::json runBench(Gpu& gpu, const BenchOptions& b) {
     o.lightGrid = b.lightGrid;
     o.shadingBias = b.shadingBias;
     o.materialRate = b.materialRate;
+    o.sunShadowCache = b.sunShadowCache;
     o.cacheLimitBytes = b.cacheLimitBytes;
     o.lightCulling = b.lightCulling;
     // --spectra compare reports on / off against the three modes: they run without spectra
@@ -547,6 +551,7 @@ nlohmann::json runBench(Gpu& gpu, const BenchOptions& b) {
     out["animate_lights"] = b.animateLights;
     out["shading_bias"] = b.shadingBias;
     out["material_rate"] = b.materialRate;
+    out["shadow_cache"] = b.sunShadowCache;
     // With --rounds N every round runs the three modes, in opposite order each round, so the
     // machine's drift over a run (a shared machine's neighbours, warm-up) hits every mode
     // alike; each ratio is the median of the rounds' ratios (forward of the same round as the

@@ -47,7 +47,8 @@ struct RenderOptions {
     uint32_t allocationCounters = SHADEL_COUNTERS;
     bool sheetAllMips = false;
     bool levelWindows = true;
-    bool materialRate = true; // --material-rate on|off
+    bool materialRate = true;   // --material-rate on|off
+    bool sunShadowCache = true; // --shadow-cache on|off
     bool capacityControl = true;
     bool reuse = true;
     uint32_t reuseRefreshPeriod = 16;
@@ -175,6 +176,7 @@ struct BenchOptions {
     bool lightGrid = true;                   // --light-grid on|off
     float shadingBias = 0.0f;                // decoupled and reuse modes
     bool materialRate = true;                // --material-rate on|off: decoupled and reuse modes
+    bool sunShadowCache = true;              // --shadow-cache on|off: every mode
     LightCulling lightCulling = LightCulling::Tiled;
     // --light-culling compare: forward and decoupled rendered again with no culling, and
     // ratios.light_culling_forward|decoupled = tiled / none median frame time.

@@ -306,6 +306,13 @@ int main(int argc, char** argv) {
                      "1..4: the sun's shadow as N cascaded maps over the view depth (1: one map "
                      "fitted to the scene)")
         ->capture_default_str();
+    std::string shadowCache = "on";
+    render
+        ->add_option("--shadow-cache", shadowCache,
+                     "on | off: keep the sun's shadow map while the sun and its casters stay put, "
+                     "drawn once from every caster in its volume (off: redrawn every frame from "
+                     "the casters whose shadow can reach the view)")
+        ->capture_default_str();
     std::string shadowCulling = "per-view";
     render
         ->add_option("--shadow-culling", shadowCulling,
@@ -520,6 +527,12 @@ int main(int argc, char** argv) {
             "--material-rate", benchMaterialRate,
             "decoupled modes: on | off: plain rough materials shaded up to one MIP coarser")
         ->capture_default_str();
+    std::string benchShadowCache = "on";
+    bench
+        ->add_option("--shadow-cache", benchShadowCache,
+                     "on | off: keep the sun's shadow map while the sun and its casters stay put "
+                     "(off: redraw it every frame)")
+        ->capture_default_str();
     std::string benchMarking = "auto";
     bench->add_option("--marking", benchMarking, "decoupled modes: auto | raster | visibility")
         ->capture_default_str();
@@ -718,6 +731,7 @@ int main(int argc, char** argv) {
             ro.spotShadows = parseOnOff("--spot-shadows", spotShadows);
             ro.sunCascades = parseSunCascades(sunCascades);
             ro.shadowCulling = parseShadowCulling(shadowCulling);
+            ro.sunShadowCache = parseOnOff("--shadow-cache", shadowCache);
             ro.decals = parseOnOff("--decals", decals);
             ro.proxyShadows = parseOnOff("--proxy-shadows", proxyShadows);
             ro.gi = parseGi(gi);
@@ -780,6 +794,7 @@ int main(int argc, char** argv) {
             bo.cameraPath = parseCameraPath(benchCameraPath);
             bo.marking = parseMarking(benchMarking);
             bo.materialRate = parseOnOff("--material-rate", benchMaterialRate);
+            bo.sunShadowCache = parseOnOff("--shadow-cache", benchShadowCache);
             bo.lightGrid = parseOnOff("--light-grid", benchLightGrid);
             bo.sunCascades = parseSunCascades(benchSunCascades);
             if (bo.rounds < 1 || bo.rounds > 100)

@@ -404,6 +404,7 @@ RenderRun runRender(Gpu& gpu, const RenderOptions& o) {
     settings.decals = o.decals;
     settings.proxyShadows = o.proxyShadows;
     settings.shadowCulling = o.shadowCulling;
+    settings.sunShadowCache = o.sunShadowCache;
     // The trace's finer CPU spans (stats "cpu_scopes").
     settings.cpuScopes = !o.trace.empty() || o.cpuScopes;
     requireCount("--gi-iterations", o.giIterations, 0, 64);
@@ -665,6 +666,7 @@ RenderRun runRender(Gpu& gpu, const RenderOptions& o) {
     if (renderer.particles) particleStats(renderer, s);
     featureSpectraStats(renderer, s);
     spotShadowStats(renderer, s);
+    sunShadowCacheStats(renderer, s);
     sunCascadeStats(renderer, s);
     decalStats(renderer, s);
     s["density_mode"] = autoDensity ? "auto" : "explicit";

@@ -373,6 +373,7 @@ FrameResult renderFrame(Renderer& r, const GpuScene& scene, const CameraView& ca
     }
     {
         auto timer = cpuScope(r, "culling + decals");
+        prepareSunShadowMap(r, scene, constants);
         prepareCullingFrame(r, scene, constants);
         constants.decals = prepareDecalFrame(r, constants);
     }
@@ -404,7 +405,8 @@ FrameResult renderFrame(Renderer& r, const GpuScene& scene, const CameraView& ca
         pass(rec, "skinning", [&](VkCommandBuffer cmd) { recordSkinning(r, cmd); });
     pass(rec, "instanceCull",
          [&](VkCommandBuffer cmd) { recordInstanceCull(r, cmd, frame, scene); });
-    pass(rec, "shadowMap", [&](VkCommandBuffer cmd) { recordShadowMap(r, cmd, frame); });
+    if (sunShadowMapThisFrame(r)) // kept from an earlier frame unless it changed (render/lighting)
+        pass(rec, "shadowMap", [&](VkCommandBuffer cmd) { recordShadowMap(r, cmd, frame); });
     if (r.sunCascades) // --sun-cascades 2..4 (render/lighting/sun_cascades.h)
         pass(rec, "sunCascades", [&](VkCommandBuffer cmd) { recordSunCascades(r, cmd, frame); });
     if (r.rt) pass(rec, "rtBuildTlas", [&](VkCommandBuffer cmd) { recordTlasBuild(r, cmd); });

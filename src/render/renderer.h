@@ -20,6 +20,7 @@
 #include "render/lighting/shadow_atlas.h"
 #include "render/lighting/spot_shadows.h"
 #include "render/lighting/sun_cascades.h"
+#include "render/lighting/sun_shadow_cache.h"
 #include "render/points_lines/points_lines.h"
 #include "render/raytracing/ray_tracing.h"
 #include "render/raytracing/rt_settings.h"
@@ -158,6 +159,7 @@ struct RenderSettings {
         true;           // --proxy-shadows: shadow views draw proxy index sets (render/culling)
     bool decals = true; // --decals: the scene's projected box decals (render/decals)
     ShadowCulling shadowCulling = ShadowCulling::PerView; // cascades' and spots' caster lists
+    bool sunShadowCache = true; // --shadow-cache: keep the sun's map while nothing in it changes
     // --trace: time the frame's CPU scopes (FrameResult::cpuScopes) and each pass's recording.
     // Off by default: reading a thread's CPU clock costs ~0.7 us, which would add to cpuFrameMs.
     bool cpuScopes = false;
@@ -294,6 +296,7 @@ struct Renderer {
     SpectraStatePtr spectra;        // --spectra on|single (render/lighting/feature_spectra.h)
     SpotShadowStatePtr spotShadows; // shadow-casting spots (render/lighting/spot_shadows.h)
     SunCascadeStatePtr sunCascades; // --sun-cascades 2..4 (render/lighting/sun_cascades.h)
+    SunShadowCache sunShadowCache;  // the sun's map kept across frames (render/lighting)
     DecalStatePtr decals;           // --decals on, scenes with decals (render/decals/decals.h)
     std::chrono::steady_clock::time_point createdAt = std::chrono::steady_clock::now();
     // This frame's CPU scopes so far (RenderSettings::cpuScopes) and their origin.

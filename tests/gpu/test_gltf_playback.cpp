@@ -123,6 +123,27 @@ TEST(GltfFeaturesPlayback, MovingCasterShadowsAreNotCarriedOverByReuse) {
     EXPECT_EQ(on.stats["reconstruction_misses"].get<uint64_t>(), 0u);
 }
 
+// A kept sun shadow map (render/lighting/sun_shadow_cache.h) is redrawn on every frame that
+// playback moves a caster: the moving cube's shadow follows it as with a map drawn every frame.
+TEST(GltfFeaturesPlayback, MovingCasterRedrawsTheKeptSunMap) {
+    RenderOptions o =
+        renderOptions(writeMovingCasterScene("moving_caster_sun"), RenderMode::Forward, 160, 90);
+    o.progress = false;
+    o.camera = "auto";
+    o.frames = 4;
+    o.time = 0.0;
+    o.timeStep = 0.25;
+    RenderRun kept = renderChecked(o);
+    o.sunShadowCache = false;
+    RenderRun redrawn = renderChecked(o);
+    EXPECT_EQ(kept.stats["sun_shadow_cache"], "on");
+    EXPECT_EQ(kept.stats["sun_shadow_map_draws"].get<uint32_t>(), 4u);
+    ASSERT_EQ(kept.frames.size(), redrawn.frames.size());
+    for (size_t i = 0; i < kept.frames.size(); ++i)
+        EXPECT_EQ(kept.frames[i].rgba, redrawn.frames[i].rgba) << "frame " << i;
+    EXPECT_LT(psnr(kept.frames.front().rgba, kept.frames.back().rgba), 45.0) << "the cube moved";
+}
+
 TEST(GltfFeaturesPlayback, SkinnedPlaybackFramesMatchSingleTimeRendersAndBothPaths) {
     constexpr double kStart = 0.2, kStep = 0.4; // 0.2, 0.6, 1.0 s: three different poses
     RenderOptions o = skinOptions(RenderMode::Forward);

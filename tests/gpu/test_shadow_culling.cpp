@@ -21,6 +21,9 @@ RenderOptions shadowCullingOptions(RenderMode mode, ShadowCulling culling) {
     RenderOptions o = renderOptions("builtin:lights", mode, 192, 108);
     o.sunCascades = 4;
     o.shadowCulling = culling;
+    // The sun's list as each culling mode builds it for one camera: a kept sun map
+    // (render/lighting/sun_shadow_cache.h, per-view only) takes every caster in its volume.
+    o.sunShadowCache = false;
     o.progress = false;
     return o;
 }

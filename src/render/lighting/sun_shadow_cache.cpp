@@ -1,0 +1,44 @@
+#include "render/lighting/sun_shadow_cache.h"
+
+#include <algorithm>
+
+#include "render/renderer.h"
+
+namespace shadel {
+
+bool sunShadowKeepable(const Renderer& r) {
+    return r.settings.sunShadowCache && !r.settings.lod &&
+           r.settings.shadowCulling == ShadowCulling::PerView;
+}
+
+static bool anySet(const std::vector<uint8_t>& flags) {
+    return std::find(flags.begin(), flags.end(), uint8_t(1)) != flags.end();
+}
+
+void prepareSunShadowMap(Renderer& r, const GpuScene& scene, const gpu::FrameConstants& constants) {
+    SunShadowCache& c = r.sunShadowCache;
+    bool keepable = sunShadowKeepable(r);
+    // Alpha-masked casters test their base colour's alpha in the map: a material whose texture
+    // streamed or that was edited may change the map. Positions change with animated playback.
+    bool unchanged = keepable && c.drawn && c.drawnAllCasters && c.drawnScene == &scene &&
+                     c.drawnViewProj == constants.sunViewProj && !anySet(r.reposedInstances) &&
+                     !anySet(r.changedMaterials);
+    c.drawThisFrame = !unchanged;
+    if (!c.drawThisFrame) return;
+    c.drawn = true;
+    c.drawnAllCasters = keepable;
+    c.drawnScene = &scene;
+    c.drawnViewProj = constants.sunViewProj;
+    c.draws++;
+}
+
+bool sunShadowMapThisFrame(const Renderer& r) {
+    return r.sunShadowCache.drawThisFrame;
+}
+
+void sunShadowCacheStats(const Renderer& r, nlohmann::json& stats) {
+    stats["sun_shadow_cache"] = sunShadowKeepable(r) ? "on" : "off";
+    stats["sun_shadow_map_draws"] = r.sunShadowCache.draws;
+}
+
+} // namespace shadel

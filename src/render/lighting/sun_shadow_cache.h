@@ -1,0 +1,40 @@
+#pragma once
+// The sun's shadow map, kept while nothing it shows changes. The map is fitted to the scene, not
+// to the camera (renderer.cpp sunViewProj), so with a still sun, still casters and casters whose
+// LODs do not follow the camera, last frame's map is this frame's: it is drawn once, from every
+// caster in the sun's volume (the instance cull then leaves out its usual "can this caster's
+// shadow reach the camera's frustum" test, which would tie the map to one camera), and redrawn
+// only when the sun's view, a caster (animated playback) or a material (an alpha-masked
+// caster's texture streamed or edited) changes. The spot maps are kept the same way
+// (render/lighting/spot_shadows.h); the cascades follow the camera and are drawn every frame.
+// --shadow-cache off draws the map every frame from the camera-culled list (as before).
+#include <nlohmann/json.hpp>
+
+#include "common/shared_types.h"
+
+namespace shadel {
+
+struct Renderer;
+struct GpuScene;
+
+struct SunShadowCache {
+    bool drawn = false;           // a map is kept (drawn by an earlier frame)
+    bool drawnAllCasters = false; // ... from every caster in the sun's volume
+    const GpuScene* drawnScene = nullptr;
+    glm::mat4 drawnViewProj{0.0f};
+    bool drawThisFrame = true;
+    uint32_t draws = 0; // frames that drew the map
+};
+
+// Whether the map may be kept this frame: --shadow-cache on, and no caster's LOD follows the
+// camera (--lod on) nor does the sun's list feed the camera-chosen whole-scene shadow views
+// (--shadow-culling whole-scene: the spots and cascades draw the sun's list). The instance cull
+// then fills the sun's list with every caster in its volume (CullingFrame::sunListAllCasters).
+bool sunShadowKeepable(const Renderer& r);
+// Decides, before the frame's passes are declared, whether "shadowMap" draws this frame.
+void prepareSunShadowMap(Renderer& r, const GpuScene& scene, const gpu::FrameConstants& constants);
+bool sunShadowMapThisFrame(const Renderer& r);
+// "sun_shadow_map_draws": frames that drew the map; "sun_shadow_cache": on | off.
+void sunShadowCacheStats(const Renderer& r, nlohmann::json& stats);
+
+} // namespace shadel
