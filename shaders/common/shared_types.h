@@ -69,6 +69,8 @@ using uint = uint32_t;
 // Light blockers (render/lighting): a light lists up to this many blockers.
 #define LIGHT_MAX_BLOCKERS_PER_LIGHT 32u
 #define LIGHT_TILE_SIZE 16u // pixels per side of a forward light culling tile
+#define TONEMAP_GROUP_X 32u // the tonemap pass's workgroup (post/tonemap.comp)
+#define TONEMAP_GROUP_Y 8u
 // Feature spectra (seed 001, render/lighting/feature_spectra.h): the features a tile needs,
 // recorded by the tile pass; each shading permutation compiles in only its set (specialization
 // constant SPECTRUM_FEATURES_CONSTANT_ID of shaders/common/lighting.glsl; SPECTRUM_MATERIAL sets

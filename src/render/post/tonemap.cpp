@@ -46,7 +46,8 @@ void recordTonemap(Renderer& r, VkCommandBuffer cmd, uint64_t frame) {
                      r.settings.height,
                      r.settings.ssaa};
     pushConstants(gpu, cmd, push);
-    vkCmdDispatch(cmd, (r.settings.width + 7) / 8, (r.settings.height + 7) / 8, 1);
+    vkCmdDispatch(cmd, (r.settings.width + TONEMAP_GROUP_X - 1) / TONEMAP_GROUP_X,
+                  (r.settings.height + TONEMAP_GROUP_Y - 1) / TONEMAP_GROUP_Y, 1);
     memoryBarrier(cmd, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT,
                   VK_PIPELINE_STAGE_2_HOST_BIT, VK_ACCESS_2_HOST_READ_BIT);
 }
