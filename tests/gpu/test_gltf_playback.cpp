@@ -138,6 +138,9 @@ TEST(GltfFeaturesPlayback, MovingCasterRedrawsTheKeptSunMap) {
     RenderRun redrawn = renderChecked(o);
     EXPECT_EQ(kept.stats["sun_shadow_cache"], "on");
     EXPECT_EQ(kept.stats["sun_shadow_map_draws"].get<uint32_t>(), 4u);
+    // Drawn from the camera-culled list while the caster moves, not from every caster.
+    EXPECT_EQ(kept.stats["culling"]["views"]["shadow"]["instances_drawn"],
+              redrawn.stats["culling"]["views"]["shadow"]["instances_drawn"]);
     ASSERT_EQ(kept.frames.size(), redrawn.frames.size());
     for (size_t i = 0; i < kept.frames.size(); ++i)
         EXPECT_EQ(kept.frames[i].rgba, redrawn.frames[i].rgba) << "frame " << i;

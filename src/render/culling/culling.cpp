@@ -153,8 +153,8 @@ void prepareCullingFrame(Renderer& r, const GpuScene& scene, gpu::FrameConstants
     // Not with GI: the reflective shadow maps draw the shadow list and need every normal.
     f.proxyShadows = r.settings.proxyShadows && !r.gi ? 1u : 0u;
     f.sceneMinY = scene.bounds.valid() ? scene.bounds.min.y : -1e30f;
-    // A kept sun map must hold every caster a later camera may see shadows of.
-    f.sunListAllCasters = sunShadowKeepable(r) ? 1u : 0u;
+    // A sun map to keep must hold every caster a later camera may see shadows of.
+    f.sunListAllCasters = r.sunShadowCache.allCastersThisFrame ? 1u : 0u;
     if (!c.levelSize.empty()) {
         f.hizLevels = uint32_t(c.levelSize.size());
         f.hizSize = c.levelSize[0];

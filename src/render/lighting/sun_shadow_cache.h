@@ -23,15 +23,18 @@ struct SunShadowCache {
     const GpuScene* drawnScene = nullptr;
     glm::mat4 drawnViewProj{0.0f};
     bool drawThisFrame = true;
-    uint32_t draws = 0; // frames that drew the map
+    bool allCastersThisFrame = false; // the sun's list: every caster in its volume
+    uint32_t draws = 0;               // frames that drew the map
 };
 
-// Whether the map may be kept this frame: --shadow-cache on, and no caster's LOD follows the
-// camera (--lod on) nor does the sun's list feed the camera-chosen whole-scene shadow views
-// (--shadow-culling whole-scene: the spots and cascades draw the sun's list). The instance cull
-// then fills the sun's list with every caster in its volume (CullingFrame::sunListAllCasters).
+// Whether the map may be kept: --shadow-cache on, and no caster's LOD follows the camera
+// (--lod on) nor does the sun's list feed the camera-chosen whole-scene shadow views
+// (--shadow-culling whole-scene: the spots and cascades draw the sun's list). A map to keep is
+// drawn from every caster in the sun's volume (CullingFrame::sunListAllCasters).
 bool sunShadowKeepable(const Renderer& r);
-// Decides, before the frame's passes are declared, whether "shadowMap" draws this frame.
+// Decides, before the frame's passes are declared, whether "shadowMap" draws this frame, and
+// from which list: every caster to keep the map, or (on a frame that changed it: playback, a
+// sun edit) the camera-culled one, as without the cache.
 void prepareSunShadowMap(Renderer& r, const GpuScene& scene, const gpu::FrameConstants& constants);
 bool sunShadowMapThisFrame(const Renderer& r);
 // "sun_shadow_map_draws": frames that drew the map; "sun_shadow_cache": on | off.
