@@ -105,6 +105,7 @@ void initRenderer(Renderer& r, Gpu& gpu, const RenderSettings& requested, const 
     r.gpu = &gpu;
     r.settings = settings;
     r.alphaMasked = hasAlphaMaskedMaterials(scene);
+    r.sunShadowCache = {}; // (a Renderer reused after destroyRenderer has a new, undrawn atlas)
     if (settings.width == 0 || settings.height == 0 || settings.ssaa == 0)
         throw InputError("--size and --ssaa must be positive");
     if (settings.spectra != Spectra::Off && settings.lightCulling != LightCulling::Tiled)
@@ -347,6 +348,7 @@ FrameResult renderFrame(Renderer& r, const GpuScene& scene, const CameraView& ca
         for (size_t i = 0; i < r.edits.materialsChanged.size(); ++i)
             r.changedMaterials[i] |= r.edits.materialsChanged[i];
     }
+    noteShadowCasterChanges(r, scene); // before the shadow maps decide to keep theirs
     {
         auto timer = cpuScope(r, "light culling");
         constants.lighting = prepareLightCulling(

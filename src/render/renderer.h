@@ -297,7 +297,8 @@ struct Renderer {
     SpotShadowStatePtr spotShadows; // shadow-casting spots (render/lighting/spot_shadows.h)
     SunCascadeStatePtr sunCascades; // --sun-cascades 2..4 (render/lighting/sun_cascades.h)
     SunShadowCache sunShadowCache;  // the sun's map kept across frames (render/lighting)
-    DecalStatePtr decals;           // --decals on, scenes with decals (render/decals/decals.h)
+    bool shadowCastersChanged = false; // this frame: what the kept shadow maps show changed
+    DecalStatePtr decals;              // --decals on, scenes with decals (render/decals/decals.h)
     std::chrono::steady_clock::time_point createdAt = std::chrono::steady_clock::now();
     // This frame's CPU scopes so far (RenderSettings::cpuScopes) and their origin.
     std::vector<CpuScope> cpuScopes;

@@ -62,9 +62,9 @@ TEST(SunShadowCache, KeptMapDrawsOnceWithTheImageOfARedrawnOne) {
     }
 }
 
-// Where the casters follow the camera the map cannot be kept: --lod on picks their LODs from the
-// camera, and with --shadow-culling whole-scene the spots and cascades draw the sun's
-// camera-culled list.
+// Where the sun's list follows the camera the map cannot be kept: --lod on picks the casters'
+// LODs from the camera, with --shadow-culling whole-scene the spots and cascades draw the sun's
+// camera-culled list, and with --gi lpv the reflective shadow maps do.
 TEST(SunShadowCache, RedrawnWhereCastersFollowTheCamera) {
     RenderOptions o = renderOptions("builtin:default", RenderMode::Forward, 160, 90);
     o.progress = false;
@@ -79,6 +79,11 @@ TEST(SunShadowCache, RedrawnWhereCastersFollowTheCamera) {
     RenderRun wholeScene = renderChecked(o);
     EXPECT_EQ(wholeScene.stats["sun_shadow_cache"], "off");
     EXPECT_EQ(sunMapDraws(wholeScene), 3u);
+    o.shadowCulling = ShadowCulling::PerView;
+    o.gi = GiMode::Lpv;
+    RenderRun gi = renderChecked(o);
+    EXPECT_EQ(gi.stats["sun_shadow_cache"], "off");
+    EXPECT_EQ(sunMapDraws(gi), 3u);
 }
 
 // A value that is neither on nor off: one error line naming the flag, exit 2.

@@ -180,6 +180,9 @@ int runViewer(const ViewOptions& o, DeviceDesc deviceDesc) {
                 else if (reload.pipelinesSwapped)
                     reloadStatus =
                         format("hot reload: %u pipeline(s) swapped", reload.pipelinesSwapped);
+                // A swapped shadow pass (forward.vert, depth.frag) changes what the kept
+                // shadow maps hold.
+                if (reload.pipelinesSwapped) forgetKeptShadowMaps(renderer);
             }
             FrameResult result =
                 renderFrame(renderer, scene.gpu, makeCameraView(camera.camera, o.width, o.height));

@@ -46,15 +46,20 @@ void destroyShadowAtlas(Gpu& gpu, ShadowAtlas& a) {
     a = {};
 }
 
+// The stages that sample the maps: fragment and compute shading, and the vertex shaders of
+// particles lit per vertex (shaders/particles: shadeParticle).
+constexpr VkPipelineStageFlags2 kShadowReaders = VK_PIPELINE_STAGE_2_VERTEX_SHADER_BIT |
+                                                 VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT |
+                                                 VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT;
+
 void beginShadowAtlas(Gpu& gpu, VkCommandBuffer cmd, const ShadowAtlas& a, VkBuffer sceneIndices) {
     // Last frame's shading sampled it; its old contents are cleared.
-    imageBarrier(
-        cmd, vkImage(gpu, a.texture), VK_IMAGE_ASPECT_DEPTH_BIT, VK_IMAGE_LAYOUT_UNDEFINED,
-        VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL,
-        VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT | VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, 0,
-        VK_PIPELINE_STAGE_2_EARLY_FRAGMENT_TESTS_BIT | VK_PIPELINE_STAGE_2_LATE_FRAGMENT_TESTS_BIT,
-        VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT |
-            VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_READ_BIT);
+    imageBarrier(cmd, vkImage(gpu, a.texture), VK_IMAGE_ASPECT_DEPTH_BIT, VK_IMAGE_LAYOUT_UNDEFINED,
+                 VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL, kShadowReaders, 0,
+                 VK_PIPELINE_STAGE_2_EARLY_FRAGMENT_TESTS_BIT |
+                     VK_PIPELINE_STAGE_2_LATE_FRAGMENT_TESTS_BIT,
+                 VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT |
+                     VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_READ_BIT);
     // Cleared to the far plane (shadow maps are not reversed Z); the viewport is the whole
     // atlas until a map's own is set.
     beginRendering(cmd, a.width, a.height, {}, {vkView(gpu, a.target), true, 1.0f});
@@ -75,8 +80,7 @@ void endShadowAtlas(Gpu& gpu, VkCommandBuffer cmd, const ShadowAtlas& a) {
     imageBarrier(cmd, vkImage(gpu, a.texture), VK_IMAGE_ASPECT_DEPTH_BIT,
                  VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL,
                  VK_PIPELINE_STAGE_2_LATE_FRAGMENT_TESTS_BIT,
-                 VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT,
-                 VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT | VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
+                 VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT, kShadowReaders,
                  VK_ACCESS_2_SHADER_SAMPLED_READ_BIT);
 }
 

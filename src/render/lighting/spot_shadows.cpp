@@ -149,8 +149,7 @@ void prepareShadows(Renderer& r, const std::vector<gpu::GpuLight>& lights,
     s.redraw = s.drawnViews.size() != views.size() || (cameraMoved && cameraChoosesCasters(r)) ||
                std::memcmp(views.data(), s.drawnViews.data(),
                            views.size() * sizeof(gpu::GpuSpotShadow)) != 0 ||
-               std::find(r.reposedInstances.begin(), r.reposedInstances.end(), 1) !=
-                   r.reposedInstances.end(); // animated casters (render/animation)
+               r.shadowCastersChanged; // playback, edits, streamed alpha-masked textures
     if (s.redraw) {
         s.drawnViews = views;
         s.drawnCamera = constants.viewProj;
@@ -159,6 +158,10 @@ void prepareShadows(Renderer& r, const std::vector<gpu::GpuLight>& lights,
     std::memcpy(out, views.data(), views.size() * sizeof(gpu::GpuSpotShadow));
     f.spotShadows = address(gpu, s.shadows);
     f.spotShadowAtlas = slot(gpu, s.atlas.read).value;
+}
+
+void redrawSpotShadowMaps(Renderer& r) {
+    if (r.spotShadows) r.spotShadows->drawnViews.clear();
 }
 
 bool spotShadowViewProj(const Renderer& r, uint32_t index, glm::mat4& viewProj) {

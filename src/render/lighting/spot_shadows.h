@@ -41,6 +41,9 @@ uint32_t spotShadowCount(const Renderer& r);
 // Whether the maps are drawn this frame: the first frame, or the spots changed since they were
 // last drawn, or the camera did while it chooses the casters (whole-scene culling or --lod on).
 bool spotShadowMapsThisFrame(const Renderer& r);
+// The maps are drawn again next frame whatever changed (render/lighting/sun_shadow_cache.h
+// forgetKeptShadowMaps).
+void redrawSpotShadowMaps(Renderer& r);
 // "spotShadowMaps": the atlas cleared, then each spot's view into its rectangle.
 void recordSpotShadowMaps(Renderer& r, VkCommandBuffer cmd, uint64_t frame);
 void spotShadowStats(const Renderer& r, nlohmann::json& stats);

@@ -8,20 +8,34 @@ namespace shadel {
 
 bool sunShadowKeepable(const Renderer& r) {
     return r.settings.sunShadowCache && !r.settings.lod &&
-           r.settings.shadowCulling == ShadowCulling::PerView;
+           r.settings.shadowCulling == ShadowCulling::PerView && !r.gi;
 }
 
 static bool anySet(const std::vector<uint8_t>& flags) {
     return std::find(flags.begin(), flags.end(), uint8_t(1)) != flags.end();
 }
 
+void noteShadowCasterChanges(Renderer& r, const GpuScene& scene) {
+    bool changed = anySet(r.reposedInstances) || anySet(r.edits.materialsChanged);
+    // Streaming restreams normal and roughness maps too: only alpha-masked materials' textures
+    // reach a shadow map (Renderer::alphaMasked: the scene has some, else the maps draw depth
+    // only).
+    for (size_t m = 0; r.alphaMasked && !changed && m < r.changedMaterials.size(); ++m)
+        changed = r.changedMaterials[m] && m < scene.materialInfo.size() &&
+                  (scene.materialInfo[m].flags & MATERIAL_ALPHA_MASK) != 0u;
+    r.shadowCastersChanged = changed;
+}
+
+void forgetKeptShadowMaps(Renderer& r) {
+    r.sunShadowCache.drawn = false;
+    redrawSpotShadowMaps(r);
+}
+
 void prepareSunShadowMap(Renderer& r, const GpuScene& scene, const gpu::FrameConstants& constants) {
     SunShadowCache& c = r.sunShadowCache;
     bool keepable = sunShadowKeepable(r);
-    // Alpha-masked casters test their base colour's alpha in the map: a material whose texture
-    // streamed or that was edited may change the map. Positions change with animated playback.
     bool changed = c.drawn && (c.drawnScene != &scene || c.drawnViewProj != constants.sunViewProj ||
-                               anySet(r.reposedInstances) || anySet(r.changedMaterials));
+                               r.shadowCastersChanged);
     c.drawThisFrame = !(keepable && c.drawn && c.drawnAllCasters && !changed);
     // A map that changes this frame is drawn from the camera-culled list, as without the cache:
     // while playback moves something every frame, every caster in the sun's volume would cost

@@ -28,10 +28,18 @@ struct SunShadowCache {
 };
 
 // Whether the map may be kept: --shadow-cache on, and no caster's LOD follows the camera
-// (--lod on) nor does the sun's list feed the camera-chosen whole-scene shadow views
-// (--shadow-culling whole-scene: the spots and cascades draw the sun's list). A map to keep is
-// drawn from every caster in the sun's volume (CullingFrame::sunListAllCasters).
+// (--lod on), nor does another pass draw the sun's list and expect it culled for this camera
+// (--shadow-culling whole-scene: the spots and cascades; --gi lpv: the reflective shadow maps).
+// A map to keep is drawn from every caster in the sun's volume (CullingFrame::sunListAllCasters).
 bool sunShadowKeepable(const Renderer& r);
+// Whether this frame changed what a kept shadow map (the sun's, the spots') shows of its casters:
+// playback moved or deformed one, a material was edited, or a streamed texture changed an
+// alpha-masked material (the maps' only material input: other materials are drawn depth-only).
+// Sets Renderer::shadowCastersChanged, after Renderer::changedMaterials is known.
+void noteShadowCasterChanges(Renderer& r, const GpuScene& scene);
+// The kept maps are stale for reasons the renderer cannot see (a shader hot reload): draw them
+// again next frame.
+void forgetKeptShadowMaps(Renderer& r);
 // Decides, before the frame's passes are declared, whether "shadowMap" draws this frame, and
 // from which list: every caster to keep the map, or (on a frame that changed it: playback, a
 // sun edit) the camera-culled one, as without the cache.
