@@ -767,12 +767,22 @@ nlohmann::json runBench(Gpu& gpu, const BenchOptions& b) {
         for (const auto& p : out["modes"][m.name]["passes"])
             if (std::find(names.begin(), names.end(), p["name"]) == names.end())
                 names.push_back(p["name"]);
+    // A pass that ran on fewer frames than the run's (the kept shadow maps: drawn when they
+    // change) shows its median over those frames and, in brackets, how many they were.
+    bool partial = false;
     for (const std::string& n : names)
         row(("  " + n).c_str(), [&](const nlohmann::json& s) {
-            for (const auto& p : s["passes"])
-                if (p["name"] == n) return format("%.3f", p["gpu_ms"].get<double>());
+            for (const auto& p : s["passes"]) {
+                if (p["name"] != n) continue;
+                uint32_t ran = p.value("frames", 0u), frames = s.value("frames", 0u);
+                if (ran >= frames) return format("%.3f", p["gpu_ms"].get<double>());
+                partial = true;
+                return format("%.3f [%u]", p["gpu_ms"].get<double>(), ran);
+            }
             return std::string("-");
         });
+    if (partial)
+        std::printf("%-28s [N]: ran on N of the %u frames (its median over those)\n", "", b.frames);
     auto decoupledOnly = [](const char* key, const char* fmt) {
         return [key, fmt](const nlohmann::json& s) {
             if (!s.contains(key)) return std::string("-");
