@@ -573,10 +573,14 @@ struct CullingFrame {
     uint64_t shadowViewDraws;  // DrawIndexedCommand[lists * maxDraws], one list per view
     uint64_t shadowViewCounts; // uint per list
     uint shadowViewCount;
-    // 1: the sun's list holds every caster in its volume, not only those whose shadow can reach
-    // the camera's frustum: its map is kept across frames (render/lighting/sun_shadow_cache.h).
-    uint sunListAllCasters;
+    // The sun's list this frame (SUN_LIST_*; render/lighting/sun_shadow_cache.h): its casters
+    // whose shadow can reach the camera's frustum, every caster in its volume (a map to keep),
+    // or none (the kept map is not redrawn and nothing else draws the list).
+    uint sunList;
 };
+#define SUN_LIST_NONE 0u
+#define SUN_LIST_CAMERA 1u
+#define SUN_LIST_ALL 2u
 
 // A cascade's or spot's view for per-view shadow culling. Depth clamp keeps casters in front of
 // the near plane in the map, so only the four sides and the far plane cull.

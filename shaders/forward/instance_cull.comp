@@ -162,8 +162,11 @@ void main() {
     uint casterTriangles = 0u, casterVertices = 0u;
     // A caster matters to the sun's views only if its shadow can reach the camera's frustum.
     bool reachesCamera = caster && !shadowCannotReachView(f, c, inst.worldMin, inst.worldMax);
-    // A kept sun map (render/lighting/sun_shadow_cache.h) holds every caster in the sun's volume.
-    bool sunCaster = c.sunListAllCasters != 0u ? caster : reachesCamera;
+    // A sun map to keep (render/lighting/sun_shadow_cache.h) holds every caster in the sun's
+    // volume; a kept one is not redrawn, and its list is not built.
+    bool sunCaster = c.sunList == SUN_LIST_ALL      ? caster
+                     : c.sunList == SUN_LIST_CAMERA ? reachesCamera
+                                                    : false;
     if (sunCaster || (caster && c.shadowViewCount != 0u)) {
         if (!haveLod) lod = selectLod(f, c, inst, mesh);
         casterTriangles = lod.indexCount / 3u;

@@ -52,6 +52,8 @@ TEST(SunShadowCache, KeptMapDrawsOnceWithTheImageOfARedrawnOne) {
                     "casters %u / %u, worst frame %.2f dB\n",
                     name, sunMapDraws(kept), sunMapDraws(redrawn), keptCasters, viewCasters, worst);
         EXPECT_GT(keptCasters, viewCasters) << name << ": every caster in the sun's volume";
+        // Frames that keep the map build no sun list (nothing else draws it here).
+        EXPECT_EQ(kept.stats["culling"]["views"]["shadow"]["instances_drawn"], 0) << name;
         ASSERT_EQ(kept.frames.size(), redrawn.frames.size());
         if (mode == RenderMode::Forward) {
             for (size_t i = 0; i < kept.frames.size(); ++i)

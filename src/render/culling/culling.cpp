@@ -154,7 +154,7 @@ void prepareCullingFrame(Renderer& r, const GpuScene& scene, gpu::FrameConstants
     f.proxyShadows = r.settings.proxyShadows && !r.gi ? 1u : 0u;
     f.sceneMinY = scene.bounds.valid() ? scene.bounds.min.y : -1e30f;
     // A sun map to keep must hold every caster a later camera may see shadows of.
-    f.sunListAllCasters = r.sunShadowCache.allCastersThisFrame ? 1u : 0u;
+    f.sunList = r.sunShadowCache.listThisFrame;
     if (!c.levelSize.empty()) {
         f.hizLevels = uint32_t(c.levelSize.size());
         f.hizSize = c.levelSize[0];

@@ -36,22 +36,24 @@ void prepareSunShadowMap(Renderer& r, const GpuScene& scene, const gpu::FrameCon
     bool keepable = sunShadowKeepable(r);
     bool changed = c.drawn && (c.drawnScene != &scene || c.drawnViewProj != constants.sunViewProj ||
                                r.shadowCastersChanged);
-    c.drawThisFrame = !(keepable && c.drawn && c.drawnAllCasters && !changed);
+    if (keepable && c.drawn && c.drawnAllCasters && !changed) {
+        c.listThisFrame = SUN_LIST_NONE;
+        return;
+    }
     // A map that changes this frame is drawn from the camera-culled list, as without the cache:
     // while playback moves something every frame, every caster in the sun's volume would cost
     // every frame (builtin:many's whole town: ~300 ms against ~180 on lavapipe). The first frame
     // that changes nothing draws them all, and that map is kept.
-    c.allCastersThisFrame = c.drawThisFrame && keepable && !changed;
-    if (!c.drawThisFrame) return;
+    c.listThisFrame = keepable && !changed ? SUN_LIST_ALL : SUN_LIST_CAMERA;
     c.drawn = true;
-    c.drawnAllCasters = c.allCastersThisFrame;
+    c.drawnAllCasters = c.listThisFrame == SUN_LIST_ALL;
     c.drawnScene = &scene;
     c.drawnViewProj = constants.sunViewProj;
     c.draws++;
 }
 
 bool sunShadowMapThisFrame(const Renderer& r) {
-    return r.sunShadowCache.drawThisFrame;
+    return r.sunShadowCache.listThisFrame != SUN_LIST_NONE;
 }
 
 void sunShadowCacheStats(const Renderer& r, nlohmann::json& stats) {

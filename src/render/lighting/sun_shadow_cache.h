@@ -22,15 +22,16 @@ struct SunShadowCache {
     bool drawnAllCasters = false; // ... from every caster in the sun's volume
     const GpuScene* drawnScene = nullptr;
     glm::mat4 drawnViewProj{0.0f};
-    bool drawThisFrame = true;
-    bool allCastersThisFrame = false; // the sun's list: every caster in its volume
-    uint32_t draws = 0;               // frames that drew the map
+    // The sun's list this frame (SUN_LIST_*): none when the kept map is not redrawn.
+    uint32_t listThisFrame = SUN_LIST_CAMERA;
+    uint32_t draws = 0; // frames that drew the map
 };
 
 // Whether the map may be kept: --shadow-cache on, and no caster's LOD follows the camera
 // (--lod on), nor does another pass draw the sun's list and expect it culled for this camera
 // (--shadow-culling whole-scene: the spots and cascades; --gi lpv: the reflective shadow maps).
-// A map to keep is drawn from every caster in the sun's volume (CullingFrame::sunListAllCasters).
+// A map to keep is drawn from every caster in the sun's volume (CullingFrame::sunList); the
+// list is the map's alone then, so a frame that keeps the map builds none.
 bool sunShadowKeepable(const Renderer& r);
 // Whether this frame changed what a kept shadow map (the sun's, the spots') shows of its casters:
 // playback moved or deformed one, a material was edited, or a streamed texture changed an
