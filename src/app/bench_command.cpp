@@ -2,6 +2,7 @@
 #include <cstdio>
 #include <fstream>
 #include <map>
+#include <unistd.h>
 #include <vector>
 
 #include "app/bench_plot.h"
@@ -498,6 +499,45 @@ std::vector<uint32_t> parseInstanceCounts(const std::string& text) {
 // Renders the same scene over the same camera path forward, decoupled with reuse off and
 // decoupled with reuse on, in one process, and prints per-pass medians and frame-time ratios
 // against forward (DESIGN §5, §7).
+// The progress line's note on how the runs of a comparison share the device.
+std::string interleaveNote(const BenchOptions& b) {
+    return b.framesPerTurn ? format(" (turns of %u frames)", b.framesPerTurn) : std::string();
+}
+
+// The stats of `runs`, rendered side by side. Interleaved (framesPerTurn > 0), every run is
+// built first, then the runs take turns of framesPerTurn frames, in the given order, then in
+// the opposite order, and so on: the host's drift (a shared machine's neighbours, its clocks)
+// then reaches every run alike at the scale of a turn instead of favouring whichever ran in its
+// quieter seconds. A turn's first frame finds the CPU's caches holding another run's data (on a
+// CPU device that costs it), so a turn has a few frames and the frame medians see warm ones.
+// framesPerTurn 0 (--interleave runs): one whole run after another, in order.
+std::vector<nlohmann::json> renderSideBySide(Gpu& gpu, const std::vector<RenderOptions>& runs,
+                                             uint32_t framesPerTurn, const std::string& label) {
+    std::vector<nlohmann::json> stats(runs.size());
+    if (framesPerTurn == 0) {
+        for (size_t k = 0; k < runs.size(); ++k) stats[k] = runRender(gpu, runs[k]).stats;
+        return stats;
+    }
+    std::vector<RenderSessionPtr> sessions;
+    for (const RenderOptions& o : runs) sessions.push_back(beginRender(gpu, o));
+    const uint32_t frames = runs.empty() ? 0u : runs[0].frames;
+    const bool tty = isatty(STDERR_FILENO);
+    for (uint32_t first = 0, turn = 0; first < frames; first += framesPerTurn, ++turn) {
+        for (size_t n = 0; n < sessions.size(); ++n) {
+            size_t k = turn % 2 == 0 ? n : sessions.size() - 1 - n;
+            for (uint32_t f = 0; f < framesPerTurn && !renderSessionDone(*sessions[k]); ++f)
+                renderNextFrame(*sessions[k]);
+        }
+        if (tty)
+            std::fprintf(stderr, "\r%s: frame %u/%u", label.c_str(),
+                         std::min(first + framesPerTurn, frames), frames);
+    }
+    if (tty && frames) std::fprintf(stderr, "\n");
+    for (size_t k = 0; k < sessions.size(); ++k)
+        stats[k] = finishRender(std::move(sessions[k])).stats;
+    return stats;
+}
+
 nlohmann::json runBench(Gpu& gpu, const BenchOptions& b) {
     if (!b.json.empty()) requireCreatableOutput("--json", b.json); // before minutes of rendering
     if (!b.plot.empty()) requireCreatableOutput("--plot", b.plot);
@@ -557,21 +597,36 @@ nlohmann::json runBench(Gpu& gpu, const BenchOptions& b) {
     // alike; each ratio is the median of the rounds' ratios (forward of the same round as the
     // denominator), and modes.<name> keeps the last round's stats plus every round's median
     // frame (frame_ms_rounds).
+    // --interleave N (the default 4): within a round the three modes also take turns of N
+    // frames (renderSideBySide).
     const uint32_t modeCount = uint32_t(std::size(modes));
     std::vector<std::vector<double>> roundMs(modeCount);
-    for (uint32_t round = 0; round < b.modeRounds; ++round)
+    out["interleave"] = b.framesPerTurn ? nlohmann::json(b.framesPerTurn) : nlohmann::json("runs");
+    for (uint32_t round = 0; round < b.modeRounds; ++round) {
+        std::vector<uint32_t> order;
+        std::vector<RenderOptions> runs;
+        std::string names;
         for (uint32_t k = 0; k < modeCount; ++k) {
             uint32_t index = round % 2 == 0 ? k : modeCount - 1 - k;
-            const Mode& m = modes[index];
-            std::fprintf(stderr, "bench: %s, %u frames at %ux%u (%s camera)", m.name, b.frames,
-                         b.width, b.height, pathNames[int(b.cameraPath)]);
-            if (b.modeRounds > 1) std::fprintf(stderr, ", round %u of %u", round + 1, b.modeRounds);
-            std::fprintf(stderr, "\n");
-            o.mode = m.mode;
-            o.reuse = m.reuse;
-            out["modes"][m.name] = runRender(gpu, o).stats;
-            roundMs[index].push_back(out["modes"][m.name]["frame_ms"]["median"].get<double>());
+            order.push_back(index);
+            o.mode = modes[index].mode;
+            o.reuse = modes[index].reuse;
+            runs.push_back(o);
+            names += std::string(k ? ", " : "") + modes[index].name;
         }
+        std::string label = "bench: " + names;
+        std::fprintf(stderr, "%s%s, %u frames at %ux%u (%s camera)", label.c_str(),
+                     interleaveNote(b).c_str(), b.frames, b.width, b.height,
+                     pathNames[int(b.cameraPath)]);
+        if (b.modeRounds > 1) std::fprintf(stderr, ", round %u of %u", round + 1, b.modeRounds);
+        std::fprintf(stderr, "\n");
+        std::vector<nlohmann::json> stats = renderSideBySide(gpu, runs, b.framesPerTurn, label);
+        for (uint32_t k = 0; k < modeCount; ++k) {
+            const Mode& m = modes[order[k]];
+            out["modes"][m.name] = std::move(stats[k]);
+            roundMs[order[k]].push_back(out["modes"][m.name]["frame_ms"]["median"].get<double>());
+        }
+    }
     auto median = [](std::vector<double> v) {
         std::sort(v.begin(), v.end());
         size_t n = v.size();
@@ -641,16 +696,25 @@ nlohmann::json runBench(Gpu& gpu, const BenchOptions& b) {
         for (const SpectraPath& path : paths) {
             std::vector<double> frameRounds[2], shadingRounds[2]; // [on, single] per round
             nlohmann::json runs = nlohmann::json::array();
-            for (uint32_t round = 0; round < spectraRounds; ++round)
+            for (uint32_t round = 0; round < spectraRounds; ++round) {
+                std::vector<RenderOptions> renders;
                 for (int k = 0; k < 2; ++k) {
                     bool on = (k == 0) == (round % 2 == 0); // on, single, then single, on
-                    std::fprintf(stderr, "bench: %s, --spectra %s (round %u of %u)\n", path.path,
-                                 on ? "on" : "single", round + 1, spectraRounds);
                     o.mode = path.mode;
                     o.reuse = false;
                     o.lightCulling = b.lightCulling;
                     o.spectra = on ? Spectra::On : Spectra::Single;
-                    nlohmann::json st = runRender(gpu, o).stats;
+                    renders.push_back(o);
+                }
+                std::string label = std::string("bench: ") + path.path + ", --spectra " +
+                                    (round % 2 == 0 ? "on, single" : "single, on");
+                std::fprintf(stderr, "%s%s (round %u of %u)\n", label.c_str(),
+                             interleaveNote(b).c_str(), round + 1, spectraRounds);
+                std::vector<nlohmann::json> stats =
+                    renderSideBySide(gpu, renders, b.framesPerTurn, label);
+                for (int k = 0; k < 2; ++k) {
+                    bool on = (k == 0) == (round % 2 == 0);
+                    nlohmann::json& st = stats[k];
                     double frame = st["frame_ms"]["median"].get<double>();
                     double shading = 0.0;
                     for (const char* name : path.passes) shading += passMs(st, name);
@@ -662,6 +726,7 @@ nlohmann::json runBench(Gpu& gpu, const BenchOptions& b) {
                                     {"shading_ms", shading}});
                     out["modes"][on ? path.onName : path.singleName] = std::move(st);
                 }
+            }
             o.spectra = Spectra::Off;
             bool forwardPath = path.mode == RenderMode::Forward;
             std::string key = std::string("spectra_") + path.path;

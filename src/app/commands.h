@@ -1,5 +1,6 @@
 #pragma once
 // The `shadel` commands as functions, so tests can run them in-process on a shared device.
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -150,6 +151,19 @@ std::string defaultCacheDir();
 
 // Renders with an existing Gpu (tests share one). Writes images/stats as the options say.
 RenderRun runRender(Gpu& gpu, const RenderOptions& options);
+// The same in steps, so that several renders can interleave their frames (the bench): load,
+// bake and build the renderer; render the next frame; write images and stats and release the
+// device's memory. runRender is beginRender, renderNextFrame until renderSessionDone, then
+// finishRender. A session destroyed unfinished (an error) releases what it holds.
+struct RenderSession;
+struct RenderSessionDeleter {
+    void operator()(RenderSession* session) const;
+};
+using RenderSessionPtr = std::unique_ptr<RenderSession, RenderSessionDeleter>;
+RenderSessionPtr beginRender(Gpu& gpu, const RenderOptions& options);
+bool renderSessionDone(const RenderSession& session); // every frame rendered (or --capture list)
+void renderNextFrame(RenderSession& session);
+RenderRun finishRender(RenderSessionPtr session);
 // Writes RGBA8 pixels as an RGB PNG; throws InputError naming the path when it cannot.
 void writePng(const std::string& path, const std::vector<uint8_t>& rgba, uint32_t width,
               uint32_t height);
@@ -207,6 +221,10 @@ struct BenchOptions {
     // The forward / decoupled / reuse comparison's rounds: 1, or --rounds when given (each round
     // runs the three modes, in alternating order; ratios are the median of the rounds').
     uint32_t modeRounds = 1;
+    // --interleave N|runs: the runs one comparison sets side by side (the three modes of a
+    // round; spectra on and single) take turns of N frames (app/bench_command.cpp
+    // renderSideBySide), or run one whole run after another (runs: 0).
+    uint32_t framesPerTurn = 4;
     // --instance-scaling N,N,...: builtin:many at each count (--lod on), --rounds rounds
     // interleaved; cpu_frame_ms per count and ratios cpu(N) / cpu(first N) (app/bench_command.cpp).
     std::vector<uint32_t> instanceScaling;

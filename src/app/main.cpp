@@ -47,6 +47,16 @@ uint32_t parseThreads(const std::string& t) {
     return uint32_t(v);
 }
 
+// --interleave N | runs: frames per turn of the bench's side-by-side runs (0 = whole runs).
+uint32_t parseInterleave(const std::string& t) {
+    if (t == "runs") return 0;
+    char* end = nullptr;
+    long v = std::strtol(t.c_str(), &end, 10);
+    if (end == t.c_str() || *end != '\0' || v < 1 || v > 1000)
+        throw InputError(format("--interleave %s: expected runs or 1..1000 frames", t.c_str()));
+    return uint32_t(v);
+}
+
 std::optional<TimingMode> parseTiming(const std::string& t) {
     if (t == "auto") return std::nullopt;
     if (t == "timestamps") return TimingMode::Timestamps;
@@ -542,6 +552,13 @@ int main(int argc, char** argv) {
             "--light-grid", benchLightGrid,
             "on | off: tiles and shadel chunks take their candidate lights from the light grid")
         ->capture_default_str();
+    std::string benchInterleave = "4";
+    bench
+        ->add_option("--interleave", benchInterleave,
+                     "N | runs: the runs a ratio compares (the three modes of a round, spectra on "
+                     "and single) take turns of N frames (1..1000), so that the host's drift "
+                     "reaches each alike, or render one whole run after another (runs)")
+        ->capture_default_str();
     std::string benchSpectra = "auto";
     bench
         ->add_option("--spectra", benchSpectra,
@@ -800,6 +817,7 @@ int main(int argc, char** argv) {
             if (bo.rounds < 1 || bo.rounds > 100)
                 throw InputError(format("--rounds %u: expected 1..100", bo.rounds));
             bo.modeRounds = benchRoundsFlag->count() ? bo.rounds : 1;
+            bo.framesPerTurn = parseInterleave(benchInterleave);
             if (bo.compareStreaming && !(bo.textureBudgetMiB > 0.0))
                 throw InputError("--streaming-compare: needs a --texture-budget above 0 MiB");
             if (*benchInstancesFlag && bo.instances == 0)

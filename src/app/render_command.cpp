@@ -221,7 +221,84 @@ void printPassTable(const nlohmann::json& stats) {
                 stats["frame_ms"]["median"].get<double>());
 }
 
+// A render's state between its steps (beginRender, renderNextFrame, finishRender): what one
+// call of runRender keeps, so that the bench can interleave the frames of several renders.
+struct RenderSession {
+    RenderSession(Gpu& g, const RenderOptions& options) : gpu(g), o(options) {}
+    RenderSession(const RenderSession&) = delete;
+    RenderSession& operator=(const RenderSession&) = delete;
+    ~RenderSession() { release(); }
+    // The renderer and the uploaded scene go back to the device (on an error too).
+    void release() {
+        if (rendererLive) destroyRenderer(renderer);
+        rendererLive = false;
+        if (sceneUploaded) destroyScene(gpu, gpuScene);
+        sceneUploaded = false;
+    }
+
+    Gpu& gpu;
+    const RenderOptions o;
+    bool outDir = false; // --out DIR/
+    bool tty = false;    // progress lines on stderr
+    Scene scene;
+    Camera camera;
+    std::optional<Camera> cutCamera; // --camera-cut
+    Aabb bounds;                     // fixes the camera path
+    std::vector<BakedMesh> baked;
+    GpuScene gpuScene;
+    bool sceneUploaded = false; // destroyScene owed
+    float density = 0.0f;
+    bool autoDensity = true;
+    ViewDensity viewDensity;
+    double bakeSeconds = 0.0, viewDensitySeconds = 0.0;
+    TextureStreamingPtr streaming;
+    std::optional<ScenePlayback> playback;
+    RenderSettings settings;
+    Renderer renderer;
+    bool rendererLive = false; // destroyRenderer owed (initRenderer was called)
+    RenderRun run;
+    // This render's pipelines, counted around its own steps: another render's steps may come
+    // between them.
+    PipelineLibraryCounters pipelines;
+    uint32_t framesRendered = 0;
+};
+
+void RenderSessionDeleter::operator()(RenderSession* session) const {
+    delete session;
+}
+
+namespace {
+void addPipelines(PipelineLibraryCounters& sum, const PipelineLibraryCounters& more) {
+    sum.created += more.created;
+    sum.shared += more.shared;
+    sum.createSeconds += more.createSeconds;
+}
+
+// The camera of frame i: the path, the cut, the sub-pixel jitter.
+CameraView viewOfFrame(const RenderSession& session, uint32_t i) {
+    const RenderOptions& o = session.o;
+    glm::vec2 jitter = o.jitter ? subpixelJitter(i) : glm::vec2(0.0f);
+    const Camera& start =
+        session.cutCamera && i >= o.cutFrame ? *session.cutCamera : session.camera;
+    Camera onPath = cameraOnPath(start, o.cameraPath, i, o.frames, session.bounds);
+    return makeCameraView(onPath, o.width * o.ssaa, o.height * o.ssaa, jitter * float(o.ssaa));
+}
+} // namespace
+
 RenderRun runRender(Gpu& gpu, const RenderOptions& o) {
+    RenderSessionPtr session = beginRender(gpu, o);
+    while (!renderSessionDone(*session)) renderNextFrame(*session);
+    return finishRender(std::move(session));
+}
+
+bool renderSessionDone(const RenderSession& session) {
+    return session.run.listedCaptures || session.framesRendered >= session.o.frames;
+}
+
+RenderSessionPtr beginRender(Gpu& gpu, const RenderOptions& options) {
+    RenderSessionPtr sessionPtr(new RenderSession(gpu, options));
+    RenderSession& session = *sessionPtr;
+    const RenderOptions& o = session.o;
     if (o.frames < 1 || o.frames > 100000)
         throw InputError(format("--frames %u: expected 1..100000", o.frames));
     if (o.ssaa < 1 || o.ssaa > 16) throw InputError(format("--ssaa %u: expected 1..16", o.ssaa));
@@ -236,7 +313,8 @@ RenderRun runRender(Gpu& gpu, const RenderOptions& o) {
     if (o.debugLinesAtX >= int32_t(o.width) || o.debugLinesAtY >= int32_t(o.height))
         throw InputError(format("--debug-lines-at %d,%d: outside the %ux%u image", o.debugLinesAtX,
                                 o.debugLinesAtY, o.width, o.height));
-    bool outDir = !o.out.empty() && o.out.back() == '/';
+    bool& outDir = session.outDir;
+    outDir = !o.out.empty() && o.out.back() == '/';
     if (outDir) {
         std::error_code ec;
         std::filesystem::create_directories(o.out, ec);
@@ -263,9 +341,11 @@ RenderRun runRender(Gpu& gpu, const RenderOptions& o) {
     BuiltinSceneOptions builtin;
     builtin.instances = o.instances;
     builtin.galleryTextureSize = o.galleryTextureSize;
-    Scene scene = loadScene(o.scene, {o.allowExternalFiles, o.time}, builtin);
-    Camera camera = runCamera(scene, o.camera, o.cameraOverrides, float(o.width) / float(o.height));
-    std::optional<Camera> cutCamera; // --camera-cut
+    Scene& scene = session.scene;
+    scene = loadScene(o.scene, {o.allowExternalFiles, o.time}, builtin);
+    Camera& camera = session.camera;
+    camera = runCamera(scene, o.camera, o.cameraOverrides, float(o.width) / float(o.height));
+    std::optional<Camera>& cutCamera = session.cutCamera;
     if (!o.cutCamera.empty()) {
         if (o.cutFrame < 1 || o.cutFrame >= o.frames)
             throw InputError(format("--camera-cut %s@%u: the cut frame must be in 1..%u (--frames "
@@ -274,14 +354,17 @@ RenderRun runRender(Gpu& gpu, const RenderOptions& o) {
         cutCamera = runCamera(scene, o.cutCamera, {}, float(o.width) / float(o.height));
     }
     // The camera path is fixed by the loaded scene's bounds (chunking does not move it).
-    Aabb bounds = scene.worldBounds();
+    Aabb& bounds = session.bounds;
+    bounds = scene.worldBounds();
 
-    std::vector<BakedMesh> baked;
-    GpuScene gpuScene;
-    float density = 0.0f;
-    bool autoDensity = !(o.shadelsPerMetre > 0.0f);
-    ViewDensity viewDensity;
-    double bakeSeconds = 0.0, viewDensitySeconds = 0.0;
+    std::vector<BakedMesh>& baked = session.baked;
+    GpuScene& gpuScene = session.gpuScene;
+    float& density = session.density;
+    bool& autoDensity = session.autoDensity;
+    autoDensity = !(o.shadelsPerMetre > 0.0f);
+    ViewDensity& viewDensity = session.viewDensity;
+    double& bakeSeconds = session.bakeSeconds;
+    double& viewDensitySeconds = session.viewDensitySeconds;
     if (autoDensity) {
         auto start = std::chrono::steady_clock::now();
         // Density from what this run's cameras can need, large meshes split into chunks. Both
@@ -336,7 +419,7 @@ RenderRun runRender(Gpu& gpu, const RenderOptions& o) {
     }
     // Texture streaming (render/streaming): with a budget, or for textures that exist only as a
     // streaming file (builtin:textures); otherwise textures load whole as before.
-    TextureStreamingPtr streaming;
+    TextureStreamingPtr& streaming = session.streaming;
     bool procedural = std::any_of(scene.textures.begin(), scene.textures.end(),
                                   [](const Texture& t) { return t.procedural.kind != 0; });
     if (!scene.textures.empty() && (o.textureBudgetMiB > 0.0 || procedural)) {
@@ -349,13 +432,14 @@ RenderRun runRender(Gpu& gpu, const RenderOptions& o) {
     }
     uploadScene(gpu, scene, gpuScene, o.mode == RenderMode::Decoupled ? &baked : nullptr,
                 streaming ? &streamedTextureSlots(*streaming) : nullptr);
+    session.sceneUploaded = true;
     // --time-step: the file posed again before every frame after the first (render/animation).
-    std::optional<ScenePlayback> playback;
+    std::optional<ScenePlayback>& playback = session.playback;
     if (o.timeStep)
         playback = startPlayback(o.scene, {o.allowExternalFiles, o.time}, o.time.value_or(0.0),
                                  *o.timeStep, scene);
 
-    RenderSettings settings;
+    RenderSettings& settings = session.settings;
     settings.width = o.width;
     settings.height = o.height;
     settings.ssaa = o.ssaa;
@@ -464,15 +548,15 @@ RenderRun runRender(Gpu& gpu, const RenderOptions& o) {
     settings.dfResidencyDistance = o.dfResidency;
     settings.timing = o.timing ? *o.timing : defaultTimingMode(gpu);
     settings.recordingThreads = o.threads ? o.threads : defaultRecordingThreads();
-    Renderer renderer;
-    RenderRun run;
+    Renderer& renderer = session.renderer;
     const PipelineLibraryCounters pipelinesBefore = pipelineLibraryCounters(gpu);
-    const bool tty = isatty(STDERR_FILENO);
+    session.tty = isatty(STDERR_FILENO);
     // Building the renderer compiles its pipelines: seconds on a CPU device, so say so.
-    bool buildingLine = o.progress && tty; // open until the renderer is built
+    bool buildingLine = o.progress && session.tty; // open until the renderer is built
     if (buildingLine) std::fprintf(stderr, "render: building the renderer's pipelines...");
     auto renderStart = std::chrono::steady_clock::now();
     try {
+        session.rendererLive = true; // (destroyRenderer takes a half-built one)
         initRenderer(renderer, gpu, settings, gpuScene);
         if (o.distanceFields)
             renderer.distanceFields = createDistanceFields(
@@ -483,82 +567,106 @@ RenderRun runRender(Gpu& gpu, const RenderOptions& o) {
         renderer.streaming = streaming.get();
         if (o.gpuSkinning) renderer.skinning = createSkinning(renderer, scene, gpuScene);
         renderer.pointsLines = createPointsLines(renderer, scene);
-        {
-            PipelineLibraryCounters p = pipelineLibraryCountersSince(gpu, pipelinesBefore);
-            double seconds =
-                std::chrono::duration<double>(std::chrono::steady_clock::now() - renderStart)
-                    .count();
-            SHADEL_DEBUG("renderer built in %.2f s: %llu pipelines compiled (%.2f s of compile "
-                         "time), %llu shared with earlier renderers",
-                         seconds, (unsigned long long)p.created, p.createSeconds,
-                         (unsigned long long)p.shared);
-            if (buildingLine)
-                std::fprintf(stderr,
-                             "\rrender: renderer built in %.1f s (%llu pipelines compiled, "
-                             "%llu shared)\n",
-                             seconds, (unsigned long long)p.created, (unsigned long long)p.shared);
-            buildingLine = false;
-        }
-        if (listCaptures) {
-            std::printf("%s", captureListing(renderer.captures).c_str());
-            run.listedCaptures = true;
-            destroyRenderer(renderer);
-            destroyScene(gpu, gpuScene);
-            return run;
-        }
-        requireCapturesExist(renderer.captures, o.captures); // before minutes of rendering
-        auto viewOfFrame = [&](uint32_t i) {
-            glm::vec2 jitter = o.jitter ? subpixelJitter(i) : glm::vec2(0.0f);
-            const Camera& start = cutCamera && i >= o.cutFrame ? *cutCamera : camera;
-            Camera onPath = cameraOnPath(start, o.cameraPath, i, o.frames, bounds);
-            return makeCameraView(onPath, o.width * o.ssaa, o.height * o.ssaa,
-                                  jitter * float(o.ssaa));
-        };
-        for (uint32_t i = 0; i < o.frames; ++i) {
-            CameraView view = viewOfFrame(i);
-            if (playback && i > 0) {
-                poseFrame(gpu, *playback, i, gpuScene, renderer.reposedInstances,
-                          renderer.skinning != nullptr, &renderer.reposedFrom);
-                if (renderer.skinning)
-                    setSkinPoses(renderer, *renderer.skinning, playback->drawn.skinPoses);
-                if (playback->lastWasPrefetched) { // it ran beside the last frame (trace)
-                    FrameResult& last = run.frames.back();
-                    auto ms = [](auto d) {
-                        return std::chrono::duration<double, std::milli>(d).count();
-                    };
-                    last.frontendWorker.push_back(
-                        {"scene update", ms(playback->lastImport.start - renderer.createdAt),
-                         ms(playback->lastImport.end - playback->lastImport.start),
-                         playback->lastImport.cpuMs});
-                }
-            }
-            // Frontend/backend overlap: with recording threads, the next frame's scene update
-            // (its pose imported from the file) runs on a worker while this frame renders, and
-            // the decoupled coarse allocation's grid visit while it records, submits and waits
-            // (render/shadel/coarse_visit.h; not with playback, which writes the next frame's
-            // bounds only before it).
-            if (renderer.settings.recordingThreads > 1 && i + 1 < o.frames) {
-                if (playback) prefetchPose(*playback, i + 1);
-                renderer.nextFrame = Renderer::NextFrame{viewOfFrame(i + 1), playback.has_value()};
-            }
-            run.frames.push_back(renderFrame(renderer, gpuScene, view));
-            if (i > 0) // what this frame took from the worker ran beside the last one
-                for (FrontendWorkerTask& t : renderer.frontendTaken)
-                    run.frames[i - 1].frontendWorker.push_back(t);
-            if (o.progress && o.frames > 1 && tty)
-                std::fprintf(stderr, "\rrender: frame %u/%u (%.1f ms)", i + 1, o.frames,
-                             run.frames.back().frameMs);
-            if (outDir)
-                writePng(format("%sframe_%04u.png", o.out.c_str(), i), run.frames.back().rgba,
-                         o.width, o.height);
-        }
-        if (o.progress && o.frames > 1 && tty) std::fprintf(stderr, "\n");
+        PipelineLibraryCounters p = pipelineLibraryCountersSince(gpu, pipelinesBefore);
+        addPipelines(session.pipelines, p);
+        double seconds =
+            std::chrono::duration<double>(std::chrono::steady_clock::now() - renderStart).count();
+        SHADEL_DEBUG("renderer built in %.2f s: %llu pipelines compiled (%.2f s of compile "
+                     "time), %llu shared with earlier renderers",
+                     seconds, (unsigned long long)p.created, p.createSeconds,
+                     (unsigned long long)p.shared);
+        if (buildingLine)
+            std::fprintf(stderr,
+                         "\rrender: renderer built in %.1f s (%llu pipelines compiled, "
+                         "%llu shared)\n",
+                         seconds, (unsigned long long)p.created, (unsigned long long)p.shared);
+        buildingLine = false;
     } catch (...) {
         if (buildingLine) std::fprintf(stderr, "\n"); // the error gets a line of its own
-        destroyRenderer(renderer);
-        destroyScene(gpu, gpuScene);
         throw;
     }
+    if (listCaptures) {
+        std::printf("%s", captureListing(renderer.captures).c_str());
+        session.run.listedCaptures = true;
+        session.release();
+        return sessionPtr;
+    }
+    requireCapturesExist(renderer.captures, o.captures); // before minutes of rendering
+    return sessionPtr;
+}
+
+void renderNextFrame(RenderSession& session) {
+    const RenderOptions& o = session.o;
+    Gpu& gpu = session.gpu;
+    Renderer& renderer = session.renderer;
+    RenderRun& run = session.run;
+    std::optional<ScenePlayback>& playback = session.playback;
+    const uint32_t i = session.framesRendered;
+    if (i >= o.frames || !session.rendererLive)
+        throw std::logic_error("renderNextFrame: the render has no frame left");
+    const PipelineLibraryCounters pipelinesBefore = pipelineLibraryCounters(gpu);
+    CameraView view = viewOfFrame(session, i);
+    if (playback && i > 0) {
+        poseFrame(gpu, *playback, i, session.gpuScene, renderer.reposedInstances,
+                  renderer.skinning != nullptr, &renderer.reposedFrom);
+        if (renderer.skinning)
+            setSkinPoses(renderer, *renderer.skinning, playback->drawn.skinPoses);
+        if (playback->lastWasPrefetched) { // it ran beside the last frame (trace)
+            FrameResult& last = run.frames.back();
+            auto ms = [](auto d) { return std::chrono::duration<double, std::milli>(d).count(); };
+            last.frontendWorker.push_back(
+                {"scene update", ms(playback->lastImport.start - renderer.createdAt),
+                 ms(playback->lastImport.end - playback->lastImport.start),
+                 playback->lastImport.cpuMs});
+        }
+    }
+    // Frontend/backend overlap: with recording threads, the next frame's scene update (its
+    // pose imported from the file) runs on a worker while this frame renders, and the
+    // decoupled coarse allocation's grid visit while it records, submits and waits
+    // (render/shadel/coarse_visit.h; not with playback, which writes the next frame's bounds
+    // only before it).
+    if (renderer.settings.recordingThreads > 1 && i + 1 < o.frames) {
+        if (playback) prefetchPose(*playback, i + 1);
+        renderer.nextFrame = Renderer::NextFrame{viewOfFrame(session, i + 1), playback.has_value()};
+    }
+    run.frames.push_back(renderFrame(renderer, session.gpuScene, view));
+    session.framesRendered++;
+    if (i > 0) // what this frame took from the worker ran beside the last one
+        for (FrontendWorkerTask& t : renderer.frontendTaken)
+            run.frames[i - 1].frontendWorker.push_back(t);
+    addPipelines(session.pipelines, pipelineLibraryCountersSince(gpu, pipelinesBefore));
+    if (o.progress && o.frames > 1 && session.tty)
+        std::fprintf(stderr, "\rrender: frame %u/%u (%.1f ms)", i + 1, o.frames,
+                     run.frames.back().frameMs);
+    if (session.outDir)
+        writePng(format("%sframe_%04u.png", o.out.c_str(), i), run.frames.back().rgba, o.width,
+                 o.height);
+    if (o.progress && o.frames > 1 && session.tty && i + 1 == o.frames) std::fprintf(stderr, "\n");
+}
+
+RenderRun finishRender(RenderSessionPtr sessionPtr) {
+    RenderSession& session = *sessionPtr;
+    if (session.run.listedCaptures) return std::move(session.run);
+    if (!renderSessionDone(session))
+        throw std::logic_error("finishRender: frames are left to render");
+    Gpu& gpu = session.gpu;
+    const RenderOptions& o = session.o;
+    Renderer& renderer = session.renderer;
+    RenderRun& run = session.run;
+    const bool outDir = session.outDir;
+    const Scene& scene = session.scene;
+    const Camera& camera = session.camera;
+    const std::optional<Camera>& cutCamera = session.cutCamera;
+    const RenderSettings& settings = session.settings;
+    GpuScene& gpuScene = session.gpuScene;
+    const bool autoDensity = session.autoDensity;
+    const ViewDensity& viewDensity = session.viewDensity;
+    const std::optional<ScenePlayback>& playback = session.playback;
+    const TextureStreamingPtr& streaming = session.streaming;
+    const std::vector<BakedMesh>& baked = session.baked;
+    const float density = session.density;
+    const double bakeSeconds = session.bakeSeconds;
+    const double viewDensitySeconds = session.viewDensitySeconds;
     if (!o.out.empty() && !outDir) {
         if (isExrPath(o.out))
             writeHdrFrame(renderer.captures, o.ssaa, o.out);
@@ -652,7 +760,7 @@ RenderRun runRender(Gpu& gpu, const RenderOptions& o) {
     s["shader_asserts"] = asserts;
     s["validation_errors"] = gpu.device.validationErrors.load();
     // This run's pipelines: compiled, or found already built on the device by an earlier run.
-    const PipelineLibraryCounters pipelines = pipelineLibraryCountersSince(gpu, pipelinesBefore);
+    const PipelineLibraryCounters& pipelines = session.pipelines;
     s["pipelines"] = {{"created", pipelines.created},
                       {"shared", pipelines.shared},
                       {"create_ms", pipelines.createSeconds * 1000.0}};
@@ -742,15 +850,15 @@ RenderRun runRender(Gpu& gpu, const RenderOptions& o) {
     }
     run.stats = s;
 
-    destroyRenderer(renderer);
-    destroyScene(gpu, gpuScene);
+    // The device's memory back before the files are written (as before the steps existed).
+    session.release();
 
     if (!o.stats.empty()) writeOutputFile(o.stats, s.dump(2) + "\n");
     if (!o.trace.empty())
         writeOutputFile(o.trace,
                         chromeTrace(run.frames, o.scene + " " + modeName(o.mode)).dump() + "\n");
     if (o.printPasses) printPassTable(s);
-    return run;
+    return std::move(run);
 }
 
 } // namespace shadel

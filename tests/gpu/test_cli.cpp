@@ -168,6 +168,8 @@ TEST(Cli, ParserErrorsAreOneLineAndExitCode2) {
         {"", "subcommand"},
         {"paint", "subcommand"},
         {"bench --frames x", "--frames"},
+        {"bench --interleave sometimes", "--interleave"},
+        {"bench --interleave 0", "--interleave"},
     };
     for (auto [args, named] : cases) {
         Result r = run(args);
