@@ -496,21 +496,20 @@ std::vector<uint32_t> parseInstanceCounts(const std::string& text) {
     return counts;
 }
 
-// Renders the same scene over the same camera path forward, decoupled with reuse off and
-// decoupled with reuse on, in one process, and prints per-pass medians and frame-time ratios
-// against forward (DESIGN §5, §7).
 // The progress line's note on how the runs of a comparison share the device.
 std::string interleaveNote(const BenchOptions& b) {
     return b.framesPerTurn ? format(" (turns of %u frames)", b.framesPerTurn) : std::string();
 }
 
 // The stats of `runs`, rendered side by side. Interleaved (framesPerTurn > 0), every run is
-// built first, then the runs take turns of framesPerTurn frames, in the given order, then in
-// the opposite order, and so on: the host's drift (a shared machine's neighbours, its clocks)
-// then reaches every run alike at the scale of a turn instead of favouring whichever ran in its
-// quieter seconds. A turn's first frame finds the CPU's caches holding another run's data (on a
-// CPU device that costs it), so a turn has a few frames and the frame medians see warm ones.
-// framesPerTurn 0 (--interleave runs): one whole run after another, in order.
+// built first, then the runs take turns of framesPerTurn frames, the order rotating by one run
+// each turn (A B C, B C A, C A B, ...): the host's drift (a shared machine's neighbours, its
+// clocks) then reaches every run alike at the scale of a turn instead of favouring whichever ran
+// in its quieter seconds. A turn's first frame finds the CPU's caches holding another run's data
+// (on a CPU device that costs it): rotating, every turn of every run follows another run's (a
+// reversed order would give the middle run twice the cold starts of the others), and a turn has
+// a few frames so that the frame medians see warm ones. framesPerTurn 0 (--interleave runs): one
+// whole run after another, in order. Runs may differ in frame count.
 std::vector<nlohmann::json> renderSideBySide(Gpu& gpu, const std::vector<RenderOptions>& runs,
                                              uint32_t framesPerTurn, const std::string& label) {
     std::vector<nlohmann::json> stats(runs.size());
@@ -519,25 +518,49 @@ std::vector<nlohmann::json> renderSideBySide(Gpu& gpu, const std::vector<RenderO
         return stats;
     }
     std::vector<RenderSessionPtr> sessions;
-    for (const RenderOptions& o : runs) sessions.push_back(beginRender(gpu, o));
-    const uint32_t frames = runs.empty() ? 0u : runs[0].frames;
+    uint32_t frames = 0;
+    for (const RenderOptions& o : runs) {
+        try {
+            sessions.push_back(beginRender(gpu, o));
+        } catch (const DeviceError& e) {
+            // Side by side, the runs hold the device's memory and bindless slots together: a
+            // scene that fits once may not fit thrice. Then one run after another, said so.
+            if (sessions.empty()) throw;
+            SHADEL_WARN("%s: the runs do not fit on the device side by side (%s); rendering "
+                        "them one after another (--interleave runs)",
+                        label.c_str(), e.what());
+            sessions.clear();
+            return renderSideBySide(gpu, runs, 0, label);
+        }
+        frames = std::max(frames, o.frames);
+    }
     const bool tty = isatty(STDERR_FILENO);
-    for (uint32_t first = 0, turn = 0; first < frames; first += framesPerTurn, ++turn) {
+    auto allDone = [&] {
+        return std::all_of(sessions.begin(), sessions.end(),
+                           [](const RenderSessionPtr& s) { return renderSessionDone(*s); });
+    };
+    for (uint32_t turn = 0; !allDone(); ++turn) {
         for (size_t n = 0; n < sessions.size(); ++n) {
-            size_t k = turn % 2 == 0 ? n : sessions.size() - 1 - n;
-            for (uint32_t f = 0; f < framesPerTurn && !renderSessionDone(*sessions[k]); ++f)
-                renderNextFrame(*sessions[k]);
+            RenderSession& session = *sessions[(n + turn) % sessions.size()];
+            for (uint32_t f = 0; f < framesPerTurn && !renderSessionDone(session); ++f)
+                renderNextFrame(session);
         }
         if (tty)
             std::fprintf(stderr, "\r%s: frame %u/%u", label.c_str(),
-                         std::min(first + framesPerTurn, frames), frames);
+                         std::min((turn + 1) * framesPerTurn, frames), frames);
     }
     if (tty && frames) std::fprintf(stderr, "\n");
-    for (size_t k = 0; k < sessions.size(); ++k)
+    for (size_t k = 0; k < sessions.size(); ++k) {
         stats[k] = finishRender(std::move(sessions[k])).stats;
+        // The device's pools held every run of the comparison while this one ended.
+        stats[k]["gpu_memory"]["runs_alive"] = sessions.size() - k;
+    }
     return stats;
 }
 
+// Renders the same scene over the same camera path forward, decoupled with reuse off and
+// decoupled with reuse on, in one process, and prints per-pass medians and frame-time ratios
+// against forward (DESIGN §5, §7).
 nlohmann::json runBench(Gpu& gpu, const BenchOptions& b) {
     if (!b.json.empty()) requireCreatableOutput("--json", b.json); // before minutes of rendering
     if (!b.plot.empty()) requireCreatableOutput("--plot", b.plot);

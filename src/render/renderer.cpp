@@ -255,7 +255,7 @@ static gpu::FrameConstants makeFrameConstants(Renderer& r, const GpuScene& scene
     f.instanceCount = scene.instanceCount;
     f.viewportSize = glm::vec2(r.internalWidth, r.internalHeight);
     f.invViewportSize = 1.0f / f.viewportSize;
-    f.frameIndex = uint32_t(gpu.frameIndex);
+    f.frameIndex = uint32_t(r.framesRendered); // this renderer's (renderers may share the device)
     f.visualize = uint32_t(r.settings.visualize);
     f.inspectPixel = INSPECT_OFF;
     if (r.settings.inspectX >= 0 && r.settings.inspectY >= 0) // the SSAA sample at its corner
