@@ -295,10 +295,43 @@ bool renderSessionDone(const RenderSession& session) {
     return session.run.listedCaptures || session.framesRendered >= session.o.frames;
 }
 
+namespace {
+// The options' own errors (no scene needed): thrown before minutes of loading and baking.
+void requireConsistentOptions(const RenderOptions& o) {
+    auto requireCount = [](const char* flag, uint32_t value, uint32_t lo, uint32_t hi) {
+        if (value < lo || value > hi)
+            throw InputError(format("%s %u: expected %u..%u", flag, value, lo, hi));
+    };
+    requireCount("--material-samples", o.materialSamples, 1, 64);
+    requireCount("--allocation-counters", o.allocationCounters, 1, SHADEL_COUNTERS);
+    requireCount("--reuse-refresh", o.reuseRefreshPeriod, 1, 1024);
+    requireCount("--particle-atlas-size", o.particleAtlasSize, 128, 8192);
+    requireCount("--gi-iterations", o.giIterations, 0, 64);
+    if (o.visualize == Visualize::Gi && o.gi == GiMode::Off)
+        throw InputError("--visualize gi: shows the indirect light of --gi lpv; GI is off");
+    if (o.visualize == Visualize::RtAo && !o.rt.ao)
+        throw InputError("--visualize rt-ao: shows the ray-traced AO of --rt-ao on; it is off");
+    if (o.visualize == Visualize::Tiles && !o.screenSpace)
+        throw InputError(
+            "--visualize tiles: shows the tile classes of --screen-space on; it is off");
+    if (o.distanceFields && !o.screenSpace)
+        throw InputError(
+            "--distance-fields on: runs on the screen-space tiles; add --screen-space on");
+    if (o.stencilEffects != StencilEffects::Off && !o.screenSpace)
+        throw InputError("--stencil-effects: composites the screen-space reflections; add "
+                         "--screen-space on");
+    for (auto [flag, value] : {std::pair{"--df-shadow-start", o.dfShadowStart},
+                               std::pair{"--df-residency", o.dfResidency}})
+        if (std::string e = checkFiniteInRange(flag, value, {0.0, 1e6}); !e.empty())
+            throw InputError(e);
+}
+} // namespace
+
 RenderSessionPtr beginRender(Gpu& gpu, const RenderOptions& options) {
     RenderSessionPtr sessionPtr(new RenderSession(gpu, options));
     RenderSession& session = *sessionPtr;
     const RenderOptions& o = session.o;
+    requireConsistentOptions(o);
     if (o.frames < 1 || o.frames > 100000)
         throw InputError(format("--frames %u: expected 1..100000", o.frames));
     if (o.ssaa < 1 || o.ssaa > 16) throw InputError(format("--ssaa %u: expected 1..16", o.ssaa));
@@ -451,14 +484,6 @@ RenderSessionPtr beginRender(Gpu& gpu, const RenderOptions& options) {
     settings.sheetShadels = o.sheetShadels;
     settings.shadingBias = o.shadingBias;
     settings.trilinearBand = o.trilinearBand;
-    auto requireCount = [](const char* flag, uint32_t value, uint32_t lo, uint32_t hi) {
-        if (value < lo || value > hi)
-            throw InputError(format("%s %u: expected %u..%u", flag, value, lo, hi));
-    };
-    requireCount("--material-samples", o.materialSamples, 1, 64);
-    requireCount("--allocation-counters", o.allocationCounters, 1, SHADEL_COUNTERS);
-    requireCount("--reuse-refresh", o.reuseRefreshPeriod, 1, 1024);
-    requireCount("--particle-atlas-size", o.particleAtlasSize, 128, 8192);
     settings.materialSamples = o.materialSamples;
     settings.forwardBelowPixels = o.forwardBelowPixels;
     settings.allocationCounters = o.allocationCounters;
@@ -491,9 +516,6 @@ RenderSessionPtr beginRender(Gpu& gpu, const RenderOptions& options) {
     settings.sunShadowCache = o.sunShadowCache;
     // The trace's finer CPU spans (stats "cpu_scopes").
     settings.cpuScopes = !o.trace.empty() || o.cpuScopes;
-    requireCount("--gi-iterations", o.giIterations, 0, 64);
-    if (o.visualize == Visualize::Gi && o.gi == GiMode::Off)
-        throw InputError("--visualize gi: shows the indirect light of --gi lpv; GI is off");
     settings.gi = o.gi;
     settings.giIterations = o.giIterations;
     settings.giSnap = o.giSnap;
@@ -524,27 +546,11 @@ RenderSessionPtr beginRender(Gpu& gpu, const RenderOptions& options) {
     settings.debugLinesAtX = o.debugLinesAtX;
     settings.debugLinesAtY = o.debugLinesAtY;
     settings.debugLineCapacity = o.debugLineCapacity;
-    if (o.visualize == Visualize::RtAo && !o.rt.ao)
-        throw InputError("--visualize rt-ao: shows the ray-traced AO of --rt-ao on; it is off");
     settings.rt = o.rt;
-    if (o.visualize == Visualize::Tiles && !o.screenSpace)
-        throw InputError(
-            "--visualize tiles: shows the tile classes of --screen-space on; it is off");
     settings.screenSpace = o.screenSpace;
-    if (o.distanceFields && !o.screenSpace)
-        throw InputError(
-            "--distance-fields on: runs on the screen-space tiles; add --screen-space on");
-    if (o.stencilEffects != StencilEffects::Off && !o.screenSpace)
-        throw InputError("--stencil-effects: composites the screen-space reflections; add "
-                         "--screen-space on");
     settings.tileClassification = o.tileClassification;
     settings.distanceFieldLighting = o.distanceFields;
-    if (std::string e = checkFiniteInRange("--df-shadow-start", o.dfShadowStart, {0.0, 1e6});
-        !e.empty())
-        throw InputError(e);
     settings.dfShadowStart = o.dfShadowStart;
-    if (std::string e = checkFiniteInRange("--df-residency", o.dfResidency, {0.0, 1e6}); !e.empty())
-        throw InputError(e);
     settings.dfResidencyDistance = o.dfResidency;
     settings.timing = o.timing ? *o.timing : defaultTimingMode(gpu);
     settings.recordingThreads = o.threads ? o.threads : defaultRecordingThreads();

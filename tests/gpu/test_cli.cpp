@@ -267,6 +267,24 @@ TEST(Cli, UncreatableOutputsFailBeforeRendering) {
     EXPECT_EQ(dir.entries(), 0u) << "nothing may be left behind";
 }
 
+// Options that contradict each other are errors before the scene is loaded and baked (the
+// scene here does not exist: the error must name the options, not the file).
+TEST(Cli, InconsistentOptionsFailBeforeLoading) {
+    const std::pair<const char*, const char*> cases[] = {
+        {"render --scene /nonexistent.gltf --visualize gi", "--visualize gi"},
+        {"render --scene /nonexistent.gltf --visualize tiles", "--visualize tiles"},
+        {"render --scene /nonexistent.gltf --distance-fields on", "--distance-fields on"},
+        {"render --scene /nonexistent.gltf --material-samples 0", "--material-samples 0"},
+        {"render --scene /nonexistent.gltf --gi lpv --gi-iterations 99", "--gi-iterations 99"},
+    };
+    for (auto [args, message] : cases) {
+        Result r = run(args);
+        EXPECT_EQ(r.exitCode, 2) << args;
+        EXPECT_EQ(lineCount(r.stderrText), 1u) << r.stderrText;
+        EXPECT_NE(r.stderrText.find(message), std::string::npos) << r.stderrText;
+    }
+}
+
 // --- issue 17: the bake cache location and glTF URIs -------------------------------------------
 
 // XDG_CACHE_HOME="" put the cache at /shadel; an empty or relative value must be ignored.
