@@ -496,9 +496,17 @@ std::vector<uint32_t> parseInstanceCounts(const std::string& text) {
     return counts;
 }
 
+// Frames per turn of the side-by-side runs (renderSideBySide; 0: whole runs). Auto: half the
+// frames, 1 to 4, so that even a short run (the spectra example's 3 frames) takes turns.
+uint32_t benchFramesPerTurn(const BenchOptions& b) {
+    if (b.framesPerTurn != BenchOptions::kFramesPerTurnAuto) return b.framesPerTurn;
+    return std::clamp(b.frames / 2, 1u, 4u);
+}
+
 // The progress line's note on how the runs of a comparison share the device.
 std::string interleaveNote(const BenchOptions& b) {
-    return b.framesPerTurn ? format(" (turns of %u frames)", b.framesPerTurn) : std::string();
+    uint32_t n = benchFramesPerTurn(b);
+    return n ? format(" (turns of %u frame%s)", n, n == 1 ? "" : "s") : std::string();
 }
 
 // The stats of `runs`, rendered side by side. Interleaved (framesPerTurn > 0), every run is
@@ -620,11 +628,12 @@ nlohmann::json runBench(Gpu& gpu, const BenchOptions& b) {
     // alike; each ratio is the median of the rounds' ratios (forward of the same round as the
     // denominator), and modes.<name> keeps the last round's stats plus every round's median
     // frame (frame_ms_rounds).
-    // --interleave N (the default 4): within a round the three modes also take turns of N
-    // frames (renderSideBySide).
+    // --interleave (auto: half the frames, 1 to 4): within a round the three modes also take
+    // turns of a few frames (renderSideBySide).
     const uint32_t modeCount = uint32_t(std::size(modes));
     std::vector<std::vector<double>> roundMs(modeCount);
-    out["interleave"] = b.framesPerTurn ? nlohmann::json(b.framesPerTurn) : nlohmann::json("runs");
+    const uint32_t framesPerTurn = benchFramesPerTurn(b);
+    out["interleave"] = framesPerTurn ? nlohmann::json(framesPerTurn) : nlohmann::json("runs");
     for (uint32_t round = 0; round < b.modeRounds; ++round) {
         std::vector<uint32_t> order;
         std::vector<RenderOptions> runs;
@@ -643,7 +652,7 @@ nlohmann::json runBench(Gpu& gpu, const BenchOptions& b) {
                      pathNames[int(b.cameraPath)]);
         if (b.modeRounds > 1) std::fprintf(stderr, ", round %u of %u", round + 1, b.modeRounds);
         std::fprintf(stderr, "\n");
-        std::vector<nlohmann::json> stats = renderSideBySide(gpu, runs, b.framesPerTurn, label);
+        std::vector<nlohmann::json> stats = renderSideBySide(gpu, runs, framesPerTurn, label);
         for (uint32_t k = 0; k < modeCount; ++k) {
             const Mode& m = modes[order[k]];
             out["modes"][m.name] = std::move(stats[k]);
@@ -734,7 +743,7 @@ nlohmann::json runBench(Gpu& gpu, const BenchOptions& b) {
                 std::fprintf(stderr, "%s%s (round %u of %u)\n", label.c_str(),
                              interleaveNote(b).c_str(), round + 1, spectraRounds);
                 std::vector<nlohmann::json> stats =
-                    renderSideBySide(gpu, renders, b.framesPerTurn, label);
+                    renderSideBySide(gpu, renders, framesPerTurn, label);
                 for (int k = 0; k < 2; ++k) {
                     bool on = (k == 0) == (round % 2 == 0);
                     nlohmann::json& st = stats[k];

@@ -221,10 +221,12 @@ struct BenchOptions {
     // The forward / decoupled / reuse comparison's rounds: 1, or --rounds when given (each round
     // runs the three modes, in alternating order; ratios are the median of the rounds').
     uint32_t modeRounds = 1;
-    // --interleave N|runs: the runs one comparison sets side by side (the three modes of a
+    // --interleave auto|N|runs: the runs one comparison sets side by side (the three modes of a
     // round; spectra on and single) take turns of N frames (app/bench_command.cpp
-    // renderSideBySide), or run one whole run after another (runs: 0).
-    uint32_t framesPerTurn = 4;
+    // renderSideBySide), or run one whole run after another (runs: 0). Auto: half the frames,
+    // 1 to 4 (benchFramesPerTurn), so that every run has at least two turns.
+    static constexpr uint32_t kFramesPerTurnAuto = ~0u;
+    uint32_t framesPerTurn = kFramesPerTurnAuto;
     // --instance-scaling N,N,...: builtin:many at each count (--lod on), --rounds rounds
     // interleaved; cpu_frame_ms per count and ratios cpu(N) / cpu(first N) (app/bench_command.cpp).
     std::vector<uint32_t> instanceScaling;

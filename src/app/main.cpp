@@ -47,13 +47,16 @@ uint32_t parseThreads(const std::string& t) {
     return uint32_t(v);
 }
 
-// --interleave N | runs: frames per turn of the bench's side-by-side runs (0 = whole runs).
+// --interleave auto | N | runs: frames per turn of the bench's side-by-side runs (0 = whole
+// runs).
 uint32_t parseInterleave(const std::string& t) {
+    if (t == "auto") return BenchOptions::kFramesPerTurnAuto;
     if (t == "runs") return 0;
     char* end = nullptr;
     long v = std::strtol(t.c_str(), &end, 10);
     if (end == t.c_str() || *end != '\0' || v < 1 || v > 1000)
-        throw InputError(format("--interleave %s: expected runs or 1..1000 frames", t.c_str()));
+        throw InputError(
+            format("--interleave %s: expected auto, runs or 1..1000 frames", t.c_str()));
     return uint32_t(v);
 }
 
@@ -552,12 +555,13 @@ int main(int argc, char** argv) {
             "--light-grid", benchLightGrid,
             "on | off: tiles and shadel chunks take their candidate lights from the light grid")
         ->capture_default_str();
-    std::string benchInterleave = "4";
+    std::string benchInterleave = "auto";
     bench
         ->add_option("--interleave", benchInterleave,
-                     "N | runs: the runs a ratio compares (the three modes of a round, spectra on "
-                     "and single) take turns of N frames (1..1000), so that the host's drift "
-                     "reaches each alike, or render one whole run after another (runs)")
+                     "auto | N | runs: the runs a ratio compares (the three modes of a round, "
+                     "spectra on and single) take turns of N frames (1..1000; auto: half the "
+                     "frames, 1 to 4), so that the host's drift reaches each alike, or render one "
+                     "whole run after another (runs)")
         ->capture_default_str();
     std::string benchSpectra = "auto";
     bench

@@ -105,5 +105,8 @@ TEST(RenderSession, BenchInterleavedByFrameCountsAsRunByRun) {
             0.0);
     }
     EXPECT_GT(result[0]["modes"]["reuse"]["shadels_reused"].get<uint64_t>(), 0u);
+    // Auto: half the frames, 1 to 4, so that 3 frames still take turns (of 1 frame).
+    b.framesPerTurn = BenchOptions::kFramesPerTurnAuto;
+    EXPECT_EQ(runBench(sharedGpu(), b)["interleave"], 1);
     EXPECT_EQ(validationErrors(), 0u);
 }
