@@ -99,6 +99,8 @@ void validateRenderOptions(const RenderOptions& o) {
         {"--trilinear-band", o.trilinearBand, kTrilinearBandRange},
         {"--shadel-budget", o.shadelBudget, kShadelBudgetRange},
         {"--forward-below", o.forwardBelowPixels, kForwardBelowRange},
+        {"--df-shadow-start", o.dfShadowStart, kDfDistanceRange},
+        {"--df-residency", o.dfResidency, kDfDistanceRange},
     };
     for (const auto& [flag, value, range] : floats)
         if (std::string problem = checkFiniteInRange(flag, value, range); !problem.empty())
@@ -130,6 +132,30 @@ void validateRenderOptions(const RenderOptions& o) {
             if (std::string problem = checkFiniteInRange(flag, (*v)[i], kCoordinateRange);
                 !problem.empty())
                 throw InputError(problem);
+    // Counts, and options that need another (checked here, before the scene is loaded and
+    // baked, not where the renderer is built).
+    auto requireCount = [](const char* flag, uint32_t value, uint32_t lo, uint32_t hi) {
+        if (value < lo || value > hi)
+            throw InputError(format("%s %u: expected %u..%u", flag, value, lo, hi));
+    };
+    requireCount("--material-samples", o.materialSamples, 1, 64);
+    requireCount("--allocation-counters", o.allocationCounters, 1, SHADEL_COUNTERS);
+    requireCount("--reuse-refresh", o.reuseRefreshPeriod, 1, 1024);
+    requireCount("--particle-atlas-size", o.particleAtlasSize, 128, 8192);
+    requireCount("--gi-iterations", o.giIterations, 0, 64);
+    if (o.visualize == Visualize::Gi && o.gi == GiMode::Off)
+        throw InputError("--visualize gi: shows the indirect light of --gi lpv; GI is off");
+    if (o.visualize == Visualize::RtAo && !o.rt.ao)
+        throw InputError("--visualize rt-ao: shows the ray-traced AO of --rt-ao on; it is off");
+    if (o.visualize == Visualize::Tiles && !o.screenSpace)
+        throw InputError(
+            "--visualize tiles: shows the tile classes of --screen-space on; it is off");
+    if (o.distanceFields && !o.screenSpace)
+        throw InputError(
+            "--distance-fields on: runs on the screen-space tiles; add --screen-space on");
+    if (o.stencilEffects != StencilEffects::Off && !o.screenSpace)
+        throw InputError("--stencil-effects: composites the screen-space reflections; add "
+                         "--screen-space on");
 }
 
 int exitForParseError(const CLI::App& app, const CLI::ParseError& error) {

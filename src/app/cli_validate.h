@@ -32,6 +32,7 @@ constexpr FloatRange kTimeRange{0, 1e6};                // seconds (--time)
 constexpr FloatRange kTimeStepRange{0, 3600, true};     // seconds per frame (--time-step)
 constexpr FloatRange kCoordinateRange{-1e9, 1e9};       // world units (--from, --look-at)
 constexpr FloatRange kTextureBudgetRange{0, 1e6, true}; // MiB (--texture-budget)
+constexpr FloatRange kDfDistanceRange{0, 1e6}; // metres (--df-shadow-start, --df-residency)
 
 // Accepts a finite number in the range. CLI11 reports a rejection as "<flag>: <reason>".
 CLI::Validator finiteInRange(FloatRange range);
@@ -48,8 +49,9 @@ CLI::Validator byteSize();
 std::string checkFiniteInRange(const char* flag, double value, FloatRange range);
 
 struct RenderOptions;
-// Throws InputError naming the flag for the first float option out of range: runRender's
-// callers in code (tests, bench) do not go through the flag checks.
+// Throws InputError naming the flag for the first float option out of range, count out of
+// range or option that needs another: runRender's callers in code (tests, bench) do not go
+// through the flag checks, and runRender checks before loading the scene.
 void validateRenderOptions(const RenderOptions& options);
 
 // What main returns for a CLI11 exception: help and version print and return 0; any other

@@ -37,14 +37,20 @@ float parseDensity(const std::string& t) {
     return float(v);
 }
 
+// A whole decimal number in lo..hi, else nothing.
+std::optional<uint32_t> parseCount(const std::string& t, long lo, long hi) {
+    char* end = nullptr;
+    long v = std::strtol(t.c_str(), &end, 10);
+    if (end == t.c_str() || *end != '\0' || v < lo || v > hi) return std::nullopt;
+    return uint32_t(v);
+}
+
 // --threads auto | N: threads recording a frame's passes (0 = auto).
 uint32_t parseThreads(const std::string& t) {
     if (t == "auto") return 0;
-    char* end = nullptr;
-    long v = std::strtol(t.c_str(), &end, 10);
-    if (end == t.c_str() || *end != '\0' || v < 1 || v > 64)
-        throw InputError(format("--threads %s: expected auto or 1..64", t.c_str()));
-    return uint32_t(v);
+    std::optional<uint32_t> n = parseCount(t, 1, 64);
+    if (!n) throw InputError(format("--threads %s: expected auto or 1..64", t.c_str()));
+    return *n;
 }
 
 // --interleave auto | N | runs: frames per turn of the bench's side-by-side runs (0 = whole
@@ -52,12 +58,11 @@ uint32_t parseThreads(const std::string& t) {
 uint32_t parseInterleave(const std::string& t) {
     if (t == "auto") return BenchOptions::kFramesPerTurnAuto;
     if (t == "runs") return 0;
-    char* end = nullptr;
-    long v = std::strtol(t.c_str(), &end, 10);
-    if (end == t.c_str() || *end != '\0' || v < 1 || v > 1000)
+    std::optional<uint32_t> n = parseCount(t, 1, 1000);
+    if (!n)
         throw InputError(
             format("--interleave %s: expected auto, runs or 1..1000 frames", t.c_str()));
-    return uint32_t(v);
+    return *n;
 }
 
 std::optional<TimingMode> parseTiming(const std::string& t) {

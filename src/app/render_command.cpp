@@ -260,7 +260,6 @@ struct RenderSession {
     // This render's pipelines, counted around its own steps: another render's steps may come
     // between them.
     PipelineLibraryCounters pipelines;
-    uint32_t framesRendered = 0;
 };
 
 void RenderSessionDeleter::operator()(RenderSession* session) const {
@@ -292,46 +291,13 @@ RenderRun runRender(Gpu& gpu, const RenderOptions& o) {
 }
 
 bool renderSessionDone(const RenderSession& session) {
-    return session.run.listedCaptures || session.framesRendered >= session.o.frames;
+    return session.run.listedCaptures || session.run.frames.size() >= session.o.frames;
 }
-
-namespace {
-// The options' own errors (no scene needed): thrown before minutes of loading and baking.
-void requireConsistentOptions(const RenderOptions& o) {
-    auto requireCount = [](const char* flag, uint32_t value, uint32_t lo, uint32_t hi) {
-        if (value < lo || value > hi)
-            throw InputError(format("%s %u: expected %u..%u", flag, value, lo, hi));
-    };
-    requireCount("--material-samples", o.materialSamples, 1, 64);
-    requireCount("--allocation-counters", o.allocationCounters, 1, SHADEL_COUNTERS);
-    requireCount("--reuse-refresh", o.reuseRefreshPeriod, 1, 1024);
-    requireCount("--particle-atlas-size", o.particleAtlasSize, 128, 8192);
-    requireCount("--gi-iterations", o.giIterations, 0, 64);
-    if (o.visualize == Visualize::Gi && o.gi == GiMode::Off)
-        throw InputError("--visualize gi: shows the indirect light of --gi lpv; GI is off");
-    if (o.visualize == Visualize::RtAo && !o.rt.ao)
-        throw InputError("--visualize rt-ao: shows the ray-traced AO of --rt-ao on; it is off");
-    if (o.visualize == Visualize::Tiles && !o.screenSpace)
-        throw InputError(
-            "--visualize tiles: shows the tile classes of --screen-space on; it is off");
-    if (o.distanceFields && !o.screenSpace)
-        throw InputError(
-            "--distance-fields on: runs on the screen-space tiles; add --screen-space on");
-    if (o.stencilEffects != StencilEffects::Off && !o.screenSpace)
-        throw InputError("--stencil-effects: composites the screen-space reflections; add "
-                         "--screen-space on");
-    for (auto [flag, value] : {std::pair{"--df-shadow-start", o.dfShadowStart},
-                               std::pair{"--df-residency", o.dfResidency}})
-        if (std::string e = checkFiniteInRange(flag, value, {0.0, 1e6}); !e.empty())
-            throw InputError(e);
-}
-} // namespace
 
 RenderSessionPtr beginRender(Gpu& gpu, const RenderOptions& options) {
     RenderSessionPtr sessionPtr(new RenderSession(gpu, options));
     RenderSession& session = *sessionPtr;
     const RenderOptions& o = session.o;
-    requireConsistentOptions(o);
     if (o.frames < 1 || o.frames > 100000)
         throw InputError(format("--frames %u: expected 1..100000", o.frames));
     if (o.ssaa < 1 || o.ssaa > 16) throw InputError(format("--ssaa %u: expected 1..16", o.ssaa));
@@ -607,7 +573,7 @@ void renderNextFrame(RenderSession& session) {
     Renderer& renderer = session.renderer;
     RenderRun& run = session.run;
     std::optional<ScenePlayback>& playback = session.playback;
-    const uint32_t i = session.framesRendered;
+    const uint32_t i = uint32_t(run.frames.size()); // this frame's index
     if (i >= o.frames || !session.rendererLive)
         throw std::logic_error("renderNextFrame: the render has no frame left");
     const PipelineLibraryCounters pipelinesBefore = pipelineLibraryCounters(gpu);
@@ -636,7 +602,6 @@ void renderNextFrame(RenderSession& session) {
         renderer.nextFrame = Renderer::NextFrame{viewOfFrame(session, i + 1), playback.has_value()};
     }
     run.frames.push_back(renderFrame(renderer, session.gpuScene, view));
-    session.framesRendered++;
     if (i > 0) // what this frame took from the worker ran beside the last one
         for (FrontendWorkerTask& t : renderer.frontendTaken)
             run.frames[i - 1].frontendWorker.push_back(t);
