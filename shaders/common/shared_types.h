@@ -189,6 +189,7 @@ using uint = uint32_t;
 #define VISUALIZE_RT_AO 7u          // --visualize rt-ao: the ray-traced ambient occlusion only
 #define VISUALIZE_TILES 20u         // --visualize tiles: the 8x8 tile classes (render/tiles)
 #define VISUALIZE_SPECTRA 18u       // --visualize spectra: each tile's shading permutation
+#define VISUALIZE_REUSE 9u          // --visualize reuse: carried-over chunks, and why others shaded
 
 // One vertex of the unified geometry buffer (matches shadel::Vertex).
 struct GpuVertex {
@@ -723,6 +724,8 @@ struct GpuShadelWork {
 #define SHADEL_SHADED_RT_HISTORY 4u  // the RT cache under it gained sqrt 2 x rays
 #define SHADEL_SHADED_VIEW 5u        // the view turned past what its specular tolerates
 #define SHADEL_SHADED_REASONS 6
+// ShadelFrame::chunkReasons of a chunk carried over from last frame's storage.
+#define SHADEL_CHUNK_CARRIED 0xFFu
 
 struct GpuShadelCounters {
     // Chunks requested through each hashed counter. The counters only spread the atomics: once
@@ -795,6 +798,9 @@ struct ShadelFrame {
     // packSnorm2x16)}; x = SHADEL_CHUNK_VIEW_NONE: no shadel of it is covered.
     uint64_t chunkViews;
     uint64_t prevChunkViews; // last frame's
+    // --visualize reuse only (else 0): uint per storage slot, why its chunk was shaded this frame
+    // (SHADEL_SHADED_*) or SHADEL_CHUNK_CARRIED.
+    uint64_t chunkReasons;
     // Regions whose lighting changed since last frame (render/shadel/reuse_invalidation.h):
     // capsules, two vec4s each: (a, radius), (b, 0); infinite radius = everywhere.
     uint64_t changedVolumes;

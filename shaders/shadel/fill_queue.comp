@@ -89,6 +89,8 @@ void main() {
                       : rtHistory    ? SHADEL_SHADED_RT_HISTORY
                                      : SHADEL_SHADED_NEW;
         shadedBecause[reason]++;
+        // (a near-change chunk's carry-over, if its check allows it, writes over this)
+        if (s.chunkReasons != 0ul) UintBuffer(s.chunkReasons).v[w.slot] = reason;
     }
     for (uint reason = 0u; reason < SHADEL_SHADED_REASONS; ++reason)
         if (shadedBecause[reason] != 0u) atomicAdd(counters.c.shadedBecause[reason], shadedBecause[reason]);

@@ -30,7 +30,7 @@ vec3 storageTap(ShadelFrame s, uint layer, int slot, uvec2 sheet) {
 
 // The bilinear filter over a level footprint (levelFootprint).
 vec3 sampleFootprint(ShadelFrame s, LevelFootprint fp, uint layer, inout uint missing,
-                     inout uint overflowed, out uint64_t firstMask) {
+                     inout uint overflowed, out uint64_t firstMask, out int firstSlot) {
     // The footprint's two columns and two rows in the sheet (clamped to the level). Each of its
     // four taps reads the chunk holding it; one chunk lookup serves all four unless the
     // footprint crosses a chunk edge (15 of 64 positions), which costs only the extra lookups:
@@ -43,6 +43,7 @@ vec3 sampleFootprint(ShadelFrame s, LevelFootprint fp, uint layer, inout uint mi
     bvec2 cross = notEqual(lo / SHADEL_CHUNK, hi / SHADEL_CHUNK);
     uint64_t mask; // of the other lookups (only the first is reported)
     int s00 = chunkSlotAt(s, lo, missing, overflowed, firstMask);
+    firstSlot = s00;
     int s10 = cross.x ? chunkSlotAt(s, uvec2(hi.x, lo.y), missing, overflowed, mask) : s00;
     int s01 = cross.y ? chunkSlotAt(s, uvec2(lo.x, hi.y), missing, overflowed, mask) : s00;
     int s11 = cross.x && cross.y ? chunkSlotAt(s, hi, missing, overflowed, mask)
@@ -60,6 +61,7 @@ struct Reconstruction {
     uint missing;    // chunk lookups that found no marked chunk
     uint overflowed; // chunk lookups whose chunk got no storage
     uint64_t mask0;  // occupancy of the first tap's block (marking view)
+    int slot0;       // storage slot of the first tap's chunk, -1 if none (reuse view)
     float lod;       // of the first tap, after fitting to the level windows
     uint mip0;
     bool windowFallback; // a level the sample wanted was outside its window: read coarser
@@ -80,6 +82,8 @@ Reconstruction reconstructSample(ShadelFrame s, ShadelObjectRef o, vec2 shadelUv
     r.mask0 = 0ul;
     r.windowFallback = false;
     uint64_t mask1, tapMask;
+    int slot1, tapSlot;
+    r.slot0 = -1;
     ShadelAniso a = shadelAniso(texelDx, texelDy);
     r.color = vec3(0.0);
     for (uint i = 0u; i < a.taps; ++i) { // the same taps and levels marking marked
@@ -87,14 +91,16 @@ Reconstruction reconstructSample(ShadelFrame s, ShadelObjectRef o, vec2 shadelUv
         ShadelLevels l = wanted;
         LevelFootprint fp0, fp1;
         r.windowFallback = fitLevelFootprints(o, uv, l, fp0, fp1) != 0u || r.windowFallback;
-        vec3 c = sampleFootprint(s, fp0, layer, r.missing, r.overflowed, tapMask);
+        vec3 c = sampleFootprint(s, fp0, layer, r.missing, r.overflowed, tapMask, tapSlot);
         if (i == 0u) {
             r.mask0 = tapMask;
+            r.slot0 = tapSlot;
             r.mip0 = l.mip0;
             r.lod = float(l.mip0) + l.blend;
             r.forward = windowFallbackTooDeep(wanted, l); // as marking decided
         }
-        if (l.two) c = mix(c, sampleFootprint(s, fp1, layer, r.missing, r.overflowed, mask1), l.blend);
+        if (l.two)
+            c = mix(c, sampleFootprint(s, fp1, layer, r.missing, r.overflowed, mask1, slot1), l.blend);
         r.color += c;
     }
     r.color /= float(a.taps);
@@ -128,9 +134,28 @@ vec3 heat(float t) {
     return clamp(vec3(1.5 - abs(4.0 * t - 3.0), 1.5 - abs(4.0 * t - 2.0), 1.5 - abs(4.0 * t - 1.0)), 0.0, 1.0);
 }
 
-// The debug views (--visualize marking|mips|chunks) over the reconstructed colour.
+// --visualize reuse: the colour of why the chunk in `slot` was shaded this frame
+// (SHADEL_SHADED_*); carried-over chunks keep their image in grey.
+vec3 reuseReasonView(ShadelFrame s, int slot, vec3 color) {
+    if (slot < 0 || s.chunkReasons == 0ul) return color;
+    uint reason = UintBuffer(s.chunkReasons).v[uint(slot)];
+    vec3 grey = vec3(dot(min(color, vec3(1.0)), vec3(0.2126, 0.7152, 0.0722)));
+    if (reason == SHADEL_CHUNK_CARRIED) return grey;
+    const vec3 tints[SHADEL_SHADED_REASONS] = vec3[](
+        vec3(1.0, 0.15, 0.1),  // not reusable: red
+        vec3(0.1, 1.0, 0.2),   // new: green
+        vec3(0.15, 0.35, 1.0), // refresh: blue
+        vec3(1.0, 0.55, 0.05), // near a change: orange
+        vec3(0.1, 0.9, 0.9),   // RT history: cyan
+        vec3(1.0, 0.9, 0.1));  // view turned: yellow
+    return mix(grey, tints[min(reason, uint(SHADEL_SHADED_REASONS - 1))], 0.6);
+}
+
+// The debug views (--visualize marking|mips|chunks|reuse) over the reconstructed colour.
 vec3 visualizeReconstruction(FrameConstants f, ShadelObjectRef o, Reconstruction r, vec3 color,
                              vec2 shadelUv, vec2 texelDx, vec2 texelDy) {
+    if (f.visualize == VISUALIZE_REUSE)
+        color = reuseReasonView(ShadelFrameRef(f.shadel).s, r.slot0, color);
     if (f.visualize == VISUALIZE_MARKING) {
         // Seed colours: green = block with any chunk marked, blue = block fully marked.
         vec3 tint = r.mask0 == ~0ul ? vec3(0.1, 0.2, 1.0) : vec3(0.1, 1.0, 0.2);

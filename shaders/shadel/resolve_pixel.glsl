@@ -61,9 +61,10 @@ vec3 forwardShade(FrameConstants f, GpuInstance inst, VisTriangle tri, VisBary b
 vec3 resolveAddressed(ShadelFrame s, ResolveAddress a, inout uint missing, inout uint overflowed) {
     const uint layer = SHADEL_LAYER_RADIANCE;
     uint64_t mask;
-    vec3 c = sampleFootprint(s, a.footprint0, layer, missing, overflowed, mask);
+    int slot;
+    vec3 c = sampleFootprint(s, a.footprint0, layer, missing, overflowed, mask, slot);
     if (a.two)
-        c = mix(c, sampleFootprint(s, a.footprint1, layer, missing, overflowed, mask), a.blend);
+        c = mix(c, sampleFootprint(s, a.footprint1, layer, missing, overflowed, mask, slot), a.blend);
     return c;
 }
 

@@ -339,5 +339,6 @@ void carryChunkRow(ShadelFrame s, uint fromSlot, uint toSlot, uint row) {
 void carryChunkRecord(ShadelFrame s, uint fromSlot, uint toSlot) {
     Uvec4Buffer(s.chunkViews).v[toSlot] = Uvec4Buffer(s.prevChunkViews).v[fromSlot];
     atomicAdd(ShadelCountersRef(s.counters).c.chunksReused, 1u);
+    if (s.chunkReasons != 0ul) UintBuffer(s.chunkReasons).v[toSlot] = SHADEL_CHUNK_CARRIED;
 }
 #endif

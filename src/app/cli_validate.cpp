@@ -147,6 +147,9 @@ void validateRenderOptions(const RenderOptions& o) {
         throw InputError("--visualize gi: shows the indirect light of --gi lpv; GI is off");
     if (o.visualize == Visualize::RtAo && !o.rt.ao)
         throw InputError("--visualize rt-ao: shows the ray-traced AO of --rt-ao on; it is off");
+    if (o.visualize == Visualize::Reuse && o.mode != RenderMode::Decoupled)
+        throw InputError("--visualize reuse: shows which shadel chunks were carried over; add "
+                         "--mode decoupled");
     if (o.visualize == Visualize::Tiles && !o.screenSpace)
         throw InputError(
             "--visualize tiles: shows the tile classes of --screen-space on; it is off");

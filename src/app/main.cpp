@@ -148,7 +148,11 @@ int main(int argc, char** argv) {
     render
         ->add_option("--visualize", visualize,
                      "none | marking | mips | chunks | sheet | layer:radiance | layer:material | "
-                     "light-count | blockers | gi (indirect light only, with --gi lpv) | rt-ao "
+                     "reuse (decoupled: carried-over chunks grey; shaded ones tinted by why: "
+                     "red not reusable, green new, blue refresh, orange near a changed light, "
+                     "cyan RT history, yellow view turned) | "
+                     "light-count | spectra (each tile's or chunk's shading permutation) | "
+                     "blockers | gi (indirect light only, with --gi lpv) | rt-ao "
                      "(ray-traced AO only, with --rt-ao on) | particle-atlas | tiles (the 8x8 "
                      "tile classes, with --screen-space on)")
         ->capture_default_str();

@@ -61,9 +61,10 @@ Visualize parseVisualize(const std::string& text) {
     if (text == "particle-atlas") return Visualize::ParticleAtlas;
     if (text == "tiles") return Visualize::Tiles;
     if (text == "spectra") return Visualize::Spectra;
+    if (text == "reuse") return Visualize::Reuse;
     throw InputError(format("--visualize %s: expected none, marking, mips, chunks, sheet, "
-                            "layer:radiance, layer:material, light-count, blockers, gi, rt-ao, "
-                            "particle-atlas, tiles or spectra",
+                            "layer:radiance, layer:material, reuse, light-count, blockers, gi, "
+                            "rt-ao, particle-atlas, tiles or spectra",
                             text.c_str()));
 }
 

@@ -61,6 +61,7 @@ enum class Visualize : uint32_t {
     ParticleAtlas = 24,                 // --visualize particle-atlas (render/particles)
     Tiles = VISUALIZE_TILES,            // --visualize tiles: 8x8 tile classes (render/tiles)
     Spectra = VISUALIZE_SPECTRA,        // each tile's shading mode (--spectra on|single)
+    Reuse = VISUALIZE_REUSE,            // decoupled: carried-over chunks grey, shaded by reason
 };
 // --particle-lighting: lit particle sprites read the atlas, or are lit per pixel / per vertex.
 enum class ParticleLighting : uint32_t { Atlas = 0, Pixel = 1, Vertex = 2 };

@@ -273,6 +273,7 @@ TEST(Cli, InconsistentOptionsFailBeforeLoading) {
     const std::pair<const char*, const char*> cases[] = {
         {"render --scene /nonexistent.gltf --visualize gi", "--visualize gi"},
         {"render --scene /nonexistent.gltf --visualize tiles", "--visualize tiles"},
+        {"render --scene /nonexistent.gltf --visualize reuse", "--visualize reuse"},
         {"render --scene /nonexistent.gltf --distance-fields on", "--distance-fields on"},
         {"render --scene /nonexistent.gltf --material-samples 0", "--material-samples 0"},
         {"render --scene /nonexistent.gltf --gi lpv --gi-iterations 99", "--gi-iterations 99"},

@@ -179,6 +179,9 @@ struct DecoupledState {
     std::array<BufferHandle, 2> offsetMap; // uint per block
     // uvec4 per storage slot: where its chunk was seen from when shaded (ShadelFrame::chunkViews)
     std::array<BufferHandle, 2> chunkViews;
+    // --visualize reuse: uint per storage slot, why its chunk was shaded or that it was carried
+    // over (ShadelFrame::chunkReasons); absent otherwise.
+    BufferHandle chunkReasons;
     uint64_t frameNumber = 0; // frames prepared so far
     uint32_t parity() const { return uint32_t(frameNumber & 1); }
     bool reuse = true;
@@ -338,6 +341,8 @@ DecoupledStatePtr createDecoupled(Renderer& r, const GpuScene& scene) {
                            VkDeviceSize(d.capacityChunks) * (SHADE_CLASSES + 1) * sizeof(uint32_t));
     d.chunkViews = {device("shadel.chunkViews.frame0", VkDeviceSize(d.capacityChunks) * 16),
                     device("shadel.chunkViews.frame1", VkDeviceSize(d.capacityChunks) * 16)};
+    if (rs.visualize == Visualize::Reuse)
+        d.chunkReasons = device("shadel.chunkReasons", VkDeviceSize(d.capacityChunks) * 4);
 
     d.clear = createComputePipeline(gpu, "shadelClear", "shadel_clear.comp.spv");
     d.allocate = createComputePipeline(gpu, "shadelAllocate", "shadel_allocate.comp.spv");
@@ -416,6 +421,7 @@ void destroyDecoupled(Renderer& r, DecoupledStatePtr& state) {
           d.occupancy[1], d.offsetMap[0], d.offsetMap[1], d.allocId, d.counters, d.markedBlocks,
           d.queue, d.copyQueue, d.classQueues, d.chunkViews[0], d.chunkViews[1]})
         destroy(gpu, b);
+    if (d.chunkReasons) destroy(gpu, d.chunkReasons);
     state.reset();
 }
 
@@ -1031,6 +1037,7 @@ void prepareDecoupledFrame(Renderer& r, const GpuScene& scene, const CameraView&
     s.prevOffsetMap = address(gpu, d.offsetMap[prev]);
     s.chunkViews = address(gpu, d.chunkViews[now]);
     s.prevChunkViews = address(gpu, d.chunkViews[prev]);
+    s.chunkReasons = d.chunkReasons ? address(gpu, d.chunkReasons) : 0u;
     s.allocId = address(gpu, d.allocId);
     s.counters = address(gpu, d.counters);
     s.rects = address(gpu, d.rectBuffer);
