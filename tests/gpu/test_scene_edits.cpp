@@ -160,6 +160,36 @@ TEST(SceneEdits, LightAndSunEditsShowInTheNextFrameBothPaths) {
     }
 }
 
+// The viewer switches its debug view between two frames of one renderer (renderer.settings),
+// as the edits above change the scene: --visualize reuse, whose per-slot reasons the renderer
+// makes only once a frame shows the view, shows in the next frame. A still camera carries every
+// chunk over (grey, the channels equal) but the few due for their refresh; a fresh renderer's
+// first frame has nothing to carry (red: not reusable).
+TEST(SceneEdits, ReuseViewSwitchedOnBetweenFrames) {
+    EditFrames f = renderEdit(RenderMode::Decoupled, [](Renderer& r, const GpuScene&) {
+        r.settings.visualize = Visualize::Reuse;
+    });
+    auto fraction = [](const std::vector<uint8_t>& rgba, auto&& test) {
+        size_t covered = 0, hits = 0;
+        for (size_t i = 0; i + 3 < rgba.size(); i += 4) {
+            if (rgba[i + 3] == 0) continue;
+            ++covered;
+            hits += test(int(rgba[i]), int(rgba[i + 1]), int(rgba[i + 2])) ? 1 : 0;
+        }
+        return double(hits) / double(std::max<size_t>(covered, 1));
+    };
+    auto grey = [](int r, int g, int b) { return r == g && g == b; };
+    auto red = [](int r, int g, int b) { return r > g + 40 && r > b + 40; };
+    double greyBefore = fraction(f.before, grey), greyAfter = fraction(f.after, grey);
+    double redFresh = fraction(f.fresh, red);
+    std::printf("[ figures ] reuse view switched on: grey pixels %.3f before, %.3f after; a fresh "
+                "renderer's first frame %.3f red\n",
+                greyBefore, greyAfter, redFresh);
+    EXPECT_GT(greyAfter, 0.8);
+    EXPECT_GT(greyAfter, greyBefore + 0.3);
+    EXPECT_GT(redFresh, 0.9);
+}
+
 TEST(SceneEdits, OutOfRangeIndexIsAnInputError) {
     Gpu& gpu = sharedGpu();
     Scene scene = loadScene("builtin:smooth", {});

@@ -12,9 +12,9 @@
 
 namespace shadel {
 
-const char* const kVisualizeNames[] = {"none",   "marking", "mips",
-                                       "chunks", "sheet",   "layer:material"};
-const int kVisualizeCount = 6;
+const char* const kVisualizeNames[] = {"none",  "marking",        "mips", "chunks",
+                                       "sheet", "layer:material", "reuse"};
+const int kVisualizeCount = 7;
 
 static void checkVk(VkResult r) {
     if (r != VK_SUCCESS) SHADEL_ERROR("ImGui Vulkan backend: VkResult %d", int(r));

@@ -36,7 +36,8 @@ struct ViewerPanel {
     bool screenshotRequested = false;
 };
 
-extern const char* const kVisualizeNames[]; // none, marking, mips, chunks, sheet, layer:material
+extern const char* const
+    kVisualizeNames[]; // none, marking, mips, chunks, sheet, layer:material, reuse
 extern const int kVisualizeCount;
 
 void initUi(ViewerUi& ui, ViewerWindow& w, Gpu& gpu);

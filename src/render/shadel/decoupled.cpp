@@ -180,7 +180,8 @@ struct DecoupledState {
     // uvec4 per storage slot: where its chunk was seen from when shaded (ShadelFrame::chunkViews)
     std::array<BufferHandle, 2> chunkViews;
     // --visualize reuse: uint per storage slot, why its chunk was shaded or that it was carried
-    // over (ShadelFrame::chunkReasons); absent otherwise.
+    // over (ShadelFrame::chunkReasons); made by the first frame that shows the view (the
+    // viewer's debug view may switch to it at any frame), absent otherwise.
     BufferHandle chunkReasons;
     uint64_t frameNumber = 0; // frames prepared so far
     uint32_t parity() const { return uint32_t(frameNumber & 1); }
@@ -341,8 +342,6 @@ DecoupledStatePtr createDecoupled(Renderer& r, const GpuScene& scene) {
                            VkDeviceSize(d.capacityChunks) * (SHADE_CLASSES + 1) * sizeof(uint32_t));
     d.chunkViews = {device("shadel.chunkViews.frame0", VkDeviceSize(d.capacityChunks) * 16),
                     device("shadel.chunkViews.frame1", VkDeviceSize(d.capacityChunks) * 16)};
-    if (rs.visualize == Visualize::Reuse)
-        d.chunkReasons = device("shadel.chunkReasons", VkDeviceSize(d.capacityChunks) * 4);
 
     d.clear = createComputePipeline(gpu, "shadelClear", "shadel_clear.comp.spv");
     d.allocate = createComputePipeline(gpu, "shadelAllocate", "shadel_allocate.comp.spv");
@@ -1037,7 +1036,13 @@ void prepareDecoupledFrame(Renderer& r, const GpuScene& scene, const CameraView&
     s.prevOffsetMap = address(gpu, d.offsetMap[prev]);
     s.chunkViews = address(gpu, d.chunkViews[now]);
     s.prevChunkViews = address(gpu, d.chunkViews[prev]);
-    s.chunkReasons = d.chunkReasons ? address(gpu, d.chunkReasons) : 0u;
+    bool showReuse = r.settings.visualize == Visualize::Reuse;
+    if (showReuse && !d.chunkReasons)
+        d.chunkReasons =
+            need(createBuffer(gpu, {"shadel.chunkReasons", VkDeviceSize(d.capacityChunks) * 4, 0,
+                                    MemoryKind::DeviceLocal}),
+                 "shadel.chunkReasons");
+    s.chunkReasons = showReuse ? address(gpu, d.chunkReasons) : 0u;
     s.allocId = address(gpu, d.allocId);
     s.counters = address(gpu, d.counters);
     s.rects = address(gpu, d.rectBuffer);
