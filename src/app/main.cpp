@@ -811,6 +811,26 @@ int main(int argc, char** argv) {
                 (unsigned long long)s["shader_asserts"].get<uint64_t>(),
                 (unsigned long long)s["validation_errors"].get<uint64_t>(),
                 ro.out.empty() ? "" : " -> ", ro.out.c_str());
+            if (s["mode"] == "decoupled") { // what a decoupled run is judged by, at a glance
+                std::string line =
+                    format("  %.2f shadels per covered pixel, %llu reconstruction misses",
+                           s["shadels_per_pixel"].get<double>(),
+                           (unsigned long long)s["reconstruction_misses"].get<uint64_t>());
+                if (s["reuse"].get<bool>() && ro.frames > 1) {
+                    line += format(", %.1f%% of stored shadels carried over; shaded for",
+                                   100.0 * s["reuse_fraction"].get<double>());
+                    // Largest first (SHADEL_SHADED_*: --visualize reuse shows where).
+                    std::vector<std::pair<double, std::string>> reasons;
+                    for (const auto& [name, fraction] : s["shaded_because"].items())
+                        if (fraction.get<double>() > 0.0)
+                            reasons.push_back({fraction.get<double>(), name});
+                    std::sort(reasons.rbegin(), reasons.rend());
+                    for (size_t i = 0; i < reasons.size(); ++i)
+                        line += format("%s %s %.1f%%", i ? "," : "", reasons[i].second.c_str(),
+                                       100.0 * reasons[i].first);
+                }
+                std::printf("%s\n", line.c_str());
+            }
             return s["shader_asserts"].get<uint64_t>() || s["validation_errors"].get<uint64_t>()
                        ? 4
                        : 0;

@@ -13,6 +13,9 @@
 
 #include "gpu_test_env.h"
 
+#include "core/log.h"
+
+using shadel::format;
 using shadel::test::tempPath;
 
 namespace {
@@ -215,6 +218,27 @@ TEST(Cli, ForwardBelowIsAFlag) {
         run("render --mode decoupled --size 32x32 --forward-below 0 --stats " + dir.file("s.json"));
     EXPECT_EQ(r.exitCode, 0) << r.stderrText;
     EXPECT_TRUE(std::filesystem::exists(dir.file("s.json")));
+}
+
+// A decoupled render's summary says what it is judged by: shadels per covered pixel, misses
+// and, with reuse over several frames, what was carried over and why the rest was shaded; the
+// figures are the stats file's.
+TEST(Cli, DecoupledSummaryGivesShadelsPerPixelAndReuse) {
+    CliTempDir dir;
+    Output o = runWithEnv("", "render --mode decoupled --size 64x36 --frames 3 --camera-path "
+                              "orbit --stats " +
+                                  dir.file("s.json"));
+    ASSERT_EQ(o.exitCode, 0) << o.stderrText;
+    nlohmann::json stats = nlohmann::json::parse(readText(dir.file("s.json")));
+    std::string perPixel =
+        format("%.2f shadels per covered pixel", stats["shadels_per_pixel"].get<double>());
+    std::string carried = format("%.1f%% of stored shadels carried over",
+                                 100.0 * stats["reuse_fraction"].get<double>());
+    EXPECT_NE(o.stdoutText.find(perPixel), std::string::npos) << o.stdoutText;
+    EXPECT_NE(o.stdoutText.find(carried), std::string::npos) << o.stdoutText;
+    EXPECT_NE(o.stdoutText.find("shaded for"), std::string::npos) << o.stdoutText;
+    Output forward = runWithEnv("", "render --size 64x36");
+    EXPECT_EQ(forward.stdoutText.find("shadels per covered pixel"), std::string::npos);
 }
 
 TEST(Cli, SubcommandHelpShowsGlobalFlagsAndTheBakeCache) {
