@@ -12,6 +12,10 @@
 // quads at 1280x720, 85% see one triangle, 13% two and 2% more. markingCompute, alternating
 // runs, 1280x720 orbit: 22.9-23.4 -> 21.2-21.9 ms; 1920x1080: 49.8 -> 47.5-48.5 (images
 // identical).
+// The quad's derivatives are coarse (shadel/vis_shadel.glsl), so its pixels of one triangle share
+// their MIP levels and anisotropy, taken once with the setup: markingCompute, alternating runs,
+// 1280x720 orbit 21.7, 21.7, 20.9 -> 21.6, 19.8, 19.4 ms; 1920x1080 45.4, 45.0, 44.7 -> 41.4,
+// 42.2, 41.3 ms (the same shadels shaded: 880,640 -> 880,448 at 1920x1080).
 #define SHADEL_MARK_CACHE // the quad's pixels mostly mark the same chunks: skip repeats
 #include "shadel/resolve_address.glsl"
 #include "shadel/vis_shadel.glsl"
@@ -57,13 +61,25 @@ void main() {
     ShadelObjectRef oa, ob;
     VisQuad qa, qb;
     bool decoupledA = false, decoupledB = false;
+    ShadelLevels la, lb;
+    ShadelAniso aa, ab;
     if (a.x != VISIBILITY_NONE) { // (a sky quad sets up nothing, nor reads, in an empty scene)
         decoupledA = setUpQuad(f, s, a, origin, oa, qa);
+        VisShadel v = visShadelSample(qa, oa, 0);
+        la = shadelLevels(oa, v.texelDx, v.texelDy, s.shadingBias, s.trilinearBand);
+        aa = shadelAniso(v.texelDx, v.texelDy);
         // A branch, but most SIMD groups take it: 1 - 0.85^8 of 8-quad groups hold a mixed quad.
         decoupledB = decoupledA;
         ob = oa;
         qb = qa;
-        if (b != a) decoupledB = setUpQuad(f, s, b, origin, ob, qb);
+        lb = la;
+        ab = aa;
+        if (b != a) {
+            decoupledB = setUpQuad(f, s, b, origin, ob, qb);
+            VisShadel w = visShadelSample(qb, ob, 0);
+            lb = shadelLevels(ob, w.texelDx, w.texelDy, s.shadingBias, s.trilinearBand);
+            ab = shadelAniso(w.texelDx, w.texelDy);
+        }
     }
     for (int i = 0; i < 4; ++i) {
         ivec2 pixel = origin + ivec2(i & 1, i >> 1);
@@ -74,11 +90,18 @@ void main() {
             ShadelObjectRef o = onA ? oa : ob;
             VisQuad q = onA ? qa : qb;
             bool decoupled = onA ? decoupledA : decoupledB;
-            if (!onA && vis[i] != b) // a third triangle in the quad (rare)
+            ShadelLevels l = onA ? la : lb;
+            ShadelAniso an = onA ? aa : ab;
+            bool third = !onA && vis[i] != b;
+            if (third) // a third triangle in the quad (rare)
                 decoupled = setUpQuad(f, s, vis[i], origin, o, q);
             if (decoupled) { // else a forward (hybrid) instance
                 VisShadel v = visShadelSample(q, o, i);
-                MarkedSample m = markSample(s, o, v.shadelUv, v.texelDx, v.texelDy);
+                if (third) {
+                    l = shadelLevels(o, v.texelDx, v.texelDy, s.shadingBias, s.trilinearBand);
+                    an = shadelAniso(v.texelDx, v.texelDy);
+                }
+                MarkedSample m = markSampleWith(s, o, v.shadelUv, l, an);
                 // As reconstructSample counts magnification (only sampled pixels count it).
                 bool magnified = max(dot(v.texelDx, v.texelDx), dot(v.texelDy, v.texelDy)) < 1.0;
                 address = packResolveAddress(m, magnified);

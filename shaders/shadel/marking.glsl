@@ -70,10 +70,10 @@ struct MarkedSample {
 };
 
 // texelDx/Dy: screen derivatives of the sample's MIP-0 shadel coordinate (shadelUv * mip0Size).
-MarkedSample markSample(ShadelFrame s, ShadelObjectRef o, vec2 shadelUv, vec2 texelDx,
-                        vec2 texelDy) {
-    ShadelLevels wanted = shadelLevels(o, texelDx, texelDy, s.shadingBias, s.trilinearBand);
-    ShadelAniso a = shadelAniso(texelDx, texelDy);
+// markSampleWith: with the levels and anisotropy already taken from the derivatives (a quad's
+// pixels of one triangle share them: vis_shadel.glsl).
+MarkedSample markSampleWith(ShadelFrame s, ShadelObjectRef o, vec2 shadelUv, ShadelLevels wanted,
+                            ShadelAniso a) {
     MarkedSample m;
     m.taps = a.taps;
     for (uint i = 0u; i < a.taps; ++i) { // the same taps reconstruction reads
@@ -94,5 +94,11 @@ MarkedSample markSample(ShadelFrame s, ShadelObjectRef o, vec2 shadelUv, vec2 te
         }
     }
     return m;
+}
+MarkedSample markSample(ShadelFrame s, ShadelObjectRef o, vec2 shadelUv, vec2 texelDx,
+                        vec2 texelDy) {
+    return markSampleWith(s, o, shadelUv,
+                          shadelLevels(o, texelDx, texelDy, s.shadingBias, s.trilinearBand),
+                          shadelAniso(texelDx, texelDy));
 }
 #endif

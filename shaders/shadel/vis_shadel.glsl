@@ -2,7 +2,9 @@
 // resolve so both rebuild exactly the same shadel UV and derivatives (hence the same MIPs and
 // chunks) from the same inputs. One invocation handles a 2x2 quad of pixels (aligned as the
 // rasterizer's quads): pixels of the same triangle share its setup and the four barycentrics,
-// and the fine derivatives are the quad's differences, as dFdx/dFdy take them.
+// and its derivatives are the quad's coarse ones (dFdxCoarse/dFdyCoarse: the differences along
+// the quad's first row and column, as GPUs take a quad's texture LOD), so the quad's pixels of
+// one triangle share their MIP choice and marking takes it once (mark_visibility.comp).
 #ifndef SHADEL_VIS_SHADEL_GLSL
 #define SHADEL_VIS_SHADEL_GLSL
 #include "common/visibility.glsl"
@@ -34,11 +36,10 @@ struct VisShadel {
 
 // Pixel `i` of the quad (x = i & 1, y = i >> 1).
 VisShadel visShadelSample(VisQuad q, ShadelObjectRef o, int i) {
-    int row = i >> 1, col = i & 1;
     VisShadel v;
     v.bary.center = q.bary[i];
-    precise vec3 bdx = q.bary[row * 2 + 1] - q.bary[row * 2];
-    precise vec3 bdy = q.bary[2 + col] - q.bary[col];
+    precise vec3 bdx = q.bary[1] - q.bary[0];
+    precise vec3 bdy = q.bary[2] - q.bary[0];
     v.bary.dx = bdx;
     v.bary.dy = bdy;
     vec2 size = vec2(o.v.mip0Size);
