@@ -31,15 +31,27 @@ layout(push_constant, scalar) uniform Push {
     uint64_t addresses; // ResolveAddressBuffer
 } pc;
 
-// The setup of the quad's pixels on `vis`'s triangle (a covered pixel's), when its instance is
-// decoupled.
-bool setUpQuad(FrameConstants f, ShadelFrame s, uvec2 vis, ivec2 origin, out ShadelObjectRef o,
-               out VisQuad q) {
-    o = shadelObject(s, vis.x);
-    bool decoupled = (o.v.flags & SHADEL_OBJECT_DECOUPLED) != 0u;
-    uvec2 any = decoupled ? vis : uvec2(vis.x, 0u); // a valid triangle to set up (unused if not)
-    visQuadSetup(f, s, InstanceBuffer(f.instances).i[any.x], any.y, origin, q);
-    return decoupled;
+// The quad's pixels on one triangle: its setup and, from the quad's coarse derivatives, the MIP
+// levels and anisotropy they all share (decoupled instances only; else unused).
+struct QuadTriangle {
+    ShadelObjectRef o;
+    VisQuad q;
+    bool decoupled;
+    ShadelLevels levels;
+    ShadelAniso aniso;
+};
+
+// The setup of the quad's pixels on `vis`'s triangle (a covered pixel's).
+QuadTriangle setUpQuad(FrameConstants f, ShadelFrame s, uvec2 vis, ivec2 origin) {
+    QuadTriangle t;
+    t.o = shadelObject(s, vis.x);
+    t.decoupled = (t.o.v.flags & SHADEL_OBJECT_DECOUPLED) != 0u;
+    uvec2 any = t.decoupled ? vis : uvec2(vis.x, 0u); // a valid triangle to set up (unused if not)
+    visQuadSetup(f, s, InstanceBuffer(f.instances).i[any.x], any.y, origin, t.q);
+    VisShadel v = visShadelSample(t.q, t.o, 0); // (every pixel's derivatives are these)
+    t.levels = shadelLevels(t.o, v.texelDx, v.texelDy, s.shadingBias, s.trilinearBand);
+    t.aniso = shadelAniso(v.texelDx, v.texelDy);
+    return t;
 }
 
 void main() {
@@ -58,28 +70,13 @@ void main() {
     for (int i = 1; i < 4; ++i) a = a.x == VISIBILITY_NONE ? vis[i] : a;
     uvec2 b = a;
     for (int i = 3; i > 0; --i) b = vis[i].x != VISIBILITY_NONE && vis[i] != a ? vis[i] : b;
-    ShadelObjectRef oa, ob;
-    VisQuad qa, qb;
-    bool decoupledA = false, decoupledB = false;
-    ShadelLevels la, lb;
-    ShadelAniso aa, ab;
+    QuadTriangle ta, tb;
+    ta.decoupled = false;
+    tb.decoupled = false;
     if (a.x != VISIBILITY_NONE) { // (a sky quad sets up nothing, nor reads, in an empty scene)
-        decoupledA = setUpQuad(f, s, a, origin, oa, qa);
-        VisShadel v = visShadelSample(qa, oa, 0);
-        la = shadelLevels(oa, v.texelDx, v.texelDy, s.shadingBias, s.trilinearBand);
-        aa = shadelAniso(v.texelDx, v.texelDy);
+        ta = setUpQuad(f, s, a, origin);
         // A branch, but most SIMD groups take it: 1 - 0.85^8 of 8-quad groups hold a mixed quad.
-        decoupledB = decoupledA;
-        ob = oa;
-        qb = qa;
-        lb = la;
-        ab = aa;
-        if (b != a) {
-            decoupledB = setUpQuad(f, s, b, origin, ob, qb);
-            VisShadel w = visShadelSample(qb, ob, 0);
-            lb = shadelLevels(ob, w.texelDx, w.texelDy, s.shadingBias, s.trilinearBand);
-            ab = shadelAniso(w.texelDx, w.texelDy);
-        }
+        tb = b != a ? setUpQuad(f, s, b, origin) : ta;
     }
     for (int i = 0; i < 4; ++i) {
         ivec2 pixel = origin + ivec2(i & 1, i >> 1);
@@ -87,21 +84,11 @@ void main() {
         uvec4 address = resolveAddressNone();
         if (vis[i].x != VISIBILITY_NONE) {
             bool onA = vis[i] == a;
-            ShadelObjectRef o = onA ? oa : ob;
-            VisQuad q = onA ? qa : qb;
-            bool decoupled = onA ? decoupledA : decoupledB;
-            ShadelLevels l = onA ? la : lb;
-            ShadelAniso an = onA ? aa : ab;
-            bool third = !onA && vis[i] != b;
-            if (third) // a third triangle in the quad (rare)
-                decoupled = setUpQuad(f, s, vis[i], origin, o, q);
-            if (decoupled) { // else a forward (hybrid) instance
-                VisShadel v = visShadelSample(q, o, i);
-                if (third) {
-                    l = shadelLevels(o, v.texelDx, v.texelDy, s.shadingBias, s.trilinearBand);
-                    an = shadelAniso(v.texelDx, v.texelDy);
-                }
-                MarkedSample m = markSampleWith(s, o, v.shadelUv, l, an);
+            QuadTriangle t = onA ? ta : tb;
+            if (!onA && vis[i] != b) t = setUpQuad(f, s, vis[i], origin); // a third (rare)
+            if (t.decoupled) { // else a forward (hybrid) instance
+                VisShadel v = visShadelSample(t.q, t.o, i);
+                MarkedSample m = markSampleWith(s, t.o, v.shadelUv, t.levels, t.aniso);
                 // As reconstructSample counts magnification (only sampled pixels count it).
                 bool magnified = max(dot(v.texelDx, v.texelDx), dot(v.texelDy, v.texelDy)) < 1.0;
                 address = packResolveAddress(m, magnified);

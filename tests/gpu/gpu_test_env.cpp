@@ -98,6 +98,29 @@ double worstFramePsnr(const RenderRun& a, const RenderRun& b) {
     return worst;
 }
 
+ReuseViewShares reuseViewShares(const std::vector<uint8_t>& rgba) {
+    ReuseViewShares v;
+    size_t covered = 0;
+    for (size_t i = 0; i + 3 < rgba.size(); i += 4) {
+        if (rgba[i + 3] == 0) continue; // sky
+        ++covered;
+        int r = rgba[i], g = rgba[i + 1], b = rgba[i + 2];
+        if (r == g && g == b)
+            v.carried += 1.0;
+        else if (r > g + 40 && r > b + 40)
+            v.notReusable += 1.0; // red
+        else if (g > r + 40 && g > b + 40)
+            v.fresh += 1.0; // green
+        else if (b > r + 40 && b > g + 20)
+            v.refresh += 1.0; // blue
+        else if (r > b + 40 && g > b + 40)
+            v.view += 1.0; // yellow
+    }
+    for (double* f : {&v.carried, &v.notReusable, &v.fresh, &v.refresh, &v.view})
+        *f /= double(std::max<size_t>(covered, 1));
+    return v;
+}
+
 int worstFrameErrorQuantile(const RenderRun& a, const RenderRun& b, double quantile) {
     int worst = 0;
     for (size_t f = 0; f < a.frames.size() && f < b.frames.size(); ++f) {

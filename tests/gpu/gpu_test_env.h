@@ -39,6 +39,14 @@ double worstFramePsnr(const RenderRun& a, const RenderRun& b);
 // which an average such as PSNR hides when few pixels differ much.
 int worstFrameErrorQuantile(const RenderRun& a, const RenderRun& b, double quantile);
 
+// --visualize reuse (shaders/shadel/resolve.glsl reuseReasonView): the shares of a frame's
+// covered pixels whose chunk was carried over (grey: the channels equal) or shaded for each
+// reason, told by its tint's dominant channels (red also counts orange: near a change).
+struct ReuseViewShares {
+    double carried = 0.0, notReusable = 0.0, fresh = 0.0, refresh = 0.0, view = 0.0;
+};
+ReuseViewShares reuseViewShares(const std::vector<uint8_t>& rgba);
+
 // The same decoupled run with --reuse on and off (checked as renderChecked checks them).
 struct ReuseRuns {
     RenderRun on, off;

@@ -143,6 +143,15 @@ size_t lineCount(const std::string& text) {
     return size_t(std::count(text.begin(), text.end(), '\n'));
 }
 
+// `args` fails as bad input must: exit code 2 and one "shadel: " line on stderr naming `named`.
+void expectOneLineError(const std::string& args, const std::string& named) {
+    Result r = run(args);
+    EXPECT_EQ(r.exitCode, 2) << args << ": " << r.stderrText;
+    EXPECT_EQ(lineCount(r.stderrText), 1u) << args << ": " << r.stderrText;
+    EXPECT_EQ(r.stderrText.rfind("shadel: ", 0), 0u) << args << ": " << r.stderrText;
+    EXPECT_NE(r.stderrText.find(named), std::string::npos) << args << ": " << r.stderrText;
+}
+
 // A scratch folder per test, removed afterwards.
 struct CliTempDir {
     CliTempDir() {
@@ -174,13 +183,7 @@ TEST(Cli, ParserErrorsAreOneLineAndExitCode2) {
         {"bench --interleave sometimes", "--interleave"},
         {"bench --interleave 0", "--interleave"},
     };
-    for (auto [args, named] : cases) {
-        Result r = run(args);
-        EXPECT_EQ(r.exitCode, 2) << args << ": " << r.stderrText;
-        EXPECT_EQ(lineCount(r.stderrText), 1u) << args << ": " << r.stderrText;
-        EXPECT_EQ(r.stderrText.rfind("shadel: ", 0), 0u) << args << ": " << r.stderrText;
-        EXPECT_NE(r.stderrText.find(named), std::string::npos) << args << ": " << r.stderrText;
-    }
+    for (auto [args, named] : cases) expectOneLineError(args, named);
 }
 
 // NaN, infinity and out-of-range floats used to render black or garbage with exit code 0.
@@ -202,13 +205,7 @@ TEST(Cli, FloatFlagsMustBeFiniteAndInRange) {
         {"bake --density inf builtin:smooth", "--density"},
         {"bake --shadel-budget 0 builtin:smooth", "--shadel-budget"},
     };
-    for (auto [args, flag] : cases) {
-        Result r = run(args);
-        EXPECT_EQ(r.exitCode, 2) << args << ": " << r.stderrText;
-        EXPECT_EQ(lineCount(r.stderrText), 1u) << args << ": " << r.stderrText;
-        EXPECT_NE(r.stderrText.find(flag), std::string::npos)
-            << "the message must name the flag: " << r.stderrText;
-    }
+    for (auto [args, flag] : cases) expectOneLineError(args, flag); // names the flag
 }
 
 // OVERVIEW documents --forward-below; it was rejected as unknown.
@@ -282,12 +279,7 @@ TEST(Cli, UncreatableOutputsFailBeforeRendering) {
         {"bench --scene /nonexistent.gltf --json " + missing + ".json",
          "--json " + missing + ".json"},
     };
-    for (const auto& [args, message] : cases) {
-        Result r = run(args);
-        EXPECT_EQ(r.exitCode, 2) << args;
-        EXPECT_EQ(lineCount(r.stderrText), 1u) << r.stderrText;
-        EXPECT_NE(r.stderrText.find(message), std::string::npos) << r.stderrText;
-    }
+    for (const auto& [args, message] : cases) expectOneLineError(args, message);
     EXPECT_EQ(dir.entries(), 0u) << "nothing may be left behind";
 }
 
@@ -302,12 +294,7 @@ TEST(Cli, InconsistentOptionsFailBeforeLoading) {
         {"render --scene /nonexistent.gltf --material-samples 0", "--material-samples 0"},
         {"render --scene /nonexistent.gltf --gi lpv --gi-iterations 99", "--gi-iterations 99"},
     };
-    for (auto [args, message] : cases) {
-        Result r = run(args);
-        EXPECT_EQ(r.exitCode, 2) << args;
-        EXPECT_EQ(lineCount(r.stderrText), 1u) << r.stderrText;
-        EXPECT_NE(r.stderrText.find(message), std::string::npos) << r.stderrText;
-    }
+    for (auto [args, message] : cases) expectOneLineError(args, message);
 }
 
 // --- issue 17: the bake cache location and glTF URIs -------------------------------------------

@@ -318,36 +318,6 @@ TEST(DecoupledCore, ReuseCarriesShadelsAcrossLevelWindowMoves) {
     EXPECT_EQ(stat(on, "reconstruction_misses"), 0u);
 }
 
-// What --visualize reuse shows of a frame's covered pixels: carried over (grey: the channels
-// equal), and shaded for each reason by its tint's dominant channels (shadel/resolve.glsl
-// reuseReasonView).
-struct ReuseView {
-    double carried = 0.0, notReusable = 0.0, fresh = 0.0, refresh = 0.0, view = 0.0;
-};
-
-ReuseView reuseView(const FrameResult& frame) {
-    ReuseView v;
-    size_t covered = 0;
-    for (size_t i = 0; i + 3 < frame.rgba.size(); i += 4) {
-        if (frame.rgba[i + 3] == 0) continue; // sky
-        ++covered;
-        int r = frame.rgba[i], g = frame.rgba[i + 1], b = frame.rgba[i + 2];
-        if (r == g && g == b)
-            v.carried += 1.0;
-        else if (r > g + 40 && r > b + 40)
-            v.notReusable += 1.0; // red (orange: r > g too)
-        else if (g > r + 40 && g > b + 40)
-            v.fresh += 1.0; // green
-        else if (b > r + 40 && b > g + 20)
-            v.refresh += 1.0; // blue
-        else if (r > b + 40 && g > b + 40)
-            v.view += 1.0; // yellow
-    }
-    for (double* f : {&v.carried, &v.notReusable, &v.fresh, &v.refresh, &v.view})
-        *f /= double(std::max<size_t>(covered, 1));
-    return v;
-}
-
 // --visualize reuse: the first frame has nothing to carry over (red: not reusable); on an orbit
 // most of the image is carried over and the rest shaded anew at the edges (green) or for its
 // view (yellow); with --reuse-refresh 1 a still camera reshades every chunk each frame (blue).
@@ -360,7 +330,8 @@ TEST(DecoupledCore, ReuseViewShowsWhyChunksWereShaded) {
     EXPECT_EQ(stat(orbit, "shadels_shaded"), stat(plain, "shadels_shaded"));
     EXPECT_EQ(stat(orbit, "shadels_reused"), stat(plain, "shadels_reused"));
     EXPECT_EQ(stat(orbit, "reconstruction_misses"), 0u);
-    ReuseView first = reuseView(orbit.frames.front()), last = reuseView(orbit.frames.back());
+    ReuseViewShares first = reuseViewShares(orbit.frames.front().rgba);
+    ReuseViewShares last = reuseViewShares(orbit.frames.back().rgba);
     std::printf("[ figures ] reuse view, default 320x180 orbit: first frame %.3f red, last frame "
                 "%.3f grey (carried), %.3f green (new), %.3f yellow (view), %.3f blue "
                 "(refresh), %.3f red; reuse fraction %.3f\n",
@@ -377,7 +348,7 @@ TEST(DecoupledCore, ReuseViewShowsWhyChunksWereShaded) {
     o.cameraPath = CameraPath::Static;
     o.frames = 3;
     o.reuseRefreshPeriod = 1;
-    ReuseView still = reuseView(renderChecked(o).frames.back());
+    ReuseViewShares still = reuseViewShares(renderChecked(o).frames.back().rgba);
     EXPECT_GT(still.refresh, 0.9);
     EXPECT_LT(still.carried, 0.002);
 }

@@ -169,19 +169,9 @@ TEST(SceneEdits, ReuseViewSwitchedOnBetweenFrames) {
     EditFrames f = renderEdit(RenderMode::Decoupled, [](Renderer& r, const GpuScene&) {
         r.settings.visualize = Visualize::Reuse;
     });
-    auto fraction = [](const std::vector<uint8_t>& rgba, auto&& test) {
-        size_t covered = 0, hits = 0;
-        for (size_t i = 0; i + 3 < rgba.size(); i += 4) {
-            if (rgba[i + 3] == 0) continue;
-            ++covered;
-            hits += test(int(rgba[i]), int(rgba[i + 1]), int(rgba[i + 2])) ? 1 : 0;
-        }
-        return double(hits) / double(std::max<size_t>(covered, 1));
-    };
-    auto grey = [](int r, int g, int b) { return r == g && g == b; };
-    auto red = [](int r, int g, int b) { return r > g + 40 && r > b + 40; };
-    double greyBefore = fraction(f.before, grey), greyAfter = fraction(f.after, grey);
-    double redFresh = fraction(f.fresh, red);
+    double greyBefore = reuseViewShares(f.before).carried;
+    double greyAfter = reuseViewShares(f.after).carried;
+    double redFresh = reuseViewShares(f.fresh).notReusable;
     std::printf("[ figures ] reuse view switched on: grey pixels %.3f before, %.3f after; a fresh "
                 "renderer's first frame %.3f red\n",
                 greyBefore, greyAfter, redFresh);
