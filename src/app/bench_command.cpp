@@ -38,7 +38,7 @@ const char* const kDecoupledSpectraPasses[] = {"shadelChunkSpectra", "shadelShad
 nlohmann::json runParticleLightingBench(Gpu& gpu, const BenchOptions& b, RenderOptions o) {
     nlohmann::json out;
     out["scene"] = b.scene;
-    out["device"] = gpu.device.name;
+    recordDevice(out, gpu);
     out["frames"] = b.frames;
     o.mode = RenderMode::Forward;
     const std::pair<const char*, ParticleLighting> modes[] = {{"atlas", ParticleLighting::Atlas},
@@ -71,7 +71,7 @@ nlohmann::json runParticleLightingBench(Gpu& gpu, const BenchOptions& b, RenderO
         pixelSprites > 0 ? (atlasLight + atlasSprites) / pixelSprites : 0.0;
     std::printf("shadel bench --particle-lighting-compare: %s at %ux%u on %s, %u frames, "
                 "medians (timing: %s)\n",
-                b.scene.c_str(), b.width, b.height, gpu.device.name.c_str(), b.frames,
+                b.scene.c_str(), b.width, b.height, deviceLabel(gpu).c_str(), b.frames,
                 out["modes"]["atlas"]["timing"].get<std::string>().c_str());
     std::printf("  particleAtlasLighting (atlas)  %10.3f ms\n", atlasLight);
     std::printf("  particleSprites atlas / pixel / vertex  %.3f / %.3f / %.3f ms\n", atlasSprites,
@@ -95,7 +95,7 @@ nlohmann::json runParticleLightingBench(Gpu& gpu, const BenchOptions& b, RenderO
 nlohmann::json runShadowCullingBench(Gpu& gpu, const BenchOptions& b, RenderOptions o) {
     nlohmann::json out;
     out["scene"] = b.scene;
-    out["device"] = gpu.device.name;
+    recordDevice(out, gpu);
     out["frames"] = b.frames;
     out["sun_cascades"] = b.sunCascades;
     o.mode = RenderMode::Forward;
@@ -145,7 +145,7 @@ nlohmann::json runShadowCullingBench(Gpu& gpu, const BenchOptions& b, RenderOpti
     out["ratios"]["shadow_culling_instance_cull"] = ratio(cullPv, cullWs);
     std::printf("shadel bench --shadow-culling-compare: %s at %ux%u on %s, %u frames, "
                 "--sun-cascades %u, medians (timing: %s)\n",
-                b.scene.c_str(), b.width, b.height, gpu.device.name.c_str(), b.frames,
+                b.scene.c_str(), b.width, b.height, deviceLabel(gpu).c_str(), b.frames,
                 b.sunCascades, pv["timing"].get<std::string>().c_str());
     std::printf("  %-16s %12s %12s %8s\n", "", "per-view", "whole-scene", "ratio");
     std::printf("  %-16s %9.3f ms %9.3f ms %8.3f\n", "frame", framePv, frameWs,
@@ -177,7 +177,7 @@ nlohmann::json runShadowCullingBench(Gpu& gpu, const BenchOptions& b, RenderOpti
 nlohmann::json runStencilBench(Gpu& gpu, const BenchOptions& b, RenderOptions o) {
     nlohmann::json out;
     out["scene"] = b.scene;
-    out["device"] = gpu.device.name;
+    recordDevice(out, gpu);
     out["frames"] = b.frames;
     o.mode = RenderMode::Forward;
     o.screenSpace = true;
@@ -207,7 +207,7 @@ nlohmann::json runStencilBench(Gpu& gpu, const BenchOptions& b, RenderOptions o)
     out["ratios"]["stencil_water"] = waterFull > 0 ? water / waterFull : 0.0;
     std::printf("shadel bench --stencil-compare: %s at %ux%u on %s, %u frames, medians (timing: "
                 "%s)\n",
-                b.scene.c_str(), b.width, b.height, gpu.device.name.c_str(), b.frames,
+                b.scene.c_str(), b.width, b.height, deviceLabel(gpu).c_str(), b.frames,
                 culled["timing"].get<std::string>().c_str());
     std::printf("  characterOutline  stencil %.3f ms / full-screen %.3f ms = %.3f\n", outline,
                 outlineFull, out["ratios"]["stencil_outline"].get<double>());
@@ -227,7 +227,7 @@ nlohmann::json runStencilBench(Gpu& gpu, const BenchOptions& b, RenderOptions o)
 static nlohmann::json roundsBenchHeader(const Gpu& gpu, const BenchOptions& b) {
     nlohmann::json out;
     out["scene"] = b.scene;
-    out["device"] = gpu.device.name;
+    recordDevice(out, gpu);
     out["frames"] = b.frames;
     out["rounds"] = b.rounds;
     out["size"] = format("%ux%u", b.width, b.height);
@@ -306,7 +306,7 @@ nlohmann::json runStreamingBench(Gpu& gpu, const BenchOptions& b, RenderOptions 
     }
     std::printf("shadel bench --streaming-compare: %s at %ux%u on %s, %u frames x %u rounds, "
                 "--texture-budget %g MiB, medians over every round's frames\n",
-                b.scene.c_str(), b.width, b.height, gpu.device.name.c_str(), b.frames, b.rounds,
+                b.scene.c_str(), b.width, b.height, deviceLabel(gpu).c_str(), b.frames, b.rounds,
                 b.textureBudgetMiB);
     std::printf("  %-10s %-9s %16s %14s %10s %12s %14s  %s\n", "mode", "textures", "cpu thread ms",
                 "of which strm", "ratio", "frame ms", "peak MiB", "cpu thread ms per round");
@@ -413,7 +413,7 @@ nlohmann::json runInstanceScalingBench(Gpu& gpu, const BenchOptions& b, RenderOp
         out["modes"][format("%s_%u", modeName(b.scalingModes[0]), counts[0])];
     std::printf("shadel bench --instance-scaling: %s at %ux%u on %s, %u frames x %u rounds, --lod "
                 "on --occlusion %s; medians of the per-round medians [min..max] (timing: %s)\n",
-                b.scene.c_str(), b.width, b.height, gpu.device.name.c_str(), b.frames, b.rounds,
+                b.scene.c_str(), b.width, b.height, deviceLabel(gpu).c_str(), b.frames, b.rounds,
                 b.scalingOcclusion ? "on" : "off", firstStats["timing"].get<std::string>().c_str());
     std::printf("  %-9s %9s %8s %24s %22s %10s %10s %10s %10s\n", "mode", "instances", "drawn",
                 "cpu frame ms", "cpu ratio to first", "prepare", "coarse", "submits", "gpu frame");
@@ -616,7 +616,7 @@ nlohmann::json runBench(Gpu& gpu, const BenchOptions& b) {
     static const char* pathNames[] = {"static", "orbit", "walk"};
     nlohmann::json out;
     out["scene"] = b.scene;
-    out["device"] = gpu.device.name;
+    recordDevice(out, gpu);
     out["frames"] = b.frames;
     out["camera_path"] = pathNames[int(b.cameraPath)];
     out["animate_lights"] = b.animateLights;
@@ -836,7 +836,7 @@ nlohmann::json runBench(Gpu& gpu, const BenchOptions& b) {
     }
 
     std::printf("shadel bench: %s at %ux%u on %s, %u frames, %s camera, medians (timing: %s)%s\n",
-                b.scene.c_str(), b.width, b.height, gpu.device.name.c_str(), b.frames,
+                b.scene.c_str(), b.width, b.height, deviceLabel(gpu).c_str(), b.frames,
                 pathNames[int(b.cameraPath)], forward["timing"].get<std::string>().c_str(),
                 b.modeRounds > 1 ? format(", %u rounds", b.modeRounds).c_str() : "");
     std::printf("%-28s %12s %12s %12s\n", "", "forward", "decoupled", "reuse");

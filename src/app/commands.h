@@ -149,6 +149,13 @@ GiMode parseGi(const std::string& text); // --gi lpv|off
 // The bake cache folder when --cache-dir is not given (see defaultBakeCacheDir()).
 std::string defaultCacheDir();
 
+// The device a run measured on, as render stats and bench JSON record it ("device", "host"):
+// a software device's timings are its host CPU's, so that CPU (core/host.h) goes beside it.
+void recordDevice(nlohmann::json& out, const Gpu& gpu);
+// The device as the bench's headings name it: "NAME", or "NAME on CPU, N threads" for a
+// software device.
+std::string deviceLabel(const Gpu& gpu);
+
 // Renders with an existing Gpu (tests share one). Writes images/stats as the options say.
 RenderRun runRender(Gpu& gpu, const RenderOptions& options);
 // The same in steps, so that several renders can interleave their frames (the bench): load,

@@ -15,6 +15,7 @@
 #include "bake/bake.h"
 #include "bake/bake_cache.h"
 #include "core/error.h"
+#include "core/host.h"
 #include "core/log.h"
 #include "gi/gi_types.h"
 #include "render/animation/scene_playback.h"
@@ -284,6 +285,18 @@ CameraView viewOfFrame(const RenderSession& session, uint32_t i) {
     return makeCameraView(onPath, o.width * o.ssaa, o.height * o.ssaa, jitter * float(o.ssaa));
 }
 } // namespace
+
+void recordDevice(nlohmann::json& out, const Gpu& gpu) {
+    out["device"] = gpu.device.name;
+    HostInfo host = hostInfo();
+    out["host"] = {{"cpu", host.cpu}, {"threads", host.threads}};
+}
+
+std::string deviceLabel(const Gpu& gpu) {
+    if (!gpu.device.isCpu) return gpu.device.name;
+    HostInfo host = hostInfo();
+    return format("%s on %s, %u threads", gpu.device.name.c_str(), host.cpu.c_str(), host.threads);
+}
 
 RenderRun runRender(Gpu& gpu, const RenderOptions& o) {
     RenderSessionPtr session = beginRender(gpu, o);
@@ -650,7 +663,7 @@ RenderRun finishRender(RenderSessionPtr sessionPtr) {
 
     // Stats (DESIGN §5): medians over frames.
     nlohmann::json s;
-    s["device"] = gpu.device.name;
+    recordDevice(s, gpu);
     s["driver"] = gpu.device.driver;
     s["scene"] = o.scene;
     s["camera"] = camera.name;

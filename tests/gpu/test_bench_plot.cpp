@@ -5,6 +5,7 @@
 #include <filesystem>
 
 #include "app/bench_plot.h"
+#include "core/host.h"
 
 using namespace shadel;
 using namespace shadel::test;
@@ -58,8 +59,19 @@ TEST(BenchPlot, BenchWritesThePlot) {
                            .string();
     BenchOptions b = smallBench();
     b.plot = path;
+    testing::internal::CaptureStdout();
     nlohmann::json result = runBench(sharedGpu(), b);
+    std::string printed = testing::internal::GetCapturedStdout();
     ASSERT_TRUE(std::filesystem::exists(path));
+    // The figures name the machine they are of: on a software device, the host CPU.
+    HostInfo host = hostInfo();
+    EXPECT_EQ(result["device"], sharedGpu().device.name);
+    EXPECT_EQ(result["host"]["cpu"], host.cpu);
+    EXPECT_EQ(result["host"]["threads"], host.threads);
+    EXPECT_EQ(result["modes"]["reuse"]["host"]["cpu"], host.cpu); // each mode's render stats
+    if (sharedGpu().device.isCpu) {
+        EXPECT_NE(printed.find("on " + host.cpu + ", "), std::string::npos) << printed;
+    }
     EXPECT_GT(std::filesystem::file_size(path), 1000u);
     PlotImage img = plotBench(result);
     // Every mode has its bar. Bar areas follow the measured times (BarAreasFollowThePassTimes),

@@ -13,9 +13,13 @@
 
 #include "gpu_test_env.h"
 
+#include "core/host.h"
 #include "core/log.h"
 
 using shadel::format;
+using shadel::HostInfo;
+using shadel::hostInfo;
+using shadel::test::sharedGpu;
 using shadel::test::tempPath;
 
 namespace {
@@ -236,6 +240,18 @@ TEST(Cli, DecoupledSummaryGivesShadelsPerPixelAndReuse) {
     EXPECT_NE(o.stdoutText.find("shaded for"), std::string::npos) << o.stdoutText;
     Output forward = runWithEnv("", "render --size 64x36");
     EXPECT_EQ(forward.stdoutText.find("shadels per covered pixel"), std::string::npos);
+}
+
+// On a software device every timing is the host CPU's: the stats name it.
+TEST(Cli, StatsNameTheDeviceAndTheHostCpu) {
+    CliTempDir dir;
+    Output o = runWithEnv("", "render --size 32x18 --stats " + dir.file("s.json"));
+    ASSERT_EQ(o.exitCode, 0) << o.stderrText;
+    nlohmann::json stats = nlohmann::json::parse(readText(dir.file("s.json")));
+    HostInfo host = hostInfo();
+    EXPECT_EQ(stats["device"], sharedGpu().device.name);
+    EXPECT_EQ(stats["host"]["cpu"], host.cpu);
+    EXPECT_EQ(stats["host"]["threads"], host.threads);
 }
 
 TEST(Cli, SubcommandHelpShowsGlobalFlagsAndTheBakeCache) {
