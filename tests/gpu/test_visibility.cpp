@@ -63,6 +63,31 @@ TEST(Visibility, MatchesRasterMarkingAndReconstruction) {
     }
 }
 
+// Marking's first pass marks quads on one triangle and lists the rest (silhouettes, and at an
+// odd size the quads the last column and row cut in half) for its second pass: every pixel of
+// both kinds must get its chunks and address, so odd sizes match the raster path too.
+TEST(Visibility, OddSizesMarkTheLastColumnAndRow) {
+    for (auto [w, h] : {std::pair{97u, 55u}, std::pair{161u, 90u}}) {
+        RenderRun raster = renderChecked(decoupled("builtin:default", MarkingMode::Raster, w, h));
+        RenderRun vis = renderChecked(decoupled("builtin:default", MarkingMode::Visibility, w, h));
+        EXPECT_EQ(stat(vis, "reconstruction_misses"), 0u) << w << "x" << h;
+        EXPECT_EQ(stat(vis, "pixels_covered"), stat(raster, "pixels_covered")) << w << "x" << h;
+        EXPECT_GE(psnr(vis.frames[0].rgba, raster.frames[0].rgba), 45.0) << w << "x" << h;
+        // The last column and row themselves, not only the image as a whole.
+        const std::vector<uint8_t>& a = vis.frames[0].rgba;
+        const std::vector<uint8_t>& b = raster.frames[0].rgba;
+        int worst = 0;
+        for (uint32_t y = 0; y < h; ++y)
+            for (uint32_t x = 0; x < w; ++x) {
+                if (x != w - 1 && y != h - 1) continue;
+                for (int c = 0; c < 3; ++c)
+                    worst = std::max(
+                        worst, std::abs(int(a[(y * w + x) * 4 + c]) - int(b[(y * w + x) * 4 + c])));
+            }
+        EXPECT_LE(worst, 8) << w << "x" << h << ": the edge pixels differ from the raster path";
+    }
+}
+
 // With --ssaa the targets are N x N larger; the compute passes cover the internal resolution.
 TEST(Visibility, SupersampledTargetsAreCoveredByTheComputePasses) {
     RenderOptions o = decoupled("builtin:smooth", MarkingMode::Visibility, 96, 54);

@@ -1,5 +1,6 @@
 #include "render/shadel/visibility.h"
 
+#include "core/assert.h"
 #include "core/error.h"
 #include "render/debug/inspect.h"
 #include "render/forward/forward_passes.h"
@@ -19,9 +20,14 @@ struct VisibilityState {
     // (misses, overflow, camera cuts) and that pass's indirect arguments
     // (shaders/shadel/resolve_pixel.glsl ResolveRebuildList).
     BufferHandle rebuildList;
+    // "markQuadList" (decoupled only): the quads marking's first pass leaves to its second (those
+    // not on one decoupled triangle), with that pass's indirect arguments
+    // (shaders/shadel/mark_quad.glsl MarkQuadList).
+    BufferHandle markList;
     // resolveInline rebuilds its rare pixels itself (debug views, --inspect); resolve lists them
     // for resolveRebuild, sized by resolveRebuildArgs.
-    Pipeline prepass, mark, resolve, resolveInline, resolveRebuild, resolveRebuildArgs;
+    Pipeline prepass, mark, markListed, markListedArgs, resolve, resolveInline, resolveRebuild,
+        resolveRebuildArgs;
 };
 
 void VisibilityStateDeleter::operator()(VisibilityState* state) const {
@@ -37,6 +43,7 @@ struct ComputePush {
     uint32_t hdrSlot;
     uint64_t address;
     uint64_t rebuildList;
+    uint64_t markList;
 };
 
 ComputePush computePush(Renderer& r, uint64_t frame) {
@@ -48,7 +55,8 @@ ComputePush computePush(Renderer& r, uint64_t frame) {
             r.internalHeight,
             slot(gpu, v.hdrWrite).value,
             v.address ? address(gpu, v.address) : 0u,
-            v.rebuildList ? address(gpu, v.rebuildList) : 0u};
+            v.rebuildList ? address(gpu, v.rebuildList) : 0u,
+            v.markList ? address(gpu, v.markList) : 0u};
 }
 
 void dispatchPixels(Renderer& r, VkCommandBuffer cmd) {
@@ -84,6 +92,11 @@ VisibilityStatePtr createVisibility(Renderer& r) {
             gpu, {"resolveRebuildList", 32 + pixels * 4,
                   VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT});
         if (!v.rebuildList) throw DeviceError("out of GPU memory for the resolve's rebuild list");
+        // 32 bytes of header, then at most every quad once.
+        v.markList = createBuffer(
+            gpu, {"markQuadList", 32 + quads * 4,
+                  VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT});
+        if (!v.markList) throw DeviceError("out of GPU memory for marking's quad list");
     }
 
     GraphicsPipelineDesc prepass;
@@ -108,6 +121,8 @@ VisibilityStatePtr createVisibility(Renderer& r) {
                          {{RESOLVE_REBUILD_INLINE_CONSTANT_ID, 0u}}});
         descs.push_back({"shadelResolveRebuild", "shadel_resolve_rebuild.comp.spv", {}});
         descs.push_back({"shadelResolveRebuildArgs", "shadel_resolve_rebuild_args.comp.spv", {}});
+        descs.push_back({"shadelMarkListed", "shadel_mark_listed.comp.spv", {}});
+        descs.push_back({"shadelMarkListedArgs", "shadel_mark_listed_args.comp.spv", {}});
     }
     std::vector<Pipeline> built = createComputePipelines(gpu, descs); // side by side
     v.mark = built[0];
@@ -116,6 +131,8 @@ VisibilityStatePtr createVisibility(Renderer& r) {
         v.resolve = built[2];
         v.resolveRebuild = built[3];
         v.resolveRebuildArgs = built[4];
+        v.markListed = built[5];
+        v.markListedArgs = built[6];
     }
     registerTextureCapture(
         r.captures, gpu, "visibility", "visibility buffer: instance, triangle (PNG)",
@@ -127,12 +144,13 @@ void destroyVisibility(Renderer& r, VisibilityStatePtr& state) {
     if (!state) return;
     Gpu& gpu = *r.gpu;
     VisibilityState& v = *state;
-    for (Pipeline* p : {&v.prepass, &v.mark, &v.resolve, &v.resolveInline, &v.resolveRebuild,
-                        &v.resolveRebuildArgs})
+    for (Pipeline* p : {&v.prepass, &v.mark, &v.markListed, &v.markListedArgs, &v.resolve,
+                        &v.resolveInline, &v.resolveRebuild, &v.resolveRebuildArgs})
         destroy(gpu, *p);
     destroy(gpu, v.hdrWrite);
     if (v.address) destroy(gpu, v.address);
     if (v.rebuildList) destroy(gpu, v.rebuildList);
+    if (v.markList) destroy(gpu, v.markList);
     destroy(gpu, v.idsRead);
     destroy(gpu, v.idsTarget);
     destroy(gpu, v.ids);
@@ -193,12 +211,37 @@ void recordVisibilityPrepass(Renderer& r, VkCommandBuffer cmd, uint64_t frame) {
 
 void recordMarkingCompute(Renderer& r, VkCommandBuffer cmd, uint64_t frame) {
     Gpu& gpu = *r.gpu;
-    // Every pixel's address is written again, after last frame's resolve read them.
-    memoryBarrier(cmd, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_SHADER_STORAGE_READ_BIT,
-                  VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT);
-    bind(gpu, cmd, r.visibility->mark);
-    pushConstants(gpu, cmd, computePush(r, frame));
+    VisibilityState& v = *r.visibility;
+    ComputePush push = computePush(r, frame);
+    SHADEL_ASSERT(v.markList); // (made with the decoupled mode)
+    // Every pixel's address is written again, after last frame's resolve read them; the quad
+    // list is cleared after last frame's second pass read it.
+    memoryBarrier(cmd,
+                  VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_2_DRAW_INDIRECT_BIT,
+                  VK_ACCESS_2_SHADER_STORAGE_READ_BIT | VK_ACCESS_2_INDIRECT_COMMAND_READ_BIT,
+                  VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_2_CLEAR_BIT,
+                  VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT | VK_ACCESS_2_TRANSFER_WRITE_BIT);
+    vkCmdFillBuffer(cmd, vkBuffer(gpu, v.markList), 0, 32, 0);
+    memoryBarrier(cmd, VK_PIPELINE_STAGE_2_CLEAR_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT,
+                  VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
+                  VK_ACCESS_2_SHADER_STORAGE_READ_BIT | VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT);
+    // First pass: quads on one decoupled triangle, without per-pixel branches; the others listed.
+    bind(gpu, cmd, v.mark);
+    pushConstants(gpu, cmd, push);
     dispatchPixels(r, cmd);
+    memoryBarrier(cmd, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT,
+                  VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
+                  VK_ACCESS_2_SHADER_STORAGE_READ_BIT | VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT);
+    bind(gpu, cmd, v.markListedArgs);
+    pushConstants(gpu, cmd, push);
+    vkCmdDispatch(cmd, 1, 1, 1);
+    memoryBarrier(cmd, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT,
+                  VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_2_DRAW_INDIRECT_BIT,
+                  VK_ACCESS_2_SHADER_STORAGE_READ_BIT | VK_ACCESS_2_INDIRECT_COMMAND_READ_BIT);
+    // Second pass: the listed quads, pixel by pixel.
+    bind(gpu, cmd, v.markListed);
+    pushConstants(gpu, cmd, push);
+    vkCmdDispatchIndirect(cmd, vkBuffer(gpu, v.markList), 0);
     memoryBarrier(cmd, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT,
                   VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
                   VK_ACCESS_2_SHADER_STORAGE_READ_BIT | VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT);

@@ -33,7 +33,9 @@ uint32_t visibilityHdrWriteSlot(Renderer& r);
 // (triangles numbered within their mesh, LOD 0's numbering continued by its other LODs).
 void recordVisibilityPrepass(Renderer& r, VkCommandBuffer cmd, uint64_t frame);
 // "markingCompute": occupancy bits from the visibility buffer (after shadelClear), and per
-// pixel the footprints it marked ("reconstructionAddress") for the resolve.
+// pixel the footprints it marked ("reconstructionAddress") for the resolve. Two dispatches: the
+// quads on one decoupled triangle, then (indirect) those it listed, pixel by pixel
+// (shaders/shadel/mark_quad.glsl says why).
 void recordMarkingCompute(Renderer& r, VkCommandBuffer cmd, uint64_t frame);
 // "resolveCompute": decoupled pixels reconstructed from their addresses (rebuilt from the
 // visibility buffer for debug views, --inspect, and the forward fallback) into the HDR target.
