@@ -152,7 +152,8 @@ void markQuadLevel(ShadelFrame s, QuadLevel q) {
 bool markWholeQuad(ShadelFrame s, QuadTriangle t, ivec2 origin) {
     if (t.aniso.taps != 1u) return false; // (one tap since the anisotropy cap: shadelAniso)
     vec2 uv[4];
-    for (int i = 0; i < 4; ++i) uv[i] = visShadelSample(t.q, t.o, i).shadelUv;
+    uv[0] = t.first.shadelUv;
+    for (int i = 1; i < 4; ++i) uv[i] = visShadelSample(t.q, t.o, i).shadelUv;
     QuadLevel level0, level1;
     if (!quadLevel(t.o, t.levels.mip0, uv, level0)) return false;
     if (t.levels.two && !quadLevel(t.o, t.levels.mip1, uv, level1)) return false;

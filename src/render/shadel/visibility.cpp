@@ -63,6 +63,40 @@ void dispatchPixels(Renderer& r, VkCommandBuffer cmd) {
     // One invocation per 2x2 quad, 8x8 invocations per group: 16x16 pixels.
     vkCmdDispatch(cmd, (r.internalWidth + 15) / 16, (r.internalHeight + 15) / 16, 1);
 }
+
+// A pass over the pixel quads that lists what its common code does not handle for a second pass
+// (marking: quads not on one triangle; the resolve: misses, overflow, camera cuts): clears the
+// list's header (after last frame's second pass read it, and last frame's readers of what
+// `first` writes), runs `first`, sizes the second pass from the list's count (`args`, one
+// invocation) and runs `second` by indirect dispatch. The list's header holds those arguments.
+void dispatchWithList(Renderer& r, VkCommandBuffer cmd, const ComputePush& push, BufferHandle list,
+                      const Pipeline& first, const Pipeline& args, const Pipeline& second) {
+    Gpu& gpu = *r.gpu;
+    memoryBarrier(cmd,
+                  VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_2_DRAW_INDIRECT_BIT,
+                  VK_ACCESS_2_SHADER_STORAGE_READ_BIT | VK_ACCESS_2_INDIRECT_COMMAND_READ_BIT,
+                  VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_2_CLEAR_BIT,
+                  VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT | VK_ACCESS_2_TRANSFER_WRITE_BIT);
+    vkCmdFillBuffer(cmd, vkBuffer(gpu, list), 0, 32, 0);
+    memoryBarrier(cmd, VK_PIPELINE_STAGE_2_CLEAR_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT,
+                  VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
+                  VK_ACCESS_2_SHADER_STORAGE_READ_BIT | VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT);
+    bind(gpu, cmd, first);
+    pushConstants(gpu, cmd, push);
+    dispatchPixels(r, cmd);
+    memoryBarrier(cmd, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT,
+                  VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
+                  VK_ACCESS_2_SHADER_STORAGE_READ_BIT | VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT);
+    bind(gpu, cmd, args);
+    pushConstants(gpu, cmd, push);
+    vkCmdDispatch(cmd, 1, 1, 1);
+    memoryBarrier(cmd, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT,
+                  VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_2_DRAW_INDIRECT_BIT,
+                  VK_ACCESS_2_SHADER_STORAGE_READ_BIT | VK_ACCESS_2_INDIRECT_COMMAND_READ_BIT);
+    bind(gpu, cmd, second);
+    pushConstants(gpu, cmd, push);
+    vkCmdDispatchIndirect(cmd, vkBuffer(gpu, list), 0);
+}
 } // namespace
 
 VisibilityStatePtr createVisibility(Renderer& r) {
@@ -210,38 +244,13 @@ void recordVisibilityPrepass(Renderer& r, VkCommandBuffer cmd, uint64_t frame) {
 }
 
 void recordMarkingCompute(Renderer& r, VkCommandBuffer cmd, uint64_t frame) {
-    Gpu& gpu = *r.gpu;
     VisibilityState& v = *r.visibility;
-    ComputePush push = computePush(r, frame);
     SHADEL_ASSERT(v.markList); // (made with the decoupled mode)
-    // Every pixel's address is written again, after last frame's resolve read them; the quad
-    // list is cleared after last frame's second pass read it.
-    memoryBarrier(cmd,
-                  VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_2_DRAW_INDIRECT_BIT,
-                  VK_ACCESS_2_SHADER_STORAGE_READ_BIT | VK_ACCESS_2_INDIRECT_COMMAND_READ_BIT,
-                  VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_2_CLEAR_BIT,
-                  VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT | VK_ACCESS_2_TRANSFER_WRITE_BIT);
-    vkCmdFillBuffer(cmd, vkBuffer(gpu, v.markList), 0, 32, 0);
-    memoryBarrier(cmd, VK_PIPELINE_STAGE_2_CLEAR_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT,
-                  VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
-                  VK_ACCESS_2_SHADER_STORAGE_READ_BIT | VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT);
-    // First pass: quads on one decoupled triangle, without per-pixel branches; the others listed.
-    bind(gpu, cmd, v.mark);
-    pushConstants(gpu, cmd, push);
-    dispatchPixels(r, cmd);
-    memoryBarrier(cmd, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT,
-                  VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
-                  VK_ACCESS_2_SHADER_STORAGE_READ_BIT | VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT);
-    bind(gpu, cmd, v.markListedArgs);
-    pushConstants(gpu, cmd, push);
-    vkCmdDispatch(cmd, 1, 1, 1);
-    memoryBarrier(cmd, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT,
-                  VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_2_DRAW_INDIRECT_BIT,
-                  VK_ACCESS_2_SHADER_STORAGE_READ_BIT | VK_ACCESS_2_INDIRECT_COMMAND_READ_BIT);
-    // Second pass: the listed quads, pixel by pixel.
-    bind(gpu, cmd, v.markListed);
-    pushConstants(gpu, cmd, push);
-    vkCmdDispatchIndirect(cmd, vkBuffer(gpu, v.markList), 0);
+    // Every pixel's address is written again, after last frame's resolve read them. First pass:
+    // quads on one decoupled triangle, without per-pixel branches; second: the listed quads,
+    // pixel by pixel.
+    dispatchWithList(r, cmd, computePush(r, frame), v.markList, v.mark, v.markListedArgs,
+                     v.markListed);
     memoryBarrier(cmd, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT,
                   VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
                   VK_ACCESS_2_SHADER_STORAGE_READ_BIT | VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT);
@@ -267,30 +276,9 @@ void recordResolveCompute(Renderer& r, VkCommandBuffer cmd, uint64_t frame) {
         return;
     }
     // The resolve lists its rare pixels (misses, overflow, camera cuts); the rebuild pass
-    // shades them, by indirect dispatch (last frame's rebuild pass read the list: cleared after).
-    memoryBarrier(cmd,
-                  VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_2_DRAW_INDIRECT_BIT,
-                  VK_ACCESS_2_SHADER_STORAGE_READ_BIT | VK_ACCESS_2_INDIRECT_COMMAND_READ_BIT,
-                  VK_PIPELINE_STAGE_2_CLEAR_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT);
-    vkCmdFillBuffer(cmd, vkBuffer(gpu, v.rebuildList), 0, 32, 0);
-    memoryBarrier(cmd, VK_PIPELINE_STAGE_2_CLEAR_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT,
-                  VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
-                  VK_ACCESS_2_SHADER_STORAGE_READ_BIT | VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT);
-    bind(gpu, cmd, v.resolve);
-    pushConstants(gpu, cmd, push);
-    dispatchPixels(r, cmd);
-    memoryBarrier(cmd, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT,
-                  VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
-                  VK_ACCESS_2_SHADER_STORAGE_READ_BIT | VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT);
-    bind(gpu, cmd, v.resolveRebuildArgs);
-    pushConstants(gpu, cmd, push);
-    vkCmdDispatch(cmd, 1, 1, 1);
-    memoryBarrier(cmd, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT,
-                  VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_2_DRAW_INDIRECT_BIT,
-                  VK_ACCESS_2_SHADER_STORAGE_READ_BIT | VK_ACCESS_2_INDIRECT_COMMAND_READ_BIT);
-    bind(gpu, cmd, v.resolveRebuild);
-    pushConstants(gpu, cmd, push);
-    vkCmdDispatchIndirect(cmd, vkBuffer(gpu, v.rebuildList), 0);
+    // shades them.
+    dispatchWithList(r, cmd, push, v.rebuildList, v.resolve, v.resolveRebuildArgs,
+                     v.resolveRebuild);
 }
 
 void recordHybridForward(Renderer& r, VkCommandBuffer cmd, uint64_t frame) {
