@@ -121,6 +121,14 @@ using uint = uint32_t;
 // Whether the compute resolve rebuilds its rare pixels inline (debug views, --inspect) or lists
 // them for its rebuild pass (shaders/shadel/resolve.comp).
 #define RESOLVE_REBUILD_INLINE_CONSTANT_ID 146
+// Whether forward shading writes display pixels (the tone curve and sRGB applied, into an RGBA8
+// target) instead of scene colour: the frame's tonemap is fused into it (render/post/tonemap.h).
+#define FORWARD_DISPLAY_OUTPUT_CONSTANT_ID 151
+// The same for the decoupled compute resolve and its rebuild pass (shaders/shadel/resolve.comp):
+// display pixels into the readback instead of scene colour. A constant, not a push-constant
+// branch: lavapipe runs both sides of a branch (resolveCompute 35.8 ms with the branch, 32.3
+// with the constant: builtin:default 1280x720, orbit).
+#define RESOLVE_DISPLAY_OUTPUT_CONSTANT_ID 152
 // Which queued chunks a shadel shading pipeline shades (shaders/shadel/shade.comp): all of them
 // (the spectra permutations, everything compiled in), or one shading class's list. The classes
 // (SHADEL_OBJECT_* flags, per object from its material): plain (no texture, procedural, clear

@@ -6,6 +6,7 @@
 #include "lighting/light_debug.glsl"
 #include "debug/inspect.glsl"
 #include "raytracing/rt_apply.glsl"
+#include "common/tone_curve.glsl"
 
 // The prepass laid the depth down and this pass tests against it (equal) without writing it, so
 // the test can run before shading. Declared because this shader has side effects (the texture
@@ -28,6 +29,10 @@ layout(location = 4) flat in uint inInstance;
 layout(location = 6) flat in uint inTriangle;
 
 layout(location = 0) out vec4 outColor;
+
+// The frame's tonemap fused into this pass (render/post/tonemap.h): display colour into an RGBA8
+// target, alpha 1 (coverage; the target clears to the sky's display colour with alpha 0).
+layout(constant_id = FORWARD_DISPLAY_OUTPUT_CONSTANT_ID) const bool kDisplayOutput = false;
 
 void main() {
     FrameConstants f = FrameConstantsRef(pc.frame).f;
@@ -63,5 +68,5 @@ void main() {
     }
     color = visualizeLighting(f, color);
     float alpha = (mat.flags & MATERIAL_ALPHA_BLEND) != 0u ? m.alpha : 1.0;
-    outColor = vec4(color, alpha);
+    outColor = kDisplayOutput ? vec4(displayColor(color, f.exposure), 1.0) : vec4(color, alpha);
 }

@@ -18,10 +18,6 @@ layout(push_constant, scalar) uniform Push {
     uint ssaa;
 } pc;
 
-vec3 linearToSrgb(vec3 c) {
-    return mix(c * 12.92, 1.055 * pow(c, vec3(1.0 / 2.4)) - 0.055, step(vec3(0.0031308), c));
-}
-
 void main() {
     uvec2 p = gl_GlobalInvocationID.xy;
     if (p.x >= pc.width || p.y >= pc.height) return;
@@ -42,7 +38,5 @@ void main() {
         }
     }
     vec3 c = linearToSrgb(sum / float(pc.ssaa * pc.ssaa));
-    uvec3 b = uvec3(clamp(c, 0.0, 1.0) * 255.0 + 0.5);
-    uint a = covered ? 255u : 0u;
-    UintBuffer(pc.pixels).v[p.y * pc.width + p.x] = b.r | (b.g << 8) | (b.b << 16) | (a << 24);
+    UintBuffer(pc.pixels).v[p.y * pc.width + p.x] = packDisplayPixel(c, covered);
 }

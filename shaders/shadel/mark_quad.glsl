@@ -91,12 +91,14 @@ void markQuadPixels(FrameConstants f, ShadelFrame s, ivec2 origin, uvec2 vis[4])
             bool onA = vis[i] == a;
             QuadTriangle t = onA ? ta : tb;
             if (!onA && vis[i] != b) t = setUpQuad(f, s, vis[i], origin); // a third (rare)
-            if (t.decoupled) { // else a forward (hybrid) instance
+            if (t.decoupled) {
                 VisShadel v = visShadelSample(t.q, t.o, i);
                 MarkedSample m = markSampleWith(s, t.o, v.shadelUv, t.levels, t.aniso);
                 // As reconstructSample counts magnification (only sampled pixels count it).
                 bool magnified = max(dot(v.texelDx, v.texelDx), dot(v.texelDy, v.texelDy)) < 1.0;
                 address = packResolveAddress(m, magnified);
+            } else {
+                address = resolveAddressForward();
             }
         }
         ResolveAddressBuffer(pc.addresses).v[resolveAddressIndex(pixel, pc.width)] = address;

@@ -6,7 +6,7 @@
 //
 // A quad whose four pixels see one decoupled triangle (85% of builtin:default's covered quads
 // at 1280x720) is marked here, without per-pixel branches (markWholeQuad); sky and forward
-// (hybrid) quads get empty addresses; every other quad (silhouettes, sky edges, the screen's
+// (hybrid) quads get addresses saying so; every other quad (silhouettes, sky edges, the screen's
 // last row or column, rare level-window fallbacks) is listed for mark_listed.comp, which marks
 // it pixel by pixel (markQuadPixels). See shadel/mark_quad.glsl for why.
 //
@@ -30,10 +30,12 @@ void main() {
                          (shadelObject(s, vis[0].x).v.flags & SHADEL_OBJECT_DECOUPLED) != 0u;
         if (decoupled) {
             listed = !markWholeQuad(s, setUpQuad(f, s, vis[0], origin), origin);
-        } else if (one) { // the sky, or a forward (hybrid) instance: drawn after the resolve
+        } else if (one) { // the sky, or a forward (hybrid) instance: drawn before the resolve
             uint first = resolveAddressIndex(origin, pc.width);
+            uvec4 address =
+                vis[0].x == VISIBILITY_NONE ? resolveAddressNone() : resolveAddressForward();
             for (uint i = 0u; i < 4u; ++i)
-                ResolveAddressBuffer(pc.addresses).v[first + i] = resolveAddressNone();
+                ResolveAddressBuffer(pc.addresses).v[first + i] = address;
         } else {
             listed = true;
         }

@@ -5,8 +5,14 @@
 // and the filter of the raster reconstruction (shadel/resolve.glsl). The debug views,
 // --inspect, misses, overflow and camera-cut samples rebuild the sample from the visibility
 // buffer instead (shadel/resolve_pixel.glsl resolveRebuilt: the same samples as the marking;
-// misses, overflow and cuts are shaded forward from the rebuilt attributes). Every other pixel
-// gets the sky: forward (hybrid) instances are drawn over it by the raster pass that follows.
+// misses, overflow and cuts are shaded forward from the rebuilt attributes). Pixels of forward
+// (hybrid) instances were drawn by the raster pass before (hybridForward) and are left as it drew
+// them; every other pixel gets the sky.
+//
+// With the frame's tonemap fused into the resolve (kDisplayOutput, render/post/tonemap.h) every
+// pixel is written as the display shows it, into the readback, forward ones read from the scene
+// colour: no scene colour is stored and no tonemap pass runs (1280x720 on lavapipe: the RGBA16F
+// image stores cost the resolve about 10 ms, the tonemap pass 13).
 //
 // Without debug views or --inspect the rebuild is not compiled in (kRebuildInline false): the
 // resolve lists those rare pixels and resolve_rebuild.comp shades them by indirect dispatch.
@@ -28,6 +34,13 @@ void resolveQuad(FrameConstants f, ShadelFrame s, ivec2 origin, inout uvec4 coun
         if (pixel.x >= int(pc.width) || pixel.y >= int(pc.height)) continue;
         ResolveAddress a = unpackResolveAddress(
             ResolveAddressBuffer(pc.addresses).v[resolveAddressIndex(pixel, pc.width)]);
+        if (a.kind == RESOLVE_ADDRESS_FORWARD) { // hybridForward drew it
+            if (kDisplayOutput) {
+                vec3 drawn = imageLoad(gImagesRgba16f[pc.hdrSlot], pixel).rgb;
+                writeResolvedPixel(f, pixel, vec4(drawn, 1.0));
+            }
+            continue; // (else the scene colour holds it)
+        }
         vec4 color = vec4(f.skyColor, 0.0); // what the raster colour pass clears to
         bool rebuild = a.kind == RESOLVE_ADDRESS_REBUILD || f.visualize != VISUALIZE_NONE ||
                        inspecting(f, uvec2(pixel));
@@ -51,7 +64,7 @@ void resolveQuad(FrameConstants f, ShadelFrame s, ivec2 origin, inout uvec4 coun
         }
         if (rebuild && kRebuildInline)
             color = resolveRebuilt(f, s, origin, i, pixel, current, o, inst, q, counts);
-        imageStore(gImagesRgba16f[pc.hdrSlot], pixel, color);
+        writeResolvedPixel(f, pixel, color);
     }
 }
 

@@ -14,9 +14,10 @@
 #define SHADEL_RESOLVE_ADDRESS_GLSL
 #include "shadel/marking.glsl"
 
-#define RESOLVE_ADDRESS_NONE 0u    // no decoupled surface: the sky (hybrid objects drawn over it)
+#define RESOLVE_ADDRESS_NONE 0u    // no surface: the sky
 #define RESOLVE_ADDRESS_READY 1u   // the footprints below
 #define RESOLVE_ADDRESS_REBUILD 2u // the resolve rebuilds the sample (more taps, or forward)
+#define RESOLVE_ADDRESS_FORWARD 3u // a forward (hybrid) instance, drawn before the resolve
 
 // Laid out by 2x2 quads, the unit both passes walk: a quad's four pixels are 64 bytes together.
 layout(buffer_reference, scalar) buffer ResolveAddressBuffer { uvec4 v[]; };
@@ -58,6 +59,9 @@ void unpackAddressAxis(uint word, out uint lo, out uint hi, out float weight) {
 }
 
 uvec4 resolveAddressNone() { return uvec4(0u); } // kind RESOLVE_ADDRESS_NONE
+uvec4 resolveAddressForward() {
+    return uvec4(RESOLVE_ADDRESS_FORWARD << kAddressExtraBit, 0u, 0u, 0u);
+}
 
 // magnified: the MIP-0 shadel is larger than the pixel (the resolve's statistics).
 uvec4 packResolveAddress(MarkedSample m, bool magnified) {

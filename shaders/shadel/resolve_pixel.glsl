@@ -8,6 +8,7 @@
 #include "shadel/vis_shadel.glsl"
 #include "common/lighting.glsl"
 #include "common/vertex.glsl"
+#include "common/tone_curve.glsl"
 #include "debug/inspect_shadel.glsl"
 
 // The pixels the resolve leaves to the rebuild pass, and that pass's indirect arguments.
@@ -26,7 +27,22 @@ layout(push_constant, scalar) uniform Push {
     uint hdrSlot;
     uint64_t addresses;   // ResolveAddressBuffer
     uint64_t rebuildList; // ResolveRebuildList
+    uint64_t markList;    // (the marking's)
+    uint64_t displayPixels; // the readback's RGBA8 pixels (kDisplayOutput)
 } pc;
+
+// The frame's tonemap fused into the resolve (render/post/tonemap.h): display pixels into the
+// readback (pc.displayPixels), else scene colour into the HDR target.
+layout(constant_id = RESOLVE_DISPLAY_OUTPUT_CONSTANT_ID) const bool kDisplayOutput = false;
+
+// The resolve's output: the pixel's scene colour (alpha: covered), or its display pixel.
+void writeResolvedPixel(FrameConstants f, ivec2 pixel, vec4 color) {
+    if (kDisplayOutput)
+        UintBuffer(pc.displayPixels).v[pixel.y * int(pc.width) + pixel.x] =
+            packDisplayPixel(displayColor(color.rgb, f.exposure), color.a > 0.0);
+    else
+        imageStore(gImagesRgba16f[pc.hdrSlot], pixel, color);
+}
 
 // The forward material + lighting at the pixel, from the triangle's interpolated attributes
 // (what the forward raster pass's varyings and dFdx/dFdy would give).

@@ -24,7 +24,7 @@ void main() {
         ShadelObjectRef o;
         GpuInstance inst;
         vec4 color = resolveRebuilt(f, s, origin, i, pixel, current, o, inst, q, counts);
-        imageStore(gImagesRgba16f[pc.hdrSlot], pixel, color);
+        writeResolvedPixel(f, pixel, color);
     }
     countResolvedPixels(s, counts);
 }

@@ -591,6 +591,7 @@ nlohmann::json runBench(Gpu& gpu, const BenchOptions& b) {
     o.shadingBias = b.shadingBias;
     o.materialRate = b.materialRate;
     o.sunShadowCache = b.sunShadowCache;
+    o.fuseTonemap = b.fuseTonemap;
     o.cacheLimitBytes = b.cacheLimitBytes;
     o.lightCulling = b.lightCulling;
     // --spectra compare reports on / off against the three modes: they run without spectra
@@ -623,6 +624,7 @@ nlohmann::json runBench(Gpu& gpu, const BenchOptions& b) {
     out["shading_bias"] = b.shadingBias;
     out["material_rate"] = b.materialRate;
     out["shadow_cache"] = b.sunShadowCache;
+    out["fuse_tonemap"] = b.fuseTonemap;
     // With --rounds N every round runs the three modes, in opposite order each round, so the
     // machine's drift over a run (a shared machine's neighbours, warm-up) hits every mode
     // alike; each ratio is the median of the rounds' ratios (forward of the same round as the

@@ -53,6 +53,7 @@ struct RenderOptions {
     bool capacityControl = true;
     bool reuse = true;
     uint32_t reuseRefreshPeriod = 16;
+    bool fuseTonemap = true; // --fuse-tonemap on|off
     bool animateLights = false;
     OitMode oit = OitMode::Wboit;                                // --oit wboit|sorted
     std::optional<uint64_t> shuffleDrawsSeed;                    // --shuffle-draws SEED
@@ -198,6 +199,7 @@ struct BenchOptions {
     float shadingBias = 0.0f;                // decoupled and reuse modes
     bool materialRate = true;                // --material-rate on|off: decoupled and reuse modes
     bool sunShadowCache = true;              // --shadow-cache on|off: every mode
+    bool fuseTonemap = true;                 // --fuse-tonemap on|off: every mode
     LightCulling lightCulling = LightCulling::Tiled;
     // --light-culling compare: forward and decoupled rendered again with no culling, and
     // ratios.light_culling_forward|decoupled = tiled / none median frame time.

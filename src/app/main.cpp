@@ -335,6 +335,14 @@ int main(int argc, char** argv) {
                      "drawn once from every caster in its volume (off: redrawn every frame from "
                      "the casters whose shadow can reach the view)")
         ->capture_default_str();
+    std::string fuseTonemap = "on";
+    render
+        ->add_option("--fuse-tonemap", fuseTonemap,
+                     "on | off: where nothing draws into the scene colour after the opaque "
+                     "shading pass (no blended materials, particles, screen-space passes, debug "
+                     "lines, --ssaa 1), that pass writes the display pixels itself and the "
+                     "tonemap pass does not run (off: always a separate pass)")
+        ->capture_default_str();
     std::string shadowCulling = "per-view";
     render
         ->add_option("--shadow-culling", shadowCulling,
@@ -555,6 +563,12 @@ int main(int argc, char** argv) {
                      "on | off: keep the sun's shadow map while the sun and its casters stay put "
                      "(off: redraw it every frame)")
         ->capture_default_str();
+    std::string benchFuseTonemap = "on";
+    bench
+        ->add_option("--fuse-tonemap", benchFuseTonemap,
+                     "every mode: on | off: the tonemap fused into the opaque shading pass where "
+                     "nothing draws after it (off: always a separate pass)")
+        ->capture_default_str();
     std::string benchMarking = "auto";
     bench->add_option("--marking", benchMarking, "decoupled modes: auto | raster | visibility")
         ->capture_default_str();
@@ -762,6 +776,7 @@ int main(int argc, char** argv) {
             ro.sunCascades = parseSunCascades(sunCascades);
             ro.shadowCulling = parseShadowCulling(shadowCulling);
             ro.sunShadowCache = parseOnOff("--shadow-cache", shadowCache);
+            ro.fuseTonemap = parseOnOff("--fuse-tonemap", fuseTonemap);
             ro.decals = parseOnOff("--decals", decals);
             ro.proxyShadows = parseOnOff("--proxy-shadows", proxyShadows);
             ro.gi = parseGi(gi);
@@ -845,6 +860,7 @@ int main(int argc, char** argv) {
             bo.marking = parseMarking(benchMarking);
             bo.materialRate = parseOnOff("--material-rate", benchMaterialRate);
             bo.sunShadowCache = parseOnOff("--shadow-cache", benchShadowCache);
+            bo.fuseTonemap = parseOnOff("--fuse-tonemap", benchFuseTonemap);
             bo.lightGrid = parseOnOff("--light-grid", benchLightGrid);
             bo.sunCascades = parseSunCascades(benchSunCascades);
             if (bo.rounds < 1 || bo.rounds > 100)

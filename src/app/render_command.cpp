@@ -494,6 +494,8 @@ RenderSessionPtr beginRender(Gpu& gpu, const RenderOptions& options) {
     settings.proxyShadows = o.proxyShadows;
     settings.shadowCulling = o.shadowCulling;
     settings.sunShadowCache = o.sunShadowCache;
+    // The scene colour is read back whole for --capture and EXR output: not fused there.
+    settings.fuseTonemap = o.fuseTonemap && o.captures.empty() && !isExrPath(o.out);
     // The trace's finer CPU spans (stats "cpu_scopes").
     settings.cpuScopes = !o.trace.empty() || o.cpuScopes;
     settings.gi = o.gi;
@@ -760,6 +762,10 @@ RenderRun finishRender(RenderSessionPtr sessionPtr) {
     featureSpectraStats(renderer, s);
     spotShadowStats(renderer, s);
     sunShadowCacheStats(renderer, s);
+    // Frames whose opaque shading pass wrote the display pixels (render/post/tonemap.h).
+    uint32_t fusedFrames = 0;
+    for (const auto& f : run.frames) fusedFrames += f.tonemapFused ? 1u : 0u;
+    s["tonemap_fused_frames"] = fusedFrames;
     sunCascadeStats(renderer, s);
     decalStats(renderer, s);
     s["density_mode"] = autoDensity ? "auto" : "explicit";

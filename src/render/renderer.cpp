@@ -60,6 +60,17 @@ static void createTargets(Renderer& r) {
     r.depthTarget = createDepthTargetView(gpu, r.depth);
     r.depthRead = createReadView(gpu, r.depth);
 
+    if (forwardMayFuseTonemap(r)) { // forward shading's display pixels (render/post/tonemap.h)
+        TextureDesc display;
+        display.name = "displayColor";
+        display.format = VK_FORMAT_R8G8B8A8_UNORM;
+        display.width = r.settings.width;
+        display.height = r.settings.height;
+        display.usage = VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT;
+        r.display = need(createTexture(gpu, display), "the display target");
+        r.displayTarget = createRenderTargetView(gpu, r.display);
+    }
+
     // The sun's whole-scene map: a one-map shadow atlas (render/lighting/shadow_atlas.h).
     r.sunShadow =
         createShadowAtlas(gpu, "sunShadow", r.settings.shadowMapSize, r.settings.shadowMapSize,
@@ -207,6 +218,8 @@ void destroyRenderer(Renderer& r) {
     destroySceneEdits(r);
     destroy(gpu, r.hdrTarget);
     destroy(gpu, r.hdrRead);
+    destroy(gpu, r.displayTarget);
+    if (r.display) destroy(gpu, r.display);
     destroy(gpu, r.depthTarget);
     destroy(gpu, r.depthRead);
     destroyShadowAtlas(gpu, r.sunShadow);
@@ -392,6 +405,9 @@ FrameResult renderFrame(Renderer& r, const GpuScene& scene, const CameraView& ca
         r.nextFrame.reset();
     }
 
+    r.tonemapFused = tonemapFusedThisFrame(r); // (after the transparent draws are prepared)
+    prepareForwardPipelines(r);                // (their first use: this output's pipelines)
+    prepareResolvePipelines(r);
     FrameRecorder& rec = r.recorder;
     auto declaring = cpuScope(r, "declare passes");
     beginFrame(rec);
@@ -437,7 +453,7 @@ FrameResult renderFrame(Renderer& r, const GpuScene& scene, const CameraView& ca
         recordDecalCulling(r, rec, frame);      // (decoupled: in recordDecoupledShading)
     if (usesTileShading(r)) { // forward, per-tile permutations (render/lighting/feature_spectra.h)
         pass(rec, "tileShading", [&](VkCommandBuffer cmd) { recordTileShading(r, cmd, frame); });
-    } else if (r.settings.mode == RenderMode::Forward) {
+    } else if (r.settings.mode == RenderMode::Forward) { // (tonemap fused: display pixels)
         pass(rec, "forwardShading",
              [&](VkCommandBuffer cmd) { recordForwardShading(r, cmd, frame); });
     } else {
@@ -454,7 +470,10 @@ FrameResult renderFrame(Renderer& r, const GpuScene& scene, const CameraView& ca
     recordTransparencyPasses(r, rec, frame); // blended materials, after every opaque surface
     if (r.debugLines) recordDebugLinePasses(r, rec, frame, scene, constants.lightCount);
     recordParticleAtlasView(r, rec, frame); // --visualize particle-atlas
-    pass(rec, "tonemap", [&](VkCommandBuffer cmd) { recordTonemap(r, cmd, frame); });
+    if (!r.tonemapFused) // else forward shading or the resolve wrote display pixels (render/post)
+        pass(rec, "tonemap", [&](VkCommandBuffer cmd) { recordTonemap(r, cmd, frame); });
+    else if (r.settings.mode == RenderMode::Forward) // (the resolve wrote the readback itself)
+        pass(rec, "displayReadback", [&](VkCommandBuffer cmd) { recordDisplayReadback(r, cmd); });
     if (r.decoupled) recordDecoupledPostPasses(r, rec, frame);
     declaring.stop();
     {
@@ -464,6 +483,7 @@ FrameResult renderFrame(Renderer& r, const GpuScene& scene, const CameraView& ca
 
     FrameResult result;
     result.passes = rec.passes;
+    result.tonemapFused = r.tonemapFused;
     result.recordingMs = rec.recordingMs;
     result.recordingWorkers = rec.workerTimings;
     result.frameMs = rec.frameMs;

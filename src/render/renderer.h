@@ -161,6 +161,10 @@ struct RenderSettings {
     bool decals = true; // --decals: the scene's projected box decals (render/decals)
     ShadowCulling shadowCulling = ShadowCulling::PerView; // cascades' and spots' caster lists
     bool sunShadowCache = true; // --shadow-cache: keep the sun's map while nothing in it changes
+    // --fuse-tonemap: where nothing draws into the scene colour after the opaque shading pass,
+    // that pass writes display pixels itself and the tonemap pass does not run
+    // (render/post/tonemap.h). Off where the scene colour is read back (--capture, EXR output).
+    bool fuseTonemap = true;
     // --trace: time the frame's CPU scopes (FrameResult::cpuScopes) and each pass's recording.
     // Off by default: reading a thread's CPU clock costs ~0.7 us, which would add to cpuFrameMs.
     bool cpuScopes = false;
@@ -178,6 +182,7 @@ struct FrameResult {
     std::vector<uint8_t> rgba; // width x height RGBA8, alpha = 255 where geometry covers the pixel
     uint64_t pixelsCovered = 0;
     std::vector<PassTiming> passes;
+    bool tonemapFused = false; // the opaque shading pass wrote the display pixels (render/post)
     double frameMs = 0.0;
     double cpuFrameMs = 0.0;   // CPU time to produce the frame (prepare + record), no GPU wait
     double cpuPrepareMs = 0.0; // of which the CPU frontend: constants, decoupled coarse allocation
@@ -248,11 +253,19 @@ struct Renderer {
     BufferHandle sceneIndices;           // the unified index buffer of the scene being drawn
     BufferHandle sceneVisibilityIndices; // ... and the visibility prepass's (GpuScene)
     glm::vec3 skyColor{0.5f};
+    // This frame's tonemap is fused into its opaque shading pass (render/post/tonemap.h): set
+    // before the passes are declared.
+    bool tonemapFused = false;
+    // Forward with --fuse-tonemap: the display target forward shading writes when fused (RGBA8,
+    // sRGB-encoded values, alpha = coverage), copied into `pixels`.
+    TextureHandle display;
+    RenderTargetView displayTarget;
     Pipeline instanceCull, depthPrepass, tonemap;
     // Forward shading of opaque surfaces, one pipeline per material class (render/forward):
     // plain materials (DRAW_LIST_OPAQUE, material features compiled out), textures only
     // (DRAW_LIST_OPAQUE_TEXTURED), any other feature (DRAW_LIST_OPAQUE_FEATURED, all of them).
     std::array<Pipeline, kForwardClassCount> forwardOpaque;
+    std::array<Pipeline, kForwardClassCount> forwardDisplay; // the same into `display` (fused)
     // The scene has alpha-masked materials: the depth-only passes (prepass, shadow maps) and the
     // visibility prepass run their alpha test. Without them they are depth-only / have the test
     // compiled out, so the depth test runs before any fragment shading (early Z).

@@ -48,6 +48,7 @@ TEST(ShaderReload, EditSwapsThePipelineAndABrokenShaderKeepsTheLastGoodOne) {
     settings.width = 96;
     settings.height = 54;
     settings.timing = defaultTimingMode(gpu);
+    settings.fuseTonemap = false; // the edit below is to the tonemap pass: it must run
     Renderer r;
     initRenderer(r, gpu, settings, gs);
     CameraView view = makeCameraView(findCamera(scene, ""), 96, 54);

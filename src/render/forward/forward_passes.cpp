@@ -2,6 +2,7 @@
 
 #include "render/culling/culling.h"
 #include "render/debug/inspect.h"
+#include "render/post/tonemap.h"
 #include "render/renderer.h"
 
 namespace shadel {
@@ -54,17 +55,8 @@ uint32_t shadingVisibilityVertices(const Renderer& r) {
     return r.settings.inspectX >= 0 ? VISIBILITY_VERTICES_ALL : VISIBILITY_VERTICES_OFF;
 }
 
-void createForwardPipelines(Renderer& r) {
-    Gpu& gpu = *r.gpu;
-    r.instanceCull = createComputePipeline(gpu, "instanceCull", "forward_instance_cull.comp.spv");
-    GraphicsPipelineDesc depth;
-    depth.name = "depthPrepass";
-    depth.vertexShader = "forward_forward.vert.spv";
-    depth.fragmentShader = r.alphaMasked ? "forward_depth.frag.spv" : ""; // (Renderer::alphaMasked)
-    depth.depthFormat = VK_FORMAT_D32_SFLOAT;
-    depth.cullMode = VK_CULL_MODE_NONE; // double-sided materials; backfaces cost little here
-    r.depthPrepass = createGraphicsPipeline(gpu, depth);
-
+// The forward pipeline of material class k, writing scene colour or display pixels.
+static GraphicsPipelineDesc forwardClassPipeline(const Renderer& r, uint32_t k, bool display) {
     GraphicsPipelineDesc opaque;
     opaque.vertexShader = "forward_forward.vert.spv";
     opaque.fragmentShader = "forward_forward.frag.spv";
@@ -85,18 +77,43 @@ void createForwardPipelines(Renderer& r) {
     // One pipeline per material class, with only the class's material features compiled in (as
     // the shadel path's shading classes): a CPU device's SIMD group runs the code of a branch
     // none of its lanes takes, so compiled-in features cost every pixel.
-    for (uint32_t k = 0; k < kForwardClassCount; ++k) {
-        GraphicsPipelineDesc c = opaque;
-        c.name = kForwardClasses[k].pipelineName;
-        c.specialization.push_back(
-            {MATERIAL_FEATURES_CONSTANT_ID, kForwardClasses[k].materialFeatures});
-        r.forwardOpaque[k] = createGraphicsPipeline(gpu, c);
+    opaque.name = kForwardClasses[k].pipelineName;
+    opaque.specialization.push_back(
+        {MATERIAL_FEATURES_CONSTANT_ID, kForwardClasses[k].materialFeatures});
+    if (display) { // the tonemap fused into it (render/post/tonemap.h)
+        opaque.name += "Display";
+        opaque.colorFormats = {VK_FORMAT_R8G8B8A8_UNORM};
+        opaque.specialization.push_back({FORWARD_DISPLAY_OUTPUT_CONSTANT_ID, 1u});
     }
+    return opaque;
+}
+
+void createForwardPipelines(Renderer& r) {
+    Gpu& gpu = *r.gpu;
+    r.instanceCull = createComputePipeline(gpu, "instanceCull", "forward_instance_cull.comp.spv");
+    GraphicsPipelineDesc depth;
+    depth.name = "depthPrepass";
+    depth.vertexShader = "forward_forward.vert.spv";
+    depth.fragmentShader = r.alphaMasked ? "forward_depth.frag.spv" : ""; // (Renderer::alphaMasked)
+    depth.depthFormat = VK_FORMAT_D32_SFLOAT;
+    depth.cullMode = VK_CULL_MODE_NONE; // double-sided materials; backfaces cost little here
+    r.depthPrepass = createGraphicsPipeline(gpu, depth);
+    // Scene colour: the hybrid objects of decoupled frames draw with them too.
+    for (uint32_t k = 0; k < kForwardClassCount; ++k)
+        r.forwardOpaque[k] = createGraphicsPipeline(gpu, forwardClassPipeline(r, k, false));
+}
+
+void prepareForwardPipelines(Renderer& r) {
+    if (!r.tonemapFused || r.settings.mode != RenderMode::Forward || r.forwardDisplay[0].pipeline)
+        return;
+    for (uint32_t k = 0; k < kForwardClassCount; ++k)
+        r.forwardDisplay[k] = createGraphicsPipeline(*r.gpu, forwardClassPipeline(r, k, true));
 }
 
 void destroyForwardPipelines(Renderer& r) {
     for (Pipeline* p : {&r.instanceCull, &r.depthPrepass}) destroy(*r.gpu, *p);
     for (Pipeline& p : r.forwardOpaque) destroy(*r.gpu, p);
+    for (Pipeline& p : r.forwardDisplay) destroy(*r.gpu, p);
 }
 
 void recordInstanceCull(Renderer& r, VkCommandBuffer cmd, uint64_t frame, const GpuScene& scene) {
@@ -202,20 +219,23 @@ void drawPrepassListsAndEnd(Renderer& r, VkCommandBuffer cmd, BufferHandle indic
                       VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT);
 }
 
-void beginSceneColorPass(Renderer& r, VkCommandBuffer cmd, bool clear) {
+// Colour (`target`, cleared to `sky` with alpha 0, or loaded) over the prepass depth.
+static void beginColorPass(Renderer& r, VkCommandBuffer cmd, TextureHandle image,
+                           RenderTargetView target, glm::vec3 sky, bool clear) {
     Gpu& gpu = *r.gpu;
     if (clear)
-        imageBarrier(
-            cmd, vkImage(gpu, r.hdr), VK_IMAGE_ASPECT_COLOR_BIT, VK_IMAGE_LAYOUT_UNDEFINED,
-            VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, 0,
-            VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT,
-            VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT | VK_ACCESS_2_COLOR_ATTACHMENT_READ_BIT);
+        imageBarrier(cmd, vkImage(gpu, image), VK_IMAGE_ASPECT_COLOR_BIT, VK_IMAGE_LAYOUT_UNDEFINED,
+                     VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL,
+                     VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_2_COPY_BIT, 0,
+                     VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT,
+                     VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT |
+                         VK_ACCESS_2_COLOR_ATTACHMENT_READ_BIT);
     VkRenderingAttachmentInfo color{VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO};
-    color.imageView = vkView(gpu, r.hdrTarget);
+    color.imageView = vkView(gpu, target);
     color.imageLayout = VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL;
     color.loadOp = clear ? VK_ATTACHMENT_LOAD_OP_CLEAR : VK_ATTACHMENT_LOAD_OP_LOAD;
     color.storeOp = VK_ATTACHMENT_STORE_OP_STORE;
-    color.clearValue.color = {{r.skyColor.x, r.skyColor.y, r.skyColor.z, 0.0f}};
+    color.clearValue.color = {{sky.x, sky.y, sky.z, 0.0f}};
     VkRenderingAttachmentInfo depth{VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO};
     depth.imageView = vkView(gpu, r.depthTarget);
     depth.imageLayout = VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL;
@@ -230,11 +250,16 @@ void beginSceneColorPass(Renderer& r, VkCommandBuffer cmd, bool clear) {
     vkCmdBeginRendering(cmd, &ri);
 }
 
-void drawForwardLists(Renderer& r, VkCommandBuffer cmd, uint64_t frame) {
+void beginSceneColorPass(Renderer& r, VkCommandBuffer cmd, bool clear) {
+    beginColorPass(r, cmd, r.hdr, r.hdrTarget, r.skyColor, clear);
+}
+
+// Each material class's list by its own pipeline (scene colour, or display pixels when fused).
+static void drawForwardLists(Renderer& r, VkCommandBuffer cmd, uint64_t frame,
+                             const std::array<Pipeline, kForwardClassCount>& pipelines) {
     Gpu& gpu = *r.gpu;
-    // Each material class's list by its own pipeline.
     for (uint32_t k = 0; k < kForwardClassCount; ++k) {
-        bind(gpu, cmd, r.forwardOpaque[k]);
+        bind(gpu, cmd, pipelines[k]);
         pushConstants(gpu, cmd, RasterPush{frame, 0});
         drawOneCameraList(r, cmd, kForwardClasses[k].list, shadingIndices(r));
     }
@@ -242,9 +267,19 @@ void drawForwardLists(Renderer& r, VkCommandBuffer cmd, uint64_t frame) {
     // transparency passes (render/oit), from a CPU list that can be shuffled or sorted.
 }
 
+void drawForwardLists(Renderer& r, VkCommandBuffer cmd, uint64_t frame) {
+    drawForwardLists(r, cmd, frame, r.forwardOpaque);
+}
+
 void recordForwardShading(Renderer& r, VkCommandBuffer cmd, uint64_t frame) {
-    beginSceneColorPass(r, cmd, true);
-    drawForwardLists(r, cmd, frame);
+    if (r.tonemapFused) { // display pixels (render/post/tonemap.h): the sky as the display shows it
+        beginColorPass(r, cmd, r.display, r.displayTarget,
+                       displayColor(r.skyColor, r.settings.exposure), true);
+        drawForwardLists(r, cmd, frame, r.forwardDisplay);
+    } else {
+        beginSceneColorPass(r, cmd, true);
+        drawForwardLists(r, cmd, frame, r.forwardOpaque);
+    }
     vkCmdEndRendering(cmd);
 }
 

@@ -17,6 +17,9 @@ struct Renderer;
 struct GpuScene;
 
 void createForwardPipelines(Renderer& r);
+// The display-output pipelines, the first time a frame fuses the tonemap into forward shading
+// (Renderer::tonemapFused), before its passes are recorded.
+void prepareForwardPipelines(Renderer& r);
 void destroyForwardPipelines(Renderer& r);
 
 // Culls every instance on the GPU, in one dispatch, against the camera frustum, the sun's
@@ -24,6 +27,8 @@ void destroyForwardPipelines(Renderer& r);
 void recordInstanceCull(Renderer& r, VkCommandBuffer cmd, uint64_t frame, const GpuScene& scene);
 void recordShadowMap(Renderer& r, VkCommandBuffer cmd, uint64_t frame);
 void recordDepthPrepass(Renderer& r, VkCommandBuffer cmd, uint64_t frame);
+// Into the scene colour, or with the frame's tonemap fused into it (Renderer::tonemapFused) as
+// display pixels into Renderer::display (render/post/tonemap.h).
 void recordForwardShading(Renderer& r, VkCommandBuffer cmd, uint64_t frame);
 // The forward-shaded opaque list inside an open scene colour pass; the decoupled frame draws it
 // next to reconstruction (hybrid). Blended instances are drawn by render/oit.

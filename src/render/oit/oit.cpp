@@ -302,9 +302,12 @@ static void afterOpaquePasses(VkCommandBuffer cmd) {
                       VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT);
 }
 
+bool transparencyThisFrame(const Renderer& r) {
+    return r.oit && (!r.oit->draws.empty() || r.oit->decoupledDraws != 0 || particlesThisFrame(r));
+}
+
 void recordTransparencyPasses(Renderer& r, FrameRecorder& rec, uint64_t frame) {
-    if (!r.oit || (r.oit->draws.empty() && r.oit->decoupledDraws == 0 && !particlesThisFrame(r)))
-        return;
+    if (!transparencyThisFrame(r)) return;
     Gpu& gpu = *r.gpu;
     OitState& o = *r.oit;
     auto meshOf = [&](uint32_t instance) -> const gpu::GpuMesh& {

@@ -29,7 +29,9 @@ const std::vector<uint32_t>& transparentDrawOrder(const Renderer& r);
 uint32_t decoupledTransparentDraws(const Renderer& r);
 
 // wboit: `oitAccumulate` (two targets) then `oitComposite` over the scene colour; sorted:
-// `sortedTransparency`. Nothing when the frame has no transparent draw.
+// `sortedTransparency`. Nothing when the frame has no transparent draw (transparencyThisFrame
+// false: after prepareTransparentDraws).
+bool transparencyThisFrame(const Renderer& r);
 void recordTransparencyPasses(Renderer& r, FrameRecorder& rec, uint64_t frame);
 
 // The WBOIT targets as colour attachments over the opaque depth (cleared, or loaded to keep

@@ -1,5 +1,9 @@
 #include "render/post/tonemap.h"
 
+#include <algorithm>
+#include <cmath>
+
+#include "render/oit/oit.h"
 #include "render/renderer.h"
 
 namespace shadel {
@@ -50,6 +54,50 @@ void recordTonemap(Renderer& r, VkCommandBuffer cmd, uint64_t frame) {
                   (r.settings.height + TONEMAP_GROUP_Y - 1) / TONEMAP_GROUP_Y, 1);
     memoryBarrier(cmd, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT,
                   VK_PIPELINE_STAGE_2_HOST_BIT, VK_ACCESS_2_HOST_READ_BIT);
+}
+
+bool forwardMayFuseTonemap(const Renderer& r) {
+    return r.settings.fuseTonemap && r.settings.ssaa == 1 &&
+           r.settings.mode == RenderMode::Forward && !usesTileShading(r);
+}
+
+bool tonemapFusedThisFrame(const Renderer& r) {
+    if (!r.settings.fuseTonemap || r.settings.ssaa != 1) return false;
+    // The opaque shading pass that writes display pixels: forward shading (not the tile path),
+    // or the decoupled compute resolve (not the raster reconstruction).
+    bool fusingPass =
+        r.settings.mode == RenderMode::Forward ? forwardMayFuseTonemap(r) : r.visibility != nullptr;
+    // Every pass declared after it that draws into or reads the scene colour.
+    bool drawnAfter = r.particles || r.screenSpace || r.stencilEffects || r.pointsLines ||
+                      r.debugLines || transparencyThisFrame(r);
+    return fusingPass && !drawnAfter;
+}
+
+void recordDisplayReadback(Renderer& r, VkCommandBuffer cmd) {
+    Gpu& gpu = *r.gpu;
+    imageBarrier(cmd, vkImage(gpu, r.display), VK_IMAGE_ASPECT_COLOR_BIT,
+                 VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL,
+                 VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT,
+                 VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT, VK_PIPELINE_STAGE_2_COPY_BIT,
+                 VK_ACCESS_2_TRANSFER_READ_BIT);
+    VkBufferImageCopy copy{};
+    copy.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
+    copy.imageExtent = {r.settings.width, r.settings.height, 1};
+    vkCmdCopyImageToBuffer(cmd, vkImage(gpu, r.display), VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL,
+                           vkBuffer(gpu, r.pixels), 1, &copy);
+    memoryBarrier(cmd, VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT,
+                  VK_PIPELINE_STAGE_2_HOST_BIT, VK_ACCESS_2_HOST_READ_BIT);
+}
+
+glm::vec3 displayColor(glm::vec3 hdr, float exposure) {
+    glm::vec3 out;
+    for (int c = 0; c < 3; ++c) {
+        float x = std::max(hdr[c], 0.0f) * exposure;
+        float y =
+            std::clamp((x * (2.51f * x + 0.03f)) / (x * (2.43f * x + 0.59f) + 0.14f), 0.0f, 1.0f);
+        out[c] = y < 0.0031308f ? y * 12.92f : 1.055f * std::pow(y, 1.0f / 2.4f) - 0.055f;
+    }
+    return out;
 }
 
 } // namespace shadel

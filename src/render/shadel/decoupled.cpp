@@ -1232,11 +1232,11 @@ void recordDecoupledShading(Renderer& r, FrameRecorder& rec, uint64_t frame, con
             VK_ACCESS_2_SHADER_STORAGE_READ_BIT);
     });
 
-    if (r.visibility) { // compute resolve, then forward (hybrid) objects rastered over it
-        pass(rec, "resolveCompute",
-             [&, frame](VkCommandBuffer cmd) { recordResolveCompute(r, cmd, frame); });
+    if (r.visibility) { // forward (hybrid) objects rastered, then the compute resolve
         pass(rec, "hybridForward",
              [&, frame](VkCommandBuffer cmd) { recordHybridForward(r, cmd, frame); });
+        pass(rec, "resolveCompute",
+             [&, frame](VkCommandBuffer cmd) { recordResolveCompute(r, cmd, frame); });
         return;
     }
     // Decoupled objects read their shadels; forward objects (hybrid) shade as usual.

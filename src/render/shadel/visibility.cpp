@@ -25,9 +25,10 @@ struct VisibilityState {
     // (shaders/shadel/mark_quad.glsl MarkQuadList).
     BufferHandle markList;
     // resolveInline rebuilds its rare pixels itself (debug views, --inspect); resolve lists them
-    // for resolveRebuild, sized by resolveRebuildArgs.
-    Pipeline prepass, mark, markListed, markListedArgs, resolve, resolveInline, resolveRebuild,
-        resolveRebuildArgs;
+    // for resolveRebuild, sized by resolveRebuildArgs. Each of the three per output: [0] scene
+    // colour, [1] display pixels (the tonemap fused into the resolve: render/post/tonemap.h).
+    Pipeline prepass, mark, markListed, markListedArgs, resolveRebuildArgs;
+    std::array<Pipeline, 2> resolve, resolveInline, resolveRebuild;
 };
 
 void VisibilityStateDeleter::operator()(VisibilityState* state) const {
@@ -44,6 +45,7 @@ struct ComputePush {
     uint64_t address;
     uint64_t rebuildList;
     uint64_t markList;
+    uint64_t displayPixels; // the resolve's: the readback when the tonemap is fused, else 0
 };
 
 ComputePush computePush(Renderer& r, uint64_t frame) {
@@ -56,7 +58,8 @@ ComputePush computePush(Renderer& r, uint64_t frame) {
             slot(gpu, v.hdrWrite).value,
             v.address ? address(gpu, v.address) : 0u,
             v.rebuildList ? address(gpu, v.rebuildList) : 0u,
-            v.markList ? address(gpu, v.markList) : 0u};
+            v.markList ? address(gpu, v.markList) : 0u,
+            r.tonemapFused ? address(gpu, r.pixels) : 0u};
 }
 
 void dispatchPixels(Renderer& r, VkCommandBuffer cmd) {
@@ -143,30 +146,19 @@ VisibilityStatePtr createVisibility(Renderer& r) {
     prepass.depthFormat = VK_FORMAT_D32_SFLOAT;
     prepass.cullMode = VK_CULL_MODE_NONE; // as the depth prepass
     v.prepass = createGraphicsPipeline(gpu, prepass);
-    std::vector<std::pair<uint32_t, uint32_t>> inlineRebuild =
-        shaderPrintSpecialization(r.settings.inspectX >= 0);
-    inlineRebuild.push_back({RESOLVE_REBUILD_INLINE_CONSTANT_ID, 1u});
     std::vector<ComputePipelineDesc> descs = {
-        {"shadelMarkVisibility", "shadel_mark_visibility.comp.spv", {}},
-        {"shadelResolveInlineRebuild", "shadel_resolve.comp.spv", inlineRebuild}};
+        {"shadelMarkVisibility", "shadel_mark_visibility.comp.spv", {}}};
     if (v.rebuildList) {
-        descs.push_back({"shadelResolve",
-                         "shadel_resolve.comp.spv",
-                         {{RESOLVE_REBUILD_INLINE_CONSTANT_ID, 0u}}});
-        descs.push_back({"shadelResolveRebuild", "shadel_resolve_rebuild.comp.spv", {}});
         descs.push_back({"shadelResolveRebuildArgs", "shadel_resolve_rebuild_args.comp.spv", {}});
         descs.push_back({"shadelMarkListed", "shadel_mark_listed.comp.spv", {}});
         descs.push_back({"shadelMarkListedArgs", "shadel_mark_listed_args.comp.spv", {}});
     }
     std::vector<Pipeline> built = createComputePipelines(gpu, descs); // side by side
     v.mark = built[0];
-    v.resolveInline = built[1];
     if (v.rebuildList) {
-        v.resolve = built[2];
-        v.resolveRebuild = built[3];
-        v.resolveRebuildArgs = built[4];
-        v.markListed = built[5];
-        v.markListedArgs = built[6];
+        v.resolveRebuildArgs = built[1];
+        v.markListed = built[2];
+        v.markListedArgs = built[3];
     }
     registerTextureCapture(
         r.captures, gpu, "visibility", "visibility buffer: instance, triangle (PNG)",
@@ -178,9 +170,11 @@ void destroyVisibility(Renderer& r, VisibilityStatePtr& state) {
     if (!state) return;
     Gpu& gpu = *r.gpu;
     VisibilityState& v = *state;
-    for (Pipeline* p : {&v.prepass, &v.mark, &v.markListed, &v.markListedArgs, &v.resolve,
-                        &v.resolveInline, &v.resolveRebuild, &v.resolveRebuildArgs})
+    for (Pipeline* p :
+         {&v.prepass, &v.mark, &v.markListed, &v.markListedArgs, &v.resolveRebuildArgs})
         destroy(gpu, *p);
+    for (auto* pipelines : {&v.resolve, &v.resolveInline, &v.resolveRebuild})
+        for (Pipeline& p : *pipelines) destroy(gpu, p);
     destroy(gpu, v.hdrWrite);
     if (v.address) destroy(gpu, v.address);
     if (v.rebuildList) destroy(gpu, v.rebuildList);
@@ -256,37 +250,84 @@ void recordMarkingCompute(Renderer& r, VkCommandBuffer cmd, uint64_t frame) {
                   VK_ACCESS_2_SHADER_STORAGE_READ_BIT | VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT);
 }
 
+void prepareResolvePipelines(Renderer& r) {
+    if (!r.visibility || !r.decoupled) return;
+    Gpu& gpu = *r.gpu;
+    VisibilityState& v = *r.visibility;
+    uint32_t display = r.tonemapFused ? 1u : 0u;
+    if (v.resolveInline[display].pipeline) return;
+    std::string suffix = display ? "Display" : "";
+    std::pair<uint32_t, uint32_t> output{RESOLVE_DISPLAY_OUTPUT_CONSTANT_ID, display};
+    std::vector<std::pair<uint32_t, uint32_t>> inlineRebuild =
+        shaderPrintSpecialization(r.settings.inspectX >= 0);
+    inlineRebuild.push_back({RESOLVE_REBUILD_INLINE_CONSTANT_ID, 1u});
+    inlineRebuild.push_back(output);
+    std::vector<ComputePipelineDesc> descs = {
+        {"shadelResolveInlineRebuild" + suffix, "shadel_resolve.comp.spv", inlineRebuild}};
+    if (v.rebuildList) {
+        descs.push_back({"shadelResolve" + suffix,
+                         "shadel_resolve.comp.spv",
+                         {{RESOLVE_REBUILD_INLINE_CONSTANT_ID, 0u}, output}});
+        descs.push_back(
+            {"shadelResolveRebuild" + suffix, "shadel_resolve_rebuild.comp.spv", {output}});
+    }
+    std::vector<Pipeline> built = createComputePipelines(gpu, descs); // side by side
+    v.resolveInline[display] = built[0];
+    if (v.rebuildList) {
+        v.resolve[display] = built[1];
+        v.resolveRebuild[display] = built[2];
+    }
+}
+
 void recordResolveCompute(Renderer& r, VkCommandBuffer cmd, uint64_t frame) {
     Gpu& gpu = *r.gpu;
     // Shade storage (buffers) written by shadelShading and carry-over, read here.
     memoryBarrier(cmd, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT,
                   VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_SHADER_STORAGE_READ_BIT);
-    imageBarrier(cmd, vkImage(gpu, r.hdr), VK_IMAGE_ASPECT_COLOR_BIT, VK_IMAGE_LAYOUT_UNDEFINED,
-                 VK_IMAGE_LAYOUT_GENERAL, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, 0,
-                 VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT);
+    // The forward (hybrid) pixels hybridForward drew: kept, or read to be tonemapped.
+    imageBarrier(cmd, vkImage(gpu, r.hdr), VK_IMAGE_ASPECT_COLOR_BIT,
+                 VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL, VK_IMAGE_LAYOUT_GENERAL,
+                 VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT,
+                 VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
+                 VK_ACCESS_2_SHADER_STORAGE_READ_BIT | VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT);
     VisibilityState& v = *r.visibility;
     ComputePush push = computePush(r, frame);
     // Debug views and --inspect rebuild every decoupled pixel: the resolve does it inline.
     bool inlineRebuild =
         !v.rebuildList || r.settings.visualize != Visualize::None || r.settings.inspectX >= 0;
+    uint32_t output = r.tonemapFused ? 1u : 0u;
     if (inlineRebuild) {
-        bind(gpu, cmd, v.resolveInline);
+        bind(gpu, cmd, v.resolveInline[output]);
         pushConstants(gpu, cmd, push);
         dispatchPixels(r, cmd);
+    } else {
+        // The resolve lists its rare pixels (misses, overflow, camera cuts); the rebuild pass
+        // shades them.
+        dispatchWithList(r, cmd, push, v.rebuildList, v.resolve[output], v.resolveRebuildArgs,
+                         v.resolveRebuild[output]);
+    }
+    if (r.tonemapFused) { // the frame's display pixels, read back
+        memoryBarrier(cmd, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
+                      VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT, VK_PIPELINE_STAGE_2_HOST_BIT,
+                      VK_ACCESS_2_HOST_READ_BIT);
         return;
     }
-    // The resolve lists its rare pixels (misses, overflow, camera cuts); the rebuild pass
-    // shades them.
-    dispatchWithList(r, cmd, push, v.rebuildList, v.resolve, v.resolveRebuildArgs,
-                     v.resolveRebuild);
-}
-
-void recordHybridForward(Renderer& r, VkCommandBuffer cmd, uint64_t frame) {
-    Gpu& gpu = *r.gpu;
+    // The scene colour, to the passes that draw into it or read it after (the tonemap).
     imageBarrier(cmd, vkImage(gpu, r.hdr), VK_IMAGE_ASPECT_COLOR_BIT, VK_IMAGE_LAYOUT_GENERAL,
                  VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
                  VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT,
                  VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT,
+                 VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT | VK_ACCESS_2_COLOR_ATTACHMENT_READ_BIT);
+}
+
+void recordHybridForward(Renderer& r, VkCommandBuffer cmd, uint64_t frame) {
+    Gpu& gpu = *r.gpu;
+    // Only the forward instances' pixels are kept (the resolve writes every other one), so last
+    // frame's contents are discarded; the last reads of the target were last frame's.
+    imageBarrier(cmd, vkImage(gpu, r.hdr), VK_IMAGE_ASPECT_COLOR_BIT, VK_IMAGE_LAYOUT_UNDEFINED,
+                 VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL,
+                 VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT,
+                 0, VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT,
                  VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT | VK_ACCESS_2_COLOR_ATTACHMENT_READ_BIT);
     beginSceneColorPass(r, cmd, false);
     drawForwardLists(r, cmd, frame);

@@ -37,10 +37,16 @@ void recordVisibilityPrepass(Renderer& r, VkCommandBuffer cmd, uint64_t frame);
 // quads on one decoupled triangle, then (indirect) those it listed, pixel by pixel
 // (shaders/shadel/mark_quad.glsl says why).
 void recordMarkingCompute(Renderer& r, VkCommandBuffer cmd, uint64_t frame);
-// "resolveCompute": decoupled pixels reconstructed from their addresses (rebuilt from the
-// visibility buffer for debug views, --inspect, and the forward fallback) into the HDR target.
-void recordResolveCompute(Renderer& r, VkCommandBuffer cmd, uint64_t frame);
-// "hybridForward": forward opaque + blended lists drawn over the resolved image.
+// The resolve's pipelines for this frame's output (Renderer::tonemapFused): created the first
+// time a frame needs them, before its passes are recorded.
+void prepareResolvePipelines(Renderer& r);
+// "hybridForward": the forward (hybrid) opaque instances drawn into the HDR target, before the
+// resolve (which keeps their pixels).
 void recordHybridForward(Renderer& r, VkCommandBuffer cmd, uint64_t frame);
+// "resolveCompute": decoupled pixels reconstructed from their addresses (rebuilt from the
+// visibility buffer for debug views, --inspect, and the forward fallback) into the HDR target,
+// or, with the tonemap fused (Renderer::tonemapFused), every pixel into the readback as the
+// display shows it.
+void recordResolveCompute(Renderer& r, VkCommandBuffer cmd, uint64_t frame);
 
 } // namespace shadel
