@@ -220,6 +220,8 @@ void destroyRenderer(Renderer& r) {
     destroy(gpu, r.hdrRead);
     destroy(gpu, r.displayTarget);
     if (r.display) destroy(gpu, r.display);
+    r.display = {}; // (forward only: a Renderer initialised again may not create it)
+    r.displayTarget = {};
     destroy(gpu, r.depthTarget);
     destroy(gpu, r.depthRead);
     destroyShadowAtlas(gpu, r.sunShadow);
