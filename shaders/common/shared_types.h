@@ -127,7 +127,7 @@ using uint = uint32_t;
 // The same for the decoupled compute resolve and its rebuild pass (shaders/shadel/resolve.comp):
 // display pixels into the readback instead of scene colour. A constant, not a push-constant
 // branch: lavapipe runs both sides of a branch (resolveCompute 35.8 ms with the branch, 32.3
-// with the constant: builtin:default 1280x720, orbit).
+// with the constant, in two bench runs of builtin:default 1280x720, orbit).
 #define RESOLVE_DISPLAY_OUTPUT_CONSTANT_ID 152
 // Which queued chunks a shadel shading pipeline shades (shaders/shadel/shade.comp): all of them
 // (the spectra permutations, everything compiled in), or one shading class's list. The classes

@@ -62,11 +62,11 @@ bool forwardMayFuseTonemap(const Renderer& r) {
 }
 
 bool tonemapFusedThisFrame(const Renderer& r) {
-    if (!r.settings.fuseTonemap || r.settings.ssaa != 1) return false;
     // The opaque shading pass that writes display pixels: forward shading (not the tile path),
     // or the decoupled compute resolve (not the raster reconstruction).
-    bool fusingPass =
-        r.settings.mode == RenderMode::Forward ? forwardMayFuseTonemap(r) : r.visibility != nullptr;
+    bool fusingPass = r.settings.mode == RenderMode::Forward
+                          ? forwardMayFuseTonemap(r)
+                          : r.settings.fuseTonemap && r.settings.ssaa == 1 && r.visibility;
     // Every pass declared after it that draws into or reads the scene colour.
     bool drawnAfter = r.particles || r.screenSpace || r.stencilEffects || r.pointsLines ||
                       r.debugLines || transparencyThisFrame(r);
