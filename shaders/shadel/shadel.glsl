@@ -86,6 +86,13 @@ ShadelLevels shadelLevels(ShadelObjectRef o, vec2 texelDx, vec2 texelDy, float b
     l.mip0 = uint(floor(lod));
     l.mip1 = min(l.mip0 + 1u, o.v.mipCount - 1u);
     float f = lod - float(l.mip0);
+    // The band narrows with the object's material rate bias (0 to 1 MIP, material_rate.h), to
+    // one level at the full bias: the rate system coarsens only plain materials whose surface
+    // shows smooth lighting alone, so neighbouring levels hold nearly the same values there and a
+    // blend adds only the finer level's chunks. At 1280x720 against 4x4 SSAA forward, shadels
+    // per pixel and PSNR: builtin:default 0.746 -> 0.653, 28.971 -> 28.970 dB; builtin:many
+    // 0.595 -> 0.429, 38.745 -> 38.716 dB; 2CylinderEngine 1.589 -> 1.173, 37.553 -> 37.537 dB.
+    band *= 1.0 - clamp(o.v.rateBias, 0.0, 1.0);
     float t = band >= 1.0 ? f : clamp((f - 0.5 * (1.0 - band)) / max(band, 1e-6), 0.0, 1.0);
     if (t >= 1.0 && l.mip1 != l.mip0) { l.mip0 = l.mip1; t = 0.0; }
     l.blend = t;

@@ -191,7 +191,9 @@ int main(int argc, char** argv) {
         ->check(finiteInRange(kShadingBiasRange));
     render
         ->add_option("--trilinear-band", ro.trilinearBand,
-                     "decoupled: LOD band blended between MIPs (1 = full trilinear)")
+                     "decoupled: LOD band blended between MIPs (1 = full trilinear); narrower on "
+                     "plain rough materials the material rate shades coarser (one MIP at its "
+                     "full bias)")
         ->capture_default_str()
         ->check(finiteInRange(kTrilinearBandRange));
     render

@@ -96,7 +96,9 @@ struct RenderSettings {
     // decoupled: LOD band blended between MIPs (1 = full trilinear). 0.5 ("brilinear"): only
     // the middle half of each LOD interval reads two MIPs. At 1280x720 it shades 24% fewer
     // chunks on builtin:default for -0.3 dB against the supersampled forward render, and 22% /
-    // 12% fewer on builtin:many / 2CylinderEngine at the same PSNR (to 0.01 dB).
+    // 12% fewer on builtin:many / 2CylinderEngine at the same PSNR (to 0.01 dB). Objects the
+    // material rate shades coarser blend over a narrower band, one level at its full bias
+    // (shadelLevels in shaders/shadel/shadel.glsl).
     float trilinearBand = 0.5f;
     uint32_t materialSamples = 4; // decoupled: material evaluations per shadel above MIP 0
     float forwardBelowPixels = 8; // decoupled: objects smaller on screen drawn forward (0 = never)

@@ -132,3 +132,36 @@ TEST(MaterialRate, LightsWithSharpEdgesKeepTheFullRate) {
     EXPECT_EQ(biased, 0u); // the blocked light reaches the whole room
     EXPECT_GE(p, 50.0);
 }
+
+// An object at the full rate bias reads one MIP level (shadelLevels narrows the blend band with
+// the bias): tests/data/gltf/quad.glb's quad is plain grey at roughness 0.7 (a full MIP) and seen
+// at a slant, so its samples span LOD fractions. With the rate on, the band setting changes
+// nothing; with it off, the wider band reads two levels over more of the quad.
+TEST(MaterialRate, FullyBiasedObjectsReadOneLevel) {
+    RenderOptions o = renderOptions(std::string(SHADEL_SOURCE_DIR) + "/tests/data/gltf/quad.glb",
+                                    RenderMode::Decoupled, 320, 180);
+    o.trilinearBand = 1.0f;
+    RenderRun wide = renderChecked(o);
+    o.trilinearBand = 0.0f;
+    RenderRun one = renderChecked(o);
+    EXPECT_EQ(wide.stats["objects_rate_biased"].get<uint64_t>(), 1u);
+    EXPECT_DOUBLE_EQ(statNumber(wide, "material_rate_bias_mean"), 1.0);
+    EXPECT_EQ(wide.stats["chunks_allocated"], one.stats["chunks_allocated"]);
+    EXPECT_TRUE(wide.frames[0].rgba == one.frames[0].rgba) << "the band changed the image";
+
+    o.materialRate = false;
+    o.trilinearBand = 1.0f;
+    RenderRun offWide = renderChecked(o);
+    o.trilinearBand = 0.0f;
+    RenderRun offOne = renderChecked(o);
+    std::printf("[ figures ] quad.glb 320x180 chunks, band 1 / band 0: rate on %llu / %llu, rate "
+                "off %llu / %llu\n",
+                (unsigned long long)wide.stats["chunks_allocated"].get<uint64_t>(),
+                (unsigned long long)one.stats["chunks_allocated"].get<uint64_t>(),
+                (unsigned long long)offWide.stats["chunks_allocated"].get<uint64_t>(),
+                (unsigned long long)offOne.stats["chunks_allocated"].get<uint64_t>());
+    EXPECT_GT(offWide.stats["chunks_allocated"].get<uint64_t>(),
+              offOne.stats["chunks_allocated"].get<uint64_t>());
+    EXPECT_EQ(wide.stats["reconstruction_misses"].get<uint64_t>(), 0u);
+    EXPECT_EQ(offWide.stats["reconstruction_misses"].get<uint64_t>(), 0u);
+}
