@@ -34,16 +34,16 @@ void resolveQuad(FrameConstants f, ShadelFrame s, ivec2 origin, inout uvec4 coun
         if (pixel.x >= int(pc.width) || pixel.y >= int(pc.height)) continue;
         ResolveAddress a = unpackResolveAddress(
             ResolveAddressBuffer(pc.addresses).v[resolveAddressIndex(pixel, pc.width)]);
-        if (a.kind == RESOLVE_ADDRESS_FORWARD) { // hybridForward drew it
-            if (kDisplayOutput) {
-                vec3 drawn = imageLoad(gImagesRgba16f[pc.hdrSlot], pixel).rgb;
-                writeResolvedPixel(f, pixel, vec4(drawn, 1.0));
-            }
-            continue; // (else the scene colour holds it)
-        }
+        // A forward (hybrid) pixel: hybridForward drew it into the scene colour, which holds it
+        // unless the display pixel is written here. Its colour then goes through the one write
+        // below: lavapipe runs a branch's code for every lane, so a write of its own would cost
+        // every pixel a second tone curve.
+        bool forward = a.kind == RESOLVE_ADDRESS_FORWARD;
+        if (forward && !kDisplayOutput) continue;
         vec4 color = vec4(f.skyColor, 0.0); // what the raster colour pass clears to
-        bool rebuild = a.kind == RESOLVE_ADDRESS_REBUILD || f.visualize != VISUALIZE_NONE ||
-                       inspecting(f, uvec2(pixel));
+        if (forward) color = vec4(imageLoad(gImagesRgba16f[pc.hdrSlot], pixel).rgb, 1.0);
+        bool rebuild = !forward && (a.kind == RESOLVE_ADDRESS_REBUILD ||
+                                    f.visualize != VISUALIZE_NONE || inspecting(f, uvec2(pixel)));
         if (a.kind == RESOLVE_ADDRESS_READY && !rebuild) {
             uint missing = 0u, overflowed = 0u;
             vec3 c = resolveAddressed(s, a, missing, overflowed);
