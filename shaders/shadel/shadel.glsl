@@ -86,7 +86,7 @@ ShadelLevels shadelLevels(ShadelObjectRef o, vec2 texelDx, vec2 texelDy, float b
     l.mip0 = uint(floor(lod));
     l.mip1 = min(l.mip0 + 1u, o.v.mipCount - 1u);
     float f = lod - float(l.mip0);
-    // The band narrows with the object's material rate bias (0 to 1 MIP, material_rate.h), to
+    // The band narrows with the object's material rate bias (0 to 1 MIP: MaterialRate::maxBias), to
     // one level at the full bias: the rate system coarsens only plain materials whose surface
     // shows smooth lighting alone, so neighbouring levels hold nearly the same values there and a
     // blend adds only the finer level's chunks. At 1280x720 against 4x4 SSAA forward, shadels

@@ -6,6 +6,10 @@
 
 namespace shadel {
 
+// shadelLevels (shaders/shadel/shadel.glsl) narrows the MIP blend band by the bias as a fraction
+// of one MIP (band x (1 - rateBias)): a larger cap would need that fraction passed to the GPU.
+static_assert(MaterialRate{}.maxBias == 1.0f, "shadelLevels takes the full bias as 1 MIP");
+
 float materialRateBias(const MaterialRate& rate, uint32_t features, float roughness) {
     if (features != 0u || !std::isfinite(roughness)) return 0.0f;
     float span = rate.broadRoughness - rate.sharpRoughness;
