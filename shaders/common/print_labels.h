@@ -25,7 +25,7 @@
 #define PRINT_RECONSTRUCTED 20u   // decoupled: radiance read back from the shade storage
 #define PRINT_OUTPUT 21u          // the colour the pass wrote for this pixel
 #define PRINT_FRAGMENT_DEPTH 22u  // gl_FragCoord.z: of several fragments, the CPU shows the front
-#define PRINT_SHADING_BIAS 23u    // decoupled: the frame's shading bias, the object's material rate
+#define PRINT_SHADING_BIAS 23u    // decoupled: frame's shading bias, material rate, texture LOD
 #define PRINT_TEST 100u           // used by the tests
 #define PRINT_LABEL_COUNT 101u
 #define SHADER_PRINT_BIT 0x80000000u // ShaderMessage::assertId of a print: this | label

@@ -132,14 +132,17 @@ using uint = uint32_t;
 // Which queued chunks a shadel shading pipeline shades (shaders/shadel/shade.comp): all of them
 // (the spectra permutations, everything compiled in), or one shading class's list. The classes
 // (SHADEL_OBJECT_* flags, per object from its material): plain (no texture, procedural, clear
-// coat or sheen: those compiled out, one material sample), featured (one material sample), and
-// supersampled (point-function procedurals).
+// coat or sheen: those compiled out, one material sample), featured (one material sample),
+// supersampled (point-function procedurals), and textured (textures only: the rest compiled out;
+// on lavapipe every compiled-in feature costs every shadel, taken or not: BoxTextured's shading
+// 91 -> 79 ms at 1280x720).
 #define SHADE_QUEUE_CONSTANT_ID 147
 #define SHADE_QUEUE_ALL 0u
 #define SHADE_QUEUE_PLAIN 1u
 #define SHADE_QUEUE_FEATURED 2u
 #define SHADE_QUEUE_SUPERSAMPLED 3u
-#define SHADE_CLASSES 3u // the class lists: SHADE_QUEUE_* - 1
+#define SHADE_QUEUE_TEXTURED 4u
+#define SHADE_CLASSES 4u // the class lists: SHADE_QUEUE_* - 1
 // After the class lists, ShadelFrame::classQueues holds one more: the near-change list, chunks
 // that could be carried over but lie on an object a changed region meets (fill_queue.comp);
 // near_change.comp carries each over or appends it to its class's list.
@@ -626,6 +629,9 @@ struct ShaderMessage {
 #define SHADEL_OBJECT_SUPERSAMPLED 4u
 // Its material uses any MATERIAL_FEATURE_* (else it is shaded by the plain pipeline).
 #define SHADEL_OBJECT_FEATURED_MATERIAL 8u
+// Of those, materials whose only feature is textures: shaded by the textured pipeline (clear coat,
+// sheen and procedurals compiled out), as the forward path's textures-only class.
+#define SHADEL_OBJECT_TEXTURED_MATERIAL 16u
 #define SHADEL_MAX_CHANGED_VOLUMES 256u
 #define SHADEL_CHUNK_VIEW_NONE 0xFFFFFFFFu // ShadelFrame::chunkViews: a NaN centre
 // Material layers of the shade storage (seed: "layers of different bit depths"): every layer
@@ -643,6 +649,9 @@ struct ShaderMessage {
 // builtin:many 38.74 / 38.62 / 38.75 / 38.85; builtin:default 28.97 in all four, at 0.74
 // shadels per covered pixel unbounded and at 3 but 0.85 at 2 (shadelShading +7 ms).
 #define SHADEL_MATERIAL_RATE_MAX_LOD 3.0
+// GpuShadelObject::textureLod of an object whose material has no texture detail to keep: the
+// rate's bias applies in full.
+#define SHADEL_TEXTURE_LOD_NONE 1000.0
 
 // Per instance: where its shadel space lives in the virtual sheet at each MIP.
 struct GpuShadelObject {
@@ -664,6 +673,10 @@ struct GpuShadelObject {
     // (render/shadel/material_rate.h: smooth, lighting-only surfaces), added to the sample's LOD
     // with the frame's shading bias, but never past SHADEL_MATERIAL_RATE_MAX_LOD.
     float rateBias;
+    // Textured materials: the finest whole level whose shadels lie at most half a texel of the
+    // material's densest texture apart; the rate coarsens a sample no further than the level
+    // before it (render/shadel/texture_rate.h). SHADEL_TEXTURE_LOD_NONE without textures.
+    float textureLod;
     uint firstRect; // index of its firstMip rect in ShadelFrame::rects (levels follow in order)
     uint idMapOffset[SHADEL_MAX_MIPS]; // in 16-bit units into ShadelFrame::idMaps
     uvec4 rect[SHADEL_MAX_MIPS];       // x, y, w, h in blocks of the virtual sheet
@@ -704,7 +717,7 @@ struct GpuDebugLines {
 
 // sizeof(GpuShadelObject) in the scalar layout: shaders address one object in place
 // (ShadelObjectRef); static_assert'ed on the C++ side.
-#define GPU_SHADEL_OBJECT_BYTES (36u + 36u * SHADEL_MAX_MIPS)
+#define GPU_SHADEL_OBJECT_BYTES (40u + 36u * SHADEL_MAX_MIPS)
 
 // One rectangle of the sheet in use this frame (the clear and allocation passes walk these).
 struct GpuShadelRect {

@@ -12,8 +12,9 @@ void inspectShadels(FrameConstants f, ShadelFrame s, ShadelObjectRef o, Reconstr
     fitLevelsToWindows(o, shadelUv, l); // the levels the reconstruction read
     shaderPrintF4(f, PRINT_SHADEL_LOD, vec4(r.lod, float(l.mip0), float(l.mip1), l.blend));
     // Why the LOD is coarser than the footprint: the frame's bias (--shading-bias + the capacity
-    // controller) and the object's material rate (render/shadel/material_rate.h).
-    shaderPrintF2(f, PRINT_SHADING_BIAS, vec2(s.shadingBias, o.v.rateBias));
+    // controller) and the object's material rate (render/shadel/material_rate.h), which a
+    // textured material takes no coarser than its texture LOD (texture_rate.h).
+    shaderPrintF3(f, PRINT_SHADING_BIAS, vec3(s.shadingBias, o.v.rateBias, o.v.textureLod));
     ivec2 t0;
     vec2 w;
     bilinearFootprint(o, r.mip0, shadelUv, t0, w);

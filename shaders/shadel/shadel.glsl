@@ -78,21 +78,28 @@ struct ShadelLevels {
 ShadelLevels shadelLevels(ShadelObjectRef o, vec2 texelDx, vec2 texelDy, float bias, float band) {
     // The object has rects only from firstMip on (the CPU's lower bound of what it can need).
     // The object's material shading rate (render/shadel/material_rate.h materialRateLod) on top
-    // of the frame's bias.
+    // of the frame's bias. A textured material's (render/shadel/texture_rate.h) coarsens a sample
+    // no further than a quarter texel (the level before o.v.textureLod); without textures
+    // o.v.textureLod is SHADEL_TEXTURE_LOD_NONE and the bias applies in full.
     float lod = shadelLod(texelDx, texelDy, bias);
-    lod = max(lod, min(lod + o.v.rateBias, SHADEL_MATERIAL_RATE_MAX_LOD));
+    float rateBias = min(o.v.rateBias, max(o.v.textureLod - 1.0 - lod, 0.0));
+    // Both levels a sample can blend hold its textures at half a texel or finer: the band below
+    // may close.
+    float bandBias = lod < o.v.textureLod ? o.v.rateBias : 0.0;
+    lod = max(lod, min(lod + rateBias, SHADEL_MATERIAL_RATE_MAX_LOD));
     lod = clamp(lod, float(o.v.firstMip), float(o.v.mipCount - 1u));
     ShadelLevels l;
     l.mip0 = uint(floor(lod));
     l.mip1 = min(l.mip0 + 1u, o.v.mipCount - 1u);
     float f = lod - float(l.mip0);
-    // The band narrows with the object's material rate bias (0 to 1 MIP: MaterialRate::maxBias), to
-    // one level at the full bias: the rate system coarsens only plain materials whose surface
-    // shows smooth lighting alone, so neighbouring levels hold nearly the same values there and a
-    // blend adds only the finer level's chunks. At 1280x720 against 4x4 SSAA forward, shadels
-    // per pixel and PSNR: builtin:default 0.746 -> 0.653, 28.971 -> 28.970 dB; builtin:many
-    // 0.595 -> 0.429, 38.745 -> 38.716 dB; 2CylinderEngine 1.589 -> 1.173, 37.553 -> 37.537 dB.
-    band *= 1.0 - clamp(o.v.rateBias, 0.0, 1.0);
+    // The band narrows with the object's material rate bias (0 to 1 MIP: MaterialRate::maxBias),
+    // to one level at the full bias: the rate system biases only surfaces that show smooth
+    // lighting alone or with textures both levels resolve, so neighbouring levels hold nearly the
+    // same values there and a blend adds only the finer level's chunks. At 1280x720 against 4x4
+    // SSAA forward, shadels per pixel and PSNR: builtin:default 0.746 -> 0.653, 28.971 -> 28.970
+    // dB; builtin:many 0.595 -> 0.429, 38.745 -> 38.716 dB; 2CylinderEngine 1.589 -> 1.173,
+    // 37.553 -> 37.537 dB.
+    band *= 1.0 - clamp(bandBias, 0.0, 1.0);
     float t = band >= 1.0 ? f : clamp((f - 0.5 * (1.0 - band)) / max(band, 1e-6), 0.0, 1.0);
     if (t >= 1.0 && l.mip1 != l.mip0) { l.mip0 = l.mip1; t = 0.0; }
     l.blend = t;
@@ -246,6 +253,7 @@ bool shadelRefreshDue(ShadelFrame s, uint chunk) {
 // The shading class of an object (its chunks' list, SHADE_QUEUE_* - 1).
 uint shadeClassOf(ShadelObjectRef o) {
     if ((o.v.flags & SHADEL_OBJECT_SUPERSAMPLED) != 0u) return SHADE_QUEUE_SUPERSAMPLED - 1u;
+    if ((o.v.flags & SHADEL_OBJECT_TEXTURED_MATERIAL) != 0u) return SHADE_QUEUE_TEXTURED - 1u;
     if ((o.v.flags & SHADEL_OBJECT_FEATURED_MATERIAL) != 0u) return SHADE_QUEUE_FEATURED - 1u;
     return SHADE_QUEUE_PLAIN - 1u;
 }

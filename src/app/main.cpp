@@ -245,8 +245,9 @@ int main(int argc, char** argv) {
     std::string materialRate = "on";
     render
         ->add_option("--material-rate", materialRate,
-                     "decoupled: on | off: shade plain (untextured, lighting-only) rough materials "
-                     "up to one MIP coarser (render/shadel/material_rate.h)")
+                     "decoupled: on | off: shade rough materials up to one MIP coarser: plain "
+                     "(lighting-only) ones, and textured ones where the view magnifies their "
+                     "textures (render/shadel/material_rate.h, texture_rate.h)")
         ->capture_default_str();
     std::string reuse = "on";
     render
@@ -557,7 +558,8 @@ int main(int argc, char** argv) {
     bench
         ->add_option(
             "--material-rate", benchMaterialRate,
-            "decoupled modes: on | off: plain rough materials shaded up to one MIP coarser")
+            "decoupled modes: on | off: rough materials shaded up to one MIP coarser (textured "
+            "ones where the view magnifies their textures)")
         ->capture_default_str();
     std::string benchShadowCache = "on";
     bench

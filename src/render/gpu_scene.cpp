@@ -195,6 +195,8 @@ void uploadScene(Gpu& gpu, const Scene& scene, GpuScene& out, const std::vector<
         materials.push_back(g);
     }
     for (gpu::GpuMaterial& g : materials) setMaterialFeatureFlags(g);
+    out.materialTexels = materialTexels(scene);
+    out.materialTexels.resize(materials.size()); // (the default material: no textures)
 
     // Unified geometry.
     std::vector<gpu::GpuVertex> vertices;
@@ -264,6 +266,11 @@ void uploadScene(Gpu& gpu, const Scene& scene, GpuScene& out, const std::vector<
             if (b.indices.empty() || b.idMaps.empty()) continue;
             info.mip0Size = {b.width, b.height};
             info.shadelsPerUnit = b.shadelsPerMetre;
+            std::vector<glm::vec2> materialUv(b.vertexRemap.size());
+            for (size_t v = 0; v < b.vertexRemap.size(); ++v)
+                materialUv[v] = scene.meshes[mi].vertices[b.vertexRemap[v]].uv0;
+            info.uvPerShadelLog2 =
+                uvPerShadelLog2(materialUv, b.shadelUv, b.indices, info.mip0Size);
             info.mipCount = std::min<uint32_t>(b.mipCount(), SHADEL_MAX_MIPS);
             for (uint32_t k = 0; k < info.mipCount; ++k) {
                 info.idMapOffset[k] = uint32_t(idMaps.size());

@@ -5,6 +5,7 @@
 #include <vector>
 
 #include "common/shared_types.h"
+#include "render/shadel/texture_rate.h"
 #include "rhi/gpu.h"
 #include "scene/scene.h"
 
@@ -17,6 +18,8 @@ struct ShadelMeshInfo {
     glm::uvec2 mip0Size{0};
     uint32_t mipCount = 0;    // 0: no shadel space (drawn forward)
     float shadelsPerUnit = 0; // MIP-0 shadels per object-space unit (BakedMesh::shadelsPerMetre)
+    // log2 of the material-UV units a MIP-0 shadel spans (render/shadel/texture_rate.h)
+    float uvPerShadelLog2 = 0;
     std::array<uint32_t, SHADEL_MAX_MIPS> idMapOffset{}; // 16-bit units into GpuScene::idMaps
     uint64_t idMapTexels = 0;
 };
@@ -52,8 +55,11 @@ struct GpuScene {
     std::vector<gpu::GpuLight> lightInfo;       // what `lights` holds
     std::vector<uint8_t> lightCastsShadow;      // per lightInfo entry (GI light views)
     std::vector<gpu::GpuMaterial> materialInfo; // what `materials` holds
-    std::vector<ParticleEmitter> emitters;      // the scene's, simulated by render/particles
-    std::vector<Decal> decals;                  // the scene's, culled and applied by render/decals
+    // Per material as loaded: its textures' density and roughness bound (the texture-limited
+    // shading rate: render/shadel/texture_rate.h).
+    std::vector<MaterialTexels> materialTexels;
+    std::vector<ParticleEmitter> emitters; // the scene's, simulated by render/particles
+    std::vector<Decal> decals;             // the scene's, culled and applied by render/decals
     uint32_t instanceCount = 0;
     uint32_t lightCount = 0;
     Aabb bounds;

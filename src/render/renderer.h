@@ -105,7 +105,7 @@ struct RenderSettings {
     uint32_t allocationCounters = SHADEL_COUNTERS; // decoupled: hashed counters used (tests)
     bool sheetAllMips = false; // decoupled: rects at every MIP (the old policy, for comparison)
     bool levelWindows = true;  // decoupled: fine levels' rects hold only what the view wanted
-    bool materialRate = true;  // decoupled: plain materials shaded coarser (shadel/material_rate.h)
+    bool materialRate = true;  // decoupled: rough materials shaded coarser (shadel/material_rate.h)
     bool capacityControl = true;      // decoupled: steer the shading bias from storage use
     bool reuse = true;                // decoupled: carry unchanged shadels over from last frame
     uint32_t reuseRefreshPeriod = 16; // decoupled: reshade every carried chunk this often

@@ -96,7 +96,7 @@ const char* printLabelName(uint32_t label) {
     case PRINT_OUTPUT:
         return "output";
     case PRINT_SHADING_BIAS:
-        return "shading bias (frame), material rate bias";
+        return "shading bias (frame), material rate bias, texture lod (1000: none)";
     case PRINT_FRAGMENT_DEPTH:
         return "fragment depth";
     case PRINT_TEST:

@@ -128,21 +128,25 @@ TEST(DecoupledCore, OccupancyAndShadelsPerPixelAreInRange) {
     // Shading classes (one pipeline each): the plaza checker and the bricks are point-function
     // procedurals, supersampled; the untextured rest is plain (every material feature compiled
     // out); every shaded chunk is in one class. Without material supersampling no chunk is
-    // supersampled, and textured materials are featured.
+    // supersampled (the procedurals are featured), and materials with textures alone are
+    // textured (every other feature compiled out).
     const auto& classes = run.stats["chunks_by_shading_class"];
     uint64_t plain = classes["plain"].get<uint64_t>();
     uint64_t featured = classes["featured"].get<uint64_t>();
     uint64_t supersampled = classes["supersampled"].get<uint64_t>();
+    uint64_t texturedClass = classes["textured"].get<uint64_t>();
     EXPECT_GT(supersampled, 0u);
     EXPECT_GT(plain, 0u);
-    EXPECT_EQ(plain + featured + supersampled, stat(run, "chunks_shaded"));
+    EXPECT_EQ(plain + featured + supersampled + texturedClass, stat(run, "chunks_shaded"));
     RenderOptions one = decoupled("builtin:default", 320, 180);
     one.materialSamples = 1;
     RenderRun single = renderChecked(one);
     EXPECT_EQ(single.stats["chunks_by_shading_class"]["supersampled"].get<uint64_t>(), 0u);
     EXPECT_GT(single.stats["chunks_by_shading_class"]["featured"].get<uint64_t>(), 0u);
     RenderRun textured = renderChecked(decoupled("builtin:textures", 320, 180));
-    EXPECT_GT(textured.stats["chunks_by_shading_class"]["featured"].get<uint64_t>(), 0u);
+    EXPECT_GT(textured.stats["chunks_by_shading_class"]["textured"].get<uint64_t>(), 0u);
+    // (its floor's bricks are supersampled; no material there has features beyond textures)
+    EXPECT_EQ(textured.stats["chunks_by_shading_class"]["featured"].get<uint64_t>(), 0u);
 }
 
 // Capacity control: with storage far too small for the view, the controller raises the shading

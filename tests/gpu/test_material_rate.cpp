@@ -7,6 +7,8 @@
 #include <limits>
 
 #include "render/shadel/material_rate.h"
+#include "render/shadel/texture_rate.h"
+#include "scene/scene.h"
 
 using namespace shadel;
 using namespace shadel::test;
@@ -164,4 +166,105 @@ TEST(MaterialRate, FullyBiasedObjectsReadOneLevel) {
               offOne.stats["chunks_allocated"].get<uint64_t>());
     EXPECT_EQ(wide.stats["reconstruction_misses"].get<uint64_t>(), 0u);
     EXPECT_EQ(offWide.stats["reconstruction_misses"].get<uint64_t>(), 0u);
+}
+
+// Texture-limited rate (render/shadel/texture_rate.h): textureLod is the finest whole level whose
+// shadels are at most half a texel of the material's densest texture apart; the rate coarsens a
+// sample no further than the level before it (a quarter texel).
+TEST(MaterialRate, TexturedMaterialsStopAtAQuarterTexel) {
+    // A quad: material UVs and shadel UVs both span [0,1]^2, 64x64 MIP-0 shadels.
+    std::vector<glm::vec2> uv = {{0, 0}, {1, 0}, {1, 1}, {0, 1}};
+    std::vector<uint32_t> quad = {0, 1, 2, 0, 2, 3};
+    float uvPerShadel = uvPerShadelLog2(uv, uv, quad, {64, 64});
+    EXPECT_NEAR(uvPerShadel, -6.0f, 1e-5f);
+    // 16x16 texels: a texel is 4 MIP-0 shadels, half a texel is level 1.
+    EXPECT_FLOAT_EQ(textureLod(uvPerShadel, 4.0f, 2.0f), 1.0f);
+    // 256x256: a texel is a quarter shadel; 24x24 (log2 4.585): rounded to the finer level.
+    EXPECT_FLOAT_EQ(textureLod(uvPerShadel, 8.0f, 2.0f), -3.0f);
+    EXPECT_FLOAT_EQ(textureLod(uvPerShadel, std::log2(24.0f), 2.0f), 0.0f);
+    // UVs that do not vary: no texture detail, no limit.
+    std::vector<glm::vec2> flat(4, glm::vec2(0.5f));
+    EXPECT_EQ(textureLod(uvPerShadelLog2(flat, uv, quad, {64, 64}), 8.0f, 2.0f),
+              float(SHADEL_TEXTURE_LOD_NONE));
+    // The mapping's dense end counts: one triangle holding 4x the UV area per shadel (2x per
+    // axis) and 11% of the surface sets the density; at 2% it would not.
+    std::vector<glm::vec2> shadelUv = {{0, 0}, {1, 0},    {1, 1},   {0, 1},
+                                       {0, 0}, {0.5f, 0}, {0, 0.5f}};
+    std::vector<glm::vec2> dense = {{0, 0}, {1, 0}, {1, 1}, {0, 1}, {0, 0}, {1, 0}, {0, 1}};
+    std::vector<uint32_t> tris = {0, 1, 2, 0, 2, 3, 4, 5, 6};
+    EXPECT_NEAR(uvPerShadelLog2(dense, shadelUv, tris, {64, 64}), -5.0f, 1e-5f);
+    shadelUv[5] = {0.2f, 0}, shadelUv[6] = {0, 0.2f};
+    dense[5] = {0.4f, 0}, dense[6] = {0, 0.4f};
+    EXPECT_NEAR(uvPerShadelLog2(dense, shadelUv, tris, {64, 64}), -6.0f, 1e-5f);
+
+    // The rate stops a level before the texture's unless the sample is already coarser.
+    EXPECT_FLOAT_EQ(materialRateLod(-2.0f, 1.0f, 1.0f), -1.0f);
+    EXPECT_FLOAT_EQ(materialRateLod(-0.5f, 1.0f, 1.0f), 0.0f);
+    EXPECT_FLOAT_EQ(materialRateLod(0.5f, 1.0f, 1.0f), 0.5f);
+    EXPECT_FLOAT_EQ(materialRateLod(1.5f, 1.0f, 1.0f), 1.5f);
+    EXPECT_FLOAT_EQ(materialRateLod(0.5f, 1.0f, SHADEL_TEXTURE_LOD_NONE), 1.5f);
+    // Textures alone allow the bias; procedurals, clear coat and sheen do not.
+    MaterialRate rate;
+    EXPECT_FLOAT_EQ(materialRateBias(rate, MATERIAL_FEATURE_TEXTURES, 1.0f), rate.maxBias);
+    EXPECT_EQ(materialRateBias(rate, MATERIAL_FEATURE_TEXTURES | MATERIAL_FEATURE_CLEARCOAT, 1.0f),
+              0.0f);
+}
+
+// A material's texels: its densest texture with KHR_texture_transform's scale, and how glossy its
+// metallic-roughness texture can make it.
+TEST(MaterialRate, MaterialTexelsTakeTheDensestTextureAndTheGlossiestTexel) {
+    Scene scene;
+    Texture small, large;
+    small.width = small.height = 64;
+    small.rgba8.assign(64 * 64 * 4, 255);
+    large.width = large.height = 256;
+    large.rgba8.assign(256 * 256 * 4, 200);
+    for (int i = 0; i < 256 * 256 / 10; ++i) large.rgba8[size_t(i) * 4 + 1] = 51; // 10%: G 0.2
+    scene.textures = {small, large};
+    Material m;
+    m.baseColorTexture = 0;
+    m.uvTransforms[uint32_t(TextureSlot::BaseColor)].c0 = {8.0f, 0.0f}; // 8x8 repeats: 512/uv
+    m.uvTransforms[uint32_t(TextureSlot::BaseColor)].c1 = {0.0f, 8.0f};
+    m.metallicRoughnessTexture = 1;
+    scene.materials = {m};
+    std::vector<MaterialTexels> t = materialTexels(scene);
+    ASSERT_EQ(t.size(), 1u);
+    EXPECT_TRUE(t[0].known);
+    EXPECT_NEAR(t[0].texelsPerUvLog2, 9.0f, 1e-5f); // the repeated 64^2 beats the 256^2
+    EXPECT_NEAR(t[0].roughnessScale, 51.0f / 255.0f, 1e-6f);
+    scene.materials[0].metallicRoughnessTexture = 7; // out of range: unknown
+    EXPECT_FALSE(materialTexels(scene)[0].known);
+}
+
+// assimp's BoxTextured: a 211x211 texture on each face of a rough box. At 1280x720 the view
+// magnifies it: the texture-limited rate reads one level where two were blended and shades it
+// under 2 shadels per covered pixel, and the image stays that of the full rate. At 320x180 the
+// texture is minified: nothing changes.
+TEST(MaterialRate, MagnifiedTexturesAreShadedCoarser) {
+    const std::string box =
+        "/usr/share/assimp/models/glTF2/BoxTextured-glTF-Binary/BoxTextured.glb";
+    RenderOptions o = renderOptions(box, RenderMode::Decoupled, 1280, 720);
+    o.frames = 2;
+    RenderRun on = renderChecked(o);
+    o.materialRate = false;
+    RenderRun off = renderChecked(o);
+    double sppOn = statNumber(on, "shadels_per_pixel"),
+           sppOff = statNumber(off, "shadels_per_pixel");
+    double p = psnr(on.frames.back().rgba, off.frames.back().rgba);
+    std::printf("[ figures ] BoxTextured 1280x720: shadels per pixel %.3f (rate off %.3f), on vs "
+                "off %.2f dB\n",
+                sppOn, sppOff, p);
+    EXPECT_EQ(on.stats["objects_rate_textured"].get<uint64_t>(), 1u);
+    EXPECT_LT(sppOn, 0.75 * sppOff);
+    EXPECT_LE(sppOn, 2.0);
+    EXPECT_GE(p, 50.0);
+    EXPECT_EQ(on.stats["reconstruction_misses"].get<uint64_t>(), 0u);
+
+    RenderOptions small = renderOptions(box, RenderMode::Decoupled, 320, 180);
+    RenderRun smallOn = renderChecked(small);
+    small.materialRate = false;
+    RenderRun smallOff = renderChecked(small);
+    EXPECT_EQ(smallOn.stats["objects_rate_textured"].get<uint64_t>(), 1u);
+    EXPECT_TRUE(smallOn.frames[0].rgba == smallOff.frames[0].rgba)
+        << "a minified texture lost detail";
 }

@@ -20,6 +20,7 @@
 #include "render/shadel/material_rate.h"
 #include "render/shadel/reuse_invalidation.h"
 #include "render/shadel/shade_storage.h"
+#include "render/shadel/texture_rate.h"
 #include "render/shadel/visibility.h"
 
 namespace shadel {
@@ -103,7 +104,8 @@ struct FrameCounters {
     uint32_t objectsSmallForward = 0;
     uint32_t objectsSheetLimited = 0;
     uint32_t objectsRateBiased = 0; // objects whose material shades them coarser (material_rate.h)
-    float rateBiasSum = 0.0f;       // of their rate biases, over the decoupled objects
+    uint32_t objectsRateTextured = 0; // of them, textured: limited by their texels (texture_rate.h)
+    float rateBiasSum = 0.0f;         // of their rate biases, over the decoupled objects
     uint64_t rectBlocks = 0;
     uint64_t wholeLevelBlocks = 0; // what the same levels would take whole (no windows)
     uint32_t windowMoves = 0;      // level rects placed again because their window changed
@@ -166,6 +168,7 @@ struct DecoupledState {
     MaterialRate materialRate;        // --material-rate (RenderSettings::materialRate) tunables
     SharpLights sharpLights;          // the lights that keep plain materials at the full rate
     uint32_t objectsRateBiased = 0;
+    uint32_t objectsRateTextured = 0;
     float rateBiasSum = 0.0f;
     std::array<uint32_t, SHADEL_MAX_MIPS> firstMipHistogram{};
 
@@ -367,17 +370,21 @@ DecoupledStatePtr createDecoupled(Renderer& r, const GpuScene& scene) {
     shadeConstants.push_back({SHADE_OPTIONAL_CONSTANT_ID, optional});
     d.shadeOptional = optional;
     // The shading classes (SHADEL_OBJECT_* flags set per object below): plain materials with
-    // every material feature compiled out, featured ones, supersampled procedurals.
+    // every material feature compiled out, featured ones, supersampled procedurals, textured
+    // ones with every feature but textures compiled out.
     const char* const classNames[SHADE_CLASSES] = {"shadelShadePlain", "shadelShadeFeatured",
-                                                   "shadelShadeSupersampled"};
+                                                   "shadelShadeSupersampled",
+                                                   "shadelShadeTextured"};
     std::vector<ComputePipelineDesc> classes;
     for (uint32_t c = 0; c < SHADE_CLASSES; ++c) {
         auto constants = shadeConstants;
         constants.push_back({SHADE_QUEUE_CONSTANT_ID, SHADE_QUEUE_PLAIN + c});
         if (c == SHADE_QUEUE_PLAIN - 1) constants.push_back({MATERIAL_FEATURES_CONSTANT_ID, 0u});
+        if (c == SHADE_QUEUE_TEXTURED - 1)
+            constants.push_back({MATERIAL_FEATURES_CONSTANT_ID, MATERIAL_FEATURE_TEXTURES});
         classes.push_back({classNames[c], "shadel_shade.comp.spv", constants});
     }
-    // Compiled side by side: the three are the renderer's largest pipelines.
+    // Compiled side by side: the four are the renderer's largest pipelines.
     std::vector<Pipeline> shade = createComputePipelines(gpu, classes);
     for (uint32_t c = 0; c < SHADE_CLASSES; ++c) d.shade[c] = shade[c];
     d.sheetView = createComputePipeline(gpu, "shadelSheetView", "shadel_sheet_view.comp.spv");
@@ -797,6 +804,7 @@ void prepareDecoupledFrame(Renderer& r, const GpuScene& scene, const CameraView&
     d.windowMoves = 0;
     d.objectsDecoupled = d.objectsForward = d.objectsSmallForward = d.objectsSheetLimited = 0;
     d.objectsRateBiased = 0;
+    d.objectsRateTextured = 0;
     d.rateBiasSum = 0.0f;
     d.firstMipHistogram.fill(0);
     d.objectsReusable = 0;
@@ -899,8 +907,25 @@ void prepareDecoupledFrame(Renderer& r, const GpuScene& scene, const CameraView&
         bool reposed = i < r.reposedInstances.size() && r.reposedInstances[i] != 0;
         // Its shading rate (material_rate.h): the GPU adds it to every sample's LOD up to the
         // rate's bound (materialRateLod), so the finest level the object can need moves with it.
-        float rateBias =
-            r.settings.materialRate ? materialRateBias(d.materialRate, features, roughness) : 0.0f;
+        // A textured material: the bias from the lowest roughness its texture gives, limited
+        // per sample to where the view magnifies its textures (texture_rate.h). An edit that
+        // changed its textures leaves their content unknown: the full rate.
+        float rateRoughness = roughness;
+        float texLod = SHADEL_TEXTURE_LOD_NONE;
+        if ((features & MATERIAL_FEATURE_TEXTURES) != 0u) {
+            const MaterialTexels* texels = inst.material < scene.materialTexels.size()
+                                               ? &scene.materialTexels[inst.material]
+                                               : nullptr;
+            bool asLoaded = known && texels && texels->known &&
+                            sameTextures(*material, scene.materialInfo[inst.material]);
+            rateRoughness = asLoaded ? roughness * texels->roughnessScale : 0.0f;
+            texLod = asLoaded ? textureLod(mesh.uvPerShadelLog2, texels->texelsPerUvLog2,
+                                           d.materialRate.shadelsPerTexel)
+                              : -SHADEL_TEXTURE_LOD_NONE;
+        }
+        float rateBias = r.settings.materialRate
+                             ? materialRateBias(d.materialRate, features, rateRoughness)
+                             : 0.0f;
         if (rateBias > 0.0f) {
             if (o.sharpLightsVersion != d.sharpLights.version || reposed) {
                 o.sharpLit = sharpLightReaches(d.sharpLights, inst.worldMin, inst.worldMax);
@@ -908,8 +933,9 @@ void prepareDecoupledFrame(Renderer& r, const GpuScene& scene, const CameraView&
             }
             if (o.sharpLit) rateBias = 0.0f;
         }
-        uint32_t wantFirst = finestMipFromLod(
-            materialRateLod(view.lodBeforeBias + d.shadingBias, rateBias), 0.0f, mesh.mipCount);
+        uint32_t wantFirst =
+            finestMipFromLod(materialRateLod(view.lodBeforeBias + d.shadingBias, rateBias, texLod),
+                             0.0f, mesh.mipCount);
         bool limited = false;
         // No room in the sheet: drawn forward this frame, retried next frame.
         if (!updateObjectRects(gpu, d, o, i, mesh, wantFirst, wasDecoupled, limited)) {
@@ -946,6 +972,8 @@ void prepareDecoupledFrame(Renderer& r, const GpuScene& scene, const CameraView&
         glm::vec3 baseColor = known ? glm::vec3(material->baseColorFactor) : glm::vec3(0.0f);
         g.viewDriftCos = std::cos(viewDriftLimitFor(roughness, metallic, baseColor));
         g.rateBias = rateBias;
+        g.textureLod = rateBias > 0.0f ? texLod : SHADEL_TEXTURE_LOD_NONE;
+        d.objectsRateTextured += rateBias > 0.0f && texLod < SHADEL_TEXTURE_LOD_NONE;
         d.objectsRateBiased += rateBias > 0.0f;
         d.rateBiasSum += rateBias;
         d.objectsReusable += g.reuseLevels != 0;
@@ -956,6 +984,7 @@ void prepareDecoupledFrame(Renderer& r, const GpuScene& scene, const CameraView&
         g.flags |= SHADEL_OBJECT_DECOUPLED;
         // Its shading class (the pipeline that shades its chunks, shaders/shadel/shade.comp).
         if (features != 0u) g.flags |= SHADEL_OBJECT_FEATURED_MATERIAL;
+        if (features == MATERIAL_FEATURE_TEXTURES) g.flags |= SHADEL_OBJECT_TEXTURED_MATERIAL;
         // Only point-function procedurals are supersampled (shaders/shadel/prefilter.glsl).
         if ((features & MATERIAL_FEATURE_PROCEDURAL) && r.settings.materialSamples >= 4)
             g.flags |= SHADEL_OBJECT_SUPERSAMPLED; // 2 x 2 samples at least
@@ -1291,6 +1320,7 @@ void finishDecoupledFrame(Renderer& r) {
     f.objectsSmallForward = d.objectsSmallForward;
     f.objectsSheetLimited = d.objectsSheetLimited;
     f.objectsRateBiased = d.objectsRateBiased;
+    f.objectsRateTextured = d.objectsRateTextured;
     f.rateBiasSum = d.rateBiasSum;
     f.firstMipHistogram = d.firstMipHistogram;
     f.rectBlocks = d.rectBlockCount;
@@ -1393,7 +1423,8 @@ void decoupledStats(const Renderer& r, nlohmann::json& s) {
     s["chunks_by_shading_class"] = {
         {"plain", last.counters.classCount[SHADE_QUEUE_PLAIN - 1]},
         {"featured", last.counters.classCount[SHADE_QUEUE_FEATURED - 1]},
-        {"supersampled", last.counters.classCount[SHADE_QUEUE_SUPERSAMPLED - 1]}};
+        {"supersampled", last.counters.classCount[SHADE_QUEUE_SUPERSAMPLED - 1]},
+        {"textured", last.counters.classCount[SHADE_QUEUE_TEXTURED - 1]}};
     nlohmann::json perMip = nlohmann::json::array();
     for (uint32_t k = 0; k < SHADEL_MAX_MIPS; ++k) perMip.push_back(last.counters.chunksPerMip[k]);
     s["chunks_per_mip"] = perMip;
@@ -1412,6 +1443,8 @@ void decoupledStats(const Renderer& r, nlohmann::json& s) {
     // mean bias over all decoupled objects (MIPs).
     s["material_rate"] = r.settings.materialRate;
     s["objects_rate_biased"] = last.objectsRateBiased;
+    // Of them, textured ones: biased only where the view magnifies their textures.
+    s["objects_rate_textured"] = last.objectsRateTextured;
     s["material_rate_bias_mean"] =
         last.objectsDecoupled ? double(last.rateBiasSum) / double(last.objectsDecoupled) : 0.0;
     nlohmann::json firstMips = nlohmann::json::array();

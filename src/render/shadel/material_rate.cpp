@@ -11,15 +11,16 @@ namespace shadel {
 static_assert(MaterialRate{}.maxBias == 1.0f, "shadelLevels takes the full bias as 1 MIP");
 
 float materialRateBias(const MaterialRate& rate, uint32_t features, float roughness) {
-    if (features != 0u || !std::isfinite(roughness)) return 0.0f;
+    if ((features & ~MATERIAL_FEATURE_TEXTURES) != 0u || !std::isfinite(roughness)) return 0.0f;
     float span = rate.broadRoughness - rate.sharpRoughness;
     float t = span > 0.0f ? (roughness - rate.sharpRoughness) / span
                           : (roughness >= rate.broadRoughness ? 1.0f : 0.0f);
     return rate.maxBias * std::clamp(t, 0.0f, 1.0f);
 }
 
-float materialRateLod(float lod, float rateBias) {
-    return std::max(lod, std::min(lod + rateBias, float(SHADEL_MATERIAL_RATE_MAX_LOD)));
+float materialRateLod(float lod, float rateBias, float textureLod) {
+    float bias = std::min(rateBias, std::max(textureLod - 1.0f - lod, 0.0f));
+    return std::max(lod, std::min(lod + bias, float(SHADEL_MATERIAL_RATE_MAX_LOD)));
 }
 
 bool lightDrawsSharpEdges(const gpu::GpuLight& light) {

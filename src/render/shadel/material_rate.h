@@ -13,9 +13,11 @@
 // lightDrawsSharpEdges), where a decal's box meets it (decals draw patterns on the surface),
 // and, everywhere, when the sun draws sharp edges: ray-traced terms (hard traced shadows, AO,
 // GI: the RT cache sets its own rate, --rt-shadel-mip-offset) or sun cascades (near shadow
-// texels about a pixel wide). Every material with features keeps it too: its pattern is the
-// signal. The sun's one whole-scene shadow map is not counted: its PCF edges are wider than a
-// shadel of the coarser level in the scenes measured (builtin:default).
+// texels about a pixel wide). Materials with procedurals, clear coat or sheen keep it too: their
+// pattern is the signal. A textured material takes the same bias where the view magnifies its
+// textures, never coarser than their texels (texture_rate.h). The sun's one whole-scene shadow map
+// is not counted: its PCF edges are wider than a shadel of the coarser level in the scenes measured
+// (builtin:default).
 #include <cstdint>
 #include <vector>
 
@@ -29,16 +31,22 @@ struct MaterialRate {
     float maxBias = 1.0f;         // MIPs coarser at most (a quarter of the shadels)
     float sharpRoughness = 0.25f; // at or below: highlights sharp enough to keep the full rate
     float broadRoughness = 0.55f; // at or above: the full bias
+    // Textured materials: textureLod is the finest whole level whose shadels are at most
+    // 1 / shadelsPerTexel texel apart; the rate stops a level finer (texture_rate.h).
+    float shadelsPerTexel = 2.0f;
 };
 
 // The MIP bias for a material with `features` (MATERIAL_FEATURE_* of shared_types.h) and
-// roughness factor `roughness`. 0 when any feature is set.
+// roughness `roughness` (of a textured material: the lowest its roughness texture gives,
+// texture_rate.h). 0 when any feature but textures is set; a textured material's bias is then
+// limited per sample by its texels (textureLod).
 float materialRateBias(const MaterialRate& rate, uint32_t features, float roughness);
 
 // A sample's LOD with an object's rate bias, as shadelLevels (shaders/shadel/shadel.glsl) takes
 // it: coarser by the bias, but not past SHADEL_MATERIAL_RATE_MAX_LOD (shared_types.h) unless
-// already there.
-float materialRateLod(float lod, float rateBias);
+// already there, nor past the level before `textureLod` (texture_rate.h: a quarter texel of a
+// textured material's densest texture) unless already there.
+float materialRateLod(float lod, float rateBias, float textureLod = SHADEL_TEXTURE_LOD_NONE);
 
 // Whether a light draws edges sharper than its smooth falloff on what it lights.
 bool lightDrawsSharpEdges(const gpu::GpuLight& light);
