@@ -53,8 +53,25 @@ float uvPerShadelLog2(std::span<const glm::vec2> materialUv, std::span<const glm
     return weightedPercentile(density, 0.95);
 }
 
+// The 2nd percentile of a metallic-roughness texture's G (roughness), 0..1; -1 when its texels
+// are not in the scene (generated later: procedural).
+static float lowRoughness(const Texture& t) {
+    size_t texels = size_t(t.width) * t.height;
+    if (t.rgba8.size() != texels * 4 || texels == 0) return -1.0f;
+    uint64_t histogram[256] = {};
+    for (size_t i = 0; i < texels; ++i) histogram[t.rgba8[i * 4 + 1]]++;
+    uint64_t low = texels / 50, sum = 0;
+    uint32_t g = 0;
+    for (; g < 255; ++g)
+        if ((sum += histogram[g]) > low) break;
+    return float(g) / 255.0f;
+}
+
 std::vector<MaterialTexels> materialTexels(const Scene& scene) {
     std::vector<MaterialTexels> out(scene.materials.size());
+    // Per texture, once: materials often share one (linear in the scene's texels).
+    std::vector<float> roughnessOfTexture(scene.textures.size(),
+                                          std::numeric_limits<float>::quiet_NaN());
     for (size_t mi = 0; mi < scene.materials.size(); ++mi) {
         const Material& m = scene.materials[mi];
         MaterialTexels& e = out[mi];
@@ -85,19 +102,13 @@ std::vector<MaterialTexels> materialTexels(const Scene& scene) {
             e.texelsPerUvLog2 = std::max(e.texelsPerUvLog2, float(0.5 * std::log2(texels)));
         }
         if (m.metallicRoughnessTexture != kNoTexture && e.known) {
-            const Texture& t = scene.textures[size_t(m.metallicRoughnessTexture)];
-            size_t texels = size_t(t.width) * t.height;
-            if (t.rgba8.size() != texels * 4 || texels == 0) {
-                e.known = false; // generated later (procedural): its roughness is not known
-            } else {
-                uint64_t histogram[256] = {};
-                for (size_t i = 0; i < texels; ++i) histogram[t.rgba8[i * 4 + 1]]++;
-                uint64_t low = texels / 50, sum = 0; // the 2nd percentile of G
-                uint32_t g = 0;
-                for (; g < 255; ++g)
-                    if ((sum += histogram[g]) > low) break;
-                e.roughnessScale = float(g) / 255.0f;
-            }
+            float& scale = roughnessOfTexture[size_t(m.metallicRoughnessTexture)];
+            if (std::isnan(scale))
+                scale = lowRoughness(scene.textures[size_t(m.metallicRoughnessTexture)]);
+            if (scale < 0.0f)
+                e.known = false; // generated later (procedural): not known
+            else
+                e.roughnessScale = scale;
         }
     }
     return out;
