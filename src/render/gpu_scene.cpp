@@ -392,13 +392,17 @@ void setMaterialFeatureFlags(gpu::GpuMaterial& m) {
     m.flags = (m.flags & ~MATERIAL_FEATURED) | (materialFeatures(m) << MATERIAL_FEATURES_SHIFT);
 }
 
+std::array<uint32_t, kTextureSlotCount> materialTextureSlots(const gpu::GpuMaterial& m) {
+    static_assert(kTextureSlotCount == 12, "one entry per TextureSlot, in its order");
+    return {m.baseColorTexture,          m.metallicRoughnessTexture, m.normalTexture,
+            m.emissiveTexture,           m.occlusionTexture,         m.clearcoatTexture,
+            m.clearcoatRoughnessTexture, m.clearcoatNormalTexture,   m.specularTexture,
+            m.specularColorTexture,      m.sheenColorTexture,        m.sheenRoughnessTexture};
+}
+
 uint32_t materialFeatures(const gpu::GpuMaterial& m) {
     uint32_t features = 0u;
-    for (uint32_t texture :
-         {m.baseColorTexture, m.metallicRoughnessTexture, m.normalTexture, m.emissiveTexture,
-          m.occlusionTexture, m.clearcoatTexture, m.clearcoatRoughnessTexture,
-          m.clearcoatNormalTexture, m.specularTexture, m.specularColorTexture, m.sheenColorTexture,
-          m.sheenRoughnessTexture})
+    for (uint32_t texture : materialTextureSlots(m))
         if (texture != NO_TEXTURE) features |= MATERIAL_FEATURE_TEXTURES;
     if (m.procedural == PROCEDURAL_TEXEL_CHECKER || m.procedural == PROCEDURAL_BRICKS)
         features |= MATERIAL_FEATURE_PROCEDURAL;

@@ -92,6 +92,8 @@ bool hasAlphaMaskedMaterials(const GpuScene& scene);
 // The MATERIAL_FEATURE_* the material uses: what shaders/common/material.glsl must evaluate for
 // it (a shader compiled without them, kMaterialFeatures, shades it the same).
 uint32_t materialFeatures(const gpu::GpuMaterial& m);
+// The material's bindless texture slots in TextureSlot order (scene.h), NO_TEXTURE when absent.
+std::array<uint32_t, kTextureSlotCount> materialTextureSlots(const gpu::GpuMaterial& m);
 // Writes materialFeatures into the material's flags (MATERIAL_FEATURES_SHIFT): the forward draw
 // lists and the tile pass read them. Uploaded and edited materials carry them.
 void setMaterialFeatureFlags(gpu::GpuMaterial& m);

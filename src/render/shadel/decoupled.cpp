@@ -917,7 +917,8 @@ void prepareDecoupledFrame(Renderer& r, const GpuScene& scene, const CameraView&
                                                ? &scene.materialTexels[inst.material]
                                                : nullptr;
             bool asLoaded = known && texels && texels->known &&
-                            sameTextures(*material, scene.materialInfo[inst.material]);
+                            (material == &scene.materialInfo[inst.material] || // not edited
+                             sameTextures(*material, scene.materialInfo[inst.material]));
             rateRoughness = asLoaded ? roughness * texels->roughnessScale : 0.0f;
             texLod = asLoaded ? textureLod(mesh.uvPerShadelLog2, texels->texelsPerUvLog2,
                                            d.materialRate.shadelsPerTexel)

@@ -15,9 +15,9 @@
 // GI: the RT cache sets its own rate, --rt-shadel-mip-offset) or sun cascades (near shadow
 // texels about a pixel wide). Materials with procedurals, clear coat or sheen keep it too: their
 // pattern is the signal. A textured material takes the same bias where the view magnifies its
-// textures, never coarser than their texels (texture_rate.h). The sun's one whole-scene shadow map
-// is not counted: its PCF edges are wider than a shadel of the coarser level in the scenes measured
-// (builtin:default).
+// textures, never coarser than a quarter texel (texture_rate.h). The sun's one whole-scene shadow
+// map is not counted: its PCF edges are wider than a shadel of the coarser level in the scenes
+// measured (builtin:default).
 #include <cstdint>
 #include <vector>
 

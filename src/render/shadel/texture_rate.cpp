@@ -1,11 +1,11 @@
 #include "render/shadel/texture_rate.h"
 
 #include <algorithm>
-#include <array>
 #include <cmath>
 #include <cstring>
 #include <limits>
 
+#include "render/gpu_scene.h"
 #include "scene/scene.h"
 
 namespace shadel {
@@ -30,6 +30,20 @@ double triangleArea(glm::vec2 a, glm::vec2 b, glm::vec2 c) {
     return 0.5 * std::abs(u.x * v.y - u.y * v.x);
 }
 
+// The 2nd percentile of a metallic-roughness texture's G (roughness), 0..1; -1 when its texels
+// are not in the scene (generated later: procedural).
+float lowRoughness(const Texture& t) {
+    size_t texels = size_t(t.width) * t.height;
+    if (t.rgba8.size() != texels * 4 || texels == 0) return -1.0f;
+    uint64_t histogram[256] = {};
+    for (size_t i = 0; i < texels; ++i) histogram[t.rgba8[i * 4 + 1]]++;
+    uint64_t low = texels / 50, sum = 0;
+    uint32_t g = 0;
+    for (; g < 255; ++g)
+        if ((sum += histogram[g]) > low) break;
+    return float(g) / 255.0f;
+}
+
 } // namespace
 
 float uvPerShadelLog2(std::span<const glm::vec2> materialUv, std::span<const glm::vec2> shadelUv,
@@ -51,20 +65,6 @@ float uvPerShadelLog2(std::span<const glm::vec2> materialUv, std::span<const glm
     }
     if (density.empty()) return none;
     return weightedPercentile(density, 0.95);
-}
-
-// The 2nd percentile of a metallic-roughness texture's G (roughness), 0..1; -1 when its texels
-// are not in the scene (generated later: procedural).
-static float lowRoughness(const Texture& t) {
-    size_t texels = size_t(t.width) * t.height;
-    if (t.rgba8.size() != texels * 4 || texels == 0) return -1.0f;
-    uint64_t histogram[256] = {};
-    for (size_t i = 0; i < texels; ++i) histogram[t.rgba8[i * 4 + 1]]++;
-    uint64_t low = texels / 50, sum = 0;
-    uint32_t g = 0;
-    for (; g < 255; ++g)
-        if ((sum += histogram[g]) > low) break;
-    return float(g) / 255.0f;
 }
 
 std::vector<MaterialTexels> materialTexels(const Scene& scene) {
@@ -115,20 +115,13 @@ std::vector<MaterialTexels> materialTexels(const Scene& scene) {
 }
 
 bool sameTextures(const gpu::GpuMaterial& a, const gpu::GpuMaterial& b) {
-    auto slots = [](const gpu::GpuMaterial& m) {
-        return std::array<uint32_t, 12>{
-            m.baseColorTexture,          m.metallicRoughnessTexture, m.normalTexture,
-            m.emissiveTexture,           m.occlusionTexture,         m.clearcoatTexture,
-            m.clearcoatRoughnessTexture, m.clearcoatNormalTexture,   m.specularTexture,
-            m.specularColorTexture,      m.sheenColorTexture,        m.sheenRoughnessTexture};
-    };
-    return slots(a) == slots(b) && a.clampMask == b.clampMask &&
+    return materialTextureSlots(a) == materialTextureSlots(b) && a.clampMask == b.clampMask &&
            std::memcmp(a.uvTransform, b.uvTransform, sizeof(a.uvTransform)) == 0;
 }
 
 float textureLod(float uvPerShadelLog2, float texelsPerUvLog2, float shadelsPerTexel) {
+    // (Both terms are finite or -infinity: no texture detail gives +infinity, clamped to NONE.)
     float lod = std::floor(-(uvPerShadelLog2 + texelsPerUvLog2) - std::log2(shadelsPerTexel));
-    if (std::isnan(lod)) return -float(SHADEL_TEXTURE_LOD_NONE); // (-inf + inf): keep the rate
     return std::clamp(lod, -float(SHADEL_TEXTURE_LOD_NONE), float(SHADEL_TEXTURE_LOD_NONE));
 }
 

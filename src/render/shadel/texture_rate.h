@@ -52,14 +52,15 @@ struct MaterialTexels {
 };
 std::vector<MaterialTexels> materialTexels(const Scene& scene);
 
-// The shadel LOD (in MIP-0 shadel units, as shadelLevels' lod) a sample is never shaded coarser
-// than: the level whose shadels lie 1 / shadelsPerTexel texels apart. A MIP-0 shadel spans
-// 2^(uvPerShadelLog2 + texelsPerUvLog2) texels, a level-L shadel 2^L times that. Clamped to
-// +-SHADEL_TEXTURE_LOD_NONE (shared_types.h): no texture detail, or no limit.
+// GpuShadelObject::textureLod (in MIP-0 shadel units, as shadelLevels' lod): the finest whole
+// level whose shadels lie at most 1 / shadelsPerTexel texels apart; the rate coarsens a sample
+// no further than the level before it. A MIP-0 shadel spans 2^(uvPerShadelLog2 +
+// texelsPerUvLog2) texels, a level-L shadel 2^L times that. Clamped to
+// +-SHADEL_TEXTURE_LOD_NONE (shared_types.h): +NONE when the textures have no detail.
 float textureLod(float uvPerShadelLog2, float texelsPerUvLog2, float shadelsPerTexel);
 
 // Whether two materials sample the same textures the same way (slots, transforms, clamping):
-// an edited material whose textures changed has no MaterialTexels.
+// an edited material whose textures changed has no MaterialTexels (the full rate).
 bool sameTextures(const gpu::GpuMaterial& a, const gpu::GpuMaterial& b);
 
 } // namespace shadel
