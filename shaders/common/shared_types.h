@@ -129,6 +129,9 @@ using uint = uint32_t;
 // branch: lavapipe runs both sides of a branch (resolveCompute 35.8 ms with the branch, 32.3
 // with the constant, in two bench runs of builtin:default 1280x720, orbit).
 #define RESOLVE_DISPLAY_OUTPUT_CONSTANT_ID 152
+// Which list marking's indirect-arguments pass sizes: the two-triangle quads' (after the first
+// pass) or the per-pixel quads' (after the second; shaders/shadel/mark_listed_args.comp).
+#define MARK_PIXEL_LIST_CONSTANT_ID 153
 // Which queued chunks a shadel shading pipeline shades (shaders/shadel/shade.comp): all of them
 // (the spectra permutations, everything compiled in), or one shading class's list. The classes
 // (SHADEL_OBJECT_* flags, per object from its material): plain (no texture, procedural, clear
@@ -774,6 +777,11 @@ struct GpuShadelCounters {
     // ... of those, the ones whose window lagged so far that they were shaded forward
     // (SHADEL_MAX_WINDOW_FALLBACK, shaders/shadel/shadel.glsl).
     uint windowForwardPixels;
+    // Compute marking's listed quads (shaders/shadel/mark_quad.glsl): those its first pass left
+    // to the two-triangle pass, and those left to the per-pixel pass (by the first pass or by
+    // the two-triangle pass, where the triangles' levels differ).
+    uint markQuadsTwoTriangles;
+    uint markQuadsPerPixel;
     // Chunks queued for shading, by why they could not be carried over (SHADEL_SHADED_*).
     uint shadedBecause[SHADEL_SHADED_REASONS];
     uvec4 fillDispatch;  // x, y, z, marked blocks in the list: indirect args of the queue fill

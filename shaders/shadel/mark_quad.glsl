@@ -1,12 +1,17 @@
-// Compute marking's per-quad code (--marking visibility), shared by its two passes:
+// Compute marking's per-quad code (--marking visibility), shared by its three passes:
 // mark_visibility.comp marks the quads whose four pixels see one decoupled triangle without
-// per-pixel branches (markWholeQuad) and lists the others, which mark_listed.comp marks pixel
-// by pixel (markQuadPixels). Both give every pixel the same chunks and reconstruction address.
-// Why two passes: on lavapipe a SIMD group runs the code of a branch whenever any of its lanes
-// takes it, and 1 - 0.85^8 of 8-quad groups hold a quad that is not on one triangle, so in one
-// pass nearly every group ran the per-pixel code, and a second triangle's setup, for all eight.
-// markingCompute, alternating runs, builtin:default 1280x720 orbit: 51.1, 51.2 -> 38.7, 39.7 ms,
-// the images byte-identical.
+// per-pixel branches (markQuadOnTriangles) and lists the others; mark_two_triangles.comp marks
+// the listed quads whose pixels see two triangles of one decoupled instance the same way; and
+// mark_listed.comp marks the rest pixel by pixel (markQuadPixel). All give every pixel the
+// same chunks and reconstruction address.
+// Why three passes: on lavapipe a SIMD group runs the code of a branch whenever any of its lanes
+// takes it. 1 - 0.85^8 of 8-quad groups hold a quad that is not on one triangle, so in one pass
+// nearly every group ran the per-pixel code, and a second triangle's setup, for all eight.
+// markingCompute, alternating runs, builtin:default 1280x720 orbit: 51.1, 51.2 -> 38.7, 39.7 ms
+// with two passes. Of the 35,016 quads the first pass lists there, 26,294 see two triangles of
+// one instance (a triangle edge crosses them), and 90% of those have the same levels on both:
+// the second pass marks them without the per-pixel code, and lists the others, with the quads
+// on sky, two instances or three triangles, for the third.
 #ifndef SHADEL_MARK_QUAD_GLSL
 #define SHADEL_MARK_QUAD_GLSL
 #define SHADEL_MARK_CACHE // the quad's pixels mostly mark the same chunks: skip repeats
@@ -25,13 +30,43 @@ layout(push_constant, scalar) uniform Push {
     uint64_t markList;    // MarkQuadList
 } pc;
 
-// The quads the first pass leaves to the second (mark_listed.comp), and its indirect arguments.
+// The quads the first pass leaves to the later two, and their indirect arguments
+// (mark_listed_args.comp). One array of a slot per quad of the screen, filled from both ends:
+// the two-triangle quads (mark_two_triangles.comp) from the front, the per-pixel ones
+// (mark_listed.comp) from the back, so neither list can overflow.
 layout(buffer_reference, scalar) buffer MarkQuadList {
-    uvec4 dispatch; // x, y, z (mark_listed_args.comp)
-    uint count;
-    uint pad0, pad1, pad2;
+    uvec4 twoTriangleDispatch; // x, y, z, count
+    uvec4 pixelDispatch;       // x, y, z, count
+    uint twoTriangleCount;
+    uint pixelCount;
+    uint pad0, pad1;
     uint quads[]; // origin x | y << 16
 };
+
+uint markQuadCapacity() { return ((pc.width + 1u) >> 1) * ((pc.height + 1u) >> 1); }
+
+uint packQuadOrigin(ivec2 origin) { return uint(origin.x) | (uint(origin.y) << 16); }
+ivec2 unpackQuadOrigin(uint packed) { return ivec2(packed & 0xFFFFu, packed >> 16); }
+
+// Appends this invocation's quad to the front (two-triangle) or back (per-pixel) list: one
+// atomic per subgroup and list. Every invocation of the subgroup must call it.
+void listMarkQuad(ivec2 origin, bool twoTriangles, bool pixels) {
+    MarkQuadList list = MarkQuadList(pc.markList);
+    uvec4 front = subgroupBallot(twoTriangles);
+    uvec4 back = subgroupBallot(pixels);
+    uint frontCount = subgroupBallotBitCount(front), backCount = subgroupBallotBitCount(back);
+    if (frontCount + backCount == 0u) return;
+    uvec2 first = uvec2(0u);
+    if (subgroupElect()) {
+        if (frontCount != 0u) first.x = atomicAdd(list.twoTriangleCount, frontCount);
+        if (backCount != 0u) first.y = atomicAdd(list.pixelCount, backCount);
+    }
+    first = subgroupBroadcastFirst(first);
+    if (twoTriangles) list.quads[first.x + subgroupBallotExclusiveBitCount(front)] = packQuadOrigin(origin);
+    if (pixels)
+        list.quads[markQuadCapacity() - 1u - (first.y + subgroupBallotExclusiveBitCount(back))] =
+            packQuadOrigin(origin);
+}
 
 // The quad's pixels on one triangle: its setup and, from the quad's coarse derivatives, the MIP
 // levels and anisotropy they all share (decoupled instances only; else unused).
@@ -65,44 +100,26 @@ void loadQuadVisibility(ivec2 origin, out uvec2 vis[4]) {
     }
 }
 
-// The pixel-by-pixel marking of a quad: each pixel's own footprints, marked and written as its
-// reconstruction address. A quad's setup (the triangle's vertices, the four pixels'
-// barycentrics) serves every pixel of the quad on that triangle: one for its first covered
-// pixel's triangle, one for the first other triangle, and a pixel on a third triangle sets up
-// its own.
-void markQuadPixels(FrameConstants f, ShadelFrame s, ivec2 origin, uvec2 vis[4]) {
-    // The quad's first covered triangle (a), and the first other one (b; a when there is none).
-    uvec2 a = vis[0];
-    for (int i = 1; i < 4; ++i) a = a.x == VISIBILITY_NONE ? vis[i] : a;
-    uvec2 b = a;
-    for (int i = 3; i > 0; --i) b = vis[i].x != VISIBILITY_NONE && vis[i] != a ? vis[i] : b;
-    QuadTriangle ta, tb;
-    ta.decoupled = false;
-    tb.decoupled = false;
-    if (a.x != VISIBILITY_NONE) { // (a sky quad sets up nothing, nor reads, in an empty scene)
-        ta = setUpQuad(f, s, a, origin);
-        tb = b != a ? setUpQuad(f, s, b, origin) : ta;
-    }
-    for (int i = 0; i < 4; ++i) {
-        ivec2 pixel = origin + ivec2(i & 1, i >> 1);
-        if (pixel.x >= int(pc.width) || pixel.y >= int(pc.height)) continue;
-        uvec4 address = resolveAddressNone();
-        if (vis[i].x != VISIBILITY_NONE) {
-            bool onA = vis[i] == a;
-            QuadTriangle t = onA ? ta : tb;
-            if (!onA && vis[i] != b) t = setUpQuad(f, s, vis[i], origin); // a third (rare)
-            if (t.decoupled) {
-                VisShadel v = visShadelSample(t.q, t.o, i);
-                MarkedSample m = markSampleWith(s, t.o, v.shadelUv, t.levels, t.aniso);
-                // As reconstructSample counts magnification (only sampled pixels count it).
-                bool magnified = max(dot(v.texelDx, v.texelDx), dot(v.texelDy, v.texelDy)) < 1.0;
-                address = packResolveAddress(m, magnified);
-            } else {
-                address = resolveAddressForward();
-            }
+// One pixel of a quad, marked on its own: its footprints, marked and written as its
+// reconstruction address. The pixel sets up its triangle over the quad (its coarse
+// derivatives are the quad's on that triangle), as the other passes set up theirs.
+void markQuadPixel(FrameConstants f, ShadelFrame s, ivec2 origin, int i, uvec2 vis) {
+    ivec2 pixel = origin + ivec2(i & 1, i >> 1);
+    if (pixel.x >= int(pc.width) || pixel.y >= int(pc.height)) return;
+    uvec4 address = resolveAddressNone();
+    if (vis.x != VISIBILITY_NONE) {
+        QuadTriangle t = setUpQuad(f, s, vis, origin);
+        if (t.decoupled) {
+            VisShadel v = visShadelSample(t.q, t.o, i);
+            MarkedSample m = markSampleWith(s, t.o, v.shadelUv, t.levels, t.aniso);
+            // As reconstructSample counts magnification (only sampled pixels count it).
+            bool magnified = max(dot(v.texelDx, v.texelDx), dot(v.texelDy, v.texelDy)) < 1.0;
+            address = packResolveAddress(m, magnified);
+        } else {
+            address = resolveAddressForward();
         }
-        ResolveAddressBuffer(pc.addresses).v[resolveAddressIndex(pixel, pc.width)] = address;
     }
+    ResolveAddressBuffer(pc.addresses).v[resolveAddressIndex(pixel, pc.width)] = address;
 }
 
 // A quad whose four pixels see one decoupled triangle at the same levels (coarse derivatives)
@@ -148,31 +165,46 @@ void markQuadLevel(ShadelFrame s, QuadLevel q) {
         if ((q.chunks & (1u << k)) != 0u) markChunk(s, q.first + uvec2(k & 1u, k >> 1u) * SHADEL_CHUNK);
 }
 
-// Marks a quad whose four pixels all see triangle t (decoupled) without per-pixel branches: the
-// chunks and addresses markQuadPixels would give it. False (nothing marked nor written) where
-// the quad needs the per-pixel code (quadLevel).
-bool markWholeQuad(ShadelFrame s, QuadTriangle t, ivec2 origin) {
-    if (t.aniso.taps != 1u) return false; // (one tap since the anisotropy cap: shadelAniso)
+// Marks a quad whose four pixels see one or two triangles of one decoupled instance at the same
+// levels (ta's and tb's: the pixels with bit i of onB set see tb) without per-pixel branches:
+// the chunks and addresses markQuadPixels would give it. Each pixel takes its own triangle's
+// shadel UV, MIP blend and magnification. False (nothing marked nor written) where the quad
+// needs the per-pixel code: the triangles' levels differ, or quadLevel fails.
+bool markQuadOnTriangles(ShadelFrame s, QuadTriangle ta, QuadTriangle tb, uint onB, ivec2 origin) {
+    // (one tap since the anisotropy cap: shadelAniso)
+    if (ta.aniso.taps != 1u || tb.aniso.taps != 1u) return false;
+    if (ta.levels.mip0 != tb.levels.mip0 || ta.levels.mip1 != tb.levels.mip1 ||
+        ta.levels.two != tb.levels.two)
+        return false;
     vec2 uv[4];
-    uv[0] = t.first.shadelUv;
-    for (int i = 1; i < 4; ++i) uv[i] = visShadelSample(t.q, t.o, i).shadelUv;
+    for (int i = 0; i < 4; ++i) {
+        vec2 a = visInterpolate(ta.q.bary[i], ta.q.uv0, ta.q.uv1, ta.q.uv2);
+        vec2 b = visInterpolate(tb.q.bary[i], tb.q.uv0, tb.q.uv1, tb.q.uv2);
+        uv[i] = ((onB >> i) & 1u) != 0u ? b : a; // (visShadelSample's shadelUv)
+    }
     QuadLevel level0, level1;
-    if (!quadLevel(t.o, t.levels.mip0, uv, level0)) return false;
-    if (t.levels.two && !quadLevel(t.o, t.levels.mip1, uv, level1)) return false;
+    if (!quadLevel(ta.o, ta.levels.mip0, uv, level0)) return false;
+    if (ta.levels.two && !quadLevel(ta.o, ta.levels.mip1, uv, level1)) return false;
     markQuadLevel(s, level0);
-    if (t.levels.two) markQuadLevel(s, level1);
-    vec2 dx = t.first.texelDx, dy = t.first.texelDy;
-    bool magnified = max(dot(dx, dx), dot(dy, dy)) < 1.0; // as reconstructSample counts it
+    if (ta.levels.two) markQuadLevel(s, level1);
+    // As reconstructSample counts magnification: from each triangle's (coarse) derivatives.
+    vec2 dx = ta.first.texelDx, dy = ta.first.texelDy;
+    bool magnifiedA = max(dot(dx, dx), dot(dy, dy)) < 1.0;
+    dx = tb.first.texelDx;
+    dy = tb.first.texelDy;
+    bool magnifiedB = max(dot(dx, dx), dot(dy, dy)) < 1.0;
     MarkedSample m;
-    m.levels = t.levels;
     m.windowFallback = false;
     m.forward = false;
     m.taps = 1u;
     uint first = resolveAddressIndex(origin, pc.width); // the quad's four, in pixel order
     for (int i = 0; i < 4; ++i) {
+        bool b = ((onB >> i) & 1u) != 0u;
+        m.levels = b ? tb.levels : ta.levels;
         m.footprint0 = level0.pixel[i];
-        m.footprint1 = t.levels.two ? level1.pixel[i] : level0.pixel[i];
-        ResolveAddressBuffer(pc.addresses).v[first + uint(i)] = packResolveAddress(m, magnified);
+        m.footprint1 = ta.levels.two ? level1.pixel[i] : level0.pixel[i];
+        ResolveAddressBuffer(pc.addresses).v[first + uint(i)] =
+            packResolveAddress(m, b ? magnifiedB : magnifiedA);
     }
     return true;
 }

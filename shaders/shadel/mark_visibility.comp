@@ -5,10 +5,11 @@
 // resolve will read and write it down for the resolve (shadel/resolve_address.glsl).
 //
 // A quad whose four pixels see one decoupled triangle (85% of builtin:default's covered quads
-// at 1280x720) is marked here, without per-pixel branches (markWholeQuad); sky and forward
-// (hybrid) quads get addresses saying so; every other quad (silhouettes, sky edges, the screen's
-// last row or column, rare level-window fallbacks) is listed for mark_listed.comp, which marks
-// it pixel by pixel (markQuadPixels). See shadel/mark_quad.glsl for why.
+// at 1280x720) is marked here, without per-pixel branches (markQuadOnTriangles); sky and forward
+// (hybrid) quads get addresses saying so. The others are listed: those whose four pixels see two
+// triangles of one decoupled instance for mark_two_triangles.comp, every other one (silhouettes,
+// sky edges, the screen's last row or column, rare level-window fallbacks) for mark_listed.comp,
+// which marks it pixel by pixel (markQuadPixels). See shadel/mark_quad.glsl for why.
 //
 // The quad's derivatives are coarse (shadel/vis_shadel.glsl), so its pixels of one triangle
 // share their MIP levels and anisotropy, taken once with the setup (setUpQuad).
@@ -18,37 +19,36 @@ layout(local_size_x = 8, local_size_y = 8) in;
 
 void main() {
     ivec2 origin = ivec2(gl_GlobalInvocationID.xy) * 2;
-    bool listed = false;
+    bool twoTriangles = false, pixels = false;
     if (origin.x < int(pc.width) && origin.y < int(pc.height)) {
         FrameConstants f = FrameConstantsRef(pc.frame).f;
         ShadelFrame s = ShadelFrameRef(f.shadel).s;
         uvec2 vis[4];
         loadQuadVisibility(origin, vis);
         bool whole = origin.x + 1 < int(pc.width) && origin.y + 1 < int(pc.height);
-        bool one = whole && vis[1] == vis[0] && vis[2] == vis[0] && vis[3] == vis[0];
-        bool decoupled = one && vis[0].x != VISIBILITY_NONE &&
+        bool oneInstance = whole && vis[1].x == vis[0].x && vis[2].x == vis[0].x &&
+                           vis[3].x == vis[0].x;
+        bool one = oneInstance && vis[1].y == vis[0].y && vis[2].y == vis[0].y &&
+                   vis[3].y == vis[0].y;
+        bool decoupled = oneInstance && vis[0].x != VISIBILITY_NONE &&
                          (shadelObject(s, vis[0].x).v.flags & SHADEL_OBJECT_DECOUPLED) != 0u;
-        if (decoupled) {
-            listed = !markWholeQuad(s, setUpQuad(f, s, vis[0], origin), origin);
+        if (decoupled && one) {
+            QuadTriangle t = setUpQuad(f, s, vis[0], origin);
+            pixels = !markQuadOnTriangles(s, t, t, 0u, origin);
         } else if (one) { // the sky, or a forward (hybrid) instance: drawn before the resolve
             uint first = resolveAddressIndex(origin, pc.width);
             uvec4 address =
                 vis[0].x == VISIBILITY_NONE ? resolveAddressNone() : resolveAddressForward();
             for (uint i = 0u; i < 4u; ++i)
                 ResolveAddressBuffer(pc.addresses).v[first + i] = address;
+        } else if (decoupled) { // two triangles of the instance, or more
+            uint b = vis[1].y != vis[0].y ? vis[1].y : vis[2].y != vis[0].y ? vis[2].y : vis[3].y;
+            twoTriangles = true;
+            for (int i = 1; i < 4; ++i) twoTriangles = twoTriangles && (vis[i].y == vis[0].y || vis[i].y == b);
+            pixels = !twoTriangles;
         } else {
-            listed = true;
+            pixels = true;
         }
     }
-    // The listed quads, one atomic per subgroup (every invocation arrives here).
-    uvec4 ballot = subgroupBallot(listed);
-    uint count = subgroupBallotBitCount(ballot);
-    if (count == 0u) return;
-    MarkQuadList list = MarkQuadList(pc.markList);
-    uint first = 0u;
-    if (subgroupElect()) first = atomicAdd(list.count, count);
-    first = subgroupBroadcastFirst(first);
-    if (listed)
-        list.quads[first + subgroupBallotExclusiveBitCount(ballot)] =
-            uint(origin.x) | (uint(origin.y) << 16);
+    listMarkQuad(origin, twoTriangles, pixels); // (every invocation arrives here)
 }

@@ -59,13 +59,25 @@ TEST(Visibility, MatchesRasterMarkingAndReconstruction) {
             EXPECT_EQ(stat(vis, "reconstructed_pixels_sampled"),
                       stat(raster, "reconstructed_pixels_sampled"))
                 << scene;
+            // Marking's later passes both ran (shaders/shadel/mark_quad.glsl): quads on two
+            // triangles of an instance, marked without per-pixel code, and the per-pixel rest.
+            // Every later test here matches the raster path only if all three passes are right.
+            uint64_t twoTriangles = vis.stats["marking_listed_quads"]["two_triangles"];
+            uint64_t perPixel = vis.stats["marking_listed_quads"]["per_pixel"];
+            std::printf("[ figures ] %s %ux%u: listed quads: %llu on two triangles, %llu per "
+                        "pixel\n",
+                        scene.c_str(), w, h, (unsigned long long)twoTriangles,
+                        (unsigned long long)perPixel);
+            EXPECT_GT(twoTriangles, 0u) << scene;
+            EXPECT_GT(perPixel, 0u) << scene;
+            EXPECT_FALSE(raster.stats.contains("marking_listed_quads")) << scene;
         }
     }
 }
 
 // Marking's first pass marks quads on one triangle and lists the rest (silhouettes, and at an
-// odd size the quads the last column and row cut in half) for its second pass: every pixel of
-// both kinds must get its chunks and address, so odd sizes match the raster path too.
+// odd size the quads the last column and row cut in half) for its later passes: every pixel of
+// every kind must get its chunks and address, so odd sizes match the raster path too.
 TEST(Visibility, OddSizesMarkTheLastColumnAndRow) {
     for (auto [w, h] : {std::pair{97u, 55u}, std::pair{161u, 90u}}) {
         RenderRun raster = renderChecked(decoupled("builtin:default", MarkingMode::Raster, w, h));

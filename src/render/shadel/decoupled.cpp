@@ -1465,6 +1465,12 @@ void decoupledStats(const Renderer& r, nlohmann::json& s) {
         last.counters.reconstructedPixels
             ? double(last.counters.windowForwardPixels) / double(last.counters.reconstructedPixels)
             : 0.0;
+    // Compute marking: the quads its first pass could not mark on one triangle, by the pass that
+    // took them (shaders/shadel/mark_quad.glsl; per_pixel includes the two-triangle quads whose
+    // triangles' levels differ).
+    if (r.visibility)
+        s["marking_listed_quads"] = {{"two_triangles", last.counters.markQuadsTwoTriangles},
+                                     {"per_pixel", last.counters.markQuadsPerPixel}};
     s["sheet_shadels"] = uint64_t(d.sheetBlocks) * SHADEL_BLOCK;
     // The seed's measure (~1.5 bits per shadel): the 64-bit occupancy mask + 32-bit offset of
     // every block in use, over the shadels its marked chunks hold.

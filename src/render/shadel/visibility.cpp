@@ -20,14 +20,15 @@ struct VisibilityState {
     // (misses, overflow, camera cuts) and that pass's indirect arguments
     // (shaders/shadel/resolve_pixel.glsl ResolveRebuildList).
     BufferHandle rebuildList;
-    // "markQuadList" (decoupled only): the quads marking's first pass leaves to its second (those
-    // not on one decoupled triangle), with that pass's indirect arguments
+    // "markQuadList" (decoupled only): the quads marking's first pass leaves to its later two
+    // (those not on one decoupled triangle), with their indirect arguments
     // (shaders/shadel/mark_quad.glsl MarkQuadList).
     BufferHandle markList;
     // resolveInline rebuilds its rare pixels itself (debug views, --inspect); resolve lists them
     // for resolveRebuild, sized by resolveRebuildArgs. Each of the three per output: [0] scene
     // colour, [1] display pixels (the tonemap fused into the resolve: render/post/tonemap.h).
-    Pipeline prepass, mark, markListed, markListedArgs, resolveRebuildArgs;
+    Pipeline prepass, mark, markTwoTriangles, markListed, markTwoTrianglesArgs, markListedArgs,
+        resolveRebuildArgs;
     std::array<Pipeline, 2> resolve, resolveInline, resolveRebuild;
 };
 
@@ -36,6 +37,12 @@ void VisibilityStateDeleter::operator()(VisibilityState* state) const {
 }
 
 namespace {
+// The lists' headers (shaders/shadel/resolve_pixel.glsl ResolveRebuildList,
+// shaders/shadel/mark_quad.glsl MarkQuadList): indirect arguments and counts, cleared each frame.
+constexpr VkDeviceSize kRebuildListHeaderBytes = 32;
+constexpr VkDeviceSize kMarkListHeaderBytes = 48;
+constexpr VkDeviceSize kMarkListPixelDispatchOffset = 16; // MarkQuadList::pixelDispatch
+
 struct ComputePush {
     uint64_t frame;
     uint32_t visibilitySlot;
@@ -68,19 +75,21 @@ void dispatchPixels(Renderer& r, VkCommandBuffer cmd) {
 }
 
 // A pass over the pixel quads that lists what its common code does not handle for a second pass
-// (marking: quads not on one triangle; the resolve: misses, overflow, camera cuts): clears the
-// list's header (after last frame's second pass read it, and last frame's readers of what
-// `first` writes), runs `first`, sizes the second pass from the list's count (`args`, one
-// invocation) and runs `second` by indirect dispatch. The list's header holds those arguments.
+// (marking: quads not on one triangle, and a third pass after: recordMarkingCompute; the
+// resolve: misses, overflow, camera cuts): clears the list's header (after last frame's later
+// passes read it, and last frame's readers of what `first` writes), runs `first`, sizes the
+// second pass from the list's count (`args`, one invocation) and runs `second` by indirect
+// dispatch. The list's header holds those arguments.
 void dispatchWithList(Renderer& r, VkCommandBuffer cmd, const ComputePush& push, BufferHandle list,
-                      const Pipeline& first, const Pipeline& args, const Pipeline& second) {
+                      VkDeviceSize headerBytes, const Pipeline& first, const Pipeline& args,
+                      const Pipeline& second) {
     Gpu& gpu = *r.gpu;
     memoryBarrier(cmd,
                   VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_2_DRAW_INDIRECT_BIT,
                   VK_ACCESS_2_SHADER_STORAGE_READ_BIT | VK_ACCESS_2_INDIRECT_COMMAND_READ_BIT,
                   VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_2_CLEAR_BIT,
                   VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT | VK_ACCESS_2_TRANSFER_WRITE_BIT);
-    vkCmdFillBuffer(cmd, vkBuffer(gpu, list), 0, 32, 0);
+    vkCmdFillBuffer(cmd, vkBuffer(gpu, list), 0, headerBytes, 0);
     memoryBarrier(cmd, VK_PIPELINE_STAGE_2_CLEAR_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT,
                   VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
                   VK_ACCESS_2_SHADER_STORAGE_READ_BIT | VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT);
@@ -123,15 +132,15 @@ VisibilityStatePtr createVisibility(Renderer& r) {
         VkDeviceSize quads = VkDeviceSize((r.internalWidth + 1) / 2) * ((r.internalHeight + 1) / 2);
         v.address = createBuffer(gpu, {"reconstructionAddress", quads * 4 * 16});
         if (!v.address) throw DeviceError("out of GPU memory for the reconstruction addresses");
-        // 32 bytes of header, then at most every pixel once.
+        // A header, then at most every pixel once.
         VkDeviceSize pixels = VkDeviceSize(r.internalWidth) * r.internalHeight;
         v.rebuildList = createBuffer(
-            gpu, {"resolveRebuildList", 32 + pixels * 4,
+            gpu, {"resolveRebuildList", kRebuildListHeaderBytes + pixels * 4,
                   VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT});
         if (!v.rebuildList) throw DeviceError("out of GPU memory for the resolve's rebuild list");
-        // 32 bytes of header, then at most every quad once.
+        // A header, then a slot per quad (filled from both ends).
         v.markList = createBuffer(
-            gpu, {"markQuadList", 32 + quads * 4,
+            gpu, {"markQuadList", kMarkListHeaderBytes + quads * 4,
                   VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT});
         if (!v.markList) throw DeviceError("out of GPU memory for marking's quad list");
     }
@@ -150,15 +159,23 @@ VisibilityStatePtr createVisibility(Renderer& r) {
         {"shadelMarkVisibility", "shadel_mark_visibility.comp.spv", {}}};
     if (v.rebuildList) {
         descs.push_back({"shadelResolveRebuildArgs", "shadel_resolve_rebuild_args.comp.spv", {}});
+        descs.push_back({"shadelMarkTwoTriangles", "shadel_mark_two_triangles.comp.spv", {}});
         descs.push_back({"shadelMarkListed", "shadel_mark_listed.comp.spv", {}});
-        descs.push_back({"shadelMarkListedArgs", "shadel_mark_listed_args.comp.spv", {}});
+        descs.push_back({"shadelMarkTwoTrianglesArgs",
+                         "shadel_mark_listed_args.comp.spv",
+                         {{MARK_PIXEL_LIST_CONSTANT_ID, 0u}}});
+        descs.push_back({"shadelMarkListedArgs",
+                         "shadel_mark_listed_args.comp.spv",
+                         {{MARK_PIXEL_LIST_CONSTANT_ID, 1u}}});
     }
     std::vector<Pipeline> built = createComputePipelines(gpu, descs); // side by side
     v.mark = built[0];
     if (v.rebuildList) {
         v.resolveRebuildArgs = built[1];
-        v.markListed = built[2];
-        v.markListedArgs = built[3];
+        v.markTwoTriangles = built[2];
+        v.markListed = built[3];
+        v.markTwoTrianglesArgs = built[4];
+        v.markListedArgs = built[5];
     }
     registerTextureCapture(
         r.captures, gpu, "visibility", "visibility buffer: instance, triangle (PNG)",
@@ -170,8 +187,8 @@ void destroyVisibility(Renderer& r, VisibilityStatePtr& state) {
     if (!state) return;
     Gpu& gpu = *r.gpu;
     VisibilityState& v = *state;
-    for (Pipeline* p :
-         {&v.prepass, &v.mark, &v.markListed, &v.markListedArgs, &v.resolveRebuildArgs})
+    for (Pipeline* p : {&v.prepass, &v.mark, &v.markTwoTriangles, &v.markListed,
+                        &v.markTwoTrianglesArgs, &v.markListedArgs, &v.resolveRebuildArgs})
         destroy(gpu, *p);
     for (auto* pipelines : {&v.resolve, &v.resolveInline, &v.resolveRebuild})
         for (Pipeline& p : *pipelines) destroy(gpu, p);
@@ -241,10 +258,25 @@ void recordMarkingCompute(Renderer& r, VkCommandBuffer cmd, uint64_t frame) {
     VisibilityState& v = *r.visibility;
     SHADEL_ASSERT(v.markList); // (made with the decoupled mode)
     // Every pixel's address is written again, after last frame's resolve read them. First pass:
-    // quads on one decoupled triangle, without per-pixel branches; second: the listed quads,
-    // pixel by pixel.
-    dispatchWithList(r, cmd, computePush(r, frame), v.markList, v.mark, v.markListedArgs,
-                     v.markListed);
+    // quads on one decoupled triangle, without per-pixel branches; second: the listed quads on
+    // two triangles of one instance, the same way; third: the quads listed by either, pixel by
+    // pixel (shaders/shadel/mark_quad.glsl).
+    Gpu& gpu = *r.gpu;
+    ComputePush push = computePush(r, frame);
+    dispatchWithList(r, cmd, push, v.markList, kMarkListHeaderBytes, v.mark, v.markTwoTrianglesArgs,
+                     v.markTwoTriangles);
+    memoryBarrier(cmd, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT,
+                  VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
+                  VK_ACCESS_2_SHADER_STORAGE_READ_BIT | VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT);
+    bind(gpu, cmd, v.markListedArgs);
+    pushConstants(gpu, cmd, push);
+    vkCmdDispatch(cmd, 1, 1, 1);
+    memoryBarrier(cmd, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT,
+                  VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_2_DRAW_INDIRECT_BIT,
+                  VK_ACCESS_2_SHADER_STORAGE_READ_BIT | VK_ACCESS_2_INDIRECT_COMMAND_READ_BIT);
+    bind(gpu, cmd, v.markListed);
+    pushConstants(gpu, cmd, push);
+    vkCmdDispatchIndirect(cmd, vkBuffer(gpu, v.markList), kMarkListPixelDispatchOffset);
     memoryBarrier(cmd, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT,
                   VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
                   VK_ACCESS_2_SHADER_STORAGE_READ_BIT | VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT);
@@ -303,8 +335,8 @@ void recordResolveCompute(Renderer& r, VkCommandBuffer cmd, uint64_t frame) {
     } else {
         // The resolve lists its rare pixels (misses, overflow, camera cuts); the rebuild pass
         // shades them.
-        dispatchWithList(r, cmd, push, v.rebuildList, v.resolve[output], v.resolveRebuildArgs,
-                         v.resolveRebuild[output]);
+        dispatchWithList(r, cmd, push, v.rebuildList, kRebuildListHeaderBytes, v.resolve[output],
+                         v.resolveRebuildArgs, v.resolveRebuild[output]);
     }
     if (r.tonemapFused) { // the frame's display pixels, read back
         memoryBarrier(cmd, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
