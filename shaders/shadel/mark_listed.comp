@@ -16,10 +16,11 @@ void main() {
     MarkQuadList list = MarkQuadList(pc.markList);
     uint index = dispatch2dGroup() * 64u + gl_LocalInvocationIndex;
     uint quad = index >> 2;
-    if (quad >= list.pixelCount) return;
-    ivec2 origin = unpackQuadOrigin(list.quads[markQuadCapacity() - 1u - quad]);
+    // (loaded before any branch: lavapipe loads a uniform address once only outside control flow)
     FrameConstants f = FrameConstantsRef(pc.frame).f;
     ShadelFrame s = ShadelFrameRef(f.shadel).s;
+    if (quad >= list.pixelCount) return;
+    ivec2 origin = unpackQuadOrigin(list.quads[markQuadCapacity() - 1u - quad]);
     int i = int(index & 3u);
     ivec2 pixel = min(origin + ivec2(i & 1, i >> 1), ivec2(pc.width, pc.height) - 1);
     markQuadPixel(f, s, origin, i, loadVisibility(pc.visibilitySlot, pixel));

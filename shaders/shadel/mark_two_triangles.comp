@@ -15,10 +15,11 @@ void main() {
     uint index = dispatch2dGroup() * 64u + gl_LocalInvocationIndex;
     bool listed = false;
     ivec2 origin = ivec2(0);
+    // (loaded before any branch: lavapipe loads a uniform address once only outside control flow)
+    FrameConstants f = FrameConstantsRef(pc.frame).f;
+    ShadelFrame s = ShadelFrameRef(f.shadel).s;
     if (index < list.twoTriangleCount) {
         origin = unpackQuadOrigin(list.quads[index]);
-        FrameConstants f = FrameConstantsRef(pc.frame).f;
-        ShadelFrame s = ShadelFrameRef(f.shadel).s;
         uvec2 vis[4];
         loadQuadVisibility(origin, vis);
         uvec2 b = vis[1] != vis[0] ? vis[1] : vis[2] != vis[0] ? vis[2] : vis[3];

@@ -20,9 +20,10 @@ layout(local_size_x = 8, local_size_y = 8) in;
 void main() {
     ivec2 origin = ivec2(gl_GlobalInvocationID.xy) * 2;
     bool twoTriangles = false, pixels = false;
+    // (loaded before any branch: lavapipe loads a uniform address once only outside control flow)
+    FrameConstants f = FrameConstantsRef(pc.frame).f;
+    ShadelFrame s = ShadelFrameRef(f.shadel).s;
     if (origin.x < int(pc.width) && origin.y < int(pc.height)) {
-        FrameConstants f = FrameConstantsRef(pc.frame).f;
-        ShadelFrame s = ShadelFrameRef(f.shadel).s;
         uvec2 vis[4];
         loadQuadVisibility(origin, vis);
         bool whole = origin.x + 1 < int(pc.width) && origin.y + 1 < int(pc.height);
