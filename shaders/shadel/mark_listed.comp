@@ -20,7 +20,7 @@ void main() {
     FrameConstants f = FrameConstantsRef(pc.frame).f;
     ShadelFrame s = ShadelFrameRef(f.shadel).s;
     if (quad >= list.pixelCount) return;
-    ivec2 origin = unpackQuadOrigin(list.quads[markQuadCapacity() - 1u - quad]);
+    ivec2 origin = unpackQuadOrigin(list.quads[markQuadCapacity() + quad]);
     int i = int(index & 3u);
     ivec2 pixel = min(origin + ivec2(i & 1, i >> 1), ivec2(pc.width, pc.height) - 1);
     markQuadPixel(f, s, origin, i, loadVisibility(pc.visibilitySlot, pixel));

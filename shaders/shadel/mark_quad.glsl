@@ -10,8 +10,9 @@
 // markingCompute, alternating runs, builtin:default 1280x720 orbit: 51.1, 51.2 -> 38.7, 39.7 ms
 // with two passes. Of the 35,016 quads the first pass lists there, 26,294 see two triangles of
 // one instance (a triangle edge crosses them), and 90% of those have the same levels on both:
-// the second pass marks them without the per-pixel code, and lists the others, with the quads
-// on sky, two instances or three triangles, for the third.
+// the second pass marks them without the per-pixel code and lists the others for the third,
+// which also takes every other quad the first pass could not mark (sky or forward edges, two
+// instances, three triangles, the screen's last row or column, level-window fallbacks).
 #ifndef SHADEL_MARK_QUAD_GLSL
 #define SHADEL_MARK_QUAD_GLSL
 #define SHADEL_MARK_CACHE // the quad's pixels mostly mark the same chunks: skip repeats
@@ -31,16 +32,18 @@ layout(push_constant, scalar) uniform Push {
 } pc;
 
 // The quads the first pass leaves to the later two, and their indirect arguments
-// (mark_listed_args.comp). One array of a slot per quad of the screen, filled from both ends:
-// the two-triangle quads (mark_two_triangles.comp) from the front, the per-pixel ones
-// (mark_listed.comp) from the back, so neither list can overflow.
+// (mark_listed_args.comp). Two lists of a slot per quad of the screen each: the two-triangle
+// quads (mark_two_triangles.comp) in the first, the per-pixel ones (mark_listed.comp) in the
+// second. The second pass appends to the second list while it reads the first, so they cannot
+// share one array: a quad goes to the first list or, from the first pass or the second, to the
+// second, so each holds at most every quad once.
 layout(buffer_reference, scalar) buffer MarkQuadList {
     uvec4 twoTriangleDispatch; // x, y, z, count
     uvec4 pixelDispatch;       // x, y, z, count
     uint twoTriangleCount;
     uint pixelCount;
     uint pad0, pad1;
-    uint quads[]; // origin x | y << 16
+    uint quads[]; // origin x | y << 16: the two-triangle list, then the per-pixel list
 };
 
 uint markQuadCapacity() { return ((pc.width + 1u) >> 1) * ((pc.height + 1u) >> 1); }
@@ -48,8 +51,8 @@ uint markQuadCapacity() { return ((pc.width + 1u) >> 1) * ((pc.height + 1u) >> 1
 uint packQuadOrigin(ivec2 origin) { return uint(origin.x) | (uint(origin.y) << 16); }
 ivec2 unpackQuadOrigin(uint packed) { return ivec2(packed & 0xFFFFu, packed >> 16); }
 
-// Appends this invocation's quad to the front (two-triangle) or back (per-pixel) list: one
-// atomic per subgroup and list. Every invocation of the subgroup must call it.
+// Appends this invocation's quad to the two-triangle or the per-pixel list: one atomic per
+// subgroup and list. Every invocation of the subgroup must call it.
 void listMarkQuad(ivec2 origin, bool twoTriangles, bool pixels) {
     MarkQuadList list = MarkQuadList(pc.markList);
     uvec4 front = subgroupBallot(twoTriangles);
@@ -64,7 +67,7 @@ void listMarkQuad(ivec2 origin, bool twoTriangles, bool pixels) {
     first = subgroupBroadcastFirst(first);
     if (twoTriangles) list.quads[first.x + subgroupBallotExclusiveBitCount(front)] = packQuadOrigin(origin);
     if (pixels)
-        list.quads[markQuadCapacity() - 1u - (first.y + subgroupBallotExclusiveBitCount(back))] =
+        list.quads[markQuadCapacity() + first.y + subgroupBallotExclusiveBitCount(back)] =
             packQuadOrigin(origin);
 }
 
@@ -167,9 +170,9 @@ void markQuadLevel(ShadelFrame s, QuadLevel q) {
 
 // Marks a quad whose four pixels see one or two triangles of one decoupled instance at the same
 // levels (ta's and tb's: the pixels with bit i of onB set see tb) without per-pixel branches:
-// the chunks and addresses markQuadPixels would give it. Each pixel takes its own triangle's
-// shadel UV, MIP blend and magnification. False (nothing marked nor written) where the quad
-// needs the per-pixel code: the triangles' levels differ, or quadLevel fails.
+// the chunks and addresses markQuadPixel would give its pixels. Each pixel takes its own
+// triangle's shadel UV, MIP blend and magnification. False (nothing marked nor written) where
+// the quad needs the per-pixel code: the triangles' levels differ, or quadLevel fails.
 bool markQuadOnTriangles(ShadelFrame s, QuadTriangle ta, QuadTriangle tb, uint onB, ivec2 origin) {
     // (one tap since the anisotropy cap: shadelAniso)
     if (ta.aniso.taps != 1u || tb.aniso.taps != 1u) return false;

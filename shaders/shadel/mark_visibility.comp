@@ -9,7 +9,7 @@
 // (hybrid) quads get addresses saying so. The others are listed: those whose four pixels see two
 // triangles of one decoupled instance for mark_two_triangles.comp, every other one (silhouettes,
 // sky edges, the screen's last row or column, rare level-window fallbacks) for mark_listed.comp,
-// which marks it pixel by pixel (markQuadPixels). See shadel/mark_quad.glsl for why.
+// which marks it pixel by pixel (markQuadPixel). See shadel/mark_quad.glsl for why.
 //
 // The quad's derivatives are coarse (shadel/vis_shadel.glsl), so its pixels of one triangle
 // share their MIP levels and anisotropy, taken once with the setup (setUpQuad).

@@ -138,9 +138,9 @@ VisibilityStatePtr createVisibility(Renderer& r) {
             gpu, {"resolveRebuildList", kRebuildListHeaderBytes + pixels * 4,
                   VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT});
         if (!v.rebuildList) throw DeviceError("out of GPU memory for the resolve's rebuild list");
-        // A header, then a slot per quad (filled from both ends).
+        // A header, then two lists of a slot per quad each.
         v.markList = createBuffer(
-            gpu, {"markQuadList", kMarkListHeaderBytes + quads * 4,
+            gpu, {"markQuadList", kMarkListHeaderBytes + 2 * quads * 4,
                   VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT});
         if (!v.markList) throw DeviceError("out of GPU memory for marking's quad list");
     }
