@@ -61,7 +61,7 @@ TEST(Visibility, MatchesRasterMarkingAndReconstruction) {
                 << scene;
             // Marking's later passes both ran (shaders/shadel/mark_quad.glsl): quads on two
             // triangles of an instance, marked without per-pixel code, and the per-pixel rest.
-            // Every later test here matches the raster path only if all three passes are right.
+            // The comparisons above hold only if every pass marks its quads as the raster path.
             uint64_t twoTriangles = vis.stats["marking_listed_quads"]["two_triangles"];
             uint64_t perPixel = vis.stats["marking_listed_quads"]["per_pixel"];
             std::printf("[ figures ] %s %ux%u: listed quads: %llu on two triangles, %llu per "

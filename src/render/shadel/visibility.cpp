@@ -74,6 +74,25 @@ void dispatchPixels(Renderer& r, VkCommandBuffer cmd) {
     vkCmdDispatch(cmd, (r.internalWidth + 15) / 16, (r.internalHeight + 15) / 16, 1);
 }
 
+// After a pass that listed work: sizes the pass over the list (`args`, one invocation, writes
+// its indirect arguments at `dispatchOffset` of the list) and runs it (`pass`).
+void dispatchListed(Renderer& r, VkCommandBuffer cmd, const ComputePush& push, BufferHandle list,
+                    VkDeviceSize dispatchOffset, const Pipeline& args, const Pipeline& pass) {
+    Gpu& gpu = *r.gpu;
+    memoryBarrier(cmd, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT,
+                  VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
+                  VK_ACCESS_2_SHADER_STORAGE_READ_BIT | VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT);
+    bind(gpu, cmd, args);
+    pushConstants(gpu, cmd, push);
+    vkCmdDispatch(cmd, 1, 1, 1);
+    memoryBarrier(cmd, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT,
+                  VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_2_DRAW_INDIRECT_BIT,
+                  VK_ACCESS_2_SHADER_STORAGE_READ_BIT | VK_ACCESS_2_INDIRECT_COMMAND_READ_BIT);
+    bind(gpu, cmd, pass);
+    pushConstants(gpu, cmd, push);
+    vkCmdDispatchIndirect(cmd, vkBuffer(gpu, list), dispatchOffset);
+}
+
 // A pass over the pixel quads that lists what its common code does not handle for a second pass
 // (marking: quads not on one triangle, and a third pass after: recordMarkingCompute; the
 // resolve: misses, overflow, camera cuts): clears the list's header (after last frame's later
@@ -96,18 +115,7 @@ void dispatchWithList(Renderer& r, VkCommandBuffer cmd, const ComputePush& push,
     bind(gpu, cmd, first);
     pushConstants(gpu, cmd, push);
     dispatchPixels(r, cmd);
-    memoryBarrier(cmd, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT,
-                  VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
-                  VK_ACCESS_2_SHADER_STORAGE_READ_BIT | VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT);
-    bind(gpu, cmd, args);
-    pushConstants(gpu, cmd, push);
-    vkCmdDispatch(cmd, 1, 1, 1);
-    memoryBarrier(cmd, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT,
-                  VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_2_DRAW_INDIRECT_BIT,
-                  VK_ACCESS_2_SHADER_STORAGE_READ_BIT | VK_ACCESS_2_INDIRECT_COMMAND_READ_BIT);
-    bind(gpu, cmd, second);
-    pushConstants(gpu, cmd, push);
-    vkCmdDispatchIndirect(cmd, vkBuffer(gpu, list), 0);
+    dispatchListed(r, cmd, push, list, 0, args, second);
 }
 } // namespace
 
@@ -261,22 +269,11 @@ void recordMarkingCompute(Renderer& r, VkCommandBuffer cmd, uint64_t frame) {
     // quads on one decoupled triangle, without per-pixel branches; second: the listed quads on
     // two triangles of one instance, the same way; third: the quads listed by either, pixel by
     // pixel (shaders/shadel/mark_quad.glsl).
-    Gpu& gpu = *r.gpu;
     ComputePush push = computePush(r, frame);
     dispatchWithList(r, cmd, push, v.markList, kMarkListHeaderBytes, v.mark, v.markTwoTrianglesArgs,
                      v.markTwoTriangles);
-    memoryBarrier(cmd, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT,
-                  VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
-                  VK_ACCESS_2_SHADER_STORAGE_READ_BIT | VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT);
-    bind(gpu, cmd, v.markListedArgs);
-    pushConstants(gpu, cmd, push);
-    vkCmdDispatch(cmd, 1, 1, 1);
-    memoryBarrier(cmd, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT,
-                  VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_2_DRAW_INDIRECT_BIT,
-                  VK_ACCESS_2_SHADER_STORAGE_READ_BIT | VK_ACCESS_2_INDIRECT_COMMAND_READ_BIT);
-    bind(gpu, cmd, v.markListed);
-    pushConstants(gpu, cmd, push);
-    vkCmdDispatchIndirect(cmd, vkBuffer(gpu, v.markList), kMarkListPixelDispatchOffset);
+    dispatchListed(r, cmd, push, v.markList, kMarkListPixelDispatchOffset, v.markListedArgs,
+                   v.markListed);
     memoryBarrier(cmd, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT,
                   VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
                   VK_ACCESS_2_SHADER_STORAGE_READ_BIT | VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT);
