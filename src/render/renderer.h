@@ -63,6 +63,10 @@ enum class Visualize : uint32_t {
     Spectra = VISUALIZE_SPECTRA,        // each tile's shading mode (--spectra on|single)
     Reuse = VISUALIZE_REUSE,            // decoupled: carried-over chunks grey, shaded by reason
 };
+// --tonemap: the display curve after exposure (shaders/common/tone_curve.glsl); the names are
+// those of the glTF Sample Viewer's tone mappers, with the same formulas.
+enum class Tonemap : uint32_t { AcesNarkowicz = 0, AcesHill = 1, KhrPbrNeutral = 2, Linear = 3 };
+
 // --particle-lighting: lit particle sprites read the atlas, or are lit per pixel / per vertex.
 enum class ParticleLighting : uint32_t { Atlas = 0, Pixel = 1, Vertex = 2 };
 
@@ -84,7 +88,21 @@ struct RenderSettings {
     // measured the opposite, frame 548 vs 506 ms; re-measured with today's shaders.)
     MarkingMode marking = MarkingMode::Auto;
     Visualize visualize = Visualize::None;
-    float exposure = 1.0f;
+    float exposure = 1.0f; // linear multiplier; the CLI takes --exposure in EV (2^EV)
+    Tonemap tonemap = Tonemap::AcesNarkowicz;
+    // Image-based lighting (render/environment): "builtin:sky" (a physically based sky lit by
+    // the scene's sun), "none", or an equirectangular .hdr / .exr file. Scenes whose lighting
+    // is authored as a sky and ambient colour (night scenes, closed rooms) get their
+    // hemisphere as an environment unless one is given (Scene::environment).
+    std::string environment = "builtin:sky";
+    bool environmentGiven = false; // --environment was on the command line
+    float environmentIntensity = 1.0f;
+    float environmentRotationDegrees = 0.0f; // about +Y
+    // --background: the environment behind the scene, or a solid sRGB colour (alpha still marks
+    // coverage in PNG and EXR output).
+    bool backgroundEnvironment = true;
+    glm::vec3 backgroundColor{0.0f}; // sRGB, when !backgroundEnvironment
+    bool shadows = true;             // --shadows off: no shadow maps (sun, spots, cascades)
     uint32_t shadowMapSize = 2048;
     TimingMode timing = TimingMode::SubmitPerPass;
     // --threads: threads recording the frame's passes (1 = serial, in declaration order;

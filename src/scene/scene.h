@@ -271,6 +271,10 @@ struct Scene {
     std::vector<GiVolume> giVolumes;       // local GI volumes (render/gi)
     glm::vec3 skyColor{0.55f, 0.7f, 0.95f};
     glm::vec3 ambientColor{0.08f, 0.09f, 0.11f};
+    // What lights the scene when --environment does not say: the physically based sky of its
+    // sun, or its sky and ambient colours as a hemisphere (rooms and night scenes authored so).
+    enum class Environment { Sky, Hemisphere };
+    Environment environment = Environment::Sky;
 
     Aabb worldBounds() const;
     uint64_t triangleCount() const; // over instances
