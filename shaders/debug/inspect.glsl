@@ -29,10 +29,8 @@ void inspectSurface(FrameConstants f, uint instance, uint triangle, MaterialSamp
 
     vec3 n = m.normal;
     vec3 v = normalize(f.cameraPosition - worldPos);
-    float up = n.y * 0.5 + 0.5;
-    vec3 ambient = mix(f.ambientColor * 0.5, f.ambientColor + f.skyColor * 0.15, up);
-    shaderPrintF3(f, PRINT_AMBIENT, ambient * m.baseColor * (1.0 - m.metallic * 0.5) * m.occlusion *
-                                        m.ambientOcclusion);
+    shaderPrintF3(f, PRINT_AMBIENT, environmentLight(f.environment, m, n, v,
+                                                     m.occlusion * m.ambientOcclusion));
     if (dot(f.sunColor, f.sunColor) > 0.0) {
         float shadow = sunShadow(f, worldPos, geometricNormal);
         shaderPrintF(f, PRINT_SUN_SHADOW, shadow);

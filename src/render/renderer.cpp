@@ -110,6 +110,11 @@ static RenderSettings resolveSettings(RenderSettings s, const GpuScene& scene) {
                         scene.lightInfo.size() > LIGHT_SUBGROUP_MAX_LIGHTS;
         s.spectra = perChunk || s.visualize == Visualize::Spectra ? Spectra::On : Spectra::Off;
     }
+    if (!s.shadows) { // --shadows off: no shadow map of any light
+        s.spotShadows = false;
+        s.sunCascades = 1;
+        s.sunSoftShadows = false;
+    }
     return s;
 }
 
@@ -266,7 +271,9 @@ static gpu::FrameConstants makeFrameConstants(Renderer& r, const GpuScene& scene
     f.exposure = r.settings.exposure;
     f.sunDirection = sun.direction;
     f.sunColor = sun.color;
-    f.sunShadowSlot = scene.sunCastsShadow ? slot(gpu, r.sunShadow.read).value : NO_TEXTURE;
+    f.sunShadowSlot = scene.sunCastsShadow && r.settings.shadows
+                          ? slot(gpu, r.sunShadow.read).value
+                          : NO_TEXTURE;
     f.shadowTexelSize = texel;
     f.skyColor = scene.skyColor;
     f.ambientColor = scene.ambientColor;
