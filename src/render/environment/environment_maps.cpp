@@ -156,9 +156,12 @@ EnvironmentMaps loadEnvironmentMaps(const EnvironmentRequest& request, const std
                                     const PrefilterSettings& settings, uint32_t threads) {
     EnvironmentMaps maps;
     maps.kind = request.kind;
-    if (request.kind == EnvironmentKind::None) return maps;
     auto start = std::chrono::steady_clock::now();
     WorkerPool pool(threadCount(threads));
+    if (request.kind == EnvironmentKind::None) { // black lighting; the BRDF table still serves
+        maps.brdf = loadBrdfTable(cacheDir, settings.brdfSize, pool);
+        return maps;
+    }
     if (request.kind == EnvironmentKind::Sky) {
         maps.sunDirection = glm::normalize(request.sunDirection);
         maps.sunDiscRadiance = sunDiscRadiance(request.sunColor);

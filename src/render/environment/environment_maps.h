@@ -51,7 +51,7 @@ struct EnvironmentMaps {
 
 // Loads the maps from `cacheDir` ("" = no cache) or builds them (printing progress) and writes
 // them there. `threads` 0 = the machine's. Throws InputError for a bad file (see
-// environment_file.h). Kind None gives empty maps at once.
+// environment_file.h). Kind None gives empty maps and the BRDF table only.
 EnvironmentMaps loadEnvironmentMaps(const EnvironmentRequest& request, const std::string& cacheDir,
                                     const PrefilterSettings& settings = {}, uint32_t threads = 0);
 

@@ -44,6 +44,8 @@ double equirectTexelSolidAngle(uint32_t width, uint32_t height, uint32_t y) {
 }
 
 glm::vec3 sampleEquirect(const EquirectImage& image, glm::vec2 uv) {
+    if (!std::isfinite(uv.x) || !std::isfinite(uv.y)) uv = glm::vec2(0.5f);
+    uv.x -= std::floor(uv.x); // wrap before converting to texels (no integer overflow)
     float x = uv.x * float(image.width) - 0.5f;
     float y = std::clamp(uv.y * float(image.height) - 0.5f, 0.0f, float(image.height - 1));
     float fx = std::floor(x), fy = std::floor(y);

@@ -107,8 +107,12 @@ std::vector<EquirectImage> prefilterSpecular(const EquirectImage& source,
     for (uint32_t l = 1; l < levelCount; ++l) {
         uint32_t w = std::max(w0 >> l, 2u), h = std::max(h0 >> l, 1u);
         double roughness = double(l) / double(levelCount - 1);
-        std::vector<LobeSample> lobe =
-            lobeSamples(roughness, settings.specularSamples, texelSolidAngle);
+        // The narrow lobes of the first (largest) levels span a few source texels, which the
+        // MIP-filtered reads cover with a quarter and a half of the samples.
+        uint32_t samples = l == 1   ? std::max(settings.specularSamples / 4, 16u)
+                           : l == 2 ? std::max(settings.specularSamples / 2, 16u)
+                                    : settings.specularSamples;
+        std::vector<LobeSample> lobe = lobeSamples(roughness, samples, texelSolidAngle);
         EquirectImage level = makeEquirect(w, h);
         std::atomic<uint32_t> rows{0};
         // Levels under 32 texels wide hold the mean of the filtered radiance over each texel

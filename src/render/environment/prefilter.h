@@ -20,11 +20,11 @@ namespace shadel {
 class WorkerPool;
 
 struct PrefilterSettings {
-    uint32_t specularWidth = 512; // level 0; height = width / 2, each level half the last
-    uint32_t specularLevels = 8;  // perceptual roughness of level l = l / (levels - 1)
-    uint32_t specularSamples = 256;
-    uint32_t irradianceWidth = 64; // height = width / 2
-    uint32_t brdfSize = 64;        // the BRDF table is brdfSize x brdfSize
+    uint32_t specularWidth = 512;   // level 0; height = width / 2, each level half the last
+    uint32_t specularLevels = 8;    // perceptual roughness of level l = l / (levels - 1)
+    uint32_t specularSamples = 256; // per texel; a quarter at level 1, half at level 2
+    uint32_t irradianceWidth = 64;  // height = width / 2
+    uint32_t brdfSize = 64;         // the BRDF table is brdfSize x brdfSize
 };
 
 // Reports the share of the work done, 0..1, from the calling thread only.
