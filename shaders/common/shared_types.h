@@ -69,6 +69,11 @@ using uint = uint32_t;
 // Light blockers (render/lighting): a light lists up to this many blockers.
 #define LIGHT_MAX_BLOCKERS_PER_LIGHT 32u
 #define LIGHT_TILE_SIZE 16u // pixels per side of a forward light culling tile
+// FrameConstants::tonemap: the display curve (RenderSettings::tonemap, common/tone_curve.glsl).
+#define TONEMAP_ACES_NARKOWICZ 0u
+#define TONEMAP_ACES_HILL 1u
+#define TONEMAP_KHR_PBR_NEUTRAL 2u
+#define TONEMAP_LINEAR 3u
 #define TONEMAP_GROUP_X 32u // the tonemap pass's workgroup (post/tonemap.comp)
 #define TONEMAP_GROUP_Y 8u
 // Feature spectra (seed 001, render/lighting/feature_spectra.h): the features a tile needs,
@@ -523,6 +528,12 @@ struct FrameConstants {
     // uvec2 per visibility vertex: (scene vertex, the triangle of its mesh it starts), what the
     // visibility prepass draws (scene/visibility_vertices.h).
     uint64_t visibilityVertices;
+    uint tonemap; // TONEMAP_*: the display curve after exposure
+    // What uncovered pixels show: the environment's background (1), or backgroundColor, the
+    // radiance the display curve turns into the --background colour (0).
+    uint backgroundEnvironment;
+    vec3 backgroundColor;
+    uint framePad;
 };
 
 // ---- GPU-driven world (render/culling) ------------------------------------------------------

@@ -43,7 +43,7 @@ void inspectSurface(FrameConstants f, uint instance, uint triangle, MaterialSamp
         // evaluateLight: every kind as shadeSurface sums it (square spots, tubes, gobos, area
         // lights, clip planes), before blockers and spot shadows.
         vec3 term = evaluateLight(lights.l[i], m, n, v, worldPos);
-        shaderPrintF4(f, PRINT_LIGHT, vec4(term * m.occlusion, float(i)));
+        shaderPrintF4(f, PRINT_LIGHT, vec4(term, float(i)));
     }
     shaderPrintF3(f, PRINT_SHADED, shaded);
 }
