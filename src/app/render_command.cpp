@@ -460,6 +460,7 @@ RenderSessionPtr beginRender(Gpu& gpu, const RenderOptions& options) {
     settings.marking = o.marking;
     settings.visualize = o.visualize;
     settings.exposure = o.exposure;
+    settings.cacheDir = o.cacheDir;
     settings.shadeStorageSize = o.shadeStorageSize;
     settings.sheetShadels = o.sheetShadels;
     settings.shadingBias = o.shadingBias;

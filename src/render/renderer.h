@@ -13,6 +13,7 @@
 #include "render/debug/debug_lines.h"
 #include "render/decals/decals.h"
 #include "render/distance_fields/distance_fields.h"
+#include "render/environment/environment_state.h"
 #include "render/gi/lpv.h"
 #include "render/gpu_scene.h"
 #include "render/lighting/feature_spectra.h"
@@ -103,6 +104,7 @@ struct RenderSettings {
     bool backgroundEnvironment = true;
     glm::vec3 backgroundColor{0.0f}; // sRGB, when !backgroundEnvironment
     bool shadows = true;             // --shadows off: no shadow maps (sun, spots, cascades)
+    std::string cacheDir; // prefiltered environments are cached here ("": the default cache)
     uint32_t shadowMapSize = 2048;
     TimingMode timing = TimingMode::SubmitPerPass;
     // --threads: threads recording the frame's passes (1 = serial, in declaration order;
@@ -326,6 +328,10 @@ struct Renderer {
     // or it was edited); the decoupled path reshades its objects.
     std::vector<uint8_t> changedMaterials;
     SceneEdits edits; // the viewer's light, sun and material edits (render/scene_edits.h)
+    EnvironmentState environment; // image-based lighting and the background (render/environment)
+    // The environment's intensity and rotation the last frame shaded with: a change relights
+    // every surface (the decoupled path reshades what it carried over).
+    glm::vec2 environmentViewLastFrame{-1.0f};
     // Per instance: animated playback (render/animation) moved or deformed it before this frame;
     // empty without playback. Decoupled reuse reshades these; spot shadow maps are redrawn.
     std::vector<uint8_t> reposedInstances;
