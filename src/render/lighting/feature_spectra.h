@@ -1,5 +1,5 @@
 #pragma once
-// Feature spectra (seed 001, "Lighting Compute Optimization"): a shader with every lighting
+// Feature spectra: a shader with every lighting
 // feature compiled in pays for all of them everywhere (registers, occupancy, code). The tile
 // pass (shaders/lighting/tile_cull.comp) records the features each 16x16 tile needs (light
 // kinds, darks, clip planes, per-pixel blockers, portals, shadows, and whether any of its
@@ -15,11 +15,11 @@
 // shading rebuilds each pixel's surface from it exactly as the raster varyings and
 // derivatives give it, then runs the same evaluateMaterial + shadeSurface.
 //   --spectra on:     the modes of kSpectrumModes, each tile in the cheapest covering one;
-//   --spectra single: the same pass with one all-features mode (the baseline the seed's
-//                     spectra are measured against);
+//   --spectra single: the same pass with one all-features mode (the baseline spectra
+//                     are measured against);
 //   --spectra off:    the raster forward shading (the default).
 //
-// Decoupled mode ("the same for chunk queues"): shading is per 8x8-shadel chunk of the shading
+// Decoupled mode (the same idea over the chunk queue): shading is per 8x8-shadel chunk of the shading
 // queue, culled against the chunk's world box (shaders/shadel/shade.comp). With --spectra
 // on|single a classify pass runs over the queue first, one invocation per chunk
 // (shaders/lighting/chunk_classify.comp: carry-over decision, the chunk's box from its 64

@@ -581,8 +581,8 @@ static void updateLevelWindow(Gpu& gpu, DecoupledState& d, ObjectSlot& o, uint32
     o.rects[k] = {d.regions[k].x0, 0, 0, 0};
 }
 
-// Coarse CPU allocation (seed: "CPU side max space estimator"): a potentially visible object
-// gets rects from the finest MIP it can need this frame down to its coarsest; objects that
+// Coarse CPU allocation (the CPU's estimate of the space an object can need): a potentially
+// visible object gets rects from the finest MIP it can need this frame down to its coarsest; objects that
 // leave the view give theirs back. Levels are added as the camera comes closer and dropped
 // (with one level of slack, so a camera hovering at a boundary does not churn the sheet) as it
 // moves away. Returns false when the object has no rects at all (drawn forward this frame).
@@ -825,7 +825,7 @@ void prepareDecoupledFrame(Renderer& r, const GpuScene& scene, const CameraView&
     // Instances near the frustum's bounds, and last frame's (to free or clear what they held):
     // every other instance stays unwanted, with its zero entry and no rects.
     // With occlusion culling the GPU's visible set of last frame is the set to allocate for
-    // (seed 004: the CPU estimator and the GPU agree on what is seen); an instance that appears
+    // (the CPU estimator and the GPU agree on what is seen); an instance that appears
     // is drawn forward for one frame. Otherwise the grid's answer for the frustum (the visit's
     // first half, coarse_visit.h: taken from the frontend worker or computed here), whose
     // instances come with their view of the camera already computed.
