@@ -82,10 +82,9 @@ struct RenderSettings {
     uint32_t width = 1280, height = 720;
     uint32_t ssaa = 1; // N x N supersampling (forward reference)
     RenderMode mode = RenderMode::Forward;
-    // Decoupled only. Visibility is the default (Auto): on lavapipe at 1280x720 (builtin:default,
-    // orbit, 6 frames) visibility prepass + compute marking + resolve cost 33 + 29 + 72 ms where
-    // depth prepass + raster marking + reconstruction cost 23 + 37 + 105 ms. (An earlier build
-    // measured the opposite, frame 548 vs 506 ms; re-measured with today's shaders.)
+    // Decoupled only. Visibility is the default (Auto): on lavapipe the visibility prepass,
+    // compute marking and compute resolve together cost less than the depth prepass, raster
+    // marking and raster reconstruction (docs/decoupled/README.md has the figures).
     MarkingMode marking = MarkingMode::Auto;
     Visualize visualize = Visualize::None;
     float exposure = 1.0f; // linear multiplier; the CLI takes --exposure in EV (2^EV)
