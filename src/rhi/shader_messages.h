@@ -16,7 +16,8 @@ namespace shadel {
 
 struct Gpu;
 
-// One shader print record (shaderPrintRecord): a label (shaders/common/print_labels.h) and up to four values.
+// One shader print record (shaderPrintRecord): a label (shaders/common/print_labels.h) and up to
+// four values.
 struct ShaderPrint {
     uint32_t label = 0;
     uint32_t shaderId = 0, line = 0;

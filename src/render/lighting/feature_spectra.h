@@ -19,8 +19,8 @@
 //                     are measured against);
 //   --spectra off:    the raster forward shading (the default).
 //
-// Decoupled mode (the same idea over the chunk queue): shading is per 8x8-shadel chunk of the shading
-// queue, culled against the chunk's world box (shaders/shadel/shade.comp). With --spectra
+// Decoupled mode (the same idea over the chunk queue): shading is per 8x8-shadel chunk of the
+// shading queue, culled against the chunk's world box (shaders/shadel/shade.comp). With --spectra
 // on|single a classify pass runs over the queue first, one invocation per chunk
 // (shaders/lighting/chunk_classify.comp: carry-over decision, the chunk's box from its 64
 // positions, light culling, the chunk's features, append to its mode's bin, its list kept for

@@ -83,7 +83,8 @@ CoarseInstanceView viewInstance(const CoarseVisitPolicy& policy, const GpuScene&
     out.inFrustum = mesh.mipCount > 0 && !(blended && policy.blendedForward) &&
                     boxVisible(planes, inst.worldMin - margin, inst.worldMax + margin);
     if (!out.inFrustum) return out;
-    // Hybrid: an object a few pixels across would still shade whole chunks at its coarsest MIP; forward is cheaper.
+    // Hybrid: an object a few pixels across would still shade whole chunks at its coarsest MIP;
+    // forward is cheaper.
     out.small = policy.forwardBelowPixels > 0.0f &&
                 projectedDiameter(
                     camera, policy.viewportHeight, 0.5f * (inst.worldMin + inst.worldMax),

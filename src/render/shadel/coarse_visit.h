@@ -34,9 +34,9 @@ struct CoarseInstanceView {
     bool inFrustum = false;
     // Projected diameter below --forward-below: drawn forward (only meaningful when inFrustum).
     bool small = false;
-    // log2 of the footprint lower bound (footprintLod) finestMipFromLod turns into a MIP, before the frame's shading
-    // bias (which the capacity controller sets from the last frame's readback): -inf when MIP 0
-    // is needed whatever the bias. Computed only when inFrustum and not small.
+    // log2 of the footprint lower bound (footprintLod) finestMipFromLod turns into a MIP, before
+    // the frame's shading bias (which the capacity controller sets from the last frame's readback):
+    // -inf when MIP 0 is needed whatever the bias. Computed only when inFrustum and not small.
     float lodBeforeBias = 0.0f;
 };
 

@@ -582,10 +582,10 @@ static void updateLevelWindow(Gpu& gpu, DecoupledState& d, ObjectSlot& o, uint32
 }
 
 // Coarse CPU allocation (the CPU's estimate of the space an object can need): a potentially
-// visible object gets rects from the finest MIP it can need this frame down to its coarsest; objects that
-// leave the view give theirs back. Levels are added as the camera comes closer and dropped
-// (with one level of slack, so a camera hovering at a boundary does not churn the sheet) as it
-// moves away. Returns false when the object has no rects at all (drawn forward this frame).
+// visible object gets rects from the finest MIP it can need this frame down to its coarsest;
+// objects that leave the view give theirs back. Levels are added as the camera comes closer and
+// dropped (with one level of slack, so a camera hovering at a boundary does not churn the sheet) as
+// it moves away. Returns false when the object has no rects at all (drawn forward this frame).
 static bool updateObjectRects(Gpu& gpu, DecoupledState& d, ObjectSlot& o, uint32_t object,
                               const ShadelMeshInfo& mesh, uint32_t wantFirst, bool wasDecoupled,
                               bool& limited) {

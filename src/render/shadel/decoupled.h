@@ -51,7 +51,8 @@ struct ShadelShadingQueue {
     uint32_t shadeOptional = 0;
 };
 ShadelShadingQueue shadelShadingQueue(const Renderer& r);
-// Adds the decoupled fields of the stats contract in docs/design.md (medians over the frames rendered so far).
+// Adds the decoupled fields of the stats contract in docs/design.md (medians over the frames
+// rendered so far).
 void decoupledStats(const Renderer& r, nlohmann::json& stats);
 
 } // namespace shadel
