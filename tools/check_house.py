@@ -12,6 +12,7 @@
                with spaces are recognised and skipped; the rest of the exceptions are listed in
                tools/house_allowed_names.txt. camelCase words in comments are held to the same
                rule, and a source file a comment names (foo.glsl, dir/bar.h) must exist.
+               The docs (docs/, README.md, OVERVIEW.md) are held to it for backticked names.
 
 Usage: check_house.py [ROOT]   (ROOT defaults to the repository holding this script)
 Prints one line per violation, "path:line: rule: message", and exits 1 when there is any.
@@ -284,6 +285,11 @@ def code_words(root):
     return words
 
 
+# Names a comment or doc may use that belong to the graphics APIs or are placeholders, not to
+# this repository: Vulkan and GLSL built-ins, commit ids, NAME_N patterns.
+EXTERNAL_NAME = re.compile(r"^(?:gl_\w+|[Vv]k[A-Z]\w*|VK_\w+|SPV_\w+|GL_\w+|[0-9a-f]{7,40}|\w+_N)$")
+
+
 def load_allowed(path):
     allowed = set()
     if os.path.exists(path):
@@ -325,11 +331,27 @@ def file_names(root):
     return names
 
 
+DOC_SCOPE = ["docs", "README.md", "OVERVIEW.md"]
+
+
 def check_names(root, allowed_path):
     words = code_words(root)
     files = file_names(root)
+    words |= {os.path.splitext(f)[0] for f in files}  # a file's stem: `render_command`
     allowed = load_allowed(allowed_path)
     out = []
+    # Docs: backticked names and name() calls only (prose has camelCase words of its own).
+    for rel in repo_files(root, DOC_SCOPE):
+        if not rel.endswith(".md"):
+            continue
+        text = read_text(root, rel) or ""
+        for number, line in enumerate(text.split("\n"), 1):
+            for token, parts, _ in names_in_comment(line):
+                missing = [p for p in parts if p not in words and p not in allowed
+                           and not EXTERNAL_NAME.match(p)]
+                if missing and token not in allowed:
+                    out.append(f"{rel}:{number}: names: the doc names `{token}`, but "
+                               f"{', '.join(missing)} is not in the code")
     for rel in repo_files(root, NAME_SCOPE):
         if not rel.endswith(COMMENTED_SUFFIXES):
             continue
@@ -341,7 +363,8 @@ def check_names(root, allowed_path):
             seen = set()
             for token, parts, _ in names_in_comment(line):
                 seen.update(parts)
-                missing = [p for p in parts if p not in words and p not in allowed]
+                missing = [p for p in parts if p not in words and p not in allowed
+                           and not EXTERNAL_NAME.match(p)]
                 if missing and token not in allowed:
                     out.append(f"{rel}:{number}: names: comment names `{token}`, but "
                                f"{', '.join(missing)} is not in the code")

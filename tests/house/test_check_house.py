@@ -53,7 +53,8 @@ def main():
         if run.returncode != 1:
             failures.append(f"exit code {run.returncode}, expected 1")
         expect("shaders/reference.glsl:1: reference:", "a design-brief citation in a shader")
-        expect("docs/notes.md:4: reference:", "an issue number in docs")
+        expect("docs/notes.md:5: reference:", "an issue number in docs")
+        expect("docs/notes.md:4: names: the doc names `vanishedDocName`", "a stale name in docs")
         refuse("docs/notes.md:3", "a random seed is not a citation")
         expect("src/big.cpp:1: size: 901 lines", "a file over 900 lines")
         expect("src/long.cpp:2: size: function tooLong is 151 lines", "a function over 150 lines")
@@ -65,8 +66,10 @@ def main():
         expect("src/stale.cpp:1: names: comment names staleCamelName", "a stale camelCase name")
         expect("src/stale.cpp:1: names: comment names the file gone_file.glsl", "a missing file")
         refuse("src/clean.cpp", "flags, file names, JSON keys and allowed names")
-        if len(out) != 9:
-            failures.append(f"{len(out)} lines reported, expected 9:\n  " + "\n  ".join(out))
+        refuse("VkImage", "a Vulkan name in docs")
+        refuse("ab77a3e", "a commit id in docs")
+        if len(out) != 10:
+            failures.append(f"{len(out)} lines reported, expected 10:\n  " + "\n  ".join(out))
 
         # A tree without violations passes.
         for name in ("big.cpp", "long.cpp", "stale.cpp"):
