@@ -1,5 +1,7 @@
 #pragma once
-// Generalized decoupled shading: the passes that replace forward shading.
+// Generalized decoupled shading: the passes that replace forward shading (the parts and the
+// glossary, shadel, chunk, block, virtual sheet, offset map, storage, shading bias, are in
+// docs/design.md).
 #include <memory>
 
 #include <nlohmann/json_fwd.hpp>
