@@ -319,7 +319,7 @@ def names_in_comment(comment):
 
 
 CAMEL = re.compile(r"(?<![\w/.`-])([a-z]+[A-Z]\w*)\b")
-SOURCE_FILE = re.compile(r"(?<![\w/.-])([\w./-]*\w\.(?:h|hpp|cpp|glsl|comp|frag|vert))\b(?!\.\w)")
+SOURCE_FILE = re.compile(r"(?<![\w/.-])([\w./-]*\w\w\.(?:h|hpp|cpp|glsl|comp|frag|vert))\b(?!\.\w)")
 
 
 def file_names(root):
