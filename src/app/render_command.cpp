@@ -664,7 +664,7 @@ RenderRun finishRender(RenderSessionPtr sessionPtr) {
     if (!o.captures.empty())
         run.captureFiles = writeCaptures(renderer.captures, o.captures, o.captureDir, o.out);
 
-    // Stats (DESIGN §5): medians over frames.
+    // Stats (the stats contract in docs/design.md): medians over frames.
     nlohmann::json s;
     recordDevice(s, gpu);
     s["driver"] = gpu.device.driver;

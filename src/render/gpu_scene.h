@@ -1,5 +1,5 @@
 #pragma once
-// The scene on the GPU (seed 003's unified geometry): one vertex buffer and one index buffer
+// The scene on the GPU (unified geometry): one vertex buffer and one index buffer
 // for every mesh, material and instance tables, textures in the bindless table.
 #include <array>
 #include <vector>
