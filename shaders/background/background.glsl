@@ -5,6 +5,7 @@
 #ifndef SHADEL_BACKGROUND_GLSL
 #define SHADEL_BACKGROUND_GLSL
 #include "common/bindless.glsl"
+#include "environment/environment.glsl"
 
 // The world-space direction through a pixel centre of the internal-resolution target.
 vec3 viewRayAt(FrameConstants f, vec2 pixelCenter) {
@@ -15,6 +16,6 @@ vec3 viewRayAt(FrameConstants f, vec2 pixelCenter) {
 
 vec3 backgroundAt(FrameConstants f, vec2 pixelCenter) {
     if (f.backgroundEnvironment == 0u) return f.backgroundColor;
-    return f.backgroundColor;
+    return environmentBackground(f.environment, viewRayAt(f, pixelCenter));
 }
 #endif

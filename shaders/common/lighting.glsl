@@ -1,5 +1,5 @@
 // Lighting shared by the forward and decoupled paths: GGX specular + Lambert diffuse, the
-// sun with a PCF shadow map, and one buffer of lights of several kinds (seed 001): omni, spot
+// sun with a PCF shadow map, and one buffer of lights of several kinds: omni, spot
 // with a round or square cone (optionally projecting a texture: gobos), tube
 // (representative-point specular), textured rectangular area lights, darks (negative lights),
 // each optionally limited by a clip plane and stopped by light blockers with portals.
@@ -38,7 +38,7 @@ layout(buffer_reference, scalar) readonly buffer LightGridEntries { uint v[]; };
 #define LIGHT_CHUNK_MAX_LIGHTS 512u // entries of a shadel chunk's list (shared memory)
 #define LIGHT_INVALID 0xFFFFFFFFu   // an entry culling removed in place
 
-// Feature spectra (seed 001, render/lighting/feature_spectra.h): the SPECTRUM_* features this
+// Feature spectra (render/lighting/feature_spectra.h): the SPECTRUM_* features this
 // pipeline compiles in. Every feature by default; a tile-shading permutation sets fewer, and
 // the branches of the features it lacks are dead code the compiler removes (fewer registers).
 // Only tiles that need none of the missing features are shaded by such a permutation, so the
@@ -241,6 +241,7 @@ vec3 brdf(MaterialSample m, vec3 n, vec3 v, vec3 l, vec3 radiance) {
     return color * radiance;
 }
 
+#include "common/environment_lighting.glsl"
 #include "lighting/shadows.glsl"
 
 // 3x3 PCF on the sun's shadow map (reversed-Z is not used for the orthographic shadow map):
@@ -571,7 +572,9 @@ vec3 shadeSurface(FrameConstants f, MaterialSample m, vec3 worldPos, vec3 geomet
     if (m.unlit) return m.baseColor;
     vec3 n = m.normal;
     vec3 v = normalize(f.cameraPosition - worldPos);
-    vec3 color = m.emissive;
+    // Emission leaves through the clear coat, which reflects its Fresnel's share back.
+    bool coat = MATERIAL_HAS(MATERIAL_FEATURE_CLEARCOAT) && m.clearcoat > 0.0;
+    vec3 color = m.emissive * (coat ? 1.0 - clearcoatFresnel(m, v) : 1.0);
     // Indirect diffuse light from the light propagation volume (0 when GI is off).
     vec3 indirect = giIrradiance(f.gi, worldPos, n) * m.baseColor * (1.0 - m.metallic) *
                     m.occlusion * m.ambientOcclusion / PI;
@@ -579,26 +582,16 @@ vec3 shadeSurface(FrameConstants f, MaterialSample m, vec3 worldPos, vec3 geomet
     if (f.visualize == VISUALIZE_RT_AO) return vec3(gRtOcclusion);
     color += indirect + gRtIndirect * m.baseColor * (1.0 - m.metallic) * m.occlusion *
                             m.ambientOcclusion;
-    // Ambient: a hemisphere term so shadowed sides are not black.
-    float up = n.y * 0.5 + 0.5;
-    vec3 ambient = mix(f.ambientColor * 0.5, f.ambientColor + f.skyColor * 0.15, up);
-    vec3 ambientLit = ambient * m.baseColor * (1.0 - m.metallic * 0.5) * m.occlusion;
-    if (MATERIAL_HAS(MATERIAL_FEATURE_CLEARCOAT) && m.clearcoat > 0.0) {
-        // The coat mirrors the same hemisphere (sky above, ground below) by its Fresnel; what it
-        // reflects does not reach the base.
-        float fc = m.clearcoat * (0.04 + 0.96 * pow(1.0 - max(dot(m.clearcoatNormal, v), 0.0), 5.0));
-        vec3 r = reflect(-v, m.clearcoatNormal);
-        vec3 mirrored = mix(f.ambientColor * 0.5, f.ambientColor + f.skyColor, r.y * 0.5 + 0.5);
-        ambientLit = ambientLit * (1.0 - fc) + fc * mirrored * m.occlusion;
-    }
-    // Distance fields: AO on the ambient; the sun's visibility in the far field.
+    // Distance fields: AO on the environment; the sun's visibility in the far field.
     bool dfLighting = kDistanceFieldLighting != 0u && f.distanceFields != 0ul;
     DistanceFieldFrame df;
+    float occlusion = m.occlusion * m.ambientOcclusion * gRtOcclusion; // AO decals: indirect only
     if (dfLighting) {
         df = DistanceFieldFrameRef(f.distanceFields).d;
-        ambientLit *= dfAmbientOcclusion(df, worldPos + geometricNormal * 0.02, geometricNormal);
+        occlusion *= dfAmbientOcclusion(df, worldPos + geometricNormal * 0.02, geometricNormal);
     }
-    color += ambientLit * gRtOcclusion * m.ambientOcclusion; // AO decals: ambient only
+    // Image-based lighting (render/environment): the sky, an HDR file, or the scene's hemisphere.
+    color += environmentLight(f.environment, m, n, v, occlusion);
 
     vec3 l = -f.sunDirection;
     LightingFrame lf;
@@ -648,19 +641,17 @@ vec3 shadeSurface(FrameConstants f, MaterialSample m, vec3 worldPos, vec3 geomet
     return color + max(direct, -color);
 }
 
-// Wrap ("non-directional") diffuse of seed 004's particles: n.l moved towards 1 by `wrap`, so
+// Wrap ("non-directional") diffuse of particles: n.l moved towards 1 by `wrap`, so
 // thin media (smoke, mesh particles) are lit from behind too; wrap 0 is Lambert.
 float wrappedNl(vec3 n, vec3 l, float wrap) {
     return max((dot(n, l) + wrap) / (1.0 + wrap), 0.0);
 }
 
-// The light reaching a diffuse particle of unit albedo at p with normal n, from the ambient
-// hemisphere, the sun and every light of the caller's list (tube lights from their closest
+// The light reaching a diffuse particle of unit albedo at p with normal n, from the
+// environment, the sun and every light of the caller's list (tube lights from their closest
 // point). Linear in albedo, so the particle atlas stores this and sprites multiply their colour.
 vec3 shadeParticle(FrameConstants f, vec3 p, vec3 n, float wrap) {
-    float up = n.y * 0.5 + 0.5;
-    vec3 color = mix(f.ambientColor * 0.5, f.ambientColor + f.skyColor * 0.15, up);
-    color += giIrradiance(f.gi, p, n) / PI;
+    vec3 color = environmentIrradiance(f.environment, n) + giIrradiance(f.gi, p, n) / PI;
     if (dot(f.sunColor, f.sunColor) > 0.0)
         color += f.sunColor * wrappedNl(n, -f.sunDirection, wrap) * sunShadow(f, p, n) / PI;
     LightBuffer lights = LightBuffer(f.lights);
