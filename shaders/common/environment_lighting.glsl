@@ -41,7 +41,9 @@ vec3 environmentLight(GpuEnvironment e, MaterialSample m, vec3 n, vec3 v, float 
     vec3 color = mix(dielectric, specularLight * metalF, m.metallic);
     float sheenMax = max(m.sheenColor.r, max(m.sheenColor.g, m.sheenColor.b));
     if (MATERIAL_HAS(MATERIAL_FEATURE_SHEEN) && sheenMax > 0.0) {
-        float sheenAlbedo = environmentBrdf(e, nv, m.sheenRoughness).z;
+        // (The Charlie lobe with its visibility term is not energy conserving at grazing views
+        // of smooth sheen: its albedo passes 1 there, and the layer below would go negative.)
+        float sheenAlbedo = min(environmentBrdf(e, nv, m.sheenRoughness).z, 1.0);
         vec3 sheenLight = environmentSpecular(e, reflect(-v, n), m.sheenRoughness) * occlusion;
         color = color * (1.0 - sheenMax * sheenAlbedo) + sheenLight * m.sheenColor * sheenAlbedo;
     }

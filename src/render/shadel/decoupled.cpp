@@ -643,13 +643,22 @@ constexpr float SPECULAR_SHARE_MIN_GAIN = 0.5f;
 constexpr float SPECULAR_SHARE_MAX_GAIN = 2.0f;
 constexpr float SPECULAR_SHARE_TOLERANCE = 0.15f;
 
-static float viewDriftLimitFor(float roughness, float metallic, glm::vec3 baseColor) {
+// Under an environment the specular reflects light from every direction, not only the lights'
+// peaks: its share is then the reflected environment (F0 = 4% of about the light the diffuse
+// receives) against the darkest channel's diffuse, whatever the roughness, and the larger of the
+// two shares sets the tolerance.
+static float viewDriftLimitFor(float roughness, float metallic, glm::vec3 baseColor,
+                               bool environment) {
     constexpr float kPi = 3.14159265f;
     float lobeWidth = std::clamp(roughness * roughness, 0.01f, 0.4f);
     float specularPeak = 0.04f / (4.0f * kPi * lobeWidth * lobeWidth);
     float darkest = std::min({baseColor.r, baseColor.g, baseColor.b});
     float darkestDiffuse = std::max(darkest, 0.0f) * 0.96f / kPi;
     float dielectricShare = specularPeak / (specularPeak + darkestDiffuse);
+    if (environment) {
+        float reflected = 0.04f / kPi;
+        dielectricShare = std::max(dielectricShare, reflected / (reflected + darkestDiffuse));
+    }
     float specularShare = glm::mix(dielectricShare, 1.0f, std::clamp(metallic, 0.0f, 1.0f));
     float gain = std::clamp(SPECULAR_SHARE_TOLERANCE / specularShare, SPECULAR_SHARE_MIN_GAIN,
                             SPECULAR_SHARE_MAX_GAIN);
@@ -959,7 +968,8 @@ void prepareDecoupledFrame(Renderer& r, const GpuScene& scene, const CameraView&
                 g.reuseLevels |= 1u << k;
         float metallic = known ? material->metallicFactor : 1.0f;
         glm::vec3 baseColor = known ? glm::vec3(material->baseColorFactor) : glm::vec3(0.0f);
-        g.viewDriftCos = std::cos(viewDriftLimitFor(roughness, metallic, baseColor));
+        g.viewDriftCos = std::cos(viewDriftLimitFor(roughness, metallic, baseColor,
+                                                    r.environment.kind != EnvironmentKind::None));
         g.rateBias = rateBias;
         g.textureLod = rateBias > 0.0f ? texLod : SHADEL_TEXTURE_LOD_NONE;
         d.objectsRateTextured += rateBias > 0.0f && texLod < SHADEL_TEXTURE_LOD_NONE;
