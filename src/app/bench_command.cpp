@@ -6,7 +6,9 @@
 #include <vector>
 
 #include "app/bench_plot.h"
+#include "app/cli_validate.h"
 #include "app/commands.h"
+#include "app/option_table.h"
 #include "app/output_files.h"
 #include "core/error.h"
 #include "core/log.h"
@@ -572,11 +574,12 @@ std::vector<nlohmann::json> renderSideBySide(Gpu& gpu, const std::vector<RenderO
 nlohmann::json runBench(Gpu& gpu, const BenchOptions& b) {
     if (!b.json.empty()) requireCreatableOutput("--json", b.json); // before minutes of rendering
     if (!b.plot.empty()) requireCreatableOutput("--plot", b.plot);
+    validate(b);
     RenderOptions o;
+    static_cast<RenderSettings&>(o) = b; // the option table's settings, shared by every mode
     o.scene = b.scene;
     o.allowExternalFiles = b.allowExternalFiles;
-    o.width = b.width;
-    o.height = b.height;
+    o.addDefaultSun = b.addDefaultSun;
     o.frames = b.frames;
     o.camera = b.camera;
     o.timing = b.timing;
@@ -584,21 +587,11 @@ nlohmann::json runBench(Gpu& gpu, const BenchOptions& b) {
     o.shadelsPerMetre = b.shadelsPerMetre;
     o.cacheDir = b.cacheDir;
     o.cameraPath = b.cameraPath;
-    o.animateLights = b.animateLights;
-    o.reuseRefreshPeriod = b.reuseRefreshPeriod;
-    o.marking = b.marking;
-    o.lightGrid = b.lightGrid;
-    o.shadingBias = b.shadingBias;
-    o.materialRate = b.materialRate;
-    o.sunShadowCache = b.sunShadowCache;
-    o.fuseTonemap = b.fuseTonemap;
     o.cacheLimitBytes = b.cacheLimitBytes;
-    o.lightCulling = b.lightCulling;
     // --spectra compare reports on / off against the three modes: they run without spectra
     // (with auto, builtin:lights' decoupled mode would be on, and on / off compare on with on).
-    o.spectra = b.compareSpectra ? Spectra::Off : b.spectra;
+    if (b.compareSpectra) o.spectra = Spectra::Off;
     o.progress = false;
-    o.sunCascades = b.sunCascades;
     o.instances = b.instances;
     if (b.compareShadowCulling) return runShadowCullingBench(gpu, b, o);
     if (b.compareParticleLighting) return runParticleLightingBench(gpu, b, o);
@@ -620,11 +613,7 @@ nlohmann::json runBench(Gpu& gpu, const BenchOptions& b) {
     recordDevice(out, gpu);
     out["frames"] = b.frames;
     out["camera_path"] = pathNames[int(b.cameraPath)];
-    out["animate_lights"] = b.animateLights;
-    out["shading_bias"] = b.shadingBias;
-    out["material_rate"] = b.materialRate;
-    out["shadow_cache"] = b.sunShadowCache;
-    out["fuse_tonemap"] = b.fuseTonemap;
+    out["settings"] = settingsJson({b, b.addDefaultSun}, kBenchCommand);
     // With --rounds N every round runs the three modes, in opposite order each round, so the
     // machine's drift over a run (a shared machine's neighbours, warm-up) hits every mode
     // alike; each ratio is the median of the rounds' ratios (forward of the same round as the
