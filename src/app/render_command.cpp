@@ -556,6 +556,125 @@ void renderNextFrame(RenderSession& session) {
     if (o.progress && o.frames > 1 && session.tty && i + 1 == o.frames) std::fprintf(stderr, "\n");
 }
 
+namespace {
+
+// Frame, CPU, recording and per-pass times: medians over the frames.
+void frameTimingStats(const std::vector<FrameResult>& frames, const RenderSettings& settings,
+                      nlohmann::json& s) {
+    std::vector<double> frameMs;
+    for (auto& f : frames) frameMs.push_back(f.frameMs);
+    std::vector<double> cpuMs;
+    for (auto& f : frames) cpuMs.push_back(f.cpuFrameMs);
+    s["cpu_frame_ms"] = median(cpuMs); // CPU time producing a frame, GPU waits excluded
+    std::vector<double> threadMs;
+    for (auto& f : frames) threadMs.push_back(f.cpuThreadMs);
+    s["cpu_frame_thread_ms"] = median(threadMs); // the same, as the thread's CPU clock counts it
+    // Render threading (rhi/frame.h): with more than one thread the passes are recorded in
+    // parallel; the wall clock of that and the CPU time each worker spent recording.
+    std::vector<double> recordingMs, recordingCpuMs;
+    for (auto& f : frames) {
+        recordingMs.push_back(f.recordingMs);
+        double cpu = 0.0;
+        for (const RecordingWorkerTiming& w : f.recordingWorkers) cpu += w.cpuMs;
+        recordingCpuMs.push_back(cpu);
+    }
+    s["recording"] = {{"threads", settings.recordingThreads},
+                      {"wall_ms", median(recordingMs)},
+                      {"workers_cpu_ms", median(recordingCpuMs)}};
+    s["cpu_scopes"] = cpuScopeStats(frames);
+    std::vector<double> streamingMs;
+    for (auto& f : frames) streamingMs.push_back(f.cpuStreamingMs);
+    s["cpu_streaming_thread_ms"] = median(streamingMs); // of which the texture streaming frontend
+    s["frame_ms"] = {{"median", median(frameMs)},
+                     {"min", *std::min_element(frameMs.begin(), frameMs.end())},
+                     {"max", *std::max_element(frameMs.begin(), frameMs.end())}};
+    // Per pass, the median over the frames that ran it, matched by name (and occurrence within
+    // the frame): frames differ in their pass lists (spot shadow maps are drawn only when they
+    // change, the first frame builds what later frames reuse), so the i-th pass of one frame
+    // is not the i-th of another. Listed in order of first appearance.
+    std::vector<std::pair<std::string, int>> passKeys;
+    std::map<std::pair<std::string, int>, std::vector<double>> passMs, recordCpuMs;
+    for (auto& f : frames) {
+        std::map<std::string, int> seen;
+        for (auto& pt : f.passes) {
+            std::pair<std::string, int> key{pt.name, seen[pt.name]++};
+            auto [it, added] = passMs.try_emplace(key);
+            if (added) passKeys.push_back(key);
+            it->second.push_back(pt.gpuMs);
+            recordCpuMs[key].push_back(pt.recordCpuMs);
+        }
+    }
+    nlohmann::json passes = nlohmann::json::array();
+    for (auto& key : passKeys) {
+        const std::vector<double>& ms = passMs[key];
+        nlohmann::json p = {{"name", key.first}, {"gpu_ms", median(ms)}, {"frames", ms.size()}};
+        // Threaded recording times every pass; serial recording with --trace.
+        if (settings.recordingThreads > 1 || settings.cpuScopes)
+            p["record_cpu_ms"] = median(recordCpuMs[key]);
+        passes.push_back(p);
+    }
+    s["passes"] = passes;
+}
+
+// --inspect: what the shading computed at the pixel in the last frame, printed and returned.
+nlohmann::json printInspectedPixel(const RenderOptions& o, const FrameResult& last) {
+    nlohmann::json prints = nlohmann::json::array();
+    InspectedPixel pixel = frontFragment(last.prints);
+    std::printf("--inspect %d,%d (%s, last frame, the front of %u fragment(s) shaded "
+                "there):\n",
+                o.inspectX, o.inspectY, modeName(o.mode), pixel.fragments);
+    for (const ShaderPrint& p : pixel.prints) {
+        std::printf("  %s\n", p.text().c_str());
+        std::vector<double> values;
+        for (uint32_t i = 0; i < p.count; ++i) values.push_back(p.f(int(i)));
+        prints.push_back({{"label", printLabelName(p.label)},
+                          {"values", values},
+                          {"shader", shaderName(p.shaderId)},
+                          {"line", p.line}});
+    }
+    if (pixel.prints.empty()) std::printf("  nothing was shaded at this pixel (background)\n");
+    return prints;
+}
+
+// The stats of the features a run may use: playback, skinning, GI, ray tracing, screen-space
+// passes, distance fields, texture memory.
+void featureStats(const RenderSession& session, nlohmann::json& s) {
+    const Gpu& gpu = session.gpu;
+    const Renderer& renderer = session.renderer;
+    const GpuScene& gpuScene = session.gpuScene;
+    const std::optional<ScenePlayback>& playback = session.playback;
+    const TextureStreamingPtr& streaming = session.streaming;
+    if (playback)
+        s["animation"] = {{"time_start", playback->startTime},
+                          {"time_step", playback->step},
+                          {"instances_reposed", playback->instancesReposed},
+                          {"meshes_reposed", playback->meshesReposed},
+                          {"vertices_written", playback->verticesWritten},
+                          // The next frame's import on the frontend worker, beside this frame.
+                          {"frontend_prefetched", playback->prefetched},
+                          {"frontend_worker_cpu_ms", playback->prefetchCpuMs},
+                          {"frontend_wait_ms", playback->prefetchWaitMs}};
+    s["points_lines_vertices"] =
+        renderer.pointsLines ? pointsLinesVertexCount(*renderer.pointsLines) : 0u;
+    s["skinning"] = {
+        {"mode", renderer.skinning ? "gpu" : "cpu"},
+        {"gpu_vertices", renderer.skinning ? skinnedVertexCount(*renderer.skinning) : 0u}};
+    if (renderer.gi) giStats(renderer, s);
+    if (renderer.rt) rayTracingStats(renderer, s);
+    if (renderer.screenSpace) screenSpaceStats(renderer, s);
+    if (renderer.distanceFields) distanceFieldStats(*renderer.distanceFields, s);
+    if (streaming) {
+        textureStreamingStats(*streaming, s);
+    } else { // textures loaded whole (RGBA8 with MIPs, what the images need at least)
+        uint64_t bytes = 0;
+        for (TextureHandle t : gpuScene.textures)
+            if (t) bytes += uint64_t(desc(gpu, t).width) * desc(gpu, t).height * 4 * 4 / 3;
+        s["texture_memory_peak_bytes"] = bytes;
+    }
+}
+
+} // namespace
+
 RenderRun finishRender(RenderSessionPtr sessionPtr) {
     RenderSession& session = *sessionPtr;
     if (session.run.listedCaptures) return std::move(session.run);
@@ -573,8 +692,6 @@ RenderRun finishRender(RenderSessionPtr sessionPtr) {
     GpuScene& gpuScene = session.gpuScene;
     const bool autoDensity = session.autoDensity;
     const ViewDensity& viewDensity = session.viewDensity;
-    const std::optional<ScenePlayback>& playback = session.playback;
-    const TextureStreamingPtr& streaming = session.streaming;
     const std::vector<BakedMesh>& baked = session.baked;
     const float density = session.density;
     const double bakeSeconds = session.bakeSeconds;
@@ -609,59 +726,7 @@ RenderRun finishRender(RenderSessionPtr sessionPtr) {
     // What the run was asked for, every option of the table (app/option_table.h).
     s["settings"] = settingsJson({o, o.addDefaultSun}, kRenderCommand);
     s["timing"] = settings.timing == TimingMode::Timestamps ? "timestamps" : "submit-per-pass";
-    std::vector<double> frameMs;
-    for (auto& f : run.frames) frameMs.push_back(f.frameMs);
-    std::vector<double> cpuMs;
-    for (auto& f : run.frames) cpuMs.push_back(f.cpuFrameMs);
-    s["cpu_frame_ms"] = median(cpuMs); // CPU time producing a frame, GPU waits excluded
-    std::vector<double> threadMs;
-    for (auto& f : run.frames) threadMs.push_back(f.cpuThreadMs);
-    s["cpu_frame_thread_ms"] = median(threadMs); // the same, as the thread's CPU clock counts it
-    // Render threading (rhi/frame.h): with more than one thread the passes are recorded in
-    // parallel; the wall clock of that and the CPU time each worker spent recording.
-    std::vector<double> recordingMs, recordingCpuMs;
-    for (auto& f : run.frames) {
-        recordingMs.push_back(f.recordingMs);
-        double cpu = 0.0;
-        for (const RecordingWorkerTiming& w : f.recordingWorkers) cpu += w.cpuMs;
-        recordingCpuMs.push_back(cpu);
-    }
-    s["recording"] = {{"threads", settings.recordingThreads},
-                      {"wall_ms", median(recordingMs)},
-                      {"workers_cpu_ms", median(recordingCpuMs)}};
-    s["cpu_scopes"] = cpuScopeStats(run.frames);
-    std::vector<double> streamingMs;
-    for (auto& f : run.frames) streamingMs.push_back(f.cpuStreamingMs);
-    s["cpu_streaming_thread_ms"] = median(streamingMs); // of which the texture streaming frontend
-    s["frame_ms"] = {{"median", median(frameMs)},
-                     {"min", *std::min_element(frameMs.begin(), frameMs.end())},
-                     {"max", *std::max_element(frameMs.begin(), frameMs.end())}};
-    // Per pass, the median over the frames that ran it, matched by name (and occurrence within
-    // the frame): frames differ in their pass lists (spot shadow maps are drawn only when they
-    // change, the first frame builds what later frames reuse), so the i-th pass of one frame
-    // is not the i-th of another. Listed in order of first appearance.
-    std::vector<std::pair<std::string, int>> passKeys;
-    std::map<std::pair<std::string, int>, std::vector<double>> passMs, recordCpuMs;
-    for (auto& f : run.frames) {
-        std::map<std::string, int> seen;
-        for (auto& pt : f.passes) {
-            std::pair<std::string, int> key{pt.name, seen[pt.name]++};
-            auto [it, added] = passMs.try_emplace(key);
-            if (added) passKeys.push_back(key);
-            it->second.push_back(pt.gpuMs);
-            recordCpuMs[key].push_back(pt.recordCpuMs);
-        }
-    }
-    nlohmann::json passes = nlohmann::json::array();
-    for (auto& key : passKeys) {
-        const std::vector<double>& ms = passMs[key];
-        nlohmann::json p = {{"name", key.first}, {"gpu_ms", median(ms)}, {"frames", ms.size()}};
-        // Threaded recording times every pass; serial recording with --trace.
-        if (settings.recordingThreads > 1 || settings.cpuScopes)
-            p["record_cpu_ms"] = median(recordCpuMs[key]);
-        passes.push_back(p);
-    }
-    s["passes"] = passes;
+    frameTimingStats(run.frames, settings, s);
     uint64_t asserts = 0;
     for (auto& f : run.frames) asserts += f.shaderAsserts;
     s["pixels_covered"] = run.frames.back().pixelsCovered;
@@ -721,51 +786,8 @@ RenderRun finishRender(RenderSessionPtr sessionPtr) {
         s["mip0_shadels"] = mip0;
         s["id_map_bytes"] = gpuScene.idMapBytes;
     }
-    if (playback)
-        s["animation"] = {{"time_start", playback->startTime},
-                          {"time_step", playback->step},
-                          {"instances_reposed", playback->instancesReposed},
-                          {"meshes_reposed", playback->meshesReposed},
-                          {"vertices_written", playback->verticesWritten},
-                          // The next frame's import on the frontend worker, beside this frame.
-                          {"frontend_prefetched", playback->prefetched},
-                          {"frontend_worker_cpu_ms", playback->prefetchCpuMs},
-                          {"frontend_wait_ms", playback->prefetchWaitMs}};
-    s["points_lines_vertices"] =
-        renderer.pointsLines ? pointsLinesVertexCount(*renderer.pointsLines) : 0u;
-    s["skinning"] = {
-        {"mode", renderer.skinning ? "gpu" : "cpu"},
-        {"gpu_vertices", renderer.skinning ? skinnedVertexCount(*renderer.skinning) : 0u}};
-    if (renderer.gi) giStats(renderer, s);
-    if (renderer.rt) rayTracingStats(renderer, s);
-    if (renderer.screenSpace) screenSpaceStats(renderer, s);
-    if (renderer.distanceFields) distanceFieldStats(*renderer.distanceFields, s);
-    if (streaming) {
-        textureStreamingStats(*streaming, s);
-    } else { // textures loaded whole (RGBA8 with MIPs, what the images need at least)
-        uint64_t bytes = 0;
-        for (TextureHandle t : gpuScene.textures)
-            if (t) bytes += uint64_t(desc(gpu, t).width) * desc(gpu, t).height * 4 * 4 / 3;
-        s["texture_memory_peak_bytes"] = bytes;
-    }
-    if (o.inspectX >= 0) {
-        nlohmann::json prints = nlohmann::json::array();
-        InspectedPixel pixel = frontFragment(run.frames.back().prints);
-        std::printf("--inspect %d,%d (%s, last frame, the front of %u fragment(s) shaded "
-                    "there):\n",
-                    o.inspectX, o.inspectY, modeName(o.mode), pixel.fragments);
-        for (const ShaderPrint& p : pixel.prints) {
-            std::printf("  %s\n", p.text().c_str());
-            std::vector<double> values;
-            for (uint32_t i = 0; i < p.count; ++i) values.push_back(p.f(int(i)));
-            prints.push_back({{"label", printLabelName(p.label)},
-                              {"values", values},
-                              {"shader", shaderName(p.shaderId)},
-                              {"line", p.line}});
-        }
-        if (pixel.prints.empty()) std::printf("  nothing was shaded at this pixel (background)\n");
-        s["inspect"] = prints;
-    }
+    featureStats(session, s);
+    if (o.inspectX >= 0) s["inspect"] = printInspectedPixel(o, run.frames.back());
     run.stats = s;
 
     // The device's memory back before the files are written (as before the steps existed).
