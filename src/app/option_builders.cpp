@@ -187,8 +187,12 @@ SettingOption shuffleDrawsOption() {
     SettingOption o{"--shuffle-draws",
                     "draw the transparent instances in a random order (order independence "
                     "tests)",
-                    kRenderCommand, "SEED"};
+                    kRenderCommand, "none | SEED"};
     o.parse = [](OptionTarget t, const std::string& text) {
+        if (text == "none") {
+            t.settings.shuffleDraws = false;
+            return;
+        }
         char* end = nullptr;
         unsigned long long seed = std::strtoull(text.c_str(), &end, 10);
         if (text.empty() || text[0] == '-' || end != text.c_str() + text.size())

@@ -112,9 +112,12 @@ SettingOption switchOption(const char* flag, Access access, uint32_t commands, c
 // An X,Y pixel option (-1,-1: none) writing two int32 members.
 template <class AccessX, class AccessY>
 SettingOption pixelOption(const char* flag, AccessX ax, AccessY ay, const char* help) {
-    SettingOption o{flag, help, kRenderCommand, "X,Y"};
+    SettingOption o{flag, help, kRenderCommand, "none | X,Y"};
     o.parse = [=](OptionTarget t, const std::string& text) {
-        parsePixel(flag, text, ax(t), ay(t));
+        if (text == "none")
+            ax(t) = ay(t) = -1;
+        else
+            parsePixel(flag, text, ax(t), ay(t));
     };
     o.text = [=](ConstOptionTarget t) {
         return ax(t) < 0 ? std::string("none") : format("%d,%d", ax(t), ay(t));
