@@ -208,6 +208,10 @@ void addGiAndWorldOptions(std::vector<SettingOption>& t) {
                             "(off: every blocker, for comparison)"));
     t.push_back(onOffOption("--lod", SETTING(lod), R,
                             "pick each instance's LOD on the GPU by projected error"));
+    t.push_back(floatOption("--lod-error", SETTING(lodErrorPixels), FloatRange{0.01, 64}, RB,
+                            "with --lod on: each instance draws its coarsest LOD whose geometric "
+                            "error projects below this many pixels (larger: fewer triangles, "
+                            "coarser silhouettes; stats triangles_drawn)"));
     t.push_back(onOffOption("--occlusion", SETTING(occlusion), R,
                             "two-phase hierarchical-Z occlusion culling of instances"));
     t.push_back(debugLinesOption());
