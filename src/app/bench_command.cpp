@@ -593,7 +593,6 @@ RenderOptions benchBaseOptions(const BenchOptions& b) {
     o.timing = b.timing;
     o.threads = b.threads;
     o.shadelsPerMetre = b.shadelsPerMetre;
-    o.cacheDir = b.cacheDir;
     o.cameraPath = b.cameraPath;
     o.cacheLimitBytes = b.cacheLimitBytes;
     // --spectra compare reports on / off against the three modes: they run without spectra
@@ -898,7 +897,7 @@ void printBenchTable(const Gpu& gpu, const BenchOptions& b, const nlohmann::json
 
 // Renders the same scene over the same camera path forward, decoupled with reuse off and
 // decoupled with reuse on, in one process, and prints per-pass medians and frame-time ratios
-// against forward.
+// against forward (the stats contract in docs/design.md, §7).
 nlohmann::json runBench(Gpu& gpu, const BenchOptions& b) {
     if (!b.json.empty()) requireCreatableOutput("--json", b.json); // before minutes of rendering
     if (!b.plot.empty()) requireCreatableOutput("--plot", b.plot);

@@ -37,7 +37,7 @@ struct RenderOptions : RenderSettings {
     // RenderSettings::recordingThreads from it.
     uint32_t threads = 0;
     float shadelsPerMetre = 0.0f; // 0 = auto: view-driven per mesh (render/view_density.h)
-    std::string cacheDir;         // empty = default cache directory
+    // (RenderSettings::cacheDir: --cache-dir, the bake cache too; "" = the default folder.)
     // --cache-limit: least recently used bake-cache files beyond it are removed (0 = none).
     uint64_t cacheLimitBytes = 4ull << 30;
     CameraPath cameraPath = CameraPath::Static;
@@ -132,7 +132,6 @@ struct BenchOptions : RenderSettings {
     uint32_t threads = 0;             // --threads N (0 = auto)
     bool compareThreads = false;      // --threads compare: every mode serial and threaded
     float shadelsPerMetre = 0.0f;     // 0 = auto
-    std::string cacheDir;
     CameraPath cameraPath = CameraPath::Static;
     uint64_t cacheLimitBytes = 4ull << 30;
     // --light-culling compare: forward and decoupled rendered again with no culling, and
@@ -142,7 +141,7 @@ struct BenchOptions : RenderSettings {
     // (ratios.particle_lighting_atlas_over_pixel; app/bench_command.cpp).
     bool compareParticleLighting = false;
     // --spectra compare: forward and decoupled (reuse off) also with --spectra on and single;
-    // ratios.spectra_forward|spectra_decoupled = on / single median frame time (the seed's
+    // ratios.spectra_forward|spectra_decoupled = on / single median frame time (the
     // spectra against one all-features shader).
     // (Without compare, --spectra auto|off sets RenderSettings::spectra, the three modes'.)
     bool compareSpectra = false;

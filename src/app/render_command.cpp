@@ -282,9 +282,9 @@ void loadRunScene(RenderSession& session) {
     builtin.galleryTextureSize = o.galleryTextureSize;
     Scene& scene = session.scene;
     scene = loadScene(o.scene,
-                      {.addDefaultSun = o.addDefaultSun,
-                       .allowExternalFiles = o.allowExternalFiles,
-                       .time = o.time},
+                      {.allowExternalFiles = o.allowExternalFiles,
+                       .time = o.time,
+                       .addDefaultSun = o.addDefaultSun},
                       builtin);
     Camera& camera = session.camera;
     camera = runCamera(scene, o.camera, o.cameraOverrides, float(o.width) / float(o.height));
@@ -396,9 +396,9 @@ void uploadRunScene(RenderSession& session) {
     std::optional<ScenePlayback>& playback = session.playback;
     if (o.timeStep)
         playback = startPlayback(o.scene,
-                                 {.addDefaultSun = o.addDefaultSun,
-                                  .allowExternalFiles = o.allowExternalFiles,
-                                  .time = o.time},
+                                 {.allowExternalFiles = o.allowExternalFiles,
+                                  .time = o.time,
+                                  .addDefaultSun = o.addDefaultSun},
                                  o.time.value_or(0.0), *o.timeStep, scene);
 }
 
@@ -705,7 +705,7 @@ RenderRun finishRender(RenderSessionPtr sessionPtr) {
     if (!o.captures.empty())
         run.captureFiles = writeCaptures(renderer.captures, o.captures, o.captureDir, o.out);
 
-    // Stats (DESIGN §5): medians over frames.
+    // Stats (the stats contract in docs/design.md): medians over frames.
     nlohmann::json s;
     recordDevice(s, gpu);
     s["driver"] = gpu.device.driver;

@@ -38,7 +38,7 @@ struct ViewerScene {
 
 void prepareScene(Gpu& gpu, const ViewOptions& o, ViewerScene& v) {
     v.scene = loadScene(
-        o.scene, {.addDefaultSun = o.addDefaultSun, .allowExternalFiles = o.allowExternalFiles});
+        o.scene, {.allowExternalFiles = o.allowExternalFiles, .addDefaultSun = o.addDefaultSun});
     v.camera = findCamera(v.scene, o.camera);
     v.bounds = v.scene.worldBounds();
     RunViews views = runViews(v.camera, CameraPath::Static, 1, v.bounds, o.width, o.height);

@@ -21,7 +21,6 @@ struct ViewOptions : RenderSettings {
     uint32_t threads = 0; // --threads: recording threads (0 = auto)
     // Hot reload: the GLSL folder watched (default: the source tree's shaders/); empty = off.
     std::string shaderSource = SHADEL_SHADER_SOURCE_DIR;
-    std::string cacheDir;
     bool allowExternalFiles = false;
     uint64_t cacheLimitBytes = 4ull << 30;
 };
