@@ -197,7 +197,8 @@ SettingOption shuffleDrawsOption() {
         unsigned long long seed = std::strtoull(text.c_str(), &end, 10);
         if (text.empty() || text[0] == '-' || end != text.c_str() + text.size())
             throw InputError(
-                format("--shuffle-draws %s: expected a whole number (the seed)", text.c_str()));
+                format("--shuffle-draws %s: expected none or a whole number (a random seed)",
+                       text.c_str()));
         t.settings.shuffleDraws = true;
         t.settings.shuffleSeed = seed;
     };
