@@ -6,7 +6,9 @@
 #include <vector>
 
 #include "app/bench_plot.h"
+#include "app/cli_validate.h"
 #include "app/commands.h"
+#include "app/option_table.h"
 #include "app/output_files.h"
 #include "core/error.h"
 #include "core/log.h"
@@ -566,65 +568,43 @@ std::vector<nlohmann::json> renderSideBySide(Gpu& gpu, const std::vector<RenderO
     return stats;
 }
 
-// Renders the same scene over the same camera path forward, decoupled with reuse off and
-// decoupled with reuse on, in one process, and prints per-pass medians and frame-time ratios
-// against forward (the stats contract in docs/design.md, §7).
-nlohmann::json runBench(Gpu& gpu, const BenchOptions& b) {
-    if (!b.json.empty()) requireCreatableOutput("--json", b.json); // before minutes of rendering
-    if (!b.plot.empty()) requireCreatableOutput("--plot", b.plot);
+namespace {
+
+// The three modes of the comparison.
+struct BenchMode {
+    const char* name;
+    RenderMode mode;
+    bool reuse;
+};
+const BenchMode kBenchModes[] = {{"forward", RenderMode::Forward, false},
+                                 {"decoupled", RenderMode::Decoupled, false},
+                                 {"reuse", RenderMode::Decoupled, true}};
+const char* const kPathNames[] = {"static", "orbit", "walk"};
+
+// What every run of the bench starts from.
+RenderOptions benchBaseOptions(const BenchOptions& b) {
     RenderOptions o;
+    static_cast<RenderSettings&>(o) = b; // the option table's settings, shared by every mode
     o.scene = b.scene;
     o.allowExternalFiles = b.allowExternalFiles;
-    o.width = b.width;
-    o.height = b.height;
+    o.addDefaultSun = b.addDefaultSun;
     o.frames = b.frames;
     o.camera = b.camera;
     o.timing = b.timing;
     o.threads = b.threads;
     o.shadelsPerMetre = b.shadelsPerMetre;
-    o.cacheDir = b.cacheDir;
     o.cameraPath = b.cameraPath;
-    o.animateLights = b.animateLights;
-    o.reuseRefreshPeriod = b.reuseRefreshPeriod;
-    o.marking = b.marking;
-    o.lightGrid = b.lightGrid;
-    o.shadingBias = b.shadingBias;
-    o.materialRate = b.materialRate;
-    o.sunShadowCache = b.sunShadowCache;
-    o.fuseTonemap = b.fuseTonemap;
     o.cacheLimitBytes = b.cacheLimitBytes;
-    o.lightCulling = b.lightCulling;
     // --spectra compare reports on / off against the three modes: they run without spectra
     // (with auto, builtin:lights' decoupled mode would be on, and on / off compare on with on).
-    o.spectra = b.compareSpectra ? Spectra::Off : b.spectra;
+    if (b.compareSpectra) o.spectra = Spectra::Off;
     o.progress = false;
-    o.sunCascades = b.sunCascades;
     o.instances = b.instances;
-    if (b.compareShadowCulling) return runShadowCullingBench(gpu, b, o);
-    if (b.compareParticleLighting) return runParticleLightingBench(gpu, b, o);
-    if (b.compareStencil) return runStencilBench(gpu, b, o);
-    if (b.compareStreaming) return runStreamingBench(gpu, b, o);
-    if (!b.instanceScaling.empty()) return runInstanceScalingBench(gpu, b, o);
+    return o;
+}
 
-    struct Mode {
-        const char* name;
-        RenderMode mode;
-        bool reuse;
-    };
-    const Mode modes[] = {{"forward", RenderMode::Forward, false},
-                          {"decoupled", RenderMode::Decoupled, false},
-                          {"reuse", RenderMode::Decoupled, true}};
-    static const char* pathNames[] = {"static", "orbit", "walk"};
-    nlohmann::json out;
-    out["scene"] = b.scene;
-    recordDevice(out, gpu);
-    out["frames"] = b.frames;
-    out["camera_path"] = pathNames[int(b.cameraPath)];
-    out["animate_lights"] = b.animateLights;
-    out["shading_bias"] = b.shadingBias;
-    out["material_rate"] = b.materialRate;
-    out["shadow_cache"] = b.sunShadowCache;
-    out["fuse_tonemap"] = b.fuseTonemap;
+// The forward / decoupled / reuse runs, --rounds rounds: out's modes, ratios, rounds.
+void runModeRounds(Gpu& gpu, const BenchOptions& b, RenderOptions o, nlohmann::json& out) {
     // With --rounds N every round runs the three modes, in opposite order each round, so the
     // machine's drift over a run (a shared machine's neighbours, warm-up) hits every mode
     // alike; each ratio is the median of the rounds' ratios (forward of the same round as the
@@ -632,7 +612,7 @@ nlohmann::json runBench(Gpu& gpu, const BenchOptions& b) {
     // frame (frame_ms_rounds).
     // --interleave (auto: half the frames, 1 to 4): within a round the three modes also take
     // turns of a few frames (renderSideBySide).
-    const uint32_t modeCount = uint32_t(std::size(modes));
+    const uint32_t modeCount = uint32_t(std::size(kBenchModes));
     std::vector<std::vector<double>> roundMs(modeCount);
     const uint32_t framesPerTurn = benchFramesPerTurn(b);
     out["interleave"] = framesPerTurn ? nlohmann::json(framesPerTurn) : nlohmann::json("runs");
@@ -643,208 +623,207 @@ nlohmann::json runBench(Gpu& gpu, const BenchOptions& b) {
         for (uint32_t k = 0; k < modeCount; ++k) {
             uint32_t index = round % 2 == 0 ? k : modeCount - 1 - k;
             order.push_back(index);
-            o.mode = modes[index].mode;
-            o.reuse = modes[index].reuse;
+            o.mode = kBenchModes[index].mode;
+            o.reuse = kBenchModes[index].reuse;
             runs.push_back(o);
-            names += std::string(k ? ", " : "") + modes[index].name;
+            names += std::string(k ? ", " : "") + kBenchModes[index].name;
         }
         std::string label = "bench: " + names;
         std::fprintf(stderr, "%s%s, %u frames at %ux%u (%s camera)", label.c_str(),
                      interleaveNote(b).c_str(), b.frames, b.width, b.height,
-                     pathNames[int(b.cameraPath)]);
+                     kPathNames[int(b.cameraPath)]);
         if (b.modeRounds > 1) std::fprintf(stderr, ", round %u of %u", round + 1, b.modeRounds);
         std::fprintf(stderr, "\n");
         std::vector<nlohmann::json> stats = renderSideBySide(gpu, runs, framesPerTurn, label);
         for (uint32_t k = 0; k < modeCount; ++k) {
-            const Mode& m = modes[order[k]];
+            const BenchMode& m = kBenchModes[order[k]];
             out["modes"][m.name] = std::move(stats[k]);
             roundMs[order[k]].push_back(out["modes"][m.name]["frame_ms"]["median"].get<double>());
         }
     }
-    auto median = [](std::vector<double> v) {
-        std::sort(v.begin(), v.end());
-        size_t n = v.size();
-        return n == 0 ? 0.0 : n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
-    };
     out["rounds"] = b.modeRounds;
     for (uint32_t k = 0; k < modeCount; ++k) {
-        out["modes"][modes[k].name]["frame_ms_rounds"] = roundMs[k];
-        out["modes"][modes[k].name]["frame_ms_median_of_rounds"] = median(roundMs[k]);
+        out["modes"][kBenchModes[k].name]["frame_ms_rounds"] = roundMs[k];
+        out["modes"][kBenchModes[k].name]["frame_ms_median_of_rounds"] = median(roundMs[k]);
     }
-    const nlohmann::json& forward = out["modes"]["forward"];
     for (uint32_t k = 1; k < modeCount; ++k) {
         std::vector<double> ratios;
         for (uint32_t r = 0; r < b.modeRounds; ++r)
             ratios.push_back(roundMs[0][r] > 0 ? roundMs[k][r] / roundMs[0][r] : 0.0);
-        out["ratios"][modes[k].name] = median(ratios);
-        out["ratios_by_round"][modes[k].name] = ratios;
+        out["ratios"][kBenchModes[k].name] = median(ratios);
+        out["ratios_by_round"][kBenchModes[k].name] = ratios;
     }
+}
 
-    if (b.compareLightCulling) {
-        // The same forward and decoupled (reuse off) runs without light culling.
-        for (RenderMode mode : {RenderMode::Forward, RenderMode::Decoupled}) {
-            const char* name = mode == RenderMode::Forward ? "forward" : "decoupled";
-            std::fprintf(stderr, "bench: %s, light culling none\n", name);
-            o.mode = mode;
-            o.reuse = false;
-            o.lightCulling = LightCulling::None;
-            nlohmann::json none = runRender(gpu, o).stats;
-            double tiledMs = out["modes"][name]["frame_ms"]["median"];
-            double noneMs = none["frame_ms"]["median"];
-            out["modes"][std::string(name) + "_no_light_culling"] = none;
-            out["ratios"][std::string("light_culling_") + name] =
-                noneMs > 0 ? tiledMs / noneMs : 0.0;
+// --light-culling compare: forward and decoupled (reuse off) again without light culling.
+void compareLightCullingRuns(Gpu& gpu, RenderOptions o, nlohmann::json& out) {
+    // The same forward and decoupled (reuse off) runs without light culling.
+    for (RenderMode mode : {RenderMode::Forward, RenderMode::Decoupled}) {
+        const char* name = mode == RenderMode::Forward ? "forward" : "decoupled";
+        std::fprintf(stderr, "bench: %s, light culling none\n", name);
+        o.mode = mode;
+        o.reuse = false;
+        o.lightCulling = LightCulling::None;
+        nlohmann::json none = runRender(gpu, o).stats;
+        double tiledMs = out["modes"][name]["frame_ms"]["median"];
+        double noneMs = none["frame_ms"]["median"];
+        out["modes"][std::string(name) + "_no_light_culling"] = none;
+        out["ratios"][std::string("light_culling_") + name] = noneMs > 0 ? tiledMs / noneMs : 0.0;
+    }
+}
+
+// --spectra compare: tile-shaded forward and decoupled by spectra and by one permutation.
+void compareSpectraRuns(Gpu& gpu, const BenchOptions& b, RenderOptions o, nlohmann::json& out) {
+    const uint32_t framesPerTurn = benchFramesPerTurn(b);
+    // Tile-shaded forward and decoupled (reuse off), by spectra and by one all-features
+    // permutation (the same classify + bin passes, one bin). On and single run in rounds
+    // (--rounds, at least 2) of alternating order (on first, then single first): a single
+    // pair on this shared machine swung on / single between 0.80 and 1.10. Each ratio is the
+    // median of the rounds' ratios (each round's on over the same round's single), each
+    // time the median of the rounds' medians; modes.<name> keeps the last run's stats.
+    struct SpectraPath {
+        const char* path;
+        RenderMode mode;
+        const char* onName;
+        const char* singleName;
+        const char* passNames;
+        std::vector<const char*> passes;
+    };
+    const SpectraPath paths[] = {
+        {"forward",
+         RenderMode::Forward,
+         "forward_spectra",
+         "forward_spectra_single",
+         "lightCulling + tileShading",
+         {std::begin(kForwardSpectraPasses), std::end(kForwardSpectraPasses)}},
+        {"decoupled",
+         RenderMode::Decoupled,
+         "decoupled_spectra",
+         "decoupled_spectra_single",
+         "shadelChunkSpectra + shadelShading",
+         {std::begin(kDecoupledSpectraPasses), std::end(kDecoupledSpectraPasses)}}};
+    auto ratio = [](double a, double b) { return b > 0 ? a / b : 0.0; };
+    uint32_t spectraRounds = std::max(2u, b.modeRounds);
+    for (const SpectraPath& path : paths) {
+        std::vector<double> frameRounds[2], shadingRounds[2]; // [on, single] per round
+        nlohmann::json runs = nlohmann::json::array();
+        for (uint32_t round = 0; round < spectraRounds; ++round) {
+            std::vector<RenderOptions> renders;
+            for (int k = 0; k < 2; ++k) {
+                bool on = (k == 0) == (round % 2 == 0); // on, single, then single, on
+                o.mode = path.mode;
+                o.reuse = false;
+                o.lightCulling = b.lightCulling;
+                o.spectra = on ? Spectra::On : Spectra::Single;
+                renders.push_back(o);
+            }
+            std::string label = std::string("bench: ") + path.path + ", --spectra " +
+                                (round % 2 == 0 ? "on, single" : "single, on");
+            std::fprintf(stderr, "%s%s (round %u of %u)\n", label.c_str(),
+                         interleaveNote(b).c_str(), round + 1, spectraRounds);
+            std::vector<nlohmann::json> stats =
+                renderSideBySide(gpu, renders, framesPerTurn, label);
+            for (int k = 0; k < 2; ++k) {
+                bool on = (k == 0) == (round % 2 == 0);
+                nlohmann::json& st = stats[k];
+                double frame = st["frame_ms"]["median"].get<double>();
+                double shading = 0.0;
+                for (const char* name : path.passes) shading += passMs(st, name);
+                frameRounds[on ? 0 : 1].push_back(frame);
+                shadingRounds[on ? 0 : 1].push_back(shading);
+                runs.push_back({{"spectra", on ? "on" : "single"},
+                                {"round", round + 1},
+                                {"frame_ms", frame},
+                                {"shading_ms", shading}});
+                out["modes"][on ? path.onName : path.singleName] = std::move(st);
+            }
         }
+        o.spectra = Spectra::Off;
+        bool forwardPath = path.mode == RenderMode::Forward;
+        std::string key = std::string("spectra_") + path.path;
+        std::vector<double> frameRatios, shadingRatios;
+        for (uint32_t round = 0; round < spectraRounds; ++round) {
+            frameRatios.push_back(ratio(frameRounds[0][round], frameRounds[1][round]));
+            shadingRatios.push_back(ratio(shadingRounds[0][round], shadingRounds[1][round]));
+        }
+        double frameMs[2] = {median(frameRounds[0]), median(frameRounds[1])};
+        double shadingMs[2] = {median(shadingRounds[0]), median(shadingRounds[1])};
+        double frameRatio = median(frameRatios), shadingRatio = median(shadingRatios);
+        out["ratios"][key] = frameRatio;
+        out["ratios"][key + "_shading"] = shadingRatio;
+        out["ratios_by_round"][key] = frameRatios;
+        out["ratios_by_round"][key + "_shading"] = shadingRatios;
+        out["spectra_frame_ms"][path.path] = {{"on", frameMs[0]}, {"single", frameMs[1]}};
+        out["spectra_shading_ms"][path.path] = {{"on", shadingMs[0]}, {"single", shadingMs[1]}};
+        out["spectra_runs"][path.path] = runs;
+        // Against the path without spectra: the raster forward pass, the plain shadel shading.
+        double other = out["modes"][path.path]["frame_ms"]["median"];
+        const char* otherName = forwardPath ? "raster" : "off";
+        out["ratios"][key + (forwardPath ? "_vs_raster" : "_vs_off")] = ratio(frameMs[0], other);
+        std::printf("spectra (%s, %u rounds): on %.3f ms, single %.3f ms, %s %.3f ms; on / "
+                    "single %.3f (median of the rounds'), on / %s %.3f\n",
+                    path.path, spectraRounds, frameMs[0], frameMs[1], otherName, other, frameRatio,
+                    otherName, ratio(frameMs[0], other));
+        std::printf("spectra (%s) shading passes (%s): on %.3f ms, single %.3f ms; on / "
+                    "single %.3f\n",
+                    path.path, path.passNames, shadingMs[0], shadingMs[1], shadingRatio);
     }
+}
 
-    if (b.compareSpectra) {
-        // Tile-shaded forward and decoupled (reuse off), by spectra and by one all-features
-        // permutation (the same classify + bin passes, one bin). On and single run in rounds
-        // (--rounds, at least 2) of alternating order (on first, then single first): a single
-        // pair on this shared machine swung on / single between 0.80 and 1.10. Each ratio is the
-        // median of the rounds' ratios (each round's on over the same round's single), each
-        // time the median of the rounds' medians; modes.<name> keeps the last run's stats.
-        struct SpectraPath {
-            const char* path;
-            RenderMode mode;
-            const char* onName;
-            const char* singleName;
-            const char* passNames;
-            std::vector<const char*> passes;
-        };
-        const SpectraPath paths[] = {
-            {"forward",
-             RenderMode::Forward,
-             "forward_spectra",
-             "forward_spectra_single",
-             "lightCulling + tileShading",
-             {std::begin(kForwardSpectraPasses), std::end(kForwardSpectraPasses)}},
-            {"decoupled",
-             RenderMode::Decoupled,
-             "decoupled_spectra",
-             "decoupled_spectra_single",
-             "shadelChunkSpectra + shadelShading",
-             {std::begin(kDecoupledSpectraPasses), std::end(kDecoupledSpectraPasses)}}};
-        auto ratio = [](double a, double b) { return b > 0 ? a / b : 0.0; };
-        uint32_t spectraRounds = std::max(2u, b.modeRounds);
-        for (const SpectraPath& path : paths) {
-            std::vector<double> frameRounds[2], shadingRounds[2]; // [on, single] per round
-            nlohmann::json runs = nlohmann::json::array();
-            for (uint32_t round = 0; round < spectraRounds; ++round) {
-                std::vector<RenderOptions> renders;
-                for (int k = 0; k < 2; ++k) {
-                    bool on = (k == 0) == (round % 2 == 0); // on, single, then single, on
-                    o.mode = path.mode;
-                    o.reuse = false;
-                    o.lightCulling = b.lightCulling;
-                    o.spectra = on ? Spectra::On : Spectra::Single;
-                    renders.push_back(o);
-                }
-                std::string label = std::string("bench: ") + path.path + ", --spectra " +
-                                    (round % 2 == 0 ? "on, single" : "single, on");
-                std::fprintf(stderr, "%s%s (round %u of %u)\n", label.c_str(),
-                             interleaveNote(b).c_str(), round + 1, spectraRounds);
-                std::vector<nlohmann::json> stats =
-                    renderSideBySide(gpu, renders, framesPerTurn, label);
-                for (int k = 0; k < 2; ++k) {
-                    bool on = (k == 0) == (round % 2 == 0);
-                    nlohmann::json& st = stats[k];
-                    double frame = st["frame_ms"]["median"].get<double>();
-                    double shading = 0.0;
-                    for (const char* name : path.passes) shading += passMs(st, name);
-                    frameRounds[on ? 0 : 1].push_back(frame);
-                    shadingRounds[on ? 0 : 1].push_back(shading);
-                    runs.push_back({{"spectra", on ? "on" : "single"},
-                                    {"round", round + 1},
-                                    {"frame_ms", frame},
-                                    {"shading_ms", shading}});
-                    out["modes"][on ? path.onName : path.singleName] = std::move(st);
+// --threads compare: every mode serial and threaded.
+void compareThreadRuns(Gpu& gpu, const BenchOptions& b, RenderOptions o, nlohmann::json& out) {
+    // Render threading (rhi/frame.h): every mode serial (--threads 1) and threaded, in two
+    // rounds of opposite order (serial first, then threaded first) so that warm-up and the
+    // machine's drift hit both alike; each figure is the mean of its two runs' medians.
+    // cpu_frame_ms is the wall clock of frontend + recording (GPU waits excluded): what
+    // parallel recording shortens; cpu_frame_thread_ms the render thread's own CPU clock.
+    uint32_t threaded = b.threads ? b.threads : defaultRecordingThreads();
+    for (const BenchMode& m : kBenchModes) {
+        o.mode = m.mode;
+        o.reuse = m.reuse;
+        double wall[2] = {0, 0}, thread[2] = {0, 0}, workers = 0, recording = 0;
+        for (int round = 0; round < 2; ++round)
+            for (int k = 0; k < 2; ++k) {
+                bool serial = (k == 0) == (round == 0); // S,T then T,S
+                std::fprintf(stderr, "bench: %s, --threads %u (round %d)\n", m.name,
+                             serial ? 1u : threaded, round + 1);
+                o.threads = serial ? 1 : threaded;
+                nlohmann::json st = runRender(gpu, o).stats;
+                wall[serial ? 0 : 1] += 0.5 * st["cpu_frame_ms"].get<double>();
+                thread[serial ? 0 : 1] += 0.5 * st["cpu_frame_thread_ms"].get<double>();
+                if (!serial) {
+                    workers += 0.5 * st["recording"]["workers_cpu_ms"].get<double>();
+                    recording += 0.5 * st["recording"]["wall_ms"].get<double>();
                 }
             }
-            o.spectra = Spectra::Off;
-            bool forwardPath = path.mode == RenderMode::Forward;
-            std::string key = std::string("spectra_") + path.path;
-            std::vector<double> frameRatios, shadingRatios;
-            for (uint32_t round = 0; round < spectraRounds; ++round) {
-                frameRatios.push_back(ratio(frameRounds[0][round], frameRounds[1][round]));
-                shadingRatios.push_back(ratio(shadingRounds[0][round], shadingRounds[1][round]));
-            }
-            double frameMs[2] = {median(frameRounds[0]), median(frameRounds[1])};
-            double shadingMs[2] = {median(shadingRounds[0]), median(shadingRounds[1])};
-            double frameRatio = median(frameRatios), shadingRatio = median(shadingRatios);
-            out["ratios"][key] = frameRatio;
-            out["ratios"][key + "_shading"] = shadingRatio;
-            out["ratios_by_round"][key] = frameRatios;
-            out["ratios_by_round"][key + "_shading"] = shadingRatios;
-            out["spectra_frame_ms"][path.path] = {{"on", frameMs[0]}, {"single", frameMs[1]}};
-            out["spectra_shading_ms"][path.path] = {{"on", shadingMs[0]}, {"single", shadingMs[1]}};
-            out["spectra_runs"][path.path] = runs;
-            // Against the path without spectra: the raster forward pass, the plain shadel shading.
-            double other = out["modes"][path.path]["frame_ms"]["median"];
-            const char* otherName = forwardPath ? "raster" : "off";
-            out["ratios"][key + (forwardPath ? "_vs_raster" : "_vs_off")] =
-                ratio(frameMs[0], other);
-            std::printf("spectra (%s, %u rounds): on %.3f ms, single %.3f ms, %s %.3f ms; on / "
-                        "single %.3f (median of the rounds'), on / %s %.3f\n",
-                        path.path, spectraRounds, frameMs[0], frameMs[1], otherName, other,
-                        frameRatio, otherName, ratio(frameMs[0], other));
-            std::printf("spectra (%s) shading passes (%s): on %.3f ms, single %.3f ms; on / "
-                        "single %.3f\n",
-                        path.path, path.passNames, shadingMs[0], shadingMs[1], shadingRatio);
-        }
+        out["threads"][m.name] = {{"threads", threaded},
+                                  {"cpu_frame_ms_serial", wall[0]},
+                                  {"cpu_frame_ms_threaded", wall[1]},
+                                  {"cpu_frame_thread_ms_serial", thread[0]},
+                                  {"cpu_frame_thread_ms_threaded", thread[1]},
+                                  {"recording_wall_ms", recording},
+                                  {"recording_workers_cpu_ms", workers}};
+        out["ratios"][std::string("threads_cpu_") + m.name] = wall[0] > 0 ? wall[1] / wall[0] : 0.0;
+        std::printf("threads (%s): cpu frame %.3f ms with %u threads, %.3f ms serial = %.3f "
+                    "(render thread's CPU clock %.3f / %.3f ms); recording %.3f ms wall, "
+                    "%.3f ms CPU on the workers\n",
+                    m.name, wall[1], threaded, wall[0], wall[0] > 0 ? wall[1] / wall[0] : 0.0,
+                    thread[1], thread[0], recording, workers);
     }
+}
 
-    if (b.compareThreads) {
-        // Render threading (rhi/frame.h): every mode serial (--threads 1) and threaded, in two
-        // rounds of opposite order (serial first, then threaded first) so that warm-up and the
-        // machine's drift hit both alike; each figure is the mean of its two runs' medians.
-        // cpu_frame_ms is the wall clock of frontend + recording (GPU waits excluded): what
-        // parallel recording shortens; cpu_frame_thread_ms the render thread's own CPU clock.
-        uint32_t threaded = b.threads ? b.threads : defaultRecordingThreads();
-        for (const Mode& m : modes) {
-            o.mode = m.mode;
-            o.reuse = m.reuse;
-            double wall[2] = {0, 0}, thread[2] = {0, 0}, workers = 0, recording = 0;
-            for (int round = 0; round < 2; ++round)
-                for (int k = 0; k < 2; ++k) {
-                    bool serial = (k == 0) == (round == 0); // S,T then T,S
-                    std::fprintf(stderr, "bench: %s, --threads %u (round %d)\n", m.name,
-                                 serial ? 1u : threaded, round + 1);
-                    o.threads = serial ? 1 : threaded;
-                    nlohmann::json st = runRender(gpu, o).stats;
-                    wall[serial ? 0 : 1] += 0.5 * st["cpu_frame_ms"].get<double>();
-                    thread[serial ? 0 : 1] += 0.5 * st["cpu_frame_thread_ms"].get<double>();
-                    if (!serial) {
-                        workers += 0.5 * st["recording"]["workers_cpu_ms"].get<double>();
-                        recording += 0.5 * st["recording"]["wall_ms"].get<double>();
-                    }
-                }
-            out["threads"][m.name] = {{"threads", threaded},
-                                      {"cpu_frame_ms_serial", wall[0]},
-                                      {"cpu_frame_ms_threaded", wall[1]},
-                                      {"cpu_frame_thread_ms_serial", thread[0]},
-                                      {"cpu_frame_thread_ms_threaded", thread[1]},
-                                      {"recording_wall_ms", recording},
-                                      {"recording_workers_cpu_ms", workers}};
-            out["ratios"][std::string("threads_cpu_") + m.name] =
-                wall[0] > 0 ? wall[1] / wall[0] : 0.0;
-            std::printf("threads (%s): cpu frame %.3f ms with %u threads, %.3f ms serial = %.3f "
-                        "(render thread's CPU clock %.3f / %.3f ms); recording %.3f ms wall, "
-                        "%.3f ms CPU on the workers\n",
-                        m.name, wall[1], threaded, wall[0], wall[0] > 0 ? wall[1] / wall[0] : 0.0,
-                        thread[1], thread[0], recording, workers);
-        }
-        o.threads = b.threads;
-    }
-
+// The comparison as a table on stdout.
+void printBenchTable(const Gpu& gpu, const BenchOptions& b, const nlohmann::json& out) {
+    const nlohmann::json& forward = out["modes"]["forward"];
     std::printf("shadel bench: %s at %ux%u on %s, %u frames, %s camera, medians (timing: %s)%s\n",
                 b.scene.c_str(), b.width, b.height, deviceLabel(gpu).c_str(), b.frames,
-                pathNames[int(b.cameraPath)], forward["timing"].get<std::string>().c_str(),
+                kPathNames[int(b.cameraPath)], forward["timing"].get<std::string>().c_str(),
                 b.modeRounds > 1 ? format(", %u rounds", b.modeRounds).c_str() : "");
     std::printf("%-28s %12s %12s %12s\n", "", "forward", "decoupled", "reuse");
     auto row = [&](const char* label, auto value) {
         std::printf("%-28s", label);
-        for (const Mode& m : modes) std::printf(" %12s", value(out["modes"][m.name]).c_str());
+        for (const BenchMode& m : kBenchModes)
+            std::printf(" %12s", value(out["modes"][m.name]).c_str());
         std::printf("\n");
     };
     // With rounds: the median over the rounds of each round's median frame, and the median
@@ -853,7 +832,7 @@ nlohmann::json runBench(Gpu& gpu, const BenchOptions& b) {
         return format("%.3f", s["frame_ms_median_of_rounds"].get<double>());
     });
     std::printf("%-28s", "ratio to forward");
-    for (const Mode& m : modes) std::printf(" %12.3f", out["ratios"].value(m.name, 1.0));
+    for (const BenchMode& m : kBenchModes) std::printf(" %12.3f", out["ratios"].value(m.name, 1.0));
     std::printf("\n");
     row("cpu frame ms",
         [](const nlohmann::json& s) { return format("%.3f", s["cpu_frame_ms"].get<double>()); });
@@ -862,7 +841,7 @@ nlohmann::json runBench(Gpu& gpu, const BenchOptions& b) {
     });
     // Passes: union by name, in frame order.
     std::vector<std::string> names;
-    for (const Mode& m : modes)
+    for (const BenchMode& m : kBenchModes)
         for (const auto& p : out["modes"][m.name]["passes"])
             if (std::find(names.begin(), names.end(), p["name"]) == names.end())
                 names.push_back(p["name"]);
@@ -912,10 +891,36 @@ nlohmann::json runBench(Gpu& gpu, const BenchOptions& b) {
                         out["modes"][std::string(name) + "_no_light_culling"]["frame_ms"]["median"]
                             .get<double>(),
                         out["ratios"][std::string("light_culling_") + name].get<double>());
+}
+
+} // namespace
+
+// Renders the same scene over the same camera path forward, decoupled with reuse off and
+// decoupled with reuse on, in one process, and prints per-pass medians and frame-time ratios
+// against forward (the stats contract in docs/design.md, §7).
+nlohmann::json runBench(Gpu& gpu, const BenchOptions& b) {
+    if (!b.json.empty()) requireCreatableOutput("--json", b.json); // before minutes of rendering
+    if (!b.plot.empty()) requireCreatableOutput("--plot", b.plot);
+    validate(b);
+    const RenderOptions o = benchBaseOptions(b);
+    if (b.compareShadowCulling) return runShadowCullingBench(gpu, b, o);
+    if (b.compareParticleLighting) return runParticleLightingBench(gpu, b, o);
+    if (b.compareStencil) return runStencilBench(gpu, b, o);
+    if (b.compareStreaming) return runStreamingBench(gpu, b, o);
+    if (!b.instanceScaling.empty()) return runInstanceScalingBench(gpu, b, o);
+    nlohmann::json out;
+    out["scene"] = b.scene;
+    recordDevice(out, gpu);
+    out["frames"] = b.frames;
+    out["camera_path"] = kPathNames[int(b.cameraPath)];
+    out["settings"] = settingsJson({b, b.addDefaultSun}, kBenchCommand);
+    runModeRounds(gpu, b, o, out);
+    if (b.compareLightCulling) compareLightCullingRuns(gpu, o, out);
+    if (b.compareSpectra) compareSpectraRuns(gpu, b, o, out);
+    if (b.compareThreads) compareThreadRuns(gpu, b, o, out);
+    printBenchTable(gpu, b, out);
     if (!b.plot.empty()) writeBenchPlot(out, b.plot);
-    if (!b.json.empty()) {
-        writeOutputFile(b.json, out.dump(2) + "\n");
-    }
+    if (!b.json.empty()) writeOutputFile(b.json, out.dump(2) + "\n");
     return out;
 }
 

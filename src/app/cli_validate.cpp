@@ -6,6 +6,7 @@
 #include <tuple>
 
 #include "app/commands.h"
+#include "app/option_table.h"
 #include "bake/cache_eviction.h"
 #include "core/error.h"
 #include "core/log.h"
@@ -91,58 +92,37 @@ std::string checkFiniteInRange(const char* flag, double value, FloatRange range)
     return problem.empty() ? problem : format("%s %g: %s", flag, value, problem.c_str());
 }
 
-void validateRenderOptions(const RenderOptions& o) {
-    const std::tuple<const char*, double, FloatRange> floats[] = {
-        {"--exposure", o.exposure, kExposureRange},
-        {"--density", o.shadelsPerMetre, kDensityRange},
-        {"--shading-bias", o.shadingBias, kShadingBiasRange},
-        {"--trilinear-band", o.trilinearBand, kTrilinearBandRange},
-        {"--shadel-budget", o.shadelBudget, kShadelBudgetRange},
-        {"--forward-below", o.forwardBelowPixels, kForwardBelowRange},
-        {"--df-shadow-start", o.dfShadowStart, kDfDistanceRange},
-        {"--df-residency", o.dfResidency, kDfDistanceRange},
-    };
-    for (const auto& [flag, value, range] : floats)
-        if (std::string problem = checkFiniteInRange(flag, value, range); !problem.empty())
-            throw InputError(problem);
+namespace {
+
+void throwIf(const std::string& problem) {
+    if (!problem.empty()) throw InputError(problem);
+}
+
+void requireCount(const char* flag, uint32_t value, uint32_t lo, uint32_t hi) {
+    if (value < lo || value > hi)
+        throw InputError(format("%s %u: expected %u..%u", flag, value, lo, hi));
+}
+
+// The command's own floats (the table checks the settings').
+void validateCommandFloats(const RenderOptions& o) {
+    throwIf(checkFiniteInRange("--density", o.shadelsPerMetre, kDensityRange));
+    throwIf(checkFiniteInRange("--shadel-budget", o.shadelBudget, kShadelBudgetRange));
     if (o.textureBudgetMiB != 0.0) // 0: no budget
-        if (std::string problem =
-                checkFiniteInRange("--texture-budget", o.textureBudgetMiB, kTextureBudgetRange);
-            !problem.empty())
-            throw InputError(problem);
-    if (o.time)
-        if (std::string problem = checkFiniteInRange("--time", *o.time, kTimeRange);
-            !problem.empty())
-            throw InputError(problem);
-    if (o.timeStep) {
-        if (std::string problem = checkFiniteInRange("--time-step", *o.timeStep, kTimeStepRange);
-            !problem.empty())
-            throw InputError(problem);
-        if (o.scene.rfind("builtin:", 0) == 0)
-            throw InputError(format("--time-step %g: plays glTF animations; %s has none",
-                                    *o.timeStep, o.scene.c_str()));
-    }
+        throwIf(checkFiniteInRange("--texture-budget", o.textureBudgetMiB, kTextureBudgetRange));
+    if (o.time) throwIf(checkFiniteInRange("--time", *o.time, kTimeRange));
+    if (o.timeStep) throwIf(checkFiniteInRange("--time-step", *o.timeStep, kTimeStepRange));
     const CameraOverrides& c = o.cameraOverrides;
-    if (c.fovDegrees != 0.0f)
-        if (std::string problem = checkFiniteInRange("--fov", c.fovDegrees, kFovRange);
-            !problem.empty())
-            throw InputError(problem);
+    if (c.fovDegrees != 0.0f) throwIf(checkFiniteInRange("--fov", c.fovDegrees, kFovRange));
     for (const auto& [flag, v] : {std::pair{"--from", c.from}, std::pair{"--look-at", c.lookAt}})
         for (int i = 0; v && i < 3; ++i)
-            if (std::string problem = checkFiniteInRange(flag, (*v)[i], kCoordinateRange);
-                !problem.empty())
-                throw InputError(problem);
-    // Counts, and options that need another (checked here, before the scene is loaded and
-    // baked, not where the renderer is built).
-    auto requireCount = [](const char* flag, uint32_t value, uint32_t lo, uint32_t hi) {
-        if (value < lo || value > hi)
-            throw InputError(format("%s %u: expected %u..%u", flag, value, lo, hi));
-    };
-    requireCount("--material-samples", o.materialSamples, 1, 64);
-    requireCount("--allocation-counters", o.allocationCounters, 1, SHADEL_COUNTERS);
-    requireCount("--reuse-refresh", o.reuseRefreshPeriod, 1, 1024);
-    requireCount("--particle-atlas-size", o.particleAtlasSize, 128, 8192);
-    requireCount("--gi-iterations", o.giIterations, 0, 64);
+            throwIf(checkFiniteInRange(flag, (*v)[i], kCoordinateRange));
+}
+
+// Options that need another, or a value inside the image.
+void validateCombinations(const RenderOptions& o) {
+    if (o.timeStep && o.scene.rfind("builtin:", 0) == 0)
+        throw InputError(format("--time-step %g: plays glTF animations; %s has none", *o.timeStep,
+                                o.scene.c_str()));
     if (o.visualize == Visualize::Gi && o.gi == GiMode::Off)
         throw InputError("--visualize gi: shows the indirect light of --gi lpv; GI is off");
     if (o.visualize == Visualize::RtAo && !o.rt.ao)
@@ -153,12 +133,54 @@ void validateRenderOptions(const RenderOptions& o) {
     if (o.visualize == Visualize::Tiles && !o.screenSpace)
         throw InputError(
             "--visualize tiles: shows the tile classes of --screen-space on; it is off");
-    if (o.distanceFields && !o.screenSpace)
+    if (o.distanceFieldLighting && !o.screenSpace)
         throw InputError(
             "--distance-fields on: runs on the screen-space tiles; add --screen-space on");
     if (o.stencilEffects != StencilEffects::Off && !o.screenSpace)
         throw InputError("--stencil-effects: composites the screen-space reflections; add "
                          "--screen-space on");
+    bool listCaptures = o.captures.size() == 1 && o.captures[0] == "list";
+    if (!o.captures.empty() && !listCaptures && o.captureDir.empty() && o.out.empty())
+        throw InputError("--capture: needs --capture-dir DIR or --out (files go next to it)");
+    if (o.inspectX >= int32_t(o.width) || o.inspectY >= int32_t(o.height))
+        throw InputError(format("--inspect %d,%d: outside the %ux%u image", o.inspectX, o.inspectY,
+                                o.width, o.height));
+    if (o.debugLinesAtX >= 0 && (o.debugLines & (DEBUG_LINES_LIGHTS | DEBUG_LINES_BLOCKERS)) == 0)
+        throw InputError(format("--debug-lines-at %d,%d: picks lights, so it needs --debug-lines "
+                                "lights or blockers",
+                                o.debugLinesAtX, o.debugLinesAtY));
+    if (o.debugLinesAtX >= int32_t(o.width) || o.debugLinesAtY >= int32_t(o.height))
+        throw InputError(format("--debug-lines-at %d,%d: outside the %ux%u image", o.debugLinesAtX,
+                                o.debugLinesAtY, o.width, o.height));
+}
+
+} // namespace
+
+void validate(const RenderOptions& o) {
+    requireCount("--frames", o.frames, 1, 100000);
+    throwIf(checkSettings({o, o.addDefaultSun}, kRenderCommand));
+    validateCommandFloats(o);
+    if (o.instances != 0) requireCount("--instances", o.instances, 1, 1000000);
+    validateCombinations(o);
+}
+
+void validate(const BenchOptions& b) {
+    throwIf(checkSettings({b, b.addDefaultSun}, kBenchCommand));
+    throwIf(checkFiniteInRange("--density", b.shadelsPerMetre, kDensityRange));
+    requireCount("--rounds", b.rounds, 1, 100);
+    if (b.compareStreaming) {
+        if (!(b.textureBudgetMiB > 0.0))
+            throw InputError("--streaming-compare: needs a --texture-budget above 0 MiB");
+        throwIf(checkFiniteInRange("--texture-budget", b.textureBudgetMiB, kTextureBudgetRange));
+    }
+    if (b.cpuScopes && b.instanceScaling.empty())
+        throw InputError("bench --cpu-scopes: only with --instance-scaling (the other benches "
+                         "choose their own)");
+    if (!b.instanceScaling.empty() && b.instances != 0)
+        throw InputError("--instances: not with --instance-scaling (which sets the counts)");
+    if (b.instances != 0) requireCount("--instances", b.instances, 1, 1000000);
+    if (b.spectra != Spectra::Auto && b.spectra != Spectra::Off)
+        throw InputError("bench --spectra: expected auto, off or compare");
 }
 
 int exitForParseError(const CLI::App& app, const CLI::ParseError& error) {

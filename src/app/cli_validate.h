@@ -18,9 +18,8 @@ struct FloatRange {
     bool minExclusive = false;
 };
 
-// The accepted values of the float flags, shared by the flag definitions and
-// validateRenderOptions (in-process callers bypass the parser).
-constexpr FloatRange kExposureRange{0, 1e6, true};      // 0 renders black
+// The accepted values of the float flags, shared by the flag definitions and validate()
+// (in-process callers bypass the parser).
 constexpr FloatRange kDensityRange{0, 1e6};             // shadels per metre; 0 = auto (view-driven)
 constexpr FloatRange kFixedDensityRange{0, 1e6, true};  // shadels per metre (bake: no auto)
 constexpr FloatRange kShadingBiasRange{-8, 8};          // MIP levels
@@ -49,10 +48,13 @@ CLI::Validator byteSize();
 std::string checkFiniteInRange(const char* flag, double value, FloatRange range);
 
 struct RenderOptions;
-// Throws InputError naming the flag for the first float option out of range, count out of
-// range or option that needs another: runRender's callers in code (tests, bench) do not go
-// through the flag checks, and runRender checks before loading the scene.
-void validateRenderOptions(const RenderOptions& options);
+struct BenchOptions;
+// Every rule about a command's options in one place: throws InputError naming the flag for the
+// first value out of range (the option table's settings, then the command's own options) or
+// option that needs another. Runs on what the command line set and on what code set (tests and
+// the bench call runRender without the flag parser), before the scene is loaded.
+void validate(const RenderOptions& options);
+void validate(const BenchOptions& options);
 
 // What main returns for a CLI11 exception: help and version print and return 0; any other
 // error prints "shadel: <message>" on one line and returns kExitBadInput.

@@ -13,12 +13,12 @@
 
 namespace shadel {
 
-struct RenderOptions {
+// `shadel render`: the renderer's settings (the option table, app/option_table.h, sets them)
+// and what the command does around the renderer.
+struct RenderOptions : RenderSettings {
     std::string scene = "builtin:default";
     bool allowExternalFiles = false; // glTF URIs may leave the model's folder
-    RenderMode mode = RenderMode::Forward;
-    MarkingMode marking = MarkingMode::Auto; // decoupled: --marking auto|raster|visibility
-    uint32_t width = 1280, height = 720;
+    bool addDefaultSun = true;       // --sun auto|off (SceneFileOptions::addDefaultSun)
     uint32_t frames = 1;
     std::string camera;
     CameraOverrides cameraOverrides; // --from, --look-at, --fov
@@ -27,79 +27,30 @@ struct RenderOptions {
     std::optional<double> timeStep;
     bool gpuSkinning = true; // --skinning gpu|cpu (render/skinning)
     bool jitter = false;
-    uint32_t ssaa = 1;
-    Visualize visualize = Visualize::None;
     std::string out;   // FILE.png or DIR/ ; empty = no image
     std::string stats; // FILE.json ; empty = none
     std::string trace; // FILE.json: Chrome trace events of the run; empty = none
+    // --timing; unset: the device's default (defaultTimingMode). Hides RenderSettings::timing,
+    // which beginRender sets from it.
     std::optional<TimingMode> timing;
-    uint32_t threads = 0; // --threads: recording threads (0 = auto: defaultRecordingThreads())
-    float exposure = 1.0f;
+    // --threads: recording threads (0 = auto: defaultRecordingThreads()); beginRender sets
+    // RenderSettings::recordingThreads from it.
+    uint32_t threads = 0;
     float shadelsPerMetre = 0.0f; // 0 = auto: view-driven per mesh (render/view_density.h)
-    std::string cacheDir;         // empty = default cache directory
+    // (RenderSettings::cacheDir: --cache-dir, the bake cache too; "" = the default folder.)
     // --cache-limit: least recently used bake-cache files beyond it are removed (0 = none).
     uint64_t cacheLimitBytes = 4ull << 30;
-    uint32_t shadeStorageSize = 4096;
-    uint32_t sheetShadels = 65536;
-    float shadingBias = 0.0f;
-    float trilinearBand = 0.5f;    // decoupled: LOD band blended between MIPs (1 = full trilinear)
-    uint32_t materialSamples = 16; // cap of material samples per shadel (prefilter.glsl)
-    float forwardBelowPixels = 8.0f;
-    uint32_t allocationCounters = SHADEL_COUNTERS;
-    bool sheetAllMips = false;
-    bool levelWindows = true;
-    bool materialRate = true;   // --material-rate on|off
-    bool sunShadowCache = true; // --shadow-cache on|off
-    bool capacityControl = true;
-    bool reuse = true;
-    uint32_t reuseRefreshPeriod = 16;
-    bool fuseTonemap = true; // --fuse-tonemap on|off
-    bool animateLights = false;
-    OitMode oit = OitMode::Wboit;                                // --oit wboit|sorted
-    std::optional<uint64_t> shuffleDrawsSeed;                    // --shuffle-draws SEED
-    bool particles = true;                                       // --particles on|off
-    ParticleLighting particleLighting = ParticleLighting::Atlas; // --particle-lighting
-    uint32_t particleAtlasSize = 1024;                           // --particle-atlas-size
-    bool particleHalfRes = true;                                 // --particle-resolution half|full
-    LightCulling lightCulling = LightCulling::Tiled;             // --light-culling tiled|none
-    bool lightBlockers = true;                                   // --blockers on|off
-    bool lightGrid = true;                                       // --light-grid on|off
-    Spectra spectra = Spectra::Auto;                             // --spectra auto|on|off|single
-    bool sunSoftShadows = false;                                 // --sun-shadows pcf|pcss
-    bool spotShadows = true;                                     // --spot-shadows on|off
-    uint32_t sunCascades = 1;                                    // --sun-cascades 1..4
-    bool decals = true;                                          // --decals on|off
-    bool proxyShadows = true;                                    // --proxy-shadows on|off
-    ShadowCulling shadowCulling = ShadowCulling::PerView; // --shadow-culling per-view|whole-scene
     CameraPath cameraPath = CameraPath::Static;
     // --camera-cut NAME@FRAME: from that frame on the camera path starts from the scene's
     // camera NAME instead (a cut, with what the earlier frames streamed or cached still warm).
     std::string cutCamera;
     uint32_t cutFrame = 0;
-    GiMode gi = GiMode::Off;    // --gi lpv|off
-    uint32_t giIterations = 8;  // --gi-iterations
-    bool giBlockerCells = true; // --gi-blocker-cells on|off (off: every tap tests every blocker)
-    bool giLocalVolumes = true; // --gi-local-volumes on|off: the scene's fixed GI volumes
-    bool giSnap = true;         // --gi-snap on|off (off: debug, cascades slide with the camera)
-    std::vector<GiBlocker> giBlockers; // GI light blockers (no flag yet: scenes will carry them)
-    double shadelBudget = 64e6;        // MIP-0 shadels the bake may use for the whole scene
+    // --gi-local-volumes on|off: the scene's fixed GI volumes (RenderSettings::giLocalVolumes).
+    bool sceneGiVolumes = true;
+    double shadelBudget = 64e6; // MIP-0 shadels the bake may use for the whole scene
     bool printPasses = false;
     bool progress = true;
     uint32_t instances = 0; // builtin:many (--instances); 0 = the scene's default
-    bool lod = false;       // --lod: GPU LOD selection (render/culling)
-    bool occlusion = false; // --occlusion: two-phase hierarchical-Z culling (render/culling)
-    // Time the frame's CPU scopes (stats "cpu_scopes": the frontend's steps, each pass's
-    // recording) without writing a trace; --trace turns it on too. Each scope reads the thread's
-    // CPU clock, which adds to cpu_frame_ms.
-    bool cpuScopes = false;
-    uint32_t debugLines = 0; // --debug-lines: DEBUG_LINES_* kinds (render/debug/debug_lines.h)
-    uint32_t debugLineCapacity = 256 * 1024; // segments the line buffer holds (tests: smaller)
-    RtSettings rt;                  // --rt-*, --rays-per-shadel, --blas-pool-*: render/raytracing
-    bool screenSpace = false;       // --screen-space: sky, SSR, SSS (render/screenspace)
-    bool tileClassification = true; // --tile-classification: per-tile dispatch (render/tiles)
-    bool distanceFields = false;    // --distance-fields: DF shadows + AO (render/distance_fields)
-    float dfShadowStart = 40.0f;    // --df-shadow-start: metres beyond which the DF shadows apply
-    float dfResidency = 0.0f;       // --df-residency: metres (0: every field resident)
     // --stencil-effects on|fullscreen: water composite + character outline (render/stencil)
     StencilEffects stencilEffects = StencilEffects::Off;
     // Texture streaming (render/streaming): --texture-budget MiB (0 = none: every texture
@@ -112,9 +63,6 @@ struct RenderOptions {
     // resources (app/capture_output.h); files go to the dir or next to --out.
     std::vector<std::string> captures;
     std::string captureDir;
-    // --inspect X,Y: print what the shading computed at that output pixel (last frame).
-    int32_t inspectX = -1, inspectY = -1;
-    int32_t debugLinesAtX = -1, debugLinesAtY = -1; // --debug-lines-at X,Y
 };
 
 struct RenderRun {
@@ -124,29 +72,22 @@ struct RenderRun {
     std::vector<std::string> captureFiles; // written by --capture
 };
 
-// Parses "WxH"; throws InputError naming the flag.
-void parseSize(const std::string& text, uint32_t& width, uint32_t& height);
+// Choice options parsed as the option table's flags (app/option_table.h); InputError naming the
+// flag otherwise.
+void parseSize(const std::string& text, uint32_t& width, uint32_t& height); // --size WxH
 RenderMode parseMode(const std::string& text);
 const char* modeName(RenderMode mode); // "forward" | "decoupled"
 Visualize parseVisualize(const std::string& text);
 MarkingMode parseMarking(const std::string& text);
-// "X,Y" -> pixel; throws InputError naming --inspect.
+LightCulling parseLightCulling(const std::string& text);
+Spectra parseSpectra(const std::string& text);
+bool parseOnOff(const char* flag, const std::string& text); // "on" / "off"
 // The median of `values` (0 for none): the stats' per-frame figures.
 double median(std::vector<double> values);
-void parseInspect(const std::string& text, int32_t& x, int32_t& y);
 // --camera-cut "NAME@FRAME" -> camera name and frame (>= 1); one-line InputError otherwise.
 void parseCameraCut(const std::string& text, std::string& camera, uint32_t& frame);
 // "X,Y" of a pixel for `flag`; one-line InputError otherwise.
 void parsePixel(const char* flag, const std::string& text, int32_t& x, int32_t& y);
-OitMode parseOit(const std::string& text);
-ParticleLighting parseParticleLighting(const std::string& text);
-LightCulling parseLightCulling(const std::string& text);
-Spectra parseSpectra(const std::string& text);
-bool parseOnOff(const char* flag, const std::string& text); // "on" / "off", else InputError
-ShadowCulling parseShadowCulling(const std::string& text);  // per-view|whole-scene
-// "1".."4", else InputError naming --sun-cascades.
-uint32_t parseSunCascades(const std::string& text);
-GiMode parseGi(const std::string& text); // --gi lpv|off
 // The bake cache folder when --cache-dir is not given (see defaultBakeCacheDir()).
 std::string defaultCacheDir();
 
@@ -178,29 +119,21 @@ void writePng(const std::string& path, const std::vector<uint8_t>& rgba, uint32_
 // Per-pass table on stdout.
 void printPassTable(const nlohmann::json& stats);
 
-struct BenchOptions {
+// `shadel bench`: the settings every mode starts from (the option table sets them; each mode then
+// sets its own mode, reuse and compared setting) and the comparisons to run.
+struct BenchOptions : RenderSettings {
     std::string scene = "builtin:default";
     bool allowExternalFiles = false;
-    uint32_t width = 1280, height = 720;
+    bool addDefaultSun = true; // --sun auto|off
     uint32_t frames = 8;
     std::string camera;
     std::string json;
-    std::optional<TimingMode> timing;
-    uint32_t threads = 0;         // --threads N (0 = auto)
-    bool compareThreads = false;  // --threads compare: every mode serial and threaded
-    float shadelsPerMetre = 0.0f; // 0 = auto
-    std::string cacheDir;
+    std::optional<TimingMode> timing; // hides RenderSettings::timing (as RenderOptions)
+    uint32_t threads = 0;             // --threads N (0 = auto)
+    bool compareThreads = false;      // --threads compare: every mode serial and threaded
+    float shadelsPerMetre = 0.0f;     // 0 = auto
     CameraPath cameraPath = CameraPath::Static;
-    bool animateLights = false;
-    uint32_t reuseRefreshPeriod = 16;
     uint64_t cacheLimitBytes = 4ull << 30;
-    MarkingMode marking = MarkingMode::Auto; // decoupled and reuse modes
-    bool lightGrid = true;                   // --light-grid on|off
-    float shadingBias = 0.0f;                // decoupled and reuse modes
-    bool materialRate = true;                // --material-rate on|off: decoupled and reuse modes
-    bool sunShadowCache = true;              // --shadow-cache on|off: every mode
-    bool fuseTonemap = true;                 // --fuse-tonemap on|off: every mode
-    LightCulling lightCulling = LightCulling::Tiled;
     // --light-culling compare: forward and decoupled rendered again with no culling, and
     // ratios.light_culling_forward|decoupled = tiled / none median frame time.
     bool compareLightCulling = false;
@@ -210,10 +143,8 @@ struct BenchOptions {
     // --spectra compare: forward and decoupled (reuse off) also with --spectra on and single;
     // ratios.spectra_forward|spectra_decoupled = on / single median frame time (the
     // spectra against one all-features shader).
+    // (Without compare, --spectra auto|off sets RenderSettings::spectra, the three modes'.)
     bool compareSpectra = false;
-    // --spectra auto|off: the three modes' spectra (render's default, auto: on in decoupled
-    // frames with more than 64 lights).
-    Spectra spectra = Spectra::Auto;
     // --stencil-compare: forward with --screen-space on and the stencil effects, stencil-culled
     // and full-screen; ratios.stencil_outline|stencil_water = culled / full-screen pass time.
     bool compareStencil = false;
@@ -241,10 +172,9 @@ struct BenchOptions {
     std::vector<uint32_t> instanceScaling;
     std::vector<RenderMode> scalingModes = {RenderMode::Forward, RenderMode::Decoupled}; // --mode
     bool scalingOcclusion = true; // --occlusion on|off (instance scaling)
-    bool cpuScopes = false;       // --cpu-scopes (instance scaling): the frontend's steps timed
-    uint32_t sunCascades = 1;     // --sun-cascades, every mode
-    uint32_t instances = 0;       // --instances (builtin:many), every mode; 0 = the scene's default
-    std::string plot;             // --plot FILE.png: per-pass bar chart (app/bench_plot.h)
+    // RenderSettings::cpuScopes: --cpu-scopes (instance scaling), the frontend's steps timed.
+    uint32_t instances = 0; // --instances (builtin:many), every mode; 0 = the scene's default
+    std::string plot;       // --plot FILE.png: per-pass bar chart (app/bench_plot.h)
 };
 nlohmann::json runBench(Gpu& gpu, const BenchOptions& options);
 // "1000,10000,1000000" -> the counts for --instance-scaling, each 1..kManyMaxInstances and none

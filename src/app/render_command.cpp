@@ -10,6 +10,7 @@
 #include "app/capture_output.h"
 #include "app/cli_validate.h"
 #include "app/commands.h"
+#include "app/option_table.h"
 #include "app/output_files.h"
 #include "app/trace_export.h"
 #include "bake/bake.h"
@@ -30,88 +31,43 @@
 
 namespace shadel {
 
+namespace {
+// `text` parsed as the option table's `flag` would (app/option_table.h), into defaults.
+RenderSettings parsedSetting(const char* flag, const std::string& text) {
+    RenderSettings s;
+    bool sun = true;
+    parseSetting(flag, text, {s, sun});
+    return s;
+}
+} // namespace
+
 void parseSize(const std::string& text, uint32_t& width, uint32_t& height) {
-    unsigned w = 0, h = 0;
-    char x = 0, extra = 0;
-    int n = std::sscanf(text.c_str(), "%u%c%u%c", &w, &x, &h, &extra);
-    if (n != 3 || (x != 'x' && x != 'X'))
-        throw InputError(format("--size %s: expected WIDTHxHEIGHT, e.g. 1280x720", text.c_str()));
-    if (w < 1 || h < 1 || w > 16384 || h > 16384)
-        throw InputError(format("--size %s: each side must be between 1 and 16384", text.c_str()));
-    width = w, height = h;
+    RenderSettings s = parsedSetting("--size", text);
+    width = s.width, height = s.height;
 }
 
 RenderMode parseMode(const std::string& text) {
-    if (text == "forward") return RenderMode::Forward;
-    if (text == "decoupled") return RenderMode::Decoupled;
-    throw InputError(format("--mode %s: expected forward or decoupled", text.c_str()));
+    return parsedSetting("--mode", text).mode;
 }
 
 Visualize parseVisualize(const std::string& text) {
-    if (text == "none") return Visualize::None;
-    if (text == "marking") return Visualize::Marking;
-    if (text == "mips") return Visualize::Mips;
-    if (text == "chunks") return Visualize::Chunks;
-    if (text == "sheet") return Visualize::Sheet;
-    if (text == "layer:radiance") return Visualize::None; // the image is the radiance layer
-    if (text == "layer:material") return Visualize::LayerMaterial;
-    if (text == "light-count") return Visualize::LightCount;
-    if (text == "blockers") return Visualize::Blockers;
-    if (text == "gi") return Visualize::Gi;
-    if (text == "rt-ao") return Visualize::RtAo;
-    if (text == "particle-atlas") return Visualize::ParticleAtlas;
-    if (text == "tiles") return Visualize::Tiles;
-    if (text == "spectra") return Visualize::Spectra;
-    if (text == "reuse") return Visualize::Reuse;
-    throw InputError(format("--visualize %s: expected none, marking, mips, chunks, sheet, "
-                            "layer:radiance, layer:material, reuse, light-count, blockers, gi, "
-                            "rt-ao, particle-atlas, tiles or spectra",
-                            text.c_str()));
+    return parsedSetting("--visualize", text).visualize;
 }
 
 LightCulling parseLightCulling(const std::string& text) {
-    if (text == "tiled") return LightCulling::Tiled;
-    if (text == "none") return LightCulling::None;
-    throw InputError(format("--light-culling %s: expected tiled or none", text.c_str()));
+    return parsedSetting("--light-culling", text).lightCulling;
 }
 
 Spectra parseSpectra(const std::string& text) {
-    if (text == "off") return Spectra::Off;
-    if (text == "on") return Spectra::On;
-    if (text == "single") return Spectra::Single;
-    if (text == "auto") return Spectra::Auto;
-    throw InputError(format("--spectra %s: expected auto, on, off or single", text.c_str()));
+    return parsedSetting("--spectra", text).spectra;
 }
 
 bool parseOnOff(const char* flag, const std::string& text) {
-    if (text == "on") return true;
-    if (text == "off") return false;
-    throw InputError(format("%s %s: expected on or off", flag, text.c_str()));
-}
-
-ShadowCulling parseShadowCulling(const std::string& text) {
-    if (text == "per-view") return ShadowCulling::PerView;
-    if (text == "whole-scene") return ShadowCulling::WholeScene;
-    throw InputError(format("--shadow-culling %s: expected per-view or whole-scene", text.c_str()));
-}
-
-uint32_t parseSunCascades(const std::string& text) {
-    if (text.size() != 1 || text[0] < '1' || text[0] > '4')
-        throw InputError(format("--sun-cascades %s: expected 1, 2, 3 or 4", text.c_str()));
-    return uint32_t(text[0] - '0');
-}
-
-GiMode parseGi(const std::string& text) {
-    if (text == "off") return GiMode::Off;
-    if (text == "lpv") return GiMode::Lpv;
-    throw InputError(format("--gi %s: expected lpv or off", text.c_str()));
+    return parseChoice<bool>(flag, text, {{"on", true}, {"off", false}});
 }
 
 MarkingMode parseMarking(const std::string& text) {
-    if (text == "auto") return MarkingMode::Auto;
-    if (text == "raster") return MarkingMode::Raster;
-    if (text == "visibility") return MarkingMode::Visibility;
-    throw InputError(format("--marking %s: expected auto, raster or visibility", text.c_str()));
+    return parsedSetting("--marking", text).marking;
 }
 
 void parsePixel(const char* flag, const std::string& text, int32_t& x, int32_t& y) {
@@ -123,10 +79,6 @@ void parsePixel(const char* flag, const std::string& text, int32_t& x, int32_t& 
     x = int32_t(px), y = int32_t(py);
 }
 
-void parseInspect(const std::string& text, int32_t& x, int32_t& y) {
-    parsePixel("--inspect", text, x, y);
-}
-
 void parseCameraCut(const std::string& text, std::string& camera, uint32_t& frame) {
     size_t at = text.rfind('@');
     std::string digits = at == std::string::npos ? "" : text.substr(at + 1);
@@ -136,20 +88,6 @@ void parseCameraCut(const std::string& text, std::string& camera, uint32_t& fram
             "--camera-cut %s: expected CAMERA@FRAME (a scene camera, frame >= 1)", text.c_str()));
     camera = text.substr(0, at);
     frame = uint32_t(std::stoul(digits));
-}
-
-ParticleLighting parseParticleLighting(const std::string& text) {
-    if (text == "atlas") return ParticleLighting::Atlas;
-    if (text == "pixel") return ParticleLighting::Pixel;
-    if (text == "vertex") return ParticleLighting::Vertex;
-    throw InputError(
-        format("--particle-lighting %s: expected atlas, pixel or vertex", text.c_str()));
-}
-
-OitMode parseOit(const std::string& text) {
-    if (text == "wboit") return OitMode::Wboit;
-    if (text == "sorted") return OitMode::Sorted;
-    throw InputError(format("--oit %s: expected wboit or sorted", text.c_str()));
 }
 
 std::string defaultCacheDir() {
@@ -308,24 +246,11 @@ bool renderSessionDone(const RenderSession& session) {
     return session.run.listedCaptures || session.run.frames.size() >= session.o.frames;
 }
 
-RenderSessionPtr beginRender(Gpu& gpu, const RenderOptions& options) {
-    RenderSessionPtr sessionPtr(new RenderSession(gpu, options));
-    RenderSession& session = *sessionPtr;
+namespace {
+
+// Output folders made and every output file checked: fail before loading and rendering.
+void prepareOutputs(RenderSession& session) {
     const RenderOptions& o = session.o;
-    if (o.frames < 1 || o.frames > 100000)
-        throw InputError(format("--frames %u: expected 1..100000", o.frames));
-    if (o.ssaa < 1 || o.ssaa > 16) throw InputError(format("--ssaa %u: expected 1..16", o.ssaa));
-    validateRenderOptions(o);
-    if (o.inspectX >= int32_t(o.width) || o.inspectY >= int32_t(o.height))
-        throw InputError(format("--inspect %d,%d: outside the %ux%u image", o.inspectX, o.inspectY,
-                                o.width, o.height));
-    if (o.debugLinesAtX >= 0 && (o.debugLines & (DEBUG_LINES_LIGHTS | DEBUG_LINES_BLOCKERS)) == 0)
-        throw InputError(format("--debug-lines-at %d,%d: picks lights, so it needs --debug-lines "
-                                "lights or blockers",
-                                o.debugLinesAtX, o.debugLinesAtY));
-    if (o.debugLinesAtX >= int32_t(o.width) || o.debugLinesAtY >= int32_t(o.height))
-        throw InputError(format("--debug-lines-at %d,%d: outside the %ux%u image", o.debugLinesAtX,
-                                o.debugLinesAtY, o.width, o.height));
     bool& outDir = session.outDir;
     outDir = !o.out.empty() && o.out.back() == '/';
     if (outDir) {
@@ -340,22 +265,27 @@ RenderSessionPtr beginRender(Gpu& gpu, const RenderOptions& options) {
     if (!o.stats.empty()) requireCreatableOutput("--stats", o.stats);
     if (!o.trace.empty()) requireCreatableOutput("--trace", o.trace);
     bool listCaptures = o.captures.size() == 1 && o.captures[0] == "list";
-    if (!o.captures.empty() && !listCaptures) {
-        if (o.captureDir.empty() && o.out.empty())
-            throw InputError("--capture: needs --capture-dir DIR or --out (files go next to it)");
-        if (!o.captureDir.empty()) {
-            std::error_code ec;
-            std::filesystem::create_directories(o.captureDir, ec);
-            if (ec)
-                throw InputError(format("--capture-dir %s: cannot create (%s)",
-                                        o.captureDir.c_str(), ec.message().c_str()));
-        }
+    if (!o.captures.empty() && !listCaptures && !o.captureDir.empty()) {
+        std::error_code ec;
+        std::filesystem::create_directories(o.captureDir, ec);
+        if (ec)
+            throw InputError(format("--capture-dir %s: cannot create (%s)", o.captureDir.c_str(),
+                                    ec.message().c_str()));
     }
+}
+
+// The scene, the camera (and the cut's) and the bounds that fix the camera path.
+void loadRunScene(RenderSession& session) {
+    const RenderOptions& o = session.o;
     BuiltinSceneOptions builtin;
     builtin.instances = o.instances;
     builtin.galleryTextureSize = o.galleryTextureSize;
     Scene& scene = session.scene;
-    scene = loadScene(o.scene, {o.allowExternalFiles, o.time}, builtin);
+    scene = loadScene(o.scene,
+                      {.allowExternalFiles = o.allowExternalFiles,
+                       .time = o.time,
+                       .addDefaultSun = o.addDefaultSun},
+                      builtin);
     Camera& camera = session.camera;
     camera = runCamera(scene, o.camera, o.cameraOverrides, float(o.width) / float(o.height));
     std::optional<Camera>& cutCamera = session.cutCamera;
@@ -369,9 +299,16 @@ RenderSessionPtr beginRender(Gpu& gpu, const RenderOptions& options) {
     // The camera path is fixed by the loaded scene's bounds (chunking does not move it).
     Aabb& bounds = session.bounds;
     bounds = scene.worldBounds();
+}
 
+// The view-driven density (auto) and, decoupled, the bake.
+void densityAndBake(RenderSession& session) {
+    const RenderOptions& o = session.o;
+    Scene& scene = session.scene;
+    const Camera& camera = session.camera;
+    const std::optional<Camera>& cutCamera = session.cutCamera;
+    const Aabb& bounds = session.bounds;
     std::vector<BakedMesh>& baked = session.baked;
-    GpuScene& gpuScene = session.gpuScene;
     float& density = session.density;
     bool& autoDensity = session.autoDensity;
     autoDensity = !(o.shadelsPerMetre > 0.0f);
@@ -430,6 +367,15 @@ RenderSessionPtr beginRender(Gpu& gpu, const RenderOptions& options) {
         bakeSeconds =
             std::chrono::duration<double>(std::chrono::steady_clock::now() - bakeStart).count();
     }
+}
+
+// Texture streaming, the upload, and animated playback.
+void uploadRunScene(RenderSession& session) {
+    const RenderOptions& o = session.o;
+    Gpu& gpu = session.gpu;
+    Scene& scene = session.scene;
+    GpuScene& gpuScene = session.gpuScene;
+    const std::vector<BakedMesh>& baked = session.baked;
     // Texture streaming (render/streaming): with a budget, or for textures that exist only as a
     // streaming file (builtin:textures); otherwise textures load whole as before.
     TextureStreamingPtr& streaming = session.streaming;
@@ -449,62 +395,25 @@ RenderSessionPtr beginRender(Gpu& gpu, const RenderOptions& options) {
     // --time-step: the file posed again before every frame after the first (render/animation).
     std::optional<ScenePlayback>& playback = session.playback;
     if (o.timeStep)
-        playback = startPlayback(o.scene, {o.allowExternalFiles, o.time}, o.time.value_or(0.0),
-                                 *o.timeStep, scene);
+        playback = startPlayback(o.scene,
+                                 {.allowExternalFiles = o.allowExternalFiles,
+                                  .time = o.time,
+                                  .addDefaultSun = o.addDefaultSun},
+                                 o.time.value_or(0.0), *o.timeStep, scene);
+}
 
+// The renderer's settings: the options' own, then what the run and the scene resolve.
+void resolveSettings(RenderSession& session) {
+    const RenderOptions& o = session.o;
+    const Scene& scene = session.scene;
+    Gpu& gpu = session.gpu;
     RenderSettings& settings = session.settings;
-    settings.width = o.width;
-    settings.height = o.height;
-    settings.ssaa = o.ssaa;
-    settings.mode = o.mode;
-    settings.marking = o.marking;
-    settings.visualize = o.visualize;
-    settings.exposure = o.exposure;
-    settings.cacheDir = o.cacheDir;
-    settings.shadeStorageSize = o.shadeStorageSize;
-    settings.sheetShadels = o.sheetShadels;
-    settings.shadingBias = o.shadingBias;
-    settings.trilinearBand = o.trilinearBand;
-    settings.materialSamples = o.materialSamples;
-    settings.forwardBelowPixels = o.forwardBelowPixels;
-    settings.allocationCounters = o.allocationCounters;
-    settings.sheetAllMips = o.sheetAllMips;
-    settings.levelWindows = o.levelWindows;
-    settings.materialRate = o.materialRate;
-    settings.capacityControl = o.capacityControl;
-    settings.reuse = o.reuse;
-    settings.reuseRefreshPeriod = o.reuseRefreshPeriod;
-    settings.animateLights = o.animateLights;
-    settings.inspectX = o.inspectX;
-    settings.inspectY = o.inspectY;
-    settings.oit = o.oit;
-    settings.shuffleDraws = o.shuffleDrawsSeed.has_value();
-    settings.shuffleSeed = o.shuffleDrawsSeed.value_or(0);
-    settings.lightCulling = o.lightCulling;
-    settings.particles = o.particles;
-    settings.particleLighting = o.particleLighting;
-    settings.particleAtlasSize = o.particleAtlasSize;
-    settings.particleHalfRes = o.particleHalfRes;
-    settings.lightBlockers = o.lightBlockers;
-    settings.lightGrid = o.lightGrid;
-    settings.spectra = o.spectra;
-    settings.sunSoftShadows = o.sunSoftShadows;
-    settings.spotShadows = o.spotShadows;
-    settings.sunCascades = o.sunCascades;
-    settings.decals = o.decals;
-    settings.proxyShadows = o.proxyShadows;
-    settings.shadowCulling = o.shadowCulling;
-    settings.sunShadowCache = o.sunShadowCache;
+    settings = o; // the option table's settings, then what the run resolves
     // The scene colour is read back whole for --capture and EXR output: not fused there.
     settings.fuseTonemap = o.fuseTonemap && o.captures.empty() && !isExrPath(o.out);
     // The trace's finer CPU spans (stats "cpu_scopes").
     settings.cpuScopes = !o.trace.empty() || o.cpuScopes;
-    settings.gi = o.gi;
-    settings.giIterations = o.giIterations;
-    settings.giSnap = o.giSnap;
-    settings.giBlockerCells = o.giBlockerCells;
     // GI stops at the scene's light blockers too (and passes their portals), as direct light.
-    settings.giBlockers = o.giBlockers;
     if (o.lightBlockers && o.gi != GiMode::Off) {
         std::vector<GiBlocker> fromScene = giBlockersOf(scene);
         size_t room = GI_MAX_BLOCKERS > settings.giBlockers.size()
@@ -516,27 +425,25 @@ RenderSessionPtr beginRender(Gpu& gpu, const RenderOptions& options) {
         fromScene.resize(std::min(fromScene.size(), room));
         settings.giBlockers.insert(settings.giBlockers.end(), fromScene.begin(), fromScene.end());
     }
-    if (o.giLocalVolumes && o.gi != GiMode::Off) { // the artist's fixed volumes (render/gi)
+    if (o.sceneGiVolumes && o.gi != GiMode::Off) { // the artist's fixed volumes (render/gi)
         size_t dropped = 0;
         settings.giLocalVolumes = giLocalVolumesOf(scene, dropped);
         if (dropped)
             SHADEL_WARN("GI: the scene has %zu local volumes; GI uses the first %u",
                         scene.giVolumes.size(), GI_MAX_LOCAL_VOLUMES);
     }
-    settings.lod = o.lod;
-    settings.occlusion = o.occlusion;
-    settings.debugLines = o.debugLines;
-    settings.debugLinesAtX = o.debugLinesAtX;
-    settings.debugLinesAtY = o.debugLinesAtY;
-    settings.debugLineCapacity = o.debugLineCapacity;
-    settings.rt = o.rt;
-    settings.screenSpace = o.screenSpace;
-    settings.tileClassification = o.tileClassification;
-    settings.distanceFieldLighting = o.distanceFields;
-    settings.dfShadowStart = o.dfShadowStart;
-    settings.dfResidencyDistance = o.dfResidency;
-    settings.timing = o.timing ? *o.timing : defaultTimingMode(gpu);
+    settings.timing = o.timing ? *o.timing : defaultTimingMode(gpu); // (RenderOptions::timing)
     settings.recordingThreads = o.threads ? o.threads : defaultRecordingThreads();
+}
+
+// Builds the renderer (its pipelines: seconds on a CPU device, so it says so).
+void buildRenderer(RenderSession& session) {
+    const RenderOptions& o = session.o;
+    Gpu& gpu = session.gpu;
+    const Scene& scene = session.scene;
+    GpuScene& gpuScene = session.gpuScene;
+    const RenderSettings& settings = session.settings;
+    const TextureStreamingPtr& streaming = session.streaming;
     Renderer& renderer = session.renderer;
     const PipelineLibraryCounters pipelinesBefore = pipelineLibraryCounters(gpu);
     session.tty = isatty(STDERR_FILENO);
@@ -547,7 +454,7 @@ RenderSessionPtr beginRender(Gpu& gpu, const RenderOptions& options) {
     try {
         session.rendererLive = true; // (destroyRenderer takes a half-built one)
         initRenderer(renderer, gpu, settings, gpuScene);
-        if (o.distanceFields)
+        if (o.distanceFieldLighting)
             renderer.distanceFields = createDistanceFields(
                 renderer, scene, gpuScene, o.cacheDir.empty() ? defaultCacheDir() : o.cacheDir);
         if (o.stencilEffects != StencilEffects::Off)
@@ -574,6 +481,23 @@ RenderSessionPtr beginRender(Gpu& gpu, const RenderOptions& options) {
         if (buildingLine) std::fprintf(stderr, "\n"); // the error gets a line of its own
         throw;
     }
+}
+
+} // namespace
+
+RenderSessionPtr beginRender(Gpu& gpu, const RenderOptions& options) {
+    RenderSessionPtr sessionPtr(new RenderSession(gpu, options));
+    RenderSession& session = *sessionPtr;
+    const RenderOptions& o = session.o;
+    validate(o);
+    prepareOutputs(session);
+    loadRunScene(session);
+    densityAndBake(session);
+    uploadRunScene(session);
+    resolveSettings(session);
+    buildRenderer(session);
+    Renderer& renderer = session.renderer;
+    bool listCaptures = o.captures.size() == 1 && o.captures[0] == "list";
     if (listCaptures) {
         std::printf("%s", captureListing(renderer.captures).c_str());
         session.run.listedCaptures = true;
@@ -632,6 +556,125 @@ void renderNextFrame(RenderSession& session) {
     if (o.progress && o.frames > 1 && session.tty && i + 1 == o.frames) std::fprintf(stderr, "\n");
 }
 
+namespace {
+
+// Frame, CPU, recording and per-pass times: medians over the frames.
+void frameTimingStats(const std::vector<FrameResult>& frames, const RenderSettings& settings,
+                      nlohmann::json& s) {
+    std::vector<double> frameMs;
+    for (auto& f : frames) frameMs.push_back(f.frameMs);
+    std::vector<double> cpuMs;
+    for (auto& f : frames) cpuMs.push_back(f.cpuFrameMs);
+    s["cpu_frame_ms"] = median(cpuMs); // CPU time producing a frame, GPU waits excluded
+    std::vector<double> threadMs;
+    for (auto& f : frames) threadMs.push_back(f.cpuThreadMs);
+    s["cpu_frame_thread_ms"] = median(threadMs); // the same, as the thread's CPU clock counts it
+    // Render threading (rhi/frame.h): with more than one thread the passes are recorded in
+    // parallel; the wall clock of that and the CPU time each worker spent recording.
+    std::vector<double> recordingMs, recordingCpuMs;
+    for (auto& f : frames) {
+        recordingMs.push_back(f.recordingMs);
+        double cpu = 0.0;
+        for (const RecordingWorkerTiming& w : f.recordingWorkers) cpu += w.cpuMs;
+        recordingCpuMs.push_back(cpu);
+    }
+    s["recording"] = {{"threads", settings.recordingThreads},
+                      {"wall_ms", median(recordingMs)},
+                      {"workers_cpu_ms", median(recordingCpuMs)}};
+    s["cpu_scopes"] = cpuScopeStats(frames);
+    std::vector<double> streamingMs;
+    for (auto& f : frames) streamingMs.push_back(f.cpuStreamingMs);
+    s["cpu_streaming_thread_ms"] = median(streamingMs); // of which the texture streaming frontend
+    s["frame_ms"] = {{"median", median(frameMs)},
+                     {"min", *std::min_element(frameMs.begin(), frameMs.end())},
+                     {"max", *std::max_element(frameMs.begin(), frameMs.end())}};
+    // Per pass, the median over the frames that ran it, matched by name (and occurrence within
+    // the frame): frames differ in their pass lists (spot shadow maps are drawn only when they
+    // change, the first frame builds what later frames reuse), so the i-th pass of one frame
+    // is not the i-th of another. Listed in order of first appearance.
+    std::vector<std::pair<std::string, int>> passKeys;
+    std::map<std::pair<std::string, int>, std::vector<double>> passMs, recordCpuMs;
+    for (auto& f : frames) {
+        std::map<std::string, int> seen;
+        for (auto& pt : f.passes) {
+            std::pair<std::string, int> key{pt.name, seen[pt.name]++};
+            auto [it, added] = passMs.try_emplace(key);
+            if (added) passKeys.push_back(key);
+            it->second.push_back(pt.gpuMs);
+            recordCpuMs[key].push_back(pt.recordCpuMs);
+        }
+    }
+    nlohmann::json passes = nlohmann::json::array();
+    for (auto& key : passKeys) {
+        const std::vector<double>& ms = passMs[key];
+        nlohmann::json p = {{"name", key.first}, {"gpu_ms", median(ms)}, {"frames", ms.size()}};
+        // Threaded recording times every pass; serial recording with --trace.
+        if (settings.recordingThreads > 1 || settings.cpuScopes)
+            p["record_cpu_ms"] = median(recordCpuMs[key]);
+        passes.push_back(p);
+    }
+    s["passes"] = passes;
+}
+
+// --inspect: what the shading computed at the pixel in the last frame, printed and returned.
+nlohmann::json printInspectedPixel(const RenderOptions& o, const FrameResult& last) {
+    nlohmann::json prints = nlohmann::json::array();
+    InspectedPixel pixel = frontFragment(last.prints);
+    std::printf("--inspect %d,%d (%s, last frame, the front of %u fragment(s) shaded "
+                "there):\n",
+                o.inspectX, o.inspectY, modeName(o.mode), pixel.fragments);
+    for (const ShaderPrint& p : pixel.prints) {
+        std::printf("  %s\n", p.text().c_str());
+        std::vector<double> values;
+        for (uint32_t i = 0; i < p.count; ++i) values.push_back(p.f(int(i)));
+        prints.push_back({{"label", printLabelName(p.label)},
+                          {"values", values},
+                          {"shader", shaderName(p.shaderId)},
+                          {"line", p.line}});
+    }
+    if (pixel.prints.empty()) std::printf("  nothing was shaded at this pixel (background)\n");
+    return prints;
+}
+
+// The stats of the features a run may use: playback, skinning, GI, ray tracing, screen-space
+// passes, distance fields, texture memory.
+void featureStats(const RenderSession& session, nlohmann::json& s) {
+    const Gpu& gpu = session.gpu;
+    const Renderer& renderer = session.renderer;
+    const GpuScene& gpuScene = session.gpuScene;
+    const std::optional<ScenePlayback>& playback = session.playback;
+    const TextureStreamingPtr& streaming = session.streaming;
+    if (playback)
+        s["animation"] = {{"time_start", playback->startTime},
+                          {"time_step", playback->step},
+                          {"instances_reposed", playback->instancesReposed},
+                          {"meshes_reposed", playback->meshesReposed},
+                          {"vertices_written", playback->verticesWritten},
+                          // The next frame's import on the frontend worker, beside this frame.
+                          {"frontend_prefetched", playback->prefetched},
+                          {"frontend_worker_cpu_ms", playback->prefetchCpuMs},
+                          {"frontend_wait_ms", playback->prefetchWaitMs}};
+    s["points_lines_vertices"] =
+        renderer.pointsLines ? pointsLinesVertexCount(*renderer.pointsLines) : 0u;
+    s["skinning"] = {
+        {"mode", renderer.skinning ? "gpu" : "cpu"},
+        {"gpu_vertices", renderer.skinning ? skinnedVertexCount(*renderer.skinning) : 0u}};
+    if (renderer.gi) giStats(renderer, s);
+    if (renderer.rt) rayTracingStats(renderer, s);
+    if (renderer.screenSpace) screenSpaceStats(renderer, s);
+    if (renderer.distanceFields) distanceFieldStats(*renderer.distanceFields, s);
+    if (streaming) {
+        textureStreamingStats(*streaming, s);
+    } else { // textures loaded whole (RGBA8 with MIPs, what the images need at least)
+        uint64_t bytes = 0;
+        for (TextureHandle t : gpuScene.textures)
+            if (t) bytes += uint64_t(desc(gpu, t).width) * desc(gpu, t).height * 4 * 4 / 3;
+        s["texture_memory_peak_bytes"] = bytes;
+    }
+}
+
+} // namespace
+
 RenderRun finishRender(RenderSessionPtr sessionPtr) {
     RenderSession& session = *sessionPtr;
     if (session.run.listedCaptures) return std::move(session.run);
@@ -649,8 +692,6 @@ RenderRun finishRender(RenderSessionPtr sessionPtr) {
     GpuScene& gpuScene = session.gpuScene;
     const bool autoDensity = session.autoDensity;
     const ViewDensity& viewDensity = session.viewDensity;
-    const std::optional<ScenePlayback>& playback = session.playback;
-    const TextureStreamingPtr& streaming = session.streaming;
     const std::vector<BakedMesh>& baked = session.baked;
     const float density = session.density;
     const double bakeSeconds = session.bakeSeconds;
@@ -682,60 +723,10 @@ RenderRun finishRender(RenderSessionPtr sessionPtr) {
     s["height"] = o.height;
     s["ssaa"] = o.ssaa;
     s["frames"] = o.frames;
+    // What the run was asked for, every option of the table (app/option_table.h).
+    s["settings"] = settingsJson({o, o.addDefaultSun}, kRenderCommand);
     s["timing"] = settings.timing == TimingMode::Timestamps ? "timestamps" : "submit-per-pass";
-    std::vector<double> frameMs;
-    for (auto& f : run.frames) frameMs.push_back(f.frameMs);
-    std::vector<double> cpuMs;
-    for (auto& f : run.frames) cpuMs.push_back(f.cpuFrameMs);
-    s["cpu_frame_ms"] = median(cpuMs); // CPU time producing a frame, GPU waits excluded
-    std::vector<double> threadMs;
-    for (auto& f : run.frames) threadMs.push_back(f.cpuThreadMs);
-    s["cpu_frame_thread_ms"] = median(threadMs); // the same, as the thread's CPU clock counts it
-    // Render threading (rhi/frame.h): with more than one thread the passes are recorded in
-    // parallel; the wall clock of that and the CPU time each worker spent recording.
-    std::vector<double> recordingMs, recordingCpuMs;
-    for (auto& f : run.frames) {
-        recordingMs.push_back(f.recordingMs);
-        double cpu = 0.0;
-        for (const RecordingWorkerTiming& w : f.recordingWorkers) cpu += w.cpuMs;
-        recordingCpuMs.push_back(cpu);
-    }
-    s["recording"] = {{"threads", settings.recordingThreads},
-                      {"wall_ms", median(recordingMs)},
-                      {"workers_cpu_ms", median(recordingCpuMs)}};
-    s["cpu_scopes"] = cpuScopeStats(run.frames);
-    std::vector<double> streamingMs;
-    for (auto& f : run.frames) streamingMs.push_back(f.cpuStreamingMs);
-    s["cpu_streaming_thread_ms"] = median(streamingMs); // of which the texture streaming frontend
-    s["frame_ms"] = {{"median", median(frameMs)},
-                     {"min", *std::min_element(frameMs.begin(), frameMs.end())},
-                     {"max", *std::max_element(frameMs.begin(), frameMs.end())}};
-    // Per pass, the median over the frames that ran it, matched by name (and occurrence within
-    // the frame): frames differ in their pass lists (spot shadow maps are drawn only when they
-    // change, the first frame builds what later frames reuse), so the i-th pass of one frame
-    // is not the i-th of another. Listed in order of first appearance.
-    std::vector<std::pair<std::string, int>> passKeys;
-    std::map<std::pair<std::string, int>, std::vector<double>> passMs, recordCpuMs;
-    for (auto& f : run.frames) {
-        std::map<std::string, int> seen;
-        for (auto& pt : f.passes) {
-            std::pair<std::string, int> key{pt.name, seen[pt.name]++};
-            auto [it, added] = passMs.try_emplace(key);
-            if (added) passKeys.push_back(key);
-            it->second.push_back(pt.gpuMs);
-            recordCpuMs[key].push_back(pt.recordCpuMs);
-        }
-    }
-    nlohmann::json passes = nlohmann::json::array();
-    for (auto& key : passKeys) {
-        const std::vector<double>& ms = passMs[key];
-        nlohmann::json p = {{"name", key.first}, {"gpu_ms", median(ms)}, {"frames", ms.size()}};
-        // Threaded recording times every pass; serial recording with --trace.
-        if (settings.recordingThreads > 1 || settings.cpuScopes)
-            p["record_cpu_ms"] = median(recordCpuMs[key]);
-        passes.push_back(p);
-    }
-    s["passes"] = passes;
+    frameTimingStats(run.frames, settings, s);
     uint64_t asserts = 0;
     for (auto& f : run.frames) asserts += f.shaderAsserts;
     s["pixels_covered"] = run.frames.back().pixelsCovered;
@@ -795,51 +786,8 @@ RenderRun finishRender(RenderSessionPtr sessionPtr) {
         s["mip0_shadels"] = mip0;
         s["id_map_bytes"] = gpuScene.idMapBytes;
     }
-    if (playback)
-        s["animation"] = {{"time_start", playback->startTime},
-                          {"time_step", playback->step},
-                          {"instances_reposed", playback->instancesReposed},
-                          {"meshes_reposed", playback->meshesReposed},
-                          {"vertices_written", playback->verticesWritten},
-                          // The next frame's import on the frontend worker, beside this frame.
-                          {"frontend_prefetched", playback->prefetched},
-                          {"frontend_worker_cpu_ms", playback->prefetchCpuMs},
-                          {"frontend_wait_ms", playback->prefetchWaitMs}};
-    s["points_lines_vertices"] =
-        renderer.pointsLines ? pointsLinesVertexCount(*renderer.pointsLines) : 0u;
-    s["skinning"] = {
-        {"mode", renderer.skinning ? "gpu" : "cpu"},
-        {"gpu_vertices", renderer.skinning ? skinnedVertexCount(*renderer.skinning) : 0u}};
-    if (renderer.gi) giStats(renderer, s);
-    if (renderer.rt) rayTracingStats(renderer, s);
-    if (renderer.screenSpace) screenSpaceStats(renderer, s);
-    if (renderer.distanceFields) distanceFieldStats(*renderer.distanceFields, s);
-    if (streaming) {
-        textureStreamingStats(*streaming, s);
-    } else { // textures loaded whole (RGBA8 with MIPs, what the images need at least)
-        uint64_t bytes = 0;
-        for (TextureHandle t : gpuScene.textures)
-            if (t) bytes += uint64_t(desc(gpu, t).width) * desc(gpu, t).height * 4 * 4 / 3;
-        s["texture_memory_peak_bytes"] = bytes;
-    }
-    if (o.inspectX >= 0) {
-        nlohmann::json prints = nlohmann::json::array();
-        InspectedPixel pixel = frontFragment(run.frames.back().prints);
-        std::printf("--inspect %d,%d (%s, last frame, the front of %u fragment(s) shaded "
-                    "there):\n",
-                    o.inspectX, o.inspectY, modeName(o.mode), pixel.fragments);
-        for (const ShaderPrint& p : pixel.prints) {
-            std::printf("  %s\n", p.text().c_str());
-            std::vector<double> values;
-            for (uint32_t i = 0; i < p.count; ++i) values.push_back(p.f(int(i)));
-            prints.push_back({{"label", printLabelName(p.label)},
-                              {"values", values},
-                              {"shader", shaderName(p.shaderId)},
-                              {"line", p.line}});
-        }
-        if (pixel.prints.empty()) std::printf("  nothing was shaded at this pixel (background)\n");
-        s["inspect"] = prints;
-    }
+    featureStats(session, s);
+    if (o.inspectX >= 0) s["inspect"] = printInspectedPixel(o, run.frames.back());
     run.stats = s;
 
     // The device's memory back before the files are written (as before the steps existed).

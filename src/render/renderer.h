@@ -120,7 +120,9 @@ struct RenderSettings {
     // material rate shades coarser blend over a narrower band, one level at its full bias
     // (shadelLevels in shaders/shadel/shadel.glsl).
     float trilinearBand = 0.5f;
-    uint32_t materialSamples = 4; // decoupled: material evaluations per shadel above MIP 0
+    // decoupled: cap of material evaluations per shadel above MIP 0 (procedurals are
+    // supersampled in proportion to their footprint, shaders/shadel/prefilter.glsl)
+    uint32_t materialSamples = 16;
     float forwardBelowPixels = 8; // decoupled: objects smaller on screen drawn forward (0 = never)
     uint32_t allocationCounters = SHADEL_COUNTERS; // decoupled: hashed counters used (tests)
     bool sheetAllMips = false; // decoupled: rects at every MIP (the old policy, for comparison)

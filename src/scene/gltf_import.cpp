@@ -841,9 +841,11 @@ class GltfConverter {
 public:
     // `skinning`: skinned meshes are posed by their joints (with --time); otherwise drawn in
     // their bind pose.
+    // `addDefaultSun`: a file without a directional light gets "auto-sun" (--sun auto).
     GltfConverter(const tinygltf::Model& model, const std::string& input, Scene& scene,
-                  bool skinning = false)
-        : model_(model), input_(input), scene_(scene), skinning_(skinning) {}
+                  bool skinning, bool addDefaultSun)
+        : model_(model), input_(input), scene_(scene), skinning_(skinning),
+          addDefaultSun_(addDefaultSun) {}
 
     void run() {
         for (size_t i = 0; i < model_.accessors.size(); ++i) validateAccessor(int(i));
@@ -887,6 +889,7 @@ private:
     std::set<std::string> warnedOnce_;
     std::vector<bool> cameraZfarGiven_;
     bool skinning_ = false;
+    bool addDefaultSun_ = true;
     std::vector<glm::mat4> worldOf_; // every node's world transform (identity if unreached)
 
     [[noreturn]] void error(const std::string& reason) { fail(input_, reason); }
@@ -1728,7 +1731,10 @@ private:
             SHADEL_INFO("%s: no camera in the file; using an automatic one framing the scene",
                         input_.c_str());
         }
-        if (scene_.lights.empty()) {
+        bool directional =
+            std::any_of(scene_.lights.begin(), scene_.lights.end(),
+                        [](const Light& l) { return l.type == LightType::Directional; });
+        if (addDefaultSun_ && !directional) {
             Light sun;
             sun.name = "auto-sun";
             sun.type = LightType::Directional;
@@ -1736,7 +1742,8 @@ private:
             sun.intensity = 3.0f;
             sun.castsShadow = true;
             scene_.lights.push_back(sun);
-            SHADEL_INFO("%s: no light in the file; adding a default sun", input_.c_str());
+            SHADEL_INFO("%s: no directional light in the file; adding a default sun",
+                        input_.c_str());
         }
     }
 };
@@ -1796,7 +1803,7 @@ Scene importGltfBytes(std::vector<uint8_t> bytes, const std::string& path,
     Scene scene;
     scene.name = std::filesystem::path(path).stem().string();
     if (!extensionsWarning.empty()) SHADEL_WARN("%s: %s", input.c_str(), extensionsWarning.c_str());
-    GltfConverter(model, input, scene, options.time.has_value()).run();
+    GltfConverter(model, input, scene, options.time.has_value(), options.addDefaultSun).run();
     return scene;
 }
 

@@ -25,7 +25,8 @@ struct SceneFileOptions {
 //
 // The node hierarchy is flattened to instances with world transforms; a primitive becomes one
 // Mesh (split into parts of at most kMaxTrianglesPerMesh triangles). A file without cameras
-// gets an "auto" camera framing the scene, one without lights an "auto-sun".
+// gets an "auto" camera framing the scene, one without a directional light an "auto-sun"
+// (unless SceneFileOptions::addDefaultSun is off).
 Scene importGltf(const std::string& path, const SceneFileOptions& options = {});
 
 // The same for the file's contents already in memory (the fuzz target): `path` names the input

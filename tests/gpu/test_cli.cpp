@@ -194,7 +194,7 @@ TEST(Cli, ParserErrorsAreOneLineAndExitCode2) {
 TEST(Cli, FloatFlagsMustBeFiniteAndInRange) {
     const std::pair<const char*, const char*> cases[] = {
         {"render --exposure nan", "--exposure"},
-        {"render --exposure 0", "--exposure"},
+        {"render --exposure 21", "--exposure"}, // EV: 2^21 is beyond the range
         {"render --exposure inf", "--exposure"},
         {"render --shading-bias nan", "--shading-bias"},
         {"render --shading-bias 1e30", "--shading-bias"},
@@ -210,6 +210,52 @@ TEST(Cli, FloatFlagsMustBeFiniteAndInRange) {
         {"bake --shadel-budget 0 builtin:smooth", "--shadel-budget"},
     };
     for (auto [args, flag] : cases) expectOneLineError(args, flag); // names the flag
+}
+
+// The image-based lighting, tone curve, background, shadow and sun options: a bad value is one
+// line naming the option (before the scene is loaded: the scene here does not exist).
+TEST(Cli, EnvironmentToneAndBackgroundOptionsRejectBadValues) {
+    const std::pair<const char*, const char*> cases[] = {
+        {"render --scene /nonexistent.gltf --environment /nonexistent/sky.hdr",
+         "--environment /nonexistent/sky.hdr: no such file"},
+        {"render --scene /nonexistent.gltf --environment sky.png",
+         "--environment sky.png: expected builtin:sky, none or an equirectangular .hdr"},
+        {"render --scene /nonexistent.gltf --environment-intensity -1",
+         "--environment-intensity -1"},
+        {"render --scene /nonexistent.gltf --environment-intensity nan",
+         "--environment-intensity nan"},
+        {"render --scene /nonexistent.gltf --environment-rotation inf",
+         "--environment-rotation inf"},
+        {"render --scene /nonexistent.gltf --tonemap sepia",
+         "--tonemap sepia: expected aces-narkowicz, aces-hill, khr-pbr-neutral or linear"},
+        {"render --scene /nonexistent.gltf --background 2,0,0", "--background 2,0,0"},
+        {"render --scene /nonexistent.gltf --background red", "--background red"},
+        {"render --scene /nonexistent.gltf --shadows maybe", "--shadows maybe: expected on or off"},
+        {"render --scene /nonexistent.gltf --sun sometimes",
+         "--sun sometimes: expected auto or off"},
+        {"bench --scene /nonexistent.gltf --tonemap sepia", "--tonemap sepia"},
+        {"view --scene /nonexistent.gltf --exposure nan", "--exposure nan"},
+    };
+    for (auto [args, message] : cases) expectOneLineError(args, message);
+}
+
+// The stats echo every option of the table as the run was asked for it: --exposure in EV, the
+// tone curve and background by name, on/off options as booleans.
+TEST(Cli, StatsEchoTheSettingsAsGiven) {
+    CliTempDir dir;
+    Output o = runWithEnv("", "render --size 32x18 --exposure 1.5 --tonemap khr-pbr-neutral "
+                              "--background 0.25,0.5,1 --shadows off --sun off --stats " +
+                                  dir.file("s.json"));
+    ASSERT_EQ(o.exitCode, 0) << o.stderrText;
+    nlohmann::json settings = nlohmann::json::parse(readText(dir.file("s.json")))["settings"];
+    EXPECT_NEAR(settings["exposure"].get<double>(), 1.5, 1e-6); // through a float 2^EV
+    EXPECT_EQ(settings["tonemap"], "khr-pbr-neutral");
+    EXPECT_EQ(settings["background"], nlohmann::json({0.25, 0.5, 1.0}));
+    EXPECT_EQ(settings["shadows"], false);
+    EXPECT_EQ(settings["sun"], false);
+    EXPECT_EQ(settings["environment"], "builtin:sky");
+    EXPECT_EQ(settings["material-samples"], 16);
+    EXPECT_EQ(settings["size"], nlohmann::json({32, 18}));
 }
 
 // OVERVIEW documents --forward-below; it was rejected as unknown.

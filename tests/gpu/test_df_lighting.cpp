@@ -14,7 +14,7 @@ RenderOptions withFields(const char* scene, RenderMode mode, float shadowStart, 
                          uint32_t h) {
     RenderOptions o = renderOptions(scene, mode, w, h);
     o.screenSpace = true;
-    o.distanceFields = true;
+    o.distanceFieldLighting = true;
     o.dfShadowStart = shadowStart;
     o.progress = false;
     return o;
@@ -50,7 +50,7 @@ TEST(DistanceFields, DecoupledMatchesForward) {
     EXPECT_EQ(decoupled.stats["reconstruction_misses"].get<uint64_t>(), 0u);
     // And the fields change the decoupled image (AO, far shadows) against no fields.
     RenderOptions plain = withFields("builtin:arena", RenderMode::Decoupled, 0.0f, 192, 108);
-    plain.distanceFields = false;
+    plain.distanceFieldLighting = false;
     RenderRun without = renderChecked(plain);
     EXPECT_LT(psnr(decoupled.frames[0].rgba, without.frames[0].rgba), 60.0);
 }
@@ -64,7 +64,7 @@ TEST(DistanceFields, ResidencyStreamsFieldsAsTheCameraMoves) {
         RenderOptions o = withFields("builtin:arena", RenderMode::Forward, 0.0f, 192, 108);
         o.frames = 12;
         o.cameraPath = CameraPath::Orbit;
-        o.dfResidency = residency;
+        o.dfResidencyDistance = residency;
         return renderChecked(o);
     };
     RenderRun all = orbit(0.0f), near = orbit(30.0f), tiny = orbit(1.0f);
@@ -99,7 +99,7 @@ TEST(DistanceFields, ResidencyChangesAreNotCarriedOverByReuse) {
     o.cameraPath = CameraPath::Orbit;
     auto [residentOn, residentOff] = renderReuseOnAndOff(o); // every field resident
     double resident = worstFramePsnr(residentOn, residentOff);
-    o.dfResidency = 8.0f;
+    o.dfResidencyDistance = 8.0f;
     auto [on, off] = renderReuseOnAndOff(o);
     double worst = worstFramePsnr(on, off);
     const auto& df = on.stats["distance_fields"];

@@ -113,7 +113,7 @@ TEST(Gi, DecoupledShadelsGetTheIndirectLight) {
 // sliding cascades re-sample the light each frame (swimming). Measured on the GI-only image.
 TEST(Gi, SnappedCascadesSwimAtMostHalfAsMuchUnderOrbit) {
     RenderOptions o = cornell(GiMode::Lpv);
-    o.giLocalVolumes = false; // the room's fixed volume would hold every point of the view
+    o.sceneGiVolumes = false; // the room's fixed volume would hold every point of the view
     o.visualize = Visualize::Gi;
     o.cameraPath = CameraPath::Orbit;
     // 12 frames over the 40-degree orbit: steps of about a cell of cascade 0. Measured: mean
@@ -191,7 +191,7 @@ TEST(Gi, TheRoomsLocalVolumeIsComputedOnceAndReadBeforeTheCascades) {
     EXPECT_GT(gi["cascade_updates"].get<uint64_t>(), 3u) << "the cascades follow the camera";
     EXPECT_EQ(gi["cells"].get<uint64_t>(), 4u * GI_GRID * GI_GRID * GI_GRID);
 
-    o.giLocalVolumes = false;
+    o.sceneGiVolumes = false;
     RenderRun cascades = renderChecked(o);
     EXPECT_TRUE(cascades.stats["gi"]["local_volumes"].empty());
     EXPECT_EQ(cascades.stats["gi"]["local_volume_updates"].get<uint64_t>(), 0u);

@@ -21,7 +21,8 @@ RenderRun renderTransparency(RenderMode mode, OitMode oit, std::optional<uint64_
     RenderOptions o = renderOptions("builtin:transparency", mode, kW, kH);
     o.oit = oit;
     o.marking = marking;
-    o.shuffleDrawsSeed = shuffle;
+    o.shuffleDraws = shuffle.has_value();
+    o.shuffleSeed = shuffle.value_or(0);
     return renderChecked(o);
 }
 

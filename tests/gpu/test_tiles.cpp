@@ -118,7 +118,7 @@ TEST(Tiles, BadFlagsAreOneLineAndExitCode2) {
 TEST(DistanceFields, ShadowsAgreeWithTheShadowMap) {
     RenderOptions o = renderOptions("builtin:smooth", RenderMode::Forward, 320, 180);
     o.screenSpace = true;
-    o.distanceFields = true;
+    o.distanceFieldLighting = true;
     o.progress = false;
     RenderRun run = renderChecked(o);
     const auto& df = run.stats["distance_fields"];
@@ -132,7 +132,7 @@ TEST(DistanceFields, ShadowsAgreeWithTheShadowMap) {
     EXPECT_LT(double(df["mean_ao"]), 0.99);
     EXPECT_GT(double(df["mean_ao"]), 0.85);
     // Applied (AO): the image differs from the same frame without fields.
-    o.distanceFields = false;
+    o.distanceFieldLighting = false;
     RenderRun plain = renderChecked(o);
     EXPECT_LT(psnr(run.frames[0].rgba, plain.frames[0].rgba), 45.0);
 }

@@ -75,6 +75,28 @@ TEST(World, BadWorldFlagsAreOneLineAndExitCode2) {
     }
 }
 
+// --lod-error: a larger projected error picks coarser LODs, so fewer triangles are drawn; the
+// stats echo the value; a value out of range is one line and exit code 2.
+TEST(World, LodErrorTradesTrianglesForSilhouetteError) {
+    const float errors[] = {0.5f, 8.0f};
+    uint64_t triangles[2] = {};
+    for (int i = 0; i < 2; ++i) {
+        RenderOptions o = manyOptions(3000, 160, 90);
+        o.lod = true;
+        o.lodErrorPixels = errors[i];
+        RenderRun run = renderChecked(o);
+        triangles[i] = run.stats["triangles_drawn"].get<uint64_t>();
+        EXPECT_FLOAT_EQ(run.stats["settings"]["lod-error"].get<float>(), errors[i]);
+    }
+    std::printf("[ figures ] many 3000 at 160x90, --lod on: %llu triangles drawn at --lod-error "
+                "0.5, %llu at 8\n",
+                (unsigned long long)triangles[0], (unsigned long long)triangles[1]);
+    EXPECT_LT(triangles[1], triangles[0]);
+    std::string err;
+    EXPECT_EQ(runShadel("render --size 16x16 --lod-error 0", err), 2) << err;
+    EXPECT_NE(err.find("--lod-error 0"), std::string::npos) << err;
+}
+
 // The GPU's per-view counts against a CPU frustum test of the same boxes.
 TEST(World, CameraAndShadowCountsMatchTheScene) {
     const uint32_t n = 3000, w = 160, h = 90;

@@ -3,6 +3,7 @@
 // InputError line naming the file and the reason, never a crash.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -559,4 +560,32 @@ TEST(GltfImportModels, OtherModelsLoadWithValidAttributes) {
         EXPECT_FALSE(s.cameras.empty()) << m.file;
         EXPECT_FALSE(s.lights.empty()) << m.file;
     }
+}
+
+// A file without a directional light gets "auto-sun" unless --sun off (addDefaultSun); a file
+// with one keeps its own lights only.
+TEST(GltfImport, DefaultSunOnlyWithoutADirectionalLight) {
+    std::ifstream in(kData + "/gltf/cameras_lights.gltf");
+    std::stringstream text;
+    text << in.rdbuf();
+    std::string gltf = text.str();
+    auto sunCount = [](const Scene& scene) {
+        return std::count_if(scene.lights.begin(), scene.lights.end(),
+                             [](const Light& l) { return l.name == "auto-sun"; });
+    };
+    Scene withSun = loadScene(kData + "/gltf/cameras_lights.gltf");
+    EXPECT_EQ(withSun.lights.size(), 3u);
+    EXPECT_EQ(sunCount(withSun), 0);
+    size_t at = gltf.find("\"directional\"");
+    ASSERT_NE(at, std::string::npos);
+    gltf.replace(at, std::strlen("\"directional\""), "\"point\"");
+    TempDir dir;
+    writeFile(dir.file("no_sun.gltf"), gltf);
+    Scene pointsOnly = loadScene(dir.file("no_sun.gltf"));
+    ASSERT_EQ(pointsOnly.lights.size(), 4u) << "a point light is not a sun";
+    EXPECT_EQ(sunCount(pointsOnly), 1);
+    EXPECT_EQ(pointsOnly.lights.back().type, LightType::Directional);
+    Scene off = loadScene(dir.file("no_sun.gltf"), {.addDefaultSun = false});
+    EXPECT_EQ(off.lights.size(), 3u);
+    EXPECT_EQ(sunCount(off), 0);
 }

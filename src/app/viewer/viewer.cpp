@@ -37,7 +37,8 @@ struct ViewerScene {
 };
 
 void prepareScene(Gpu& gpu, const ViewOptions& o, ViewerScene& v) {
-    v.scene = loadScene(o.scene, {o.allowExternalFiles});
+    v.scene = loadScene(
+        o.scene, {.allowExternalFiles = o.allowExternalFiles, .addDefaultSun = o.addDefaultSun});
     v.camera = findCamera(v.scene, o.camera);
     v.bounds = v.scene.worldBounds();
     RunViews views = runViews(v.camera, CameraPath::Static, 1, v.bounds, o.width, o.height);
@@ -52,15 +53,11 @@ void prepareScene(Gpu& gpu, const ViewOptions& o, ViewerScene& v) {
 }
 
 RenderSettings settingsFor(const ViewOptions& o, const ViewerPanel& p, const Gpu& gpu) {
-    RenderSettings s;
-    s.width = o.width;
-    s.height = o.height;
+    RenderSettings s = o; // the command line's, then the panel's choices
     s.mode = p.mode == 1 ? RenderMode::Decoupled : RenderMode::Forward;
-    s.marking = parseMarking(o.marking);
     s.visualize = p.mode == 1 ? parseVisualize(kVisualizeNames[p.visualize]) : Visualize::None;
     s.timing = defaultTimingMode(gpu);
     s.recordingThreads = o.threads ? o.threads : defaultRecordingThreads();
-    s.materialSamples = 16; // as `shadel render`
     s.materialRate = p.materialRate;
     return s;
 }
@@ -105,13 +102,10 @@ int runViewer(const ViewOptions& o, DeviceDesc deviceDesc) {
         throw InputError(
             format("--size %ux%u: the window must be 16..8192 per side", o.width, o.height));
     if (!o.screenshot.empty()) requireCreatableOutput("--screenshot", o.screenshot);
-    parseMarking(o.marking);
     ViewerPanel panel;
     SceneEditor editor; // lights, sun and materials the user edits
-    if (o.mode == "decoupled")
-        panel.mode = 1;
-    else if (o.mode != "forward")
-        throw InputError(format("--mode %s: expected forward or decoupled", o.mode.c_str()));
+    panel.mode = o.mode == RenderMode::Decoupled ? 1 : 0;
+    panel.materialRate = o.materialRate;
 
     ViewerWindow window;
     Gpu gpu;

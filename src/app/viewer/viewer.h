@@ -4,23 +4,23 @@
 // CI runs it under Xvfb: `--frames N --screenshot FILE.png --no-ui` quits after N frames.
 #include <string>
 
+#include "render/renderer.h"
 #include "rhi/device.h"
 
 namespace shadel {
 
-struct ViewOptions {
+// The settings the window starts from (the option table sets them: --size is the window's,
+// --mode the panel's first choice) and the viewer's own options.
+struct ViewOptions : RenderSettings {
     std::string scene = "builtin:default";
     std::string camera;
-    std::string mode = "forward";
-    std::string marking = "auto";
-    uint32_t width = 1280, height = 720;
-    uint32_t frames = 0;    // 0 = until the window closes
-    std::string screenshot; // PNG of the window's last frame (with --frames) or on request
+    bool addDefaultSun = true; // --sun auto|off
+    uint32_t frames = 0;       // 0 = until the window closes
+    std::string screenshot;    // PNG of the window's last frame (with --frames) or on request
     bool noUi = false;
     uint32_t threads = 0; // --threads: recording threads (0 = auto)
     // Hot reload: the GLSL folder watched (default: the source tree's shaders/); empty = off.
     std::string shaderSource = SHADEL_SHADER_SOURCE_DIR;
-    std::string cacheDir;
     bool allowExternalFiles = false;
     uint64_t cacheLimitBytes = 4ull << 30;
 };
