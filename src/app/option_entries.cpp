@@ -54,6 +54,9 @@ void addImageOptions(std::vector<SettingOption>& t) {
     t.push_back(floatOption("--environment-rotation", SETTING(environmentRotationDegrees),
                             FloatRange{-360, 360}, RBV,
                             "degrees: the environment turned about +Y"));
+    t.push_back(floatOption("--environment-spin", SETTING(environmentSpinDegrees),
+                            FloatRange{-360, 360}, RBV,
+                            "degrees the environment turns every frame (a turntable)"));
     t.push_back(backgroundOption());
 }
 

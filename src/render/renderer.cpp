@@ -167,8 +167,6 @@ void initRenderer(Renderer& r, Gpu& gpu, const RenderSettings& requested, const 
         throw DeviceError("out of GPU memory for the renderer's frame buffers");
     createTonemapPipeline(r);
     createBackgroundPipelines(r);
-    createEnvironment(gpu, r.environment, settings, scene,
-                      settings.cacheDir.empty() ? defaultBakeCacheDir() : settings.cacheDir);
     initShaderMessages(gpu, r.messages);
     initFrameRecorder(gpu, r.recorder, settings.timing, std::max(1u, settings.recordingThreads));
     if (settings.mode == RenderMode::Decoupled) r.decoupled = createDecoupled(r, scene);
@@ -190,6 +188,10 @@ void initRenderer(Renderer& r, Gpu& gpu, const RenderSettings& requested, const 
     r.debugLines = createDebugLines(r);
     if (settings.rt.enabled()) r.rt = createRayTracing(r, scene);
     createScreenSpace(r);
+    // Last: prefiltering a new environment takes seconds, and every check above that can refuse
+    // the settings (a device without ray queries, ...) answers first.
+    createEnvironment(gpu, r.environment, settings, scene,
+                      settings.cacheDir.empty() ? defaultBakeCacheDir() : settings.cacheDir);
 }
 
 void destroyRenderer(Renderer& r) {

@@ -104,10 +104,9 @@ glm::vec3 checkSurface(const Printed& p, const Scene& scene, const std::string& 
     const Camera& cam = scene.cameras.front();
     glm::vec3 v = glm::normalize(cam.position - pos);
     glm::vec3 sum = p.v3(PRINT_EMISSIVE) + p.v3(PRINT_AMBIENT);
-    glm::vec3 ambient = glm::mix(scene.ambientColor * 0.5f,
-                                 scene.ambientColor + scene.skyColor * 0.15f, n.y * 0.5f + 0.5f) *
-                        base * (1.0f - mat.metallicFactor * 0.5f);
-    EXPECT_LT(relError(p.v3(PRINT_AMBIENT), ambient), 0.01f) << where;
+    // Rendered without an environment, so that every light term has a CPU oracle here (the
+    // environment's is judged by the furnace test, ImageBasedLighting): its term is zero.
+    EXPECT_LT(glm::length(p.v3(PRINT_AMBIENT)), 1e-6f) << where;
     bool haveSun = false;
     size_t punctual = 0;
     for (const Light& l : scene.lights) {
@@ -147,6 +146,8 @@ RenderOptions inspectOptions(RenderMode mode, int32_t x, int32_t y) {
     o.shadelsPerMetre = 32.0f; // one density, no chunks: instance i is the scene's instance i
     o.inspectX = x;
     o.inspectY = y;
+    o.environment = "none";
+    o.environmentGiven = true;
     return o;
 }
 
