@@ -211,6 +211,16 @@ using uint = uint32_t;
 #define DRAW_LIST_OPAQUE_FEATURED 4u
 #define DRAW_LIST_OPAQUE_TEXTURED 5u
 #define DRAW_LIST_COUNT 6u
+// Each camera list is two, by the faces its instances draw (render/forward drawCameraList sets
+// the cull mode per side, vkCmdSetCullMode): single-sided materials cull back faces (DRAW_SIDE_FRONT), double-
+// sided ones draw both (DRAW_SIDE_BOTH). Front faces are counter-clockwise for every instance:
+// the glTF importer gives instances whose transform mirrors (which glTF says flips the winding)
+// a copy of the mesh with the winding reversed. Camera list l, side s: slot
+// l * DRAW_SIDE_COUNT + s of DRAW_CAMERA_SLOTS.
+#define DRAW_SIDE_FRONT 0u
+#define DRAW_SIDE_BOTH 1u
+#define DRAW_SIDE_COUNT 2u
+#define DRAW_CAMERA_SLOTS 12u
 
 // Debug views (--visualize).
 #define VISUALIZE_NONE 0u
