@@ -1,4 +1,4 @@
-// Labels of shaderPrint records (shaders/common/shader_print.glsl), shared by GLSL and C++ (the
+// Labels of shader print records (shaders/common/shader_print.glsl), shared by GLSL and C++ (the
 // decoder in rhi/shader_messages.cpp names each one): GLSL has no strings, so a print carries a
 // label id and the CPU prints its text. Add new labels at the end.
 #ifndef SHADEL_PRINT_LABELS_H
@@ -15,7 +15,7 @@
 #define PRINT_SHADING_NORMAL 10u  // material: normal (normal map applied)
 #define PRINT_OCCLUSION 11u       // material: occlusion
 #define PRINT_EMISSIVE 12u        // term: emissive
-#define PRINT_AMBIENT 13u         // term: hemisphere ambient
+#define PRINT_AMBIENT 13u         // term: the environment (image-based lighting)
 #define PRINT_SUN_SHADOW 14u      // the sun's PCF shadow factor
 #define PRINT_SUN 15u             // term: the sun
 #define PRINT_LIGHT 16u           // term: one punctual light (rgb, index)

@@ -91,9 +91,14 @@ using uint = uint32_t;
 // Light blockers (render/lighting): a light lists up to this many blockers.
 #define LIGHT_MAX_BLOCKERS_PER_LIGHT 32u
 #define LIGHT_TILE_SIZE 16u // pixels per side of a forward light culling tile
+// FrameConstants::tonemap: the display curve (RenderSettings::tonemap, common/tone_curve.glsl).
+#define TONEMAP_ACES_NARKOWICZ 0u
+#define TONEMAP_ACES_HILL 1u
+#define TONEMAP_KHR_PBR_NEUTRAL 2u
+#define TONEMAP_LINEAR 3u
 #define TONEMAP_GROUP_X 32u // the tonemap pass's workgroup (post/tonemap.comp)
 #define TONEMAP_GROUP_Y 8u
-// Feature spectra (seed 001, render/lighting/feature_spectra.h): the features a tile needs,
+// Feature spectra (render/lighting/feature_spectra.h): the features a tile needs,
 // recorded by the tile pass; each shading permutation compiles in only its set (specialization
 // constant SPECTRUM_FEATURES_CONSTANT_ID of shaders/common/lighting.glsl; SPECTRUM_MATERIAL sets
 // MATERIAL_FEATURES_CONSTANT_ID of shaders/common/material.glsl).
@@ -329,7 +334,7 @@ struct GpuLight {
                         // the cone); area: 1
 };
 
-// A light blocker (seed 001): an artist-placed rectangle (a wall's mid-plane) that stops the
+// A light blocker: an artist-placed rectangle (a wall's mid-plane) that stops the
 // lights listing it, without a shadow map. Portals are rectangular holes in it.
 struct GpuLightBlocker {
     vec3 center;
@@ -507,6 +512,34 @@ struct DrawIndexedCommand { // VkDrawIndexedIndirectCommand
     uint firstInstance;
 };
 
+// ---- Image-based lighting (render/environment, shaders/environment) --------------------------
+// GpuEnvironment::flags
+#define ENVIRONMENT_FLAG_NONE 1u     // no environment: lighting and background read 0
+#define ENVIRONMENT_FLAG_SUN_DISC 2u // the background draws the sun's disc
+
+// Every map is equirectangular in the convention of render/environment/equirect.h (row 0 looks
+// up, the middle column along +Z), sampled bilinearly with u wrapping and v kept inside the
+// first and last rows' texel centres.
+struct GpuEnvironment {
+    uint specularSlot;    // radiance, GGX-prefiltered: MIP l for perceptual roughness
+                          // l / (specularLevels - 1), level 0 unfiltered
+    uint irradianceSlot;  // irradiance / pi (the Lambert radiance for albedo 1)
+    uint backgroundSlot;  // what the camera sees behind the scene (without the sun's disc)
+    uint brdfSlot;        // (n.v, perceptual roughness): GGX scale, GGX bias, sheen albedo
+    uint specularLevels;  // MIP count of the specular map
+    uint flags;           // ENVIRONMENT_FLAG_*
+    float intensity;      // multiplies every radiance (not the BRDF table)
+    float rotationCos;    // world to environment: the rotation about +Y by the environment
+    float rotationSin;    // rotation angle (x' = c x + s z, z' = -s x + c z)
+    float sunCosRadius;   // cosine of the sun disc's angular radius
+    float specularHeight; // texel rows of specular level 0 (level l: max(height >> l, 1))
+    float irradianceHeight;
+    vec3 sunDirection;    // the way sunlight travels, in the environment's frame
+    float backgroundHeight;
+    vec3 sunRadiance;     // radiance of the disc (0 without one)
+    float brdfSize;       // texels per side of the BRDF table
+};
+
 struct FrameConstants {
     mat4 view;
     mat4 proj;
@@ -557,6 +590,13 @@ struct FrameConstants {
     // uvec2 per visibility vertex: (scene vertex, the triangle of its mesh it starts), what the
     // visibility prepass draws (scene/visibility_vertices.h).
     uint64_t visibilityVertices;
+    uint tonemap; // TONEMAP_*: the display curve after exposure
+    // What uncovered pixels show: the environment's background (1), or backgroundColor, the
+    // radiance the display curve turns into the --background colour (0).
+    uint backgroundEnvironment;
+    vec3 backgroundColor;
+    uint framePad;
+    GpuEnvironment environment; // image-based lighting (render/environment)
 };
 
 // ---- GPU-driven world (render/culling) ------------------------------------------------------
@@ -575,7 +615,7 @@ struct GpuLod {
     uint firstIndex;
     uint indexCount;
     float error; // object-space deviation from LOD 0 (meshoptimizer's error, in scene units)
-    // The proxy (shadow) index set of this level (seed 003's "main and proxy index sets"): the
+    // The proxy (shadow) index set of this level (shadow views draw it): the
     // same triangles over position-only deduplicated vertices (meshopt_generateShadowIndexBuffer),
     // so a depth-only view fetches each position once instead of once per normal/UV/chart seam.
     uint proxyFirstIndex;     // indexCount indices, the same vertexOffset
@@ -654,7 +694,7 @@ struct ShaderMessage {
 
 // ---- Decoupled shading (render/shadel) ----------------------------------------------------
 #define SHADEL_MAX_MIPS 10u
-#define SHADEL_COUNTERS 16u // hashed allocation counters (seed: N parallel allocations)
+#define SHADEL_COUNTERS 16u // hashed allocation counters (N allocations in parallel)
 #define SHADEL_BLOCK 64u    // shadels per block side (8 x 8 chunks)
 #define SHADEL_CHUNK 8u     // shadels per chunk side
 #define SHADEL_INVALID 0xFFFFFFFFu
@@ -671,8 +711,8 @@ struct ShaderMessage {
 #define SHADEL_OBJECT_TEXTURED_MATERIAL 16u
 #define SHADEL_MAX_CHANGED_VOLUMES 256u
 #define SHADEL_CHUNK_VIEW_NONE 0xFFFFFFFFu // ShadelFrame::chunkViews: a NaN centre
-// Material layers of the shade storage (seed: "layers of different bit depths"): every layer
-// shares the slot allocation; each has its own format.
+// Material layers of the shade storage (layers of different formats): every layer shares the slot
+// allocation; each has its own format.
 #define SHADEL_LAYER_RADIANCE 0u // lit colour, RGBA16F
 #define SHADEL_LAYER_MATERIAL 1u // base colour + roughness, RGBA8 (for GI injection, debugging)
 #define SHADEL_LAYERS 2u
@@ -765,7 +805,7 @@ struct GpuShadelRect {
     uint pad;
 };
 
-// One chunk of shading work: {chunk, storage slot, object, MIP} as in the seed.
+// One chunk of shading work: {chunk, storage slot, object, MIP}.
 struct GpuShadelWork {
     uint chunk; // sheet chunk coordinate, x | y << 16
     uint slot;  // storage chunk slot
@@ -885,8 +925,8 @@ struct ShadelFrame {
 };
 
 // ---- Projected box decals (render/decals, shaders/decals) -----------------------------------
-// Decal stages, applied in this order to the material before lighting (seed 004's decal render
-// stages; the AO-only kind is seed 001's character shadow). A decal may take part in several.
+// Decal stages, applied in this order to the material before lighting (the AO-only kind darkens
+// only ambient light, a character's contact shadow). A decal may take part in several.
 #define DECAL_STAGE_BASE_COLOR 0u
 #define DECAL_STAGE_NORMAL 1u
 #define DECAL_STAGE_ROUGHNESS 2u
