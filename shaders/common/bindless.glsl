@@ -20,9 +20,10 @@ layout(set = 0, binding = 1, rgba16f) uniform image2D gImagesRgba16f[];
 layout(set = 0, binding = 1, rgba8) uniform image2D gImagesRgba8[];
 layout(set = 0, binding = 1, r32ui) uniform uimage2D gImagesR32ui[];
 layout(set = 0, binding = 1, rgba32ui) uniform uimage2D gImagesRgba32ui[];
-layout(set = 0, binding = 2) uniform sampler gSamplers[4];
-layout(set = 0, binding = 2) uniform samplerShadow gShadowSamplers[4];
+layout(set = 0, binding = 2) uniform sampler gSamplers[SAMPLER_COUNT];
+layout(set = 0, binding = 2) uniform samplerShadow gShadowSamplers[SAMPLER_COUNT];
 
+// The engine's samplers; material textures use their slot's (materialSampler, material.glsl).
 #define SAMPLER_LINEAR_REPEAT 0
 #define SAMPLER_LINEAR_CLAMP 1
 #define SAMPLER_NEAREST_CLAMP 2
@@ -54,10 +55,12 @@ layout(buffer_reference, scalar) buffer ShaderMessages {
 };
 
 vec4 sampleTexture(uint slot, uint samplerId, vec2 uv, vec2 dx, vec2 dy) {
-    return textureGrad(sampler2D(gTextures[nonuniformEXT(slot)], gSamplers[samplerId]), uv, dx, dy);
+    return textureGrad(sampler2D(gTextures[nonuniformEXT(slot)], gSamplers[nonuniformEXT(samplerId)]),
+                       uv, dx, dy);
 }
 vec4 sampleTextureLod(uint slot, uint samplerId, vec2 uv, float lod) {
-    return textureLod(sampler2D(gTextures[nonuniformEXT(slot)], gSamplers[samplerId]), uv, lod);
+    return textureLod(sampler2D(gTextures[nonuniformEXT(slot)], gSamplers[nonuniformEXT(samplerId)]),
+                      uv, lod);
 }
 vec4 fetchTexture(uint slot, ivec2 texel, int lod) {
     return texelFetch(gTextures[nonuniformEXT(slot)], texel, lod);

@@ -66,16 +66,35 @@ float toksvigRoughness(float roughness, float meanNormalLength) {
     return clamp(sqrt(sqrt(alpha * alpha + (1.0 - len) / len)), 0.04, 1.0);
 }
 
+// The bindless sampler of a material texture slot (GpuMaterial.samplers: its glTF sampler).
+uint materialSampler(GpuMaterial m, uint slot) {
+    return (m.samplers[slot >> 2u] >> ((slot & 3u) * 8u)) & 0xFFu;
+}
+
 // A material texture through its slot's KHR_texture_transform (derivatives transformed with it)
-// and its sampler's wrap mode.
+// and its slot's sampler (wrap modes and filters as authored).
 vec4 sampleMaterialTexture(GpuMaterial m, uint slot, uint tex, SurfaceInput s) {
     vec2 c0 = m.uvTransform[slot * 3u], c1 = m.uvTransform[slot * 3u + 1u];
     vec2 uv = c0 * s.uv.x + c1 * s.uv.y + m.uvTransform[slot * 3u + 2u];
     vec2 dx = c0 * s.uvDx.x + c1 * s.uvDx.y;
     vec2 dy = c0 * s.uvDy.x + c1 * s.uvDy.y;
-    uint samplerId = ((m.clampMask >> slot) & 1u) != 0u ? SAMPLER_LINEAR_CLAMP : SAMPLER_LINEAR_REPEAT;
-    recordTextureFeedback(tex, dx, dy);
+    uint samplerId = materialSampler(m, slot);
+    // Filters without mipmaps read level 0 whatever the footprint: streaming must bring it in.
+    bool level0 = (samplerId - SAMPLER_MATERIAL_FIRST) % SAMPLER_MIN_COUNT <= SAMPLER_MIN_LINEAR;
+    recordTextureFeedback(tex, level0 ? vec2(0.0) : dx, level0 ? vec2(0.0) : dy);
     return sampleTexture(tex, samplerId, uv, dx, dy);
+}
+
+// The base colour's alpha where only coverage matters (alpha-tested depth and visibility
+// passes, decoupled transparency): the same texture transform and sampler as shading.
+float materialBaseAlpha(GpuMaterial m, vec2 uv, vec2 uvDx, vec2 uvDy) {
+    float alpha = m.baseColorFactor.a;
+    if (m.baseColorTexture == NO_TEXTURE) return alpha;
+    SurfaceInput s;
+    s.uv = uv;
+    s.uvDx = uvDx;
+    s.uvDy = uvDy;
+    return alpha * sampleMaterialTexture(m, TEXTURE_SLOT_BASE_COLOR, m.baseColorTexture, s).a;
 }
 
 // A tangent-space normal map applied to n; `roughness` widened by Toksvig (filtered normals

@@ -31,7 +31,7 @@ using uint = uint32_t;
 #define MATERIAL_CLASS_SHIFT 8u
 #define MATERIAL_CLASS_MASK 7u
 
-// Texture slots of a material (scene.h TextureSlot), for uvTransform and clampMask.
+// Texture slots of a material (scene.h TextureSlot), for uvTransform and samplers.
 #define TEXTURE_SLOT_BASE_COLOR 0u
 #define TEXTURE_SLOT_METALLIC_ROUGHNESS 1u
 #define TEXTURE_SLOT_NORMAL 2u
@@ -45,6 +45,28 @@ using uint = uint32_t;
 #define TEXTURE_SLOT_SHEEN_COLOR 10u     // KHR_materials_sheen: RGB
 #define TEXTURE_SLOT_SHEEN_ROUGHNESS 11u // A
 #define TEXTURE_SLOT_COUNT 12u
+
+// Samplers of the bindless table (rhi/bindless.h): the engine's own first, then one per
+// combination of a glTF sampler's wrap modes and filters, each material texture slot naming
+// one (GpuMaterial.samplers): index SAMPLER_MATERIAL_FIRST + ((wrapS * 3 + wrapT) * 2 + mag) *
+// 6 + min.
+#define SAMPLER_WRAP_REPEAT 0u
+#define SAMPLER_WRAP_MIRRORED_REPEAT 1u
+#define SAMPLER_WRAP_CLAMP_TO_EDGE 2u
+#define SAMPLER_MAG_NEAREST 0u
+#define SAMPLER_MAG_LINEAR 1u
+#define SAMPLER_MIN_NEAREST 0u // without mipmaps: level 0 only
+#define SAMPLER_MIN_LINEAR 1u  // without mipmaps: level 0 only
+#define SAMPLER_MIN_NEAREST_MIPMAP_NEAREST 2u
+#define SAMPLER_MIN_LINEAR_MIPMAP_NEAREST 3u
+#define SAMPLER_MIN_NEAREST_MIPMAP_LINEAR 4u
+#define SAMPLER_MIN_LINEAR_MIPMAP_LINEAR 5u
+#define SAMPLER_MIN_COUNT 6u
+#define SAMPLER_MATERIAL_FIRST 4u
+#define SAMPLER_MATERIAL_COUNT 108u // 3 wrapS x 3 wrapT x 2 mag x 6 min
+#define SAMPLER_COUNT 112u
+// glTF's default (no sampler, or no filters given): repeat, linear, trilinear.
+#define SAMPLER_MATERIAL_DEFAULT (SAMPLER_MATERIAL_FIRST + SAMPLER_MAG_LINEAR * 6u + SAMPLER_MIN_LINEAR_MIPMAP_LINEAR)
 
 #define PROCEDURAL_NONE 0u
 #define PROCEDURAL_TEXEL_CHECKER 1u
@@ -194,6 +216,16 @@ using uint = uint32_t;
 #define DRAW_LIST_OPAQUE_FEATURED 4u
 #define DRAW_LIST_OPAQUE_TEXTURED 5u
 #define DRAW_LIST_COUNT 6u
+// Each camera list is two, by the faces its instances draw (render/forward drawCameraList sets
+// the cull mode per side, vkCmdSetCullMode): single-sided materials cull back faces (DRAW_SIDE_FRONT), double-
+// sided ones draw both (DRAW_SIDE_BOTH). Front faces are counter-clockwise for every instance:
+// the glTF importer gives instances whose transform mirrors (which glTF says flips the winding)
+// a copy of the mesh with the winding reversed. Camera list l, side s: slot
+// l * DRAW_SIDE_COUNT + s of DRAW_CAMERA_SLOTS.
+#define DRAW_SIDE_FRONT 0u
+#define DRAW_SIDE_BOTH 1u
+#define DRAW_SIDE_COUNT 2u
+#define DRAW_CAMERA_SLOTS 12u
 
 // Debug views (--visualize).
 #define VISUALIZE_NONE 0u
@@ -260,7 +292,9 @@ struct GpuMaterial {
     // glTF material extensions (scene.h Material; shaders/common/material.glsl).
     vec2 uvTransform[36]; // 3 x TEXTURE_SLOT_COUNT: per texture slot (TEXTURE_SLOT_*): columns c0,
                           // c1, translation c2
-    uint clampMask;       // bit per texture slot: clamp-to-edge sampler
+    // Per texture slot, its sampler's index in the bindless table (SAMPLER_MATERIAL_*): a byte
+    // each, slot s in samplers[s / 4] bits 8 * (s % 4).
+    uint samplers[3];
     uint clearcoatTexture;
     uint clearcoatRoughnessTexture;
     uint clearcoatNormalTexture;

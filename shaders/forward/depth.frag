@@ -16,9 +16,6 @@ void main() {
     GpuInstance inst = InstanceBuffer(f.instances).i[inInstance];
     GpuMaterial m = MaterialBuffer(f.materials).m[inst.material];
     if ((m.flags & MATERIAL_ALPHA_MASK) != 0u) {
-        float alpha = m.baseColorFactor.a;
-        if (m.baseColorTexture != NO_TEXTURE)
-            alpha *= sampleTexture(m.baseColorTexture, SAMPLER_LINEAR_REPEAT, inUv, dFdx(inUv), dFdy(inUv)).a;
-        if (alpha < m.alphaCutoff) discard;
+        if (materialBaseAlpha(m, inUv, dFdx(inUv), dFdy(inUv)) < m.alphaCutoff) discard;
     }
 }

@@ -18,8 +18,8 @@ layout(local_size_x = 64) in;
 
 layout(push_constant, scalar) uniform Push {
     uint64_t frame;
-    uint64_t draws;  // camera: DrawIndexedCommand[DRAW_LIST_COUNT * maxDraws]
-    uint64_t counts; // camera: uint[DRAW_LIST_COUNT]
+    uint64_t draws;  // camera: DrawIndexedCommand[DRAW_CAMERA_SLOTS * maxDraws]
+    uint64_t counts; // camera: uint[DRAW_CAMERA_SLOTS]
     uint maxDraws;
     uint shadowViews; // 1: the shadow views too (the sun's and CullingFrame's per-view lists)
     uint phase;       // CullPhase (render/culling/culling.h): 0 = single pass
@@ -39,8 +39,9 @@ layout(buffer_reference, scalar) readonly buffer ShadowCullViewBuffer {
 #define PHASE_LAST_VISIBLE 1u
 #define PHASE_REST 2u
 
-// The camera's list for an instance (its material's bucket).
-uint cameraListOf(FrameConstants f, GpuMaterial mat, uint id) {
+// The camera's list for an instance (its material's bucket), and in it the side the instance
+// draws (DRAW_SIDE_*): its slot of DRAW_CAMERA_SLOTS.
+uint cameraSlotOf(FrameConstants f, GpuMaterial mat, uint id) {
     uint list = (mat.flags & MATERIAL_ALPHA_BLEND) != 0u ? DRAW_LIST_BLEND : DRAW_LIST_OPAQUE;
     // Instances allocated in the shadel sheet this frame are drawn by the decoupled passes
     // (blended ones through the OIT targets, render/oit).
@@ -52,7 +53,9 @@ uint cameraListOf(FrameConstants f, GpuMaterial mat, uint id) {
     if (list == DRAW_LIST_OPAQUE && features != 0u)
         list = features == MATERIAL_FEATURE_TEXTURES ? DRAW_LIST_OPAQUE_TEXTURED
                                                      : DRAW_LIST_OPAQUE_FEATURED;
-    return list;
+    // Single-sided materials cull back faces.
+    uint side = (mat.flags & MATERIAL_DOUBLE_SIDED) != 0u ? DRAW_SIDE_BOTH : DRAW_SIDE_FRONT;
+    return list * DRAW_SIDE_COUNT + side;
 }
 
 // Appends one command to list `list` of `draws` (maxDraws commands per list); false when full.
@@ -132,7 +135,7 @@ void main() {
         if (draw) {
             lod = selectLod(f, c, inst, mesh);
             haveLod = true;
-            if (appendDraw(pc.draws, pc.counts, cameraListOf(f, mat, id), lod, false, mesh, id,
+            if (appendDraw(pc.draws, pc.counts, cameraSlotOf(f, mat, id), lod, false, mesh, id,
                            f)) {
                 drawn = true;
                 triangles = lod.indexCount / 3u;

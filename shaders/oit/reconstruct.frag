@@ -28,9 +28,8 @@ void main() {
                                          reconstructionLayer(f, s));
     countReconstruction(s, r);
     GpuMaterial mat = MaterialBuffer(f.materials).m[InstanceBuffer(f.instances).i[inInstance].material];
-    float alpha = mat.baseColorFactor.a; // outside the branch: implicit derivatives
-    if (mat.baseColorTexture != NO_TEXTURE)
-        alpha *= sampleTexture(mat.baseColorTexture, SAMPLER_LINEAR_REPEAT, inUv, dFdx(inUv), dFdy(inUv)).a;
+    vec2 uvDx = dFdx(inUv), uvDy = dFdy(inUv); // outside any branch
+    float alpha = materialBaseAlpha(mat, inUv, uvDx, uvDy);
     TransparentFragment t = transparentFragment(r.color, alpha, mat.additiveness);
     if (r.missing + r.overflowed != 0u) t = shadeTransparentFragment(f);
     t.premultiplied = visualizeReconstruction(f, o, r, t.premultiplied, inShadelUv, texelDx, texelDy);

@@ -88,7 +88,9 @@ static void setMaterialExtensions(gpu::GpuMaterial& g, const Material& m, SlotOf
         g.uvTransform[t * 3 + 1] = m.uvTransforms[t].c1;
         g.uvTransform[t * 3 + 2] = m.uvTransforms[t].c2;
     }
-    g.clampMask = m.clampMask;
+    for (uint32_t t = 0; t < 3; ++t) g.samplers[t] = 0;
+    for (uint32_t t = 0; t < kTextureSlotCount; ++t)
+        g.samplers[t / 4] |= samplerIndex(m.samplers[t]) << (8 * (t % 4));
     g.clearcoatTexture = textureSlot(m.clearcoatTexture);
     g.clearcoatRoughnessTexture = textureSlot(m.clearcoatRoughnessTexture);
     g.clearcoatNormalTexture = textureSlot(m.clearcoatNormalTexture);

@@ -153,11 +153,12 @@ void initRenderer(Renderer& r, Gpu& gpu, const RenderSettings& requested, const 
     r.maxDraws = std::max<uint32_t>(scene.instanceCount, 1);
     VkDeviceSize drawBytes =
         VkDeviceSize(DRAW_LIST_COUNT) * r.maxDraws * sizeof(gpu::DrawIndexedCommand);
-    r.draws = createBuffer(gpu, {"draws.camera", drawBytes, VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT});
+    r.draws = createBuffer(
+        gpu, {"draws.camera", DRAW_SIDE_COUNT * drawBytes, VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT});
     r.shadowDraws =
         createBuffer(gpu, {"draws.sunShadow", drawBytes, VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT});
-    r.drawCounts = createBuffer(
-        gpu, {"draws.counts", 2 * DRAW_LIST_COUNT * 4, VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT});
+    r.drawCounts = createBuffer(gpu, {"draws.counts", (DRAW_CAMERA_SLOTS + DRAW_LIST_COUNT) * 4,
+                                      VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT});
     r.frameConstants =
         createBuffer(gpu, {"frameConstants", sizeof(gpu::FrameConstants), 0, MemoryKind::Upload});
     r.pixels =

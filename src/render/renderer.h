@@ -269,10 +269,10 @@ struct Renderer {
     ShadowAtlas sunShadow; // the sun's whole-scene map (--sun-cascades: beyond the last slice)
     // Per-frame data.
     BufferHandle frameConstants; // host-visible gpu::FrameConstants
-    BufferHandle draws;          // DrawIndexedCommand[DRAW_LIST_COUNT * maxDraws], camera view
-    BufferHandle shadowDraws;
-    BufferHandle drawCounts; // uint[DRAW_LIST_COUNT] camera, then uint[...] shadow
-    BufferHandle pixels;     // readback RGBA8
+    BufferHandle draws;          // DrawIndexedCommand[DRAW_CAMERA_SLOTS * maxDraws], camera view
+    BufferHandle shadowDraws;    // DrawIndexedCommand[DRAW_LIST_COUNT * maxDraws], the sun's
+    BufferHandle drawCounts;     // uint[DRAW_CAMERA_SLOTS] camera, then uint[DRAW_LIST_COUNT] sun
+    BufferHandle pixels;         // readback RGBA8
     uint32_t maxDraws = 0;
     BufferHandle sceneIndices;           // the unified index buffer of the scene being drawn
     BufferHandle sceneVisibilityIndices; // ... and the visibility prepass's (GpuScene)

@@ -1,6 +1,7 @@
 #include "rhi/bindless.h"
 
 #include <algorithm>
+#include <string>
 
 #include "core/assert.h"
 #include "core/log.h"
@@ -8,24 +9,87 @@
 
 namespace shadel {
 
-static VkSampler makeSampler(Gpu& gpu, VkFilter filter, VkSamplerAddressMode mode, bool compare,
-                             float anisotropy, const char* name) {
+struct SamplerState {
+    VkFilter mag = VK_FILTER_LINEAR, min = VK_FILTER_LINEAR;
+    VkSamplerMipmapMode mipmap = VK_SAMPLER_MIPMAP_MODE_LINEAR;
+    VkSamplerAddressMode u = VK_SAMPLER_ADDRESS_MODE_REPEAT, v = VK_SAMPLER_ADDRESS_MODE_REPEAT;
+    float maxLod = VK_LOD_CLAMP_NONE;
+    float anisotropy = 1.0f;
+    bool compare = false;
+};
+
+static VkSampler makeSampler(Gpu& gpu, const SamplerState& st, const std::string& name) {
     VkSamplerCreateInfo ci{VK_STRUCTURE_TYPE_SAMPLER_CREATE_INFO};
-    ci.magFilter = filter;
-    ci.minFilter = filter;
-    ci.mipmapMode =
-        filter == VK_FILTER_LINEAR ? VK_SAMPLER_MIPMAP_MODE_LINEAR : VK_SAMPLER_MIPMAP_MODE_NEAREST;
-    ci.addressModeU = ci.addressModeV = ci.addressModeW = mode;
-    ci.maxLod = VK_LOD_CLAMP_NONE;
-    ci.anisotropyEnable = anisotropy > 1.0f;
-    ci.maxAnisotropy = anisotropy;
-    ci.compareEnable = compare;
+    ci.magFilter = st.mag;
+    ci.minFilter = st.min;
+    ci.mipmapMode = st.mipmap;
+    ci.addressModeU = st.u;
+    ci.addressModeV = st.v;
+    ci.addressModeW = st.u;
+    ci.maxLod = st.maxLod;
+    ci.anisotropyEnable = st.anisotropy > 1.0f;
+    ci.maxAnisotropy = st.anisotropy;
+    ci.compareEnable = st.compare;
     ci.compareOp = VK_COMPARE_OP_LESS_OR_EQUAL;
     ci.borderColor = VK_BORDER_COLOR_FLOAT_OPAQUE_WHITE;
     VkSampler s;
     VK_CHECK(vkCreateSampler(gpu.device.device, &ci, nullptr, &s));
-    setName(gpu.device, s, VK_OBJECT_TYPE_SAMPLER, name);
+    setName(gpu.device, s, VK_OBJECT_TYPE_SAMPLER, name.c_str());
     return s;
+}
+
+static SamplerState engineSampler(VkFilter filter, VkSamplerAddressMode mode, float anisotropy,
+                                  bool compare) {
+    SamplerState st;
+    st.mag = st.min = filter;
+    st.mipmap =
+        filter == VK_FILTER_LINEAR ? VK_SAMPLER_MIPMAP_MODE_LINEAR : VK_SAMPLER_MIPMAP_MODE_NEAREST;
+    st.u = st.v = mode;
+    st.anisotropy = anisotropy;
+    st.compare = compare;
+    return st;
+}
+
+// The material samplers, in the order of SAMPLER_MATERIAL_* (common/shared_types.h). The
+// linearly filtered mipmapped ones filter anisotropically as far as the device allows, up to
+// 16x (what the Khronos glTF Sample Viewer asks WebGL for).
+static void makeMaterialSamplers(Gpu& gpu, float maxAnisotropy) {
+    constexpr VkSamplerAddressMode kWrap[3] = {VK_SAMPLER_ADDRESS_MODE_REPEAT,
+                                               VK_SAMPLER_ADDRESS_MODE_MIRRORED_REPEAT,
+                                               VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE};
+    constexpr const char* kWrapName[3] = {"repeat", "mirror", "clamp"};
+    constexpr const char* kMinName[SAMPLER_MIN_COUNT] = {"nearest",           "linear",
+                                                         "nearestMipNearest", "linearMipNearest",
+                                                         "nearestMipLinear",  "linearMipLinear"};
+    float anisotropy = std::min(16.0f, maxAnisotropy);
+    uint32_t index = SAMPLER_MATERIAL_FIRST;
+    for (uint32_t s = 0; s < 3; ++s)
+        for (uint32_t t = 0; t < 3; ++t)
+            for (uint32_t mag = 0; mag < 2; ++mag)
+                for (uint32_t min = 0; min < SAMPLER_MIN_COUNT; ++min) {
+                    SamplerState st;
+                    st.u = kWrap[s];
+                    st.v = kWrap[t];
+                    st.mag = mag == SAMPLER_MAG_LINEAR ? VK_FILTER_LINEAR : VK_FILTER_NEAREST;
+                    bool linearMin = min == SAMPLER_MIN_LINEAR ||
+                                     min == SAMPLER_MIN_LINEAR_MIPMAP_NEAREST ||
+                                     min == SAMPLER_MIN_LINEAR_MIPMAP_LINEAR;
+                    st.min = linearMin ? VK_FILTER_LINEAR : VK_FILTER_NEAREST;
+                    st.mipmap = min == SAMPLER_MIN_NEAREST_MIPMAP_LINEAR ||
+                                        min == SAMPLER_MIN_LINEAR_MIPMAP_LINEAR
+                                    ? VK_SAMPLER_MIPMAP_MODE_LINEAR
+                                    : VK_SAMPLER_MIPMAP_MODE_NEAREST;
+                    // glTF's NEAREST and LINEAR read level 0 only. A maxLod of 0 would clamp the
+                    // level of detail to 0, which selects magFilter; 0.25 keeps minification's
+                    // minFilter and still rounds to level 0 (nearest mipmap mode).
+                    st.maxLod = min <= SAMPLER_MIN_LINEAR ? 0.25f : VK_LOD_CLAMP_NONE;
+                    if (linearMin && min != SAMPLER_MIN_LINEAR) st.anisotropy = anisotropy;
+                    std::string name = std::string("sampler.material.") + kWrapName[s] + "." +
+                                       kWrapName[t] + "." + (mag ? "linear" : "nearest") + "." +
+                                       kMinName[min];
+                    gpu.bindless.samplers[index++] = makeSampler(gpu, st, name);
+                }
+    SHADEL_ASSERT(index == SAMPLER_COUNT);
 }
 
 static void writeNow(Gpu& gpu, VkDescriptorSet set, const BindlessWrite& w) {
@@ -52,15 +116,21 @@ static void writeNow(Gpu& gpu, VkDescriptorSet set, const BindlessWrite& w) {
 void initBindless(Gpu& gpu) {
     BindlessTable& t = gpu.bindless;
     VkDevice dev = gpu.device.device;
-    float aniso = std::min(8.0f, gpu.device.properties.limits.maxSamplerAnisotropy);
-    t.samplers[0] = makeSampler(gpu, VK_FILTER_LINEAR, VK_SAMPLER_ADDRESS_MODE_REPEAT, false, aniso,
-                                "sampler.linearRepeat");
-    t.samplers[1] = makeSampler(gpu, VK_FILTER_LINEAR, VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE, false,
-                                1.0f, "sampler.linearClamp");
-    t.samplers[2] = makeSampler(gpu, VK_FILTER_NEAREST, VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE,
-                                false, 1.0f, "sampler.nearestClamp");
-    t.samplers[3] = makeSampler(gpu, VK_FILTER_LINEAR, VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_BORDER,
-                                true, 1.0f, "sampler.shadowCompare");
+    float maxAniso = gpu.device.properties.limits.maxSamplerAnisotropy;
+    float aniso = std::min(8.0f, maxAniso);
+    t.samplers[0] = makeSampler(
+        gpu, engineSampler(VK_FILTER_LINEAR, VK_SAMPLER_ADDRESS_MODE_REPEAT, aniso, false),
+        "sampler.linearRepeat");
+    t.samplers[1] = makeSampler(
+        gpu, engineSampler(VK_FILTER_LINEAR, VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE, 1.0f, false),
+        "sampler.linearClamp");
+    t.samplers[2] = makeSampler(
+        gpu, engineSampler(VK_FILTER_NEAREST, VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE, 1.0f, false),
+        "sampler.nearestClamp");
+    t.samplers[3] = makeSampler(
+        gpu, engineSampler(VK_FILTER_LINEAR, VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_BORDER, 1.0f, true),
+        "sampler.shadowCompare");
+    makeMaterialSamplers(gpu, maxAniso);
 
     VkDescriptorSetLayoutBinding bindings[3]{};
     bindings[0] = {0, VK_DESCRIPTOR_TYPE_SAMPLED_IMAGE, kBindlessSampledCapacity,

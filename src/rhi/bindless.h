@@ -9,6 +9,7 @@
 #include <array>
 #include <vector>
 
+#include "common/shared_types.h"
 #include "rhi/handles.h"
 #include "rhi/vk.h"
 
@@ -20,9 +21,10 @@ constexpr uint32_t kBindlessSampledStatic = 16384 - 1024;
 constexpr uint32_t kBindlessSampledCapacity = 16384; // last 1024: dynamic section
 constexpr uint32_t kBindlessStorageStatic = 4096 - 512;
 constexpr uint32_t kBindlessStorageCapacity = 4096;
-constexpr uint32_t kBindlessSamplerCount = 4;
+constexpr uint32_t kBindlessSamplerCount = SAMPLER_COUNT;
 
-// Immutable samplers, indexed in GLSL through shaders/common/bindless.glsl.
+// Immutable samplers, indexed in GLSL through shaders/common/bindless.glsl: the engine's own
+// (below), then the glTF material samplers (SAMPLER_MATERIAL_* in common/shared_types.h).
 enum class SamplerId : uint32_t {
     LinearRepeat = 0,
     LinearClamp = 1,

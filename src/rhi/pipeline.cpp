@@ -107,6 +107,7 @@ static std::string graphicsKey(const GraphicsPipelineDesc& d, const std::vector<
     k.pod(d.depthFormat);
     k.pod(d.depthTest), k.pod(d.depthWrite), k.pod(d.depthCompare), k.pod(d.cullMode);
     k.pod(d.topology), k.pod(d.depthClamp), k.pod(d.depthBias), k.pod(d.blend);
+    k.pod(d.dynamicCulling);
     k.pod(d.attachmentBlends.size());
     for (const VkPipelineColorBlendAttachmentState& b : d.attachmentBlends) k.pod(b);
     k.specialization(d.specialization);
@@ -284,11 +285,14 @@ Pipeline createGraphicsPipeline(Gpu& gpu, const GraphicsPipelineDesc& desc) {
         VK_STRUCTURE_TYPE_PIPELINE_COLOR_BLEND_STATE_CREATE_INFO};
     blend.attachmentCount = uint32_t(blends.size());
     blend.pAttachments = blends.data();
-    VkDynamicState dynamics[] = {VK_DYNAMIC_STATE_VIEWPORT, VK_DYNAMIC_STATE_SCISSOR,
-                                 VK_DYNAMIC_STATE_DEPTH_BIAS};
+    std::vector<VkDynamicState> dynamics = {VK_DYNAMIC_STATE_VIEWPORT, VK_DYNAMIC_STATE_SCISSOR};
+    if (desc.depthBias) dynamics.push_back(VK_DYNAMIC_STATE_DEPTH_BIAS);
+    if (desc.dynamicCulling) {
+        dynamics.push_back(VK_DYNAMIC_STATE_CULL_MODE);
+    }
     VkPipelineDynamicStateCreateInfo dynamic{VK_STRUCTURE_TYPE_PIPELINE_DYNAMIC_STATE_CREATE_INFO};
-    dynamic.dynamicStateCount = desc.depthBias ? 3 : 2;
-    dynamic.pDynamicStates = dynamics;
+    dynamic.dynamicStateCount = uint32_t(dynamics.size());
+    dynamic.pDynamicStates = dynamics.data();
     VkPipelineRenderingCreateInfo rendering{VK_STRUCTURE_TYPE_PIPELINE_RENDERING_CREATE_INFO};
     rendering.colorAttachmentCount = uint32_t(desc.colorFormats.size());
     rendering.pColorAttachmentFormats = desc.colorFormats.data();

@@ -1128,13 +1128,7 @@ private:
         textures.resolve = [&](int t, int texCoord, bool srgb, const char* slot) {
             return texture(t, texCoord, srgb, slot, index);
         };
-        textures.clamps = [&](int t) {
-            int sampler = model_.textures[size_t(t)].sampler;
-            if (sampler < 0 || size_t(sampler) >= model_.samplers.size()) return false;
-            const tinygltf::Sampler& s = model_.samplers[size_t(sampler)];
-            return s.wrapS == TINYGLTF_TEXTURE_WRAP_CLAMP_TO_EDGE &&
-                   s.wrapT == TINYGLTF_TEXTURE_WRAP_CLAMP_TO_EDGE;
-        };
+        textures.sampler = [&](int t) { return gltfTextureSampler(model_, t); };
         textures.glossinessToRoughness = [&](int t, float glossinessFactor) {
             return glossinessToRoughness(t, glossinessFactor, index);
         };

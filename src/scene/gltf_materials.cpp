@@ -55,7 +55,7 @@ void setSlot(Material& m, TextureSlot slot, int32_t texture, int gltfTexture,
              const UvTransform& transform, const MaterialTextures& t) {
     uint32_t s = uint32_t(slot);
     m.uvTransforms[s] = transform;
-    if (texture != kNoTexture && t.clamps && t.clamps(gltfTexture)) m.clampMask |= 1u << s;
+    if (texture != kNoTexture && t.sampler) m.samplers[s] = t.sampler(gltfTexture);
 }
 
 // KHR_materials_pbrSpecularGlossiness as metal/rough: a specular-glossiness material is a
@@ -100,6 +100,41 @@ void convertSpecularGlossiness(const tinygltf::Value& sg, int index, Material& o
 }
 
 } // namespace
+
+TextureSampler gltfTextureSampler(const tinygltf::Model& model, int texture) {
+    TextureSampler out;
+    int sampler = model.textures[size_t(texture)].sampler;
+    if (sampler < 0 || size_t(sampler) >= model.samplers.size()) return out;
+    const tinygltf::Sampler& s = model.samplers[size_t(sampler)];
+    auto wrap = [](int mode) -> uint8_t {
+        return mode == TINYGLTF_TEXTURE_WRAP_CLAMP_TO_EDGE     ? SAMPLER_WRAP_CLAMP_TO_EDGE
+               : mode == TINYGLTF_TEXTURE_WRAP_MIRRORED_REPEAT ? SAMPLER_WRAP_MIRRORED_REPEAT
+                                                               : SAMPLER_WRAP_REPEAT;
+    };
+    out.wrapS = wrap(s.wrapS);
+    out.wrapT = wrap(s.wrapT);
+    if (s.magFilter == TINYGLTF_TEXTURE_FILTER_NEAREST) out.mag = SAMPLER_MAG_NEAREST;
+    switch (s.minFilter) {
+    case TINYGLTF_TEXTURE_FILTER_NEAREST:
+        out.min = SAMPLER_MIN_NEAREST;
+        break;
+    case TINYGLTF_TEXTURE_FILTER_LINEAR:
+        out.min = SAMPLER_MIN_LINEAR;
+        break;
+    case TINYGLTF_TEXTURE_FILTER_NEAREST_MIPMAP_NEAREST:
+        out.min = SAMPLER_MIN_NEAREST_MIPMAP_NEAREST;
+        break;
+    case TINYGLTF_TEXTURE_FILTER_LINEAR_MIPMAP_NEAREST:
+        out.min = SAMPLER_MIN_LINEAR_MIPMAP_NEAREST;
+        break;
+    case TINYGLTF_TEXTURE_FILTER_NEAREST_MIPMAP_LINEAR:
+        out.min = SAMPLER_MIN_NEAREST_MIPMAP_LINEAR;
+        break;
+    default:
+        break; // LINEAR_MIPMAP_LINEAR, or unset
+    }
+    return out;
+}
 
 UvTransform uvTransformOf(const tinygltf::ExtensionMap& map) {
     UvTransform out;

@@ -23,13 +23,18 @@ namespace shadel {
 // in warnings.
 struct MaterialTextures {
     std::function<int32_t(int texture, int texCoord, bool srgb, const char* slot)> resolve;
-    // True when the glTF texture's sampler clamps to the edge in both directions.
-    std::function<bool(int texture)> clamps;
+    // The glTF texture's sampler (glTF's defaults filled in).
+    std::function<TextureSampler(int texture)> sampler;
     // Converts a KHR_materials_pbrSpecularGlossiness specularGlossinessTexture into a
     // metallic-roughness texture (roughness = 1 - glossiness x factor); kNoTexture when unusable.
     std::function<int32_t(int texture, float glossinessFactor)> glossinessToRoughness;
     std::function<void(const std::string&)> warn;
 };
+
+// The sampler of glTF texture `texture` (a valid index): glTF's defaults for what it leaves out,
+// repeat and the filters the Khronos Sample Viewer uses when none is given (linear magnification,
+// trilinear minification); a texture without a sampler gets all of them.
+TextureSampler gltfTextureSampler(const tinygltf::Model& model, int texture);
 
 // Reads a texture info's KHR_texture_transform (identity when absent).
 UvTransform uvTransformOf(const tinygltf::ExtensionMap& textureInfoExtensions);

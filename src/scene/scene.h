@@ -8,6 +8,7 @@
 
 #include <glm/glm.hpp>
 
+#include "common/shared_types.h"
 #include "scene/decal.h"
 #include "scene/particle_emitter.h"
 
@@ -109,6 +110,19 @@ struct UvTransform {
     glm::vec2 c0{1.0f, 0.0f}, c1{0.0f, 1.0f}, c2{0.0f, 0.0f};
 };
 
+// A glTF sampler (SAMPLER_WRAP_*, SAMPLER_MAG_*, SAMPLER_MIN_* of common/shared_types.h); the
+// defaults are glTF's for a texture without one: repeat, linear, trilinear.
+struct TextureSampler {
+    uint8_t wrapS = SAMPLER_WRAP_REPEAT, wrapT = SAMPLER_WRAP_REPEAT;
+    uint8_t mag = SAMPLER_MAG_LINEAR, min = SAMPLER_MIN_LINEAR_MIPMAP_LINEAR;
+    bool operator==(const TextureSampler&) const = default;
+};
+// Its index in the bindless sampler table (rhi/bindless.h).
+inline uint32_t samplerIndex(const TextureSampler& s) {
+    return SAMPLER_MATERIAL_FIRST +
+           ((uint32_t(s.wrapS) * 3u + s.wrapT) * 2u + s.mag) * SAMPLER_MIN_COUNT + s.min;
+}
+
 struct Material {
     std::string name;
     glm::vec4 baseColorFactor{1.0f};
@@ -133,8 +147,8 @@ struct Material {
 
     // glTF material extensions (scene/gltf_materials.h); the defaults leave core PBR unchanged.
     UvTransform uvTransforms[kTextureSlotCount];
-    uint32_t clampMask = 0; // bit per TextureSlot: sampled clamp-to-edge instead of repeat
-    bool unlit = false;     // KHR_materials_unlit: the base colour is the output
+    TextureSampler samplers[kTextureSlotCount]; // per TextureSlot: its texture's glTF sampler
+    bool unlit = false; // KHR_materials_unlit: the base colour is the output
     float clearcoatFactor = 0.0f;
     float clearcoatRoughnessFactor = 0.0f;
     float clearcoatNormalScale = 1.0f;

@@ -83,7 +83,9 @@ TEST(GltfExtensions, TextureTransformFollowsTheExtensionsMatrix) {
     glm::vec2 expected = glm::vec2(-0.2f, -0.1f) + 1.5f * glm::vec2(std::sin(0.3f), std::cos(0.3f));
     EXPECT_NEAR(glm::distance(apply(all, {0, 1}), expected), 0.0f, 1e-6f);
     // The file's sampler clamps; the untransformed materials keep the identity.
-    EXPECT_EQ(materialNamed(s, "Offset U").clampMask & 1u, 1u);
+    const TextureSampler& clamped = materialNamed(s, "Offset U").samplers[0];
+    EXPECT_EQ(clamped.wrapS, SAMPLER_WRAP_CLAMP_TO_EDGE);
+    EXPECT_EQ(clamped.wrapT, SAMPLER_WRAP_CLAMP_TO_EDGE);
     const UvTransform& none = materialNamed(s, "Correct").uvTransforms[0];
     EXPECT_EQ(apply(none, {0.3f, 0.7f}), glm::vec2(0.3f, 0.7f));
 }
@@ -161,4 +163,28 @@ TEST(GltfExtensions, WrongTypesInMaterialExtensionsAreErrors) {
     text = doc.dump();
     EXPECT_THROW(importGltfBytes(std::vector<uint8_t>(text.begin(), text.end()), "x.gltf"),
                  InputError); // texture index out of range
+}
+
+// Samplers as authored: BoxTextured's (mirrored repeat across, clamp down, linear, nearest-
+// mipmap-linear) reach its base colour slot; a texture without a sampler gets glTF's default
+// (repeat, linear, trilinear), and the slot indices name the bindless table's samplers.
+TEST(GltfExtensions, TextureSamplersAreReadAsAuthored) {
+    Scene s = loadScene(kAssimp + "/BoxTextured-glTF/BoxTextured.gltf");
+    ASSERT_EQ(s.materials.size(), 1u);
+    const TextureSampler& box = s.materials[0].samplers[0];
+    EXPECT_EQ(box.wrapS, SAMPLER_WRAP_MIRRORED_REPEAT);
+    EXPECT_EQ(box.wrapT, SAMPLER_WRAP_CLAMP_TO_EDGE);
+    EXPECT_EQ(box.mag, SAMPLER_MAG_LINEAR);
+    EXPECT_EQ(box.min, SAMPLER_MIN_NEAREST_MIPMAP_LINEAR);
+    EXPECT_EQ(samplerIndex(box), SAMPLER_MATERIAL_FIRST + ((1u * 3u + 2u) * 2u + 1u) * 6u + 4u);
+    TextureSampler unset;
+    EXPECT_EQ(samplerIndex(unset), SAMPLER_MATERIAL_DEFAULT);
+    TextureSampler last{SAMPLER_WRAP_CLAMP_TO_EDGE, SAMPLER_WRAP_CLAMP_TO_EDGE, SAMPLER_MAG_LINEAR,
+                        SAMPLER_MIN_LINEAR_MIPMAP_LINEAR};
+    EXPECT_EQ(samplerIndex(last), SAMPLER_COUNT - 1u);
+    // The clear-coat test's textures have no sampler: the default.
+    Scene coat = loadScene(kAssimp + "/ClearCoat-glTF/ClearCoatTest.gltf");
+    for (const Material& m : coat.materials)
+        for (const TextureSampler& t : m.samplers)
+            EXPECT_EQ(samplerIndex(t), SAMPLER_MATERIAL_DEFAULT);
 }

@@ -23,7 +23,7 @@ struct CullingState {
     BufferHandle visibility; // uint per instance (camera, last frame)
     // Occlusion only.
     BufferHandle pyramid;     // float, every level packed
-    BufferHandle phase2Draws; // DrawIndexedCommand[DRAW_LIST_COUNT * maxDraws]
+    BufferHandle phase2Draws; // DrawIndexedCommand[DRAW_CAMERA_SLOTS * maxDraws]
     BufferHandle phase2Counts;
     BufferHandle visibleList;               // uint[1 + instances]: count, then ids (read back)
     std::vector<uint32_t> visibleLastFrame; // in instance order
@@ -104,10 +104,10 @@ CullingStatePtr createCulling(Renderer& r, const GpuScene& scene) {
         }
         c->pyramid = createBuffer(gpu, {"culling.depthPyramid", VkDeviceSize(texels) * 4});
         VkDeviceSize drawBytes =
-            VkDeviceSize(DRAW_LIST_COUNT) * r.maxDraws * sizeof(gpu::DrawIndexedCommand);
+            VkDeviceSize(DRAW_CAMERA_SLOTS) * r.maxDraws * sizeof(gpu::DrawIndexedCommand);
         c->phase2Draws = createBuffer(
             gpu, {"draws.cameraPhase2", drawBytes, VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT});
-        c->phase2Counts = createBuffer(gpu, {"draws.cameraPhase2Counts", DRAW_LIST_COUNT * 4,
+        c->phase2Counts = createBuffer(gpu, {"draws.cameraPhase2Counts", DRAW_CAMERA_SLOTS * 4,
                                              VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT});
         c->visibleList =
             createBuffer(gpu, {"culling.visibleList", perInstance + 4, 0, MemoryKind::Readback});
@@ -250,11 +250,13 @@ void recordOcclusionPasses(Renderer& r, FrameRecorder& rec, uint64_t frame, cons
         vkCmdSetViewport(cmd, 0, 1, &vp);
         vkCmdSetScissor(cmd, 0, 1, &scissor);
         pushConstants(gpu, cmd, RasterPush{frame, 0});
+        vkCmdBindIndexBuffer(cmd, vkBuffer(gpu, r.sceneIndices), 0, VK_INDEX_TYPE_UINT32);
         for (uint32_t list : {DRAW_LIST_OPAQUE, DRAW_LIST_OPAQUE_TEXTURED,
-                              DRAW_LIST_OPAQUE_FEATURED, DRAW_LIST_DECOUPLED}) {
-            vkCmdBindIndexBuffer(cmd, vkBuffer(gpu, r.sceneIndices), 0, VK_INDEX_TYPE_UINT32);
-            drawPhase2List(r, cmd, list);
-        }
+                              DRAW_LIST_OPAQUE_FEATURED, DRAW_LIST_DECOUPLED})
+            for (uint32_t side = 0; side < DRAW_SIDE_COUNT; ++side) {
+                setDrawSide(cmd, side);
+                drawPhase2List(r, cmd, list * DRAW_SIDE_COUNT + side);
+            }
         vkCmdEndRendering(cmd);
         memoryBarrier(cmd, VK_PIPELINE_STAGE_2_LATE_FRAGMENT_TESTS_BIT,
                       VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT,
@@ -265,7 +267,7 @@ void recordOcclusionPasses(Renderer& r, FrameRecorder& rec, uint64_t frame, cons
     });
 }
 
-void drawPhase2List(Renderer& r, VkCommandBuffer cmd, uint32_t list) {
+void drawPhase2List(Renderer& r, VkCommandBuffer cmd, uint32_t list) { // list: a camera slot
     CullingState* c = r.culling.get();
     if (!c || !c->phase2Draws) return;
     Gpu& gpu = *r.gpu;

@@ -66,9 +66,9 @@ void recordInstanceCullDispatch(Renderer& r, VkCommandBuffer cmd, const Instance
                                 uint32_t instances);
 // --occlusion on: the three passes above, after the depth prepass.
 void recordOcclusionPasses(Renderer& r, FrameRecorder& rec, uint64_t frame, const GpuScene& scene);
-// Inside a raster pass drawing the camera's list: the phase-2 part of it (nothing without
-// occlusion culling).
-void drawPhase2List(Renderer& r, VkCommandBuffer cmd, uint32_t list);
+// Inside a raster pass drawing the camera's list: the phase-2 part of camera slot `slot`
+// (list * DRAW_SIDE_COUNT + side; nothing without occlusion culling).
+void drawPhase2List(Renderer& r, VkCommandBuffer cmd, uint32_t slot);
 // Inside a shadow view's depth pass (index buffer bound): draws the casters of view
 // CULL_VIEW_CASCADE0 + i or CULL_VIEW_SPOT0 + i (its own list, or the sun's with whole-scene
 // culling).

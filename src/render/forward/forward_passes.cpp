@@ -38,16 +38,24 @@ constexpr ForwardClass kForwardClasses[kForwardClassCount] = {
     {DRAW_LIST_OPAQUE_TEXTURED, MATERIAL_FEATURE_TEXTURES, "forwardOpaqueTextured"},
     {DRAW_LIST_OPAQUE_FEATURED, MATERIAL_FEATURES_ALL, "forwardOpaqueFeatured"}};
 
-// One camera list exactly (drawCameraList draws the opaque lists as one).
+// One camera list exactly (drawCameraList draws the opaque lists as one), side by side.
 void drawOneCameraList(Renderer& r, VkCommandBuffer cmd, uint32_t list, BufferHandle indices) {
     Gpu& gpu = *r.gpu;
     setViewport(cmd, r.internalWidth, r.internalHeight);
     vkCmdBindIndexBuffer(cmd, vkBuffer(gpu, indices ? indices : r.sceneIndices), 0,
                          VK_INDEX_TYPE_UINT32);
-    drawList(r, cmd, r.draws, 0, list);
-    drawPhase2List(r, cmd, list); // occlusion culling's second phase (render/culling)
+    for (uint32_t side = 0; side < DRAW_SIDE_COUNT; ++side) {
+        setDrawSide(cmd, side);
+        uint32_t slot = list * DRAW_SIDE_COUNT + side;
+        drawList(r, cmd, r.draws, 0, slot);
+        drawPhase2List(r, cmd, slot); // occlusion culling's second phase (render/culling)
+    }
 }
 } // namespace
+
+void setDrawSide(VkCommandBuffer cmd, uint32_t side) {
+    vkCmdSetCullMode(cmd, side == DRAW_SIDE_BOTH ? VK_CULL_MODE_NONE : VK_CULL_MODE_BACK_BIT);
+}
 
 BufferHandle shadingIndices(const Renderer& r) {
     return r.settings.inspectX >= 0 ? r.sceneVisibilityIndices : r.sceneIndices;
@@ -66,7 +74,7 @@ static GraphicsPipelineDesc forwardClassPipeline(const Renderer& r, uint32_t k, 
     opaque.depthFormat = VK_FORMAT_D32_SFLOAT;
     opaque.depthWrite = false;
     opaque.depthCompare = VK_COMPARE_OP_EQUAL; // the prepass resolved visibility
-    opaque.cullMode = VK_CULL_MODE_NONE;
+    opaque.dynamicCulling = true;              // per list side (drawCameraList)
     opaque.specialization = shaderPrintSpecialization(r.settings.inspectX >= 0);
     opaque.specialization.push_back(
         {VISIBILITY_VERTICES_CONSTANT_ID, shadingVisibilityVertices(r)});
@@ -98,7 +106,7 @@ void createForwardPipelines(Renderer& r) {
     depth.vertexShader = "forward_forward.vert.spv";
     depth.fragmentShader = r.alphaMasked ? "forward_depth.frag.spv" : ""; // (Renderer::alphaMasked)
     depth.depthFormat = VK_FORMAT_D32_SFLOAT;
-    depth.cullMode = VK_CULL_MODE_NONE; // double-sided materials; backfaces cost little here
+    depth.dynamicCulling = true; // per list side (drawCameraList)
     r.depthPrepass = createGraphicsPipeline(gpu, depth);
     // Scene colour: the hybrid objects of decoupled frames draw with them too.
     for (uint32_t k = 0; k < kForwardClassCount; ++k)
@@ -135,7 +143,7 @@ void recordInstanceCull(Renderer& r, VkCommandBuffer cmd, uint64_t frame, const 
                           1,
                           r.settings.occlusion ? CullLastVisible : CullSinglePass};
     push.sunDraws = address(gpu, r.shadowDraws);
-    push.sunCounts = address(gpu, r.drawCounts) + DRAW_LIST_COUNT * 4;
+    push.sunCounts = address(gpu, r.drawCounts) + DRAW_CAMERA_SLOTS * 4;
     recordInstanceCullDispatch(r, cmd, push, scene.instanceCount);
     memoryBarrier(cmd, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT,
                   VK_PIPELINE_STAGE_2_DRAW_INDIRECT_BIT, VK_ACCESS_2_INDIRECT_COMMAND_READ_BIT);
@@ -150,7 +158,7 @@ void recordShadowMap(Renderer& r, VkCommandBuffer cmd, uint64_t frame) {
 }
 
 void drawSunShadowList(Renderer& r, VkCommandBuffer cmd) {
-    drawList(r, cmd, r.shadowDraws, DRAW_LIST_COUNT * 4, DRAW_LIST_OPAQUE);
+    drawList(r, cmd, r.shadowDraws, DRAW_CAMERA_SLOTS * 4, DRAW_LIST_OPAQUE);
 }
 
 void drawCameraList(Renderer& r, VkCommandBuffer cmd, uint32_t list, BufferHandle indices) {

@@ -39,8 +39,13 @@ void drawForwardLists(Renderer& r, VkCommandBuffer cmd, uint64_t frame);
 void drawSunShadowList(Renderer& r, VkCommandBuffer cmd);
 // Shared by every raster pass that draws the culled camera list (decoupled passes too), from the
 // scene's index buffer unless `indices` names another of the same layout (the visibility
-// prepass's: GpuScene::visibilityIndices).
+// prepass's: GpuScene::visibilityIndices). Each list is drawn side by side (DRAW_SIDE_*), the
+// cull mode set for each: the pipeline has GraphicsPipelineDesc::dynamicCulling.
 void drawCameraList(Renderer& r, VkCommandBuffer cmd, uint32_t list, BufferHandle indices = {});
+// The cull mode of a draw of side `side` (DRAW_SIDE_*), for dynamicCulling pipelines: back
+// faces culled for single-sided materials, none for double-sided ones (front faces are counter-
+// clockwise: mirrored instances have a mesh copy with the winding reversed, scene/gltf_import).
+void setDrawSide(VkCommandBuffer cmd, uint32_t side);
 // Begins depth-only rendering into the scene depth (cleared for the prepass, loaded after).
 void beginSceneDepthPass(Renderer& r, VkCommandBuffer cmd, bool clear);
 // --inspect prints the triangle under the pixel: forward shading and the raster reconstruction

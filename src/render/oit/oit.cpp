@@ -16,6 +16,7 @@ struct OitState {
     std::vector<uint32_t> draws;        // this frame's, in drawing order
     std::vector<gpu::GpuMesh> meshes;   // the scene's (draws are recorded from the CPU list)
     std::vector<uint32_t> instanceMesh; // per instance
+    std::vector<uint8_t> doubleSided;   // per instance: its material's
     // WBOIT targets: accumulation (sum of premultiplied colour * w, sum of coverage * w) and
     // revealage (R: product of 1 - opacity; G: the same over plain alpha layers; A: summed
     // additiveness).
@@ -23,7 +24,7 @@ struct OitState {
     RenderTargetView accumTarget, revealTarget;
     TextureReadView accumRead, revealRead;
     uint32_t decoupledDraws = 0; // blended instances shaded in shadel space this frame
-    Pipeline accumulate, composite, sortedBackFaces, sortedFrontFaces;
+    Pipeline accumulate, composite, sorted;
     Pipeline reconstruct; // decoupled mode: transparent surfaces read their shadels
 };
 
@@ -118,6 +119,11 @@ OitStatePtr createOit(Renderer& r, const GpuScene& scene) {
     o.meshes = scene.meshInfo;
     for (uint32_t i = 0; i < scene.instanceCount; ++i)
         o.instanceMesh.push_back(scene.instanceInfo[i].mesh);
+    for (uint32_t i = 0; i < scene.instanceCount; ++i) {
+        uint32_t m = scene.instanceInfo[i].material;
+        o.doubleSided.push_back(m < scene.materialInfo.size() &&
+                                (scene.materialInfo[m].flags & MATERIAL_DOUBLE_SIDED) != 0u);
+    }
     Gpu& gpu = *r.gpu;
 
     o.accum = createWboitTarget(gpu, "oit.accumulation", r.internalWidth, r.internalHeight);
@@ -136,7 +142,7 @@ OitStatePtr createOit(Renderer& r, const GpuScene& scene) {
     acc.depthFormat = VK_FORMAT_D32_SFLOAT;
     acc.depthWrite = false; // against the opaque depth only, never against each other
     acc.depthCompare = VK_COMPARE_OP_GREATER_OR_EQUAL;
-    acc.cullMode = VK_CULL_MODE_NONE;
+    acc.dynamicCulling = true; // per instance (drawInstance) or list side (drawCameraList)
     acc.attachmentBlends = wboitAttachmentBlends();
     o.accumulate = createGraphicsPipeline(gpu, acc);
     if (r.settings.mode == RenderMode::Decoupled) {
@@ -158,24 +164,21 @@ OitStatePtr createOit(Renderer& r, const GpuScene& scene) {
                                         VK_BLEND_FACTOR_ONE, VK_BLEND_FACTOR_ONE_MINUS_SRC_ALPHA)};
     o.composite = createGraphicsPipeline(gpu, comp);
 
-    // Sorted reference: premultiplied "over"; each instance's back faces, then its front faces
-    // (exact for convex shapes such as the glass sphere).
+    // Sorted reference: premultiplied "over"; each instance's back faces (double-sided
+    // materials), then its front faces (exact for convex shapes such as the glass sphere).
     GraphicsPipelineDesc sorted;
-    sorted.name = "sortedTransparencyBackFaces";
+    sorted.name = "sortedTransparency";
     sorted.vertexShader = "forward_forward.vert.spv";
     sorted.fragmentShader = "oit_sorted.frag.spv";
     sorted.colorFormats = {VK_FORMAT_R16G16B16A16_SFLOAT};
     sorted.depthFormat = VK_FORMAT_D32_SFLOAT;
     sorted.depthWrite = false;
     sorted.depthCompare = VK_COMPARE_OP_GREATER_OR_EQUAL;
-    sorted.cullMode = VK_CULL_MODE_FRONT_BIT;
+    sorted.dynamicCulling = true; // back faces, then front faces (recordTransparencyPasses)
     sorted.attachmentBlends = {blendState(VK_BLEND_FACTOR_ONE, VK_BLEND_FACTOR_ONE_MINUS_SRC_ALPHA,
                                           VK_BLEND_FACTOR_ONE,
                                           VK_BLEND_FACTOR_ONE_MINUS_SRC_ALPHA)};
-    o.sortedBackFaces = createGraphicsPipeline(gpu, sorted);
-    sorted.name = "sortedTransparencyFrontFaces";
-    sorted.cullMode = VK_CULL_MODE_BACK_BIT;
-    o.sortedFrontFaces = createGraphicsPipeline(gpu, sorted);
+    o.sorted = createGraphicsPipeline(gpu, sorted);
     return state;
 }
 
@@ -183,8 +186,7 @@ void destroyOit(Renderer& r, OitStatePtr& state) {
     if (!state) return;
     Gpu& gpu = *r.gpu;
     OitState& o = *state;
-    for (Pipeline* p : {&o.accumulate, &o.composite, &o.sortedBackFaces, &o.sortedFrontFaces})
-        destroy(gpu, *p);
+    for (Pipeline* p : {&o.accumulate, &o.composite, &o.sorted}) destroy(gpu, *p);
     if (o.reconstruct.pipeline) destroy(gpu, o.reconstruct);
     destroy(gpu, o.accumTarget);
     destroy(gpu, o.revealTarget);
@@ -320,12 +322,17 @@ void recordTransparencyPasses(Renderer& r, FrameRecorder& rec, uint64_t frame) {
             beginSceneColorPass(r, cmd, false);
             setViewport(cmd, r.internalWidth, r.internalHeight);
             vkCmdBindIndexBuffer(cmd, vkBuffer(gpu, r.sceneIndices), 0, VK_INDEX_TYPE_UINT32);
+            bind(gpu, cmd, o.sorted);
+            pushConstants(gpu, cmd, RasterPush{frame, 0});
             for (uint32_t i : o.draws) {
-                for (const Pipeline* p : {&o.sortedBackFaces, &o.sortedFrontFaces}) {
-                    bind(gpu, cmd, *p);
-                    pushConstants(gpu, cmd, RasterPush{frame, 0});
+                // A double-sided instance's back faces, then its front faces; a single-sided
+                // one's front faces only.
+                if (o.doubleSided[i]) {
+                    vkCmdSetCullMode(cmd, VK_CULL_MODE_FRONT_BIT);
                     drawInstance(cmd, meshOf(i), i);
                 }
+                vkCmdSetCullMode(cmd, VK_CULL_MODE_BACK_BIT);
+                drawInstance(cmd, meshOf(i), i);
             }
             vkCmdEndRendering(cmd);
         });
@@ -338,7 +345,10 @@ void recordTransparencyPasses(Renderer& r, FrameRecorder& rec, uint64_t frame) {
         bind(gpu, cmd, o.accumulate);
         pushConstants(gpu, cmd, RasterPush{frame, 0});
         vkCmdBindIndexBuffer(cmd, vkBuffer(gpu, r.sceneIndices), 0, VK_INDEX_TYPE_UINT32);
-        for (uint32_t i : o.draws) drawInstance(cmd, meshOf(i), i);
+        for (uint32_t i : o.draws) {
+            setDrawSide(cmd, o.doubleSided[i] ? DRAW_SIDE_BOTH : DRAW_SIDE_FRONT);
+            drawInstance(cmd, meshOf(i), i);
+        }
         if (o.decoupledDraws) { // reconstructed from shadel space into the same targets
             bind(gpu, cmd, o.reconstruct);
             pushConstants(gpu, cmd, RasterPush{frame, 0});

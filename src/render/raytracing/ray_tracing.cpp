@@ -88,7 +88,7 @@ static void createPixelTargets(Renderer& r, RayTracingState& s) {
     p.depthFormat = VK_FORMAT_D32_SFLOAT;
     p.depthWrite = false;
     p.depthCompare = VK_COMPARE_OP_EQUAL; // the prepass resolved visibility
-    p.cullMode = VK_CULL_MODE_NONE;
+    p.dynamicCulling = true;              // per list side (drawCameraList), as the prepass
     s.pixelTerms = createGraphicsPipeline(gpu, p);
 }
 

@@ -396,7 +396,7 @@ DecoupledStatePtr createDecoupled(Renderer& r, const GpuScene& scene) {
     mark.depthFormat = VK_FORMAT_D32_SFLOAT;
     mark.depthWrite = false;
     mark.depthCompare = VK_COMPARE_OP_EQUAL;
-    mark.cullMode = VK_CULL_MODE_NONE;
+    mark.dynamicCulling = true; // per list side (drawCameraList), as the prepass
     d.mark = createGraphicsPipeline(gpu, mark);
     GraphicsPipelineDesc markTransparent = mark;
     markTransparent.name = "shadelMarkTransparent";

@@ -115,7 +115,8 @@ std::vector<MaterialTexels> materialTexels(const Scene& scene) {
 }
 
 bool sameTextures(const gpu::GpuMaterial& a, const gpu::GpuMaterial& b) {
-    return materialTextureSlots(a) == materialTextureSlots(b) && a.clampMask == b.clampMask &&
+    return materialTextureSlots(a) == materialTextureSlots(b) &&
+           std::memcmp(a.samplers, b.samplers, sizeof(a.samplers)) == 0 &&
            std::memcmp(a.uvTransform, b.uvTransform, sizeof(a.uvTransform)) == 0;
 }
 

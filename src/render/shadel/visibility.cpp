@@ -161,7 +161,7 @@ VisibilityStatePtr createVisibility(Renderer& r) {
                               {VISIBILITY_VERTICES_CONSTANT_ID, VISIBILITY_VERTICES_PREPASS}};
     prepass.colorFormats = {VK_FORMAT_R32G32_UINT};
     prepass.depthFormat = VK_FORMAT_D32_SFLOAT;
-    prepass.cullMode = VK_CULL_MODE_NONE; // as the depth prepass
+    prepass.dynamicCulling = true; // per list side (drawCameraList), as the depth prepass
     v.prepass = createGraphicsPipeline(gpu, prepass);
     std::vector<ComputePipelineDesc> descs = {
         {"shadelMarkVisibility", "shadel_mark_visibility.comp.spv", {}}};
