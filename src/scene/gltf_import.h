@@ -10,13 +10,13 @@
 namespace shadel {
 
 struct SceneFileOptions {
-    // --sun auto|off: a file without a directional light gets a default sun (auto), or none.
-    bool addDefaultSun = true;
     // Buffer and image URIs may resolve outside the model's folder (`../`, absolute paths).
     bool allowExternalFiles = false;
     // --time: animations posed at this time in seconds (node TRS and morph weights); unset =
     // the file's rest pose.
     std::optional<double> time;
+    // --sun auto|off: a file without a directional light gets a default sun (auto), or none.
+    bool addDefaultSun = true;
 };
 
 // Loads a glTF 2.0 file. Every malformed input throws InputError with one line
