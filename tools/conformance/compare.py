@@ -163,11 +163,13 @@ def render(shadel, scene, mode, size, flags, out):
 
 # ---- pictures ----------------------------------------------------------------------------------
 
-def side_by_side(ref_rgb, renders):
+def side_by_side(ref_rgb, ref_alpha, renders):
+    """Rows of reference | shadel | difference x4 (over the covered pixels PSNR measures)."""
     rows = []
     for rgba in renders:
         shadel_rgb = rgba[..., :3].astype(np.float64)
-        diff = np.clip(np.abs(ref_rgb - shadel_rgb) * 4, 0, 255)
+        covered = (ref_alpha > 0) | (rgba[..., 3] > 0)
+        diff = np.clip(np.abs(ref_rgb - shadel_rgb) * 4, 0, 255) * covered[..., None]
         rows.append(np.concatenate([ref_rgb, shadel_rgb, diff], axis=1))
     img = np.concatenate(rows, axis=0).astype(np.uint8)
     return Image.fromarray(img, "RGB")
@@ -277,7 +279,7 @@ def main():
             results.append(r)
             if len(renders) == len(MODES) and not args.no_docs:
                 os.makedirs(DOCS, exist_ok=True)
-                save_png(side_by_side(ref_rgb, renders), os.path.join(DOCS, f"{name}.png"))
+                save_png(side_by_side(ref_rgb, ref[..., 3], renders), os.path.join(DOCS, f"{name}.png"))
             print(f"{name}: forward {r.get('psnr_forward', float('nan')):.2f} dB, decoupled "
                   f"{r.get('psnr_decoupled', float('nan')):.2f} dB"
                   + (f", metal L* diff {r['lstar_forward']:.2f} / {r['lstar_decoupled']:.2f}"
