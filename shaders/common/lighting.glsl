@@ -167,10 +167,6 @@ float visibilitySmithGgx(float nv, float nl, float a2) {
     return 0.5 / max(gv + gl, 1e-5);
 }
 
-vec3 fresnelSchlick(vec3 f0, float vh) {
-    return f0 + (1.0 - f0) * pow(1.0 - vh, 5.0);
-}
-
 // KHR_materials_sheen: Charlie distribution and Neubelt's visibility (Estevez and Kulla 2017).
 float distributionCharlie(float nh, float alpha) {
     float inv = 1.0 / alpha;
@@ -178,10 +174,32 @@ float distributionCharlie(float nh, float alpha) {
     return (2.0 + inv) * pow(sin2, inv * 0.5) / (2.0 * PI);
 }
 
+// The glTF metal/rough BRDF is a mix, by metallic, of two BRDFs with their own Fresnel terms: a
+// dielectric (Lambert diffuse under a specular layer whose F0/F90 come from ior and
+// KHR_materials_specular; what the layer reflects does not reach the diffuse) and a metal
+// (specular only, F0 = base colour). Both share the GGX microfacet term D * V.
+vec3 dielectricFresnel(MaterialSample m, float vh) {
+    return m.specularF0 + (m.specularF90 - m.specularF0) * pow(1.0 - vh, 5.0);
+}
+// The weights of the diffuse (Lambert, albedo baseColor / pi) and of the specular D * V terms.
+void gltfFresnelWeights(MaterialSample m, float vh, out vec3 diffuseWeight, out vec3 specularWeight) {
+    vec3 dielectric = dielectricFresnel(m, vh);
+    vec3 metal = m.baseColor + (1.0 - m.baseColor) * pow(1.0 - vh, 5.0);
+    diffuseWeight = (1.0 - m.metallic) * (1.0 - dielectric);
+    specularWeight = mix(dielectric, metal, m.metallic);
+}
+
+// The clear coat's Fresnel toward the viewer, times its weight: what the coat reflects of the
+// light and the environment and takes from the layers below (KHR_materials_clearcoat).
+float clearcoatFresnel(MaterialSample m, vec3 v) {
+    float cnv = max(dot(m.clearcoatNormal, v), 0.0);
+    return m.clearcoat * (0.04 + 0.96 * pow(1.0 - cnv, 5.0));
+}
+
 // Radiance reflected toward v from a light of `radiance` arriving from direction l: the base
-// layer (GGX + Lambert, dielectric F0/F90 from ior and specular), under sheen (its albedo taken
-// from the layer below by max(sheen colour)), under the clear coat (Fresnel 0.04 on its own
-// normal; what it reflects does not reach the layers below).
+// layer (the glTF BRDF above), under sheen (its albedo taken from the layer below by max(sheen
+// colour)), under the clear coat (Fresnel on its own normal; what it reflects does not reach the
+// layers below).
 vec3 brdf(MaterialSample m, vec3 n, vec3 v, vec3 l, vec3 radiance) {
     float nl = dot(n, l);
     bool coat = MATERIAL_HAS(MATERIAL_FEATURE_CLEARCOAT) && m.clearcoat > 0.0;
@@ -195,12 +213,10 @@ vec3 brdf(MaterialSample m, vec3 n, vec3 v, vec3 l, vec3 radiance) {
         float nh = max(dot(n, h), 0.0);
         float a = m.roughness * m.roughness;
         float a2 = a * a;
-        vec3 f0 = mix(m.specularF0, m.baseColor, m.metallic);
-        float f90 = mix(m.specularF90, 1.0, m.metallic);
-        vec3 f = f0 + (f90 - f0) * pow(1.0 - vh, 5.0);
-        vec3 specular = f * distributionGgx(nh, a2) * visibilitySmithGgx(nv, nl, a2);
-        vec3 diffuse = (1.0 - f) * (1.0 - m.metallic) * m.baseColor / PI;
-        color = diffuse + specular;
+        vec3 diffuseWeight, specularWeight;
+        gltfFresnelWeights(m, vh, diffuseWeight, specularWeight);
+        float specular = distributionGgx(nh, a2) * visibilitySmithGgx(nv, nl, a2);
+        color = diffuseWeight * m.baseColor / PI + specularWeight * specular;
         float sheenMax = max(m.sheenColor.r, max(m.sheenColor.g, m.sheenColor.b));
         if (MATERIAL_HAS(MATERIAL_FEATURE_SHEEN) && sheenMax > 0.0) {
             float alpha = m.sheenRoughness * m.sheenRoughness;
@@ -212,20 +228,20 @@ vec3 brdf(MaterialSample m, vec3 n, vec3 v, vec3 l, vec3 radiance) {
     }
     if (coat) {
         vec3 cn = m.clearcoatNormal;
-        float cnv = max(dot(cn, v), 1e-4);
-        float fcView = 0.04 + 0.96 * pow(1.0 - cnv, 5.0);
-        color *= 1.0 - m.clearcoat * fcView;
+        float fc = clearcoatFresnel(m, v);
+        vec3 coatColor = vec3(0.0);
         if (coatNl > 0.0) {
             float ca = m.clearcoatRoughness * m.clearcoatRoughness;
             float ca2 = ca * ca;
-            float fc = 0.04 + 0.96 * pow(1.0 - vh, 5.0);
-            color += m.clearcoat * fc * distributionGgx(max(dot(cn, h), 0.0), ca2) *
-                     visibilitySmithGgx(cnv, coatNl, ca2) * coatNl;
+            coatColor = vec3(distributionGgx(max(dot(cn, h), 0.0), ca2) *
+                             visibilitySmithGgx(max(dot(cn, v), 1e-4), coatNl, ca2) * coatNl);
         }
+        color = mix(color, coatColor, fc);
     }
     return color * radiance;
 }
 
+#include "common/environment_lighting.glsl"
 #include "lighting/shadows.glsl"
 
 // 3x3 PCF on the sun's shadow map (reversed-Z is not used for the orthographic shadow map):
@@ -341,13 +357,13 @@ vec3 tubeLight(GpuLight light, MaterialSample m, vec3 n, vec3 v, vec3 p) {
 
     float nlD = dot(n, dirD);
     float nlS = dot(n, dirS);
-    vec3 f0 = mix(vec3(0.04), m.baseColor, m.metallic);
     float alpha = m.roughness * m.roughness;
     vec3 color = vec3(0.0);
+    vec3 diffuseWeight, specularWeight;
     if (nlD > 0.0) {
         vec3 radiance = light.color * rangeAttenuation(distD, light.range);
-        vec3 f = fresnelSchlick(f0, max(dot(v, normalize(v + dirD)), 0.0));
-        color += (1.0 - f) * (1.0 - m.metallic) * m.baseColor / PI * radiance * nlD;
+        gltfFresnelWeights(m, max(dot(v, normalize(v + dirD)), 0.0), diffuseWeight, specularWeight);
+        color += diffuseWeight * m.baseColor / PI * radiance * nlD;
     }
     if (nlS > 0.0) {
         vec3 radiance = light.color * rangeAttenuation(distS, light.range);
@@ -355,8 +371,8 @@ vec3 tubeLight(GpuLight light, MaterialSample m, vec3 n, vec3 v, vec3 p) {
         float energy = (alpha * alpha) / max(widened * widened, 1e-6);
         vec3 h = normalize(v + dirS);
         float a2 = widened * widened;
-        vec3 f = fresnelSchlick(f0, max(dot(v, h), 0.0));
-        vec3 spec = f * distributionGgx(max(dot(n, h), 0.0), a2) *
+        gltfFresnelWeights(m, max(dot(v, h), 0.0), diffuseWeight, specularWeight);
+        vec3 spec = specularWeight * distributionGgx(max(dot(n, h), 0.0), a2) *
                     visibilitySmithGgx(max(dot(n, v), 1e-4), nlS, a2);
         color += spec * energy * radiance * nlS;
     }
@@ -417,9 +433,8 @@ vec3 areaLight(GpuLight light, MaterialSample m, vec3 n, vec3 v, vec3 p) {
     float hw = light.halfLength, hh = light.radius;
     if (dot(p - light.position, emitNormal) <= 0.0) return vec3(0.0); // behind the emitter
     float texels = areaTexels(light);
-    vec3 f0 = mix(m.specularF0, m.baseColor, m.metallic);
-    float f90 = mix(m.specularF90, 1.0, m.metallic);
     float nv = max(dot(n, v), 1e-4);
+    vec3 diffuseWeight, specularWeight;
 
     // Diffuse: irradiance summed over the cells. Farther than AREA_FAR_HALF_DIAGONALS half
     // diagonals the cells' terms differ little and one cell, the whole rectangle in its mean
@@ -451,8 +466,8 @@ vec3 areaLight(GpuLight light, MaterialSample m, vec3 n, vec3 v, vec3 p) {
     vec3 color = vec3(0.0);
     if (dot(meanDir, meanDir) > 0.0) {
         vec3 l = normalize(meanDir);
-        vec3 f = f0 + (f90 - f0) * pow(1.0 - max(dot(v, normalize(v + l)), 0.0), 5.0);
-        color += (1.0 - f) * (1.0 - m.metallic) * m.baseColor / PI * irradiance * light.color;
+        gltfFresnelWeights(m, max(dot(v, normalize(v + l)), 0.0), diffuseWeight, specularWeight);
+        color += diffuseWeight * m.baseColor / PI * irradiance * light.color;
     }
 
     // Specular: the representative point.
@@ -473,8 +488,8 @@ vec3 areaLight(GpuLight light, MaterialSample m, vec3 n, vec3 v, vec3 p) {
         float energy = (alpha * alpha) / max(widened * widened, 1e-6);
         float a2 = alpha * alpha;
         vec3 h = normalize(v + dirS);
-        vec3 f = f0 + (f90 - f0) * pow(1.0 - max(dot(v, h), 0.0), 5.0);
-        vec3 spec = f * distributionGgx(max(dot(n, h), 0.0), a2) * visibilitySmithGgx(nv, nlS, a2);
+        gltfFresnelWeights(m, max(dot(v, h), 0.0), diffuseWeight, specularWeight);
+        vec3 spec = specularWeight * distributionGgx(max(dot(n, h), 0.0), a2) * visibilitySmithGgx(nv, nlS, a2);
         // The lobe's footprint on the rectangle, in texels: its MIP.
         float footprint = 2.0 * distS * widened;
         float lod = log2(max(footprint * texels / (2.0 * max(hw, hh)), 1.0));
@@ -557,7 +572,9 @@ vec3 shadeSurface(FrameConstants f, MaterialSample m, vec3 worldPos, vec3 geomet
     if (m.unlit) return m.baseColor;
     vec3 n = m.normal;
     vec3 v = normalize(f.cameraPosition - worldPos);
-    vec3 color = m.emissive;
+    // Emission leaves through the clear coat, which reflects its Fresnel's share back.
+    bool coat = MATERIAL_HAS(MATERIAL_FEATURE_CLEARCOAT) && m.clearcoat > 0.0;
+    vec3 color = m.emissive * (coat ? 1.0 - clearcoatFresnel(m, v) : 1.0);
     // Indirect diffuse light from the light propagation volume (0 when GI is off).
     vec3 indirect = giIrradiance(f.gi, worldPos, n) * m.baseColor * (1.0 - m.metallic) *
                     m.occlusion * m.ambientOcclusion / PI;
@@ -565,26 +582,16 @@ vec3 shadeSurface(FrameConstants f, MaterialSample m, vec3 worldPos, vec3 geomet
     if (f.visualize == VISUALIZE_RT_AO) return vec3(gRtOcclusion);
     color += indirect + gRtIndirect * m.baseColor * (1.0 - m.metallic) * m.occlusion *
                             m.ambientOcclusion;
-    // Ambient: a hemisphere term so shadowed sides are not black.
-    float up = n.y * 0.5 + 0.5;
-    vec3 ambient = mix(f.ambientColor * 0.5, f.ambientColor + f.skyColor * 0.15, up);
-    vec3 ambientLit = ambient * m.baseColor * (1.0 - m.metallic * 0.5) * m.occlusion;
-    if (MATERIAL_HAS(MATERIAL_FEATURE_CLEARCOAT) && m.clearcoat > 0.0) {
-        // The coat mirrors the same hemisphere (sky above, ground below) by its Fresnel; what it
-        // reflects does not reach the base.
-        float fc = m.clearcoat * (0.04 + 0.96 * pow(1.0 - max(dot(m.clearcoatNormal, v), 0.0), 5.0));
-        vec3 r = reflect(-v, m.clearcoatNormal);
-        vec3 mirrored = mix(f.ambientColor * 0.5, f.ambientColor + f.skyColor, r.y * 0.5 + 0.5);
-        ambientLit = ambientLit * (1.0 - fc) + fc * mirrored * m.occlusion;
-    }
-    // Distance fields: AO on the ambient; the sun's visibility in the far field.
+    // Distance fields: AO on the environment; the sun's visibility in the far field.
     bool dfLighting = kDistanceFieldLighting != 0u && f.distanceFields != 0ul;
     DistanceFieldFrame df;
+    float occlusion = m.occlusion * m.ambientOcclusion * gRtOcclusion; // AO decals: indirect only
     if (dfLighting) {
         df = DistanceFieldFrameRef(f.distanceFields).d;
-        ambientLit *= dfAmbientOcclusion(df, worldPos + geometricNormal * 0.02, geometricNormal);
+        occlusion *= dfAmbientOcclusion(df, worldPos + geometricNormal * 0.02, geometricNormal);
     }
-    color += ambientLit * gRtOcclusion * m.ambientOcclusion; // AO decals: ambient only
+    // Image-based lighting (render/environment): the sky, an HDR file, or the scene's hemisphere.
+    color += environmentLight(f.environment, m, n, v, occlusion);
 
     vec3 l = -f.sunDirection;
     LightingFrame lf;
@@ -629,8 +636,9 @@ vec3 shadeSurface(FrameConstants f, MaterialSample m, vec3 worldPos, vec3 geomet
                               kSpectrumFeatures);
     // Darks subtract light; they never make a surface emit negative light.
     // Without darks the sum is not negative and the clamp changes nothing.
-    if (!SPECTRUM_HAS(SPECTRUM_DARK)) return color + direct * m.occlusion;
-    return color + max(direct * m.occlusion, -color);
+    // The material's occlusion map darkens indirect light only (glTF), not the lights.
+    if (!SPECTRUM_HAS(SPECTRUM_DARK)) return color + direct;
+    return color + max(direct, -color);
 }
 
 // Wrap ("non-directional") diffuse of seed 004's particles: n.l moved towards 1 by `wrap`, so
@@ -639,13 +647,11 @@ float wrappedNl(vec3 n, vec3 l, float wrap) {
     return max((dot(n, l) + wrap) / (1.0 + wrap), 0.0);
 }
 
-// The light reaching a diffuse particle of unit albedo at p with normal n, from the ambient
-// hemisphere, the sun and every light of the caller's list (tube lights from their closest
+// The light reaching a diffuse particle of unit albedo at p with normal n, from the
+// environment, the sun and every light of the caller's list (tube lights from their closest
 // point). Linear in albedo, so the particle atlas stores this and sprites multiply their colour.
 vec3 shadeParticle(FrameConstants f, vec3 p, vec3 n, float wrap) {
-    float up = n.y * 0.5 + 0.5;
-    vec3 color = mix(f.ambientColor * 0.5, f.ambientColor + f.skyColor * 0.15, up);
-    color += giIrradiance(f.gi, p, n) / PI;
+    vec3 color = environmentIrradiance(f.environment, n) + giIrradiance(f.gi, p, n) / PI;
     if (dot(f.sunColor, f.sunColor) > 0.0)
         color += f.sunColor * wrappedNl(n, -f.sunDirection, wrap) * sunShadow(f, p, n) / PI;
     LightBuffer lights = LightBuffer(f.lights);

@@ -15,7 +15,7 @@
 #define PRINT_SHADING_NORMAL 10u  // material: normal (normal map applied)
 #define PRINT_OCCLUSION 11u       // material: occlusion
 #define PRINT_EMISSIVE 12u        // term: emissive
-#define PRINT_AMBIENT 13u         // term: hemisphere ambient
+#define PRINT_AMBIENT 13u         // term: the environment (image-based lighting)
 #define PRINT_SUN_SHADOW 14u      // the sun's PCF shadow factor
 #define PRINT_SUN 15u             // term: the sun
 #define PRINT_LIGHT 16u           // term: one punctual light (rgb, index)

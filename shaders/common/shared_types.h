@@ -69,6 +69,11 @@ using uint = uint32_t;
 // Light blockers (render/lighting): a light lists up to this many blockers.
 #define LIGHT_MAX_BLOCKERS_PER_LIGHT 32u
 #define LIGHT_TILE_SIZE 16u // pixels per side of a forward light culling tile
+// FrameConstants::tonemap: the display curve (RenderSettings::tonemap, common/tone_curve.glsl).
+#define TONEMAP_ACES_NARKOWICZ 0u
+#define TONEMAP_ACES_HILL 1u
+#define TONEMAP_KHR_PBR_NEUTRAL 2u
+#define TONEMAP_LINEAR 3u
 #define TONEMAP_GROUP_X 32u // the tonemap pass's workgroup (post/tonemap.comp)
 #define TONEMAP_GROUP_Y 8u
 // Feature spectra (seed 001, render/lighting/feature_spectra.h): the features a tile needs,
@@ -473,6 +478,34 @@ struct DrawIndexedCommand { // VkDrawIndexedIndirectCommand
     uint firstInstance;
 };
 
+// ---- Image-based lighting (render/environment, shaders/environment) --------------------------
+// GpuEnvironment::flags
+#define ENVIRONMENT_FLAG_NONE 1u     // no environment: lighting and background read 0
+#define ENVIRONMENT_FLAG_SUN_DISC 2u // the background draws the sun's disc
+
+// Every map is equirectangular in the convention of render/environment/equirect.h (row 0 looks
+// up, the middle column along +Z), sampled bilinearly with u wrapping and v kept inside the
+// first and last rows' texel centres.
+struct GpuEnvironment {
+    uint specularSlot;    // radiance, GGX-prefiltered: MIP l for perceptual roughness
+                          // l / (specularLevels - 1), level 0 unfiltered
+    uint irradianceSlot;  // irradiance / pi (the Lambert radiance for albedo 1)
+    uint backgroundSlot;  // what the camera sees behind the scene (without the sun's disc)
+    uint brdfSlot;        // (n.v, perceptual roughness): GGX scale, GGX bias, sheen albedo
+    uint specularLevels;  // MIP count of the specular map
+    uint flags;           // ENVIRONMENT_FLAG_*
+    float intensity;      // multiplies every radiance (not the BRDF table)
+    float rotationCos;    // world to environment: the rotation about +Y by the environment
+    float rotationSin;    // rotation angle (x' = c x + s z, z' = -s x + c z)
+    float sunCosRadius;   // cosine of the sun disc's angular radius
+    float specularHeight; // texel rows of specular level 0 (level l: max(height >> l, 1))
+    float irradianceHeight;
+    vec3 sunDirection;    // the way sunlight travels, in the environment's frame
+    float backgroundHeight;
+    vec3 sunRadiance;     // radiance of the disc (0 without one)
+    float brdfSize;       // texels per side of the BRDF table
+};
+
 struct FrameConstants {
     mat4 view;
     mat4 proj;
@@ -523,6 +556,13 @@ struct FrameConstants {
     // uvec2 per visibility vertex: (scene vertex, the triangle of its mesh it starts), what the
     // visibility prepass draws (scene/visibility_vertices.h).
     uint64_t visibilityVertices;
+    uint tonemap; // TONEMAP_*: the display curve after exposure
+    // What uncovered pixels show: the environment's background (1), or backgroundColor, the
+    // radiance the display curve turns into the --background colour (0).
+    uint backgroundEnvironment;
+    vec3 backgroundColor;
+    uint framePad;
+    GpuEnvironment environment; // image-based lighting (render/environment)
 };
 
 // ---- GPU-driven world (render/culling) ------------------------------------------------------

@@ -29,10 +29,8 @@ void inspectSurface(FrameConstants f, uint instance, uint triangle, MaterialSamp
 
     vec3 n = m.normal;
     vec3 v = normalize(f.cameraPosition - worldPos);
-    float up = n.y * 0.5 + 0.5;
-    vec3 ambient = mix(f.ambientColor * 0.5, f.ambientColor + f.skyColor * 0.15, up);
-    shaderPrintF3(f, PRINT_AMBIENT, ambient * m.baseColor * (1.0 - m.metallic * 0.5) * m.occlusion *
-                                        m.ambientOcclusion);
+    shaderPrintF3(f, PRINT_AMBIENT, environmentLight(f.environment, m, n, v,
+                                                     m.occlusion * m.ambientOcclusion));
     if (dot(f.sunColor, f.sunColor) > 0.0) {
         float shadow = sunShadow(f, worldPos, geometricNormal);
         shaderPrintF(f, PRINT_SUN_SHADOW, shadow);
@@ -43,7 +41,7 @@ void inspectSurface(FrameConstants f, uint instance, uint triangle, MaterialSamp
         // evaluateLight: every kind as shadeSurface sums it (square spots, tubes, gobos, area
         // lights, clip planes), before blockers and spot shadows.
         vec3 term = evaluateLight(lights.l[i], m, n, v, worldPos);
-        shaderPrintF4(f, PRINT_LIGHT, vec4(term * m.occlusion, float(i)));
+        shaderPrintF4(f, PRINT_LIGHT, vec4(term, float(i)));
     }
     shaderPrintF3(f, PRINT_SHADED, shaded);
 }

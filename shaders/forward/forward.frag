@@ -68,5 +68,5 @@ void main() {
     }
     color = visualizeLighting(f, color);
     float alpha = (mat.flags & MATERIAL_ALPHA_BLEND) != 0u ? m.alpha : 1.0;
-    outColor = kDisplayOutput ? vec4(displayColor(color, f.exposure), 1.0) : vec4(color, alpha);
+    outColor = kDisplayOutput ? vec4(displayColor(color, f.exposure, f.tonemap), 1.0) : vec4(color, alpha);
 }

@@ -11,6 +11,7 @@
 #include "common/visibility.glsl"
 #include "lighting/light_debug.glsl"
 #include "lighting/spectra.glsl"
+#include "background/background.glsl"
 
 layout(local_size_x = 16, local_size_y = 16) in;
 
@@ -31,7 +32,7 @@ void main() {
     uvec2 tileXY = uvec2(tile % lf.tilesX, tile / lf.tilesX);
     ivec2 pixel = ivec2(tileXY * LIGHT_TILE_SIZE + gl_LocalInvocationID.xy);
     if (any(greaterThanEqual(pixel, ivec2(f.viewportSize)))) return;
-    vec4 color = vec4(f.skyColor, 0.0); // what the raster colour pass clears to
+    vec4 color = vec4(0.0);
     uvec2 vis = loadVisibility(pc.visibilitySlot, pixel);
     if (vis.x != VISIBILITY_NONE) {
         GpuInstance inst = InstanceBuffer(f.instances).i[vis.x];
@@ -59,8 +60,10 @@ void main() {
             shaded = mix(vec3(l / (1.0 + l)), spectrumColor(kSpectrumMode), 0.6);
         }
         color = vec4(shaded, 1.0);
-    } else if (f.visualize == VISUALIZE_SPECTRA) {
-        color.rgb = mix(color.rgb, spectrumColor(kSpectrumMode), 0.3);
+    } else {
+        color.rgb = backgroundAt(f, vec2(pixel) + 0.5);
+        if (f.visualize == VISUALIZE_SPECTRA)
+            color.rgb = mix(color.rgb, spectrumColor(kSpectrumMode), 0.3);
     }
     imageStore(gImagesRgba16f[pc.hdrSlot], pixel, color);
 }

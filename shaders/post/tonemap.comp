@@ -1,5 +1,5 @@
 #version 460
-// HDR scene colour -> display: exposure, ACES fit, N x N supersample resolve (averaged after
+// HDR scene colour -> display: exposure, the display curve, N x N supersample resolve (averaged after
 // the tone curve, before sRGB encoding), sRGB encode, RGBA8 into a readback buffer. Alpha
 // records coverage: 255 where any sample saw geometry (reversed-Z depth > 0). Workgroups of
 // 32x8 (TONEMAP_GROUP_*): fewer of them than 8x8 cost lavapipe ~0.4 ms less at 1280x720.
@@ -25,14 +25,14 @@ void main() {
     vec3 sum = vec3(0.0);
     bool covered = false;
     if (pc.ssaa == 1u) { // the common case, without the loops' bookkeeping (-1.3 ms at 1280x720)
-        sum = acesFit(max(fetchTextureUniform(pc.hdrSlot, ivec2(p), 0).rgb, vec3(0.0)) * f.exposure);
+        sum = toneCurve(max(fetchTextureUniform(pc.hdrSlot, ivec2(p), 0).rgb, vec3(0.0)) * f.exposure, f.tonemap);
         covered = fetchTextureUniform(pc.depthSlot, ivec2(p), 0).r > 0.0;
     } else {
         for (uint y = 0u; y < pc.ssaa; ++y) {
             for (uint x = 0u; x < pc.ssaa; ++x) {
                 ivec2 q = ivec2(p * pc.ssaa + uvec2(x, y));
                 vec3 hdr = fetchTextureUniform(pc.hdrSlot, q, 0).rgb;
-                sum += acesFit(max(hdr, vec3(0.0)) * f.exposure);
+                sum += toneCurve(max(hdr, vec3(0.0)) * f.exposure, f.tonemap);
                 covered = covered || fetchTextureUniform(pc.depthSlot, q, 0).r > 0.0;
             }
         }

@@ -179,8 +179,7 @@ vec3 rtShadeHit(FrameConstants f, RtFrame rt, uint instanceId, uint primitive, v
     m.roughness = 1.0;
     vec3 v = -rayDir;
     vec3 color = m.emissive;
-    float up = n.y * 0.5 + 0.5;
-    color += mix(f.ambientColor * 0.5, f.ambientColor + f.skyColor * 0.15, up) * m.baseColor;
+    color += environmentIrradiance(f.environment, n) * m.baseColor;
     vec3 toSun = -f.sunDirection;
     if (dot(f.sunColor, f.sunColor) > 0.0 && dot(n, toSun) > 0.0) {
         bool shadowed = rtOccluded(rt, rtOrigin(f, rt, s.position, ng, toSun), toSun, 1e30);

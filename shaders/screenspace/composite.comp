@@ -1,6 +1,7 @@
 #version 460
 // Puts the screen-space results on the lit surfaces: skin takes most of its lighting from the
-// scattered half-resolution image, and every surface adds its reflection weighted by Fresnel
+// scattered half-resolution image, and every surface adds what its reflection changes (the
+// traced hit against the environment the shading already reflects) weighted by Fresnel
 // (tiles without a smooth surface read the SSR target's cleared zeros). Sky pixels are the sky
 // pass's.
 #include "screenspace/sss.glsl"

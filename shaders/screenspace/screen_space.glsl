@@ -46,20 +46,6 @@ vec3 worldPositionAt(FrameConstants f, vec2 pixelCenter, float depth) {
     return p.xyz / p.w;
 }
 
-// The sky seen along `dir`: the scene's sky colour brightening towards the horizon, a darker
-// ground below it and a glow around the sun.
-vec3 skyRadiance(FrameConstants f, vec3 dir) {
-    float up = dir.y;
-    vec3 zenith = f.skyColor * 0.55;
-    vec3 horizon = f.skyColor * 1.15;
-    vec3 ground = f.skyColor * 0.3;
-    vec3 c = up >= 0.0 ? mix(horizon, zenith, sqrt(clamp(up, 0.0, 1.0)))
-                       : mix(horizon, ground, clamp(-up * 4.0, 0.0, 1.0));
-    float sun = max(dot(dir, -f.sunDirection), 0.0);
-    c += f.sunColor * (pow(sun, 600.0) * 8.0 + pow(sun, 12.0) * 0.15);
-    return c;
-}
-
 vec3 viewDirectionAt(FrameConstants f, vec2 pixelCenter) {
     return normalize(worldPositionAt(f, pixelCenter, 0.5) - f.cameraPosition);
 }

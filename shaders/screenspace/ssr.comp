@@ -8,6 +8,7 @@
 // radiance and the weight the composite gives it. Permutation 1 (tiles with no smooth surface)
 // only clears the target.
 #include "screenspace/screen_space.glsl"
+#include "environment/environment.glsl"
 
 layout(local_size_x = 8, local_size_y = 8) in;
 layout(constant_id = 0) const uint CLEAR_ONLY = 0u;
@@ -100,14 +101,15 @@ void main() {
             vec3 position = worldPositionAt(f, vec2(p) + 0.5, depth);
             vec3 view = normalize(position - f.cameraPosition);
             vec3 dir = reflect(view, g.normal);
-            vec3 environment = skyRadiance(f, dir);
+            // The shading already reflects the environment: the pass stores what a hit changes.
+            vec3 environment = environmentSpecular(f.environment, dir, g.roughness);
             float roughFade = smoothstep(SSR_ROUGHNESS_FADE, SSR_MAX_ROUGHNESS, g.roughness);
             vec3 radiance = environment;
             if (roughFade < 1.0) {
                 vec4 hit = march(f, position, dir, linearDepth(f, depth));
                 radiance = mix(environment, hit.rgb, hit.w * (1.0 - roughFade));
             }
-            result = vec4(radiance, 1.0 - roughFade);
+            result = vec4(radiance - environment, 1.0 - roughFade);
         }
     }
     imageStore(gImagesRgba16f[pc.ssrSlot], p, result);

@@ -40,7 +40,8 @@ void resolveQuad(FrameConstants f, ShadelFrame s, ivec2 origin, inout uvec4 coun
         // every pixel a second tone curve.
         bool forward = a.kind == RESOLVE_ADDRESS_FORWARD;
         if (forward && !kDisplayOutput) continue;
-        vec4 color = vec4(f.skyColor, 0.0); // what the raster colour pass clears to
+        vec4 color = vec4(0.0);
+        if (a.kind == RESOLVE_ADDRESS_NONE) color.rgb = backgroundAt(f, vec2(pixel) + 0.5);
         if (forward) color = vec4(imageLoad(gImagesRgba16f[pc.hdrSlot], pixel).rgb, 1.0);
         bool rebuild = !forward && (a.kind == RESOLVE_ADDRESS_REBUILD ||
                                     f.visualize != VISUALIZE_NONE || inspecting(f, uvec2(pixel)));

@@ -9,6 +9,7 @@
 #include "common/lighting.glsl"
 #include "common/vertex.glsl"
 #include "common/tone_curve.glsl"
+#include "background/background.glsl"
 #include "debug/inspect_shadel.glsl"
 
 // The pixels the resolve leaves to the rebuild pass, and that pass's indirect arguments.
@@ -39,7 +40,7 @@ layout(constant_id = RESOLVE_DISPLAY_OUTPUT_CONSTANT_ID) const bool kDisplayOutp
 void writeResolvedPixel(FrameConstants f, ivec2 pixel, vec4 color) {
     if (kDisplayOutput)
         UintBuffer(pc.displayPixels).v[pixel.y * int(pc.width) + pixel.x] =
-            packDisplayPixel(displayColor(color.rgb, f.exposure), color.a > 0.0);
+            packDisplayPixel(displayColor(color.rgb, f.exposure, f.tonemap), color.a > 0.0);
     else
         imageStore(gImagesRgba16f[pc.hdrSlot], pixel, color);
 }
@@ -91,7 +92,7 @@ vec4 resolveRebuilt(FrameConstants f, ShadelFrame s, ivec2 origin, int i, ivec2 
                     inout uvec2 current, inout ShadelObjectRef o, inout GpuInstance inst,
                     inout VisQuad q, inout uvec4 counts) {
     uvec2 vis = loadVisibility(pc.visibilitySlot, pixel);
-    if (vis.x == VISIBILITY_NONE) return vec4(f.skyColor, 0.0);
+    if (vis.x == VISIBILITY_NONE) return vec4(backgroundAt(f, vec2(pixel) + 0.5), 0.0);
     if (vis != current) {
         current = vis;
         o = shadelObject(s, vis.x);

@@ -6,6 +6,7 @@
 // colour, and without them lavapipe would shade every pixel before testing the stencil.
 #define SCREEN_SPACE_FRAGMENT // no tile lists here
 #include "screenspace/screen_space.glsl"
+#include "environment/environment.glsl"
 
 layout(early_fragment_tests) in;
 
@@ -24,6 +25,9 @@ void main() {
     float cosView = clamp(dot(g.normal, view), 0.0, 1.0);
     float fresnel = WATER_F0 + (1.0 - WATER_F0) * pow(1.0 - cosView, 5.0);
     vec3 refracted = color.rgb * mix(kRefractionTint, vec3(1.0), cosView);
-    color.rgb = refracted * (1.0 - fresnel) + reflection.rgb * reflection.a * fresnel;
+    // The SSR target holds what a traced hit changes against the environment's reflection.
+    vec3 reflected = environmentSpecular(f.environment, reflect(-view, g.normal), g.roughness) +
+                     reflection.rgb * reflection.a;
+    color.rgb = refracted * (1.0 - fresnel) + reflected * fresnel;
     imageStore(gImagesRgba16f[pc.hdrSlot], p, color);
 }

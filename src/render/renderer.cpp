@@ -7,10 +7,12 @@
 
 #include "common/print_labels.h"
 #include "core/log.h"
+#include "render/background/background.h"
 #include "render/forward/forward_passes.h"
 #include "render/lighting/light_animation.h"
 #include "render/oit/oit.h"
 #include "render/particles/particles.h"
+#include "render/post/tone_curve.h"
 #include "render/post/tonemap.h"
 #include "render/screenspace/screen_space.h"
 #include "render/shadel/decoupled.h"
@@ -108,6 +110,11 @@ static RenderSettings resolveSettings(RenderSettings s, const GpuScene& scene) {
                         scene.lightInfo.size() > LIGHT_SUBGROUP_MAX_LIGHTS;
         s.spectra = perChunk || s.visualize == Visualize::Spectra ? Spectra::On : Spectra::Off;
     }
+    if (!s.shadows) { // --shadows off: no shadow map of any light
+        s.spotShadows = false;
+        s.sunCascades = 1;
+        s.sunSoftShadows = false;
+    }
     return s;
 }
 
@@ -158,6 +165,7 @@ void initRenderer(Renderer& r, Gpu& gpu, const RenderSettings& requested, const 
     if (!r.draws || !r.shadowDraws || !r.drawCounts || !r.frameConstants || !r.pixels)
         throw DeviceError("out of GPU memory for the renderer's frame buffers");
     createTonemapPipeline(r);
+    createBackgroundPipelines(r);
     initShaderMessages(gpu, r.messages);
     initFrameRecorder(gpu, r.recorder, settings.timing, std::max(1u, settings.recordingThreads));
     if (settings.mode == RenderMode::Decoupled) r.decoupled = createDecoupled(r, scene);
@@ -212,6 +220,7 @@ void destroyRenderer(Renderer& r) {
     destroyShaderMessages(gpu, r.messages);
     destroyForwardPipelines(r);
     destroy(gpu, r.tonemap);
+    destroyBackgroundPipelines(r);
     for (BufferHandle b : {r.draws, r.shadowDraws, r.drawCounts, r.frameConstants, r.pixels})
         destroy(gpu, b);
     if (r.liveLights) destroy(gpu, r.liveLights);
@@ -262,10 +271,15 @@ static gpu::FrameConstants makeFrameConstants(Renderer& r, const GpuScene& scene
     f.exposure = r.settings.exposure;
     f.sunDirection = sun.direction;
     f.sunColor = sun.color;
-    f.sunShadowSlot = scene.sunCastsShadow ? slot(gpu, r.sunShadow.read).value : NO_TEXTURE;
+    f.sunShadowSlot = scene.sunCastsShadow && r.settings.shadows
+                          ? slot(gpu, r.sunShadow.read).value
+                          : NO_TEXTURE;
     f.shadowTexelSize = texel;
     f.skyColor = scene.skyColor;
     f.ambientColor = scene.ambientColor;
+    f.tonemap = uint32_t(r.settings.tonemap);
+    f.backgroundEnvironment = r.settings.backgroundEnvironment ? 1u : 0u;
+    f.backgroundColor = r.skyColor;
     f.lightCount = scene.lightCount;
     f.instanceCount = scene.instanceCount;
     f.viewportSize = glm::vec2(r.internalWidth, r.internalHeight);
@@ -335,7 +349,12 @@ FrameResult renderFrame(Renderer& r, const GpuScene& scene, const CameraView& ca
     r.recorder.timeRecording = r.settings.cpuScopes;
     r.sceneIndices = scene.indices;
     r.sceneVisibilityIndices = scene.visibilityIndices;
-    r.skyColor = scene.skyColor;
+    // Uncovered pixels: the environment, or the radiance the display curve shows as the solid
+    // --background colour (the clears of the colour passes use it too).
+    r.skyColor = r.settings.backgroundEnvironment
+                     ? scene.skyColor
+                     : radianceForDisplay(r.settings.backgroundColor, r.settings.exposure,
+                                          r.settings.tonemap);
     gpu::FrameConstants constants;
     {
         auto timer = cpuScope(r, "constants + lights");

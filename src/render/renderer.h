@@ -281,6 +281,9 @@ struct Renderer {
     TextureHandle display;
     RenderTargetView displayTarget;
     Pipeline instanceCull, depthPrepass, tonemap;
+    // The environment behind the surfaces in the colour passes (render/background), into the
+    // scene colour or the fused display target.
+    Pipeline background, backgroundDisplay;
     // Forward shading of opaque surfaces, one pipeline per material class (render/forward):
     // plain materials (DRAW_LIST_OPAQUE, material features compiled out), textures only
     // (DRAW_LIST_OPAQUE_TEXTURED), any other feature (DRAW_LIST_OPAQUE_FEATURED, all of them).

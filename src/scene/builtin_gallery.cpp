@@ -58,6 +58,7 @@ Scene makeTextureGallery(uint32_t textureSize) {
     scene.name = "textures";
     scene.skyColor = {0.35f, 0.4f, 0.5f};
     scene.ambientColor = {0.25f, 0.25f, 0.27f};
+    scene.environment = Scene::Environment::Hemisphere; // lit as authored, not by a day sky
     const float spacing = 2.5f, wallX = 1.6f;
     const uint32_t perWall = kGalleryPanels / 2;
     Material floorMat;

@@ -250,6 +250,7 @@ Scene makeBlockersScene() {
     scene.name = "blockers";
     scene.skyColor = glm::vec3(0.01f, 0.012f, 0.02f);
     scene.ambientColor = glm::vec3(0.0f); // only the lamp lights anything: leaks are plain
+    scene.environment = Scene::Environment::Hemisphere; // lit as authored, not by a day sky
     uint32_t ground = addMaterial(scene, "ground", {0.6f, 0.6f, 0.6f}, 0.85f);
     uint32_t wall = addMaterial(scene, "wall", {0.75f, 0.7f, 0.62f}, 0.8f);
     scene.meshes.push_back(makePlane("ground", 30.0f, 30.0f, ground, 6));
@@ -345,6 +346,7 @@ Scene makeLightsScene(Scene scene) {
         }
     scene.skyColor = glm::vec3(0.012f, 0.018f, 0.04f);
     scene.ambientColor = glm::vec3(0.012f, 0.014f, 0.02f);
+    scene.environment = Scene::Environment::Hemisphere; // lit as authored, not by a day sky
 
     // Streets: the lines between the 15 m lots (buildings reach at most 7 m from a lot centre),
     // and the open avenue and plaza. A position on a street, at a height.
@@ -459,6 +461,7 @@ Scene makeTexturedLightsScene() {
     scene.name = "textured-lights";
     scene.skyColor = glm::vec3(0.01f, 0.012f, 0.02f);
     scene.ambientColor = glm::vec3(0.015f, 0.015f, 0.018f);
+    scene.environment = Scene::Environment::Hemisphere; // lit as authored, not by a day sky
     uint32_t floor = addMaterial(scene, "floor", {0.5f, 0.5f, 0.5f}, 0.8f);
     uint32_t wall = addMaterial(scene, "wall", {0.7f, 0.7f, 0.7f}, 0.75f);
     uint32_t housing = addMaterial(scene, "panel housing", {0.05f, 0.05f, 0.05f}, 0.5f);

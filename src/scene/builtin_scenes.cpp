@@ -680,6 +680,7 @@ Scene makeCornell() {
     scene.name = "cornell";
     scene.skyColor = glm::vec3(0.02f);
     scene.ambientColor = glm::vec3(0.02f);
+    scene.environment = Scene::Environment::Hemisphere; // lit as authored, not by a day sky
     SceneBuilder b(scene);
     uint32_t white = b.material("white", {0.8f, 0.8f, 0.8f}, 0.9f);
     uint32_t red = b.material("red", {0.8f, 0.08f, 0.06f}, 0.9f);

@@ -18,8 +18,8 @@ namespace {
 
 constexpr float kPi = 3.14159265358979f;
 
-// CPU port of the BRDF of shaders/common/lighting.glsl (GGX + Smith + Schlick, Lambert), for
-// this test only.
+// The glTF metal/rough BRDF written from the glTF 2.0 specification (GGX, height-correlated
+// Smith, Schlick, Lambert), for this test only: an oracle independent of lighting.glsl.
 glm::vec3 brdf(glm::vec3 base, float metallic, float roughness, glm::vec3 n, glm::vec3 v,
                glm::vec3 l, glm::vec3 radiance) {
     float nl = glm::dot(n, l);
@@ -34,11 +34,14 @@ glm::vec3 brdf(glm::vec3 base, float metallic, float roughness, glm::vec3 n, glm
     float gv = nl * std::sqrt(nv * nv * (1.0f - a2) + a2);
     float gl = nv * std::sqrt(nl * nl * (1.0f - a2) + a2);
     float vis = 0.5f / std::max(gv + gl, 1e-5f);
-    glm::vec3 f0 = glm::mix(glm::vec3(0.04f), base, metallic);
-    glm::vec3 f = f0 + (1.0f - f0) * std::pow(1.0f - vh, 5.0f);
-    glm::vec3 specular = f * ggx * vis;
-    glm::vec3 diffuse = (1.0f - f) * (1.0f - metallic) * base / kPi;
-    return (diffuse + specular) * radiance * nl;
+    // glTF 2.0, appendix B: mix(dielectric, metal, metallic); the dielectric's Fresnel (F0 0.04)
+    // weights its diffuse and its specular, the metal's (F0 = base colour) its specular.
+    float schlick = std::pow(1.0f - vh, 5.0f);
+    float fDielectric = 0.04f + 0.96f * schlick;
+    glm::vec3 fMetal = base + (1.0f - base) * schlick;
+    glm::vec3 dielectric = (1.0f - fDielectric) * base / kPi + glm::vec3(fDielectric * ggx * vis);
+    glm::vec3 metal = fMetal * ggx * vis;
+    return glm::mix(dielectric, metal, metallic) * radiance * nl;
 }
 
 float rangeAttenuation(float dist, float range) {

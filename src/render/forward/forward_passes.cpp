@@ -1,7 +1,9 @@
 #include "render/forward/forward_passes.h"
 
+#include "render/background/background.h"
 #include "render/culling/culling.h"
 #include "render/debug/inspect.h"
+#include "render/post/tone_curve.h"
 #include "render/post/tonemap.h"
 #include "render/renderer.h"
 
@@ -273,12 +275,16 @@ void drawForwardLists(Renderer& r, VkCommandBuffer cmd, uint64_t frame) {
 
 void recordForwardShading(Renderer& r, VkCommandBuffer cmd, uint64_t frame) {
     if (r.tonemapFused) { // display pixels (render/post/tonemap.h): the sky as the display shows it
-        beginColorPass(r, cmd, r.display, r.displayTarget,
-                       displayColor(r.skyColor, r.settings.exposure), true);
+        glm::vec3 clear = r.settings.backgroundEnvironment
+                              ? displayColor(r.skyColor, r.settings.exposure, r.settings.tonemap)
+                              : r.settings.backgroundColor; // exactly the colour asked for
+        beginColorPass(r, cmd, r.display, r.displayTarget, clear, true);
         drawForwardLists(r, cmd, frame, r.forwardDisplay);
+        recordBackground(r, cmd, frame, true);
     } else {
         beginSceneColorPass(r, cmd, true);
         drawForwardLists(r, cmd, frame, r.forwardOpaque);
+        recordBackground(r, cmd, frame, false);
     }
     vkCmdEndRendering(cmd);
 }

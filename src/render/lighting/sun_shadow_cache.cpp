@@ -33,6 +33,10 @@ void forgetKeptShadowMaps(Renderer& r) {
 
 void prepareSunShadowMap(Renderer& r, const GpuScene& scene, const gpu::FrameConstants& constants) {
     SunShadowCache& c = r.sunShadowCache;
+    if (!r.settings.shadows) { // --shadows off: the map is never read
+        c.listThisFrame = SUN_LIST_NONE;
+        return;
+    }
     bool keepable = sunShadowKeepable(r);
     bool changed = c.drawn && (c.drawnScene != &scene || c.drawnViewProj != constants.sunViewProj ||
                                r.shadowCastersChanged);

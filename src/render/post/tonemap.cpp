@@ -89,15 +89,4 @@ void recordDisplayReadback(Renderer& r, VkCommandBuffer cmd) {
                   VK_PIPELINE_STAGE_2_HOST_BIT, VK_ACCESS_2_HOST_READ_BIT);
 }
 
-glm::vec3 displayColor(glm::vec3 hdr, float exposure) {
-    glm::vec3 out;
-    for (int c = 0; c < 3; ++c) {
-        float x = std::max(hdr[c], 0.0f) * exposure;
-        float y =
-            std::clamp((x * (2.51f * x + 0.03f)) / (x * (2.43f * x + 0.59f) + 0.14f), 0.0f, 1.0f);
-        out[c] = y < 0.0031308f ? y * 12.92f : 1.055f * std::pow(y, 1.0f / 2.4f) - 0.055f;
-    }
-    return out;
-}
-
 } // namespace shadel

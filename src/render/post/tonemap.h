@@ -24,7 +24,4 @@ bool tonemapFusedThisFrame(const Renderer& r);
 bool forwardMayFuseTonemap(const Renderer& r);
 // Forward, fused: the display target forward shading wrote, copied into the readback.
 void recordDisplayReadback(Renderer& r, VkCommandBuffer cmd);
-// A scene colour as the display shows it, sRGB-encoded in [0, 1] (the fused forward pass clears
-// to the sky's): the CPU side of shaders/common/tone_curve.glsl displayColor.
-glm::vec3 displayColor(glm::vec3 hdr, float exposure);
 } // namespace shadel

@@ -10,6 +10,7 @@
 #include "core/block_allocator.h"
 #include "core/error.h"
 #include "core/log.h"
+#include "render/background/background.h"
 #include "render/culling/instance_grid.h"
 #include "render/debug/inspect.h"
 #include "render/forward/forward_passes.h"
@@ -1276,6 +1277,7 @@ void recordDecoupledShading(Renderer& r, FrameRecorder& rec, uint64_t frame, con
         pushConstants(gpu, cmd, RasterPush{frame, 0});
         drawCameraList(r, cmd, DRAW_LIST_DECOUPLED, shadingIndices(r));
         drawForwardLists(r, cmd, frame);
+        recordBackground(r, cmd, frame, false);
         vkCmdEndRendering(cmd);
     });
 }

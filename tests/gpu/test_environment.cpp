@@ -1,0 +1,156 @@
+// The environment on the GPU (render/environment/environment_state.h) read through
+// shaders/environment/environment.glsl by a compute probe: a uniform environment comes back
+// uniform at every level, at the poles and across the seam; the shader's direction convention
+// is the C++ one (equirect.h), rotation included.
+#include "gpu_test_env.h"
+
+#include <cmath>
+#include <cstring>
+#include <random>
+
+#include "core/worker_pool.h"
+#include "render/environment/environment_state.h"
+#include "render/environment/equirect.h"
+#include "render/environment/prefilter.h"
+#include "rhi/frame.h"
+#include "rhi/pipeline.h"
+#include "rhi/resources.h"
+
+using namespace shadel;
+using namespace shadel::test;
+
+namespace {
+
+// Runs the probe over `queries` (direction, roughness); four vec4 per query back.
+std::vector<glm::vec4> probeEnvironment(Gpu& gpu, const EnvironmentState& state,
+                                        const std::vector<glm::vec4>& queries) {
+    Pipeline pipeline =
+        createComputePipeline(gpu, "test.environmentProbe", "tests_environment_probe.comp.spv");
+    BufferHandle constants =
+        createBuffer(gpu, {"test.environment", sizeof(gpu::GpuEnvironment), 0, MemoryKind::Upload});
+    BufferHandle in =
+        createBuffer(gpu, {"test.environmentQueries", queries.size() * 16, 0, MemoryKind::Upload});
+    BufferHandle out = createBuffer(
+        gpu, {"test.environmentResults", queries.size() * 64, 0, MemoryKind::Readback});
+    std::memcpy(mapped(gpu, constants), &state.constants, sizeof(state.constants));
+    std::memcpy(mapped(gpu, in), queries.data(), queries.size() * 16);
+    FrameRecorder recorder;
+    initFrameRecorder(gpu, recorder, TimingMode::Timestamps);
+    beginFrame(recorder);
+    pass(recorder, "environmentProbe", [&](VkCommandBuffer cmd) {
+        struct {
+            uint64_t environment, queries, results;
+            uint32_t count;
+        } push{address(gpu, constants), address(gpu, in), address(gpu, out),
+               uint32_t(queries.size())};
+        bind(gpu, cmd, pipeline);
+        pushConstants(gpu, cmd, push);
+        vkCmdDispatch(cmd, (uint32_t(queries.size()) + 63) / 64, 1, 1);
+        memoryBarrier(cmd, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
+                      VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT, VK_PIPELINE_STAGE_2_HOST_BIT,
+                      VK_ACCESS_2_HOST_READ_BIT);
+    });
+    endFrame(recorder);
+    std::vector<glm::vec4> results(queries.size() * 4);
+    std::memcpy(results.data(), mapped(gpu, out), results.size() * 16);
+    destroyFrameRecorder(recorder);
+    destroy(gpu, constants);
+    destroy(gpu, in);
+    destroy(gpu, out);
+    destroy(gpu, pipeline);
+    return results;
+}
+
+std::vector<glm::vec4> queryDirections() {
+    std::vector<glm::vec4> q;
+    const glm::vec3 special[] = {{0, 1, 0},  {0, -1, 0},         {0, 0, -1},         {1, 0, 0},
+                                 {-1, 0, 0}, {0.001f, 0, -1.0f}, {-0.001f, 0, -1.0f}};
+    for (glm::vec3 d : special)
+        for (float r : {0.0f, 0.37f, 1.0f}) q.push_back(glm::vec4(glm::normalize(d), r));
+    std::mt19937 rng(3);
+    std::normal_distribution<float> n;
+    std::uniform_real_distribution<float> u(0.0f, 1.0f);
+    for (int i = 0; i < 100; ++i)
+        q.push_back(glm::vec4(glm::normalize(glm::vec3(n(rng), n(rng), n(rng))), u(rng)));
+    return q;
+}
+
+EnvironmentMaps mapsOf(const EquirectImage& source) {
+    WorkerPool pool(2);
+    PrefilterSettings s;
+    s.specularWidth = 64, s.specularLevels = 5, s.specularSamples = 32;
+    EnvironmentMaps maps;
+    maps.kind = EnvironmentKind::File;
+    maps.specular = prefilterSpecular(source, s, pool);
+    maps.irradiance = prefilterIrradiance(maps.specular[0], 32, pool);
+    maps.background = source;
+    maps.brdf = integrateBrdf(16, pool);
+    return maps;
+}
+
+} // namespace
+
+TEST(Environment, UniformEnvironmentReadsUniformEverywhere) {
+    Gpu& gpu = sharedGpu();
+    uint32_t before = validationErrors();
+    const glm::vec3 radiance(0.4f, 1.1f, 2.5f);
+    EnvironmentState state;
+    createEnvironment(gpu, state, mapsOf(makeEquirect(64, 32, radiance)), 2.0f, 30.0f);
+    std::vector<glm::vec4> q = queryDirections();
+    std::vector<glm::vec4> r = probeEnvironment(gpu, state, q);
+    double worst = 0.0;
+    for (size_t i = 0; i < q.size(); ++i)
+        for (int k = 0; k < 3; ++k) // irradiance, specular, background
+            for (int c = 0; c < 3; ++c)
+                worst =
+                    std::max(worst, std::abs(double(r[4 * i + k][c]) / (2.0 * radiance[c]) - 1.0));
+    EXPECT_LT(worst, 0.01) << "largest relative error " << worst;
+    // The BRDF table at n.v = 1, roughness 0 (the pole queries): a mirror.
+    EXPECT_NEAR(r[3].x, 1.0f, 0.03f);
+    EXPECT_NEAR(r[3].y, 0.0f, 0.01f);
+    destroyEnvironment(gpu, state);
+    EXPECT_EQ(validationErrors(), before);
+}
+
+TEST(Environment, ShaderDirectionsAreTheCppConvention) {
+    Gpu& gpu = sharedGpu();
+    uint32_t before = validationErrors();
+    // Radiance that tells every direction apart: 1 + the direction (no two texels alike).
+    EquirectImage source = makeEquirect(128, 64);
+    for (uint32_t y = 0; y < source.height; ++y)
+        for (uint32_t x = 0; x < source.width; ++x)
+            source.at(x, y) =
+                glm::vec3(1.0f) +
+                equirectDirection(glm::vec2((x + 0.5f) / source.width, (y + 0.5f) / source.height));
+    const float rotation = 40.0f;
+    EnvironmentState state;
+    createEnvironment(gpu, state, mapsOf(source), 1.0f, rotation);
+    std::vector<glm::vec4> q = queryDirections();
+    std::vector<glm::vec4> r = probeEnvironment(gpu, state, q);
+    double worst = 0.0;
+    for (size_t i = 0; i < q.size(); ++i) {
+        glm::vec3 d(q[i]);
+        glm::vec3 want = sampleEquirect(source, rotateToEnvironment(d, rotation));
+        worst = std::max(worst, double(glm::length(glm::vec3(r[4 * i + 2]) - want)));
+    }
+    // Half floats (3 decimal digits) and one texel of bilinear slop near the poles.
+    EXPECT_LT(worst, 0.02) << "largest background difference " << worst;
+    destroyEnvironment(gpu, state);
+    EXPECT_EQ(validationErrors(), before);
+}
+
+TEST(Environment, NoneReadsBlackButKeepsTheBrdfTable) {
+    Gpu& gpu = sharedGpu();
+    EnvironmentMaps maps;
+    WorkerPool pool(2);
+    maps.brdf = integrateBrdf(16, pool);
+    EnvironmentState state;
+    createEnvironment(gpu, state, maps, 1.0f, 0.0f);
+    EXPECT_TRUE(state.constants.flags & ENVIRONMENT_FLAG_NONE);
+    std::vector<glm::vec4> r = probeEnvironment(gpu, state, {glm::vec4(0, 1, 0, 0)});
+    EXPECT_EQ(glm::vec3(r[0]), glm::vec3(0.0f));
+    EXPECT_EQ(glm::vec3(r[1]), glm::vec3(0.0f));
+    EXPECT_EQ(glm::vec3(r[2]), glm::vec3(0.0f));
+    EXPECT_NEAR(r[3].x, 1.0f, 0.03f);
+    destroyEnvironment(gpu, state);
+}
