@@ -1,4 +1,4 @@
-// Allocator benchmarks (issue 3): the block allocator against the naive baseline it replaces,
+// Allocator benchmarks: the block allocator against the naive baseline it replaces,
 // and TLSF against a first-fit free list and malloc/free. Every benchmark reports the time of one
 // operation (median of the repetitions); the table at the end divides them within this run.
 //
@@ -115,7 +115,7 @@ void timePerOp(benchmark::State& state, uint32_t liveCount, Body body) {
     }
 }
 
-// By id (what the engine does: it keeps the Placement) or by origin (the seed's interface; the
+// By id (what the engine does: it keeps the Placement) or by origin (the original interface; the
 // fast allocator descends the tree, so this costs the depth of the element's leaf).
 template <class Allocator, bool byId>
 void removal(benchmark::State& state, uint32_t liveCount) {

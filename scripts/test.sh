@@ -10,6 +10,9 @@ jobs=$(nproc 2>/dev/null || echo 2)
 echo "== build (Release)"
 bash scripts/build.sh
 
+echo "== house check (tools/check_house.py: no outside references, sizes, names in comments)"
+python3 tools/check_house.py
+
 echo "== tests: unit + GPU (Release, Khronos validation on)"
 export SHADEL_CACHE_DIR="$PWD/build/test-cache"
 # One test per core: a GPU test on lavapipe spends most of its time in one thread (pipeline

@@ -1,5 +1,5 @@
 // Lighting shared by the forward and decoupled paths: GGX specular + Lambert diffuse, the
-// sun with a PCF shadow map, and one buffer of lights of several kinds (seed 001): omni, spot
+// sun with a PCF shadow map, and one buffer of lights of several kinds: omni, spot
 // with a round or square cone (optionally projecting a texture: gobos), tube
 // (representative-point specular), textured rectangular area lights, darks (negative lights),
 // each optionally limited by a clip plane and stopped by light blockers with portals.
@@ -38,7 +38,7 @@ layout(buffer_reference, scalar) readonly buffer LightGridEntries { uint v[]; };
 #define LIGHT_CHUNK_MAX_LIGHTS 512u // entries of a shadel chunk's list (shared memory)
 #define LIGHT_INVALID 0xFFFFFFFFu   // an entry culling removed in place
 
-// Feature spectra (seed 001, render/lighting/feature_spectra.h): the SPECTRUM_* features this
+// Feature spectra (render/lighting/feature_spectra.h): the SPECTRUM_* features this
 // pipeline compiles in. Every feature by default; a tile-shading permutation sets fewer, and
 // the branches of the features it lacks are dead code the compiler removes (fewer registers).
 // Only tiles that need none of the missing features are shaded by such a permutation, so the
@@ -641,7 +641,7 @@ vec3 shadeSurface(FrameConstants f, MaterialSample m, vec3 worldPos, vec3 geomet
     return color + max(direct, -color);
 }
 
-// Wrap ("non-directional") diffuse of seed 004's particles: n.l moved towards 1 by `wrap`, so
+// Wrap ("non-directional") diffuse of particles: n.l moved towards 1 by `wrap`, so
 // thin media (smoke, mesh particles) are lit from behind too; wrap 0 is Lambert.
 float wrappedNl(vec3 n, vec3 l, float wrap) {
     return max((dot(n, l) + wrap) / (1.0 + wrap), 0.0);

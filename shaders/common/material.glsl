@@ -39,7 +39,7 @@ struct MaterialSample {
 
 #include "decals/decals.glsl"
 
-// One-texel checker: the seed's `IntTexCoord.x % 2` shader. It is a point function of the
+// One-texel checker: texel x mod 2. It is a point function of the
 // texel coordinate and has no filtered form, so any path that point-samples it aliases.
 float texelChecker(vec2 uv, float scale) {
     ivec2 cell = ivec2(floor(uv * scale));

@@ -1,4 +1,4 @@
-// Labels of shaderPrint records (shaders/common/shader_print.glsl), shared by GLSL and C++ (the
+// Labels of shader print records (shaders/common/shader_print.glsl), shared by GLSL and C++ (the
 // decoder in rhi/shader_messages.cpp names each one): GLSL has no strings, so a print carries a
 // label id and the CPU prints its text. Add new labels at the end.
 #ifndef SHADEL_PRINT_LABELS_H

@@ -10,17 +10,15 @@
 //       uv = ((x + 0.5) / (W >> k), (y + 0.5) / (H >> k))
 //   in the object's shadel-UV space [0,1]^2 (BakedMesh::shadelUv). x grows with u, y grows with v;
 //   ID maps are stored row-major, index y * (W >> k) + x, row 0 first.
-//
-// Barycentrics follow the seed: the two free coordinates are clamped to [-eps, 1 + eps] and the
-// third is 1 minus the others. Shadels near a triangle edge, and every shadel the ID-map flood
-// pushed into the gutter, have centres outside their triangle; their barycentrics must
+//  Barycentrics of shadels outside their triangle: the two free coordinates are clamped to [-eps, 1
+// + eps] and the third is 1 minus the others. Shadels near a triangle edge, and every shadel the
+// ID-map flood pushed into the gutter, have centres outside their triangle; their barycentrics must
 // extrapolate the triangle's plane so that the reconstruction filter, which blends them with
-// shadels inside the triangle, sees a smooth continuation. Clamping to [0,1] would snap all of
-// them onto the edge: every outside shadel then shades the same edge point and bilinear
-// reconstruction shows a visible band along chart borders (the same artefact as centroid vs.
-// non-centroid sampling with MSAA). The epsilon only bounds extrapolation on slivers, where one
-// shadel of distance is many triangle heights and unbounded barycentrics would fling the
-// position far off the surface.
+// shadels inside the triangle, sees a smooth continuation. Clamping to [0,1] would snap all of them
+// onto the edge: every outside shadel then shades the same edge point and bilinear reconstruction
+// shows a visible band along chart borders (the same artefact as centroid vs. non-centroid sampling
+// with MSAA). The epsilon only bounds extrapolation on slivers, where one shadel of distance is
+// many triangle heights and unbounded barycentrics would fling the position far off the surface.
 #ifndef SHADEL_BARY_H
 #define SHADEL_BARY_H
 

@@ -1,7 +1,8 @@
-// shaderPrint (seed 003: shaders send values and short strings to the CPU): a record of up to
-// four values with a label (common/print_labels.h) goes through the shader message buffer the
-// asserts use; the CPU decodes and prints it after the frame (rhi/shader_messages.h). Prints are
-// meant for one pixel or shadel at a time: guard them with inspecting(f, pixel) (--inspect X,Y).
+// Shader prints (shaderPrintU, shaderPrintF and their vector forms: shaders send values to the
+// CPU): a record of up to four values with a label (common/print_labels.h) goes through the shader
+// message buffer the asserts use; the CPU decodes and prints it after the frame
+// (rhi/shader_messages.h). Prints are meant for one pixel or shadel at a time: guard them with
+// inspecting(f, pixel) (--inspect X,Y).
 #ifndef SHADEL_SHADER_PRINT_GLSL
 #define SHADEL_SHADER_PRINT_GLSL
 #include "common/bindless.glsl"

@@ -76,7 +76,7 @@ using uint = uint32_t;
 #define TONEMAP_LINEAR 3u
 #define TONEMAP_GROUP_X 32u // the tonemap pass's workgroup (post/tonemap.comp)
 #define TONEMAP_GROUP_Y 8u
-// Feature spectra (seed 001, render/lighting/feature_spectra.h): the features a tile needs,
+// Feature spectra (render/lighting/feature_spectra.h): the features a tile needs,
 // recorded by the tile pass; each shading permutation compiles in only its set (specialization
 // constant SPECTRUM_FEATURES_CONSTANT_ID of shaders/common/lighting.glsl; SPECTRUM_MATERIAL sets
 // MATERIAL_FEATURES_CONSTANT_ID of shaders/common/material.glsl).
@@ -300,7 +300,7 @@ struct GpuLight {
                         // the cone); area: 1
 };
 
-// A light blocker (seed 001): an artist-placed rectangle (a wall's mid-plane) that stops the
+// A light blocker: an artist-placed rectangle (a wall's mid-plane) that stops the
 // lights listing it, without a shadow map. Portals are rectangular holes in it.
 struct GpuLightBlocker {
     vec3 center;
@@ -581,7 +581,7 @@ struct GpuLod {
     uint firstIndex;
     uint indexCount;
     float error; // object-space deviation from LOD 0 (meshoptimizer's error, in scene units)
-    // The proxy (shadow) index set of this level (seed 003's "main and proxy index sets"): the
+    // The proxy (shadow) index set of this level (shadow views draw it): the
     // same triangles over position-only deduplicated vertices (meshopt_generateShadowIndexBuffer),
     // so a depth-only view fetches each position once instead of once per normal/UV/chart seam.
     uint proxyFirstIndex;     // indexCount indices, the same vertexOffset
@@ -660,7 +660,7 @@ struct ShaderMessage {
 
 // ---- Decoupled shading (render/shadel) ----------------------------------------------------
 #define SHADEL_MAX_MIPS 10u
-#define SHADEL_COUNTERS 16u // hashed allocation counters (seed: N parallel allocations)
+#define SHADEL_COUNTERS 16u // hashed allocation counters (N allocations in parallel)
 #define SHADEL_BLOCK 64u    // shadels per block side (8 x 8 chunks)
 #define SHADEL_CHUNK 8u     // shadels per chunk side
 #define SHADEL_INVALID 0xFFFFFFFFu
@@ -677,8 +677,8 @@ struct ShaderMessage {
 #define SHADEL_OBJECT_TEXTURED_MATERIAL 16u
 #define SHADEL_MAX_CHANGED_VOLUMES 256u
 #define SHADEL_CHUNK_VIEW_NONE 0xFFFFFFFFu // ShadelFrame::chunkViews: a NaN centre
-// Material layers of the shade storage (seed: "layers of different bit depths"): every layer
-// shares the slot allocation; each has its own format.
+// Material layers of the shade storage (layers of different formats): every layer shares the slot
+// allocation; each has its own format.
 #define SHADEL_LAYER_RADIANCE 0u // lit colour, RGBA16F
 #define SHADEL_LAYER_MATERIAL 1u // base colour + roughness, RGBA8 (for GI injection, debugging)
 #define SHADEL_LAYERS 2u
@@ -771,7 +771,7 @@ struct GpuShadelRect {
     uint pad;
 };
 
-// One chunk of shading work: {chunk, storage slot, object, MIP} as in the seed.
+// One chunk of shading work: {chunk, storage slot, object, MIP}.
 struct GpuShadelWork {
     uint chunk; // sheet chunk coordinate, x | y << 16
     uint slot;  // storage chunk slot
@@ -891,8 +891,8 @@ struct ShadelFrame {
 };
 
 // ---- Projected box decals (render/decals, shaders/decals) -----------------------------------
-// Decal stages, applied in this order to the material before lighting (seed 004's decal render
-// stages; the AO-only kind is seed 001's character shadow). A decal may take part in several.
+// Decal stages, applied in this order to the material before lighting (the AO-only kind darkens
+// only ambient light, a character's contact shadow). A decal may take part in several.
 #define DECAL_STAGE_BASE_COLOR 0u
 #define DECAL_STAGE_NORMAL 1u
 #define DECAL_STAGE_ROUGHNESS 2u

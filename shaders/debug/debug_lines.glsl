@@ -1,4 +1,4 @@
-// 3-D debug lines a shader can emit (seed 003's GPU-side debugging: shaders send lines to be
+// 3-D debug lines a shader can emit (GPU-side debugging: shaders send lines to be
 // drawn over the frame). debugLine appends one world-space segment to the frame's line buffer;
 // render/debug/debug_lines.cpp draws them, depth-tested, before tonemapping. Off (address 0)
 // unless --debug-lines asks for the kind. Segments beyond the buffer's capacity are counted and

@@ -1,7 +1,7 @@
-// --inspect X,Y: what the shading computed at one pixel, printed term by term through
-// shaderPrint. The terms are shadeSurface's (common/lighting.glsl) taken apart with the same
-// functions (brdf, sunShadow, evaluateLight); PRINT_SHADED is shadeSurface's own result, and
-// the GPU test checks that the printed terms add up to it, so the two cannot drift apart.
+// --inspect X,Y: what the shading computed at one pixel, printed term by term through shaderPrintF
+// and its kin. The terms are shadeSurface's (common/lighting.glsl) taken apart with the same
+// functions (brdf, sunShadow, evaluateLight); PRINT_SHADED is shadeSurface's own result, and the
+// GPU test checks that the printed terms add up to it, so the two cannot drift apart.
 #ifndef SHADEL_INSPECT_GLSL
 #define SHADEL_INSPECT_GLSL
 #include "common/lighting.glsl"

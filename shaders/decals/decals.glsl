@@ -1,4 +1,4 @@
-// Projected box decals (seeds 001 and 004, render/decals): applied to the material before
+// Projected box decals (render/decals): applied to the material before
 // lighting, in the material code both paths share (evaluateMaterial, common/material.glsl, calls
 // applyDecals last). The caller picks the list first, as it does for lights: forward shading the
 // list of its pixel's 16x16 tile (useTileDecalList, built by the culling pass,

@@ -7,7 +7,7 @@
 #define SHADEL_ENVIRONMENT_GLSL
 
 #include "common/bindless.glsl"
-#include "environment/environment_types.h"
+#include "common/shared_types.h" // GpuEnvironment
 
 #ifndef PI
 #define ENVIRONMENT_PI 3.14159265358979

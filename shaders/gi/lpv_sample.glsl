@@ -20,7 +20,7 @@ vec3 giCascadeIrradiance(GiFrame g, GiCascade c, vec3 p, vec3 n) {
     vec4 lobe = shCosineLobe(-n);
     vec3 sum = vec3(0.0);
     float kept = 0.0;
-    // Blockers culled per macro-cell (the seed's 4x4x4): most cells test none.
+    // Blockers culled per macro-cell (4x4x4 cells each): most cells test none.
     uint64_t near = g.blockerCount > 0u ? giBlockersNear(g, c, p) : 0ul;
     for (int k = 0; k < 8; ++k) {
         ivec3 o = ivec3(k & 1, (k >> 1) & 1, (k >> 2) & 1);

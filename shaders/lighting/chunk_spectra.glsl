@@ -1,5 +1,5 @@
-// Feature spectra of the shadel path (seed 001's spectra, "the same for chunk queues"; see
-// render/lighting/feature_spectra.h). Two passes:
+// Feature spectra of the shadel path (the tiles' spectra applied to the chunk
+// queue; see render/lighting/feature_spectra.h). Two passes:
 //   classify (chunk_classify.comp, one invocation per queued chunk): the carry-over decision,
 //             the chunk's light culling against its world box, the features its list needs (the
 //             entryFeatures of a screen tile) and an append to the bin of the first mode

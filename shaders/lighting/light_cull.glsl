@@ -1,7 +1,7 @@
 // Culling tests shared by the forward tile pass (tile_cull.comp) and the shadel path's chunk
 // culling (shaders/shadel/shade.comp): a light's bounding sphere (an area light's: its
 // rectangle's plus its range), a spot's cone, its clip plane, an area light's back side, and
-// the "shadow" volume a blocker casts from the light (seed 001) against a convex volume given by
+// the "shadow" volume a blocker casts from the light against a convex volume given by
 // its 8 corners (a tile's depth-bounded frustum or a chunk's box). Every test is conservative:
 // what culling removes contributes exactly nothing per pixel, so the image does not change.
 #ifndef SHADEL_LIGHT_CULL_GLSL

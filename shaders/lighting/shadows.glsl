@@ -1,4 +1,4 @@
-// Shadow maps (seed 001): the sun's (orthographic, its own map) and shadow-casting spots'
+// Shadow maps: the sun's (orthographic, its own map) and shadow-casting spots'
 // (perspective, rectangles of one atlas, render/lighting/spot_shadows.h). PCF: a fixed 3x3
 // kernel of hardware comparisons. PCSS (variable penumbra, Fernando 2005): a blocker search
 // finds the mean depth of what occludes the point, the penumbra grows with the distance from

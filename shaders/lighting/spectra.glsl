@@ -1,4 +1,4 @@
-// Feature spectra (seed 001): the tile pass records which lighting features a tile needs and
+// Feature spectra: the tile pass records which lighting features a tile needs and
 // bins the tile into the cheapest shading permutation ("mode") whose features cover them; the
 // tile shading pass (tile_shade.comp) then runs each mode's permutation over its bin through
 // an indirect dispatch. See render/lighting/feature_spectra.h.

@@ -1,5 +1,5 @@
 #version 460
-// Tiled light culling (seed 001): one workgroup per 16x16-pixel screen tile, 8x8 invocations
+// Tiled light culling: one workgroup per 16x16-pixel screen tile, 8x8 invocations
 // reading four of its pixels each (common/tile_frustum.glsl, TILE_CULL_THREADS). The tile's
 // depth bounds come from the prepass depth; every light's sphere is tested against the tile's
 // depth-bounded frustum (its clip plane and an area light's back side against the frustum's

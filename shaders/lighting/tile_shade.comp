@@ -1,5 +1,5 @@
 #version 460
-// Tile shading with feature spectra (seed 001), forward mode with --spectra on|single: one
+// Tile shading with feature spectra, forward mode with --spectra on|single: one
 // 16x16 workgroup per light tile of this pipeline's bin (an indirect dispatch per mode). The
 // pipeline is one permutation: kSpectrumFeatures (shaders/common/lighting.glsl) holds only
 // the features of its mode, so what its tiles do not need is not compiled in. Each pixel

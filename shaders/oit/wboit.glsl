@@ -1,4 +1,4 @@
-// Weighted blended order-independent transparency with additiveness (seed 001, after McGuire &
+// Weighted blended order-independent transparency with additiveness (after McGuire &
 // Bavoil 2013). Shared by every pass that writes transparent fragments (forward accumulation,
 // decoupled reconstruction) and by the composite, so they all use one definition.
 #ifndef SHADEL_WBOIT_GLSL
@@ -39,7 +39,7 @@ const float WBOIT_STORAGE_SCALE = 1.0 / 16.0;
 const float WBOIT_MAX_COLOR = 100.0;
 
 // w = min(1e4 b^3 + bias, 300) a^3 with a from the fragment's coverage (additive layers
-// included: the seed adds emission for the same reason, a purely additive layer has opacity
+// included, as emission is: a purely additive layer has opacity
 // 0 but must still weigh) and b = 1 - canonical depth.
 float wboitWeight(float coverage, float viewDepth) {
     const float n = WBOIT_CANONICAL_NEAR, fa = WBOIT_CANONICAL_FAR;
@@ -65,8 +65,8 @@ void wboitOutputs(TransparentFragment t, float viewDepth, out vec4 accum, out ve
 // The composite: C = sum(P w) / sum(coverage w) is the coverage-weighted mean colour (McGuire),
 // scaled by how much the layers cover in total: 1 - R for what hides (R = revealage) plus the
 // additiveness A (the summed coverage of additive layers: n layers of one colour c add n c).
-// Like the seed, A counts less where plain alpha layers may hide it: mix(A / 4, A, G), with G
-// the revealage of the additiveness-0 layers alone (the seed uses R, which would also dim an
+// A counts less where plain alpha layers may hide it: mix(A / 4, A, G), with G
+// the revealage of the additiveness-0 layers alone (R would also dim an
 // additive layer by its own opacity).
 // final = C ((1 - R) + mix(A / 4, A, G)) + D R. Limits: all additive (R = 1) is exactly the
 // sum of the layers; no additiveness is exactly McGuire's WBOIT; a single layer of any

@@ -1,5 +1,5 @@
 #version 460
-// Particle lightmap atlas (seed 004): one 8x8 workgroup per particle; a lit sprite with an atlas
+// Particle lightmap atlas: one 8x8 workgroup per particle; a lit sprite with an atlas
 // rectangle lights every texel of it from the sprite's position and normal map with the full
 // light list (shadeParticle, shaders/common/lighting.glsl), at unit albedo.
 #include "particles/particles.glsl"

@@ -1,5 +1,5 @@
 #version 460
-// Mesh particles (seed 004): opaque boxes on the forward path, PARTICLE_MESH_VERTICES vertices
+// Mesh particles: opaque boxes on the forward path, PARTICLE_MESH_VERTICES vertices
 // per particle slot (slots of sprite emitters and dead particles collapse to a point). Each box
 // is scaled per axis and tumbles about a random axis, both from the particle's seed. Lit per
 // vertex here (emitters flagged vertex-lit, or --particle-lighting vertex) or per pixel in

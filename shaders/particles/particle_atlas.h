@@ -1,14 +1,14 @@
-// The particle lightmap atlas (seed 004): the LOD a lit sprite gets from its estimated screen
+// The particle lightmap atlas: the LOD a lit sprite gets from its estimated screen
 // size, and where a sprite's rectangle lies in this frame's packing. Shared by C++ (tests) and
 // GLSL (simulate.comp counts, atlas_light.comp writes, sprite.frag reads), so both agree.
 //
 // LODs: LOD 0 is 128x128 texels and each LOD is 3/4 of the one above it (rounded to a multiple
 // of 4, at least 8), so one LOD per 25% less screen size keeps atlas texels per screen pixel
 // roughly constant. A sprite at least PARTICLE_NEAR_SCREEN_FRACTION of the viewport height
-// ("near the camera") gets PARTICLE_ATLAS_DEFAULT_LOD, 32x32, as in the seed; each 25% it
+// ("near the camera") gets PARTICLE_ATLAS_DEFAULT_LOD, 32x32; each 25% it
 // shrinks from there drops one LOD; the emitter's artist bias is added (-5: LOD 0).
 //
-// Packing: every frame, from scratch (the seed repacks every frame), a shelf packer by LOD:
+// Packing: every frame, from scratch (sprites come and go every frame), a shelf packer by LOD:
 // LOD 0's sprites fill rows of 128-texel shelves from the top of the atlas, LOD 1's the rows
 // below, and so on. A sprite's rectangle follows from the per-LOD counts and its index among
 // its LOD's sprites alone, so the GPU packs with one atomic per sprite and no CPU round trip.

@@ -21,7 +21,7 @@ using uint = uint32_t;
 #define PARTICLE_MESH_VERTICES 36u     // a mesh particle: a box, 12 triangles
 
 // --particle-lighting: where a lit sprite's lighting is computed.
-#define PARTICLE_LIGHTING_ATLAS 0u  // per atlas texel, once per frame (seed 004)
+#define PARTICLE_LIGHTING_ATLAS 0u  // per atlas texel, once per frame
 #define PARTICLE_LIGHTING_PIXEL 1u  // per pixel of every sprite layer (the reference)
 #define PARTICLE_LIGHTING_VERTEX 2u // per sprite corner, interpolated
 

@@ -1,8 +1,9 @@
-// Hands the ray-traced terms to the shared lighting code (gRt* in common/lighting.glsl).
-// Forward path: the pixel's ray-traced terms (written by rt_pixel.frag, the pass before
-// forward shading) to the shared lighting code (gRt* in common/lighting.glsl). AO, indirect
-// light and soft shadows are noisy per pixel (a few rays each), so they are read through a
-// small depth-aware 3x3 filter; hard shadows are exact and read as they are.
+// Hands the ray-traced terms to the shared lighting code (gRtOcclusion and the other globals of
+// common/lighting.glsl). Forward path: the pixel's ray-traced terms (written by rt_pixel.frag, the
+// pass before forward shading) to the shared lighting code (gRtOcclusion and the other globals of
+// common/lighting.glsl). AO, indirect light and soft shadows are noisy per pixel (a few rays each),
+// so they are read through a small depth-aware 3x3 filter; hard shadows are exact and read as they
+// are.
 #ifndef SHADEL_RT_APPLY_GLSL
 #define SHADEL_RT_APPLY_GLSL
 #include "common/lighting.glsl"

@@ -134,8 +134,8 @@ void main() {
     uint blockTexels = blockShared ? block.surfaces : 0u;
     vec4 history = imageLoad(gImagesRgba16f[rt.shadelTermsWrite], atlas);
     float count = reset ? 0.0 : history.w;
-    // Converged: the texel is reused as it is until its inputs change (the seed's "trace once
-    // per shadel and reuse"; a reset starts it again).
+    // Converged: the texel is reused as it is until its inputs change (traced once
+    // per shadel, then reused; a reset starts it again).
     if (count >= float(rt.historyRays)) return;
     // Seen this frame? (A shared block is tested at its centre: it stands for all four texels.)
     vec2 seenAt = blockShared ? vec2((texel & ~1u) + 1u) / vec2(o.size) : shadelCenterUv(texel, o.size);

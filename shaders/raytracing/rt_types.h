@@ -69,7 +69,8 @@ struct RtFrame {
     uint shadelIndirectRead;
     // Spot shadows (--rt-shadows on, scenes with shadow-casting spots): the visibility of every
     // shadow-casting spot (by GpuLight::shadowIndex), 8 bits each, packed in a uvec4 per sample
-    // (rtPackSpot / rtSpotVisibility in raytracing/rt_spots.glsl).
+    // (packed by rtSpotVisibilities in raytracing/rt_effects.glsl, read by rtSpotVisibility in
+    // common/lighting.glsl).
     uint spotShadowCount; // shadow-casting spots traced (<= LIGHT_MAX_SPOT_SHADOWS), 0: none
     uint64_t spotLights;  // uint per shadow index: the light's index in FrameConstants::lights
     uint pixelSpotSlot;   // forward: bindless read slot of the traced spot visibilities (uint)

@@ -1,5 +1,5 @@
 #version 460
-// The thin G-buffer (seed 004): what the screen-space passes read of the visible surface, drawn
+// The thin G-buffer: what the screen-space passes read of the visible surface, drawn
 // with the prepass depth (equal test): world normal + roughness, and a byte of PIXEL_* flags
 // with the surface class. Sky pixels keep the cleared 0.
 #include "common/material.glsl"

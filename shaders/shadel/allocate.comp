@@ -1,11 +1,11 @@
 #version 460
-// Allocation (seed: "Allocation Pass/Collection"): every marked block reserves room for its
-// marked chunks through one of 16 counters picked by hashing the block, so the atomics of
-// different blocks rarely meet. This pass only records the block's place within its counter;
-// queue setup lays the counters' sections end to end and the fill pass turns place + section
-// base into the block's storage offset. Storage is thereby shared by all counters: a block
-// overflows only when storage as a whole is full. Overflowed blocks are counted and left
-// unallocated; reconstruction then shades those samples forward, so nothing is corrupted.
+// Allocation: every marked block reserves room for its marked chunks through one of 16 counters
+// picked by hashing the block, so the atomics of different blocks rarely meet. This pass only
+// records the block's place within its counter; queue setup lays the counters' sections end to end
+// and the fill pass turns place + section base into the block's storage offset. Storage is thereby
+// shared by all counters: a block overflows only when storage as a whole is full. Overflowed blocks
+// are counted and left unallocated; reconstruction then shades those samples forward, so nothing is
+// corrupted.
 #include "shadel/shadel.glsl"
 #include "shadel/rects.glsl"
 

@@ -1,8 +1,7 @@
-// Marking (seed: "Shadel Marking pass"), shared by the raster marking (mark.frag) and the
-// compute marking over the visibility buffer (mark_visibility.comp): a visible sample ORs into
-// the occupancy masks the bits of every chunk the reconstruction filter will read: the 2x2
-// bilinear taps of both MIPs of the trilinear blend, across chunk and block edges, at every
-// anisotropic tap (shadelAniso).
+// Marking, shared by the raster marking (mark.frag) and the compute marking over the visibility
+// buffer (mark_visibility.comp): a visible sample ORs into the occupancy masks the bits of every
+// chunk the reconstruction filter will read: the 2x2 bilinear taps of both MIPs of the trilinear
+// blend, across chunk and block edges, at every anisotropic tap (shadelAniso).
 #ifndef SHADEL_MARKING_GLSL
 #define SHADEL_MARKING_GLSL
 #include "shadel/shadel.glsl"

@@ -6,9 +6,9 @@
 // are lit at: none in a changed region, it is carried over (as carry_over.comp, one invocation
 // for the chunk); else it goes to its shading class's list. The spectra's classify takes the
 // same decision for its queue (lighting/chunk_classify.comp).
-// The check used to run in the shading itself, a workgroup per chunk sharing its answer through
-// shared memory: the barrier that took made every shading pipeline run as coroutines on
-// lavapipe, near change or not, and the chunks it then shaded paid the all-features pipeline.
+// The check is a pass of its own rather than part of the shading: sharing its answer across a
+// chunk's workgroup would need a barrier, and a barrier makes every shading pipeline run as
+// coroutines on lavapipe, near change or not.
 #include "shadel/shade_chunk.glsl"
 #include "common/dispatch_2d.h"
 

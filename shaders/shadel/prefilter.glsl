@@ -1,4 +1,4 @@
-// Prefiltered material in shadel space (issue 8): a shadel stands for its whole footprint on the
+// Prefiltered material in shadel space: a shadel stands for its whole footprint on the
 // surface (2^k x 2^k MIP-0 shadels at MIP k, and at MIP 0 itself whatever the density makes it).
 // Textures are already filtered by that footprint (the UV derivatives come from neighbouring
 // shadels); point-function procedurals (the one-texel checker, bricks) have no filtered form,

@@ -1,9 +1,9 @@
-// Reconstruction (seed: "Scene Render"), shared by the raster reconstruction (reconstruct.frag)
-// and the compute resolve over the visibility buffer (resolve.comp): offset map + popcount find
-// each tap's chunk in storage, bilinear across chunk edges and trilinear across MIPs. A tap
-// whose chunk was never marked is a miss (counted; must be 0); a tap whose chunk overflowed
-// storage is counted too. Either way the caller shades the pixel forward with the same
-// material code, so the image never shows a hole.
+// Reconstruction, shared by the raster reconstruction (reconstruct.frag) and the compute resolve
+// over the visibility buffer (resolve.comp): offset map + popcount find each tap's chunk in
+// storage, bilinear across chunk edges and trilinear across MIPs. A tap whose chunk was never
+// marked is a miss (counted; must be 0); a tap whose chunk overflowed storage is counted too.
+// Either way the caller shades the pixel forward with the same material code, so the image never
+// shows a hole.
 #ifndef SHADEL_RESOLVE_GLSL
 #define SHADEL_RESOLVE_GLSL
 #include "shadel/shadel.glsl"
@@ -28,7 +28,7 @@ vec3 storageTap(ShadelFrame s, uint layer, int slot, uvec2 sheet) {
     return loadLayer(s, layer, storageIndex(uint(slot), sheet % SHADEL_CHUNK)).rgb;
 }
 
-// The bilinear filter over a level footprint (levelFootprint).
+// The bilinear filter over a level footprint (LevelFootprint).
 vec3 sampleFootprint(ShadelFrame s, LevelFootprint fp, uint layer, inout uint missing,
                      inout uint overflowed, out uint64_t firstMask, out int firstSlot) {
     // The footprint's two columns and two rows in the sheet (clamped to the level). Each of its

@@ -1,11 +1,11 @@
 #version 460
-// Shading (seed: "Shadel Shader"): one 8x8 workgroup per queued chunk. Each shadel finds its
-// triangle in the object's triangle-ID map, rebuilds the surface from the triangle's vertices
-// with clamped barycentrics (and the barycentrics one shadel right and down, for derivatives),
-// then runs the same material and lighting code as the forward path. Every queued chunk that
-// reaches a pipeline is shaded: carry-over decisions were taken before (fill_queue.comp,
-// near_change.comp, or the spectra's classify), so no barrier is needed here beyond the chunk
-// light culling's (only in pipelines that have it, SHADE_OPTIONAL_CHUNK_LIGHTS).
+// Shading: one 8x8 workgroup per queued chunk. Each shadel finds its triangle in the object's
+// triangle-ID map, rebuilds the surface from the triangle's vertices with clamped barycentrics (and
+// the barycentrics one shadel right and down, for derivatives), then runs the same material and
+// lighting code as the forward path. Every queued chunk that reaches a pipeline is shaded:
+// carry-over decisions were taken before (fill_queue.comp, near_change.comp, or the spectra's
+// classify), so no barrier is needed here beyond the chunk light culling's (only in pipelines that
+// have it, SHADE_OPTIONAL_CHUNK_LIGHTS).
 #include "shadel/shadel.glsl"
 #include "shadel/shade_chunk.glsl"
 #include "common/dispatch_2d.h"

@@ -92,11 +92,11 @@ bool chunkTouchesChangedRegion(FrameConstants f, ShadelFrame s, GpuShadelWork wo
     return false;
 }
 
-// Preserved layers (seed: "GetIndexPrevSampleVirtualCoords ... if it was computed last frame
-// it's there"). Where last frame stored this chunk, returns its storage slot then; -1 when the
-// chunk must be shaded: reuse off, the object's level changed (reuseLevels, decided on the
-// CPU), this chunk's turn to be refreshed (each chunk is reshaded once per refresh period, at
-// its own phase), or its view turned past what its specular tolerates (chunkViewTurned).
+// Preserved layers: a sample computed last frame is still in last frame's storage. Where last frame
+// stored this chunk, returns its storage slot then; -1 when the chunk must be shaded: reuse off,
+// the object's level changed (reuseLevels, decided on the CPU), this chunk's turn to be refreshed
+// (each chunk is reshaded once per refresh period, at its own phase), or its view turned past what
+// its specular tolerates (chunkViewTurned).
 int carrySource(ShadelFrame s, ShadelObjectRef o, GpuShadelWork work, vec3 camera) {
     if (s.reuse == 0u || ((o.v.reuseLevels >> work.mip) & 1u) == 0u) return -1;
     if (shadelRefreshDue(s, work.chunk)) return -1;

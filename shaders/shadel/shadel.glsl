@@ -11,15 +11,15 @@ layout(buffer_reference, scalar) buffer Uvec4Buffer { uvec4 v[]; };
 layout(buffer_reference, scalar) buffer Uvec2Buffer { uvec2 v[]; };
 layout(buffer_reference, scalar) readonly buffer Vec4Buffer { vec4 v[]; };
 
-// Anisotropic footprint (issue 8): a pixel's footprint in MIP-0 shadels is the parallelogram
-// spanned by texelDx and texelDy: its length is the longer axis, its width the area over that
-// length. A grazing footprint is read by `taps` bilinear samples spread along the long axis, from
-// the MIP whose shadel is length / aniso, aniso = min(length / width, SHADEL_MAX_ANISO): the MIP
-// follows both screen axes instead of blurring to the long one (at a bounded cost in shadels:
-// about aniso times the isotropic count). aniso <= length / width keeps the chosen footprint
-// >= the width, so the MIP is never finer than the footprint's narrow side and the CPU's
-// per-object lower bound of the finest MIP (finestMipNeeded in decoupled.cpp, from the shortest
-// span a pixel can have) stays a lower bound.
+// Anisotropic footprint: a pixel's footprint in MIP-0 shadels is the parallelogram spanned by
+// texelDx and texelDy: its length is the longer axis, its width the area over that length. A
+// grazing footprint is read by `taps` bilinear samples spread along the long axis, from the MIP
+// whose shadel is length / aniso, aniso = min(length / width, SHADEL_MAX_ANISO): the MIP follows
+// both screen axes instead of blurring to the long one (at a bounded cost in shadels: about aniso
+// times the isotropic count). aniso <= length / width keeps the chosen footprint >= the width, so
+// the MIP is never finer than the footprint's narrow side and the CPU's per-object lower bound of
+// the finest MIP (footprintLod and finestMipFromLod in coarse_visit.cpp, from the shortest span a
+// pixel can have) stays a lower bound.
 ShadelObjectRef shadelObject(ShadelFrame s, uint object) {
     return ShadelObjectRef(s.objects + uint64_t(object) * GPU_SHADEL_OBJECT_BYTES);
 }
@@ -55,8 +55,8 @@ vec2 shadelTapUv(uvec2 mip0Size, vec2 uv, ShadelAniso a, uint i) {
     return uv + a.step * (float(i) - 0.5 * float(a.taps - 1u)) / vec2(mip0Size);
 }
 
-// MIP selection: the same in marking and reconstruction (the seed's custom MIP calculation).
-// `texel` is the position in MIP-0 shadels; derivatives are per pixel.
+// MIP selection: the same in marking and reconstruction (a custom MIP calculation, not the
+// hardware's). `texel` is the position in MIP-0 shadels; derivatives are per pixel.
 float shadelLod(vec2 texelDx, vec2 texelDy, float bias) {
     return 0.5 * log2(max(shadelAniso(texelDx, texelDy).footprintSq, 1e-16)) + bias;
 }
@@ -64,7 +64,7 @@ float shadelLod(vec2 texelDx, vec2 texelDy, float bias) {
 uvec2 levelSize(ShadelObjectRef o, uint mip) { return max(o.v.mip0Size >> mip, uvec2(1u)); }
 
 // The MIPs a sample reads and the weight of the second. Two MIPs are blended only inside a band
-// around the middle of each LOD interval ("brilinear", the seed's aside): near integer LODs one
+// around the middle of each LOD interval ("brilinear"): near integer LODs one
 // level is read, so marking, storage and reconstruction all touch fewer chunks. Marking and
 // reconstruction call this with the same inputs, so they always agree.
 struct ShadelLevels {

@@ -2,7 +2,7 @@
 // --visualize sheet: an image of the virtual sheet. The full width (every MIP region, one
 // column each, finest at the left) and the rows in use, stretched to the image. Allocated
 // rects are tinted by their MIP, blocks with any marked chunk are green, fully marked blocks
-// blue (the seed's colours), region borders grey.
+// blue, region borders grey.
 #include "shadel/shadel.glsl"
 
 layout(local_size_x = 8, local_size_y = 8) in;

@@ -1,5 +1,5 @@
 #version 460
-// Character outline and occlusion tint (seed 004): on the pixels a character covers, seen or
+// Character outline and occlusion tint: on the pixels a character covers, seen or
 // hidden behind something (stencil EQUAL to STENCIL_CHARACTER), an outline on the inside of the
 // silhouette where a neighbour within the radius is not a character, and a tint where the
 // character is hidden (the centre sample decides). The full-screen version runs every pixel and

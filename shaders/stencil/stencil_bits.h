@@ -1,4 +1,4 @@
-// Stencil bits of the stencil-culled effects (seed 004; render/stencil), shared by C++ and GLSL.
+// Stencil bits of the stencil-culled effects (render/stencil), shared by C++ and GLSL.
 #ifndef SHADEL_STENCIL_BITS_H
 #define SHADEL_STENCIL_BITS_H
 

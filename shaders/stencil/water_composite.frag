@@ -1,5 +1,5 @@
 #version 460
-// The water composite (seed 004's water stenciling): screen-space reflection and a refraction
+// The water composite (water stenciling): screen-space reflection and a refraction
 // tint on the water's pixels. A full-screen triangle: with the stencil test (EQUAL to
 // STENCIL_WATER) only water pixels run it; the full-screen version (bench, tests) runs every
 // pixel and branches on the G-buffer class. Early fragment tests: the shader stores to the scene

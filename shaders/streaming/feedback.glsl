@@ -1,4 +1,4 @@
-// Texture streaming feedback (render/streaming, seed 003's GPU priorities): every material
+// Texture streaming feedback (render/streaming, GPU priorities): every material
 // texture sample reports the finest MIP it wanted, per bindless slot, atomically min-reduced into
 // a small buffer the CPU reads after the frame. The MIP is that of a virtual 32768^2 texture, so
 // it does not depend on how much of the texture is resident: the CPU turns it into the side the

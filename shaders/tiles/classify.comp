@@ -1,5 +1,5 @@
 #version 460
-// Tile classification (seed 004): each subgroup classifies one 8x8 tile. Its lanes read the
+// Tile classification: each subgroup classifies one 8x8 tile. Its lanes read the
 // thin G-buffer's pixel flags (a lane takes 64 / subgroup size pixels), subgroupOr /
 // subgroupAnd merge them, and one lane appends the tile to the list of every permutation it
 // needs; each list's count is the x of its indirect dispatch arguments. No shared memory and

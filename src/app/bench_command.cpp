@@ -568,7 +568,7 @@ std::vector<nlohmann::json> renderSideBySide(Gpu& gpu, const std::vector<RenderO
 
 // Renders the same scene over the same camera path forward, decoupled with reuse off and
 // decoupled with reuse on, in one process, and prints per-pass medians and frame-time ratios
-// against forward (DESIGN §5, §7).
+// against forward (the stats contract in docs/design.md, §7).
 nlohmann::json runBench(Gpu& gpu, const BenchOptions& b) {
     if (!b.json.empty()) requireCreatableOutput("--json", b.json); // before minutes of rendering
     if (!b.plot.empty()) requireCreatableOutput("--plot", b.plot);

@@ -208,7 +208,7 @@ struct BenchOptions {
     // (ratios.particle_lighting_atlas_over_pixel; app/bench_command.cpp).
     bool compareParticleLighting = false;
     // --spectra compare: forward and decoupled (reuse off) also with --spectra on and single;
-    // ratios.spectra_forward|spectra_decoupled = on / single median frame time (the seed's
+    // ratios.spectra_forward|spectra_decoupled = on / single median frame time (the
     // spectra against one all-features shader).
     bool compareSpectra = false;
     // --spectra auto|off: the three modes' spectra (render's default, auto: on in decoupled

@@ -460,6 +460,7 @@ RenderSessionPtr beginRender(Gpu& gpu, const RenderOptions& options) {
     settings.marking = o.marking;
     settings.visualize = o.visualize;
     settings.exposure = o.exposure;
+    settings.cacheDir = o.cacheDir;
     settings.shadeStorageSize = o.shadeStorageSize;
     settings.sheetShadels = o.sheetShadels;
     settings.shadingBias = o.shadingBias;
@@ -663,7 +664,7 @@ RenderRun finishRender(RenderSessionPtr sessionPtr) {
     if (!o.captures.empty())
         run.captureFiles = writeCaptures(renderer.captures, o.captures, o.captureDir, o.out);
 
-    // Stats (DESIGN §5): medians over frames.
+    // Stats (the stats contract in docs/design.md): medians over frames.
     nlohmann::json s;
     recordDevice(s, gpu);
     s["driver"] = gpu.device.driver;

@@ -7,7 +7,7 @@
 // rect whose sides are rounded up to multiples of 8 (one chunk) and clamped to [minResolution,
 // maxResolution]. The renderer places the object in the virtual sheet in 64x64-shadel blocks: at
 // MIP k the object needs ceil((width >> k) / 64) x ceil((height >> k) / 64) blocks, and once a side
-// drops below 64 it is snapped up to one block (the seed's snapping of small MIPs). The density is
+// drops below 64 it is snapped up to one block (small MIPs snap to a whole block). The density is
 // raised above the setting only when needed: for tiny objects (to fill minResolution) and for
 // meshes whose triangles are too small for each to own a shadel at MIP 0; lowered only to fit
 // maxResolution. BakedMesh::shadelsPerMetre is the density actually used.

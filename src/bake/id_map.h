@@ -1,7 +1,7 @@
 #pragma once
 // Triangle-ID maps: which triangle every shadel of one MIP level belongs to.
 //
-// Built as the seed does: a standard pass (shadel centres, top-left rule), a conservative pass
+// Built in two passes merged: a standard pass (shadel centres, top-left rule), a conservative pass
 // (any positive-area overlap of triangle and shadel square) that fills only shadels the first
 // pass left empty, then a flood of the IDs into the empty shadels around the charts. Where
 // several triangles compete for a shadel (conservative pass, flood) the one nearest to the shadel

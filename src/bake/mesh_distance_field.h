@@ -1,5 +1,5 @@
 #pragma once
-// Mesh distance fields (seed 004): a signed distance field per mesh on a regular voxel grid in
+// Mesh distance fields: a signed distance field per mesh on a regular voxel grid in
 // object space, built on the CPU at bake time and cached on disk next to the bakes. The GPU
 // keeps them in one 3-D atlas (render/distance_fields) and sphere-traces far soft shadows and
 // ambient occlusion through them.

@@ -1,5 +1,5 @@
 #pragma once
-// The streaming file of a scene's textures (seed 003's streamed textures): every texture as a
+// The streaming file of a scene's textures (streamed textures): every texture as a
 // square power-of-two RGBA8 image with all its pre-filtered MIP levels, each level stored as
 // fixed-size tiles (kTexturePackTile^2 texels, row-major tiles, each tile's rows contiguous) so a
 // level uploads as one copy region per tile and a sparse image could page single tiles in.

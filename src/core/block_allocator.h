@@ -1,7 +1,7 @@
 #pragma once
 // Guillotine binary-tree block allocator for 2-D and 3-D atlases (the structure of UE4's
-// FTextureLayout3d, with the improvements of seed 004 and a placement policy that keeps the tree
-// shallow).
+// FTextureLayout3d, with parent indices, a tree search, swap-remove with stack fix-up, batched
+// insertion and a placement policy that keeps the tree shallow).
 //
 // Every node is an axis-aligned box; an inner node is cut into two children along one axis.
 // Removing an element frees its leaf and collapses the highest ancestor whose subtree is now

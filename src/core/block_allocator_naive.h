@@ -1,5 +1,5 @@
 #pragma once
-// The block allocator as seed 004 found it in UE4's FTextureLayout3d, before any optimisation:
+// The block allocator as UE4's FTextureLayout3d has it, before any optimisation:
 // nodes know only their children; removal finds the element by scanning every node, finds each
 // parent by scanning every node, asks "is this subtree used" by walking the subtree, and deletes
 // nodes with an order-preserving erase followed by a pass over all nodes to fix their indices;
@@ -24,7 +24,7 @@ public:
                                             std::span<const BlockTreeNode<N>> nodes);
 
     std::optional<Placement<N>> insert(const Extent<N>& extent);
-    // One root walk per element, as before the seed's batched insertion.
+    // One root walk per element, without batched insertion.
     std::vector<std::optional<Placement<N>>> insertBatch(std::span<const Extent<N>> extents);
     bool remove(const Position<N>& origin);
     bool remove(BlockId id);

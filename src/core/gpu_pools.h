@@ -1,5 +1,5 @@
 #pragma once
-// A growable set of fixed-size memory pools, each sub-allocated with TLSF (seed 003: 128 MiB
+// A growable set of fixed-size memory pools, each sub-allocated with TLSF (128 MiB
 // pools created on demand, an upper limit on their number, unused pools released, and allocation
 // that fails cleanly at the limit so the caller can fall back, e.g. to the always-resident
 // least-detailed LOD). The set only manages offsets; the owner creates and destroys the backing

@@ -1,6 +1,6 @@
 #pragma once
 // A small fixed pool of worker threads for fork-join work inside a frame (render threading,
-// seed 003's parallel command recording). `parallelFor` hands out indices 0..count-1 to the
+// parallel command recording). `parallelFor` hands out indices 0..count-1 to the
 // calling thread and the workers as each becomes free, and returns when every index is done.
 // The caller is worker 0, so a pool of N threads starts N-1 of its own.
 #include <condition_variable>

@@ -323,6 +323,7 @@ void uploadScene(Gpu& gpu, const Scene& scene, GpuScene& out, const std::vector<
     out.emitters = scene.emitters;
     out.decals = scene.decals;
     out.ambientColor = scene.ambientColor;
+    out.environment = scene.environment;
 
     VkBufferUsageFlags indexUsage = VK_BUFFER_USAGE_INDEX_BUFFER_BIT;
     // Ray tracing (render/raytracing) builds BLASes straight from the unified geometry.

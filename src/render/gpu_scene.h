@@ -1,10 +1,11 @@
 #pragma once
-// The scene on the GPU (seed 003's unified geometry): one vertex buffer and one index buffer
+// The scene on the GPU (unified geometry): one vertex buffer and one index buffer
 // for every mesh, material and instance tables, textures in the bindless table.
 #include <array>
 #include <vector>
 
 #include "common/shared_types.h"
+#include "scene/scene.h"
 #include "render/shadel/texture_rate.h"
 #include "rhi/gpu.h"
 #include "scene/scene.h"
@@ -69,6 +70,7 @@ struct GpuScene {
     bool sunCastsShadow = false;
     glm::vec3 skyColor{0.5f};
     glm::vec3 ambientColor{0.05f};
+    Scene::Environment environment = Scene::Environment::Sky; // Scene::environment
     uint64_t geometryBytes = 0;
     uint64_t idMapBytes = 0;
 };

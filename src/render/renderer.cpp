@@ -6,6 +6,7 @@
 #include <glm/gtc/matrix_transform.hpp>
 
 #include "common/print_labels.h"
+#include "bake/bake_cache.h"
 #include "core/log.h"
 #include "render/background/background.h"
 #include "render/forward/forward_passes.h"
@@ -166,6 +167,8 @@ void initRenderer(Renderer& r, Gpu& gpu, const RenderSettings& requested, const 
         throw DeviceError("out of GPU memory for the renderer's frame buffers");
     createTonemapPipeline(r);
     createBackgroundPipelines(r);
+    createEnvironment(gpu, r.environment, settings, scene,
+                      settings.cacheDir.empty() ? defaultBakeCacheDir() : settings.cacheDir);
     initShaderMessages(gpu, r.messages);
     initFrameRecorder(gpu, r.recorder, settings.timing, std::max(1u, settings.recordingThreads));
     if (settings.mode == RenderMode::Decoupled) r.decoupled = createDecoupled(r, scene);
@@ -221,6 +224,7 @@ void destroyRenderer(Renderer& r) {
     destroyForwardPipelines(r);
     destroy(gpu, r.tonemap);
     destroyBackgroundPipelines(r);
+    destroyEnvironment(gpu, r.environment);
     for (BufferHandle b : {r.draws, r.shadowDraws, r.drawCounts, r.frameConstants, r.pixels})
         destroy(gpu, b);
     if (r.liveLights) destroy(gpu, r.liveLights);
@@ -280,6 +284,9 @@ static gpu::FrameConstants makeFrameConstants(Renderer& r, const GpuScene& scene
     f.tonemap = uint32_t(r.settings.tonemap);
     f.backgroundEnvironment = r.settings.backgroundEnvironment ? 1u : 0u;
     f.backgroundColor = r.skyColor;
+    setEnvironmentView(r.environment, r.settings.environmentIntensity,
+                       r.settings.environmentRotationDegrees); // (the viewer edits them)
+    f.environment = r.environment.constants;
     f.lightCount = scene.lightCount;
     f.instanceCount = scene.instanceCount;
     f.viewportSize = glm::vec2(r.internalWidth, r.internalHeight);
@@ -361,6 +368,12 @@ FrameResult renderFrame(Renderer& r, const GpuScene& scene, const CameraView& ca
         constants = makeFrameConstants(r, scene, camera);
         if (r.skinning) constants.vertices = skinnedVerticesAddress(r, *r.skinning); // every view
         updateLights(r, scene, constants);
+        // A turned or dimmed environment relights every surface (as a changed sun does).
+        glm::vec2 view(r.settings.environmentIntensity, r.settings.environmentRotationDegrees);
+        if (r.framesRendered > 0 && view != r.environmentViewLastFrame)
+            r.changedLightVolumes.push_back(
+                glm::vec4(0.0f, 0.0f, 0.0f, std::numeric_limits<float>::infinity()));
+        r.environmentViewLastFrame = view;
     }
     // Before beginFrame (streaming rebinds texture slots in the set this frame uses) and before
     // the decoupled frontend (which must not carry over shading of re-streamed textures).

@@ -13,6 +13,7 @@
 #include "render/debug/debug_lines.h"
 #include "render/decals/decals.h"
 #include "render/distance_fields/distance_fields.h"
+#include "render/environment/environment_state.h"
 #include "render/gi/lpv.h"
 #include "render/gpu_scene.h"
 #include "render/lighting/feature_spectra.h"
@@ -82,10 +83,9 @@ struct RenderSettings {
     uint32_t width = 1280, height = 720;
     uint32_t ssaa = 1; // N x N supersampling (forward reference)
     RenderMode mode = RenderMode::Forward;
-    // Decoupled only. Visibility is the default (Auto): on lavapipe at 1280x720 (builtin:default,
-    // orbit, 6 frames) visibility prepass + compute marking + resolve cost 33 + 29 + 72 ms where
-    // depth prepass + raster marking + reconstruction cost 23 + 37 + 105 ms. (An earlier build
-    // measured the opposite, frame 548 vs 506 ms; re-measured with today's shaders.)
+    // Decoupled only. Visibility is the default (Auto): on lavapipe the visibility prepass,
+    // compute marking and compute resolve together cost less than the depth prepass, raster
+    // marking and raster reconstruction (docs/decoupled/README.md has the figures).
     MarkingMode marking = MarkingMode::Auto;
     Visualize visualize = Visualize::None;
     float exposure = 1.0f; // linear multiplier; the CLI takes --exposure in EV (2^EV)
@@ -103,6 +103,7 @@ struct RenderSettings {
     bool backgroundEnvironment = true;
     glm::vec3 backgroundColor{0.0f}; // sRGB, when !backgroundEnvironment
     bool shadows = true;             // --shadows off: no shadow maps (sun, spots, cascades)
+    std::string cacheDir; // prefiltered environments are cached here ("": the default cache)
     uint32_t shadowMapSize = 2048;
     TimingMode timing = TimingMode::SubmitPerPass;
     // --threads: threads recording the frame's passes (1 = serial, in declaration order;
@@ -158,7 +159,7 @@ struct RenderSettings {
     ParticleLighting particleLighting = ParticleLighting::Atlas;
     uint32_t particleAtlasSize = 1024; // texels per side of the particle lightmap atlas
     // Sprites accumulated at half resolution in their own WBOIT targets, combined with the
-    // full-resolution surfaces' in the composite (seed 001's low-resolution particles).
+    // full-resolution surfaces' in the composite (low-resolution particles).
     bool particleHalfRes = true;
     // Seed 004's screen-space passes (render/screenspace: thin G-buffer, sky, SSR, SSS) and
     // whether they run per classified 8x8 tile (render/tiles) or over every tile.
@@ -218,7 +219,7 @@ struct FrameResult {
     // prefetchPose; the decoupled coarse visit, render/shadel/coarse_visit.h).
     std::vector<FrontendWorkerTask> frontendWorker;
     uint32_t shaderAsserts = 0;
-    std::vector<ShaderPrint> prints;        // shaderPrint records of this frame (--inspect)
+    std::vector<ShaderPrint> prints;        // shader print records of this frame (--inspect)
     uint32_t transparentDraws = 0;          // blended instances drawn (render/oit)
     uint32_t transparentDecoupledDraws = 0; // ... of which shaded in shadel space
     // Threaded frames: the wall clock of the parallel recording and what each worker did.
@@ -326,6 +327,10 @@ struct Renderer {
     // or it was edited); the decoupled path reshades its objects.
     std::vector<uint8_t> changedMaterials;
     SceneEdits edits; // the viewer's light, sun and material edits (render/scene_edits.h)
+    EnvironmentState environment; // image-based lighting and the background (render/environment)
+    // The environment's intensity and rotation the last frame shaded with: a change relights
+    // every surface (the decoupled path reshades what it carried over).
+    glm::vec2 environmentViewLastFrame{-1.0f};
     // Per instance: animated playback (render/animation) moved or deformed it before this frame;
     // empty without playback. Decoupled reuse reshades these; spot shadow maps are redrawn.
     std::vector<uint8_t> reposedInstances;
@@ -343,7 +348,7 @@ struct Renderer {
     // This frame's frontend work that ran ahead on the frontend worker (the decoupled coarse
     // visit): the caller files it under the frame it ran beside (FrameResult::frontendWorker).
     std::vector<FrontendWorkerTask> frontendTaken;
-    // Frontend/backend overlap (issue 16): set by a caller that renders a known sequence with
+    // Frontend/backend overlap: set by a caller that renders a known sequence with
     // recording threads, for one renderFrame. Once this frame's frontend is done, the next
     // frame's decoupled grid visit (render/shadel/coarse_visit.h) runs on the frontend worker
     // while this frame records, submits and waits. `sceneMoves`: animated playback writes the

@@ -1,6 +1,6 @@
 #pragma once
-// Live edits of the scene's lights, sun and materials (the viewer's light and material panels;
-// issue 16). The uploaded GpuScene stays as loaded: edited copies live in upload buffers that
+// Live edits of the scene's lights, sun and materials (the viewer's light and material panels).
+// The uploaded GpuScene stays as loaded: edited copies live in upload buffers that
 // the frame binds in place of the scene's, and each edit also says what it invalidates, so the
 // decoupled path's preserved layers reshade exactly what changed (a light's reach, a
 // material's objects; the sun reaches everything) instead of carrying stale shading over.

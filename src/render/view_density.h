@@ -1,5 +1,5 @@
 #pragma once
-// View-driven shadel density (issue 8): each mesh gets the density the cameras of this run can
+// View-driven shadel density: each mesh gets the density the cameras of this run can
 // need, instead of one shadels-per-metre for the whole scene.
 //
 // For an instance seen at nearest distance d by a camera with focal length f pixels, a MIP-0

@@ -1,5 +1,5 @@
 #pragma once
-// One global descriptor table (seed 003): every sampled and storage image of the engine sits
+// One global descriptor table: every sampled and storage image of the engine sits
 // at a persistent slot; shaders index it. Buffers are reached by device address instead.
 //
 // Static section: slots that live as long as their view. Dynamic section: slots valid for one
@@ -46,7 +46,7 @@ struct BindlessTable {
     std::array<VkSampler, kBindlessSamplerCount> samplers{};
     VkPipelineLayout pipelineLayout = VK_NULL_HANDLE; // set 0 = this table, 128 B push constants
 
-    // Pending writes per set, applied in prepareFrame() when that set is not in use.
+    // Pending writes per set, applied in prepareBindlessFrame() when that set is not in use.
     std::array<std::vector<BindlessWrite>, 2> pending;
     // Freed slots wait until both sets hold the null resource.
     struct Retired {

@@ -137,7 +137,8 @@ std::string listPhysicalDevices() {
     return out;
 }
 
-// Checks every feature DESIGN §2 requires; returns the name of the first one missing.
+// Checks every feature the platform section of docs/design.md requires; returns the name of the
+// first one missing.
 struct FeatureChain {
     VkPhysicalDeviceFeatures2 core{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2};
     VkPhysicalDeviceVulkan11Features v11{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_1_FEATURES};

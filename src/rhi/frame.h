@@ -6,7 +6,7 @@
 // own submission and the CPU waits for it; slower, but the only trustworthy per-pass figure
 // on lavapipe, whose timestamps after a graphics pass are attributed late.
 //
-// Recording threads (seed 003's parallel command recording). With one thread each pass is
+// Recording threads (parallel command recording). With one thread each pass is
 // recorded when it is declared. With more, `pass` only keeps the pass; endFrame records every
 // kept pass into its own command buffer on a pool of workers (each worker its own command
 // pool), then submits them in declaration order, so the GPU sees the same commands in the same

@@ -1,5 +1,5 @@
 #pragma once
-// The bare resource model (seed 003): memory heaps, resources and views are separate concepts,
+// The bare resource model: memory heaps, resources and views are separate concepts,
 // and each view kind is its own type. A read view cannot be bound as a render target, a buffer
 // cannot be a depth target, a texture is not a buffer: such mistakes do not compile.
 #include <compare>

@@ -1,5 +1,5 @@
 #pragma once
-// The shader -> CPU message channel (seed 003's GPU inspection): a buffer any shader appends to
+// The shader -> CPU message channel (GPU inspection): a buffer any shader appends to
 // with atomics: asserts (shaders/common/bindless.glsl, SHADEL_ASSERT) and prints of labelled
 // values (shaders/common/shader_print.glsl, shaderPrintF...). After each frame the CPU decodes
 // it, prints each distinct assert once with its source location, counts all of them, keeps the
@@ -16,7 +16,8 @@ namespace shadel {
 
 struct Gpu;
 
-// One shaderPrint record: a label (shaders/common/print_labels.h) and up to four values.
+// One shader print record (shaderPrintRecord): a label (shaders/common/print_labels.h) and up to
+// four values.
 struct ShaderPrint {
     uint32_t label = 0;
     uint32_t shaderId = 0, line = 0;

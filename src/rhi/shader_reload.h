@@ -1,5 +1,5 @@
 #pragma once
-// Hot shader reload (seed 003: rapid iterations): watches a GLSL source folder (the project's
+// Hot shader reload (rapid iterations): watches a GLSL source folder (the project's
 // shaders/ or a copy), recompiles a stage when it or anything it includes
 // changes, and swaps every pipeline built from that stage without touching the techniques that
 // own them: bind() looks the pipeline's replacement up. A stage that fails to compile keeps

@@ -3,7 +3,7 @@
 // overlapping projected decals of every kind: graffiti (base colour) on the wall, a riveted
 // plate (normal + base colour) across the wall and the crate, road stripes (base colour) and a
 // puddle (roughness) on the ground, and AO-only contact shadows under the figure and the crate
-// (seed 001's character shadow: a decal that darkens only the ambient light).
+// (character shadow: a decal that darkens only the ambient light).
 #include "scene/scene.h"
 
 namespace shadel {

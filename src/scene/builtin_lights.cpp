@@ -292,7 +292,7 @@ Scene makeBlockersScene() {
 
 namespace {
 
-// builtin:lights' textured lights (issue 10): shop signs (textured area lights) and gobo spots,
+// builtin:lights' textured lights: shop signs (textured area lights) and gobo spots,
 // half along the avenue before the night camera, half on the streets. Their own generator,
 // so the lights before them are the same as without them.
 void addStreetTexturedLights(Scene& scene) {

@@ -1,5 +1,5 @@
 #pragma once
-// Built-in scenes of the lighting work (seed 001): a night street with thousands of lights of
+// Built-in scenes of the lighting work: a night street with thousands of lights of
 // every kind, and a small room whose light blockers keep its light inside.
 #include "scene/scene.h"
 

@@ -501,7 +501,7 @@ Texture makePuffTexture() {
     return t;
 }
 
-// Transparency (seed 001): overlapping coloured glass panes, a glass sphere, a smoke column of
+// Transparency: overlapping coloured glass panes, a glass sphere, a smoke column of
 // alpha-blended sprites and a fire of additive ones, in front of opaque geometry. Blended
 // materials carry an additiveness: 0 for glass and smoke, 1 for the fire's core, 0.6 for its
 // outer flames.
@@ -582,7 +582,7 @@ Scene makeTransparency() {
     return scene;
 }
 
-// GPU particles (seed 004, render/particles): rock debris as mesh particles, a lit smoke column
+// GPU particles (render/particles): rock debris as mesh particles, a lit smoke column
 // (alpha-blended sprites with a normal map, lit by the sun, a warm light by the fire and a cool one
 // on the left, through the particle lightmap atlas) beside an unlit additive fire, in front of
 // opaque geometry. Seeded: every run simulates the same particles.
@@ -640,7 +640,7 @@ Scene makeParticles() {
     scene.emitters.push_back(fire);
 
     // Mesh particles: embers of rock thrown up from the fire pit, bouncing on the ground; opaque,
-    // lit per vertex with wrap shading (the forward path of seed 004's mesh particles).
+    // lit per vertex with wrap shading (the forward path of mesh particles).
     ParticleEmitter debris;
     debris.name = "debris";
     debris.position = {1.4f, 0.3f, -0.5f};

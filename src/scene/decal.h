@@ -1,5 +1,5 @@
 #pragma once
-// A projected box decal (seeds 001 and 004): whatever opaque surface lies inside the box takes
+// A projected box decal: whatever opaque surface lies inside the box takes
 // the decal's contribution to its material before lighting (render/decals). The box's local z
 // axis is the projection direction; the decal's pattern lies in its x/y face.
 #include <cstdint>

@@ -986,7 +986,7 @@ private:
         return out;
     }
 
-    // Calls apply(element, valueBytes) for each sparse substitution, bounds-checked.
+    // Calls apply(element, bytes of the value) for each sparse substitution, bounds-checked.
     template <typename F>
     void applySparse(int index, F&& apply) {
         const tinygltf::Accessor& acc = model_.accessors[size_t(index)];

@@ -28,7 +28,7 @@ struct ParticleEmitter {
     float wrap = 0.5f;        // wrap shading of lit particles (0 = Lambert)
     float normalScale = 1.0f; // strength of the sprite's normal map
     uint32_t seed = 1;
-    // Mesh particles (seed 004: "meshes need to go down a forward shading path"): opaque boxes
+    // Mesh particles (meshes cannot be lit through the atlas, so they go forward): opaque boxes
     // drawn with the forward pass's depth, lit per pixel or (vertexLit) per vertex, with wrap.
     bool mesh = false;
     bool vertexLit = false;

@@ -24,7 +24,7 @@ struct Aabb {
 };
 Aabb transformAabb(const Aabb& box, const glm::mat4& m);
 
-// The one vertex format of the unified geometry buffer (seed 003: few vertex formats).
+// The one vertex format of the unified geometry buffer (few vertex formats).
 struct Vertex {
     glm::vec3 position;
     glm::vec3 normal;
@@ -81,7 +81,7 @@ enum class Procedural : uint32_t {
 
 constexpr int32_t kNoTexture = -1;
 
-// What screen-space passes treat a surface as (seed 004's material classes, written to the thin
+// What screen-space passes treat a surface as (material classes, written to the thin
 // G-buffer, render/screenspace): skin gets subsurface scattering, water the water composite.
 // Unlit materials are SurfaceClass::Unlit whatever this says.
 enum class SurfaceClass : uint32_t { DefaultLit = 0, Foliage = 1, Skin = 2, Water = 3, Unlit = 4 };
@@ -127,7 +127,7 @@ struct Material {
     int32_t occlusionTexture = kNoTexture;
     Procedural procedural = Procedural::None;
     float proceduralScale = 1.0f; // pattern cells per uv unit
-    // Blended materials only: 0 = alpha-blended, 1 = additive (seed 001's "additiveness"),
+    // Blended materials only: 0 = alpha-blended, 1 = additive (the additiveness channel),
     // composited without sorting by weighted blended OIT (render/oit).
     float additiveness = 0.0f;
 
@@ -177,7 +177,7 @@ struct Instance {
 
 // Point is the omni light; Spot has a round cone, SquareSpot a square one (a pyramid whose
 // half-angles are the cone angles, turned about the direction by `axis`); Tube is a line light
-// of `tubeLength` along `axis` (seed 001's "realistic" tube lights); Area is a one-sided
+// of `tubeLength` along `axis` (a capsule's closest-point lighting); Area is a one-sided
 // rectangle of `areaSize` (along `axis`, and along cross(direction, axis)) centred at `position`,
 // emitting `texture` (or a flat colour) toward `direction`. A spot with a `texture` projects it
 // (a gobo). glTF KHR_lights_punctual gives Directional, Point and Spot.
@@ -217,7 +217,7 @@ struct Light {
     std::vector<uint32_t> blockers; // indices into Scene::blockers that stop this light
 };
 
-// A light blocker (seed 001): an artist-placed rectangle (say a wall's mid-plane) that stops
+// A light blocker: an artist-placed rectangle (say a wall's mid-plane) that stops
 // the lights listing it, without shadow maps. Portals are rectangular holes in it (doorways).
 struct LightBlocker {
     std::string name;
@@ -231,7 +231,7 @@ struct LightBlocker {
     std::vector<Portal> portals;
 };
 
-// A fixed light propagation volume an artist places (seed 001, issue 11): GI is computed once
+// A fixed light propagation volume an artist places: GI is computed once
 // in a grid over this box and read before the camera-centred cascades where it holds a point
 // (render/gi). glTF: a node whose extras have "shadel_gi_volume": true; the box is the node's
 // unit cube ([-1, 1]^3, as an empty's cube display) in world space.

@@ -139,7 +139,7 @@ TEST(Cli, RenderWritesPngAndStatsJson) {
         EXPECT_NE(ss.str().find(key), std::string::npos) << key;
 }
 
-// --- issue 17: every command-line error is one line and exit code 2 ------------------------
+// --- every command-line error is one line and exit code 2 ------------------------
 
 namespace {
 
@@ -267,7 +267,7 @@ TEST(Cli, SubcommandHelpShowsGlobalFlagsAndTheBakeCache) {
     EXPECT_EQ(r.exitCode, 0) << r.stderrText;
 }
 
-// --- issue 17: every write is checked ---------------------------------------------------------
+// --- every write is checked ------------------------------------------------------------------
 
 TEST(Cli, FullDeviceFailsTheRenderWithOneLine) {
     for (const char* flag : {"--out", "--stats"}) {
@@ -313,7 +313,7 @@ TEST(Cli, InconsistentOptionsFailBeforeLoading) {
     for (auto [args, message] : cases) expectOneLineError(args, message);
 }
 
-// --- issue 17: the bake cache location and glTF URIs -------------------------------------------
+// --- the bake cache location and glTF URIs ----------------------------------------------------
 
 // XDG_CACHE_HOME="" put the cache at /shadel; an empty or relative value must be ignored.
 TEST(Cli, EmptyOrRelativeXdgCacheHomeIsIgnored) {

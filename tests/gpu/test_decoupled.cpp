@@ -1,7 +1,7 @@
-// Decoupled shading against its references (DESIGN §6): forward on smooth content, an 8x8
-// supersampled forward render on high-frequency content, and frame-to-frame stability under
-// sub-pixel jitter. Plus the invariants: no reconstruction misses, no asserts, no validation
-// errors, and graceful storage overflow.
+// Decoupled shading against its references (docs/design.md, how correctness is judged): forward on
+// smooth content, an 8x8 supersampled forward render on high-frequency content, and frame-to-frame
+// stability under sub-pixel jitter. Plus the invariants: no reconstruction misses, no asserts, no
+// validation errors, and graceful storage overflow.
 #include "gpu_test_env.h"
 
 #include <cmath>

@@ -1,6 +1,6 @@
-// The decoupled core done as the seed does it (issue 19): the sheet holds only the MIPs a frame
+// The decoupled core: the sheet holds only the MIPs a frame
 // can need, storage is shared by the hashed counters, the shading bias lowers the work, the
-// 256k sheet works, and the seed's occupancy measure is reported.
+// 256k sheet works, and the occupancy measure (bits of occupancy per shadel) is reported.
 #include "gpu_test_env.h"
 
 #include <cmath>
@@ -369,7 +369,7 @@ TEST(DecoupledCore, MaterialLayerIsVisibleAndDiffersFromRadiance) {
     EXPECT_LT(psnr(material.frames[0].rgba, radiance.frames[0].rgba), 30.0);
 }
 
-// Level windows (issue 19): once last frame's marks are known, a fine level's rect holds only
+// Level windows: once last frame's marks are known, a fine level's rect holds only
 // the blocks the view wanted plus a margin, and a level nothing wanted holds none. The sheet
 // then needs far fewer blocks, with the same image and no misses.
 TEST(DecoupledCore, LevelWindowsAtLeastHalveTheSheet) {

@@ -1,6 +1,7 @@
-// Issue 8, the runtime half: shadels where the screen needs them (view-driven density per mesh,
-// world chunks), a prefiltered material in shadel space and anisotropic MIP selection, judged at
-// the sizes users run (DESIGN §6), not only at one small size.
+// View-driven density, the runtime half: shadels where the screen needs them (view-driven density
+// per mesh, world chunks), a prefiltered material in shadel space and anisotropic MIP selection,
+// judged at the sizes users run (docs/design.md, how correctness is judged), not only at one small
+// size.
 #include "gpu_test_env.h"
 
 #include <cmath>

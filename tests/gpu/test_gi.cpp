@@ -1,4 +1,4 @@
-// Light propagation volume GI (issue 11, render/gi): colour bleeding on builtin:cornell, stable
+// Light propagation volume GI (render/gi): colour bleeding on builtin:cornell, stable
 // cascades under camera motion, stats and bad input.
 #include "gpu_test_env.h"
 
@@ -171,7 +171,7 @@ TEST(Gi, StaticCameraReusesTheVolumesAndMovingSpotsRedrawThem) {
     EXPECT_EQ(moving.stats["gi"]["local_volume_updates"].get<uint64_t>(), 3u);
 }
 
-// builtin:cornell places a local volume over its room (seed 001's artist-placed volumes): a
+// builtin:cornell places a local volume over its room (artist-placed volumes): a
 // fixed grid of cells half as wide as cascade 0's, propagated GI_GRID steps once. The camera
 // orbits, the cascades follow it, the room's volume stays computed; inside the room the apply
 // reads it before the cascades, so the indirect light differs from the cascades' alone.
@@ -233,7 +233,7 @@ TEST(Gi, BlockerStopsPropagationIntoTheRoomBeyondIt) {
     EXPECT_GE(redLight(blocked, 0, 24), 0.5 * redLight(open, 0, 24)) << "the red wall's side";
 }
 
-// Portals are holes in blockers (seed 001), in GI as in direct light: the wall across the room
+// Portals are holes in blockers, in GI as in direct light: the wall across the room
 // with a portal as large as the room's cross-section lets the red wall's light into the room
 // again (the part of the wall outside the room still blocks).
 TEST(Gi, PortalInABlockerLetsTheLightThrough) {
@@ -258,7 +258,7 @@ TEST(Gi, PortalInABlockerLetsTheLightThrough) {
     EXPECT_GE(beyondPortal, 3.0 * beyondBlocked);
 }
 
-// Macro-cell culling (seed 001: blockers culled against 4x4x4 macro-cells) only skips blockers
+// Macro-cell culling (blockers culled against 4x4x4 macro-cells) only skips blockers
 // that cannot cut a tap: the image is the one of testing every blocker, while a macro-cell
 // tests a fraction of them.
 TEST(Gi, MacroCellBlockerCullingChangesNothing) {

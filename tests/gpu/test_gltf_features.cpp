@@ -1,4 +1,4 @@
-// glTF features as users have them (issue 18): automatic framing covers 25%-90% of the image for
+// glTF features as users have them: automatic framing covers 25%-90% of the image for
 // any model and size, --from/--look-at/--fov and orthographic cameras, and material extensions
 // that visibly apply and agree between the forward and decoupled paths.
 #include <gtest/gtest.h>

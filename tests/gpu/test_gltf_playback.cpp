@@ -1,4 +1,4 @@
-// Animated glTF playback over --frames (issue 18, `--time-step`, render/animation): every frame
+// Animated glTF playback over --frames (`--time-step`, render/animation): every frame
 // is the file posed at T0 + i * step, the same image a single `--time` render of that moment
 // gives, and the decoupled path (with reuse, which must see the object move) agrees with forward.
 #include <gtest/gtest.h>

@@ -1,4 +1,4 @@
-// glTF points and lines (issue 18, render/points_lines): drawn forward in both modes, unlit
+// glTF points and lines (render/points_lines): drawn forward in both modes, unlit
 // (base colour factor x COLOR_0), depth tested against the surfaces.
 #include <gtest/gtest.h>
 

@@ -1,4 +1,4 @@
-// --inspect X,Y (shaders/debug/inspect.glsl through shaderPrint): what the shading printed for a
+// --inspect X,Y (shaders/debug/inspect.glsl through shaderPrintF): what the shading printed for a
 // pixel agrees with a CPU evaluation of the same material and lights at that surface point, and
 // with the pixel the frame shows.
 #include "gpu_test_env.h"

@@ -1,4 +1,4 @@
-// Textured light kinds (issue 10): gobo spots project their texture, textured area lights light
+// Textured light kinds: gobo spots project their texture, textured area lights light
 // with their texture's colour; both paths and the culling / spectra permutations agree on
 // builtin:textured-lights.
 #include "gpu_test_env.h"

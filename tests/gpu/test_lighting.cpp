@@ -1,4 +1,4 @@
-// Lighting (issue 10, seed 001): tiled light culling changes nothing in the image, in both
+// Lighting: tiled light culling changes nothing in the image, in both
 // paths, on a night street of >= 2000 lights of every kind; light blockers keep a room's light
 // inside its walls, and their portals let it out through the doorway.
 #include "gpu_test_env.h"

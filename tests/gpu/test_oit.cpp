@@ -187,7 +187,7 @@ TEST(Oit, DecoupledTransparencyMatchesForward) {
 // Additiveness 1: the layers add to what is behind them. WBOIT gets the sum as the weighted
 // mean colour times the additive coverage, so it is exact where the layers weigh the same
 // (here: both nearer than 1.6 m, where the depth term is capped at 300, and coverage >= 1/3);
-// with unequal weights the nearer layer's hue dominates (the seed's "colour dominance").
+// with unequal weights the nearer layer's hue dominates (colour dominance).
 TEST(Oit, AdditivenessOneIsAdditiveBlending) {
     std::vector<Layer> layers = {{1.0f, {0.30f, 0.10f, 0.05f}, 1.0f, 1.0f},
                                  {1.5f, {0.05f, 0.20f, 0.10f}, 0.8f, 1.0f}};

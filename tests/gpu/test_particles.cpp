@@ -1,4 +1,4 @@
-// GPU particles (render/particles, seed 004): the particle lightmap atlas against per-pixel
+// GPU particles (render/particles): the particle lightmap atlas against per-pixel
 // lighting on the smoke, reproducible simulation, LOD from screen size, CLI input.
 #include <algorithm>
 #include <cmath>

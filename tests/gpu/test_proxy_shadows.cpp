@@ -1,4 +1,4 @@
-// Proxy (shadow) index sets (render/culling/mesh_lods.h, seed 003): every LOD has a second index
+// Proxy (shadow) index sets (render/culling/mesh_lods.h): every LOD has a second index
 // range over position-only deduplicated vertices, drawn by the shadow views.
 #include <cstdio>
 

@@ -1,4 +1,4 @@
-// Ray tracing (render/raytracing, issue 20): BLASes per mesh LOD in TLSF pools with the
+// Ray tracing (render/raytracing): BLASes per mesh LOD in TLSF pools with the
 // least-detailed fallback, the per-frame TLAS, and the ray-traced effects of the forward path.
 #include <algorithm>
 #include <cstdio>
@@ -276,7 +276,7 @@ double flickerFrom(const RenderRun& run, size_t first) {
 // A static camera, so every change between frames is the estimator's noise: the shadel path's
 // history converges, the per-pixel forward path draws new rays every frame. (Under
 // --camera-path orbit the frame-to-frame change at 96x54 is dominated by the motion itself for
-// both paths; see the report of issue 20.)
+// both paths; docs/raytracing/README.md has the figures.)
 TEST(RayTracing, ShadelAoFlickersLessThanPerPixelAtTheSameRayBudget) {
     if (!sharedGpu().device.optional.rayQuery) GTEST_SKIP() << "no ray query on this device";
     RenderRun shadel = renderChecked(shadelAoOptions(16, 1, 3));
@@ -351,7 +351,7 @@ double raysOverTheRun(const RenderRun& run) {
 
 } // namespace
 
-// Issue 20, "What must hold" 2: with a moving camera the shadel path's AO flickers at most half
+// With a moving camera the shadel path's AO flickers at most half
 // as much as the per-pixel forward path's at the same ray budget (all rays of the run, counted
 // on the GPU). The shadel path: its cache one MIP coarser than the default
 // (--rt-shadel-mip-offset 3), 2 rays per shadel per frame; forward: the fewest whole rays per

@@ -1,5 +1,5 @@
 // runRender's in-code callers (tests, bench) skip the command-line flag checks; the same float
-// ranges are enforced on RenderOptions, naming the flag (issue 17).
+// ranges are enforced on RenderOptions, naming the flag.
 #include <gtest/gtest.h>
 
 #include <cmath>

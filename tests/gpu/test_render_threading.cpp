@@ -1,4 +1,4 @@
-// Render threading (issue 16, rhi/frame.h): with --threads N the frame's passes are recorded on
+// Render threading (rhi/frame.h): with --threads N the frame's passes are recorded on
 // N threads, each pass into its own command buffer, and submitted in declaration order. The
 // images must be the same bytes as the serial frame's (--threads 1) for every technique that
 // records passes, in both timing modes, and the workers' work shows in the stats and the trace.

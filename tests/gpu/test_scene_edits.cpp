@@ -1,4 +1,4 @@
-// Live scene edits (render/scene_edits.h; the viewer's light, sun and material editor, issue 16):
+// Live scene edits (render/scene_edits.h; the viewer's light, sun and material editor):
 // an edit made between two frames of one renderer shows in full in the next frame, in both
 // paths. The decoupled path reuses last frame's shadels (preserved layers, --reuse on), so this
 // checks that an edit invalidates what it reaches: without that, the carried-over chunks would

@@ -1,4 +1,4 @@
-// Issue 8, "seams": colour discontinuity across chart seams in the decoupled image. A smooth,
+// Seams: colour discontinuity across chart seams in the decoupled image. A smooth,
 // sun-lit sphere without UVs (builtin:smooth's white sphere, 48 x 24, charted by the baker) is
 // rendered close up in forward and decoupled mode. Pixels are assigned to charts through the
 // visibility capture (instance, triangle) and the same bake the renderer used (a fixed density,

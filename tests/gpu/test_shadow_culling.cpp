@@ -1,4 +1,4 @@
-// Per-view shadow culling (issue 13; render/culling/culling.h): the instanceCull dispatch that
+// Per-view shadow culling (render/culling/culling.h): the instanceCull dispatch that
 // fills the camera's and the sun's lists also culls every instance against each sun cascade's
 // box and each shadow-casting spot's frustum, so a spot or cascade draws only its own casters,
 // where --shadow-culling whole-scene draws every caster of the scene for each of them. The maps

@@ -1,4 +1,4 @@
-// Shadows (issue 10, seed 001): spot shadow maps share one atlas placed by the block allocator;
+// Shadows: spot shadow maps share one atlas placed by the block allocator;
 // a shadow only removes light; PCSS (soft spots, --sun-shadows pcss) changes penumbrae, not the
 // lit and shadowed areas as a whole.
 #include "gpu_test_env.h"

@@ -1,4 +1,4 @@
-// Feature spectra (issue 10, seed 001): forward tiles shaded by permutations compiled with only
+// Feature spectra: forward tiles shaded by permutations compiled with only
 // the features each tile needs give the image the all-features shaders give, on a night street
 // of >= 2000 lights of every kind; the tiles spread over several spectra, and the stats count
 // the features a spectrum compiles in that its tiles did not need.

@@ -1,4 +1,4 @@
-// Cascaded sun shadows (issue 10, seed 001; render/lighting/sun_cascades.h): the view depth cut
+// Cascaded sun shadows (render/lighting/sun_cascades.h): the view depth cut
 // into slices, each with its own map, spends far more texels per metre near the camera than the
 // one map fitted to the scene, still covers the view out to the scene's far end, changes the
 // image only at shadow edges, and shades the decoupled path as the forward one (shared GLSL).

@@ -1,6 +1,6 @@
 // Bake-cache files that pass the checksum but lie about the mesh (edited, then re-signed), a
 // directory where a cache file should be, and an unwritable cache: each is a rebake with one
-// warning, never a black image or an exit (issue 17).
+// warning, never a black image or an exit.
 #include <gtest/gtest.h>
 
 #include <algorithm>

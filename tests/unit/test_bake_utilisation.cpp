@@ -1,4 +1,4 @@
-// Issue 8, "charts that use their rectangles": at the settings `shadel bake` uses, every glTF2
+// Charts that use their rectangles: at the settings `shadel bake` uses, every glTF2
 // test model of Debian's assimp-testmodels that shadel loads, and a procedural sphere and torus
 // without UVs, cover >= 60% of their MIP-0 shadel rects. A missing model fails (the package is a
 // build dependency, scripts/setup.sh). Models left out are the deliberately broken ones, which

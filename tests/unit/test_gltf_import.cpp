@@ -265,7 +265,7 @@ TEST(GltfImport, BlendMaterialsMapOntoAdditiveness) {
 
 // --- content ------------------------------------------------------------------------------
 
-// Local GI volumes (issue 11): a node whose extras say "shadel_gi_volume": true places one, its
+// Local GI volumes: a node whose extras say "shadel_gi_volume": true places one, its
 // unit cube in world space; anything else is warned about and ignored, never fatal.
 TEST(GltfImport, NodeExtrasPlaceLocalGiVolumes) {
     std::ifstream in(kData + "/gltf/cameras_lights.gltf");

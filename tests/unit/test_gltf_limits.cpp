@@ -1,6 +1,6 @@
 // Hostile glTF input is bounded: parsing and import are linear in the file size, element
 // counts have limits with a clear error, and buffer/image URIs stay inside the model's folder
-// (issue 17).
+//.
 #include <gtest/gtest.h>
 
 #include <chrono>

@@ -1,5 +1,5 @@
 #pragma once
-// The viewer's light, sun and material editor (issue 16): a section of the panel listing the
+// The viewer's light, sun and material editor: a section of the panel listing the
 // scene's lights and materials. What the user changes goes to the renderer as scene edits
 // (render/scene_edits.h), so both paths show it from the next frame, and the decoupled path
 // reshades only what the edit reaches.

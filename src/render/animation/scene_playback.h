@@ -28,7 +28,7 @@ struct ScenePlayback {
     // Totals over the run (stats).
     uint64_t instancesReposed = 0, meshesReposed = 0, verticesWritten = 0;
 
-    // Frontend/backend overlap (seed 003): the next frame's pose is imported on a worker thread
+    // Frontend/backend overlap: the next frame's pose is imported on a worker thread
     // (prefetchPose) while this frame is recorded, submitted and drawn; poseFrame takes it.
     struct Import {
         Scene scene;

@@ -1,5 +1,5 @@
 #pragma once
-// The GPU-driven world's culling state (seeds 003/004): per-mesh LOD chains chosen on the GPU by
+// The GPU-driven world's culling state: per-mesh LOD chains chosen on the GPU by
 // projected error, per-view counts, and two-phase hierarchical-Z occlusion culling of the
 // camera view. The cull itself is shaders/forward/instance_cull.comp (its helpers live in
 // shaders/culling/cull.glsl); this owns what it reads and writes besides the draw lists.

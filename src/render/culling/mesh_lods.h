@@ -1,5 +1,5 @@
 #pragma once
-// Per-mesh LOD chains for the unified geometry buffers (seed 003: LODs in one buffer, the least
+// Per-mesh LOD chains for the unified geometry buffers (LODs in one buffer, the least
 // detailed always resident), made with meshoptimizer: each level simplified from LOD 0 under an
 // error bound (meshopt_simplify only removes vertices, so every level indexes LOD 0's vertices
 // and a baked mesh's shadel UVs: one chart atlas for all LODs, switching never reallocates),

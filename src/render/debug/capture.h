@@ -1,5 +1,5 @@
 #pragma once
-// Frame extraction (seed 003: "capture and show any resource"): each technique registers the
+// Frame extraction (capture any resource and show it): each technique registers the
 // images and buffers of its frame under a name (`--capture NAME`); after the frame's GPU work
 // has finished, a registered source reads its resource back into a CapturedImage, and the app
 // writes it (src/app/capture_output.h): EXR for HDR colour and depth, PNG for display formats,

@@ -1,5 +1,5 @@
 #pragma once
-// 3-D debug lines (issue 16, seed 003's GPU-side debugging): shaders append world-space segments
+// 3-D debug lines (GPU-side debugging): shaders append world-space segments
 // to one buffer (shaders/debug/debug_lines.glsl: debugLine, debugBox, debugSphere, ...) and this
 // pass draws them over the frame, depth-tested, before tonemapping. `--debug-lines KIND,...`:
 //   lights    light ranges, spot cones, tube segments (debugLinesEmit, one invocation per light)

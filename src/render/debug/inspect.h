@@ -1,5 +1,5 @@
 #pragma once
-// --inspect X,Y: of the shaderPrint records a frame produced at the inspected pixel, the ones of
+// --inspect X,Y: of the shader print records a frame produced at the inspected pixel, the ones of
 // the fragment the frame shows (shaders/debug/inspect.glsl tags each fragment's records and
 // prints its depth; with reversed Z the front fragment has the largest depth).
 #include <cstdint>

@@ -135,7 +135,7 @@ uint64_t prepareDecalFrame(Renderer& r, const gpu::FrameConstants& constants) {
     if (!r.decals) return 0;
     Gpu& gpu = *r.gpu;
     DecalState& s = *r.decals;
-    // Boxes against the camera frustum (the seed's single frustum cull, for every stage).
+    // Boxes against the camera frustum (one frustum cull serves every stage).
     std::array<glm::vec4, 6> planes = frustumPlanes(constants.viewProj);
     uint32_t* out = static_cast<uint32_t*>(mapped(gpu, s.frustumDecals));
     s.frustumCount = 0;

@@ -1,10 +1,10 @@
 #pragma once
-// Projected box decals (seed 004's decal stages, seed 001's AO-only character shadow): base
+// Projected box decals in stages (an AO-only kind makes a character's contact shadow): base
 // colour, normal, roughness and ambient-occlusion decals applied to the material before
 // lighting, in the material code both paths share (shaders/decals/decals.glsl).
 //
-// One culling pass builds every stage's list at once (seed 004: "build the decal lists with a
-// single frustum cull, then copy each decal that passes into the relevant list"): the CPU keeps
+// One culling pass builds every stage's list at once (one frustum cull, each
+// decal that passes copied into the list of every stage it takes part in): the CPU keeps
 // the decals meeting the camera frustum, then one compute pass gives each 16x16 screen tile
 // (forward shading, and the shadel path's forward fallbacks) its lists, one per stage, in decal
 // order, and, in decoupled mode, each instance the decals meeting its world bounds. Shadel

@@ -1,5 +1,5 @@
 #pragma once
-// The 3-D atlas of mesh distance fields (seed 004): every resident field gets a box of voxels in
+// The 3-D atlas of mesh distance fields: every resident field gets a box of voxels in
 // one atlas volume from the 3-D block allocator (core/block_allocator.h); fields are added and
 // removed as meshes come and go (streaming), and freed room is reused. Only the bookkeeping
 // lives here (CPU); render/distance_fields/distance_fields.* owns the GPU copy.

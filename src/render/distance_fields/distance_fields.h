@@ -1,5 +1,5 @@
 #pragma once
-// Mesh distance fields on the GPU (seed 004, --distance-fields on): the fields of the scene's
+// Mesh distance fields on the GPU (--distance-fields on): the fields of the scene's
 // opaque meshes (bake/mesh_distance_field.h, built on the CPU and cached) placed in one 3-D
 // atlas by the 3-D block allocator (df_atlas.h), a list of the instances that cast, and a compute
 // pass over the surface tiles that sphere-traces soft sun shadows and ambient occlusion

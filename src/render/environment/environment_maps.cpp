@@ -126,10 +126,18 @@ BrdfTable loadBrdfTable(const std::string& cacheDir, uint32_t size, WorkerPool& 
 EnvironmentRequest environmentRequest(const std::string& setting, bool settingGiven,
                                       const Scene& scene, glm::vec3 sunDirection,
                                       glm::vec3 sunColor) {
+    return environmentRequest(setting, settingGiven, scene.environment, scene.skyColor,
+                              scene.ambientColor, sunDirection, sunColor);
+}
+
+EnvironmentRequest environmentRequest(const std::string& setting, bool settingGiven,
+                                      Scene::Environment sceneEnvironment, glm::vec3 skyColor,
+                                      glm::vec3 ambientColor, glm::vec3 sunDirection,
+                                      glm::vec3 sunColor) {
     EnvironmentRequest r;
     r.sunDirection = sunDirection, r.sunColor = sunColor;
-    r.skyColor = scene.skyColor, r.ambientColor = scene.ambientColor;
-    if (!settingGiven && scene.environment == Scene::Environment::Hemisphere) {
+    r.skyColor = skyColor, r.ambientColor = ambientColor;
+    if (!settingGiven && sceneEnvironment == Scene::Environment::Hemisphere) {
         r.kind = EnvironmentKind::Hemisphere;
     } else if (setting == "none") {
         r.kind = EnvironmentKind::None;

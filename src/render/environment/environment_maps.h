@@ -13,10 +13,10 @@
 
 #include "render/environment/equirect.h"
 #include "render/environment/prefilter.h"
+#include "scene/scene.h"
 
 namespace shadel {
 
-struct Scene;
 
 enum class EnvironmentKind { None, File, Sky, Hemisphere };
 
@@ -34,6 +34,11 @@ struct EnvironmentRequest {
 // InputError for an unknown "builtin:" name.
 EnvironmentRequest environmentRequest(const std::string& setting, bool settingGiven,
                                       const Scene& scene, glm::vec3 sunDirection,
+                                      glm::vec3 sunColor);
+// The same from the scene's environment kind and colours (as the GPU scene keeps them).
+EnvironmentRequest environmentRequest(const std::string& setting, bool settingGiven,
+                                      Scene::Environment sceneEnvironment, glm::vec3 skyColor,
+                                      glm::vec3 ambientColor, glm::vec3 sunDirection,
                                       glm::vec3 sunColor);
 
 struct EnvironmentMaps {

@@ -6,7 +6,7 @@
 // constants; intensity and rotation can change between frames without rebuilding anything.
 #include <string>
 
-#include "environment/environment_types.h"
+#include "common/shared_types.h"
 #include "render/environment/environment_maps.h"
 #include "rhi/gpu.h"
 
@@ -33,7 +33,7 @@ void createEnvironment(Gpu& gpu, EnvironmentState& state, const EnvironmentMaps&
 // the GPU scene's sun (direction and colour x intensity): loads or builds the maps in cacheDir
 // ("" = no cache), then uploads them. Throws InputError for a bad environment file.
 void createEnvironment(Gpu& gpu, EnvironmentState& state, const RenderSettings& settings,
-                       const Scene& scene, const GpuScene& gpuScene, const std::string& cacheDir);
+                       const GpuScene& scene, const std::string& cacheDir);
 // Intensity and rotation for the next frames (the maps stay).
 void setEnvironmentView(EnvironmentState& state, float intensity, float rotationDegrees);
 void destroyEnvironment(Gpu& gpu, EnvironmentState& state);

@@ -304,7 +304,7 @@ static bool blockerMeetsBox(const GiBlocker& b, glm::vec3 lo, glm::vec3 hi) {
            glm::all(glm::greaterThanEqual(b.center + reach, lo));
 }
 
-// Macro-cell culling of the blockers (seed 001: "blockers culled against 4x4x4 macro-cells"):
+// Macro-cell culling of the blockers (against 4x4x4-cell macro-cells):
 // per macro-cell of a cascade at its origin, the blockers a tap segment starting there can
 // cross. Segments end within one cell (and a half, the apply's offset along the normal).
 static uint64_t fillBlockerCells(const GiState& gi, glm::vec3 origin, float cell, uint64_t* cells) {

@@ -1,5 +1,5 @@
 #pragma once
-// Light propagation volume GI (seed 001, after Kaplanyan and Dachsbacher 2010): reflective
+// Light propagation volume GI (after Kaplanyan and Dachsbacher 2010): reflective
 // shadow maps from the sun and shadow-casting spots, injected as 2-band SH into three
 // camera-centred cascades of 32^3 cells (snapped to their cell size so they do not swim),
 // propagated N steps with geometry occlusion, plus up to two fixed local volumes an artist
@@ -23,7 +23,7 @@ struct GpuScene;
 struct CameraView;
 struct GiState;
 
-// A light blocker (seed 001) as GI uses it: a rectangle (say a wall's mid-plane) that light does
+// A light blocker as GI uses it: a rectangle (say a wall's mid-plane) that light does
 // not propagate through, stored per cascade as axial occlusion (how much of each cell face it
 // covers along x, y, z), with portals (holes light passes through). The scene's light blockers
 // (Scene::LightBlocker, direct lighting's) become these (giBlockersOf), so GI and direct light
@@ -36,7 +36,7 @@ struct GiBlocker {
     std::vector<glm::vec4> portals; // min u, min v, max u, max v: metres along axisU, axisV
 };
 
-// A local volume (Scene::GiVolume, seed 001's "local volumes an artist places"): the same
+// A local volume (Scene::GiVolume, placed by an artist): the same
 // grid as a cascade, cubic, centred on the box and just covering its longest side; it never
 // moves, so it is injected and propagated only when the lights change, and the apply reads it
 // before the camera cascades wherever it holds the point.

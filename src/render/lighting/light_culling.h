@@ -1,5 +1,5 @@
 #pragma once
-// Tiled light culling (seed 001): after the depth prepass, one compute workgroup per 16x16-pixel
+// Tiled light culling: after the depth prepass, one compute workgroup per 16x16-pixel
 // tile builds that tile's light list from its depth bounds, with light blockers and portals
 // classified per tile (shaders/lighting/tile_cull.comp). Forward shading reads the list of
 // its pixel's tile; the shadel path culls per chunk inside its shading workgroup

@@ -1,5 +1,5 @@
 #pragma once
-// Spot light shadows (seed 001): every shadow-casting spot (Light::castsShadow, up to
+// Spot light shadows: every shadow-casting spot (Light::castsShadow, up to
 // LIGHT_MAX_SPOT_SHADOWS, GpuLight::shadowIndex) gets a rectangle of one depth atlas, placed by
 // the 2-D block allocator (core/block_allocator.h): soft (PCSS) spots 1024^2, the others 512^2.
 // Each map is the spot's perspective view of the opaque shadow casters, culled per spot on the

@@ -1,5 +1,5 @@
 #pragma once
-// Cascaded sun shadows (seed 001: "PCF and PCSS for the sun (cascaded)"). One orthographic map
+// Cascaded sun shadows (PCF and PCSS over cascades). One orthographic map
 // fitted to the whole scene spends its texels evenly over a town, so near the camera a texel is
 // metres wide and small casters' shadows vanish. With --sun-cascades N (2..4) the camera's view
 // depth is cut into N slices (the "practical" split: a blend of logarithmic and uniform), each

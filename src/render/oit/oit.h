@@ -1,6 +1,6 @@
 #pragma once
-// Transparency (seed 001): weighted blended order-independent transparency with the seed's
-// "additiveness" channel (--oit wboit, the default), or a CPU-sorted back-to-front reference
+// Transparency: weighted blended order-independent transparency with an
+// additiveness channel (--oit wboit, the default), or a CPU-sorted back-to-front reference
 // (--oit sorted) for tests. Transparent surfaces are the instances of blended materials; the
 // CPU lists the visible ones each frame (in scene order, shuffled with --shuffle-draws, or
 // sorted), and the passes below draw them after the opaque scene, before tonemapping.

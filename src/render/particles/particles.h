@@ -1,5 +1,5 @@
 #pragma once
-// GPU particles (seed 004): emitters simulated in compute, drawn as camera-plane sprites into
+// GPU particles: emitters simulated in compute, drawn as camera-plane sprites into
 // the WBOIT targets of render/oit (no sorting; additiveness per emitter: fire adds, smoke
 // blends), lit per pixel, per vertex, or through the particle lightmap atlas: every frame each
 // visible lit sprite gets a rectangle at an LOD from its estimated screen size (repacked from

@@ -1,5 +1,5 @@
 #pragma once
-// glTF points and lines primitives (issue 18), drawn forward in both modes: they have no
+// glTF points and lines primitives, drawn forward in both modes: they have no
 // surface to parametrize, so the decoupled path never sees them. One pass after the opaque
 // surfaces and the screen-space passes, before transparency: one-pixel points and lines
 // (at the internal resolution), depth tested and written, unlit (glTF defines no lighting

@@ -1,5 +1,5 @@
 #pragma once
-// Acceleration structures (seed 003): one BLAS per mesh LOD, built at load from the unified
+// Acceleration structures: one BLAS per mesh LOD, built at load from the unified
 // geometry and compacted into TLSF pools (blas_pools.h), least-detailed LODs first so that a
 // failed allocation can always fall back to the mesh's least-detailed BLAS; and the TLAS,
 // rebuilt every frame from the instances the CPU keeps (ray-tracing distance, not the frustum).

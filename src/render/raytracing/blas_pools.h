@@ -1,5 +1,5 @@
 #pragma once
-// BLAS memory (seed 003): acceleration-structure storage buffers of a fixed size (128 MiB by
+// BLAS memory: acceleration-structure storage buffers of a fixed size (128 MiB by
 // default), created on demand up to a limit, sub-allocated with TLSF (core/gpu_pools.h), empty
 // ones released. Unlike raster geometry an allocation may fail: the caller falls back to the
 // least-detailed BLAS of the mesh, which is always built first.

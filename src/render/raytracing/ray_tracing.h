@@ -1,5 +1,5 @@
 #pragma once
-// Ray tracing (seed 003, issue 20): BLASes per mesh LOD in TLSF pools, a TLAS rebuilt every
+// Ray tracing: BLASes per mesh LOD in TLSF pools, a TLAS rebuilt every
 // frame from the instances within the ray-tracing distance, and ray-traced sun and
 // shadow-casting spot shadows, ambient occlusion and one-bounce diffuse GI
 // (shaders/raytracing/rt_effects.glsl). The forward path

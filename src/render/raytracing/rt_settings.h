@@ -19,7 +19,7 @@ struct RtSettings {
     uint32_t raysPerShadel = 1;   // shadel path: AO / GI rays per shadel per frame
     uint32_t shadelMipOffset = 2; // shadel path: the RT cache's MIP, this much coarser than needed
     uint32_t historyRays = 256;   // shadel path: rays per texel after which it is reused as it is
-    // BLAS memory (seed 003): pools of this size, sub-allocated with TLSF, at most this many.
+    // BLAS memory: pools of this size, sub-allocated with TLSF, at most this many.
     uint32_t blasPoolMb = 128;
     uint32_t blasPoolLimit = 16;
     float distance = 0.0f; // TLAS instances within this distance of the camera (0 = all)

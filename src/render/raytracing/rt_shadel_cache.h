@@ -1,5 +1,5 @@
 #pragma once
-// The shadel path's ray-traced terms (issue 20: "traced once per shadel and reused"): every
+// The shadel path's ray-traced terms, traced once per shadel and reused: every
 // instance shaded in shadel space this frame gets a rect in a persistent atlas at one MIP of its
 // shadel space, --rt-shadel-mip-offset levels coarser than the finest its view can need, kept
 // while it stays in view. Each frame `rtShadelTrace` traces --rays-per-shadel rays per texel and

@@ -1,5 +1,5 @@
 #pragma once
-// The thin G-buffer (seed 004): what the screen-space passes read of the visible surface, drawn
+// The thin G-buffer: what the screen-space passes read of the visible surface, drawn
 // by a raster pass over the prepass depth (equal test, no depth writes) from the same camera
 // lists: world normal + roughness (RGBA16F) and one byte of PIXEL_* flags with the surface class
 // (shaders/screenspace/gbuffer.frag). The decoupled path could fill it from its reconstruction.

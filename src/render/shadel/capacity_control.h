@@ -1,8 +1,8 @@
 #pragma once
-// Capacity control (seed: "global shading adjustment if we get close to our maximum shadel
-// storage"): one global fractional MIP bias steered by last frame's storage counts. Raised at
-// once when storage is near full or overflows, relaxed slowly (hysteresis) when there is room,
-// so overflow lasts a few frames at most and the bias does not oscillate.
+// Capacity control (a global shading adjustment when storage nears its maximum): one global
+// fractional MIP bias steered by last frame's storage counts. Raised at once when storage is near
+// full or overflows, relaxed slowly (hysteresis) when there is room, so overflow lasts a few frames
+// at most and the bias does not oscillate.
 #include <cstdint>
 
 namespace shadel {

@@ -16,7 +16,7 @@ namespace {
 // No footprint bound: the finest MIP is needed whatever the bias.
 constexpr float kNeedsMip0 = -std::numeric_limits<float>::infinity();
 
-// The footprint half of finestMipNeeded (see finestMipFromLod for the rest): a lower bound of
+// The footprint half of an instance's finest MIP (finestMipFromLod adds the bias): a lower bound of
 // the instance's screen footprint in MIP-0 shadels. The nearest view depth of the (margin-
 // padded) bounds bounds every point's depth; a pixel there spans at least depth * cos(the
 // screen's half-diagonal angle) / focal world units in any screen direction; one world unit
@@ -83,8 +83,8 @@ CoarseInstanceView viewInstance(const CoarseVisitPolicy& policy, const GpuScene&
     out.inFrustum = mesh.mipCount > 0 && !(blended && policy.blendedForward) &&
                     boxVisible(planes, inst.worldMin - margin, inst.worldMax + margin);
     if (!out.inFrustum) return out;
-    // Hybrid (seed: "small objects fall back to a direct only render"): an object a few pixels
-    // across would still shade whole chunks at its coarsest MIP; forward is cheaper.
+    // Hybrid: an object a few pixels across would still shade whole chunks at its coarsest MIP;
+    // forward is cheaper.
     out.small = policy.forwardBelowPixels > 0.0f &&
                 projectedDiameter(
                     camera, policy.viewportHeight, 0.5f * (inst.worldMin + inst.worldMax),

@@ -1,5 +1,5 @@
 #pragma once
-// The decoupled coarse allocation's first half (issue 16: the frontend of frame N+1 beside the
+// The decoupled coarse allocation's first half (the frontend of frame N+1 beside the
 // backend of frame N): which instances a camera may need, and per instance what the camera and
 // the instance's bounds alone decide (frustum test with the margin, the hybrid's small-object
 // test, the finest MIP's footprint before the shading bias). It reads no readback and no
@@ -34,9 +34,9 @@ struct CoarseInstanceView {
     bool inFrustum = false;
     // Projected diameter below --forward-below: drawn forward (only meaningful when inFrustum).
     bool small = false;
-    // log2 of the footprint lower bound finestMipNeeded compares, before the frame's shading
-    // bias (which the capacity controller sets from the last frame's readback): -inf when MIP 0
-    // is needed whatever the bias. Computed only when inFrustum and not small.
+    // log2 of the footprint lower bound (footprintLod) finestMipFromLod turns into a MIP, before
+    // the frame's shading bias (which the capacity controller sets from the last frame's readback):
+    // -inf when MIP 0 is needed whatever the bias. Computed only when inFrustum and not small.
     float lodBeforeBias = 0.0f;
 };
 

@@ -582,11 +582,11 @@ static void updateLevelWindow(Gpu& gpu, DecoupledState& d, ObjectSlot& o, uint32
     o.rects[k] = {d.regions[k].x0, 0, 0, 0};
 }
 
-// Coarse CPU allocation (seed: "CPU side max space estimator"): a potentially visible object
-// gets rects from the finest MIP it can need this frame down to its coarsest; objects that
-// leave the view give theirs back. Levels are added as the camera comes closer and dropped
-// (with one level of slack, so a camera hovering at a boundary does not churn the sheet) as it
-// moves away. Returns false when the object has no rects at all (drawn forward this frame).
+// Coarse CPU allocation (the CPU's estimate of the space an object can need): a potentially
+// visible object gets rects from the finest MIP it can need this frame down to its coarsest;
+// objects that leave the view give theirs back. Levels are added as the camera comes closer and
+// dropped (with one level of slack, so a camera hovering at a boundary does not churn the sheet) as
+// it moves away. Returns false when the object has no rects at all (drawn forward this frame).
 static bool updateObjectRects(Gpu& gpu, DecoupledState& d, ObjectSlot& o, uint32_t object,
                               const ShadelMeshInfo& mesh, uint32_t wantFirst, bool wasDecoupled,
                               bool& limited) {
@@ -636,22 +636,9 @@ static bool updateObjectRects(Gpu& gpu, DecoupledState& d, ObjectSlot& o, uint32
 // [SPECULAR_SHARE_MIN_GAIN, SPECULAR_SHARE_MAX_GAIN]: the lag a turn leaves is about share x
 // turn / lobe, so the tolerance is roughly the error allowed in the darkest channel. A rough
 // light-coloured dielectric (share ~8%) keeps the cap, the trees (share 0.25) 0.6 lobes.
-// Tolerance, 1280x720 24-frame orbit, reuse fraction / worst frame against reuse off, default
-// and many: grey share for every dielectric (before) 0.793 / 45.4 dB, 0.489 / 29.2 dB; 0.1:
-// 0.753 / 49.5, 0.381 / 49.4; 0.2: 0.765 / 49.1, 0.480 / 49.4; 0.3: 0.775 / 49.1, 0.487 / 49.4;
-// 0.5: 0.784 / 49.0, 0.489 / 27.2 (the trees back at the cap). Those runs kept at least one
-// lobe, and the trees' carried chunks, 25% off in red and blue, showed as 8x8 patches beside the
-// chunks refreshed that frame (99.9th percentile channel error of the worst frame: 12 levels
-// at 640x360). Tolerance / least gain, 640x360, reuse fraction / worst frame / that error,
-// many then default: 0.3 / 1: 0.474 / 49.3 dB / 12, 0.767 / 48.4 / 10; 0.2 / 0.5: 0.465 / 49.3 /
-// 11, 0.734 / 49.5 / 8; 0.15 / 0.5: 0.416 / 55.3 / 5, 0.715 / 49.6 / 8; 0.1 / 0.5: 0.357 / 55.7
-// / 5, 0.689 / 50.0 / 8. (Reshading a block's chunks past half the tolerance once one of them
-// passed it, to keep neighbours' ages together, gave 12 and 9 at 0.3 / 1: the lag itself shows.)
-// Cap of the gain, with the round-robin refresh period. builtin:default 320x180, 24-frame orbit,
-// reuse on vs off (reuse fraction, worst frame): gain 1, period 16: 0.736, 47.5 dB; 1, 32:
-// 0.755, 46.6 dB; 2, 16: 0.774, 45.5 dB; 2, 32: 0.796, 43.7 dB; 3, 32: 0.807, 41.3 dB. (Checked
-// per object, at the nearest point of its box against the last step's turn, gain 3 and period 8
-// reused 0.712 at 45.9 dB: the near end of a large object set the pace of all its chunks.)
+// The tolerance, the least gain and the cap of the gain are chosen from sweeps of reuse
+// fraction against the worst frame's PSNR (reuse on vs off) on builtin:default and builtin:many;
+// docs/decoupled/README.md has them.
 constexpr float SPECULAR_SHARE_MIN_GAIN = 0.5f;
 constexpr float SPECULAR_SHARE_MAX_GAIN = 2.0f;
 constexpr float SPECULAR_SHARE_TOLERANCE = 0.15f;
@@ -826,7 +813,7 @@ void prepareDecoupledFrame(Renderer& r, const GpuScene& scene, const CameraView&
     // Instances near the frustum's bounds, and last frame's (to free or clear what they held):
     // every other instance stays unwanted, with its zero entry and no rects.
     // With occlusion culling the GPU's visible set of last frame is the set to allocate for
-    // (seed 004: the CPU estimator and the GPU agree on what is seen); an instance that appears
+    // (the CPU estimator and the GPU agree on what is seen); an instance that appears
     // is drawn forward for one frame. Otherwise the grid's answer for the frustum (the visit's
     // first half, coarse_visit.h: taken from the frontend worker or computed here), whose
     // instances come with their view of the camera already computed.

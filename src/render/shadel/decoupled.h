@@ -1,5 +1,7 @@
 #pragma once
-// Generalized decoupled shading (seeds 000/002): the passes that replace forward shading.
+// Generalized decoupled shading: the passes that replace forward shading (the parts and the
+// glossary, shadel, chunk, block, virtual sheet, offset map, storage, shading bias, are in
+// docs/design.md).
 #include <memory>
 
 #include <nlohmann/json_fwd.hpp>
@@ -21,7 +23,7 @@ void destroyDecoupled(Renderer& r, DecoupledStatePtr& state);
 // sheet, shading bias; fills the decoupled fields of the frame constants.
 void prepareDecoupledFrame(Renderer& r, const GpuScene& scene, const CameraView& camera,
                            gpu::FrameConstants& constants);
-// Frontend/backend overlap (issue 16): starts the grid visit (coarse_visit.h) of the next frame
+// Frontend/backend overlap: starts the grid visit (coarse_visit.h) of the next frame
 // on the frontend worker, for `nextCamera`; that frame's prepareDecoupledFrame takes it. Called
 // by renderFrame after this frame's frontend (Renderer::nextFrame). Nothing with --occlusion on
 // (the visit is last frame's visible set, a readback) or when `sceneMoves` (animated playback:
@@ -51,7 +53,8 @@ struct ShadelShadingQueue {
     uint32_t shadeOptional = 0;
 };
 ShadelShadingQueue shadelShadingQueue(const Renderer& r);
-// Adds the decoupled fields of DESIGN §5 (medians over the frames rendered so far).
+// Adds the decoupled fields of the stats contract in docs/design.md (medians over the frames
+// rendered so far).
 void decoupledStats(const Renderer& r, nlohmann::json& stats);
 
 } // namespace shadel

@@ -1,9 +1,9 @@
 #pragma once
-// The shade storage (seed: "actual storage is ~4kx4k"): one buffer per material layer, all
-// sharing the chunk slot allocation, and two frames of each so a chunk can carry last frame's
-// shadels over (preserved layers, seed: "GetIndexPrevSampleVirtualCoords"). Chunk-linear:
-// shadel (x, y) of the chunk in slot s is element s * 64 + y * 8 + x (shaders/shadel/shadel.glsl
-// storageIndex), so a chunk is contiguous and a shader reads a shadel with one buffer load.
+// The shade storage (about 4k x 4k shadels by default): one buffer per material layer, all sharing
+// the chunk slot allocation, and two frames of each so a chunk can carry last frame's shadels over
+// (preserved layers, an exact previous-sample lookup). Chunk-linear: shadel (x, y) of the chunk in
+// slot s is element s * 64 + y * 8 + x (shaders/shadel/shadel.glsl storageIndex), so a chunk is
+// contiguous and a shader reads a shadel with one buffer load.
 #include <array>
 
 #include "common/shared_types.h"

@@ -1,5 +1,5 @@
 #pragma once
-// GPU skinning (issue 18): a compute pass at the top of the frame, before every view (shadow
+// GPU skinning: a compute pass at the top of the frame, before every view (shadow
 // maps, prepass, marking, shading, reconstruction), writes each skinned vertex as
 // sum(weight x joint matrix) applied to its unskinned vertex into a deformed copy of the
 // unified vertex buffer; FrameConstants::vertices points every pass at that copy. Joint

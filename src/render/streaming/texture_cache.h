@@ -1,5 +1,5 @@
 #pragma once
-// The layered texture cache's bookkeeping (seed 003), CPU only: which texture sits in which slot
+// The layered texture cache's bookkeeping, CPU only: which texture sits in which slot
 // of which layer, and which pairwise exchanges to start this frame. The GPU side
 // (texture_streaming.h) owns the images and carries the exchanges out.
 //

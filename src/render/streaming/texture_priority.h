@@ -1,5 +1,5 @@
 #pragma once
-// Texture streaming priorities (seed 003): the CPU's from texel density and the projected size of
+// Texture streaming priorities: the CPU's from texel density and the projected size of
 // the instances using a texture, the GPU's from what shading sampled (shaders/streaming/
 // feedback.glsl), merged into one "wanted side in texels" per texture.
 #include <cstdint>

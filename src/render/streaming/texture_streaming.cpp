@@ -30,7 +30,7 @@ uint32_t log2u(uint32_t v) {
 }
 
 // One cache image: a square RGBA8 image with its full MIP chain, read through a linear or an sRGB
-// view (the slot serves both kinds of texture, as the seed's slots do).
+// view (the slot serves both kinds of texture, so one slot size serves both).
 struct CacheImage {
     TextureHandle image;
     TextureReadView linear, srgb;

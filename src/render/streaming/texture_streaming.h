@@ -1,5 +1,5 @@
 #pragma once
-// Texture streaming (seed 003): a scene's textures stream from their file (bake/texture_pack.h)
+// Texture streaming: a scene's textures stream from their file (bake/texture_pack.h)
 // into a layered cache (texture_cache.h) under a hard memory budget (--texture-budget MiB).
 //
 // Every scene texture is a logical texture with a persistent bindless slot (materials never

@@ -1,5 +1,5 @@
 #pragma once
-// Tile classification (seed 004): the screen is cut into 8x8 tiles, classified once per frame
+// Tile classification: the screen is cut into 8x8 tiles, classified once per frame
 // from the thin G-buffer's pixel flags (one subgroup per tile: subgroup OR / AND), and each tile is
 // appended to the list of every screen-space permutation it needs (TILE_LIST_* in
 // shaders/tiles/tile_types.h), with the indirect dispatch arguments of each list. Passes then
