@@ -14,10 +14,13 @@ sRGB curve shadel writes, so both are compared in sRGB.
 Writes docs/conformance/README.md (the table, the commit measured, the command) and
 docs/conformance/NAME.png (reference | shadel forward | difference x4, and the decoupled pair
 below). With --set-floors MARGIN, writes floor_forward / floor_decoupled = measured - MARGIN
-(rounded down to 0.1 dB) into the manifest for the GPU test (tests/gpu/test_conformance.cpp).
+(rounded down to 0.1 dB) into the manifest for the GPU test (tests/gpu/test_conformance.cpp);
+with --floors-from LOG it takes the figures from that test's output instead (the test measures
+over its own coverage, which a shadel PNG without alpha does not carry).
 
 Usage: tools/conformance/compare.py [--shadel build/src/app/shadel] [--only NAME,...]
                                     [--set-floors 1.0] [--no-docs]
+       tools/conformance/compare.py --floors-from GPU_TEST_LOG [--set-floors 1.0]
 Needs python3-numpy and python3-pil (Debian); run with /usr/bin/python3.
 """
 import argparse
@@ -199,7 +202,8 @@ def write_docs(results, manifest, missing, notes, commit, command, seconds):
              f"{manifest['size'][0]}x{manifest['size'][1]}.", "",
              "PSNR is over covered pixels (alpha > 0 in either image), RGB in sRGB encoding;",
              "the images (docs/conformance/NAME.png) are reference | shadel | difference x4,",
-             "forward above, decoupled below.", ""]
+             "forward above, decoupled below. The GPU test's own figures and floors:",
+             "[gpu_test.md](gpu_test.md).", ""]
     if missing:
         lines += [f"This build lacked {', '.join(missing)}: those parts of the view were shadel's "
                   "defaults, so these figures do not yet measure conformance.", ""]
@@ -221,13 +225,67 @@ def write_docs(results, manifest, missing, notes, commit, command, seconds):
     os.replace(path + ".tmp", path)
 
 
+def write_manifest(manifest):
+    with open(MANIFEST + ".tmp", "w") as f:
+        f.write(json.dumps(manifest, indent=2) + "\n")
+    os.replace(MANIFEST + ".tmp", MANIFEST)
+
+
+def floors_from_log(log, margin):
+    """Floors = the figures the GPU test printed ("[ figures ] conformance NAME MODE: PSNR X dB")
+    minus `margin`, rounded down to 0.1 dB."""
+    measured = {}
+    with open(log) as f:
+        for line in f:
+            m = re.search(r"\[ figures \] conformance (\S+) (forward|decoupled): PSNR ([\d.]+) dB",
+                          line)
+            if m:
+                measured[(m.group(1), m.group(2))] = float(m.group(3))
+    if not measured:
+        fail(f"{log}: no conformance figures in it")
+    with open(MANIFEST) as f:
+        manifest = json.load(f)
+    for model in manifest["models"]:
+        for mode in MODES:
+            if (model["name"], mode) in measured:
+                p = measured[(model["name"], mode)]
+                model[f"floor_{mode}"] = math.floor((p - margin) * 10) / 10
+    write_manifest(manifest)
+    lines = ["# GPU test figures (Models/Conformance)", "",
+             "PSNR of shadel against the glTF Sample Viewer as tests/gpu/test_conformance.cpp "
+             "measures it",
+             "(over the pixels either image covers, shadel's coverage from the renderer) and the "
+             f"floors set from them ({margin:g} dB below, rounded down to 0.1 dB), on "
+             f"`{git_commit()}`.", "",
+             "| model | forward (dB) | floor | decoupled (dB) | floor |",
+             "| --- | --- | --- | --- | --- |"]
+    for model in manifest["models"]:
+        cells = []
+        for mode in MODES:
+            p = measured.get((model["name"], mode))
+            cells += [f"{p:.2f}" if p is not None else "", str(model.get(f"floor_{mode}", ""))]
+        lines.append(f"| {model['name']} | " + " | ".join(cells) + " |")
+    os.makedirs(DOCS, exist_ok=True)
+    path = os.path.join(DOCS, "gpu_test.md")
+    with open(path + ".tmp", "w") as f:
+        f.write("\n".join(lines) + "\n")
+    os.replace(path + ".tmp", path)
+    print(f"set {len(measured)} floors from {log}; wrote {path}")
+    return 0
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--shadel", default=os.path.join(ROOT, "build", "src", "app", "shadel"))
     ap.add_argument("--only", default="")
     ap.add_argument("--set-floors", type=float, default=None, metavar="MARGIN_DB")
     ap.add_argument("--no-docs", action="store_true")
+    ap.add_argument("--floors-from", metavar="LOG",
+                    help="set the floors from a GPU test log's figures (Models/Conformance.*) "
+                         "minus --set-floors (default 1.0 dB), render nothing")
     args = ap.parse_args()
+    if args.floors_from:
+        return floors_from_log(args.floors_from, 1.0 if args.set_floors is None else args.set_floors)
     if not os.access(args.shadel, os.X_OK):
         fail(f"{args.shadel}: not an executable (build shadel first)")
     with open(MANIFEST) as f:
@@ -297,9 +355,7 @@ def main():
             for mode in MODES:
                 if r and f"psnr_{mode}" in r:
                     m[f"floor_{mode}"] = math.floor((r[f"psnr_{mode}"] - args.set_floors) * 10) / 10
-        with open(MANIFEST + ".tmp", "w") as f:
-            f.write(json.dumps(manifest, indent=2) + "\n")
-        os.replace(MANIFEST + ".tmp", MANIFEST)
+        write_manifest(manifest)
     return 0
 
 
