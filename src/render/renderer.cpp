@@ -256,6 +256,12 @@ static glm::mat4 sunViewProj(const GpuScene& scene, glm::vec3 dir, float& texelW
     return proj * view;
 }
 
+// Degrees about +Y: --environment-rotation, turned by --environment-spin every frame.
+static float environmentRotationThisFrame(const Renderer& r) {
+    return r.settings.environmentRotationDegrees +
+           r.settings.environmentSpinDegrees * float(r.framesRendered);
+}
+
 static gpu::FrameConstants makeFrameConstants(Renderer& r, const GpuScene& scene,
                                               const CameraView& camera) {
     Gpu& gpu = *r.gpu;
@@ -285,7 +291,7 @@ static gpu::FrameConstants makeFrameConstants(Renderer& r, const GpuScene& scene
     f.backgroundEnvironment = r.settings.backgroundEnvironment ? 1u : 0u;
     f.backgroundColor = r.skyColor;
     setEnvironmentView(r.environment, r.settings.environmentIntensity,
-                       r.settings.environmentRotationDegrees); // (the viewer edits them)
+                       environmentRotationThisFrame(r)); // (the viewer edits them)
     f.environment = r.environment.constants;
     f.lightCount = scene.lightCount;
     f.instanceCount = scene.instanceCount;
@@ -369,7 +375,7 @@ FrameResult renderFrame(Renderer& r, const GpuScene& scene, const CameraView& ca
         if (r.skinning) constants.vertices = skinnedVerticesAddress(r, *r.skinning); // every view
         updateLights(r, scene, constants);
         // A turned or dimmed environment relights every surface (as a changed sun does).
-        glm::vec2 view(r.settings.environmentIntensity, r.settings.environmentRotationDegrees);
+        glm::vec2 view(r.settings.environmentIntensity, environmentRotationThisFrame(r));
         if (r.framesRendered > 0 && view != r.environmentViewLastFrame)
             r.changedLightVolumes.push_back(
                 glm::vec4(0.0f, 0.0f, 0.0f, std::numeric_limits<float>::infinity()));

@@ -98,6 +98,7 @@ struct RenderSettings {
     bool environmentGiven = false; // --environment was on the command line
     float environmentIntensity = 1.0f;
     float environmentRotationDegrees = 0.0f; // about +Y
+    float environmentSpinDegrees = 0.0f;     // added to the rotation every frame (a turntable)
     // --background: the environment behind the scene, or a solid sRGB colour (alpha still marks
     // coverage in PNG and EXR output).
     bool backgroundEnvironment = true;

@@ -104,7 +104,8 @@ TEST(Environment, UniformEnvironmentReadsUniformEverywhere) {
             for (int c = 0; c < 3; ++c)
                 worst =
                     std::max(worst, std::abs(double(r[4 * i + k][c]) / (2.0 * radiance[c]) - 1.0));
-    EXPECT_LT(worst, 0.01) << "largest relative error " << worst;
+    // Measured 0.00036 (the background's half floats); 1% was the requirement.
+    EXPECT_LT(worst, 0.0004) << "largest relative error " << worst;
     // The BRDF table at n.v = 1, roughness 0 (the pole queries): a mirror.
     EXPECT_NEAR(r[3].x, 1.0f, 0.03f);
     EXPECT_NEAR(r[3].y, 0.0f, 0.01f);
@@ -133,8 +134,8 @@ TEST(Environment, ShaderDirectionsAreTheCppConvention) {
         glm::vec3 want = sampleEquirect(source, rotateToEnvironment(d, rotation));
         worst = std::max(worst, double(glm::length(glm::vec3(r[4 * i + 2]) - want)));
     }
-    // Half floats (3 decimal digits) and one texel of bilinear slop near the poles.
-    EXPECT_LT(worst, 0.02) << "largest background difference " << worst;
+    // Measured 0.00054: half floats and the device's bilinear weights.
+    EXPECT_LT(worst, 0.0006) << "largest background difference " << worst;
     destroyEnvironment(gpu, state);
     EXPECT_EQ(validationErrors(), before);
 }

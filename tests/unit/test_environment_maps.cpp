@@ -126,7 +126,7 @@ TEST(EnvironmentPrefilter, UniformEnvironmentComesBackUnchangedAtEveryLevel) {
 TEST(EnvironmentPrefilter, OneBrightTexelKeepsItsEnergyAtEveryLevel) {
     WorkerPool pool(2);
     PrefilterSettings s;
-    s.specularWidth = 128, s.specularLevels = 6, s.specularSamples = 128;
+    s.specularWidth = 128, s.specularLevels = 6, s.specularSamples = 256; // the default count
     for (uint32_t row : {20u, 40u, 8u}) {
         EquirectImage source = makeEquirect(128, 64, glm::vec3(0.0f));
         source.at(37, row) = glm::vec3(1000.0f);
@@ -134,8 +134,8 @@ TEST(EnvironmentPrefilter, OneBrightTexelKeepsItsEnergyAtEveryLevel) {
         std::vector<EquirectImage> levels = prefilterSpecular(source, s, pool);
         for (size_t l = 0; l < levels.size(); ++l) {
             double ratio = equirectEnergy(levels[l]).x / energy;
-            // Measured: within 0.0146 (row 8, level 1).
-            EXPECT_NEAR(ratio, 1.0, 0.016) << "row " << row << " level " << l;
+            // Measured: within 0.0111 (row 8, level 1).
+            EXPECT_NEAR(ratio, 1.0, 0.012) << "row " << row << " level " << l;
         }
         double diffuse = equirectEnergy(prefilterIrradiance(levels[0], 64, pool)).x / energy;
         EXPECT_NEAR(diffuse, 1.0, 0.0005) << "row " << row << " irradiance (measured 0.00042)";

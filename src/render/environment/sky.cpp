@@ -70,9 +70,9 @@ glm::dvec3 opticalDepth(double r, double mu, double length, int steps) {
     return depth;
 }
 
-// Transmittance to the top of the atmosphere per (radius, zenith cosine), on the
-// horizon-resolving parametrization of precomputed atmospheric scattering: x_r is the
-// distance to the horizon, x_mu the distance to the top between its least and largest values.
+// Transmittance to the top of the atmosphere per (radius, zenith cosine), on a parametrization
+// that resolves the horizon: x_r is the distance to the horizon over its largest value, x_mu the
+// distance to the top between its least and largest values from that radius.
 struct TransmittanceTable {
     static constexpr int kMu = 256, kR = 64;
     std::vector<glm::dvec3> t = std::vector<glm::dvec3>(size_t(kMu) * kR);
