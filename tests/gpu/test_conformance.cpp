@@ -1,10 +1,10 @@
 // Conformance with the Khronos glTF Sample Viewer, the reference implementation of glTF PBR: each
 // model of tools/conformance/models.json rendered by shadel (forward and decoupled) at the
-// manifest's size with the view the reference used (camera "conformance" and the file's light,
-// the committed environment, ACES Narkowicz at exposure 0 EV, no shadows, black background),
-// compared with the viewer's image in tests/data/conformance/reference/. PSNR is over the pixels
-// either image covers; each model has a floor per mode in the manifest, set from measurements
-// (tools/conformance/compare.py --set-floors; the figures are in docs/conformance/README.md).
+// manifest's size from the file's camera "conformance" with the file's light, compared with the
+// viewer's image in tests/data/conformance/reference/ (rendered with the committed environment,
+// ACES Narkowicz at exposure 1, no shadows, a black background). PSNR is over the pixels either
+// image covers; each model has a floor per mode in the manifest, set from this test's figures
+// (tools/conformance/compare.py --floors-from; they are in docs/conformance/gpu_test.md).
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -124,8 +124,8 @@ Measure measure(const std::vector<uint8_t>& ref, const std::vector<uint8_t>& img
     return m;
 }
 
-// The reference's view: camera and light from the file, the committed environment, the tone
-// curve, exposure 0 EV, no shadows, a black background (alpha still marks coverage).
+// The reference's view as RenderOptions carries it: camera and light from the file, exposure 1.
+// The environment, tone curve, background and shadows are the renderer's defaults.
 RenderOptions conformanceOptions(const std::string& scene, RenderMode mode, uint32_t w,
                                  uint32_t h) {
     RenderOptions o = renderOptions(scene, mode, w, h);
