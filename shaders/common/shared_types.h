@@ -66,7 +66,8 @@ using uint = uint32_t;
 #define SAMPLER_MATERIAL_COUNT 108u // 3 wrapS x 3 wrapT x 2 mag x 6 min
 #define SAMPLER_COUNT 112u
 // glTF's default (no sampler, or no filters given): repeat, linear, trilinear.
-#define SAMPLER_MATERIAL_DEFAULT (SAMPLER_MATERIAL_FIRST + SAMPLER_MAG_LINEAR * 6u + SAMPLER_MIN_LINEAR_MIPMAP_LINEAR)
+#define SAMPLER_MATERIAL_DEFAULT                                                                   \
+    (SAMPLER_MATERIAL_FIRST + SAMPLER_MAG_LINEAR * 6u + SAMPLER_MIN_LINEAR_MIPMAP_LINEAR)
 
 #define PROCEDURAL_NONE 0u
 #define PROCEDURAL_TEXEL_CHECKER 1u
@@ -217,11 +218,11 @@ using uint = uint32_t;
 #define DRAW_LIST_OPAQUE_TEXTURED 5u
 #define DRAW_LIST_COUNT 6u
 // Each camera list is two, by the faces its instances draw (render/forward drawCameraList sets
-// the cull mode per side, vkCmdSetCullMode): single-sided materials cull back faces (DRAW_SIDE_FRONT), double-
-// sided ones draw both (DRAW_SIDE_BOTH). Front faces are counter-clockwise for every instance:
-// the glTF importer gives instances whose transform mirrors (which glTF says flips the winding)
-// a copy of the mesh with the winding reversed. Camera list l, side s: slot
-// l * DRAW_SIDE_COUNT + s of DRAW_CAMERA_SLOTS.
+// the cull mode per side, vkCmdSetCullMode): single-sided materials cull back faces
+// (DRAW_SIDE_FRONT), double-sided ones draw both (DRAW_SIDE_BOTH). Front faces are
+// counter-clockwise for every instance: the glTF importer gives instances whose transform mirrors
+// (which glTF says flips the winding) a copy of the mesh with the winding reversed. Camera list l,
+// side s: slot l * DRAW_SIDE_COUNT + s of DRAW_CAMERA_SLOTS.
 #define DRAW_SIDE_FRONT 0u
 #define DRAW_SIDE_BOTH 1u
 #define DRAW_SIDE_COUNT 2u
@@ -534,10 +535,10 @@ struct GpuEnvironment {
     float sunCosRadius;   // cosine of the sun disc's angular radius
     float specularHeight; // texel rows of specular level 0 (level l: max(height >> l, 1))
     float irradianceHeight;
-    vec3 sunDirection;    // the way sunlight travels, in the environment's frame
+    vec3 sunDirection; // the way sunlight travels, in the environment's frame
     float backgroundHeight;
-    vec3 sunRadiance;     // radiance of the disc (0 without one)
-    float brdfSize;       // texels per side of the BRDF table
+    vec3 sunRadiance; // radiance of the disc (0 without one)
+    float brdfSize;   // texels per side of the BRDF table
 };
 
 struct FrameConstants {

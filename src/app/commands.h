@@ -113,9 +113,11 @@ RenderSessionPtr beginRender(Gpu& gpu, const RenderOptions& options);
 bool renderSessionDone(const RenderSession& session); // every frame rendered (or --capture list)
 void renderNextFrame(RenderSession& session);
 RenderRun finishRender(RenderSessionPtr session);
-// Writes RGBA8 pixels as an RGB PNG; throws InputError naming the path when it cannot.
+// Writes RGBA8 pixels as an RGB PNG, or with `coverageAlpha` as an RGBA PNG whose alpha marks
+// the pixels a surface covers (renders over a solid --background); throws InputError naming the
+// path when it cannot.
 void writePng(const std::string& path, const std::vector<uint8_t>& rgba, uint32_t width,
-              uint32_t height);
+              uint32_t height, bool coverageAlpha = false);
 // Per-pass table on stdout.
 void printPassTable(const nlohmann::json& stats);
 

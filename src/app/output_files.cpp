@@ -22,21 +22,31 @@ void writeOutputFile(const std::string& path, const std::string& text) {
     writeOutputFile(path, text.data(), text.size());
 }
 
-std::vector<uint8_t> encodePngRgb(const std::vector<uint8_t>& rgba, uint32_t width,
-                                  uint32_t height) {
-    std::vector<uint8_t> rgb(size_t(width) * height * 3);
-    for (size_t i = 0, n = size_t(width) * height; i < n; ++i)
-        for (int c = 0; c < 3; ++c) rgb[i * 3 + c] = rgba[i * 4 + c];
+static std::vector<uint8_t> encodePng(const uint8_t* pixels, uint32_t width, uint32_t height,
+                                      int channels) {
     std::vector<uint8_t> png;
     auto append = [](void* context, void* data, int size) {
         auto* out = static_cast<std::vector<uint8_t>*>(context);
         const uint8_t* bytes = static_cast<const uint8_t*>(data);
         out->insert(out->end(), bytes, bytes + size);
     };
-    if (!stbi_write_png_to_func(append, &png, int(width), int(height), 3, rgb.data(),
-                                int(width * 3)))
+    if (!stbi_write_png_to_func(append, &png, int(width), int(height), channels, pixels,
+                                int(width) * channels))
         throw InputError(format("cannot encode a %ux%u PNG", width, height));
     return png;
+}
+
+std::vector<uint8_t> encodePngRgb(const std::vector<uint8_t>& rgba, uint32_t width,
+                                  uint32_t height) {
+    std::vector<uint8_t> rgb(size_t(width) * height * 3);
+    for (size_t i = 0, n = size_t(width) * height; i < n; ++i)
+        for (int c = 0; c < 3; ++c) rgb[i * 3 + c] = rgba[i * 4 + c];
+    return encodePng(rgb.data(), width, height, 3);
+}
+
+std::vector<uint8_t> encodePngRgba(const std::vector<uint8_t>& rgba, uint32_t width,
+                                   uint32_t height) {
+    return encodePng(rgba.data(), width, height, 4);
 }
 
 } // namespace shadel

@@ -19,5 +19,8 @@ void writeOutputFile(const std::string& path, const std::string& text);
 // RGBA8 pixels encoded as an RGB PNG in memory.
 std::vector<uint8_t> encodePngRgb(const std::vector<uint8_t>& rgba, uint32_t width,
                                   uint32_t height);
+// The same with the alpha channel kept (an RGBA PNG).
+std::vector<uint8_t> encodePngRgba(const std::vector<uint8_t>& rgba, uint32_t width,
+                                   uint32_t height);
 
 } // namespace shadel

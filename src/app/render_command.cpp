@@ -95,8 +95,9 @@ std::string defaultCacheDir() {
 }
 
 void writePng(const std::string& path, const std::vector<uint8_t>& rgba, uint32_t width,
-              uint32_t height) {
-    std::vector<uint8_t> png = encodePngRgb(rgba, width, height);
+              uint32_t height, bool coverageAlpha) {
+    std::vector<uint8_t> png =
+        coverageAlpha ? encodePngRgba(rgba, width, height) : encodePngRgb(rgba, width, height);
     writeOutputFile(path, png.data(), png.size());
 }
 
@@ -552,7 +553,7 @@ void renderNextFrame(RenderSession& session) {
                      run.frames.back().frameMs);
     if (session.outDir)
         writePng(format("%sframe_%04u.png", o.out.c_str(), i), run.frames.back().rgba, o.width,
-                 o.height);
+                 o.height, !o.backgroundEnvironment);
     if (o.progress && o.frames > 1 && session.tty && i + 1 == o.frames) std::fprintf(stderr, "\n");
 }
 
@@ -700,7 +701,7 @@ RenderRun finishRender(RenderSessionPtr sessionPtr) {
         if (isExrPath(o.out))
             writeHdrFrame(renderer.captures, o.ssaa, o.out);
         else
-            writePng(o.out, run.frames.back().rgba, o.width, o.height);
+            writePng(o.out, run.frames.back().rgba, o.width, o.height, !o.backgroundEnvironment);
     }
     if (!o.captures.empty())
         run.captureFiles = writeCaptures(renderer.captures, o.captures, o.captureDir, o.out);

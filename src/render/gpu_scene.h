@@ -5,7 +5,6 @@
 #include <vector>
 
 #include "common/shared_types.h"
-#include "scene/scene.h"
 #include "render/shadel/texture_rate.h"
 #include "rhi/gpu.h"
 #include "scene/scene.h"

@@ -5,8 +5,8 @@
 
 #include <glm/gtc/matrix_transform.hpp>
 
-#include "common/print_labels.h"
 #include "bake/bake_cache.h"
+#include "common/print_labels.h"
 #include "core/log.h"
 #include "render/background/background.h"
 #include "render/forward/forward_passes.h"
@@ -284,9 +284,8 @@ static gpu::FrameConstants makeFrameConstants(Renderer& r, const GpuScene& scene
     f.exposure = r.settings.exposure;
     f.sunDirection = sun.direction;
     f.sunColor = sun.color;
-    f.sunShadowSlot = scene.sunCastsShadow && r.settings.shadows
-                          ? slot(gpu, r.sunShadow.read).value
-                          : NO_TEXTURE;
+    f.sunShadowSlot =
+        scene.sunCastsShadow && r.settings.shadows ? slot(gpu, r.sunShadow.read).value : NO_TEXTURE;
     f.shadowTexelSize = texel;
     f.skyColor = scene.skyColor;
     f.ambientColor = scene.ambientColor;

@@ -124,14 +124,23 @@ Measure measure(const std::vector<uint8_t>& ref, const std::vector<uint8_t>& img
     return m;
 }
 
-// The reference's view as RenderOptions carries it: camera and light from the file, exposure 1.
-// The environment, tone curve, background and shadows are the renderer's defaults.
+// The reference's view: camera and light from the file, the manifest's environment (the
+// viewer's rotation 90 is shadel's 0), ACES (Narkowicz) at exposure 0 EV, no shadows (the
+// reference draws none), no added sun, a black background with alpha 0 (coverage).
 RenderOptions conformanceOptions(const std::string& scene, RenderMode mode, uint32_t w,
                                  uint32_t h) {
     RenderOptions o = renderOptions(scene, mode, w, h);
     o.camera = "conformance";
     o.allowExternalFiles = true;
     o.exposure = 1.0f;
+    o.environment = (kRoot / manifest()["environment"].get<std::string>()).string();
+    o.environmentGiven = true;
+    o.environmentRotationDegrees = manifest()["shadel_environment_rotation"].get<float>();
+    o.tonemap = Tonemap::AcesNarkowicz;
+    o.backgroundEnvironment = false;
+    o.backgroundColor = glm::vec3(0.0f);
+    o.shadows = false;
+    o.addDefaultSun = false;
     return o;
 }
 

@@ -12,6 +12,8 @@
 #include <cstdio>
 #include <fstream>
 
+#include <stb/stb_image.h>
+
 using namespace shadel;
 using namespace shadel::test;
 using nlohmann::json;
@@ -50,8 +52,8 @@ std::string writeSphere(const std::string& name, float metallic, float roughness
     for (int r = 0; r < rings; ++r)
         for (int s = 0; s < segments; ++s) {
             uint16_t a = uint16_t(r * (segments + 1) + s), b = uint16_t(a + segments + 1);
-            indices.insert(indices.end(), {a, uint16_t(a + 1), b, uint16_t(a + 1),
-                                           uint16_t(b + 1), b});
+            indices.insert(indices.end(),
+                           {a, uint16_t(a + 1), b, uint16_t(a + 1), uint16_t(b + 1), b});
         }
     size_t count = positions.size() / 3;
     std::vector<float> floats = positions;
@@ -125,11 +127,12 @@ TEST(ImageBasedLighting, FurnaceWhiteSpheresReflectTheEnvironment) {
     std::string hdr = writeUniformHdr("furnace", radiance);
     for (float metallic : {0.0f, 1.0f})
         for (float roughness : {0.05f, 0.5f, 1.0f}) {
-            SCOPED_TRACE(testing::Message() << "metallic " << metallic << " roughness " << roughness);
+            SCOPED_TRACE(testing::Message()
+                         << "metallic " << metallic << " roughness " << roughness);
             for (RenderMode mode : {RenderMode::Forward, RenderMode::Decoupled}) {
                 RenderOptions o = renderOptions(
-                    writeSphere("furnace_sphere", metallic, roughness, glm::vec3(1.0f)), mode,
-                    96, 96);
+                    writeSphere("furnace_sphere", metallic, roughness, glm::vec3(1.0f)), mode, 96,
+                    96);
                 o.camera = "camera";
                 o.environment = hdr;
                 o.environmentGiven = true;
@@ -192,4 +195,45 @@ TEST(ImageBasedLighting, TurningEnvironmentLeavesNoStaleShading) {
                 worst, turned);
     EXPECT_LT(turned, 40.0);
     EXPECT_GE(worst, 45.0);
+}
+
+// A solid --background shows exactly the colour asked for under every tone curve (the radiance
+// the curve maps onto it, radianceForDisplay), and the PNG keeps alpha as coverage.
+TEST(ImageBasedLighting, SolidBackgroundIsExactAndPngAlphaIsCoverage) {
+    const glm::vec3 colour(0.2f, 0.45f, 0.8f);
+    for (Tonemap curve :
+         {Tonemap::AcesNarkowicz, Tonemap::AcesHill, Tonemap::KhrPbrNeutral, Tonemap::Linear})
+        for (RenderMode mode : {RenderMode::Forward, RenderMode::Decoupled}) {
+            SCOPED_TRACE(testing::Message() << "curve " << int(curve) << " mode " << int(mode));
+            RenderOptions o = renderOptions(
+                writeSphere("background_sphere", 0.0f, 0.5f, glm::vec3(0.8f)), mode, 64, 48);
+            o.camera = "camera";
+            o.tonemap = curve;
+            o.backgroundEnvironment = false;
+            o.backgroundColor = colour;
+            o.out = tempPath("background.png");
+            RenderRun run = renderChecked(o);
+            const std::vector<uint8_t>& rgba = run.frames[0].rgba;
+            int worst = 0;
+            size_t uncovered = 0;
+            for (size_t p = 0; p < rgba.size() / 4; ++p) {
+                if (rgba[p * 4 + 3] != 0) continue;
+                ++uncovered;
+                for (int c = 0; c < 3; ++c)
+                    worst = std::max(worst, std::abs(int(rgba[p * 4 + c]) -
+                                                     int(std::lround(colour[c] * 255.0f))));
+            }
+            ASSERT_GT(uncovered, 500u);
+            EXPECT_LE(worst, 1) << "background off by " << worst << " levels";
+            int w = 0, h = 0, channels = 0;
+            uint8_t* png = stbi_load(o.out.c_str(), &w, &h, &channels, 0);
+            ASSERT_NE(png, nullptr);
+            EXPECT_EQ(channels, 4);
+            size_t alphaMismatches = 0;
+            for (size_t p = 0; channels == 4 && p < size_t(w) * size_t(h); ++p)
+                alphaMismatches += (png[p * 4 + 3] != 0) != (rgba[p * 4 + 3] != 0);
+            stbi_image_free(png);
+            std::remove(o.out.c_str());
+            EXPECT_EQ(alphaMismatches, 0u);
+        }
 }

@@ -80,8 +80,8 @@ void buildSceneEditor(SceneEditor& e, Renderer& r, const GpuScene& scene) {
         // The next frame reads them (the decoupled path relights everything it carried over).
         ImGui::DragFloat("environment intensity", &r.settings.environmentIntensity, 0.01f, 0.0f,
                          100.0f, "%.2f");
-        ImGui::SliderFloat("environment rotation", &r.settings.environmentRotationDegrees,
-                           -180.0f, 180.0f, "%.0f deg");
+        ImGui::SliderFloat("environment rotation", &r.settings.environmentRotationDegrees, -180.0f,
+                           180.0f, "%.0f deg");
     }
     if (ImGui::CollapsingHeader("sun")) {
         SunEdit sun = currentSun(r, scene);

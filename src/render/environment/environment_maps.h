@@ -17,7 +17,6 @@
 
 namespace shadel {
 
-
 enum class EnvironmentKind { None, File, Sky, Hemisphere };
 
 struct EnvironmentRequest {

@@ -153,9 +153,9 @@ void createEnvironment(Gpu& gpu, EnvironmentState& state, const EnvironmentMaps&
 
 void createEnvironment(Gpu& gpu, EnvironmentState& state, const RenderSettings& settings,
                        const GpuScene& scene, const std::string& cacheDir) {
-    EnvironmentRequest request = environmentRequest(
-        settings.environment, settings.environmentGiven, scene.environment, scene.skyColor,
-        scene.ambientColor, scene.sunDirection, scene.sunColor);
+    EnvironmentRequest request =
+        environmentRequest(settings.environment, settings.environmentGiven, scene.environment,
+                           scene.skyColor, scene.ambientColor, scene.sunDirection, scene.sunColor);
     EnvironmentMaps maps = loadEnvironmentMaps(request, cacheDir);
     createEnvironment(gpu, state, maps, settings.environmentIntensity,
                       settings.environmentRotationDegrees);
