@@ -272,7 +272,10 @@ TEST(DecoupledCore, ReuseKeepsSaturatedMaterialsUnderColouredLights) {
                 fraction, worst, worstPixels);
     EXPECT_EQ(stat(on, "reconstruction_misses"), 0u);
     EXPECT_GE(worst, 40.0);
-    EXPECT_LE(worstPixels, 10); // 12 with the tolerance at 0.3, at least one lobe
+    // Measured 12 levels: 8 while every material drew both faces; with single-sided materials
+    // culled the orbit, which passes inside buildings, sees the street through their walls and
+    // measures 14 without an environment (12 with the environment's tighter tolerance).
+    EXPECT_LE(worstPixels, 13);
     EXPECT_GT(fraction, 0.3);
 }
 

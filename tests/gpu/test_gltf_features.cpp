@@ -263,6 +263,11 @@ struct MaterialCase {
     const char* extension;
     double minChanged;  // fraction of the model's pixels that visibly change with the extension
     bool front = false; // seen from the front (ClearCoatTest's labelled side), not "auto"
+    // Decoupled against forward, dB. TextureTransformTest's sampler minifies level 0 only
+    // (minFilter LINEAR, no mipmaps), as authored: each path aliases the minified arrows at its
+    // own sample positions (forward per pixel, decoupled per shadel), so its edges differ;
+    // measured 23.2 dB at 160x90 (38.2 while every sampler was trilinear).
+    double decoupledFloor = 30.0;
 };
 
 class GltfMaterialExtension : public ::testing::TestWithParam<MaterialCase> {};
@@ -293,7 +298,7 @@ TEST_P(GltfMaterialExtension, IsVisibleAndAgreesBetweenForwardAndDecoupled) {
     double pd = psnr(dec.frames[0].rgba, fwd.frames[0].rgba);
     std::printf("%s: decoupled vs forward %.1f dB, misses %llu\n", GetParam().model, pd,
                 (unsigned long long)dec.stats["reconstruction_misses"].get<uint64_t>());
-    EXPECT_GE(pd, 30.0);
+    EXPECT_GE(pd, GetParam().decoupledFloor);
     EXPECT_EQ(dec.stats["reconstruction_misses"].get<uint64_t>(), 0u);
 }
 
@@ -303,7 +308,8 @@ INSTANTIATE_TEST_SUITE_P(
     // column of the three carries it, where it reflects light or sky (25%). Specular-glossiness:
     // the file's fallback is the same texture, rough instead of glossy (46%).
     ::testing::Values(
-        MaterialCase{"textureTransform/TextureTransformTest.gltf", "KHR_texture_transform", 0.4},
+        MaterialCase{"textureTransform/TextureTransformTest.gltf", "KHR_texture_transform", 0.4,
+                     false, 21.7},
         MaterialCase{"ClearCoat-glTF/ClearCoatTest.gltf", "KHR_materials_clearcoat", 0.15, true},
         MaterialCase{"BoxTextured-glTF-pbrSpecularGlossiness/BoxTextured.gltf",
                      "KHR_materials_pbrSpecularGlossiness", 0.2}),
@@ -394,6 +400,9 @@ RenderRun renderQuad(const std::string& file, RenderMode mode) {
     o.progress = false;
     o.cameraOverrides.from = glm::vec3(0.0f, 0.7f, 2.0f);
     o.cameraOverrides.lookAt = glm::vec3(0.0f);
+    // A solid background: the built-in sky behind the quad follows the sun's intensity.
+    o.backgroundEnvironment = false;
+    o.backgroundColor = glm::vec3(0.5f);
     return renderChecked(o);
 }
 } // namespace

@@ -180,12 +180,15 @@ TEST(ImageBasedLighting, MirrorSphereReflectsTheSky) {
     }
 }
 
-// Decoupled reuse with the environment turning 15 degrees a frame: every frame relights every
+// Decoupled reuse with the environment turning 36 degrees a frame: every frame relights every
 // surface, so the images with reuse on equal those with reuse off.
 TEST(ImageBasedLighting, TurningEnvironmentLeavesNoStaleShading) {
     RenderOptions o = renderOptions("builtin:default", RenderMode::Decoupled, 192, 108);
     o.frames = 6;
-    o.environmentSpinDegrees = 15.0f;
+    // The conformance environment: a bright window and coloured patches turn into view.
+    o.environment = std::string(SHADEL_SOURCE_DIR) + "/tests/data/conformance/environment.hdr";
+    o.environmentGiven = true;
+    o.environmentSpinDegrees = 36.0f; // half a turn by the last frame
     ReuseRuns runs = renderReuseOnAndOff(o);
     double worst = worstFramePsnr(runs.on, runs.off);
     // Positive control: the turning is visible (the first and last frames differ).

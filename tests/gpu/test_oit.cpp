@@ -6,6 +6,8 @@
 #include <glm/gtc/matrix_transform.hpp>
 
 #include "gpu_test_env.h"
+
+#include "render/post/tone_curve.h"
 #include "render/oit/oit.h"
 #include "scene/mesh_utils.h"
 
@@ -82,6 +84,12 @@ glm::ivec3 renderCentre(const std::vector<Layer>& layers, OitMode mode) {
     s.height = 18;
     s.shadowMapSize = 64;
     s.oit = mode;
+    // The layers' only light is their emission: no environment, and behind them kSky's radiance
+    // (the solid background the display shows as kSky's display colour).
+    s.environment = "none";
+    s.environmentGiven = true;
+    s.backgroundEnvironment = false;
+    s.backgroundColor = displayColor(kSky, 1.0f, Tonemap::AcesNarkowicz);
     Renderer r;
     initRenderer(r, gpu, s, gs);
     FrameResult f = renderFrame(r, gs, makeCameraView(scene.cameras[0], s.width, s.height));

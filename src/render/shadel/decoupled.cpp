@@ -642,11 +642,14 @@ static bool updateObjectRects(Gpu& gpu, DecoupledState& d, ObjectSlot& o, uint32
 constexpr float SPECULAR_SHARE_MIN_GAIN = 0.5f;
 constexpr float SPECULAR_SHARE_MAX_GAIN = 2.0f;
 constexpr float SPECULAR_SHARE_TOLERANCE = 0.15f;
+constexpr float SPECULAR_SHARE_MIN_GAIN_ENVIRONMENT = 0.25f;
 
 // Under an environment the specular reflects light from every direction, not only the lights'
-// peaks: its share is then the reflected environment (F0 = 4% of about the light the diffuse
-// receives) against the darkest channel's diffuse, whatever the roughness, and the larger of the
-// two shares sets the tolerance.
+// peaks: its share is then the reflected environment (Fresnel averaged over the hemisphere,
+// F0 + (1 - F0) / 21, of about the light the diffuse receives) against the darkest channel's
+// diffuse, whatever the roughness; the larger of the two shares sets the tolerance, and the
+// gain may fall to SPECULAR_SHARE_MIN_GAIN_ENVIRONMENT: a grazing view of a saturated material
+// reflects mostly the environment, which a turn of half a lobe already shows at its rim.
 static float viewDriftLimitFor(float roughness, float metallic, glm::vec3 baseColor,
                                bool environment) {
     constexpr float kPi = 3.14159265f;
@@ -656,12 +659,13 @@ static float viewDriftLimitFor(float roughness, float metallic, glm::vec3 baseCo
     float darkestDiffuse = std::max(darkest, 0.0f) * 0.96f / kPi;
     float dielectricShare = specularPeak / (specularPeak + darkestDiffuse);
     if (environment) {
-        float reflected = 0.04f / kPi;
+        float reflected = (0.04f + 0.96f / 21.0f) / kPi;
         dielectricShare = std::max(dielectricShare, reflected / (reflected + darkestDiffuse));
     }
     float specularShare = glm::mix(dielectricShare, 1.0f, std::clamp(metallic, 0.0f, 1.0f));
-    float gain = std::clamp(SPECULAR_SHARE_TOLERANCE / specularShare, SPECULAR_SHARE_MIN_GAIN,
-                            SPECULAR_SHARE_MAX_GAIN);
+    float minGain = environment ? SPECULAR_SHARE_MIN_GAIN_ENVIRONMENT : SPECULAR_SHARE_MIN_GAIN;
+    float gain =
+        std::clamp(SPECULAR_SHARE_TOLERANCE / specularShare, minGain, SPECULAR_SHARE_MAX_GAIN);
     return lobeWidth * gain;
 }
 
