@@ -296,7 +296,10 @@ TEST(DecoupledCore, ReuseReshadesChunksWhoseViewTurned) {
     EXPECT_GE(worst, 40.0);
     EXPECT_GT(because["view"].get<double>(), 0.01);
     EXPECT_LT(because["refresh"].get<double>(), 0.01);
-    EXPECT_GT(on.stats["reuse_fraction"].get<double>(), 0.7);
+    // Measured 0.644 under the built-in sky (0.710 with the old specular-free ambient): the
+    // environment's reflection is view-dependent on every material, so more chunks turn past
+    // their tolerance.
+    EXPECT_GT(on.stats["reuse_fraction"].get<double>(), 0.58);
 
     o.cameraPath = CameraPath::Static;
     o.frames = 6;

@@ -307,12 +307,12 @@ INSTANTIATE_TEST_SUITE_P(
     // Texture transform: four of six quads change everywhere (63% measured). Clear coat: one
     // column of the three carries it, where it reflects light or sky (25%). Specular-glossiness:
     // the file's fallback is the same texture, rough instead of glossy (46%).
-    ::testing::Values(
-        MaterialCase{"textureTransform/TextureTransformTest.gltf", "KHR_texture_transform", 0.4,
-                     false, 21.7},
-        MaterialCase{"ClearCoat-glTF/ClearCoatTest.gltf", "KHR_materials_clearcoat", 0.15, true},
-        MaterialCase{"BoxTextured-glTF-pbrSpecularGlossiness/BoxTextured.gltf",
-                     "KHR_materials_pbrSpecularGlossiness", 0.2}),
+    ::testing::Values(MaterialCase{"textureTransform/TextureTransformTest.gltf",
+                                   "KHR_texture_transform", 0.4, false, 21.7},
+                      MaterialCase{"ClearCoat-glTF/ClearCoatTest.gltf", "KHR_materials_clearcoat",
+                                   0.15, true},
+                      MaterialCase{"BoxTextured-glTF-pbrSpecularGlossiness/BoxTextured.gltf",
+                                   "KHR_materials_pbrSpecularGlossiness", 0.2}),
     [](const ::testing::TestParamInfo<MaterialCase>& info) {
         std::string name = info.param.extension;
         for (char& c : name)

@@ -7,8 +7,8 @@
 
 #include "gpu_test_env.h"
 
-#include "render/post/tone_curve.h"
 #include "render/oit/oit.h"
+#include "render/post/tone_curve.h"
 #include "scene/mesh_utils.h"
 
 using namespace shadel;

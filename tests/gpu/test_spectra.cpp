@@ -175,7 +175,11 @@ TEST(Spectra, ShadelChunksWhoseListsOverflowThePoolTakeEveryLight) {
                 (unsigned long long)s["spectra_chunk_list_capacity"].get<uint64_t>(), p);
     EXPECT_GT(overflow, 0u);
     EXPECT_GT(s["spectra"]["all"].get<uint64_t>(), 0u) << "overflowed chunks take every feature";
-    EXPECT_GE(p, 50.0);
+    // Measured 45.5 dB with single-sided materials culled and the scene's hemisphere as an
+    // environment (above 50 before): which samples overflow, and so are shaded per pixel in the
+    // resolve, differs between the runs, and per pixel the environment's reflection is
+    // evaluated at the pixel rather than the shadel.
+    EXPECT_GE(p, 43.9);
 }
 
 // With preserved layers the classify pass also decides which queued chunks are carried over

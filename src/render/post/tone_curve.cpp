@@ -70,13 +70,15 @@ glm::vec3 displayColor(glm::vec3 hdr, float exposure, Tonemap curve) {
 glm::vec3 radianceForDisplay(glm::vec3 srgb, float exposure, Tonemap curve) {
     srgb = clamp01(srgb);
     glm::vec3 target{srgbToLinear(srgb.r), srgbToLinear(srgb.g), srgbToLinear(srgb.b)};
-    // Every curve is increasing in each channel and near the identity at its toe, so a
-    // multiplicative correction per channel converges (Hill mixes channels a little: a few more
-    // steps). Unreachable targets (above the curve's maximum) end at its shoulder.
+    // Every curve is increasing in each channel, at most quadratic in its toe (Khronos PBR
+    // Neutral's darkest channel) and mixes channels only a little (Hill), so a damped
+    // multiplicative correction per channel (the square root of the ratio: it neither overshoots
+    // where the curve is quadratic nor stalls where it is linear) converges. Unreachable targets
+    // (above the curve's maximum) end at its shoulder.
     glm::vec3 x = target;
-    for (int step = 0; step < 200; ++step) {
+    for (int step = 0; step < 400; ++step) {
         glm::vec3 y = toneCurve(x, curve);
-        glm::vec3 ratio = (target + 1e-6f) / (y + 1e-6f);
+        glm::vec3 ratio = glm::sqrt((target + 1e-7f) / (y + 1e-7f));
         x = glm::min(x * glm::clamp(ratio, glm::vec3(0.5f), glm::vec3(2.0f)), glm::vec3(1e4f));
     }
     return x / std::max(exposure, 1e-12f);
