@@ -26,6 +26,19 @@ float specularOcclusion(float nv, float occlusion, float roughness) {
     return clamp(pow(nv + occlusion, exp2(-16.0 * alpha - 1.0)) - 1.0 + occlusion, 0.0, 1.0);
 }
 
+// The sheen's albedo scaling for the view direction (KHR_materials_sheen): the layers below
+// keep 1 - max(sheenColor) x E(n.v), E the sheen's directional albedo from the BRDF table. Used
+// for the lights too: E(n.l), which the extension's min() also asks for, matters only where
+// n.l (and so the light's share) is small.
+MaterialSample sheenForView(GpuEnvironment e, MaterialSample m, vec3 n, vec3 v) {
+    float sheenMax = max(m.sheenColor.r, max(m.sheenColor.g, m.sheenColor.b));
+    if (MATERIAL_HAS(MATERIAL_FEATURE_SHEEN) && sheenMax > 0.0 && e.brdfSize > 0.0) {
+        float nv = clamp(dot(n, v), 1e-4, 1.0);
+        m.sheenAlbedoScale = 1.0 - sheenMax * min(environmentBrdf(e, nv, m.sheenRoughness).z, 1.0);
+    }
+    return m;
+}
+
 // The environment's light reflected toward v; `occlusion` darkens it (the material's occlusion
 // map, AO decals, ray-traced or distance-field AO).
 vec3 environmentLight(GpuEnvironment e, MaterialSample m, vec3 n, vec3 v, float occlusion) {
@@ -44,7 +57,7 @@ vec3 environmentLight(GpuEnvironment e, MaterialSample m, vec3 n, vec3 v, float 
         // (The Charlie lobe with its visibility term is not energy conserving at grazing views
         // of smooth sheen: its albedo passes 1 there, and the layer below would go negative.)
         float sheenAlbedo = min(environmentBrdf(e, nv, m.sheenRoughness).z, 1.0);
-        vec3 sheenLight = environmentSpecular(e, reflect(-v, n), m.sheenRoughness) * occlusion;
+        vec3 sheenLight = environmentSheen(e, reflect(-v, n), m.sheenRoughness) * occlusion;
         color = color * (1.0 - sheenMax * sheenAlbedo) + sheenLight * m.sheenColor * sheenAlbedo;
     }
     if (MATERIAL_HAS(MATERIAL_FEATURE_CLEARCOAT) && m.clearcoat > 0.0) {

@@ -197,8 +197,8 @@ float clearcoatFresnel(MaterialSample m, vec3 v) {
 }
 
 // Radiance reflected toward v from a light of `radiance` arriving from direction l: the base
-// layer (the glTF BRDF above), under sheen (its albedo taken from the layer below by max(sheen
-// colour)), under the clear coat (Fresnel on its own normal; what it reflects does not reach the
+// layer (the glTF BRDF above), under sheen (the layer below scaled by m.sheenAlbedoScale), under
+// the clear coat (Fresnel on its own normal; what it reflects does not reach the
 // layers below).
 vec3 brdf(MaterialSample m, vec3 n, vec3 v, vec3 l, vec3 radiance) {
     float nl = dot(n, l);
@@ -222,7 +222,7 @@ vec3 brdf(MaterialSample m, vec3 n, vec3 v, vec3 l, vec3 radiance) {
             float alpha = m.sheenRoughness * m.sheenRoughness;
             vec3 sheen = m.sheenColor * distributionCharlie(nh, alpha) /
                          (4.0 * (nl + nv - nl * nv));
-            color = color * (1.0 - sheenMax * 0.25) + sheen;
+            color = color * m.sheenAlbedoScale + sheen;
         }
         color *= nl;
     }
@@ -572,6 +572,7 @@ vec3 shadeSurface(FrameConstants f, MaterialSample m, vec3 worldPos, vec3 geomet
     if (m.unlit) return m.baseColor;
     vec3 n = m.normal;
     vec3 v = normalize(f.cameraPosition - worldPos);
+    m = sheenForView(f.environment, m, n, v);
     // Emission leaves through the clear coat, which reflects its Fresnel's share back.
     bool coat = MATERIAL_HAS(MATERIAL_FEATURE_CLEARCOAT) && m.clearcoat > 0.0;
     vec3 color = m.emissive * (coat ? 1.0 - clearcoatFresnel(m, v) : 1.0);

@@ -34,6 +34,9 @@ struct MaterialSample {
     vec3 sheenColor;          // 0 = no sheen
     float sheenRoughness;
     bool unlit;               // KHR_materials_unlit: the output is baseColor
+    // What sheen leaves of the layers below toward the viewer: 1 - max(sheenColor) x the sheen's
+    // directional albedo at n.v (the BRDF table's; set by sheenForView, else its mean 0.25).
+    float sheenAlbedoScale;
 };
 
 
@@ -191,6 +194,7 @@ MaterialSample evaluateMaterial(GpuMaterial m, SurfaceInput s) {
                                                     m.sheenRoughnessTexture, s).a;
     }
     o.sheenRoughness = max(sheenRoughness, 0.07);
+    o.sheenAlbedoScale = 1.0 - max(o.sheenColor.r, max(o.sheenColor.g, o.sheenColor.b)) * 0.25;
     o.unlit = (m.flags & MATERIAL_UNLIT) != 0u;
     o.ambientOcclusion = 1.0;
     applyDecals(o, s.position, n); // the caller's decal list, if it chose one (decals.glsl)

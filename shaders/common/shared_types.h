@@ -539,6 +539,10 @@ struct GpuEnvironment {
     float backgroundHeight;
     vec3 sunRadiance; // radiance of the disc (0 without one)
     float brdfSize;   // texels per side of the BRDF table
+    uint sheenSlot;   // radiance, Charlie-prefiltered: MIP l for sheen roughness l / (levels - 1)
+    uint sheenLevels;
+    float sheenHeight; // texel rows of sheen level 0
+    float sheenPad;
 };
 
 struct FrameConstants {

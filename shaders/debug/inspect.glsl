@@ -29,6 +29,7 @@ void inspectSurface(FrameConstants f, uint instance, uint triangle, MaterialSamp
 
     vec3 n = m.normal;
     vec3 v = normalize(f.cameraPosition - worldPos);
+    m = sheenForView(f.environment, m, n, v); // as shadeSurface does
     shaderPrintF3(f, PRINT_AMBIENT, environmentLight(f.environment, m, n, v,
                                                      m.occlusion * m.ambientOcclusion));
     if (dot(f.sunColor, f.sunColor) > 0.0) {

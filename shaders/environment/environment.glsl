@@ -54,6 +54,19 @@ vec3 environmentSpecular(GpuEnvironment e, vec3 r, float perceptualRoughness) {
     return e.intensity * mix(a, b, lod - l0);
 }
 
+// Radiance around r prefiltered for the Charlie (sheen) lobe of `sheenRoughness`, as
+// environmentSpecular does for GGX.
+vec3 environmentSheen(GpuEnvironment e, vec3 r, float sheenRoughness) {
+    if ((e.flags & ENVIRONMENT_FLAG_NONE) != 0u || e.sheenLevels == 0u) return vec3(0.0);
+    vec2 uv = environmentUv(environmentFrame(e, r));
+    float top = float(e.sheenLevels - 1u);
+    float lod = clamp(sheenRoughness, 0.0, 1.0) * top;
+    float l0 = floor(lod), l1 = min(l0 + 1.0, top);
+    vec3 a = environmentFetch(e.sheenSlot, uv, l0, max(floor(e.sheenHeight / exp2(l0)), 1.0));
+    vec3 b = environmentFetch(e.sheenSlot, uv, l1, max(floor(e.sheenHeight / exp2(l1)), 1.0));
+    return e.intensity * mix(a, b, lod - l0);
+}
+
 // What the camera sees along viewDir (from the eye outward), with the sun's disc.
 vec3 environmentBackground(GpuEnvironment e, vec3 viewDir) {
     if ((e.flags & ENVIRONMENT_FLAG_NONE) != 0u) return vec3(0.0);

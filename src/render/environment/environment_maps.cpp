@@ -55,7 +55,7 @@ BakeKey sourceKey(const EnvironmentRequest& r, const std::vector<uint8_t>& fileB
     Hasher h;
     h.add(kEnvironmentFormatVersion);
     h.add(uint32_t(r.kind));
-    h.add(s.specularWidth), h.add(s.specularLevels), h.add(s.specularSamples);
+    h.add(s.specularWidth), h.add(s.specularLevels), h.add(s.specularSamples), h.add(s.sheenWidth);
     h.add(s.irradianceWidth);
     if (r.kind == EnvironmentKind::File) h.add(fileBytes.data(), fileBytes.size());
     if (r.kind == EnvironmentKind::Sky) h.add(glm::normalize(r.sunDirection)), h.add(r.sunColor);
@@ -88,16 +88,22 @@ EquirectImage backgroundOf(const EnvironmentRequest& r, const EquirectImage& sou
     return source;
 }
 
-// Cached images: background, irradiance, then the specular levels.
-bool cachedMapsFit(const std::vector<EquirectImage>& images, const PrefilterSettings& s) {
-    if (images.size() != 2 + size_t(s.specularLevels)) return false;
-    if (images[1].width != s.irradianceWidth || images[1].height != s.irradianceWidth / 2)
-        return false;
-    for (uint32_t l = 0; l < s.specularLevels; ++l)
-        if (images[2 + l].width != std::max(s.specularWidth >> l, 2u) ||
-            images[2 + l].height != std::max((s.specularWidth / 2) >> l, 1u))
+// Cached images: background, irradiance, the specular levels, then the sheen levels.
+bool chainFits(const std::vector<EquirectImage>& images, size_t first, uint32_t width,
+               uint32_t levels) {
+    for (uint32_t l = 0; l < levels; ++l)
+        if (images[first + l].width != std::max(width >> l, 2u) ||
+            images[first + l].height != std::max((width / 2) >> l, 1u))
             return false;
     return true;
+}
+
+bool cachedMapsFit(const std::vector<EquirectImage>& images, const PrefilterSettings& s) {
+    if (images.size() != 2 + size_t(s.specularLevels) + sheenLevelCount(s)) return false;
+    if (images[1].width != s.irradianceWidth || images[1].height != s.irradianceWidth / 2)
+        return false;
+    return chainFits(images, 2, s.specularWidth, s.specularLevels) &&
+           chainFits(images, 2 + s.specularLevels, s.sheenWidth, sheenLevelCount(s));
 }
 
 BrdfTable loadBrdfTable(const std::string& cacheDir, uint32_t size, WorkerPool& pool) {
@@ -196,17 +202,24 @@ EnvironmentMaps loadEnvironmentMaps(const EnvironmentRequest& request, const std
                 SHADEL_INFO("environment: prefiltering %s ... %d%%", name.c_str(), quarter * 25);
             }
         };
-        std::vector<EquirectImage> specular = prefilterSpecular(source, settings, pool, progress);
+        // The sheen chain is a quarter of the specular one's size: a sixteenth of the work.
+        std::vector<EquirectImage> specular =
+            prefilterSpecular(source, settings, pool, [&](float done) { progress(done * 0.94f); });
+        std::vector<EquirectImage> sheen = prefilterSheen(
+            source, settings, pool, [&](float done) { progress(0.94f + done * 0.06f); });
         images = {backgroundOf(request, source),
                   prefilterIrradiance(specular[0], settings.irradianceWidth, pool)};
         for (EquirectImage& level : specular) images.push_back(std::move(level));
+        for (EquirectImage& level : sheen) images.push_back(std::move(level));
         if (!path.empty() && !writeEnvironmentCache(path, key, images, &why))
             SHADEL_WARN("environment: cache not written: %s", why.c_str());
     }
     maps.background = std::move(images[0]);
     maps.irradiance = std::move(images[1]);
+    auto sheenBegin = images.begin() + 2 + settings.specularLevels;
     maps.specular.assign(std::make_move_iterator(images.begin() + 2),
-                         std::make_move_iterator(images.end()));
+                         std::make_move_iterator(sheenBegin));
+    maps.sheen.assign(std::make_move_iterator(sheenBegin), std::make_move_iterator(images.end()));
     maps.brdf = loadBrdfTable(cacheDir, settings.brdfSize, pool);
     maps.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     SHADEL_INFO("environment: %s %s in %.2f s", name.c_str(),

@@ -3,7 +3,8 @@
 // (environment_state.h) uploads: built once per source and cached on disk by content.
 //
 // Sizes (defaults of PrefilterSettings): specular 512x256 at level 0 and 8 levels down to 4x2
-// (level l: GGX of perceptual roughness l / 7); irradiance / pi 64x32; BRDF table 64x64;
+// (level l: GGX of perceptual roughness l / 7); sheen 128x64 and 7 levels down to 2x1 (the Charlie
+// lobe of sheen roughness l / 6); irradiance / pi 64x32; BRDF table 64x64;
 // background the source up to 2048x1024 (the sky: 1024x512; the hemisphere: its sky colour).
 #include <cstdint>
 #include <string>
@@ -43,8 +44,9 @@ EnvironmentRequest environmentRequest(const std::string& setting, bool settingGi
 struct EnvironmentMaps {
     EnvironmentKind kind = EnvironmentKind::None;
     std::vector<EquirectImage> specular; // level l: perceptual roughness l / (levels - 1)
-    EquirectImage irradiance;            // irradiance / pi
-    EquirectImage background;            // what the camera sees (no sun disc)
+    std::vector<EquirectImage> sheen; // level l: Charlie lobe of sheen roughness l / (levels - 1)
+    EquirectImage irradiance;         // irradiance / pi
+    EquirectImage background;         // what the camera sees (no sun disc)
     BrdfTable brdf;
     // The sun's disc, drawn only in the background (the directional light carries the sun).
     glm::vec3 sunDirection{0.0f, -1.0f, 0.0f};

@@ -14,7 +14,7 @@
 
 namespace shadel {
 
-static_assert(sizeof(gpu::GpuEnvironment) == 80, "GpuEnvironment: scalar layout, 80 bytes");
+static_assert(sizeof(gpu::GpuEnvironment) == 96, "GpuEnvironment: scalar layout, 96 bytes");
 
 namespace {
 
@@ -131,6 +131,16 @@ void createEnvironment(Gpu& gpu, EnvironmentState& state, const EnvironmentMaps&
     std::vector<Level> levels;
     for (const EquirectImage& l : maps.specular) levels.push_back({l.width, l.height, &l.texels});
     state.specular = uploadLevels(gpu, "environment.specular", light, levels);
+    if (!maps.sheen.empty()) {
+        std::vector<Level> sheenLevels;
+        for (const EquirectImage& l : maps.sheen)
+            sheenLevels.push_back({l.width, l.height, &l.texels});
+        state.sheen = uploadLevels(gpu, "environment.sheen", light, sheenLevels);
+        state.sheenView = createReadView(gpu, state.sheen);
+        c.sheenSlot = slot(gpu, state.sheenView).value;
+        c.sheenLevels = uint32_t(maps.sheen.size());
+        c.sheenHeight = float(maps.sheen[0].height);
+    }
     state.irradiance = uploadImage(gpu, "environment.irradiance", light, maps.irradiance);
     state.background =
         uploadImage(gpu, "environment.background", VK_FORMAT_R16G16B16A16_SFLOAT, maps.background);
@@ -169,10 +179,11 @@ void setEnvironmentView(EnvironmentState& state, float intensity, float rotation
 }
 
 void destroyEnvironment(Gpu& gpu, EnvironmentState& state) {
-    for (TextureReadView* v :
-         {&state.specularView, &state.irradianceView, &state.backgroundView, &state.brdfView})
+    for (TextureReadView* v : {&state.specularView, &state.irradianceView, &state.backgroundView,
+                               &state.brdfView, &state.sheenView})
         if (v->valid()) destroy(gpu, *v), *v = {};
-    for (TextureHandle* t : {&state.specular, &state.irradiance, &state.background, &state.brdf})
+    for (TextureHandle* t :
+         {&state.specular, &state.irradiance, &state.background, &state.brdf, &state.sheen})
         if (t->valid()) destroy(gpu, *t), *t = {};
     state.constants = {};
     state.constants.flags = ENVIRONMENT_FLAG_NONE;

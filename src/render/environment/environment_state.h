@@ -1,7 +1,7 @@
 #pragma once
-// The environment on the GPU: the maps of environment_maps.h uploaded (specular and irradiance
-// RGBA32F, background and BRDF table RGBA16F, each named for RenderDoc as "environment.*"), in
-// the bindless table, and the GpuEnvironment shaders read them through
+// The environment on the GPU: the maps of environment_maps.h uploaded (specular, sheen and
+// irradiance RGBA32F, background and BRDF table RGBA16F, each named for RenderDoc as
+// "environment.*"), in the bindless table, and the GpuEnvironment shaders read them through
 // (shaders/environment/environment.glsl). The renderer embeds `constants` in its frame
 // constants; intensity and rotation can change between frames without rebuilding anything.
 #include <string>
@@ -18,8 +18,8 @@ struct Scene;
 
 struct EnvironmentState {
     EnvironmentKind kind = EnvironmentKind::None;
-    TextureHandle specular, irradiance, background, brdf;
-    TextureReadView specularView, irradianceView, backgroundView, brdfView;
+    TextureHandle specular, irradiance, background, brdf, sheen;
+    TextureReadView specularView, irradianceView, backgroundView, brdfView, sheenView;
     gpu::GpuEnvironment constants{0, 0, 0, 0, 0, ENVIRONMENT_FLAG_NONE}; // until created
     bool fromCache = false;
     double seconds = 0.0; // building or loading the maps (CPU)

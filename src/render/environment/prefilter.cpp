@@ -43,15 +43,41 @@ struct LobeSample {
     float lod;
 };
 
-std::vector<LobeSample> lobeSamples(double roughness, uint32_t count, double texelSolidAngle) {
+// The Charlie (sheen) distribution for alpha = roughness^2, unclamped.
+double charlie(double nh, double alpha) {
+    double inv = 1.0 / alpha;
+    return (2.0 + inv) * std::pow(std::max(1.0 - nh * nh, 0.0), inv * 0.5) / (2.0 * kPi);
+}
+
+// A Charlie half vector around +Z (sin theta = xi^(alpha / (2 alpha + 1))).
+glm::dvec3 sampleCharlie(glm::dvec2 xi, double alpha) {
+    double sinT = std::pow(xi.x, alpha / (2.0 * alpha + 1.0));
+    double cosT = std::sqrt(std::max(0.0, 1.0 - sinT * sinT));
+    double phi = 2.0 * kPi * xi.y;
+    return {sinT * std::cos(phi), sinT * std::sin(phi), cosT};
+}
+
+std::vector<LobeSample> lobeSamples(PrefilterLobe lobe, double roughness, uint32_t count,
+                                    double texelSolidAngle) {
     std::vector<LobeSample> out;
     double alpha = std::max(roughness * roughness, 1e-4);
+    // With n = v, directions above the horizon come from half vectors within 45 degrees of n.
+    // Most of a thin Charlie lobe's half vectors lie near the tangent plane, beyond that: its
+    // samples are drawn from the part within (the share `within` of the lobe), so every one
+    // counts and the level is the lobe's mean over the directions above the horizon.
+    double within = 1.0;
+    if (lobe == PrefilterLobe::Charlie)
+        within = std::pow(std::sqrt(0.5), (2.0 * alpha + 1.0) / alpha); // CDF of sin(theta)
     for (uint32_t i = 0; i < count; ++i) {
-        glm::dvec3 h = sampleGgx(hammersley(i, count), alpha);
+        glm::dvec2 xi = hammersley(i, count);
+        glm::dvec3 h = lobe == PrefilterLobe::Ggx ? sampleGgx(xi, alpha)
+                                                  : sampleCharlie({xi.x * within, xi.y}, alpha);
         glm::dvec3 l = 2.0 * h.z * h - glm::dvec3(0.0, 0.0, 1.0);
         if (l.z <= 0.0) continue;
-        // With n = v the pdf of l is D / 4; the sample stands for 1 / (count * pdf) steradians.
-        double pdf = ggx(h.z, alpha * alpha) / 4.0;
+        // With n = v the pdf of l is D n.h / (4 v.h) = D / 4 (over `within` of the lobe); the
+        // sample stands for 1 / (count * pdf) steradians.
+        double d = lobe == PrefilterLobe::Ggx ? ggx(h.z, alpha * alpha) : charlie(h.z, alpha);
+        double pdf = std::max(d / 4.0 / std::max(within, 1e-300), 1e-12);
         double sampleSolidAngle = 1.0 / (double(count) * pdf);
         double lod = std::max(0.0, 0.5 * std::log2(sampleSolidAngle / texelSolidAngle) + 1.0);
         out.push_back({glm::vec3(l), float(l.z), float(lod)});
@@ -93,26 +119,55 @@ glm::vec3 texelDirection(uint32_t x, uint32_t y, uint32_t width, uint32_t height
 std::vector<EquirectImage> prefilterSpecular(const EquirectImage& source,
                                              const PrefilterSettings& settings, WorkerPool& pool,
                                              const PrefilterProgress& progress) {
-    uint32_t w0 = settings.specularWidth, h0 = w0 / 2;
+    return prefilterLobes(source, PrefilterLobe::Ggx, settings.specularWidth,
+                          settings.specularLevels, settings.specularSamples, pool, progress);
+}
+
+std::vector<EquirectImage> prefilterSheen(const EquirectImage& source,
+                                          const PrefilterSettings& settings, WorkerPool& pool,
+                                          const PrefilterProgress& progress) {
+    return prefilterLobes(source, PrefilterLobe::Charlie, settings.sheenWidth,
+                          sheenLevelCount(settings), settings.specularSamples, pool, progress);
+}
+
+uint32_t sheenLevelCount(const PrefilterSettings& settings) {
+    uint32_t fit = 1;
+    while ((settings.sheenWidth >> fit) >= 2) ++fit; // level fit - 1 is 2 texels wide
+    return std::max(std::min(settings.specularLevels, fit), 2u);
+}
+
+std::vector<EquirectImage> prefilterLobes(const EquirectImage& source, PrefilterLobe lobeKind,
+                                          uint32_t width, uint32_t levelsWanted,
+                                          uint32_t samplesWanted, WorkerPool& pool,
+                                          const PrefilterProgress& progress) {
+    uint32_t w0 = width, h0 = w0 / 2;
+    bool ggxLobe = lobeKind == PrefilterLobe::Ggx;
     std::vector<EquirectImage> pyramid{resampleEquirect(source, w0, h0)};
     while (pyramid.back().height > 1 && pyramid.back().width % 2 == 0)
         pyramid.push_back(downsampleEquirect(pyramid.back()));
-    std::vector<EquirectImage> levels{pyramid[0]};
-    uint32_t levelCount = std::max(settings.specularLevels, 2u);
+    // GGX level 0 is the lobe of roughness 0, the source itself. The Charlie lobe of roughness 0
+    // is a ring at the horizon, with no weight (n.l = 0) above it: its level 0 holds the
+    // smoothest sheen materials have (kMinSheenRoughness, the shaders' clamp).
+    std::vector<EquirectImage> levels;
+    if (ggxLobe) levels.push_back(pyramid[0]);
+    uint32_t levelCount = std::max(levelsWanted, 2u);
+    uint32_t first = ggxLobe ? 1 : 0;
     // Work in texel-samples, for the progress.
     double total = 0.0, done = 0.0;
-    for (uint32_t l = 1; l < levelCount; ++l)
+    for (uint32_t l = first; l < levelCount; ++l)
         total += double(std::max(w0 >> l, 2u)) * std::max(h0 >> l, 1u);
     const double texelSolidAngle = 4.0 * kPi / (double(w0) * h0);
-    for (uint32_t l = 1; l < levelCount; ++l) {
+    for (uint32_t l = first; l < levelCount; ++l) {
         uint32_t w = std::max(w0 >> l, 2u), h = std::max(h0 >> l, 1u);
         double roughness = double(l) / double(levelCount - 1);
-        // The narrow lobes of the first (largest) levels span a few source texels, which the
-        // MIP-filtered reads cover with a quarter and a half of the samples.
-        uint32_t samples = l == 1   ? std::max(settings.specularSamples / 4, 16u)
-                           : l == 2 ? std::max(settings.specularSamples / 2, 16u)
-                                    : settings.specularSamples;
-        std::vector<LobeSample> lobe = lobeSamples(roughness, samples, texelSolidAngle);
+        if (!ggxLobe) roughness = std::max(roughness, double(kMinSheenRoughness));
+        // The narrow GGX lobes of the first (largest) levels span a few source texels, which the
+        // MIP-filtered reads cover with a quarter and a half of the samples. (Thin Charlie lobes
+        // are wide rings.)
+        uint32_t samples = ggxLobe && l == 1   ? std::max(samplesWanted / 4, 16u)
+                           : ggxLobe && l == 2 ? std::max(samplesWanted / 2, 16u)
+                                               : samplesWanted;
+        std::vector<LobeSample> lobe = lobeSamples(lobeKind, roughness, samples, texelSolidAngle);
         EquirectImage level = makeEquirect(w, h);
         std::atomic<uint32_t> rows{0};
         // Levels under 32 texels wide hold the mean of the filtered radiance over each texel

@@ -21,6 +21,7 @@ class WorkerPool;
 
 struct PrefilterSettings {
     uint32_t specularWidth = 512;   // level 0; height = width / 2, each level half the last
+    uint32_t sheenWidth = 128;      // level 0 of the sheen chain (as many levels as specular)
     uint32_t specularLevels = 8;    // perceptual roughness of level l = l / (levels - 1)
     uint32_t specularSamples = 256; // per texel; a quarter at level 1, half at level 2
     uint32_t irradianceWidth = 64;  // height = width / 2
@@ -33,6 +34,25 @@ using PrefilterProgress = std::function<void(float)>;
 std::vector<EquirectImage> prefilterSpecular(const EquirectImage& source,
                                              const PrefilterSettings& settings, WorkerPool& pool,
                                              const PrefilterProgress& progress = {});
+// The smallest sheen roughness the shaders use (shaders/common/material.glsl clamps to it).
+constexpr float kMinSheenRoughness = 0.07f;
+
+// The same chain for the sheen lobe: level l convolved with the Charlie distribution of sheen
+// roughness max(l / (levels - 1), kMinSheenRoughness), weighted by n.l, over the part of the
+// lobe above the horizon (with n = v, half vectors within 45 degrees of n).
+// Levels of the sheen chain: as many as the specular chain, but none narrower than 2x1 (the
+// image's own MIP chain).
+uint32_t sheenLevelCount(const PrefilterSettings& settings);
+std::vector<EquirectImage> prefilterSheen(const EquirectImage& source,
+                                          const PrefilterSettings& settings, WorkerPool& pool,
+                                          const PrefilterProgress& progress = {});
+
+enum class PrefilterLobe { Ggx, Charlie };
+// Either chain: `levels` levels from `width` x width / 2 down, `samples` per texel.
+std::vector<EquirectImage> prefilterLobes(const EquirectImage& source, PrefilterLobe lobe,
+                                          uint32_t width, uint32_t levels, uint32_t samples,
+                                          WorkerPool& pool, const PrefilterProgress& progress = {});
+
 EquirectImage prefilterIrradiance(const EquirectImage& source, uint32_t width, WorkerPool& pool);
 
 // texel (x, y): n.v = (x + 0.5) / size, perceptual roughness = (y + 0.5) / size; R = scale and
