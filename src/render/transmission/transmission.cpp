@@ -1,7 +1,9 @@
 #include "render/transmission/transmission.h"
 
 #include <algorithm>
+#include <array>
 #include <bit>
+#include <vector>
 
 #include "core/error.h"
 #include "render/forward/forward_passes.h"
@@ -188,11 +190,6 @@ void prepareTransmissionDraws(Renderer& r, const GpuScene& scene, const CameraVi
 
 bool transmissionThisFrame(const Renderer& r) {
     return r.transmission && !r.transmission->draws.empty();
-}
-
-const std::vector<uint32_t>& transmissionDraws(const Renderer& r) {
-    static const std::vector<uint32_t> none;
-    return r.transmission ? r.transmission->draws : none;
 }
 
 void recordTransmissionPasses(Renderer& r, FrameRecorder& rec, uint64_t frame) {

@@ -8,7 +8,6 @@
 // Transmissive surfaces therefore do not see each other through the copy.
 #include <cstdint>
 #include <memory>
-#include <vector>
 
 #include "rhi/frame.h"
 
@@ -32,7 +31,6 @@ void destroyTransmission(Renderer& r, TransmissionStatePtr& s);
 void prepareTransmissionDraws(Renderer& r, const GpuScene& scene, const CameraView& camera);
 // Whether the frame has transmissive draws (false before prepareTransmissionDraws).
 bool transmissionThisFrame(const Renderer& r);
-const std::vector<uint32_t>& transmissionDraws(const Renderer& r);
 
 // `transmissionBackground` then `transmissionShading` (nothing without transmissive draws).
 void recordTransmissionPasses(Renderer& r, FrameRecorder& rec, uint64_t frame);
