@@ -42,12 +42,15 @@ MaterialSample sheenForView(GpuEnvironment e, MaterialSample m, vec3 n, vec3 v) 
 // The environment's light reflected toward v; `occlusion` darkens it (the material's occlusion
 // map, AO decals, ray-traced or distance-field AO).
 vec3 environmentLight(GpuEnvironment e, MaterialSample m, vec3 n, vec3 v, float occlusion) {
-    if ((e.flags & ENVIRONMENT_FLAG_NONE) != 0u) return vec3(0.0);
+    // (A transmissive surface shows what lies behind it with or without an environment.)
+    if ((e.flags & ENVIRONMENT_FLAG_NONE) != 0u && !transmissionLobe()) return vec3(0.0);
     float nv = clamp(dot(n, v), 1e-4, 1.0);
     vec3 table = environmentBrdf(e, nv, m.roughness);
     vec3 specularLight = environmentSpecular(e, reflect(-v, n), m.roughness) *
                          specularOcclusion(nv, occlusion, m.roughness);
     vec3 diffuseLight = environmentIrradiance(e, n) * m.baseColor * occlusion;
+    if (transmissionLobe()) // KHR_materials_transmission (common/transmission.glsl)
+        diffuseLight = mix(diffuseLight, transmittedBackground(m, table.xy), gTransmission.factor);
     vec3 dielectricF = specularAlbedo(m.specularF0, m.specularF90, nv, m.roughness, table.xy);
     vec3 metalF = specularAlbedo(m.baseColor, 1.0, nv, m.roughness, table.xy);
     vec3 dielectric = diffuseLight * (1.0 - dielectricF) + specularLight * dielectricF;

@@ -189,6 +189,8 @@ void gltfFresnelWeights(MaterialSample m, float vh, out vec3 diffuseWeight, out 
     specularWeight = mix(dielectric, metal, m.metallic);
 }
 
+#include "common/transmission.glsl"
+
 // The clear coat's Fresnel toward the viewer, times its weight: what the coat reflects of the
 // light and the environment and takes from the layers below (KHR_materials_clearcoat).
 float clearcoatFresnel(MaterialSample m, vec3 v) {
@@ -204,7 +206,8 @@ vec3 brdf(MaterialSample m, vec3 n, vec3 v, vec3 l, vec3 radiance) {
     float nl = dot(n, l);
     bool coat = MATERIAL_HAS(MATERIAL_FEATURE_CLEARCOAT) && m.clearcoat > 0.0;
     float coatNl = coat ? dot(m.clearcoatNormal, l) : 0.0;
-    if (nl <= 0.0 && coatNl <= 0.0) return vec3(0.0);
+    bool transmits = transmissionLobe(); // (false, compiled out, outside the transmission pass)
+    if (nl <= 0.0 && coatNl <= 0.0 && !transmits) return vec3(0.0);
     vec3 h = normalize(v + l);
     float vh = max(dot(v, h), 0.0);
     vec3 color = vec3(0.0);
@@ -225,6 +228,17 @@ vec3 brdf(MaterialSample m, vec3 n, vec3 v, vec3 l, vec3 radiance) {
             color = color * m.sheenAlbedoScale + sheen;
         }
         color *= nl;
+    }
+    if (transmits) {
+        // transmissionFactor of the diffuse lobe's share transmits the light from behind
+        // instead (KHR_materials_transmission), under the same Fresnel weight: at the half
+        // vector of the light mirrored through the surface when it lies behind (v + l may
+        // vanish there).
+        float vhT = nl > 0.0 ? vh : max(dot(v, normalize(reflect(l, n) + v)), 0.0);
+        vec3 diffuseWeight, specularWeight;
+        gltfFresnelWeights(m, vhT, diffuseWeight, specularWeight);
+        vec3 lambert = m.baseColor / PI * max(nl, 0.0);
+        color += diffuseWeight * gTransmission.factor * (transmissionBtdf(m, n, v, l) - lambert);
     }
     if (coat) {
         vec3 cn = m.clearcoatNormal;

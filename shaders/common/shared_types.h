@@ -22,6 +22,9 @@ using uint = uint32_t;
 #define MATERIAL_ALPHA_BLEND 2u
 #define MATERIAL_DOUBLE_SIDED 4u
 #define MATERIAL_UNLIT 8u
+// KHR_materials_transmission (factor above 0, not blended): drawn after the opaque scene by
+// render/transmission over a copy of it, in no camera list of the opaque passes.
+#define MATERIAL_TRANSMISSION 16u
 // Bits 12..15: the MATERIAL_FEATURE_* it uses (texture, procedural, clear coat, sheen), set at
 // upload and on edits from materialFeatures (setMaterialFeatureFlags, render/gpu_scene.h), read
 // where a shader or the cull chooses what to compile in. MATERIAL_FEATURED: any of them.
@@ -44,7 +47,9 @@ using uint = uint32_t;
 #define TEXTURE_SLOT_SPECULAR_COLOR 9u   // RGB = F0 tint
 #define TEXTURE_SLOT_SHEEN_COLOR 10u     // KHR_materials_sheen: RGB
 #define TEXTURE_SLOT_SHEEN_ROUGHNESS 11u // A
-#define TEXTURE_SLOT_COUNT 12u
+#define TEXTURE_SLOT_TRANSMISSION 12u     // KHR_materials_transmission: R = factor
+#define TEXTURE_SLOT_THICKNESS 13u        // KHR_materials_volume: G = thickness
+#define TEXTURE_SLOT_COUNT 14u
 
 // Samplers of the bindless table (rhi/bindless.h): the engine's own first, then one per
 // combination of a glTF sampler's wrap modes and filters, each material texture slot naming
@@ -291,11 +296,11 @@ struct GpuMaterial {
     // weighted blended OIT composites both without sorting (render/oit).
     float additiveness;
     // glTF material extensions (scene.h Material; shaders/common/material.glsl).
-    vec2 uvTransform[36]; // 3 x TEXTURE_SLOT_COUNT: per texture slot (TEXTURE_SLOT_*): columns c0,
+    vec2 uvTransform[42]; // 3 x TEXTURE_SLOT_COUNT: per texture slot (TEXTURE_SLOT_*): columns c0,
                           // c1, translation c2
     // Per texture slot, its sampler's index in the bindless table (SAMPLER_MATERIAL_*): a byte
     // each, slot s in samplers[s / 4] bits 8 * (s % 4).
-    uint samplers[3];
+    uint samplers[4];
     uint clearcoatTexture;
     uint clearcoatRoughnessTexture;
     uint clearcoatNormalTexture;
@@ -311,6 +316,14 @@ struct GpuMaterial {
     uint specularColorTexture;
     uint sheenColorTexture;
     uint sheenRoughnessTexture;
+    // KHR_materials_transmission and KHR_materials_volume (render/transmission).
+    float transmissionFactor; // 0: opaque
+    uint transmissionTexture;
+    float thicknessFactor; // in the mesh's space (scaled by the instance's transform); 0: thin
+    uint thicknessTexture;
+    vec3 attenuationColor;     // what white light becomes after attenuationDistance
+    float attenuationDistance; // world units; infinity: no attenuation
+    float ior;                 // KHR_materials_ior (the refraction; dielectricF0Scalar holds F0)
 };
 
 struct GpuLight {

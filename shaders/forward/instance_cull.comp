@@ -132,6 +132,9 @@ void main() {
         } else if (!inFrustum && pc.phase == PHASE_REST) {
             UintBuffer(c.visibility).v[id] = 0u;
         }
+        // Transmissive surfaces are drawn after the opaque scene, from a CPU list
+        // (render/transmission): in none of the camera's lists, so not in the prepass either.
+        if ((mat.flags & MATERIAL_TRANSMISSION) != 0u) draw = false;
         if (draw) {
             lod = selectLod(f, c, inst, mesh);
             haveLod = true;

@@ -88,7 +88,7 @@ static void setMaterialExtensions(gpu::GpuMaterial& g, const Material& m, SlotOf
         g.uvTransform[t * 3 + 1] = m.uvTransforms[t].c1;
         g.uvTransform[t * 3 + 2] = m.uvTransforms[t].c2;
     }
-    for (uint32_t t = 0; t < 3; ++t) g.samplers[t] = 0;
+    for (uint32_t& word : g.samplers) word = 0;
     for (uint32_t t = 0; t < kTextureSlotCount; ++t)
         g.samplers[t / 4] |= samplerIndex(m.samplers[t]) << (8 * (t % 4));
     g.clearcoatTexture = textureSlot(m.clearcoatTexture);
@@ -107,8 +107,16 @@ static void setMaterialExtensions(gpu::GpuMaterial& g, const Material& m, SlotOf
     g.specularColorTexture = textureSlot(m.specularColorTexture);
     g.sheenColorTexture = textureSlot(m.sheenColorTexture);
     g.sheenRoughnessTexture = textureSlot(m.sheenRoughnessTexture);
+    g.transmissionFactor = m.transmissionFactor;
+    g.transmissionTexture = textureSlot(m.transmissionTexture);
+    g.thicknessFactor = m.thicknessFactor;
+    g.thicknessTexture = textureSlot(m.thicknessTexture);
+    g.attenuationColor = m.attenuationColor;
+    g.attenuationDistance = m.attenuationDistance;
+    g.ior = m.ior;
 }
-static_assert(kTextureSlotCount == TEXTURE_SLOT_COUNT && 3 * TEXTURE_SLOT_COUNT == 36,
+static_assert(kTextureSlotCount == TEXTURE_SLOT_COUNT && 3 * TEXTURE_SLOT_COUNT == 42 &&
+                  TEXTURE_SLOT_COUNT <= 4 * 4,
               "scene.h TextureSlot and shared_types.h TEXTURE_SLOT_* agree");
 
 void uploadScene(Gpu& gpu, const Scene& scene, GpuScene& out, const std::vector<BakedMesh>* baked,
@@ -179,6 +187,9 @@ void uploadScene(Gpu& gpu, const Scene& scene, GpuScene& out, const std::vector<
         g.flags = (m.alphaMode == AlphaMode::Mask ? MATERIAL_ALPHA_MASK : 0u) |
                   (m.alphaMode == AlphaMode::Blend ? MATERIAL_ALPHA_BLEND : 0u) |
                   (m.doubleSided ? MATERIAL_DOUBLE_SIDED : 0u) | (m.unlit ? MATERIAL_UNLIT : 0u);
+        // Blended and unlit materials keep their own paths (transmission is a lit, opaque lobe).
+        if (m.transmissionFactor > 0.0f && m.alphaMode != AlphaMode::Blend && !m.unlit)
+            g.flags |= MATERIAL_TRANSMISSION;
         g.flags |= (uint32_t(m.surfaceClass) & MATERIAL_CLASS_MASK) << MATERIAL_CLASS_SHIFT;
         g.procedural = uint32_t(m.procedural);
         g.proceduralScale = m.proceduralScale;
@@ -396,11 +407,12 @@ void setMaterialFeatureFlags(gpu::GpuMaterial& m) {
 }
 
 std::array<uint32_t, kTextureSlotCount> materialTextureSlots(const gpu::GpuMaterial& m) {
-    static_assert(kTextureSlotCount == 12, "one entry per TextureSlot, in its order");
+    static_assert(kTextureSlotCount == 14, "one entry per TextureSlot, in its order");
     return {m.baseColorTexture,          m.metallicRoughnessTexture, m.normalTexture,
             m.emissiveTexture,           m.occlusionTexture,         m.clearcoatTexture,
             m.clearcoatRoughnessTexture, m.clearcoatNormalTexture,   m.specularTexture,
-            m.specularColorTexture,      m.sheenColorTexture,        m.sheenRoughnessTexture};
+            m.specularColorTexture,      m.sheenColorTexture,        m.sheenRoughnessTexture,
+            m.transmissionTexture,       m.thicknessTexture};
 }
 
 uint32_t materialFeatures(const gpu::GpuMaterial& m) {

@@ -45,7 +45,9 @@ static void createTargets(Renderer& r) {
     hdr.format = VK_FORMAT_R16G16B16A16_SFLOAT;
     hdr.width = r.internalWidth;
     hdr.height = r.internalHeight;
-    hdr.usage = VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT | VK_IMAGE_USAGE_SAMPLED_BIT;
+    // (copied from by render/transmission)
+    hdr.usage = VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT | VK_IMAGE_USAGE_SAMPLED_BIT |
+                VK_IMAGE_USAGE_TRANSFER_SRC_BIT;
     // compute resolve, screen space, tile shading
     if (usesVisibilityBuffer(r.settings) || r.settings.screenSpace || usesTileShading(r))
         hdr.usage |= VK_IMAGE_USAGE_STORAGE_BIT;
@@ -174,6 +176,7 @@ void initRenderer(Renderer& r, Gpu& gpu, const RenderSettings& requested, const 
     // Tile shading (--spectra on|single, forward) reads the visibility buffer too.
     if (usesVisibilityBuffer(settings) || usesTileShading(r)) r.visibility = createVisibility(r);
     r.oit = createOit(r, scene);
+    r.transmission = createTransmission(r, scene);
     r.particles = createParticles(r, scene);
     r.lightCulling = createLightCulling(r, scene);
     r.spotShadows = createSpotShadows(r, scene);
@@ -220,6 +223,7 @@ void destroyRenderer(Renderer& r) {
     if (r.visibility) destroyVisibility(r, r.visibility);
     destroyParticles(r, r.particles);
     destroyOit(r, r.oit);
+    destroyTransmission(r, r.transmission);
     if (r.decoupled) destroyDecoupled(r, r.decoupled);
     destroyCulling(r, r.culling);
     destroyFrameRecorder(r.recorder);
@@ -426,6 +430,7 @@ FrameResult renderFrame(Renderer& r, const GpuScene& scene, const CameraView& ca
     {
         auto timer = cpuScope(r, "transparency + particles");
         prepareTransparentDraws(r, scene, camera);
+        prepareTransmissionDraws(r, scene, camera);
         prepareParticleFrame(r);
     }
     {
@@ -509,6 +514,7 @@ FrameResult renderFrame(Renderer& r, const GpuScene& scene, const CameraView& ca
     recordScreenSpacePasses(r, rec, frame); // sky, SSR, SSS over classified tiles
     recordStencilEffects(r, rec, frame, constants.viewProj); // water, character outline
     recordPointsLines(r, rec, frame);        // glTF points and lines, forward in both modes
+    recordTransmissionPasses(r, rec, frame); // over a mipmapped copy of the opaque scene colour
     recordTransparencyPasses(r, rec, frame); // blended materials, after every opaque surface
     if (r.debugLines) recordDebugLinePasses(r, rec, frame, scene, constants.lightCount);
     recordParticleAtlasView(r, rec, frame); // --visualize particle-atlas

@@ -29,6 +29,7 @@
 #include "render/shadel/visibility.h"
 #include "render/skinning/skinning.h"
 #include "render/stencil/stencil_effects.h"
+#include "render/transmission/transmission.h"
 #include "rhi/frame.h"
 #include "rhi/pipeline.h"
 #include "rhi/shader_messages.h"
@@ -361,6 +362,7 @@ struct Renderer {
         bool sceneMoves = false;
     };
     std::optional<NextFrame> nextFrame;
+    TransmissionStatePtr transmission; // scenes with transmissive materials (render/transmission)
 };
 
 // Times the enclosing block as the CPU scope `name` of this frame (nothing unless

@@ -15,11 +15,12 @@ namespace {
 // Sorted: looked up with binary search. Each one is applied by the importer or the shared
 // material code; nothing here is "accepted and ignored".
 constexpr std::string_view kSupported[] = {
-    "EXT_meshopt_compression", "KHR_lights_punctual",
-    "KHR_materials_clearcoat", "KHR_materials_emissive_strength",
-    "KHR_materials_ior",       "KHR_materials_pbrSpecularGlossiness",
-    "KHR_materials_sheen",     "KHR_materials_specular",
-    "KHR_materials_unlit",     "KHR_mesh_quantization",
+    "EXT_meshopt_compression",    "KHR_lights_punctual",
+    "KHR_materials_clearcoat",    "KHR_materials_emissive_strength",
+    "KHR_materials_ior",          "KHR_materials_pbrSpecularGlossiness",
+    "KHR_materials_sheen",        "KHR_materials_specular",
+    "KHR_materials_transmission", "KHR_materials_unlit",
+    "KHR_materials_volume",       "KHR_mesh_quantization",
     "KHR_texture_transform",
 };
 

@@ -580,6 +580,10 @@ private:
             {"KHR_materials_sheen",
              {{"sheenColorFactor", 3}, {"sheenRoughnessFactor", 0}},
              {"sheenColorTexture", "sheenRoughnessTexture"}},
+            {"KHR_materials_transmission", {{"transmissionFactor", 0}}, {"transmissionTexture"}},
+            {"KHR_materials_volume",
+             {{"thicknessFactor", 0}, {"attenuationDistance", 0}, {"attenuationColor", 3}},
+             {"thicknessTexture"}},
         };
         for (const Known& k : known) {
             const json* e = member(ext, k.name);

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "core/log.h"
 
@@ -96,6 +97,31 @@ void convertSpecularGlossiness(const tinygltf::Value& sg, int index, Material& o
         t.warn(format("material %d: the specular colour of specularGlossinessTexture is not "
                       "kept (specularFactor is); its glossiness is",
                       index));
+    }
+}
+
+// KHR_materials_transmission (factor x texture R) and KHR_materials_volume (thickness factor x
+// texture G, in the mesh's space; attenuation colour and distance, infinite by default). The
+// volume extension means nothing without transmission, so it is read only beside it.
+void applyTransmission(const tinygltf::Material& gm, Material& out, const MaterialTextures& t) {
+    const tinygltf::Value* tr = extension(gm.extensions, "KHR_materials_transmission");
+    if (!tr) return;
+    out.transmissionFactor = std::clamp(number(*tr, "transmissionFactor", 0.0f), 0.0f, 1.0f);
+    if (ValueTextureInfo info = textureInfoOf(*tr, "transmissionTexture"); info.index >= 0) {
+        out.transmissionTexture = t.resolve(info.index, info.texCoord, false, "transmission");
+        setSlot(out, TextureSlot::Transmission, out.transmissionTexture, info.index, info.transform,
+                t);
+    }
+    const tinygltf::Value* vol = extension(gm.extensions, "KHR_materials_volume");
+    if (!vol) return;
+    out.thicknessFactor = std::max(number(*vol, "thicknessFactor", 0.0f), 0.0f);
+    out.attenuationColor = glm::clamp(vec3Of(*vol, "attenuationColor", glm::vec3(1.0f)),
+                                      glm::vec3(0.0f), glm::vec3(1.0f));
+    float distance = number(*vol, "attenuationDistance", 0.0f);
+    out.attenuationDistance = distance > 0.0f ? distance : std::numeric_limits<float>::infinity();
+    if (ValueTextureInfo info = textureInfoOf(*vol, "thicknessTexture"); info.index >= 0) {
+        out.thicknessTexture = t.resolve(info.index, info.texCoord, false, "thickness");
+        setSlot(out, TextureSlot::Thickness, out.thicknessTexture, info.index, info.transform, t);
     }
 }
 
@@ -245,6 +271,7 @@ void applyMaterialExtensions(const tinygltf::Material& gm, int index, Material& 
                     info.transform, t);
         }
     }
+    applyTransmission(gm, out, t);
 }
 
 } // namespace shadel

@@ -2,6 +2,7 @@
 // The scene model: plain data, no GPU objects. Importers (glTF, built-in scenes) fill it;
 // the baker and the renderers read it.
 #include <cstdint>
+#include <limits>
 #include <memory>
 #include <string>
 #include <vector>
@@ -101,6 +102,8 @@ enum class TextureSlot : uint32_t {
     SpecularColor,  // RGB = dielectric F0 tint
     SheenColor,     // KHR_materials_sheen: RGB = sheen colour
     SheenRoughness, // A = sheen roughness
+    Transmission,   // KHR_materials_transmission: R = transmission
+    Thickness,      // KHR_materials_volume: G = thickness
     Count
 };
 constexpr uint32_t kTextureSlotCount = uint32_t(TextureSlot::Count);
@@ -165,6 +168,15 @@ struct Material {
     int32_t sheenColorTexture = kNoTexture;
     int32_t sheenRoughnessTexture = kNoTexture;
     SurfaceClass surfaceClass = SurfaceClass::DefaultLit;
+    // KHR_materials_transmission: the share of the diffuse lobe that is instead specular
+    // transmission through the surface (render/transmission); KHR_materials_volume: the
+    // thickness (mesh space) the refracted ray travels, and Beer-Lambert attenuation in it.
+    float transmissionFactor = 0.0f;
+    int32_t transmissionTexture = kNoTexture;
+    float thicknessFactor = 0.0f; // 0: thin-walled
+    int32_t thicknessTexture = kNoTexture;
+    glm::vec3 attenuationColor{1.0f};
+    float attenuationDistance = std::numeric_limits<float>::infinity();
 };
 
 // A texture made by code instead of stored pixels (scene/procedural_textures.h): its texels

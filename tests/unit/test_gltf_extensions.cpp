@@ -2,6 +2,8 @@
 // is an InputError naming it; optional unsupported ones are one warning listing each once.
 #include <gtest/gtest.h>
 
+#include <cmath>
+
 #include <nlohmann/json.hpp>
 
 #include "core/error.h"
@@ -141,6 +143,48 @@ TEST(GltfExtensions, IorSpecularSheenUnlitFactorsAreRead) {
     EXPECT_EQ(m.sheenColorFactor, glm::vec3(0.9f, 0.1f, 0.2f));
     EXPECT_FLOAT_EQ(m.sheenRoughnessFactor, 0.4f);
     EXPECT_TRUE(m.unlit);
+}
+
+// KHR_materials_transmission and KHR_materials_volume: factors as authored; an attenuation
+// distance left out is infinite (no attenuation); a volume without transmission is not one.
+TEST(GltfExtensions, TransmissionAndVolumeFactorsAreRead) {
+    nlohmann::json doc = nlohmann::json::parse(R"({
+      "asset": {"version": "2.0"},
+      "extensionsUsed": ["KHR_materials_transmission", "KHR_materials_volume"],
+      "materials": [
+        {"extensions": {
+          "KHR_materials_transmission": {"transmissionFactor": 0.75},
+          "KHR_materials_volume": {"thicknessFactor": 1.2, "attenuationColor": [0.9, 0.5, 0.2],
+                                   "attenuationDistance": 0.6}}},
+        {"extensions": {
+          "KHR_materials_transmission": {"transmissionFactor": 1},
+          "KHR_materials_volume": {"thicknessFactor": 0.5}}},
+        {"extensions": {"KHR_materials_volume": {"thicknessFactor": 2}}}],
+      "meshes": [{"primitives": [{"attributes": {"POSITION": 0}, "material": 0}]}],
+      "nodes": [{"mesh": 0}], "scenes": [{"nodes": [0]}],
+      "accessors": [{"bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3"}],
+      "bufferViews": [{"buffer": 0, "byteLength": 36}],
+      "buffers": [{"byteLength": 36,
+        "uri": "data:application/octet-stream;base64,AAAAAAAAAAAAAAAAAACAPwAAAAAAAAAAAAAAAAAAgD8AAAAA"}]
+    })");
+    std::string text = doc.dump();
+    Scene s = importGltfBytes(std::vector<uint8_t>(text.begin(), text.end()), "/tmp/f.gltf");
+    ASSERT_EQ(s.materials.size(), 3u);
+    const Material& volume = s.materials[0];
+    EXPECT_FLOAT_EQ(volume.transmissionFactor, 0.75f);
+    EXPECT_FLOAT_EQ(volume.thicknessFactor, 1.2f);
+    EXPECT_EQ(volume.attenuationColor, glm::vec3(0.9f, 0.5f, 0.2f));
+    EXPECT_FLOAT_EQ(volume.attenuationDistance, 0.6f);
+    EXPECT_EQ(volume.transmissionTexture, kNoTexture);
+    const Material& clear = s.materials[1];
+    EXPECT_FLOAT_EQ(clear.transmissionFactor, 1.0f);
+    EXPECT_TRUE(std::isinf(clear.attenuationDistance));
+    EXPECT_EQ(clear.attenuationColor, glm::vec3(1.0f));
+    const Material& opaque = s.materials[2];
+    EXPECT_FLOAT_EQ(opaque.transmissionFactor, 0.0f);
+    EXPECT_FLOAT_EQ(opaque.thicknessFactor, 0.0f);
+    EXPECT_TRUE(gltfExtensionSupported("KHR_materials_transmission"));
+    EXPECT_TRUE(gltfExtensionSupported("KHR_materials_volume"));
 }
 
 TEST(GltfExtensions, WrongTypesInMaterialExtensionsAreErrors) {

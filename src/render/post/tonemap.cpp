@@ -69,7 +69,7 @@ bool tonemapFusedThisFrame(const Renderer& r) {
                           : r.settings.fuseTonemap && r.settings.ssaa == 1 && r.visibility;
     // Every pass declared after it that draws into or reads the scene colour.
     bool drawnAfter = r.particles || r.screenSpace || r.stencilEffects || r.pointsLines ||
-                      r.debugLines || transparencyThisFrame(r);
+                      r.debugLines || transparencyThisFrame(r) || transmissionThisFrame(r);
     return fusingPass && !drawnAfter;
 }
 

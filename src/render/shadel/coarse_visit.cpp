@@ -80,7 +80,10 @@ CoarseInstanceView viewInstance(const CoarseVisitPolicy& policy, const GpuScene&
     // targets (render/oit); the sorted reference keeps them forward.
     bool blended = inst.material < scene.materialInfo.size() &&
                    (scene.materialInfo[inst.material].flags & MATERIAL_ALPHA_BLEND) != 0u;
-    out.inFrustum = mesh.mipCount > 0 && !(blended && policy.blendedForward) &&
+    // Transmissive surfaces are drawn forward after the opaque scene (render/transmission).
+    bool transmissive = inst.material < scene.materialInfo.size() &&
+                        (scene.materialInfo[inst.material].flags & MATERIAL_TRANSMISSION) != 0u;
+    out.inFrustum = mesh.mipCount > 0 && !(blended && policy.blendedForward) && !transmissive &&
                     boxVisible(planes, inst.worldMin - margin, inst.worldMax + margin);
     if (!out.inFrustum) return out;
     // Hybrid: an object a few pixels across would still shade whole chunks at its coarsest MIP;
