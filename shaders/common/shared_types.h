@@ -248,7 +248,8 @@ struct GpuVertex {
     vec3 position;
     vec3 normal;
     vec4 tangent;
-    vec2 uv0;
+    vec2 uv0; // TEXCOORD_0
+    vec2 uv1; // TEXCOORD_1 (uv0 where the mesh has none)
 };
 
 struct GpuMesh {
@@ -311,6 +312,8 @@ struct GpuMaterial {
     uint specularColorTexture;
     uint sheenColorTexture;
     uint sheenRoughnessTexture;
+    // Bit s: texture slot s (TEXTURE_SLOT_*) reads the second UV set (GpuVertex.uv1), else uv0.
+    uint texCoords;
 };
 
 struct GpuLight {
