@@ -71,4 +71,10 @@ uint packDisplayPixel(vec3 display, bool covered) {
     uvec3 b = uvec3(clamp(display, 0.0, 1.0) * 255.0 + 0.5);
     return b.r | (b.g << 8) | (b.b << 16) | ((covered ? 255u : 0u) << 24);
 }
+
+// The same with a fractional coverage (supersampled frames): alpha = coverage x 255.
+uint packDisplayPixel(vec3 display, float coverage) {
+    uvec4 b = uvec4(clamp(vec4(display, coverage), 0.0, 1.0) * 255.0 + 0.5);
+    return b.r | (b.g << 8) | (b.b << 16) | (b.a << 24);
+}
 #endif

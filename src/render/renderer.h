@@ -203,7 +203,7 @@ struct FrontendWorkerTask {
 };
 
 struct FrameResult {
-    std::vector<uint8_t> rgba; // width x height RGBA8, alpha = 255 where geometry covers the pixel
+    std::vector<uint8_t> rgba; // width x height RGBA8, alpha = the covered share of the pixel (255 or 0 without --ssaa)
     uint64_t pixelsCovered = 0;
     std::vector<PassTiming> passes;
     bool tonemapFused = false; // the opaque shading pass wrote the display pixels (render/post)

@@ -2,7 +2,8 @@
 // model of tools/conformance/models.json rendered by shadel (forward and decoupled) at the
 // manifest's size from the file's camera "conformance" with the file's light, compared with the
 // viewer's image in tests/data/conformance/reference/ (rendered with the committed environment,
-// ACES Narkowicz at exposure 1, no shadows, a black background). PSNR is over the pixels either
+// ACES Narkowicz at exposure 1, no shadows, a black background; four times the size, box-filtered,
+// against shadel's 4x4 supersampling). PSNR is over the pixels either
 // image covers; each model has a floor per mode in the manifest, set from this test's figures
 // (tools/conformance/compare.py --floors-from; they are in docs/conformance/gpu_test.md).
 #include <gtest/gtest.h>
@@ -78,6 +79,24 @@ uint8_t viewerToSrgb(uint8_t v) {
     return uint8_t(std::lround(std::clamp(s, 0.0, 1.0) * 255.0));
 }
 
+// shadel's supersampled PNG has straight alpha (the covered samples' colour, alpha their share);
+// the reference holds partly covered pixels composited over black as light. This puts shadel's
+// in the same form.
+void compositeOverBlack(std::vector<uint8_t>& rgba) {
+    for (size_t i = 0; i + 3 < rgba.size(); i += 4) {
+        uint8_t a = rgba[i + 3];
+        if (a == 0 || a == 255) continue;
+        for (int c = 0; c < 3; ++c) {
+            double e = rgba[i + c] / 255.0;
+            double linear =
+                (e <= 0.04045 ? e / 12.92 : std::pow((e + 0.055) / 1.055, 2.4)) * (a / 255.0);
+            double s =
+                linear <= 0.0031308 ? linear * 12.92 : 1.055 * std::pow(linear, 1 / 2.4) - 0.055;
+            rgba[i + c] = uint8_t(std::lround(std::clamp(s, 0.0, 1.0) * 255.0));
+        }
+    }
+}
+
 std::vector<uint8_t> loadReference(const std::string& name, int& w, int& h) {
     fs::path path = kRoot / "tests/data/conformance/reference" / (name + ".png");
     int channels = 0;
@@ -141,6 +160,9 @@ RenderOptions conformanceOptions(const std::string& scene, RenderMode mode, uint
     o.backgroundColor = glm::vec3(0.0f);
     o.shadows = false;
     o.addDefaultSun = false;
+    // The reference is rendered at this many times the size and box-filtered (and multisampled):
+    // shadel supersamples as much, so edges and minified textures compare like for like.
+    o.ssaa = manifest().value("shadel_ssaa", 1u);
     return o;
 }
 
@@ -165,7 +187,8 @@ TEST_P(Conformance, MatchesSampleViewer) {
     fs::path scene = stage(model);
     RenderRun run = renderChecked(conformanceOptions(scene.string(), c.mode, w, h));
     ASSERT_EQ(run.frames.size(), 1u);
-    const std::vector<uint8_t>& img = run.frames[0].rgba;
+    std::vector<uint8_t> img = run.frames[0].rgba;
+    compositeOverBlack(img);
     ASSERT_EQ(img.size(), ref.size());
     fs::remove_all(scene.parent_path());
 

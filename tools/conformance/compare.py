@@ -67,6 +67,14 @@ def reference_as_srgb(rgba):
     return np.round(srgb_encode(linear) * 255.0)
 
 
+def shadel_over_black(rgba):
+    """shadel's straight-alpha PNG composited over black as light (the reference's encoding of
+    partly covered pixels), 0..255 sRGB floats; unchanged where alpha is 0 or 255."""
+    a = rgba[..., 3:4].astype(np.float64) / 255.0
+    linear = srgb_decode(rgba[..., :3].astype(np.float64) / 255.0) * np.where(a > 0, a, 1.0)
+    return np.round(srgb_encode(linear) * 255.0)
+
+
 def lightness(srgb255):
     """CIE L* of sRGB colours (0..255)."""
     lin = srgb_decode(srgb255 / 255.0)
@@ -115,7 +123,7 @@ def supported_flags(shadel):
     except (OSError, subprocess.TimeoutExpired) as e:
         fail(f"{shadel}: cannot run ({e})")
     flags = ("--environment", "--environment-rotation", "--tonemap", "--exposure", "--background",
-             "--sun", "--shadows")
+             "--sun", "--shadows", "--ssaa")
     return {f for f in flags if re.search(r"(?<![\w-])" + re.escape(f) + r"(?![\w-])", text)}
 
 
@@ -141,6 +149,7 @@ def shadel_flags(manifest, supported):
         ("--background", ",".join(str(c) for c in manifest["background"])),
         ("--sun", "off"),
         ("--shadows", "off"),
+        ("--ssaa", str(manifest.get("shadel_ssaa", 1))),
     ]
     if manifest["exposure_ev"] != 0:  # 0 EV is shadel's default
         wanted.append(("--exposure", str(manifest["exposure_ev"])))
@@ -199,7 +208,9 @@ def write_docs(results, manifest, missing, notes, commit, command, seconds):
              "and wrappers of the assimp glTF2 sample models. How the harness works:",
              "tools/conformance/README.md.", "",
              f"Measured on `{commit}` with `{command}` ({seconds:.0f} s), "
-             f"{manifest['size'][0]}x{manifest['size'][1]}.", "",
+             f"{manifest['size'][0]}x{manifest['size'][1]}: the reference drawn "
+             f"{manifest.get('reference_scale', 1)}x as large (multisampled) and box-filtered, "
+             f"shadel with --ssaa {manifest.get('shadel_ssaa', 1)}.", "",
              "PSNR is over covered pixels (alpha > 0 in either image), RGB in sRGB encoding;",
              "the images (docs/conformance/NAME.png) are reference | shadel | difference x4,",
              "forward above, decoupled below. The GPU test's own figures and floors:",
@@ -280,6 +291,7 @@ def main():
     ap.add_argument("--only", default="")
     ap.add_argument("--set-floors", type=float, default=None, metavar="MARGIN_DB")
     ap.add_argument("--no-docs", action="store_true")
+    ap.add_argument("--keep", metavar="DIR", help="render into DIR and keep the renders")
     ap.add_argument("--floors-from", metavar="LOG",
                     help="set the floors from a GPU test log's figures (Models/Conformance.*) "
                          "minus --set-floors (default 1.0 dB), render nothing")
@@ -300,7 +312,8 @@ def main():
     started = time.time()
     results = []
     notes = set()
-    tmp = tempfile.mkdtemp(prefix="shadel_conformance_")
+    tmp = args.keep or tempfile.mkdtemp(prefix="shadel_conformance_")
+    os.makedirs(tmp, exist_ok=True)
     try:
         for m in models:
             name = m["name"]
@@ -324,6 +337,7 @@ def main():
                     if not has_alpha:  # no coverage in the file: the reference's alone counts
                         rgba[..., 3] = 0
                         notes.add("shadel's PNG had no alpha: PSNR over the reference's coverage")
+                    rgba[..., :3] = shadel_over_black(rgba)
                     p, n = covered_psnr(ref_rgb, ref[..., 3], rgba)
                     r[f"psnr_{mode}"] = p
                     r["covered"] = n
@@ -343,7 +357,8 @@ def main():
                   + (f", metal L* diff {r['lstar_forward']:.2f} / {r['lstar_decoupled']:.2f}"
                      if "lstar_forward" in r else ""), flush=True)
     finally:
-        shutil.rmtree(tmp, ignore_errors=True)
+        if not args.keep:
+            shutil.rmtree(tmp, ignore_errors=True)
     seconds = time.time() - started
     command = "tools/conformance/compare.py" + (f" --only {args.only}" if args.only else "")
     if not args.no_docs:

@@ -15,9 +15,14 @@
 // (renderEnvironmentMap false), clearColor (0, 0, 0, 0), exposure 1, tone map "ACES Filmic Tone
 // Mapping (Narkowicz)", no animation. The PNG holds the drawing buffer as read back: RGB as the
 // viewer encodes it, pow(x, 1/2.2) (not the sRGB curve), over black; alpha is coverage (0 where
-// nothing was drawn; the canvas is multisampled, so edges are fractional).
+// nothing was drawn). The canvas is reference_scale times the size, multisampled, and box-filtered
+// down; the projection is moved up by reference_y_offset canvas pixels (see README.md).
 //
 // Usage: node tools/conformance/render_reference.js [--only NAME[,NAME...]] [--chromium PATH]
+//          [--out DIR] [--scale N] [--y-offset PIXELS] [--no-msaa]
+// --scale and --y-offset default to the manifest's reference_scale and reference_y_offset; --out
+// (experiments) writes elsewhere and leaves VERSIONS.md alone. CONFORMANCE_ENVIRONMENT=FILE.hdr
+// replaces the manifest's environment (a small one skips minutes of prefiltering).
 "use strict";
 const fs = require("fs");
 const path = require("path");
@@ -32,11 +37,16 @@ const outDir = path.join(root, "tests", "data", "conformance", "reference");
 const origin = "http://conformance.invalid";
 
 function parseArgs() {
-  const args = { only: null, chromium: "/usr/lib/chromium/chromium" };
+  const args = { only: null, chromium: "/usr/lib/chromium/chromium", out: null, msaa: true,
+    scale: null, yOffset: null };
   const argv = process.argv.slice(2);
   for (let i = 0; i < argv.length; i++) {
     if (argv[i] === "--only") args.only = argv[++i].split(",");
     else if (argv[i] === "--chromium") args.chromium = argv[++i];
+    else if (argv[i] === "--out") args.out = argv[++i];
+    else if (argv[i] === "--no-msaa") args.msaa = false;
+    else if (argv[i] === "--scale") args.scale = Number(argv[++i]);
+    else if (argv[i] === "--y-offset") args.yOffset = Number(argv[++i]);
     else {
       console.error(`render_reference.js: unknown argument ${argv[i]}`);
       process.exit(2);
@@ -91,6 +101,31 @@ function encodePng(width, height, rgba) {
   ]);
 }
 
+// Box-filters a (width*scale) x (height*scale) readback to width x height: RGB averaged as light
+// (the viewer's pow(x, 1/2.2) undone, then redone), alpha averaged as coverage.
+function downsample(rgba, width, height, scale) {
+  if (scale === 1) return rgba;
+  const out = Buffer.alloc(width * height * 4);
+  const w = width * scale;
+  const n = scale * scale;
+  for (let y = 0; y < height; y++) {
+    for (let x = 0; x < width; x++) {
+      const sum = [0, 0, 0, 0];
+      for (let sy = 0; sy < scale; sy++) {
+        for (let sx = 0; sx < scale; sx++) {
+          const i = ((y * scale + sy) * w + x * scale + sx) * 4;
+          for (let c = 0; c < 3; c++) sum[c] += Math.pow(rgba[i + c] / 255, 2.2);
+          sum[3] += rgba[i + 3];
+        }
+      }
+      const o = (y * width + x) * 4;
+      for (let c = 0; c < 3; c++) out[o + c] = Math.round(Math.pow(sum[c] / n, 1 / 2.2) * 255);
+      out[o + 3] = Math.round(sum[3] / n);
+    }
+  }
+  return out;
+}
+
 function writeAtomic(file, data) {
   const tmp = `${file}.tmp`;
   fs.writeFileSync(tmp, data);
@@ -121,7 +156,7 @@ function resolveFile(manifest, urlPath) {
   if (p === "/index.html") return { body: Buffer.from(pageHtml()), type: "text/html" };
   let file = null;
   if (p.startsWith("/viewer/")) file = path.join(viewerDir, p.slice("/viewer/".length));
-  else if (p === "/environment.hdr") file = path.join(root, manifest.environment);
+  else if (p === "/environment.hdr") file = process.env.CONFORMANCE_ENVIRONMENT || path.join(root, manifest.environment);
   else if (p === "/lut_sheen_E.png") file = path.join(here, "lut_sheen_E.png");
   else if (p.startsWith("/models/")) {
     const [name, ...rest] = p.slice("/models/".length).split("/");
@@ -146,7 +181,7 @@ async function setUpViewer(page, settings) {
     canvas.height = settings.height;
     document.body.appendChild(canvas);
     const gl = canvas.getContext("webgl2", {
-      alpha: true, antialias: true, premultipliedAlpha: false, preserveDrawingBuffer: true,
+      alpha: true, antialias: settings.msaa, premultipliedAlpha: false, preserveDrawingBuffer: true,
     });
     const view = new GltfView(gl);
     const state = view.createState();
@@ -167,6 +202,7 @@ async function setUpViewer(page, settings) {
     state.environment = await loader.loadEnvironment("/environment.hdr", {
       lut_sheen_E_file: "/lut_sheen_E.png",
     });
+    window.conformanceYOffset = settings.yOffset;
     window.conformance = { gl, view, state, loader, canvas };
     return {
       renderer: gl.getParameter(gl.getExtension("WEBGL_debug_renderer_info").UNMASKED_RENDERER_WEBGL),
@@ -184,6 +220,17 @@ async function renderModel(page, name, file) {
     const cameras = state.gltf.cameras || [];
     state.cameraIndex = cameras.findIndex((c) => c.name === "conformance");
     if (state.cameraIndex < 0) throw new Error(`${name}: no camera named "conformance"`);
+    const yOffset = window.conformanceYOffset;
+    if (yOffset) {
+      // Moves the picture up by yOffset pixels: clip y += ndcOffset * w, and w = -z_view.
+      const camera = cameras[state.cameraIndex];
+      const projection = camera.getProjectionMatrix.bind(camera);
+      camera.getProjectionMatrix = (aspect) => {
+        const m = projection(aspect);
+        m[9] -= (2 * yOffset) / canvas.height;
+        return m;
+      };
+    }
     for (let i = 0; i < 3; i++) view.renderFrame(state, canvas.width, canvas.height);
     gl.finish();
     const w = canvas.width, h = canvas.height;
@@ -249,19 +296,24 @@ async function main() {
       }
       req.respond({ status: 200, contentType: found.type, body: found.body });
     });
-    await page.setViewport({ width, height });
+    const scale = args.scale || manifest.reference_scale || 1;
+    const yOffset = args.yOffset !== null ? args.yOffset : manifest.reference_y_offset || 0;
+    const out = args.out || outDir;
+    fs.mkdirSync(out, { recursive: true });
+    await page.setViewport({ width: width * scale, height: height * scale });
     await page.goto(`${origin}/index.html`);
     await page.waitForFunction(() => window.viewerReady === true);
     const env = await setUpViewer(page, {
-      width, height, environmentRotation: manifest.viewer_environment_rotation,
+      width: width * scale, height: height * scale, msaa: args.msaa, yOffset,
+      environmentRotation: manifest.viewer_environment_rotation,
     });
     console.log(`WebGL renderer: ${env.renderer}`);
     const timings = [];
     for (const m of models) {
       const url = `/models/${m.name}/${path.basename(m.file)}`;
       const r = await renderModel(page, m.name, url);
-      const png = encodePng(width, height, Buffer.from(r.rgba, "base64"));
-      writeAtomic(path.join(outDir, `${m.name}.png`), png);
+      const rgba = downsample(Buffer.from(r.rgba, "base64"), width, height, scale);
+      writeAtomic(path.join(out, `${m.name}.png`), encodePng(width, height, rgba));
       timings.push(`${m.name} ${r.seconds.toFixed(1)} s`);
       console.log(`${m.name}: ${r.seconds.toFixed(1)} s`);
     }
@@ -283,10 +335,12 @@ tests/gpu/test_conformance.cpp. Regenerate with \`tools/conformance/setup.sh\` (
 | node | ${v.node} |
 
 - Chromium flags: \`--headless --use-angle=swiftshader --enable-unsafe-swiftshader --no-sandbox\`.
-- Size ${width}x${height}; camera "conformance" and the file's lights; environment
+- Size ${width}x${height}: drawn ${scale}x as large into a multisampled canvas with the projection
+  moved ${yOffset} canvas pixels up (headless ANGLE/SwiftShader draws half a pixel low), then
+  box-filtered (RGB as light, alpha as coverage); camera "conformance" and the file's lights; environment
   ${manifest.environment} as image-based light only (not drawn), environmentRotation
   ${manifest.viewer_environment_rotation}; tone map ACES Filmic (Narkowicz), exposure 1;
-  clear colour (0, 0, 0, 0); multisampled canvas.
+  clear colour (0, 0, 0, 0).
 - Encoding: RGB is the viewer's output, pow(linear, 1/2.2) — not the sRGB curve — over black;
   alpha is coverage. Comparisons decode with the 2.2 power and re-encode with the sRGB curve.
 - The sheen albedo table (lut_sheen_E.png) is computed by tools/conformance/make_environment.py;
@@ -294,7 +348,7 @@ tests/gpu/test_conformance.cpp. Regenerate with \`tools/conformance/setup.sh\` (
 - The whole run took ${total.toFixed(0)} s. The viewer prefilters the environment when the first
   model is drawn, so the first model's time includes it (${models.length} models: ${timings.join(", ")}).
 `;
-    if (!args.only) writeAtomic(path.join(outDir, "VERSIONS.md"), md);
+    if (!args.only && !args.out) writeAtomic(path.join(outDir, "VERSIONS.md"), md);
     console.log(`done in ${total.toFixed(0)} s`);
   } finally {
     await browser.close();
