@@ -10,9 +10,12 @@ struct SurfaceInput {
     vec3 position;  // world
     vec3 normal;    // world, normalised geometric/interpolated normal
     vec4 tangent;   // world xyz + handedness
-    vec2 uv;
+    vec2 uv;        // the first UV set (TEXCOORD_0)
     vec2 uvDx;      // derivatives of uv along the two screen (or shadel) axes
     vec2 uvDy;
+    vec2 uv1;       // the second UV set (TEXCOORD_1) and its derivatives, for the texture slots
+    vec2 uv1Dx;     // that read it (GpuMaterial.texCoords)
+    vec2 uv1Dy;
     bool frontFacing;
 };
 
@@ -74,13 +77,27 @@ uint materialSampler(GpuMaterial m, uint slot) {
     return (m.samplers[slot >> 2u] >> ((slot & 3u) * 8u)) & 0xFFu;
 }
 
-// A material texture through its slot's KHR_texture_transform (derivatives transformed with it)
-// and its slot's sampler (wrap modes and filters as authored).
+// Whether a material texture slot reads the second UV set (TEXCOORD_1) instead of the first.
+bool materialReadsUv1(GpuMaterial m, uint slot) {
+    return ((m.texCoords >> slot) & 1u) != 0u;
+}
+
+// The UV set a texture slot reads, of the two a shader has at hand.
+vec2 materialSlotUv(GpuMaterial m, uint slot, vec2 uv0, vec2 uv1) {
+    return materialReadsUv1(m, slot) ? uv1 : uv0;
+}
+
+// A material texture through its slot's UV set and KHR_texture_transform (derivatives
+// transformed with it) and its slot's sampler (wrap modes and filters as authored).
 vec4 sampleMaterialTexture(GpuMaterial m, uint slot, uint tex, SurfaceInput s) {
+    bool second = materialReadsUv1(m, slot);
+    vec2 st = second ? s.uv1 : s.uv;
+    vec2 stDx = second ? s.uv1Dx : s.uvDx;
+    vec2 stDy = second ? s.uv1Dy : s.uvDy;
     vec2 c0 = m.uvTransform[slot * 3u], c1 = m.uvTransform[slot * 3u + 1u];
-    vec2 uv = c0 * s.uv.x + c1 * s.uv.y + m.uvTransform[slot * 3u + 2u];
-    vec2 dx = c0 * s.uvDx.x + c1 * s.uvDx.y;
-    vec2 dy = c0 * s.uvDy.x + c1 * s.uvDy.y;
+    vec2 uv = c0 * st.x + c1 * st.y + m.uvTransform[slot * 3u + 2u];
+    vec2 dx = c0 * stDx.x + c1 * stDx.y;
+    vec2 dy = c0 * stDy.x + c1 * stDy.y;
     uint samplerId = materialSampler(m, slot);
     // Filters without mipmaps read level 0 whatever the footprint: streaming must bring it in.
     bool level0 = (samplerId - SAMPLER_MATERIAL_FIRST) % SAMPLER_MIN_COUNT <= SAMPLER_MIN_LINEAR;
@@ -89,7 +106,8 @@ vec4 sampleMaterialTexture(GpuMaterial m, uint slot, uint tex, SurfaceInput s) {
 }
 
 // The base colour's alpha where only coverage matters (alpha-tested depth and visibility
-// passes, decoupled transparency): the same texture transform and sampler as shading.
+// passes, decoupled transparency): the same texture transform and sampler as shading. uv is the
+// UV set the base colour reads (materialSlotUv with TEXTURE_SLOT_BASE_COLOR).
 float materialBaseAlpha(GpuMaterial m, vec2 uv, vec2 uvDx, vec2 uvDy) {
     float alpha = m.baseColorFactor.a;
     if (m.baseColorTexture == NO_TEXTURE) return alpha;
@@ -97,6 +115,9 @@ float materialBaseAlpha(GpuMaterial m, vec2 uv, vec2 uvDx, vec2 uvDy) {
     s.uv = uv;
     s.uvDx = uvDx;
     s.uvDy = uvDy;
+    s.uv1 = uv;
+    s.uv1Dx = uvDx;
+    s.uv1Dy = uvDy;
     return alpha * sampleMaterialTexture(m, TEXTURE_SLOT_BASE_COLOR, m.baseColorTexture, s).a;
 }
 

@@ -253,7 +253,8 @@ struct GpuVertex {
     vec3 position;
     vec3 normal;
     vec4 tangent;
-    vec2 uv0;
+    vec2 uv0; // TEXCOORD_0
+    vec2 uv1; // TEXCOORD_1 (uv0 where the mesh has none)
 };
 
 struct GpuMesh {
@@ -324,6 +325,8 @@ struct GpuMaterial {
     vec3 attenuationColor;     // what white light becomes after attenuationDistance
     float attenuationDistance; // world units; infinity: no attenuation
     float ior;                 // KHR_materials_ior (the refraction; dielectricF0Scalar holds F0)
+    // Bit s: texture slot s (TEXTURE_SLOT_*) reads the second UV set (GpuVertex.uv1), else uv0.
+    uint texCoords;
 };
 
 struct GpuLight {

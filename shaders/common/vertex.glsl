@@ -8,6 +8,7 @@ struct WorldVertex {
     vec3 normal;
     vec4 tangent;
     vec2 uv0;
+    vec2 uv1;
 };
 
 WorldVertex fetchWorldVertex(FrameConstants f, GpuInstance inst, uint vertexIndex) {
@@ -17,6 +18,7 @@ WorldVertex fetchWorldVertex(FrameConstants f, GpuInstance inst, uint vertexInde
     o.normal = normalize(mat3(inst.normalMatrix) * v.normal);
     o.tangent = vec4(normalize(mat3(inst.model) * v.tangent.xyz + vec3(1e-9)), v.tangent.w);
     o.uv0 = v.uv0;
+    o.uv1 = v.uv1;
     return o;
 }
 #endif

@@ -23,6 +23,7 @@ layout(location = 0) in vec3 inPosition;
 layout(location = 1) in vec3 inNormal;
 layout(location = 2) in vec4 inTangent;
 layout(location = 3) in vec2 inUv;
+layout(location = 7) in vec2 inUv1; // the second UV set (TEXCOORD_1)
 layout(location = 4) flat in uint inInstance;
 // --inspect: the triangle, from visibility vertices (VISIBILITY_VERTICES_ALL); reading
 // gl_PrimitiveID, even only there, cost lavapipe's forward shading of builtin:many a fifth.
@@ -46,6 +47,9 @@ void main() {
     s.uv = inUv;
     s.uvDx = dFdx(inUv);
     s.uvDy = dFdy(inUv);
+    s.uv1 = inUv1;
+    s.uv1Dx = dFdx(inUv1);
+    s.uv1Dy = dFdy(inUv1);
     s.frontFacing = gl_FrontFacing;
     // Decals land on opaque surfaces: the list of this pixel's tile (render/decals).
     if ((mat.flags & MATERIAL_ALPHA_BLEND) == 0u) useTileDecalList(f, gl_FragCoord.xy);
@@ -60,7 +64,8 @@ void main() {
     vec3 color = shadeSurface(f, m, inPosition, s.normal);
     if (inspecting(f, uvec2(gl_FragCoord.xy))) {
         beginInspect(f, inInstance, inTriangle, gl_FragCoord);
-        vec2 footprint = max(abs(s.uvDx), abs(s.uvDy));
+        bool uv1 = materialReadsUv1(mat, TEXTURE_SLOT_BASE_COLOR);
+        vec2 footprint = max(abs(uv1 ? s.uv1Dx : s.uvDx), abs(uv1 ? s.uv1Dy : s.uvDy));
         if (mat.baseColorTexture != NO_TEXTURE)
             footprint *= vec2(textureSize(gTextures[nonuniformEXT(mat.baseColorTexture)], 0));
         shaderPrintF(f, PRINT_UV_LOD, log2(max(max(footprint.x, footprint.y), 1e-8)));

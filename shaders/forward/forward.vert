@@ -12,6 +12,7 @@ layout(location = 0) out vec3 outPosition;
 layout(location = 1) out vec3 outNormal;
 layout(location = 2) out vec4 outTangent;
 layout(location = 3) out vec2 outUv;
+layout(location = 7) out vec2 outUv1; // the second UV set (TEXCOORD_1)
 layout(location = 4) flat out uint outInstance;
 layout(location = 5) out vec2 outShadelUv; // object's shadel space (decoupled path only)
 layout(location = 6) flat out uint outTriangle; // with visibility vertices, else 0
@@ -41,6 +42,7 @@ void main() {
     outNormal = v.normal;
     outTangent = v.tangent;
     outUv = v.uv0;
+    outUv1 = v.uv1;
     outInstance = instanceId;
     outShadelUv = f.shadel != 0ul ? Vec2Buffer(ShadelFrameRef(f.shadel).s.shadelUvs).v[vertexIndex] : vec2(0.0);
     if (kVisibilityVertices == VISIBILITY_VERTICES_PREPASS) { // it reads only the IDs and UVs

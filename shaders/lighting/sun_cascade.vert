@@ -13,6 +13,7 @@ layout(push_constant, scalar) uniform Push {
 } pc;
 
 layout(location = 3) out vec2 outUv;
+layout(location = 7) out vec2 outUv1; // the second UV set (TEXCOORD_1)
 layout(location = 4) flat out uint outInstance;
 
 void main() {
@@ -21,6 +22,7 @@ void main() {
     GpuInstance inst = InstanceBuffer(f.instances).i[instanceId];
     WorldVertex v = fetchWorldVertex(f, inst, gl_VertexIndex);
     outUv = v.uv0;
+    outUv1 = v.uv1;
     outInstance = instanceId;
     LightingFrame lf = LightingFrameRef(f.lighting).l;
     gl_Position = SunCascadesRef(lf.sunCascades).c.viewProj[pc.shadowView] * vec4(v.position, 1.0);

@@ -50,6 +50,9 @@ void main() {
         s.uv = visInterpolate(w, a.uv0, b.uv0, c.uv0);
         s.uvDx = visInterpolate(bary.dx, a.uv0, b.uv0, c.uv0);
         s.uvDy = visInterpolate(bary.dy, a.uv0, b.uv0, c.uv0);
+        s.uv1 = visInterpolate(w, a.uv1, b.uv1, c.uv1);
+        s.uv1Dx = visInterpolate(bary.dx, a.uv1, b.uv1, c.uv1);
+        s.uv1Dy = visInterpolate(bary.dy, a.uv1, b.uv1, c.uv1);
         s.frontFacing = tri.frontFacing;
         useTileDecalList(f, vec2(pixel) + 0.5); // decals (render/decals)
         MaterialSample m = evaluateMaterial(mat, s);

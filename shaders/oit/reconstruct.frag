@@ -28,8 +28,9 @@ void main() {
                                          reconstructionLayer(f, s));
     countReconstruction(s, r);
     GpuMaterial mat = MaterialBuffer(f.materials).m[InstanceBuffer(f.instances).i[inInstance].material];
-    vec2 uvDx = dFdx(inUv), uvDy = dFdy(inUv); // outside any branch
-    float alpha = materialBaseAlpha(mat, inUv, uvDx, uvDy);
+    vec2 uv = materialSlotUv(mat, TEXTURE_SLOT_BASE_COLOR, inUv, inUv1);
+    vec2 uvDx = dFdx(uv), uvDy = dFdy(uv); // outside any branch
+    float alpha = materialBaseAlpha(mat, uv, uvDx, uvDy);
     TransparentFragment t = transparentFragment(r.color, alpha, mat.additiveness);
     if (r.missing + r.overflowed != 0u) t = shadeTransparentFragment(f);
     t.premultiplied = visualizeReconstruction(f, o, r, t.premultiplied, inShadelUv, texelDx, texelDy);

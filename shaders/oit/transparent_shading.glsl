@@ -9,6 +9,7 @@ layout(location = 0) in vec3 inPosition;
 layout(location = 1) in vec3 inNormal;
 layout(location = 2) in vec4 inTangent;
 layout(location = 3) in vec2 inUv;
+layout(location = 7) in vec2 inUv1; // the second UV set (TEXCOORD_1)
 layout(location = 4) flat in uint inInstance;
 
 TransparentFragment shadeTransparentFragment(FrameConstants f) {
@@ -21,6 +22,9 @@ TransparentFragment shadeTransparentFragment(FrameConstants f) {
     s.uv = inUv;
     s.uvDx = dFdx(inUv);
     s.uvDy = dFdy(inUv);
+    s.uv1 = inUv1;
+    s.uv1Dx = dFdx(inUv1);
+    s.uv1Dy = dFdy(inUv1);
     s.frontFacing = gl_FrontFacing;
     MaterialSample m = evaluateMaterial(mat, s);
     vec3 color = shadeSurface(f, m, inPosition, s.normal);

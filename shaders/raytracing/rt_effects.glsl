@@ -169,6 +169,9 @@ vec3 rtShadeHit(FrameConstants f, RtFrame rt, uint instanceId, uint primitive, v
     s.uv = a.uv0 * w.x + b.uv0 * w.y + c.uv0 * w.z;
     s.uvDx = vec2(0.0);
     s.uvDy = vec2(0.0);
+    s.uv1 = a.uv1 * w.x + b.uv1 * w.y + c.uv1 * w.z;
+    s.uv1Dx = vec2(0.0);
+    s.uv1Dy = vec2(0.0);
     s.frontFacing = frontFace;
     GpuMaterial mat = MaterialBuffer(f.materials).m[inst.material];
     MaterialSample m = evaluateMaterial(mat, s);

@@ -18,6 +18,7 @@ layout(location = 0) in vec3 inPosition;
 layout(location = 1) in vec3 inNormal;
 layout(location = 2) in vec4 inTangent;
 layout(location = 3) in vec2 inUv;
+layout(location = 7) in vec2 inUv1; // the second UV set (TEXCOORD_1)
 layout(location = 4) flat in uint inInstance;
 
 layout(location = 0) out vec4 outTerms;
@@ -36,6 +37,9 @@ void main() {
     s.uv = inUv;
     s.uvDx = dFdx(inUv);
     s.uvDy = dFdy(inUv);
+    s.uv1 = inUv1;
+    s.uv1Dx = dFdx(inUv1);
+    s.uv1Dy = dFdy(inUv1);
     s.frontFacing = gl_FrontFacing;
     MaterialSample m = evaluateMaterial(mat, s);
     if ((mat.flags & MATERIAL_ALPHA_MASK) != 0u && m.alpha < mat.alphaCutoff) discard;

@@ -34,11 +34,16 @@ SurfaceInput prefilterSample(SurfaceInput si, uint i, uint j, uint n, inout uint
                              vec2 step, vec2 s0, vec2 s1, vec2 s2, vec2 t0, vec2 t1, vec2 t2) {
     h = h * 747796405u + 2891336453u;
     vec2 jitter = vec2(float(h & 0xFFFFu), float(h >> 16)) / 65536.0;
-    vec2 at = centre + ((vec2(i, j) + jitter) / float(n) - 0.5) * step;
+    vec2 offset = (vec2(i, j) + jitter) / float(n) - 0.5; // in shadels from the centre
+    vec2 at = centre + offset * step;
     SurfaceInput sub = si;
     sub.uv = shadelInterpolate2(shadelBarycentrics(at, s0, s1, s2), t0, t1, t2);
     sub.uvDx = si.uvDx / float(n);
     sub.uvDy = si.uvDy / float(n);
+    // The second UV set is affine over the triangle too: its shadel derivatives carry it.
+    sub.uv1 = si.uv1 + si.uv1Dx * offset.x + si.uv1Dy * offset.y;
+    sub.uv1Dx = si.uv1Dx / float(n);
+    sub.uv1Dy = si.uv1Dy / float(n);
     return sub;
 }
 

@@ -16,6 +16,7 @@ layout(location = 0) in vec3 inPosition;
 layout(location = 1) in vec3 inNormal;
 layout(location = 2) in vec4 inTangent;
 layout(location = 3) in vec2 inUv;
+layout(location = 7) in vec2 inUv1; // the second UV set (TEXCOORD_1)
 layout(location = 4) flat in uint inInstance;
 layout(location = 5) in vec2 inShadelUv;
 // --inspect: the triangle, from visibility vertices (VISIBILITY_VERTICES_ALL); reading
@@ -34,6 +35,9 @@ vec3 forwardShade(FrameConstants f) {
     si.uv = inUv;
     si.uvDx = dFdx(inUv);
     si.uvDy = dFdy(inUv);
+    si.uv1 = inUv1;
+    si.uv1Dx = dFdx(inUv1);
+    si.uv1Dy = dFdy(inUv1);
     si.frontFacing = gl_FrontFacing;
     useTileDecalList(f, gl_FragCoord.xy); // decals, as forward shading applies them
     MaterialSample m = evaluateMaterial(mat, si);

@@ -61,6 +61,9 @@ vec3 forwardShade(FrameConstants f, GpuInstance inst, VisTriangle tri, VisBary b
     si.uv = visInterpolate(w, a.uv0, b.uv0, c.uv0);
     si.uvDx = visInterpolate(bary.dx, a.uv0, b.uv0, c.uv0);
     si.uvDy = visInterpolate(bary.dy, a.uv0, b.uv0, c.uv0);
+    si.uv1 = visInterpolate(w, a.uv1, b.uv1, c.uv1);
+    si.uv1Dx = visInterpolate(bary.dx, a.uv1, b.uv1, c.uv1);
+    si.uv1Dy = visInterpolate(bary.dy, a.uv1, b.uv1, c.uv1);
     si.frontFacing = tri.frontFacing;
     MaterialSample m = evaluateMaterial(mat, si);
     // The lights as forward shading culls them (a tile's list, or the light grid's candidates

@@ -222,6 +222,9 @@ void main() {
     vec2 uv = shadelInterpolate2(bary.center, v0.uv0, v1.uv0, v2.uv0);
     vec2 uvDx = shadelInterpolate2(bary.right, v0.uv0, v1.uv0, v2.uv0) - uv;
     vec2 uvDy = shadelInterpolate2(bary.down, v0.uv0, v1.uv0, v2.uv0) - uv;
+    vec2 uv1 = shadelInterpolate2(bary.center, v0.uv1, v1.uv1, v2.uv1);
+    vec2 uv1Dx = shadelInterpolate2(bary.right, v0.uv1, v1.uv1, v2.uv1) - uv1;
+    vec2 uv1Dy = shadelInterpolate2(bary.down, v0.uv1, v1.uv1, v2.uv1) - uv1;
 
     SurfaceInput si;
     si.position = (inst.model * vec4(p, 1.0)).xyz;
@@ -230,6 +233,9 @@ void main() {
     si.uv = uv;
     si.uvDx = uvDx;
     si.uvDy = uvDy;
+    si.uv1 = uv1;
+    si.uv1Dx = uv1Dx;
+    si.uv1Dy = uv1Dy;
     // With few lights each subgroup culls them for its own shadels (no barrier); else the
     // chunk culls them, or a spectrum's permutation reads the list its classify pass culled.
     // Spectra never cull per subgroup nor per chunk: their permutations compile neither in.

@@ -11,6 +11,7 @@ layout(push_constant, scalar) uniform Push {
 } pc;
 
 layout(location = 3) in vec2 inUv;
+layout(location = 7) in vec2 inUv1; // the second UV set (TEXCOORD_1)
 layout(location = 4) flat in uint inInstance;
 layout(location = 6) flat in uint inTriangle; // from the provoking vertex (kVisibilityVertices)
 
@@ -24,7 +25,8 @@ void main() {
         GpuInstance inst = InstanceBuffer(f.instances).i[inInstance];
         GpuMaterial m = MaterialBuffer(f.materials).m[inst.material];
         if ((m.flags & MATERIAL_ALPHA_MASK) != 0u) {
-            if (materialBaseAlpha(m, inUv, dFdx(inUv), dFdy(inUv)) < m.alphaCutoff) discard;
+            vec2 uv = materialSlotUv(m, TEXTURE_SLOT_BASE_COLOR, inUv, inUv1);
+            if (materialBaseAlpha(m, uv, dFdx(uv), dFdy(uv)) < m.alphaCutoff) discard;
         }
     }
     outVisibility = uvec2(inInstance, inTriangle);

@@ -47,5 +47,6 @@ void main() {
     o.normal = n;
     o.tangent = vec4(len > 1e-6 ? t / len : anyPerpendicular(n), b.tangent.w);
     o.uv0 = b.uv0;
+    o.uv1 = b.uv1;
     DeformedBuffer(pc.deformed).v[s.target] = o;
 }

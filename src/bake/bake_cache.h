@@ -14,11 +14,12 @@
 namespace shadel {
 
 // Bump whenever the bake output for the same input can change (algorithm or layout).
-constexpr uint32_t kBakeFormatVersion = 6; // 2: conformal charts, outline packing, stretch;
+constexpr uint32_t kBakeFormatVersion = 7; // 2: conformal charts, outline packing, stretch;
                                            // 3: charts bounded by the mesh density CV;
                                            // 4: waste-aware packing of few charts;
                                            // 5: 22.5-degree orientations;
-                                           // 6: wider growth cones tried on few charts
+                                           // 6: wider growth cones tried on few charts;
+                                           // 7: vertices carry a second UV set
 
 struct BakeKey {
     uint64_t lo = 0, hi = 0;

@@ -91,6 +91,9 @@ static void setMaterialExtensions(gpu::GpuMaterial& g, const Material& m, SlotOf
     for (uint32_t& word : g.samplers) word = 0;
     for (uint32_t t = 0; t < kTextureSlotCount; ++t)
         g.samplers[t / 4] |= samplerIndex(m.samplers[t]) << (8 * (t % 4));
+    g.texCoords = 0;
+    for (uint32_t t = 0; t < kTextureSlotCount; ++t)
+        if (m.texCoords[t] == 1) g.texCoords |= 1u << t;
     g.clearcoatTexture = textureSlot(m.clearcoatTexture);
     g.clearcoatRoughnessTexture = textureSlot(m.clearcoatRoughnessTexture);
     g.clearcoatNormalTexture = textureSlot(m.clearcoatNormalTexture);
@@ -230,7 +233,8 @@ void uploadScene(Gpu& gpu, const Scene& scene, GpuScene& out, const std::vector<
         if (b && !b->indices.empty()) {
             for (size_t v = 0; v < b->vertexRemap.size(); ++v) {
                 const Vertex& src = mesh.vertices[b->vertexRemap[v]];
-                geometry.vertices.push_back({src.position, src.normal, src.tangent, src.uv0});
+                geometry.vertices.push_back(
+                    {src.position, src.normal, src.tangent, src.uv0, src.uv1});
             }
             geometry.shadelUvs = b->shadelUv;
             geometry.sources = b->vertexRemap;
@@ -239,7 +243,7 @@ void uploadScene(Gpu& gpu, const Scene& scene, GpuScene& out, const std::vector<
             g.shadelMesh = uint32_t(mi);
         } else {
             for (const Vertex& v : mesh.vertices)
-                geometry.vertices.push_back({v.position, v.normal, v.tangent, v.uv0});
+                geometry.vertices.push_back({v.position, v.normal, v.tangent, v.uv0, v.uv1});
             geometry.indices = mesh.indices;
         }
         // LOD 0 and its simplified levels, all in the unified buffers (render/culling).
@@ -283,6 +287,10 @@ void uploadScene(Gpu& gpu, const Scene& scene, GpuScene& out, const std::vector<
             for (size_t v = 0; v < b.vertexRemap.size(); ++v)
                 materialUv[v] = scene.meshes[mi].vertices[b.vertexRemap[v]].uv0;
             info.uvPerShadelLog2 =
+                uvPerShadelLog2(materialUv, b.shadelUv, b.indices, info.mip0Size);
+            for (size_t v = 0; v < b.vertexRemap.size(); ++v)
+                materialUv[v] = scene.meshes[mi].vertices[b.vertexRemap[v]].uv1;
+            info.uv1PerShadelLog2 =
                 uvPerShadelLog2(materialUv, b.shadelUv, b.indices, info.mip0Size);
             info.mipCount = std::min<uint32_t>(b.mipCount(), SHADEL_MAX_MIPS);
             for (uint32_t k = 0; k < info.mipCount; ++k) {

@@ -18,8 +18,10 @@ struct ShadelMeshInfo {
     glm::uvec2 mip0Size{0};
     uint32_t mipCount = 0;    // 0: no shadel space (drawn forward)
     float shadelsPerUnit = 0; // MIP-0 shadels per object-space unit (BakedMesh::shadelsPerMetre)
-    // log2 of the material-UV units a MIP-0 shadel spans (render/shadel/texture_rate.h)
+    // log2 of the material-UV units a MIP-0 shadel spans (render/shadel/texture_rate.h), in
+    // the first UV set and in the second
     float uvPerShadelLog2 = 0;
+    float uv1PerShadelLog2 = 0;
     std::array<uint32_t, SHADEL_MAX_MIPS> idMapOffset{}; // 16-bit units into GpuScene::idMaps
     uint64_t idMapTexels = 0;
 };

@@ -149,8 +149,10 @@ Light addAreaLight(Scene& scene, const std::string& name, glm::vec3 centre, glm:
     m.emissiveTexture = texture;
     scene.materials.push_back(m);
     Mesh quad = makePlane(name, size.x, size.y, uint32_t(scene.materials.size() - 1));
-    for (Vertex& v : quad.vertices) // the texture across the quad, top row up
+    for (Vertex& v : quad.vertices) { // the texture across the quad, top row up
         v.uv0 = glm::vec2(v.position.x / size.x + 0.5f, v.position.z / size.y + 0.5f);
+        v.uv1 = v.uv0;
+    }
     scene.meshes.push_back(quad);
     glm::vec3 up = glm::cross(normal, right);
     Instance inst;

@@ -477,6 +477,7 @@ Mesh makeCard(const std::string& name, float width, float height, uint32_t mater
         v.normal = glm::vec3(0, 0, 1);
         v.tangent = glm::vec4(1, 0, 0, 1);
         v.uv0 = glm::vec2(c.x + x, y - c.y) / glm::vec2(width, height);
+        v.uv1 = v.uv0;
         m.vertices.push_back(v);
     }
     m.indices = {0, 1, 2, 0, 2, 3};

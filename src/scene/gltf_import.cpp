@@ -1032,11 +1032,8 @@ private:
         }
     }
 
-    int32_t texture(int textureIndex, int texCoord, bool srgb, const char* slot, int material) {
+    int32_t texture(int textureIndex, bool srgb, const char* slot, int material) {
         if (textureIndex < 0) return kNoTexture;
-        if (texCoord != 0)
-            warnOnce(format("material %d: %s texture uses TEXCOORD_%d; only TEXCOORD_0 is imported",
-                            material, slot, texCoord));
         int source = model_.textures[size_t(textureIndex)].source;
         if (source < 0) {
             warn(format(
@@ -1117,20 +1114,15 @@ private:
                                                  : AlphaMode::Opaque;
         out.doubleSided = m.doubleSided;
         out.additiveness = blendAdditiveness(m, emissiveStrength);
-        out.baseColorTexture = texture(pbr.baseColorTexture.index, pbr.baseColorTexture.texCoord,
-                                       true, "base colour", index);
+        out.baseColorTexture = texture(pbr.baseColorTexture.index, true, "base colour", index);
         out.metallicRoughnessTexture =
-            texture(pbr.metallicRoughnessTexture.index, pbr.metallicRoughnessTexture.texCoord,
-                    false, "metal-roughness", index);
-        out.normalTexture =
-            texture(m.normalTexture.index, m.normalTexture.texCoord, false, "normal", index);
-        out.occlusionTexture = texture(m.occlusionTexture.index, m.occlusionTexture.texCoord, false,
-                                       "occlusion", index);
-        out.emissiveTexture =
-            texture(m.emissiveTexture.index, m.emissiveTexture.texCoord, true, "emissive", index);
+            texture(pbr.metallicRoughnessTexture.index, false, "metal-roughness", index);
+        out.normalTexture = texture(m.normalTexture.index, false, "normal", index);
+        out.occlusionTexture = texture(m.occlusionTexture.index, false, "occlusion", index);
+        out.emissiveTexture = texture(m.emissiveTexture.index, true, "emissive", index);
         MaterialTextures textures;
-        textures.resolve = [&](int t, int texCoord, bool srgb, const char* slot) {
-            return texture(t, texCoord, srgb, slot, index);
+        textures.resolve = [&](int t, bool srgb, const char* slot) {
+            return texture(t, srgb, slot, index);
         };
         textures.sampler = [&](int t) { return gltfTextureSampler(model_, t); };
         textures.glossinessToRoughness = [&](int t, float glossinessFactor) {
@@ -1144,7 +1136,7 @@ private:
     // A metallic-roughness texture (G = 1 - alpha x glossinessFactor, B = 0) from a
     // specularGlossinessTexture (glossiness in alpha).
     int32_t glossinessToRoughness(int textureIndex, float glossinessFactor, int material) {
-        int32_t source = texture(textureIndex, 0, false, "specular-glossiness", material);
+        int32_t source = texture(textureIndex, false, "specular-glossiness", material);
         if (source == kNoTexture) return kNoTexture;
         Texture tex = scene_.textures[size_t(source)];
         tex.name += " (roughness from glossiness)";
@@ -1332,12 +1324,16 @@ private:
         std::vector<float> normals = readAttribute("NORMAL", 3);
         std::vector<float> tangents = readAttribute("TANGENT", 4);
         applyMorphTargets(prim, weights, vertexCount, mesh, normals);
+        // Two UV sets (float, or normalized unsigned byte / short: readFloats scales them); a
+        // mesh without a second one reads the first wherever a material asks for it.
         std::vector<float> uvs = readAttribute("TEXCOORD_0", 2);
+        std::vector<float> uvs1 = readAttribute("TEXCOORD_1", 2);
         for (size_t v = 0; v < vertexCount; ++v) {
             Vertex& vert = mesh.vertices[v];
             if (!normals.empty()) vert.normal = glm::make_vec3(&normals[v * 3]);
             if (!tangents.empty()) vert.tangent = glm::make_vec4(&tangents[v * 4]);
             if (!uvs.empty()) vert.uv0 = glm::make_vec2(&uvs[v * 2]);
+            vert.uv1 = uvs1.empty() ? vert.uv0 : glm::make_vec2(&uvs1[v * 2]);
         }
 
         std::vector<uint32_t> indices;
@@ -1358,12 +1354,24 @@ private:
             return std::nullopt;
         }
         mesh.material = prim.material >= 0 ? uint32_t(prim.material) : defaultMaterial();
+        if (uvs1.empty() && mesh.material < scene_.materials.size()) {
+            const uint8_t* sets = scene_.materials[mesh.material].texCoords;
+            if (std::find(sets, sets + kTextureSlotCount, 1) != sets + kTextureSlotCount)
+                warnOnce(format("%s: material '%s' reads TEXCOORD_1, which the primitive lacks; "
+                                "it reads TEXCOORD_0",
+                                where.c_str(), scene_.materials[mesh.material].name.c_str()));
+        }
 
         if (normals.empty()) computeSmoothNormals(mesh);
         if (tangents.empty()) {
             // Tangents from the UV gradients need valid normals first.
             sanitizeNormalsAndTangents(mesh);
-            computeTangents(mesh);
+            // Along the normal map's UV set (glTF: tangents follow the normal texture's).
+            int normalSet =
+                mesh.material < scene_.materials.size()
+                    ? scene_.materials[mesh.material].texCoords[uint32_t(TextureSlot::Normal)]
+                    : 0;
+            computeTangents(mesh, normalSet);
         }
         if (uint32_t repaired = sanitizeNormalsAndTangents(mesh); repaired > 0)
             warn(format("%s: %u vertices had invalid normals/tangents/UVs; repaired", where.c_str(),

@@ -48,14 +48,24 @@ ValueTextureInfo textureInfoOf(const tinygltf::Value& obj, const char* key) {
         const tinygltf::Value& ext = t.Get("extensions");
         for (const std::string& k : ext.Keys()) map[k] = ext.Get(k);
         out.transform = uvTransformOf(map);
+        out.texCoord = texCoordOf(map, out.texCoord);
     }
     return out;
 }
 
+// Records a texture slot's UV transform, UV set (texCoord, KHR_texture_transform's override
+// applied) and sampler. Vertices carry two UV sets: a slot naming a third reads the first,
+// with a warning naming the material and the slot.
 void setSlot(Material& m, TextureSlot slot, int32_t texture, int gltfTexture,
-             const UvTransform& transform, const MaterialTextures& t) {
+             const UvTransform& transform, int texCoord, const MaterialTextures& t,
+             const char* name) {
     uint32_t s = uint32_t(slot);
     m.uvTransforms[s] = transform;
+    m.texCoords[s] = texture != kNoTexture && texCoord == 1 ? 1 : 0;
+    if (texture != kNoTexture && texCoord >= 2 && t.warn)
+        t.warn(format("material '%s': its %s texture reads TEXCOORD_%d, which is not supported "
+                      "(only TEXCOORD_0 and TEXCOORD_1 are imported); it reads TEXCOORD_0",
+                      m.name.c_str(), name, texCoord));
     if (texture != kNoTexture && t.sampler) m.samplers[s] = t.sampler(gltfTexture);
 }
 
@@ -82,8 +92,9 @@ void convertSpecularGlossiness(const tinygltf::Value& sg, int index, Material& o
     out.specularColorFactor = glm::clamp(specular / 0.04f, glm::vec3(0.0f), glm::vec3(25.0f));
     ValueTextureInfo dt = textureInfoOf(sg, "diffuseTexture");
     if (dt.index >= 0) {
-        out.baseColorTexture = t.resolve(dt.index, dt.texCoord, true, "diffuse");
-        setSlot(out, TextureSlot::BaseColor, out.baseColorTexture, dt.index, dt.transform, t);
+        out.baseColorTexture = t.resolve(dt.index, true, "diffuse");
+        setSlot(out, TextureSlot::BaseColor, out.baseColorTexture, dt.index, dt.transform,
+                dt.texCoord, t, "diffuse");
     }
     ValueTextureInfo gt = textureInfoOf(sg, "specularGlossinessTexture");
     if (gt.index >= 0) {
@@ -92,7 +103,7 @@ void convertSpecularGlossiness(const tinygltf::Value& sg, int index, Material& o
             out.roughnessFactor = 1.0f; // the texture holds 1 - glossiness x factor
             out.metallicFactor = 0.0f;
             setSlot(out, TextureSlot::MetallicRoughness, out.metallicRoughnessTexture, gt.index,
-                    gt.transform, t);
+                    gt.transform, gt.texCoord, t, "specular-glossiness");
         }
         t.warn(format("material %d: the specular colour of specularGlossinessTexture is not "
                       "kept (specularFactor is); its glossiness is",
@@ -108,9 +119,9 @@ void applyTransmission(const tinygltf::Material& gm, Material& out, const Materi
     if (!tr) return;
     out.transmissionFactor = std::clamp(number(*tr, "transmissionFactor", 0.0f), 0.0f, 1.0f);
     if (ValueTextureInfo info = textureInfoOf(*tr, "transmissionTexture"); info.index >= 0) {
-        out.transmissionTexture = t.resolve(info.index, info.texCoord, false, "transmission");
+        out.transmissionTexture = t.resolve(info.index, false, "transmission");
         setSlot(out, TextureSlot::Transmission, out.transmissionTexture, info.index, info.transform,
-                t);
+                info.texCoord, t, "transmission");
     }
     const tinygltf::Value* vol = extension(gm.extensions, "KHR_materials_volume");
     if (!vol) return;
@@ -120,8 +131,9 @@ void applyTransmission(const tinygltf::Material& gm, Material& out, const Materi
     float distance = number(*vol, "attenuationDistance", 0.0f);
     out.attenuationDistance = distance > 0.0f ? distance : std::numeric_limits<float>::infinity();
     if (ValueTextureInfo info = textureInfoOf(*vol, "thicknessTexture"); info.index >= 0) {
-        out.thicknessTexture = t.resolve(info.index, info.texCoord, false, "thickness");
-        setSlot(out, TextureSlot::Thickness, out.thicknessTexture, info.index, info.transform, t);
+        out.thicknessTexture = t.resolve(info.index, false, "thickness");
+        setSlot(out, TextureSlot::Thickness, out.thicknessTexture, info.index, info.transform,
+                info.texCoord, t, "thickness");
     }
 }
 
@@ -184,20 +196,31 @@ UvTransform uvTransformOf(const tinygltf::ExtensionMap& map) {
     return out;
 }
 
+int texCoordOf(const tinygltf::ExtensionMap& map, int texCoord) {
+    const tinygltf::Value* tt = extension(map, "KHR_texture_transform");
+    if (!tt || !tt->Has("texCoord") || !tt->Get("texCoord").IsNumber()) return texCoord;
+    return tt->Get("texCoord").GetNumberAsInt();
+}
+
 void applyMaterialExtensions(const tinygltf::Material& gm, int index, Material& out,
                              const MaterialTextures& t) {
     const auto& pbr = gm.pbrMetallicRoughness;
-    setSlot(out, TextureSlot::BaseColor, out.baseColorTexture, pbr.baseColorTexture.index,
-            uvTransformOf(pbr.baseColorTexture.extensions), t);
-    setSlot(out, TextureSlot::MetallicRoughness, out.metallicRoughnessTexture,
-            pbr.metallicRoughnessTexture.index,
-            uvTransformOf(pbr.metallicRoughnessTexture.extensions), t);
+    auto core = [&](TextureSlot slot, int32_t texture, const tinygltf::TextureInfo& info,
+                    const char* name) {
+        setSlot(out, slot, texture, info.index, uvTransformOf(info.extensions),
+                texCoordOf(info.extensions, info.texCoord), t, name);
+    };
+    core(TextureSlot::BaseColor, out.baseColorTexture, pbr.baseColorTexture, "base colour");
+    core(TextureSlot::MetallicRoughness, out.metallicRoughnessTexture, pbr.metallicRoughnessTexture,
+         "metal-roughness");
     setSlot(out, TextureSlot::Normal, out.normalTexture, gm.normalTexture.index,
-            uvTransformOf(gm.normalTexture.extensions), t);
-    setSlot(out, TextureSlot::Emissive, out.emissiveTexture, gm.emissiveTexture.index,
-            uvTransformOf(gm.emissiveTexture.extensions), t);
+            uvTransformOf(gm.normalTexture.extensions),
+            texCoordOf(gm.normalTexture.extensions, gm.normalTexture.texCoord), t, "normal");
+    core(TextureSlot::Emissive, out.emissiveTexture, gm.emissiveTexture, "emissive");
     setSlot(out, TextureSlot::Occlusion, out.occlusionTexture, gm.occlusionTexture.index,
-            uvTransformOf(gm.occlusionTexture.extensions), t);
+            uvTransformOf(gm.occlusionTexture.extensions),
+            texCoordOf(gm.occlusionTexture.extensions, gm.occlusionTexture.texCoord), t,
+            "occlusion");
 
     if (const tinygltf::Value* es = extension(gm.extensions, "KHR_materials_emissive_strength"))
         out.emissiveFactor *= std::max(number(*es, "emissiveStrength", 1.0f), 0.0f);
@@ -227,8 +250,8 @@ void applyMaterialExtensions(const tinygltf::Material& gm, int index, Material& 
         for (const CoatTexture& c : coat) {
             ValueTextureInfo info = textureInfoOf(*cc, c.key);
             if (info.index < 0) continue;
-            *c.target = t.resolve(info.index, info.texCoord, false, c.name);
-            setSlot(out, c.slot, *c.target, info.index, info.transform, t);
+            *c.target = t.resolve(info.index, false, c.name);
+            setSlot(out, c.slot, *c.target, info.index, info.transform, info.texCoord, t, c.name);
             if (c.slot == TextureSlot::ClearcoatNormal) out.clearcoatNormalScale = info.scale;
         }
     }
@@ -243,14 +266,14 @@ void applyMaterialExtensions(const tinygltf::Material& gm, int index, Material& 
             glm::max(vec3Of(*sp, "specularColorFactor", glm::vec3(1.0f)), glm::vec3(0.0f));
         // Strength in A (linear), F0 tint in RGB (sRGB).
         if (ValueTextureInfo info = textureInfoOf(*sp, "specularTexture"); info.index >= 0) {
-            out.specularTexture = t.resolve(info.index, info.texCoord, false, "specular");
-            setSlot(out, TextureSlot::Specular, out.specularTexture, info.index, info.transform, t);
+            out.specularTexture = t.resolve(info.index, false, "specular");
+            setSlot(out, TextureSlot::Specular, out.specularTexture, info.index, info.transform,
+                    info.texCoord, t, "specular");
         }
         if (ValueTextureInfo info = textureInfoOf(*sp, "specularColorTexture"); info.index >= 0) {
-            out.specularColorTexture =
-                t.resolve(info.index, info.texCoord, true, "specular colour");
+            out.specularColorTexture = t.resolve(info.index, true, "specular colour");
             setSlot(out, TextureSlot::SpecularColor, out.specularColorTexture, info.index,
-                    info.transform, t);
+                    info.transform, info.texCoord, t, "specular colour");
         }
     }
     if (const tinygltf::Value* sh = extension(gm.extensions, "KHR_materials_sheen")) {
@@ -260,15 +283,14 @@ void applyMaterialExtensions(const tinygltf::Material& gm, int index, Material& 
             std::clamp(number(*sh, "sheenRoughnessFactor", 0.0f), 0.0f, 1.0f);
         // Colour in RGB (sRGB), roughness in A (linear).
         if (ValueTextureInfo info = textureInfoOf(*sh, "sheenColorTexture"); info.index >= 0) {
-            out.sheenColorTexture = t.resolve(info.index, info.texCoord, true, "sheen colour");
+            out.sheenColorTexture = t.resolve(info.index, true, "sheen colour");
             setSlot(out, TextureSlot::SheenColor, out.sheenColorTexture, info.index, info.transform,
-                    t);
+                    info.texCoord, t, "sheen colour");
         }
         if (ValueTextureInfo info = textureInfoOf(*sh, "sheenRoughnessTexture"); info.index >= 0) {
-            out.sheenRoughnessTexture =
-                t.resolve(info.index, info.texCoord, false, "sheen roughness");
+            out.sheenRoughnessTexture = t.resolve(info.index, false, "sheen roughness");
             setSlot(out, TextureSlot::SheenRoughness, out.sheenRoughnessTexture, info.index,
-                    info.transform, t);
+                    info.transform, info.texCoord, t, "sheen roughness");
         }
     }
     applyTransmission(gm, out, t);

@@ -3,6 +3,7 @@
 // this; the shared material code in shaders/common/material.glsl evaluates the result, so the
 // forward and decoupled paths agree):
 //  KHR_texture_transform              uv transform per texture slot (offset, rotation, scale)
+//                                     and its texCoord override (TEXCOORD_0 or TEXCOORD_1)
 //  KHR_materials_emissive_strength    scales emissiveFactor
 //  KHR_materials_unlit                output = base colour
 //  KHR_materials_pbrSpecularGlossiness converted to metal/rough + specular (see .cpp)
@@ -22,7 +23,7 @@ namespace shadel {
 // Resolves a glTF texture index to a scene texture (kNoTexture when unusable); `slot` names it
 // in warnings.
 struct MaterialTextures {
-    std::function<int32_t(int texture, int texCoord, bool srgb, const char* slot)> resolve;
+    std::function<int32_t(int texture, bool srgb, const char* slot)> resolve;
     // The glTF texture's sampler (glTF's defaults filled in).
     std::function<TextureSampler(int texture)> sampler;
     // Converts a KHR_materials_pbrSpecularGlossiness specularGlossinessTexture into a
@@ -38,6 +39,9 @@ TextureSampler gltfTextureSampler(const tinygltf::Model& model, int texture);
 
 // Reads a texture info's KHR_texture_transform (identity when absent).
 UvTransform uvTransformOf(const tinygltf::ExtensionMap& textureInfoExtensions);
+// The UV set a texture info reads: KHR_texture_transform's texCoord when it gives one, else the
+// texture info's own `texCoord`.
+int texCoordOf(const tinygltf::ExtensionMap& textureInfoExtensions, int texCoord);
 
 // Applies every supported extension of `gm` to `out` (whose core PBR fields are filled).
 void applyMaterialExtensions(const tinygltf::Material& gm, int materialIndex, Material& out,

@@ -18,11 +18,11 @@ using Cell = glm::i64vec3;
 // (deduplicated by their exact bits, so edges shared by two triangles share their new vertices).
 struct VertexPool {
     std::vector<Vertex> vertices;
-    std::map<std::array<uint32_t, 12>, uint32_t> made;
+    std::map<std::array<uint32_t, 14>, uint32_t> made;
 
     uint32_t add(const Vertex& v) {
-        static_assert(sizeof(Vertex) == 12 * sizeof(float));
-        std::array<uint32_t, 12> key;
+        static_assert(sizeof(Vertex) == 14 * sizeof(float));
+        std::array<uint32_t, 14> key;
         std::memcpy(key.data(), &v, sizeof(Vertex));
         auto [it, inserted] = made.emplace(key, uint32_t(vertices.size()));
         if (inserted) vertices.push_back(v);
@@ -59,6 +59,7 @@ struct VertexPool {
                                                             : glm::vec3(p->tangent),
                               p->tangent.w);
         v.uv0 = glm::mix(p->uv0, q->uv0, t);
+        v.uv1 = glm::mix(p->uv1, q->uv1, t);
         return add(v);
     }
 };

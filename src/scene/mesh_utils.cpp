@@ -57,7 +57,7 @@ void computeSmoothNormals(Mesh& mesh) {
     }
 }
 
-void computeTangents(Mesh& mesh) {
+void computeTangents(Mesh& mesh, int uvSet) {
     std::vector<glm::vec3> tangentSum(mesh.vertices.size(), glm::vec3(0.0f));
     std::vector<glm::vec3> bitangentSum(mesh.vertices.size(), glm::vec3(0.0f));
     for (size_t t = 0; t + 2 < mesh.indices.size(); t += 3) {
@@ -66,7 +66,8 @@ void computeTangents(Mesh& mesh) {
         const Vertex& v1 = mesh.vertices[idx[1]];
         const Vertex& v2 = mesh.vertices[idx[2]];
         glm::vec3 e1 = v1.position - v0.position, e2 = v2.position - v0.position;
-        glm::vec2 d1 = v1.uv0 - v0.uv0, d2 = v2.uv0 - v0.uv0;
+        auto uv = [uvSet](const Vertex& v) { return uvSet == 1 ? v.uv1 : v.uv0; };
+        glm::vec2 d1 = uv(v1) - uv(v0), d2 = uv(v2) - uv(v0);
         float det = d1.x * d2.y - d2.x * d1.y;
         if (!(std::abs(det) > 1e-20f)) continue; // no UV parametrisation on this triangle
         glm::vec3 tangent = (e1 * d2.y - e2 * d1.y) / det;
@@ -125,6 +126,8 @@ uint32_t sanitizeNormalsAndTangents(Mesh& mesh) {
         v.tangent = glm::vec4(t, w);
         if (!std::isfinite(v.uv0.x) || !std::isfinite(v.uv0.y))
             v.uv0 = glm::vec2(0.0f), fixed = true;
+        if (!std::isfinite(v.uv1.x) || !std::isfinite(v.uv1.y))
+            v.uv1 = glm::vec2(0.0f), fixed = true;
         repaired += fixed ? 1 : 0;
     }
     return repaired;
@@ -185,7 +188,8 @@ std::string sceneInvariantViolation(const Scene& scene) {
             const Vertex& vert = mesh.vertices[v];
             std::string at = where + " vertex " + std::to_string(v);
             if (!isFinite(vert.position)) return at + ": position not finite";
-            if (!std::isfinite(vert.uv0.x) || !std::isfinite(vert.uv0.y))
+            if (!std::isfinite(vert.uv0.x) || !std::isfinite(vert.uv0.y) ||
+                !std::isfinite(vert.uv1.x) || !std::isfinite(vert.uv1.y))
                 return at + ": uv not finite";
             if (!unit(vert.normal)) return at + ": normal not unit length";
             if (!unit(glm::vec3(vert.tangent))) return at + ": tangent not unit length";
@@ -283,6 +287,7 @@ Mesh makeBox(const std::string& name, glm::vec3 size, uint32_t material) {
             v.position = centre + f.right * (hr * c[0]) + f.up * (hu * c[1]);
             v.normal = f.normal;
             v.uv0 = glm::vec2((c[0] + 1.0f) * hr, (c[1] + 1.0f) * hu);
+            v.uv1 = v.uv0; // one UV set: the second is the first
             mesh.vertices.push_back(v);
         }
         for (uint32_t i : {0u, 1u, 2u, 0u, 2u, 3u}) mesh.indices.push_back(base + i);
@@ -304,6 +309,7 @@ Mesh makePlane(const std::string& name, float sizeX, float sizeZ, uint32_t mater
                           sizeZ * (float(j) / float(n) - 0.5f)};
             v.normal = {0, 1, 0};
             v.uv0 = {v.position.x, -v.position.z};
+            v.uv1 = v.uv0; // one UV set: the second is the first
             mesh.vertices.push_back(v);
         }
     }
@@ -335,6 +341,7 @@ Mesh makeSphere(const std::string& name, float radius, uint32_t material, uint32
             v.position = dir * radius;
             v.normal = dir;
             v.uv0 = {phi * radius, theta * radius};
+            v.uv1 = v.uv0; // one UV set: the second is the first
             mesh.vertices.push_back(v);
         }
     }
@@ -367,6 +374,7 @@ Mesh makeCylinder(const std::string& name, float radius, float height, uint32_t 
             v.position = dir * radius + glm::vec3(0, ring * height, 0);
             v.normal = dir;
             v.uv0 = {phi * radius, ring * height};
+            v.uv1 = v.uv0; // one UV set: the second is the first
             mesh.vertices.push_back(v);
         }
     }
@@ -390,6 +398,7 @@ Mesh makeCylinder(const std::string& name, float radius, float height, uint32_t 
             v.position = {radius * std::cos(phi), y, -radius * std::sin(phi)};
             v.normal = normal;
             v.uv0 = {v.position.x, cap ? -v.position.z : v.position.z};
+            v.uv1 = v.uv0; // one UV set: the second is the first
             mesh.vertices.push_back(v);
         }
         for (uint32_t j = 0; j < segments; ++j) {

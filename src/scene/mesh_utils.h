@@ -19,8 +19,9 @@ void computeSmoothNormals(Mesh& mesh);
 
 // Per-triangle UV-gradient tangents accumulated per vertex, orthogonalised against the normal,
 // handedness in w (bitangent = cross(normal, tangent.xyz) * w points along +v). Where the UVs
-// give no direction an arbitrary unit tangent perpendicular to the normal is used.
-void computeTangents(Mesh& mesh);
+// give no direction an arbitrary unit tangent perpendicular to the normal is used. `uvSet` is
+// the set the normal map reads (0: Vertex::uv0, 1: uv1), which glTF's tangents follow.
+void computeTangents(Mesh& mesh, int uvSet = 0);
 
 // Makes every normal and tangent finite and unit length (tangent perpendicular to the normal,
 // w = ±1). Returns how many vertices needed repair.

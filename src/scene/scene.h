@@ -31,7 +31,8 @@ struct Vertex {
     glm::vec3 position;
     glm::vec3 normal;
     glm::vec4 tangent; // xyz tangent, w handedness
-    glm::vec2 uv0;     // material UVs (may overlap / tile: never used for shadel space)
+    glm::vec2 uv0;     // material UVs, glTF TEXCOORD_0 (may overlap / tile: never shadel space)
+    glm::vec2 uv1;     // the second set, TEXCOORD_1 (uv0 where the mesh has none)
 };
 
 // What GPU skinning (render/skinning) needs of a skinned mesh, parallel to Mesh::vertices: the
@@ -151,6 +152,9 @@ struct Material {
     // glTF material extensions (scene/gltf_materials.h); the defaults leave core PBR unchanged.
     UvTransform uvTransforms[kTextureSlotCount];
     TextureSampler samplers[kTextureSlotCount]; // per TextureSlot: its texture's glTF sampler
+    // Per TextureSlot: the UV set it reads, 0 (Vertex::uv0) or 1 (uv1): the texture info's
+    // texCoord, or KHR_texture_transform's when it gives one.
+    uint8_t texCoords[kTextureSlotCount] = {};
     bool unlit = false; // KHR_materials_unlit: the base colour is the output
     float clearcoatFactor = 0.0f;
     float clearcoatRoughnessFactor = 0.0f;

@@ -103,7 +103,7 @@ void poseFrame(Gpu& gpu, ScenePlayback& p, uint32_t frame, GpuScene& gpuScene,
             std::vector<gpu::GpuVertex> vertices(end - first);
             for (uint32_t v = first; v < end; ++v) {
                 const Vertex& src = now.vertices[gpuScene.vertexSource[v]];
-                vertices[v - first] = {src.position, src.normal, src.tangent, src.uv0};
+                vertices[v - first] = {src.position, src.normal, src.tangent, src.uv0, src.uv1};
             }
             uploadBuffer(gpu, gpuScene.vertices, vertices.data(),
                          vertices.size() * sizeof(gpu::GpuVertex),

@@ -921,8 +921,11 @@ void prepareDecoupledFrame(Renderer& r, const GpuScene& scene, const CameraView&
                             (material == &scene.materialInfo[inst.material] || // not edited
                              sameTextures(*material, scene.materialInfo[inst.material]));
             rateRoughness = asLoaded ? roughness * texels->roughnessScale : 0.0f;
-            texLod = asLoaded ? textureLod(mesh.uvPerShadelLog2, texels->texelsPerUvLog2,
-                                           d.materialRate.shadelsPerTexel)
+            // Each UV set's textures against that set's mapping: the denser one sets the level.
+            texLod = asLoaded ? std::min(textureLod(mesh.uvPerShadelLog2, texels->texelsPerUvLog2,
+                                                    d.materialRate.shadelsPerTexel),
+                                         textureLod(mesh.uv1PerShadelLog2, texels->texelsPerUv1Log2,
+                                                    d.materialRate.shadelsPerTexel))
                               : -SHADEL_TEXTURE_LOD_NONE;
         }
         float rateBias = r.settings.materialRate

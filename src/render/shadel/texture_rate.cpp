@@ -77,6 +77,7 @@ std::vector<MaterialTexels> materialTexels(const Scene& scene) {
         MaterialTexels& e = out[mi];
         e.known = true;
         e.texelsPerUvLog2 = -std::numeric_limits<float>::infinity();
+        e.texelsPerUv1Log2 = -std::numeric_limits<float>::infinity();
         // The slots a textured material without extension features samples (the clear coat and
         // sheen slots come with features of their own, which keep the full rate).
         const int32_t slots[] = {m.baseColorTexture,    m.metallicRoughnessTexture,
@@ -99,7 +100,9 @@ std::vector<MaterialTexels> materialTexels(const Scene& scene) {
             double det = std::abs(double(x.c0.x) * x.c1.y - double(x.c0.y) * x.c1.x);
             double texels = double(t.width) * double(t.height) * det;
             if (!(texels > 0.0) || !std::isfinite(texels)) continue; // a constant lookup
-            e.texelsPerUvLog2 = std::max(e.texelsPerUvLog2, float(0.5 * std::log2(texels)));
+            float& densest =
+                m.texCoords[uint32_t(slotOf[k])] == 1 ? e.texelsPerUv1Log2 : e.texelsPerUvLog2;
+            densest = std::max(densest, float(0.5 * std::log2(texels)));
         }
         if (m.metallicRoughnessTexture != kNoTexture && e.known) {
             float& scale = roughnessOfTexture[size_t(m.metallicRoughnessTexture)];
@@ -117,7 +120,8 @@ std::vector<MaterialTexels> materialTexels(const Scene& scene) {
 bool sameTextures(const gpu::GpuMaterial& a, const gpu::GpuMaterial& b) {
     return materialTextureSlots(a) == materialTextureSlots(b) &&
            std::memcmp(a.samplers, b.samplers, sizeof(a.samplers)) == 0 &&
-           std::memcmp(a.uvTransform, b.uvTransform, sizeof(a.uvTransform)) == 0;
+           std::memcmp(a.uvTransform, b.uvTransform, sizeof(a.uvTransform)) == 0 &&
+           a.texCoords == b.texCoords;
 }
 
 float textureLod(float uvPerShadelLog2, float texelsPerUvLog2, float shadelsPerTexel) {

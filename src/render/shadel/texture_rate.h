@@ -24,8 +24,10 @@
 //     triangles' UV and shadel-UV areas: the 95th percentile by surface, so a mesh whose mapping
 //     is denser in places is taken at its dense end;
 //   - per material, the texels per UV unit of its densest texture (with KHR_texture_transform's
-//     scale), and a lower bound of the roughness its metallic-roughness texture gives (the 2nd
-//     percentile of G), so a rough factor over a glossy texture keeps the full rate.
+//     scale), per UV set (a slot reads TEXCOORD_0 or TEXCOORD_1; each set is measured per mesh,
+//     and the denser of the two products sets the level), and a lower bound of the roughness its
+//     metallic-roughness texture gives (the 2nd percentile of G), so a rough factor over a glossy
+//     texture keeps the full rate.
 #include <cstdint>
 #include <span>
 #include <vector>
@@ -48,6 +50,7 @@ float uvPerShadelLog2(std::span<const glm::vec2> materialUv, std::span<const glm
 struct MaterialTexels {
     bool known = false;          // false: the rate keeps the full rate (unknown texture content)
     float texelsPerUvLog2 = 0;   // log2 of its densest texture's texels per UV unit (linear)
+    float texelsPerUv1Log2 = 0;  // ... of the textures on the second UV set (-inf: none)
     float roughnessScale = 1.0f; // lower bound of the metallic-roughness texture's G (0..1)
 };
 std::vector<MaterialTexels> materialTexels(const Scene& scene);

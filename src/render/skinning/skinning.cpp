@@ -69,7 +69,7 @@ SkinningStatePtr createSkinning(Renderer& r, const Scene& scene, const GpuScene&
         for (uint32_t v = first; v < end; ++v) {
             uint32_t src = gpuScene.vertexSource[v];
             const Vertex& b = s->bindVertices[src];
-            bind.push_back({b.position, b.normal, b.tangent, b.uv0});
+            bind.push_back({b.position, b.normal, b.tangent, b.uv0, b.uv1});
             skin.push_back({v, s->joints[src] + glm::uvec4(firstMatrix[s->skin]), s->weights[src]});
         }
     }

@@ -6,20 +6,25 @@
 namespace shadel {
 
 std::vector<TextureUse> textureUses(const Scene& scene) {
-    // UV units per metre per mesh (object space): sqrt of UV area over surface area.
-    std::vector<float> meshUvPerMetre(scene.meshes.size(), 0.0f);
+    // UV units per metre per mesh and UV set (object space): sqrt of UV area over surface area.
+    std::vector<glm::vec2> meshUvPerMetre(scene.meshes.size(), glm::vec2(0.0f));
     for (size_t m = 0; m < scene.meshes.size(); ++m) {
         const Mesh& mesh = scene.meshes[m];
-        double uvArea = 0.0, area = 0.0;
+        double uvArea[2] = {0.0, 0.0}, area = 0.0;
+        auto uvTriangleArea = [](glm::vec2 a, glm::vec2 b, glm::vec2 c) {
+            glm::vec2 e1 = b - a, e2 = c - a;
+            return 0.5 * std::abs(double(e1.x) * e2.y - double(e1.y) * e2.x);
+        };
         for (size_t i = 0; i + 2 < mesh.indices.size(); i += 3) {
             const Vertex& a = mesh.vertices[mesh.indices[i]];
             const Vertex& b = mesh.vertices[mesh.indices[i + 1]];
             const Vertex& c = mesh.vertices[mesh.indices[i + 2]];
             area += 0.5 * glm::length(glm::cross(b.position - a.position, c.position - a.position));
-            glm::vec2 e1 = b.uv0 - a.uv0, e2 = c.uv0 - a.uv0;
-            uvArea += 0.5 * std::abs(double(e1.x) * e2.y - double(e1.y) * e2.x);
+            uvArea[0] += uvTriangleArea(a.uv0, b.uv0, c.uv0);
+            uvArea[1] += uvTriangleArea(a.uv1, b.uv1, c.uv1);
         }
-        meshUvPerMetre[m] = area > 0.0 ? float(std::sqrt(uvArea / area)) : 0.0f;
+        for (int set = 0; set < 2; ++set)
+            meshUvPerMetre[m][set] = area > 0.0 ? float(std::sqrt(uvArea[set] / area)) : 0.0f;
     }
     std::vector<TextureUse> uses;
     for (const Instance& inst : scene.instances) {
@@ -29,14 +34,18 @@ std::vector<TextureUse> textureUses(const Scene& scene) {
         const Material& mat = scene.materials[mesh.material];
         Aabb world = transformAabb(mesh.bounds, inst.transform);
         float scale = std::cbrt(std::abs(glm::determinant(glm::mat3(inst.transform))));
-        float uvPerMetre = scale > 0.0f ? meshUvPerMetre[inst.mesh] / scale : 0.0f;
-        if (!(uvPerMetre > 0.0f)) continue;
-        for (int32_t t :
-             {mat.baseColorTexture, mat.metallicRoughnessTexture, mat.normalTexture,
-              mat.emissiveTexture, mat.occlusionTexture, mat.clearcoatTexture,
-              mat.clearcoatRoughnessTexture, mat.clearcoatNormalTexture, mat.specularTexture,
-              mat.specularColorTexture, mat.sheenColorTexture, mat.sheenRoughnessTexture}) {
+        if (!(scale > 0.0f)) continue;
+        // In TextureSlot order: each slot's footprint in the UV set it reads.
+        const int32_t slots[kTextureSlotCount] = {
+            mat.baseColorTexture,          mat.metallicRoughnessTexture, mat.normalTexture,
+            mat.emissiveTexture,           mat.occlusionTexture,         mat.clearcoatTexture,
+            mat.clearcoatRoughnessTexture, mat.clearcoatNormalTexture,   mat.specularTexture,
+            mat.specularColorTexture,      mat.sheenColorTexture,        mat.sheenRoughnessTexture};
+        for (uint32_t slot = 0; slot < kTextureSlotCount; ++slot) {
+            int32_t t = slots[slot];
             if (t < 0 || size_t(t) >= scene.textures.size()) continue;
+            float uvPerMetre = meshUvPerMetre[inst.mesh][mat.texCoords[slot] == 1 ? 1 : 0] / scale;
+            if (!(uvPerMetre > 0.0f)) continue;
             uses.push_back(
                 {uint32_t(t), world.center(), 0.5f * glm::length(world.extent()), uvPerMetre});
         }
