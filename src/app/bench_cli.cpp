@@ -72,6 +72,10 @@ void addComparisonFlags(CLI::App& c, BenchFlags& f) {
     c.add_flag("--stencil-compare", bo.compareStencil,
                "forward with --screen-space on: the stencil-culled water composite and character "
                "outline against their full-screen versions");
+    c.add_flag("--environment-compare", bo.compareEnvironment,
+               "instead of the three modes: forward and decoupled lit by builtin:sky and by "
+               "--environment none, --rounds rounds; median frame times and their ratios (the "
+               "cost of image-based lighting)");
     c.add_flag("--shadow-culling-compare", bo.compareShadowCulling,
                "instead of the three modes: forward with --shadow-culling per-view and "
                "whole-scene; frame and shadow-pass medians and their ratios");

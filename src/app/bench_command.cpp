@@ -904,6 +904,7 @@ nlohmann::json runBench(Gpu& gpu, const BenchOptions& b) {
     validate(b);
     const RenderOptions o = benchBaseOptions(b);
     if (b.compareShadowCulling) return runShadowCullingBench(gpu, b, o);
+    if (b.compareEnvironment) return runEnvironmentBench(gpu, b, o);
     if (b.compareParticleLighting) return runParticleLightingBench(gpu, b, o);
     if (b.compareStencil) return runStencilBench(gpu, b, o);
     if (b.compareStreaming) return runStreamingBench(gpu, b, o);

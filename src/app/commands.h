@@ -177,8 +177,13 @@ struct BenchOptions : RenderSettings {
     // RenderSettings::cpuScopes: --cpu-scopes (instance scaling), the frontend's steps timed.
     uint32_t instances = 0; // --instances (builtin:many), every mode; 0 = the scene's default
     std::string plot;       // --plot FILE.png: per-pass bar chart (app/bench_plot.h)
+    // --environment-compare: forward and decoupled lit by builtin:sky and by none, --rounds
+    // rounds; ratios.environment_forward|decoupled = sky / none median frame time
+    // (app/bench_environment.cpp).
+    bool compareEnvironment = false;
 };
 nlohmann::json runBench(Gpu& gpu, const BenchOptions& options);
+nlohmann::json runEnvironmentBench(Gpu& gpu, const BenchOptions& b, RenderOptions o);
 // "1000,10000,1000000" -> the counts for --instance-scaling, each 1..kManyMaxInstances and none
 // twice; one-line InputError naming the flag and the input otherwise.
 std::vector<uint32_t> parseInstanceCounts(const std::string& text);
