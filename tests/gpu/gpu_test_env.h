@@ -17,6 +17,19 @@ uint32_t validationErrors();
 // Renders and returns the run; asserts no validation errors / shader asserts were added.
 RenderRun renderChecked(const RenderOptions& options);
 
+// What an RGBA8 image shows: the share of its pixels that saw geometry (alpha > 0: the display
+// pixels' alpha is their coverage) and the standard deviation of its RGB values (8-bit levels).
+// A render that drew nothing has no coverage, or one flat colour.
+struct ImageContent {
+    double coverage = 0.0, deviation = 0.0;
+    bool any() const { return coverage > 0.0 && deviation > 0.0; }
+};
+ImageContent imageContent(const std::vector<uint8_t>& rgba);
+
+// PSNR of the RGB channels (99 for equal images). Comparisons of two images also check that
+// at least one has content (ImageContent::any): two empty renders agree perfectly, and that
+// must not pass a test. psnr, worstFramePsnr, worstFrameErrorQuantile and meanFrameDelta add
+// a failure when neither image of a compared pair has content.
 double psnr(const std::vector<uint8_t>& a, const std::vector<uint8_t>& b);
 
 // Options for rendering `scene` in `mode` at w x h (everything else default).
