@@ -30,6 +30,11 @@ Gpu& sharedGpu() {
     return shared.gpu;
 }
 
+bool runningInCi() {
+    const char* ci = std::getenv("CI");
+    return ci && *ci;
+}
+
 uint32_t validationErrors() {
     return sharedGpu().device.validationErrors.load();
 }

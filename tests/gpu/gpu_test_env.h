@@ -14,6 +14,23 @@ namespace shadel::test {
 Gpu& sharedGpu();
 uint32_t validationErrors();
 
+// True when the environment variable CI is set (not empty): every test must run, so a missing
+// capability is a failure there. .ci/run sets it.
+bool runningInCi();
+
+// A test that needs what a machine may lack (ray query, xvfb, the assimp sample models) starts
+// with SHADEL_REQUIRE(have, "what is missing"): without it the test skips on a developer's
+// machine and fails under CI, naming what is missing.
+#define SHADEL_REQUIRE(have, missing)                                                              \
+    do {                                                                                           \
+        if (!(have)) {                                                                             \
+            if (::shadel::test::runningInCi())                                                     \
+                GTEST_FAIL() << "CI is set and this machine lacks what the test needs: "           \
+                             << missing;                                                           \
+            GTEST_SKIP() << missing << " (under CI this fails)";                                   \
+        }                                                                                          \
+    } while (false)
+
 // Renders and returns the run; asserts no validation errors / shader asserts were added.
 RenderRun renderChecked(const RenderOptions& options);
 
