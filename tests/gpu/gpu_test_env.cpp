@@ -30,6 +30,11 @@ Gpu& sharedGpu() {
     return shared.gpu;
 }
 
+bool runningInCi() {
+    const char* ci = std::getenv("CI");
+    return ci && *ci;
+}
+
 uint32_t validationErrors() {
     return sharedGpu().device.validationErrors.load();
 }
@@ -48,8 +53,39 @@ RenderRun renderChecked(const RenderOptions& options) {
     return run;
 }
 
+ImageContent imageContent(const std::vector<uint8_t>& rgba) {
+    size_t pixels = rgba.size() / 4, covered = 0;
+    double sum = 0.0, sumSquares = 0.0;
+    for (size_t i = 0; i + 3 < rgba.size(); i += 4) {
+        covered += rgba[i + 3] > 0;
+        for (int c = 0; c < 3; ++c) {
+            double v = rgba[i + c];
+            sum += v, sumSquares += v * v;
+        }
+    }
+    ImageContent content;
+    if (pixels == 0) return content;
+    double n = double(pixels) * 3.0, mean = sum / n;
+    content.coverage = double(covered) / double(pixels);
+    content.deviation = std::sqrt(std::max(0.0, sumSquares / n - mean * mean));
+    return content;
+}
+
+namespace {
+// Adds a failure when neither image has content (see ImageContent).
+void expectSomeContent(const std::vector<uint8_t>& a, const std::vector<uint8_t>& b) {
+    ImageContent ca = imageContent(a), cb = imageContent(b);
+    EXPECT_TRUE(ca.any() || cb.any())
+        << "comparing two images without content (an empty render matches anything empty): "
+        << "coverage " << ca.coverage << " and " << cb.coverage << ", RGB deviation "
+        << ca.deviation << " and " << cb.deviation << " levels, " << a.size() / 4 << " and "
+        << b.size() / 4 << " pixels";
+}
+} // namespace
+
 double psnr(const std::vector<uint8_t>& a, const std::vector<uint8_t>& b) {
     EXPECT_EQ(a.size(), b.size());
+    expectSomeContent(a, b);
     double se = 0;
     size_t n = 0;
     for (size_t i = 0; i + 3 < a.size(); i += 4)
@@ -76,6 +112,7 @@ double meanFrameDelta(const RenderRun& run) {
     for (size_t f = 1; f < run.frames.size(); ++f) {
         const auto& a = run.frames[f - 1].rgba;
         const auto& b = run.frames[f].rgba;
+        expectSomeContent(a, b);
         for (size_t i = 0; i < a.size(); i += 4)
             for (int c = 0; c < 3; ++c, ++n) sum += std::abs(double(a[i + c]) - double(b[i + c]));
     }
@@ -127,6 +164,7 @@ int worstFrameErrorQuantile(const RenderRun& a, const RenderRun& b, double quant
         const std::vector<uint8_t>& x = a.frames[f].rgba;
         const std::vector<uint8_t>& y = b.frames[f].rgba;
         EXPECT_EQ(x.size(), y.size());
+        expectSomeContent(x, y);
         std::array<size_t, 256> histogram{};
         size_t n = 0;
         for (size_t i = 0; i + 3 < x.size() && i + 3 < y.size(); i += 4)

@@ -14,9 +14,39 @@ namespace shadel::test {
 Gpu& sharedGpu();
 uint32_t validationErrors();
 
+// True when the environment variable CI is set (not empty): every test must run, so a missing
+// capability is a failure there. .ci/run sets it.
+bool runningInCi();
+
+// A test that needs what a machine may lack (ray query, xvfb, the assimp sample models) starts
+// with SHADEL_REQUIRE(have, "what is missing"): without it the test skips on a developer's
+// machine and fails under CI, naming what is missing.
+#define SHADEL_REQUIRE(have, missing)                                                              \
+    do {                                                                                           \
+        if (!(have)) {                                                                             \
+            if (::shadel::test::runningInCi())                                                     \
+                GTEST_FAIL() << "CI is set and this machine lacks what the test needs: "           \
+                             << missing;                                                           \
+            GTEST_SKIP() << missing << " (under CI this fails)";                                   \
+        }                                                                                          \
+    } while (false)
+
 // Renders and returns the run; asserts no validation errors / shader asserts were added.
 RenderRun renderChecked(const RenderOptions& options);
 
+// What an RGBA8 image shows: the share of its pixels that saw geometry (alpha > 0: the display
+// pixels' alpha is their coverage) and the standard deviation of its RGB values (8-bit levels).
+// A render that drew nothing has no coverage, or one flat colour.
+struct ImageContent {
+    double coverage = 0.0, deviation = 0.0;
+    bool any() const { return coverage > 0.0 && deviation > 0.0; }
+};
+ImageContent imageContent(const std::vector<uint8_t>& rgba);
+
+// PSNR of the RGB channels (99 for equal images). Comparisons of two images also check that
+// at least one has content (ImageContent::any): two empty renders agree perfectly, and that
+// must not pass a test. psnr, worstFramePsnr, worstFrameErrorQuantile and meanFrameDelta add
+// a failure when neither image of a compared pair has content.
 double psnr(const std::vector<uint8_t>& a, const std::vector<uint8_t>& b);
 
 // Options for rendering `scene` in `mode` at w x h (everything else default).

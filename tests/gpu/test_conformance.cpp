@@ -173,8 +173,9 @@ TEST_P(Conformance, MatchesSampleViewer) {
     nlohmann::json model;
     for (const auto& m : manifest()["models"])
         if (m["name"] == c.model) model = m;
-    if (model.contains("resources") && !fs::exists(model["resources"].get<std::string>()))
-        GTEST_SKIP() << model["resources"].get<std::string>() << " missing (assimp-testmodels)";
+    SHADEL_REQUIRE(!model.contains("resources") ||
+                       fs::exists(model["resources"].get<std::string>()),
+                   model["resources"].get<std::string>() << " (the assimp-testmodels package)");
     const char* modeName = c.mode == RenderMode::Forward ? "forward" : "decoupled";
     std::string floorKey = std::string("floor_") + modeName;
 

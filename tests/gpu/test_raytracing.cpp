@@ -66,7 +66,8 @@ size_t lineCount(const std::string& s) {
 } // namespace
 
 TEST(RayTracing, BuildsCompactedBlasesAndTracesOneSunRayPerPixel) {
-    if (!sharedGpu().device.optional.rayQuery) GTEST_SKIP() << "no ray query on this device";
+    SHADEL_REQUIRE(sharedGpu().device.optional.rayQuery,
+                   "ray query (VK_KHR_ray_query) on the device");
     RenderOptions o = rtOptions();
     o.rt.shadows = true;
     RenderRun run = renderChecked(o);
@@ -96,7 +97,8 @@ TEST(RayTracing, BuildsCompactedBlasesAndTracesOneSunRayPerPixel) {
 }
 
 TEST(RayTracing, TlasKeepsTheInstancesWithinTheRayTracingDistance) {
-    if (!sharedGpu().device.optional.rayQuery) GTEST_SKIP() << "no ray query on this device";
+    SHADEL_REQUIRE(sharedGpu().device.optional.rayQuery,
+                   "ray query (VK_KHR_ray_query) on the device");
     RenderOptions o = rtOptions();
     o.width = 64;
     o.height = 36;
@@ -111,7 +113,8 @@ TEST(RayTracing, TlasKeepsTheInstancesWithinTheRayTracingDistance) {
 }
 
 TEST(RayTracing, PoolLimitFallsBackToTheLeastDetailedBlas) {
-    if (!sharedGpu().device.optional.rayQuery) GTEST_SKIP() << "no ray query on this device";
+    SHADEL_REQUIRE(sharedGpu().device.optional.rayQuery,
+                   "ray query (VK_KHR_ray_query) on the device");
     RenderOptions o = rtOptions();
     o.rt.shadows = true;
     RenderRun full = renderChecked(o);
@@ -139,7 +142,8 @@ TEST(RayTracing, PoolLimitFallsBackToTheLeastDetailedBlas) {
 }
 
 TEST(RayTracing, SunShadowsAgreeWithTheShadowMap) {
-    if (!sharedGpu().device.optional.rayQuery) GTEST_SKIP() << "no ray query on this device";
+    SHADEL_REQUIRE(sharedGpu().device.optional.rayQuery,
+                   "ray query (VK_KHR_ray_query) on the device");
     RenderOptions o = rtOptions();
     RenderRun shadowMap = renderChecked(o);
     o.rt.shadows = true;
@@ -151,7 +155,8 @@ TEST(RayTracing, SunShadowsAgreeWithTheShadowMap) {
 }
 
 TEST(RayTracing, AmbientOcclusionDarkensAndGiBrightens) {
-    if (!sharedGpu().device.optional.rayQuery) GTEST_SKIP() << "no ray query on this device";
+    SHADEL_REQUIRE(sharedGpu().device.optional.rayQuery,
+                   "ray query (VK_KHR_ray_query) on the device");
     RenderOptions o = rtOptions();
     o.rt.shadows = true;
     RenderRun plain = renderChecked(o);
@@ -207,7 +212,8 @@ RenderOptions shadelAoOptions(uint32_t frames, uint32_t raysPerShadel, uint32_t 
 } // namespace
 
 TEST(RayTracing, ShadelAoConvergesToTheHighRayReference) {
-    if (!sharedGpu().device.optional.rayQuery) GTEST_SKIP() << "no ray query on this device";
+    SHADEL_REQUIRE(sharedGpu().device.optional.rayQuery,
+                   "ray query (VK_KHR_ray_query) on the device");
     RenderRun reference = renderChecked(shadelAoOptions(1, 256, 4));
     RenderRun one = renderChecked(shadelAoOptions(1, 1, 4));
     RenderRun sixteen = renderChecked(shadelAoOptions(16, 1, 4));
@@ -229,7 +235,8 @@ TEST(RayTracing, ShadelAoConvergesToTheHighRayReference) {
 // off (which reshades every chunk every frame) on every frame; carrying the terms over until the
 // round-robin refresh trailed it by 5-9 dB.
 TEST(RayTracing, ShadelReuseFollowsTheRtCacheAsItConverges) {
-    if (!sharedGpu().device.optional.rayQuery) GTEST_SKIP() << "no ray query on this device";
+    SHADEL_REQUIRE(sharedGpu().device.optional.rayQuery,
+                   "ray query (VK_KHR_ray_query) on the device");
     auto options = [](uint32_t frames, uint32_t rays, bool reuse) {
         RenderOptions o = shadelAoOptions(frames, rays, 2);
         o.width = 160;
@@ -278,7 +285,8 @@ double flickerFrom(const RenderRun& run, size_t first) {
 // --camera-path orbit the frame-to-frame change at 96x54 is dominated by the motion itself for
 // both paths; docs/raytracing/README.md has the figures.)
 TEST(RayTracing, ShadelAoFlickersLessThanPerPixelAtTheSameRayBudget) {
-    if (!sharedGpu().device.optional.rayQuery) GTEST_SKIP() << "no ray query on this device";
+    SHADEL_REQUIRE(sharedGpu().device.optional.rayQuery,
+                   "ray query (VK_KHR_ray_query) on the device");
     RenderRun shadel = renderChecked(shadelAoOptions(16, 1, 3));
     double shadelRays = shadel.stats["rt"]["rays_traced_mean"].get<double>();
     // Forward: as many rays per pixel as the shadel path traced per covered pixel (at least 1).
@@ -357,7 +365,8 @@ double raysOverTheRun(const RenderRun& run) {
 // (--rt-shadel-mip-offset 3), 2 rays per shadel per frame; forward: the fewest whole rays per
 // pixel that spend at least as many rays (1 here), with its 3x3 filter.
 TEST(RayTracing, ShadelAoFlickersLessThanPerPixelUnderAnOrbitingCamera) {
-    if (!sharedGpu().device.optional.rayQuery) GTEST_SKIP() << "no ray query on this device";
+    SHADEL_REQUIRE(sharedGpu().device.optional.rayQuery,
+                   "ray query (VK_KHR_ray_query) on the device");
     RenderOptions s = orbitAoOptions(RenderMode::Decoupled);
     s.rt.shadelMipOffset = 3;
     s.rt.raysPerShadel = 2;
@@ -487,7 +496,8 @@ std::string thinPostScene(const std::string& name, float floorSize) {
 // small floor's map shows, and sharper. (The other classic failure, contact gaps from the map's
 // depth bias, is also absent: a ray leaves the receiver itself.)
 TEST(RayTracing, SunShadowsKeepAThinCastersShadowTheWholeSceneMapLoses) {
-    if (!sharedGpu().device.optional.rayQuery) GTEST_SKIP() << "no ray query on this device";
+    SHADEL_REQUIRE(sharedGpu().device.optional.rayQuery,
+                   "ray query (VK_KHR_ray_query) on the device");
     auto options = [](const std::string& scene, RenderMode mode, bool traced) {
         RenderOptions o = renderOptions(scene, mode, 320, 180);
         o.progress = false;
@@ -526,7 +536,8 @@ TEST(RayTracing, SunShadowsKeepAThinCastersShadowTheWholeSceneMapLoses) {
 // to the light; soft: --rt-shadow-rays over the lamp head) in place of their maps, in the
 // shared lighting code, so both paths get them.
 TEST(RayTracing, SpotShadowsAgreeWithTheSpotShadowMaps) {
-    if (!sharedGpu().device.optional.rayQuery) GTEST_SKIP() << "no ray query on this device";
+    SHADEL_REQUIRE(sharedGpu().device.optional.rayQuery,
+                   "ray query (VK_KHR_ray_query) on the device");
     for (RenderMode mode : {RenderMode::Forward, RenderMode::Decoupled}) {
         SCOPED_TRACE(mode == RenderMode::Forward ? "forward" : "decoupled");
         RenderOptions o = renderOptions("builtin:lights", mode, 192, 108);
@@ -623,7 +634,8 @@ std::string skinnedStripOverAFloor() {
 // its traced shadow on the floor is the shadow map's at every time; the bind pose's static BLAS
 // (--rt-animated-blas off) casts the wrong one.
 TEST(RayTracing, SkinnedBlasRefitsFollowThePose) {
-    if (!sharedGpu().device.optional.rayQuery) GTEST_SKIP() << "no ray query on this device";
+    SHADEL_REQUIRE(sharedGpu().device.optional.rayQuery,
+                   "ray query (VK_KHR_ray_query) on the device");
     std::string scene = skinnedStripOverAFloor();
     // The shadel path too: its RT cache restarts every history when playback reposes anything.
     for (RenderMode mode : {RenderMode::Forward, RenderMode::Decoupled}) {
@@ -665,7 +677,8 @@ TEST(RayTracing, SkinnedBlasRefitsFollowThePose) {
 // The refit schedule: near the camera every changed pose is an update, every 9th a build (after
 // 8 refits); 60 m away (beyond 16 m: at most one update per ceil(60 / 16) = 4 frames) fewer.
 TEST(RayTracing, SkinnedBlasRebuildsAfterEightRefitsAndFarOnesUpdateLessOften) {
-    if (!sharedGpu().device.optional.rayQuery) GTEST_SKIP() << "no ray query on this device";
+    SHADEL_REQUIRE(sharedGpu().device.optional.rayQuery,
+                   "ray query (VK_KHR_ray_query) on the device");
     RenderOptions o = renderOptions("/usr/share/assimp/models/glTF2/simple_skin/simple_skin.gltf",
                                     RenderMode::Forward, 64, 36);
     o.progress = false;

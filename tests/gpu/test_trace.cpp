@@ -35,19 +35,33 @@ TEST(Trace, OneEventPerPassPerFrameNamedAsThePasses) {
     std::map<std::string, int> gpuEvents;
     int frames = 0, frontends = 0;
     double lastStart = -1.0;
+    std::map<int, double> frameStart, frameDuration, gpuDuration; // per frame, microseconds
     for (const auto& e : trace["traceEvents"]) {
         if (e["ph"] != "X") continue;
-        EXPECT_GE(e["dur"].get<double>(), 0.0);
-        if (e["cat"] == "gpu") gpuEvents[e["name"].get<std::string>()]++;
+        // Every span measured something (steady clocks with nanosecond steps).
+        EXPECT_GT(e["dur"].get<double>(), 0.0) << e["name"];
+        int frame = e["args"].value("frame", -1);
+        if (e["cat"] == "gpu") {
+            gpuEvents[e["name"].get<std::string>()]++;
+            gpuDuration[frame] += e["dur"].get<double>();
+            EXPECT_GT(e["ts"].get<double>(), frameStart.at(frame)) << e["name"]; // frame first
+        }
         if (e["cat"] == "cpu" && e["name"].get<std::string>().rfind("frame ", 0) == 0) {
             ++frames;
             EXPECT_GT(e["ts"].get<double>(), lastStart); // frames in order
             lastStart = e["ts"].get<double>();
+            frameStart[frame] = e["ts"].get<double>();
+            frameDuration[frame] = e["dur"].get<double>();
         }
         if (e["name"] == "frontend") ++frontends;
     }
     EXPECT_EQ(frames, 3);
     EXPECT_EQ(frontends, 3);
+    // A frame's passes run one after another inside it: their times sum to no more than the
+    // frame's (from its start to the GPU finishing).
+    for (auto& [frame, gpuUs] : gpuDuration)
+        EXPECT_LE(gpuUs, frameDuration.at(frame))
+            << "frame " << frame << ": passes " << gpuUs << " us, frame " << frameDuration[frame];
     ASSERT_FALSE(run.stats["passes"].empty());
     EXPECT_EQ(gpuEvents.size(), run.stats["passes"].size());
     // One event for each frame a pass ran: every frame, but the kept sun shadow map
@@ -84,7 +98,7 @@ TEST(Trace, CpuScopesItemiseTheFrontendAndEverySubmit) {
         if (name == "decoupled coarse allocation" || name.rfind("submit ", 0) == 0) {
             ASSERT_TRUE(e["args"].contains("thread_cpu_ms")) << name;
             double cpuMs = e["args"]["thread_cpu_ms"].get<double>();
-            EXPECT_GE(cpuMs, 0.0) << name;
+            EXPECT_GT(cpuMs, 0.0) << name; // a thread CPU clock with nanosecond steps
             // A thread cannot run longer than the wall clock (+ the clocks' granularity).
             EXPECT_LE(cpuMs, dur / 1000.0 + 0.05) << name;
         }

@@ -37,7 +37,7 @@ std::vector<uint8_t> readPng(const std::string& path, int& w, int& h) {
 } // namespace
 
 TEST(Viewer, ScreenshotUnderXvfbMatchesRenderOfTheSameCamera) {
-    if (!haveXvfb()) GTEST_SKIP() << "xvfb-run is not installed (scripts/setup.sh installs xvfb)";
+    SHADEL_REQUIRE(haveXvfb(), "xvfb-run (scripts/setup.sh installs xvfb)");
     std::string shot = (std::filesystem::temp_directory_path() /
                         ("shadel-view-" + std::to_string(::getpid()) + ".png"))
                            .string();
