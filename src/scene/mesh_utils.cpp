@@ -208,7 +208,9 @@ std::string sceneInvariantViolation(const Scene& scene) {
             !textureOk(mat.normalTexture) || !textureOk(mat.emissiveTexture) ||
             !textureOk(mat.occlusionTexture) || !textureOk(mat.specularTexture) ||
             !textureOk(mat.specularColorTexture) || !textureOk(mat.sheenColorTexture) ||
-            !textureOk(mat.sheenRoughnessTexture))
+            !textureOk(mat.sheenRoughnessTexture) || !textureOk(mat.clearcoatTexture) ||
+            !textureOk(mat.clearcoatRoughnessTexture) || !textureOk(mat.clearcoatNormalTexture) ||
+            !textureOk(mat.transmissionTexture) || !textureOk(mat.thicknessTexture))
             return "material " + std::to_string(i) + ": texture index out of range";
     }
     for (const PointLineSet& set : scene.pointLines) {

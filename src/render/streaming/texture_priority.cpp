@@ -40,7 +40,9 @@ std::vector<TextureUse> textureUses(const Scene& scene) {
             mat.baseColorTexture,          mat.metallicRoughnessTexture, mat.normalTexture,
             mat.emissiveTexture,           mat.occlusionTexture,         mat.clearcoatTexture,
             mat.clearcoatRoughnessTexture, mat.clearcoatNormalTexture,   mat.specularTexture,
-            mat.specularColorTexture,      mat.sheenColorTexture,        mat.sheenRoughnessTexture};
+            mat.specularColorTexture,      mat.sheenColorTexture,        mat.sheenRoughnessTexture,
+            mat.transmissionTexture,       mat.thicknessTexture};
+        static_assert(kTextureSlotCount == 14, "one entry per TextureSlot, in its order");
         for (uint32_t slot = 0; slot < kTextureSlotCount; ++slot) {
             int32_t t = slots[slot];
             if (t < 0 || size_t(t) >= scene.textures.size()) continue;

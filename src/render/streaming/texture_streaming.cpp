@@ -413,7 +413,8 @@ TextureStreamingPtr createTextureStreaming(Gpu& gpu, const Scene& scene,
                  {mat.baseColorTexture, mat.metallicRoughnessTexture, mat.normalTexture,
                   mat.emissiveTexture, mat.occlusionTexture, mat.clearcoatTexture,
                   mat.clearcoatRoughnessTexture, mat.clearcoatNormalTexture, mat.specularTexture,
-                  mat.specularColorTexture, mat.sheenColorTexture, mat.sheenRoughnessTexture})
+                  mat.specularColorTexture, mat.sheenColorTexture, mat.sheenRoughnessTexture,
+                  mat.transmissionTexture, mat.thicknessTexture})
                 if (t >= 0 && size_t(t) < n) s.materialsOf[t].push_back(m);
         }
         s.restreamed.assign(scene.materials.size(), 0);
