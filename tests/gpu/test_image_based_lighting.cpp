@@ -240,3 +240,26 @@ TEST(ImageBasedLighting, SolidBackgroundIsExactAndPngAlphaIsCoverage) {
             EXPECT_EQ(alphaMismatches, 0u);
         }
 }
+
+// bench --environment-compare runs forward and decoupled with the sky and without an
+// environment, and its ratio is the sky's frame time over none's (one round: exactly).
+TEST(ImageBasedLighting, BenchEnvironmentCompareRunsBothPathsWithAndWithout) {
+    BenchOptions b;
+    b.width = 96, b.height = 54;
+    b.frames = 2;
+    b.rounds = 1;
+    b.compareEnvironment = true;
+    nlohmann::json out = runBench(sharedGpu(), b);
+    for (const char* mode : {"forward", "decoupled"}) {
+        const nlohmann::json& sky = out["modes"][std::string(mode) + "_sky"];
+        const nlohmann::json& none = out["modes"][std::string(mode) + "_none"];
+        ASSERT_TRUE(sky.is_object() && none.is_object()) << out.dump().substr(0, 400);
+        EXPECT_EQ(sky["mode"], mode);
+        EXPECT_EQ(sky["settings"]["environment"], "builtin:sky");
+        EXPECT_EQ(none["settings"]["environment"], "none");
+        double skyMs = sky["frame_ms"]["median"], noneMs = none["frame_ms"]["median"];
+        ASSERT_GT(noneMs, 0.0);
+        EXPECT_DOUBLE_EQ(out["ratios"][std::string("environment_") + mode].get<double>(),
+                         skyMs / noneMs);
+    }
+}
