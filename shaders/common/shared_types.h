@@ -47,8 +47,8 @@ using uint = uint32_t;
 #define TEXTURE_SLOT_SPECULAR_COLOR 9u   // RGB = F0 tint
 #define TEXTURE_SLOT_SHEEN_COLOR 10u     // KHR_materials_sheen: RGB
 #define TEXTURE_SLOT_SHEEN_ROUGHNESS 11u // A
-#define TEXTURE_SLOT_TRANSMISSION 12u     // KHR_materials_transmission: R = factor
-#define TEXTURE_SLOT_THICKNESS 13u        // KHR_materials_volume: G = thickness
+#define TEXTURE_SLOT_TRANSMISSION 12u    // KHR_materials_transmission: R = factor
+#define TEXTURE_SLOT_THICKNESS 13u       // KHR_materials_volume: G = thickness
 #define TEXTURE_SLOT_COUNT 14u
 
 // Samplers of the bindless table (rhi/bindless.h): the engine's own first, then one per

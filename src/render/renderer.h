@@ -204,7 +204,7 @@ struct FrontendWorkerTask {
 };
 
 struct FrameResult {
-    std::vector<uint8_t> rgba; // width x height RGBA8, alpha = the covered share of the pixel (255 or 0 without --ssaa)
+    std::vector<uint8_t> rgba; // width x height RGBA8; alpha: covered share (0 or 255 at --ssaa 1)
     uint64_t pixelsCovered = 0;
     std::vector<PassTiming> passes;
     bool tonemapFused = false; // the opaque shading pass wrote the display pixels (render/post)
