@@ -184,6 +184,10 @@ struct BenchOptions : RenderSettings {
 };
 nlohmann::json runBench(Gpu& gpu, const BenchOptions& options);
 nlohmann::json runEnvironmentBench(Gpu& gpu, const BenchOptions& b, RenderOptions o);
+// --shadow-culling-compare (app/bench_shadow_culling.cpp).
+nlohmann::json runShadowCullingBench(Gpu& gpu, const BenchOptions& b, RenderOptions o);
+// A pass's median GPU time in a run's stats (0 when the run has no such pass).
+double passMs(const nlohmann::json& stats, const char* name);
 // "1000,10000,1000000" -> the counts for --instance-scaling, each 1..kManyMaxInstances and none
 // twice; one-line InputError naming the flag and the input otherwise.
 std::vector<uint32_t> parseInstanceCounts(const std::string& text);
