@@ -18,6 +18,7 @@ Results go to DIR (default build/mutation): results.json and results.md, rewritt
 mutation so an interrupted run keeps what it measured.
 """
 import argparse
+import fnmatch
 import json
 import os
 import shutil
@@ -116,18 +117,30 @@ def test_command(e):
     return [binary, "--gtest_filter=" + e["tests"]]
 
 
+# Sources whose output the bake and environment caches keep (keyed by their inputs, not by the
+# code): a mutation there runs with empty caches, or it would read what the clean code wrote.
+CACHED_STAGES = ("src/bake/", "src/render/environment/")
+
+
 def run_tests(e, timeout, scratch, log):
+    """The entry's tests, with GALLIVM_PERF=nopt. The caches (SHADEL_CACHE_DIR, and TMPDIR, where
+    the GPU tests keep theirs) are the run's scratch, shared by its mutations, or fresh and
+    removed after for a mutation of a cached stage."""
     env = dict(os.environ)
     env["GALLIVM_PERF"] = "nopt"
-    cache = os.path.join(scratch, "cache-" + e["id"])
-    shutil.rmtree(cache, ignore_errors=True)
-    os.makedirs(cache)
-    env["SHADEL_CACHE_DIR"] = cache
+    fresh = e.get("file", "").startswith(CACHED_STAGES)
+    tmp = os.path.join(scratch, "tmp-" + e["id"] if fresh else "tmp")
+    if fresh:
+        shutil.rmtree(tmp, ignore_errors=True)
+    os.makedirs(os.path.join(tmp, "cache"), exist_ok=True)
+    env["TMPDIR"] = tmp
+    env["SHADEL_CACHE_DIR"] = os.path.join(tmp, "cache")
     env.pop("GTEST_FILTER", None)
     try:
         return run(test_command(e), timeout, env=env, log=log)
     finally:
-        shutil.rmtree(cache, ignore_errors=True)
+        if fresh:
+            shutil.rmtree(tmp, ignore_errors=True)
 
 
 def count_ran(out):
@@ -141,13 +154,46 @@ def count_ran(out):
 
 
 def failed_tests(out):
+    """The failed tests' names (a parameterised test's line adds ", where GetParam() = ...")."""
     names = []
     for line in out.splitlines():
-        if line.startswith("[  FAILED  ] ") and "," not in line and "listed below" not in line:
-            name = line[len("[  FAILED  ] "):].split(" (")[0].strip()
-            if name and name not in names:
-                names.append(name)
+        if not line.startswith("[  FAILED  ] ") or "listed below" in line:
+            continue
+        name = line[len("[  FAILED  ] "):].split(", where")[0].split(" (")[0].strip()
+        if name and " " not in name and name not in names:
+            names.append(name)
     return names
+
+
+def list_tests(binary):
+    """Every test name of a GoogleTest binary (--gtest_list_tests)."""
+    out = subprocess.run([binary, "--gtest_list_tests"], cwd=ROOT, capture_output=True,
+                         text=True, env=dict(os.environ, GALLIVM_PERF="nopt")).stdout
+    names, suite = [], ""
+    for line in out.splitlines():
+        if not line.strip() or line.startswith(("Note:", "[")):
+            continue
+        if not line.startswith(" "):
+            suite = line.split("#")[0].strip()
+        else:
+            names.append(suite + line.split("#")[0].strip())
+    return names
+
+
+def unmatched_patterns(entries):
+    """(id, pattern) of every filter pattern that names no test: a mutation whose tests do not
+    exist would only ever survive."""
+    bad = []
+    for suite, binary in BINARIES.items():
+        mine = [e for e in entries if e.get("suite", "gpu") == suite]
+        if not mine:
+            continue
+        names = list_tests(os.path.join(ROOT, binary))
+        for e in mine:
+            for pattern in e["tests"].split("-")[0].split(":"):
+                if pattern and not any(fnmatch.fnmatchcase(n, pattern) for n in names):
+                    bad.append((e["id"], pattern))
+    return bad
 
 
 def classify(rc, out):
@@ -208,9 +254,27 @@ def markdown(results, wall):
     return "\n".join(lines) + "\n"
 
 
-def save(results, out_dir, wall, started):
+def previous_results(out_dir):
+    try:
+        with open(os.path.join(out_dir, "results.json")) as f:
+            return json.load(f).get("results", [])
+    except (OSError, ValueError):
+        return []
+
+
+def save(results, out_dir, wall, started, earlier=None):
+    """results.json and results.md; with `earlier` (--merge), the earlier run's results of the
+    entries not run now are kept, in mutations.json's order."""
+    if earlier is not None:
+        now = {r["id"]: r for r in results}
+        order = [e["id"] for e in load()]
+        merged = {r["id"]: r for r in earlier}
+        merged.update(now)
+        results = [merged[i] for i in order if i in merged]
+    commit = subprocess.run(["git", "rev-parse", "--short", "HEAD"], cwd=ROOT,
+                            capture_output=True, text=True).stdout.strip()
     write_atomic(os.path.join(out_dir, "results.json"),
-                 json.dumps({"started_utc": started, "wall_s": round(wall, 1),
+                 json.dumps({"started_utc": started, "wall_s": round(wall, 1), "commit": commit,
                              "results": results}, indent=1) + "\n")
     write_atomic(os.path.join(out_dir, "results.md"), markdown(results, wall))
 
@@ -231,6 +295,8 @@ def main():
     ap.add_argument("--scratch", default=os.path.join(tempfile.gettempdir(), "shadel-mutation"))
     ap.add_argument("--timeout", type=float, default=600, help="seconds per test run")
     ap.add_argument("--build-timeout", type=float, default=1200, help="seconds per build")
+    ap.add_argument("--merge", action="store_true",
+                    help="keep the other entries' results of an earlier run in --out (with --only)")
     ap.add_argument("--no-final-build", action="store_true",
                     help="skip the rebuild of the restored tree at the end")
     args = ap.parse_args()
@@ -262,9 +328,10 @@ def main():
         return 2
     signal.signal(signal.SIGTERM, on_sigterm)
     os.makedirs(args.out, exist_ok=True)
+    shutil.rmtree(args.scratch, ignore_errors=True)  # caches of an earlier run: start empty
     os.makedirs(args.scratch, exist_ok=True)
     log = os.path.join(args.out, "baseline.log" if args.baseline else "run.log")
-    open(log, "w").close()
+    open(log, "a" if args.merge else "w").close()
     started = time.strftime("%Y-%m-%dT%H:%M:%SZ", time.gmtime())
     t0 = time.monotonic()
 
@@ -276,6 +343,9 @@ def main():
             print("mutate.py: the clean tree does not build", file=sys.stderr)
             return 1
         bad = 0
+        for i, pattern in unmatched_patterns(entries):
+            print(f"baseline {i}: the filter pattern {pattern} names no test", flush=True)
+            bad += 1
         for suite in sorted({e.get("suite", "gpu") for e in entries}):
             filters = []
             for e in entries:
@@ -290,6 +360,7 @@ def main():
                   f"{'all pass' if state == 'survived' else state + ' ' + str(failed)}", flush=True)
         return 1 if bad else 0
 
+    earlier = previous_results(args.out) if args.merge else None
     results = []
     try:
         for i, e in enumerate(entries, 1):
@@ -300,7 +371,7 @@ def main():
             extra += f" [{r['detail']}]" if r.get("detail") else ""
             print(f"[{i}/{len(entries)}] {e['id']}: {r['result']}  build {r.get('build_s', 0):.0f} s"
                   f", tests {r.get('test_s', 0):.0f} s{extra}", flush=True)
-            save(results, args.out, time.monotonic() - t0, started)
+            save(results, args.out, time.monotonic() - t0, started, earlier)
     except (KeyboardInterrupt, Terminated):
         print("mutate.py: interrupted; the mutated file is restored", file=sys.stderr)
     finally:
@@ -311,7 +382,7 @@ def main():
             print("rebuilding the restored tree ...", flush=True)
             build(args.build_timeout, log)
     wall = time.monotonic() - t0
-    save(results, args.out, wall, started)
+    save(results, args.out, wall, started, earlier)
     caught = sum(r["result"] == "caught" for r in results)
     print(f"caught {caught} of {len(results)}; wall time {wall / 60:.1f} min; "
           f"results in {os.path.relpath(args.out, ROOT)}/results.md")
