@@ -6,7 +6,9 @@
 // - thin, IOR 1.5: also times (1 - F0)^2, F0 = 0.04: the light passes two interfaces at normal
 //   incidence (the reflected share at the front, and the same share again leaving the back);
 // - a volume of thickness d, IOR 1, attenuation colour c at distance D: the backdrop times
-//   c^(d / D) per channel (Beer-Lambert: exp(-sigma d) with sigma = -ln(c) / D).
+//   c^(d / D) per channel (Beer-Lambert: exp(-sigma d) with sigma = -ln(c) / D);
+// - a rough thin slab at IOR 1 (no interface: the roughness bends nothing) over a backdrop whose
+//   right half is dark: the step behind it as sharp as beside it.
 // Forward and decoupled (the backdrop shaded in shadel space, the slab forward after it). The
 // tolerance, 0.0075 of the backdrop, is about one and a half 8-bit sRGB levels at these
 // radiances: the display quantisation the measurement reads through.
@@ -29,7 +31,11 @@ struct Slab {
     float thickness = 0.0f; // 0: a thin quad; else a box this deep
     glm::vec3 attenuationColor{1.0f};
     float attenuationDistance = 0.0f; // 0: none given
+    float roughness = 0.0f;
+    bool darkRightHalf = false; // a dark quad over the backdrop's right half (x > 0)
 };
+
+const glm::vec3 kDarkBackdrop(0.1f, 0.1f, 0.1f);
 
 void appendMesh(json& doc, std::vector<float>& floats, std::vector<uint16_t>& indices,
                 const std::vector<float>& positions, const std::vector<float>& normals,
@@ -76,7 +82,7 @@ std::string writeSlabScene(const std::string& name, const Slab& slab) {
         {"pbrMetallicRoughness",
          {{"baseColorFactor", {slab.baseColor.r, slab.baseColor.g, slab.baseColor.b, 1.0}},
           {"metallicFactor", 0.0},
-          {"roughnessFactor", 0.0}}},
+          {"roughnessFactor", slab.roughness}}},
         {"extensions",
          {{"KHR_materials_transmission", {{"transmissionFactor", 1.0}}},
           {"KHR_materials_ior", {{"ior", slab.ior}}}}}};
@@ -89,16 +95,25 @@ std::string writeSlabScene(const std::string& name, const Slab& slab) {
             volume["attenuationDistance"] = slab.attenuationDistance;
         slabMaterial["extensions"]["KHR_materials_volume"] = volume;
     }
-    doc["materials"] = {{{"pbrMetallicRoughness",
-                          {{"baseColorFactor", {kBackdrop.r, kBackdrop.g, kBackdrop.b, 1.0}}}},
-                         {"extensions", {{"KHR_materials_unlit", json::object()}}}},
-                        slabMaterial};
+    doc["materials"] = {
+        {{"pbrMetallicRoughness",
+          {{"baseColorFactor", {kBackdrop.r, kBackdrop.g, kBackdrop.b, 1.0}}}},
+         {"extensions", {{"KHR_materials_unlit", json::object()}}}},
+        slabMaterial,
+        {{"pbrMetallicRoughness",
+          {{"baseColorFactor", {kDarkBackdrop.r, kDarkBackdrop.g, kDarkBackdrop.b, 1.0}}}},
+         {"extensions", {{"KHR_materials_unlit", json::object()}}}}};
     std::vector<float> floats;
     std::vector<uint16_t> indices;
     {
         std::vector<float> p = {-4, -4, -2, 4, -4, -2, 4, 4, -2, -4, 4, -2};
         std::vector<float> n = {0, 0, 1, 0, 0, 1, 0, 0, 1, 0, 0, 1};
         appendMesh(doc, floats, indices, p, n, {0, 1, 2, 0, 2, 3}, 0);
+    }
+    if (slab.darkRightHalf) {
+        std::vector<float> p = {0, -4, -1.9f, 4, -4, -1.9f, 4, 4, -1.9f, 0, 4, -1.9f};
+        std::vector<float> n = {0, 0, 1, 0, 0, 1, 0, 0, 1, 0, 0, 1};
+        appendMesh(doc, floats, indices, p, n, {0, 1, 2, 0, 2, 3}, 2);
     }
     if (slab.thickness > 0.0f) {
         std::vector<float> p, n;
@@ -207,6 +222,37 @@ TEST_P(TransmissionTest, VolumeAttenuatesByBeerLambert) {
     glm::vec3 ratio = transmittedRatio("transmission_volume", slab, GetParam());
     glm::vec3 expected = glm::pow(slab.attenuationColor, glm::vec3(2.0f));
     expectRatio(ratio, expected, 0.0075f); // measured: 0.0035 off
+}
+
+// Either side of the dark half's edge (x = 0, between pixels 47 and 48), 4 pixels away: behind
+// the slab (rows 45..51) as beside it (rows 9..15), where the backdrop shows directly.
+TEST_P(TransmissionTest, RoughThinSlabAtIorOneKeepsTheBackdropSharp) {
+    Slab slab;
+    slab.roughness = 0.6f;
+    slab.darkRightHalf = true;
+    RenderOptions o =
+        renderOptions(writeSlabScene("transmission_rough_ior1", slab), GetParam(), 96, 96);
+    o.camera = "ortho";
+    o.environment = "none";
+    o.environmentGiven = true;
+    o.addDefaultSun = false;
+    o.shadows = false;
+    o.tonemap = Tonemap::Linear;
+    o.exposure = 1.0f;
+    RenderRun run = renderChecked(o);
+    const std::vector<uint8_t>& rgba = run.frames[0].rgba;
+    glm::vec3 leftBeside = meanLinear(rgba, 96, 42, 12, 1);
+    glm::vec3 rightBeside = meanLinear(rgba, 96, 53, 12, 1);
+    glm::vec3 leftBehind = meanLinear(rgba, 96, 42, 48, 1);
+    glm::vec3 rightBehind = meanLinear(rgba, 96, 53, 48, 1);
+    EXPECT_NEAR(leftBeside.g, kBackdrop.g, 0.01f);
+    EXPECT_NEAR(rightBeside.g, kDarkBackdrop.g, 0.01f);
+    std::printf("[ figures ] rough slab at IOR 1: green left of the edge %.4f behind / %.4f "
+                "beside, right %.4f / %.4f\n",
+                leftBehind.g, leftBeside.g, rightBehind.g, rightBeside.g);
+    // Measured equal to four digits on both sides, both paths.
+    EXPECT_NEAR(leftBehind.g, leftBeside.g, 0.0075f);
+    EXPECT_NEAR(rightBehind.g, rightBeside.g, 0.0075f);
 }
 
 INSTANTIATE_TEST_SUITE_P(Modes, TransmissionTest,
