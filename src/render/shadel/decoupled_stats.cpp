@@ -170,8 +170,8 @@ void decoupledStats(const Renderer& r, nlohmann::json& s) {
         s["marking_listed_quads"] = {{"two_triangles", last.counters.markQuadsTwoTriangles},
                                      {"per_pixel", last.counters.markQuadsPerPixel}};
     s["sheet_shadels"] = uint64_t(d.sheetBlocks) * SHADEL_BLOCK;
-    // The seed's measure (~1.5 bits per shadel): the 64-bit occupancy mask + 32-bit offset of
-    // every block in use, over the shadels its marked chunks hold.
+    // The occupancy bookkeeping per shadel (~1.5 bits when chunks are full): the 64-bit mask +
+    // 32-bit offset of every block in use, over the shadels its marked chunks hold.
     uint64_t shadelsMarked = uint64_t(last.counters.chunksRequested) * 64;
     s["occupancy_bits_per_shadel"] =
         shadelsMarked ? double(last.counters.markedBlocks) * 96.0 / double(shadelsMarked) : 0.0;
