@@ -69,7 +69,7 @@ vec3 bricks(vec2 uv, float scale) {
 float toksvigRoughness(float roughness, float meanNormalLength) {
     float len = clamp(meanNormalLength, 1e-3, 1.0);
     float alpha = roughness * roughness;
-    return clamp(sqrt(sqrt(alpha * alpha + (1.0 - len) / len)), 0.04, 1.0);
+    return clamp(sqrt(sqrt(alpha * alpha + (1.0 - len) / len)), 0.0, 1.0);
 }
 
 // The bindless sampler of a material texture slot (GpuMaterial.samplers: its glTF sampler).
@@ -161,7 +161,7 @@ MaterialSample evaluateMaterial(GpuMaterial m, SurfaceInput s) {
         o.roughness *= mr.g;
         o.metallic *= mr.b;
     }
-    o.roughness = clamp(o.roughness, 0.04, 1.0);
+    o.roughness = clamp(o.roughness, 0.0, 1.0);
     o.metallic = clamp(o.metallic, 0.0, 1.0);
 
     o.occlusion = 1.0;
@@ -199,7 +199,7 @@ MaterialSample evaluateMaterial(GpuMaterial m, SurfaceInput s) {
         if (m.clearcoatRoughnessTexture != NO_TEXTURE && MATERIAL_HAS(MATERIAL_FEATURE_TEXTURES))
             o.clearcoatRoughness *= sampleMaterialTexture(m, TEXTURE_SLOT_CLEARCOAT_ROUGHNESS,
                                                           m.clearcoatRoughnessTexture, s).g;
-        o.clearcoatRoughness = clamp(o.clearcoatRoughness, 0.04, 1.0);
+        o.clearcoatRoughness = clamp(o.clearcoatRoughness, 0.0, 1.0);
         o.clearcoatNormal = applyNormalMap(m, TEXTURE_SLOT_CLEARCOAT_NORMAL, m.clearcoatNormalTexture,
                                            m.clearcoatNormalScale, s, n, o.clearcoatRoughness);
     }
