@@ -3,6 +3,7 @@
 // symlink, a FIFO) is reported, never given to the driver, and replaced by a good one.
 #include "gpu_test_env.h"
 
+#include <algorithm>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -87,9 +88,11 @@ struct Output {
 };
 
 // `shadel render` of a small forward frame with its cache folder, stats to `stats`.
-Output renderWithCache(const std::string& folder, const std::string& stats) {
+Output renderWithCache(const std::string& folder, const std::string& stats,
+                       const std::string& globalFlags = "") {
     std::string errFile = tempPath("pipeline-cache-stderr.txt");
-    std::string cmd = "env SHADEL_CACHE_DIR=" + folder + " timeout 300 " + SHADEL_BINARY +
+    std::string cmd = "env SHADEL_CACHE_DIR=" + folder + " timeout 300 " + SHADEL_BINARY + " " +
+                      globalFlags +
                       " render --scene builtin:default --mode forward --size 64x36 --stats " +
                       stats + " --out " + folder + "/frame.png >/dev/null 2>" + errFile;
     int status = std::system(cmd.c_str());
@@ -143,6 +146,25 @@ TEST(PipelineCache, ASecondRunLoadsWhatTheFirstSaved) {
     EXPECT_EQ(b["loaded_bytes"].get<uint64_t>(), 0u);
     EXPECT_GT(b["saved_bytes"].get<uint64_t>(), 0u);
     EXPECT_EQ(readBytes(file).substr(0, 8), "SHDLPIPE"); // replaced by a good file
+}
+
+// --pipeline-cache off: no file is read or written (cold compiles); a value other than on or
+// off is one error line and exit code 2.
+TEST(PipelineCache, OffKeepsNoFileAndABadValueIsAnInputError) {
+    TempFolder folder("pipeline-cache-off");
+    std::string stats = folder.path + "/stats.json";
+    Output off = renderWithCache(folder.path, stats, "--pipeline-cache off");
+    ASSERT_EQ(off.exitCode, 0) << off.stderrText;
+    nlohmann::json c = takeJsonFile(stats)["pipeline_cache"];
+    EXPECT_EQ(c["status"], "off");
+    EXPECT_EQ(c["file"], "");
+    EXPECT_EQ(c["saved_bytes"].get<uint64_t>(), 0u);
+    for (const auto& entry : std::filesystem::directory_iterator(folder.path))
+        EXPECT_NE(entry.path().filename().string().rfind("pipelines-", 0), 0u) << entry.path();
+    Output bad = renderWithCache(folder.path, stats, "--pipeline-cache maybe");
+    EXPECT_EQ(bad.exitCode, 2);
+    EXPECT_NE(bad.stderrText.find("--pipeline-cache"), std::string::npos) << bad.stderrText;
+    EXPECT_EQ(std::count(bad.stderrText.begin(), bad.stderrText.end(), '\n'), 1) << bad.stderrText;
 }
 
 // Every kind of bad file, on a fresh device each: rejected with its reason, the pipelines still
