@@ -67,7 +67,10 @@ vec3 bricks(vec2 uv, float scale) {
 // than 1 means the normals under the footprint disagree; widening the lobe by that variance keeps
 // specular from aliasing. roughness is perceptual (alpha = roughness^2).
 float toksvigRoughness(float roughness, float meanNormalLength) {
-    float len = clamp(meanNormalLength, 1e-3, 1.0);
+    // A unit normal stored in 8-bit texels reads up to about 0.007 short of 1 (a step of 1/255
+    // in each component): encoding, not disagreement, and at 8 bits it would already roughen
+    // a mirror to 0.25.
+    float len = clamp(meanNormalLength + 0.007, 1e-3, 1.0);
     float alpha = roughness * roughness;
     return clamp(sqrt(sqrt(alpha * alpha + (1.0 - len) / len)), 0.0, 1.0);
 }
