@@ -1,4 +1,5 @@
-# Compiles every GLSL stage under shaders/ to SPIR-V with glslc, at build time.
+# Compiles every GLSL stage under shaders/ to SPIR-V with glslc, at build time. glslc writes
+# each stage's includes to a depfile, so editing one include rebuilds only the stages that use it.
 # Each stage gets SHADEL_SHADER_ID (its index in the generated table shader_table.inc) so
 # shader asserts can name the file they came from.
 function(shadel_compile_shaders target source_dir binary_dir)
@@ -6,7 +7,6 @@ function(shadel_compile_shaders target source_dir binary_dir)
        ${source_dir}/*.vert ${source_dir}/*.frag ${source_dir}/*.comp
        ${source_dir}/*.mesh ${source_dir}/*.task)
   list(SORT stages)
-  file(GLOB_RECURSE includes CONFIGURE_DEPENDS ${source_dir}/*.glsl ${source_dir}/*.h)
   set(outputs "")
   set(table "")
   set(id 1)
@@ -22,8 +22,9 @@ function(shadel_compile_shaders target source_dir binary_dir)
     add_custom_command(
       OUTPUT ${spv}
       COMMAND ${GLSLC} --target-env=vulkan1.3 -O -g -I ${source_dir} -DSHADEL_SHADER_ID=${id} ${debug_flags}
-              -Werror -o ${spv} ${stage}
-      DEPENDS ${stage} ${includes}
+              -Werror -MD -MF ${spv}.d -o ${spv} ${stage}
+      DEPENDS ${stage}
+      DEPFILE ${spv}.d
       COMMENT "glslc ${rel}"
       VERBATIM)
     list(APPEND outputs ${spv})

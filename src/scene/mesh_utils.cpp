@@ -85,7 +85,7 @@ void computeTangents(Mesh& mesh, int uvSet) {
             continue;
         }
         t /= len;
-        float w = glm::dot(glm::cross(n, t), bitangentSum[v]) < 0.0f ? -1.0f : 1.0f;
+        float w = glm::dot(glm::cross(n, t), bitangentSum[v]) < 0.0f ? 1.0f : -1.0f;
         vert.tangent = glm::vec4(t, w);
     }
 }

@@ -18,9 +18,11 @@ constexpr uint32_t kMaxTrianglesPerMesh = 65535;
 void computeSmoothNormals(Mesh& mesh);
 
 // Per-triangle UV-gradient tangents accumulated per vertex, orthogonalised against the normal,
-// handedness in w (bitangent = cross(normal, tangent.xyz) * w points along +v). Where the UVs
-// give no direction an arbitrary unit tangent perpendicular to the normal is used. `uvSet` is
-// the set the normal map reads (0: Vertex::uv0, 1: uv1), which glTF's tangents follow.
+// handedness in w: bitangent = cross(normal, tangent.xyz) * w points along -v, toward the
+// texture's top row, which is +Y of a glTF normal map ("+Y is up"; glTF's UV origin is the
+// top-left corner), as the glTF Sample Viewer's derivative tangents have it. Where the UVs give
+// no direction an arbitrary unit tangent perpendicular to the normal is used. `uvSet` is the set
+// the normal map reads (0: Vertex::uv0, 1: uv1), which glTF's tangents follow.
 void computeTangents(Mesh& mesh, int uvSet = 0);
 
 // Makes every normal and tangent finite and unit length (tangent perpendicular to the normal,

@@ -49,7 +49,9 @@ TEST(DecoupledCore, SheetHoldsOnlyTheMipsTheFrameCanNeed) {
     EXPECT_LT(double(neededBlocks), 0.85 * double(allBlocks));
     EXPECT_GT(needed.stats["objects_by_first_mip"][1].get<uint64_t>(), 0u);
     EXPECT_EQ(stat(needed, "reconstruction_misses"), 0u);
-    EXPECT_GE(p, 50.0);
+    // Measured 99 dB (the same image): a sheet without the levels the frame can need reads
+    // coarser ones (the finest level one too coarse per object gave 63.9 dB).
+    EXPECT_GE(p, 97.5) << "PSNR " << p << " dB against every MIP in the sheet, measured 99";
 }
 
 // The 16 counters only spread the atomics: with every block hashed onto one or two counters,

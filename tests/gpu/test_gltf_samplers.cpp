@@ -3,8 +3,10 @@
 // wrap (repeat, mirrored repeat, clamp to edge) and filter (nearest, bilinear, level 0 only or
 // mipmapped) worked out on the CPU, then the display encoding (ACES fit, sRGB, 8 bits). Culling:
 // single-sided quads seen from behind show the background, double-sided ones their flipped-
-// normal colour, and a mirrored (negative-scale) instance is not turned inside out. Every case
-// in both paths.
+// normal colour, and a mirrored (negative-scale) instance is not turned inside out. Normal maps:
+// a quad whose normal texture tilts its normal lights as a quad whose geometry is tilted as
+// much. Exposure: an unlit colour times the exposure, then the display encoding, with the tonemap
+// fused into shading or as its own pass. Every case in both paths.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -135,7 +137,8 @@ struct Quad {
 std::string writeQuads(const std::string& name, const std::vector<Quad>& quads,
                        const nlohmann::json& materials, const TestTexture* texture,
                        const nlohmann::json& samplers, float xmag, float ymag,
-                       const nlohmann::json& lights = nullptr) {
+                       const nlohmann::json& lights = nullptr,
+                       const nlohmann::json& lightRotation = nullptr) {
     nlohmann::json doc;
     doc["asset"] = {{"version", "2.0"}};
     doc["extensionsUsed"] = {"KHR_materials_unlit", "KHR_lights_punctual"};
@@ -198,8 +201,11 @@ std::string writeQuads(const std::string& name, const std::vector<Quad>& quads,
     if (!lights.is_null()) {
         doc["extensions"] = {{"KHR_lights_punctual", {{"lights", lights}}}};
         doc["scenes"][0]["nodes"].push_back(doc["nodes"].size());
-        // Pointing down -Z, the way the camera looks: light arrives from the viewer.
-        doc["nodes"].push_back({{"extensions", {{"KHR_lights_punctual", {{"light", 0}}}}}});
+        // Pointing down -Z, the way the camera looks: light arrives from the viewer (unless the
+        // node is rotated).
+        nlohmann::json node = {{"extensions", {{"KHR_lights_punctual", {{"light", 0}}}}}};
+        if (!lightRotation.is_null()) node["rotation"] = lightRotation;
+        doc["nodes"].push_back(node);
     }
     return writeGltf(name, doc, floats, indices);
 }
@@ -428,4 +434,93 @@ TEST(GltfSamplers, SingleSidedBackFacesAreCulledMirroredInstancesAreNot) {
         EXPECT_NEAR(mean[2].r, mean[0].r, 3.0) << label << ": C's normal is flipped to the viewer";
         EXPECT_NEAR(mean[3].r, mean[0].r, 3.0) << label << ": D's normal faces the viewer";
     }
+}
+
+// The normal texture's tangent-space normal (0, 0.6, 0.8) (glTF: +Y toward the texture's top, on
+// a quad whose texture's top is world +Y) must light the quad as a quad without a normal map
+// whose geometry is turned to the world normal (0, 0.6, 0.8): a light from (0, 0.6, 0.8) meets
+// both head on. A wrong tangent frame (a flipped bitangent: (0, -0.6, 0.8), n.l = 0.28) or an
+// ignored map (n.l = 0.8) darkens the mapped quad only.
+TEST(GltfSamplers, NormalMapTiltsTheNormalAsTurnedGeometryDoes) {
+    TestTexture tilt{2, std::vector<uint8_t>(2 * 2 * 4)};
+    for (int i = 0; i < 4; ++i) { // (n + 1) / 2 of (0, 0.6, 0.8)
+        uint8_t* p = &tilt.rgba[size_t(i) * 4];
+        p[0] = 128, p[1] = 204, p[2] = 230, p[3] = 255;
+    }
+    nlohmann::json plain = {{"pbrMetallicRoughness",
+                             {{"baseColorFactor", {0.7, 0.7, 0.7, 1.0}},
+                              {"metallicFactor", 0.0},
+                              {"roughnessFactor", 0.6}}}};
+    nlohmann::json mapped = plain;
+    mapped["normalTexture"] = {{"index", 0}};
+    // Left: the mapped quad facing +Z; right: the plain quad turned about X until its normal is
+    // (0, 0.6, 0.8) (a quarter-angle sin/cos of 36.87 degrees / 2).
+    const double s = std::sin(-0.5 * std::atan2(0.6, 0.8)),
+                 c = std::cos(0.5 * std::atan2(0.6, 0.8));
+    std::vector<Quad> quads(2);
+    quads[0].centre = {-1.5f, 0.0f};
+    quads[1].centre = {1.5f, 0.0f};
+    quads[1].material = 1;
+    quads[1].rotation = {s, 0.0, 0.0, c};
+    // The light's node turned the same way: it travels along -(0, 0.6, 0.8).
+    nlohmann::json sun = {{{"type", "directional"}, {"intensity", 2.0}}};
+    std::string file = writeQuads("samplers_normal_map", quads, {mapped, plain}, &tilt,
+                                  nlohmann::json::array({nlohmann::json::object()}), 3.0f, 1.2f,
+                                  sun, nlohmann::json::array({s, 0.0, 0.0, c}));
+    for (RenderMode mode : {RenderMode::Forward, RenderMode::Decoupled}) {
+        RenderRun run = renderOrtho(file, mode, 200, 80);
+        const std::vector<uint8_t>& img = run.frames.back().rgba;
+        // The middle 16 x 16 pixels of each quad (33 pixels per world unit).
+        auto mean = [&](float x) {
+            int cx = 100 + int(std::lround(x * 100.0 / 3.0));
+            glm::dvec3 sum(0.0);
+            for (int y = 32; y < 48; ++y)
+                for (int px = cx - 8; px < cx + 8; ++px) {
+                    const uint8_t* p = &img[(size_t(y) * 200 + size_t(px)) * 4];
+                    sum += glm::dvec3(p[0], p[1], p[2]);
+                }
+            return sum / 256.0;
+        };
+        glm::dvec3 a = mean(-1.5f), b = mean(1.5f);
+        const char* label = modeLabel(mode);
+        std::printf("[ figures ] normal map %s: mapped quad %.1f, turned quad %.1f (display "
+                    "levels, red)\n",
+                    label, a.r, b.r);
+        EXPECT_GT(b.r, 60.0) << label << ": the turned quad faces the light";
+        // Measured 0 levels apart (205 both, either path); the bitangent flipped gave 150.
+        EXPECT_NEAR(a.r, b.r, 3.0) << label << ": mapped " << a.r << ", turned " << b.r;
+    }
+}
+
+// The exposure scales the scene colour before the tone curve (the display encoding of exposure x
+// the unlit colour), whether the tonemap runs as its own pass or fused into shading.
+TEST(GltfSamplers, ExposureScalesTheSceneColourBeforeTheCurve) {
+    const Rgb colour{0.05, 0.12, 0.3};
+    nlohmann::json unlit = {
+        {"pbrMetallicRoughness", {{"baseColorFactor", {colour.r, colour.g, colour.b, 1.0}}}},
+        {"extensions", {{"KHR_materials_unlit", nlohmann::json::object()}}}};
+    std::string file = writeQuads("samplers_exposure", {Quad{}}, nlohmann::json::array({unlit}),
+                                  nullptr, nlohmann::json::array(), 1.5f, 1.5f);
+    const float exposure = 4.0f; // two stops
+    for (RenderMode mode : {RenderMode::Forward, RenderMode::Decoupled})
+        for (bool fuse : {false, true}) {
+            RenderOptions o = renderOptions(file, mode, 48, 48);
+            o.progress = false;
+            o.camera = "ortho";
+            o.exposure = exposure;
+            o.fuseTonemap = fuse;
+            RenderRun run = renderChecked(o);
+            std::string label = std::string(modeLabel(mode)) + (fuse ? " fused" : " separate");
+            // The middle 16 x 16 pixels (the quad covers 32 x 32).
+            double worst = worstError(
+                run, 48, 16, 16, 16, 16,
+                [&](int, int) {
+                    return Rgb{exposure * colour.r, exposure * colour.g, exposure * colour.b};
+                },
+                [](int, int) { return true; });
+            std::printf("[ figures ] exposure x4 %s: largest error %.2f levels\n", label.c_str(),
+                        worst);
+            // Measured 0.16 levels in every case.
+            EXPECT_LE(worst, 0.25) << label;
+        }
 }

@@ -76,7 +76,8 @@ void expectOutwardCcw(const Mesh& mesh) {
             << mesh.name << " normal points inwards";
 }
 
-// Tangents follow the UV gradient: d(position)/du projected on the tangent plane.
+// Tangents follow the UV gradient: d(position)/du projected on the tangent plane; bitangents
+// point along -d(position)/dv, toward the texture's top (a glTF normal map's +Y).
 void expectTangentsFollowU(const Mesh& mesh) {
     for (size_t t = 0; t < mesh.triangleCount(); ++t) {
         const Vertex* v[3] = {&mesh.vertices[mesh.indices[t * 3]],
@@ -93,7 +94,7 @@ void expectTangentsFollowU(const Mesh& mesh) {
                 << mesh.name << " triangle " << t;
             glm::vec3 bitangent =
                 glm::cross(vert->normal, glm::vec3(vert->tangent)) * vert->tangent.w;
-            EXPECT_GT(glm::dot(bitangent, dPdv), 0.0f) << mesh.name << " triangle " << t;
+            EXPECT_LT(glm::dot(bitangent, dPdv), 0.0f) << mesh.name << " triangle " << t;
         }
     }
 }
