@@ -156,6 +156,14 @@ uvec2 lightListEntry(FrameConstants f, uint i) {
 
 const float PI = 3.14159265358979;
 
+// GGX alpha of a light's specular lobe: a punctual light on a perfect mirror is a delta the
+// lobe cannot hold, so the lights floor perceptual roughness at 0.04. Materials keep the
+// authored value: the environment's mirror level (roughness 0) is read as authored.
+float lightLobeAlpha(float perceptualRoughness) {
+    float r = max(perceptualRoughness, 0.04);
+    return r * r;
+}
+
 float distributionGgx(float nh, float a2) {
     float d = nh * nh * (a2 - 1.0) + 1.0;
     return a2 / (PI * d * d);
@@ -214,7 +222,7 @@ vec3 brdf(MaterialSample m, vec3 n, vec3 v, vec3 l, vec3 radiance) {
     if (nl > 0.0) {
         float nv = max(dot(n, v), 1e-4);
         float nh = max(dot(n, h), 0.0);
-        float a = m.roughness * m.roughness;
+        float a = lightLobeAlpha(m.roughness);
         float a2 = a * a;
         vec3 diffuseWeight, specularWeight;
         gltfFresnelWeights(m, vh, diffuseWeight, specularWeight);
@@ -245,7 +253,7 @@ vec3 brdf(MaterialSample m, vec3 n, vec3 v, vec3 l, vec3 radiance) {
         float fc = clearcoatFresnel(m, v);
         vec3 coatColor = vec3(0.0);
         if (coatNl > 0.0) {
-            float ca = m.clearcoatRoughness * m.clearcoatRoughness;
+            float ca = lightLobeAlpha(m.clearcoatRoughness);
             float ca2 = ca * ca;
             coatColor = vec3(distributionGgx(max(dot(cn, h), 0.0), ca2) *
                              visibilitySmithGgx(max(dot(cn, v), 1e-4), coatNl, ca2) * coatNl);
@@ -371,7 +379,7 @@ vec3 tubeLight(GpuLight light, MaterialSample m, vec3 n, vec3 v, vec3 p) {
 
     float nlD = dot(n, dirD);
     float nlS = dot(n, dirS);
-    float alpha = m.roughness * m.roughness;
+    float alpha = lightLobeAlpha(m.roughness);
     vec3 color = vec3(0.0);
     vec3 diffuseWeight, specularWeight;
     if (nlD > 0.0) {
@@ -496,7 +504,7 @@ vec3 areaLight(GpuLight light, MaterialSample m, vec3 n, vec3 v, vec3 p) {
     vec3 dirS = ls / max(distS, 1e-4);
     float nlS = dot(n, dirS), cosEmitter = -dot(emitNormal, dirS);
     if (nlS > 0.0 && cosEmitter > 0.0) {
-        float alpha = max(m.roughness * m.roughness, 1e-3);
+        float alpha = lightLobeAlpha(m.roughness);
         float sourceRadius = sqrt(4.0 * hw * hh / PI); // a disc of the rectangle's area
         float widened = clamp(alpha + sourceRadius / (2.0 * max(distS, 1e-4)), 0.0, 1.0);
         float energy = (alpha * alpha) / max(widened * widened, 1e-6);

@@ -67,9 +67,12 @@ vec3 bricks(vec2 uv, float scale) {
 // than 1 means the normals under the footprint disagree; widening the lobe by that variance keeps
 // specular from aliasing. roughness is perceptual (alpha = roughness^2).
 float toksvigRoughness(float roughness, float meanNormalLength) {
-    float len = clamp(meanNormalLength, 1e-3, 1.0);
+    // A unit normal stored in 8-bit texels reads up to about 0.007 short of 1 (a step of 1/255
+    // in each component): encoding, not disagreement, and at 8 bits it would already roughen
+    // a mirror to 0.25.
+    float len = clamp(meanNormalLength + 0.007, 1e-3, 1.0);
     float alpha = roughness * roughness;
-    return clamp(sqrt(sqrt(alpha * alpha + (1.0 - len) / len)), 0.04, 1.0);
+    return clamp(sqrt(sqrt(alpha * alpha + (1.0 - len) / len)), 0.0, 1.0);
 }
 
 // The bindless sampler of a material texture slot (GpuMaterial.samplers: its glTF sampler).
@@ -161,7 +164,7 @@ MaterialSample evaluateMaterial(GpuMaterial m, SurfaceInput s) {
         o.roughness *= mr.g;
         o.metallic *= mr.b;
     }
-    o.roughness = clamp(o.roughness, 0.04, 1.0);
+    o.roughness = clamp(o.roughness, 0.0, 1.0);
     o.metallic = clamp(o.metallic, 0.0, 1.0);
 
     o.occlusion = 1.0;
@@ -199,7 +202,7 @@ MaterialSample evaluateMaterial(GpuMaterial m, SurfaceInput s) {
         if (m.clearcoatRoughnessTexture != NO_TEXTURE && MATERIAL_HAS(MATERIAL_FEATURE_TEXTURES))
             o.clearcoatRoughness *= sampleMaterialTexture(m, TEXTURE_SLOT_CLEARCOAT_ROUGHNESS,
                                                           m.clearcoatRoughnessTexture, s).g;
-        o.clearcoatRoughness = clamp(o.clearcoatRoughness, 0.04, 1.0);
+        o.clearcoatRoughness = clamp(o.clearcoatRoughness, 0.0, 1.0);
         o.clearcoatNormal = applyNormalMap(m, TEXTURE_SLOT_CLEARCOAT_NORMAL, m.clearcoatNormalTexture,
                                            m.clearcoatNormalScale, s, n, o.clearcoatRoughness);
     }

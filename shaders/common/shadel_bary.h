@@ -39,8 +39,8 @@ using uint = glm::uint;
 #define SHADEL_CONST const
 #endif
 
-// How far (in barycentric units) reconstruction may extrapolate beyond a triangle. The seed
-// ships 1.0: the ID-map flood places shadels at most ~2 shadels outside their triangle, which for
+// How far (in barycentric units) reconstruction may extrapolate beyond a triangle: 1.0. The
+// ID-map flood places shadels at most ~2 shadels outside their triangle, which for
 // any triangle wider than ~2 shadels stays well inside this bound and is therefore exact.
 SHADEL_CONST float kShadelBaryEpsilon = 1.0f;
 // Below this |2 * signed area| (in the units of the inputs) a triangle is treated as degenerate.

@@ -59,7 +59,7 @@ vec3 volumeTransmissionRay(vec3 n, vec3 v, float thickness, float ior, mat4 mode
 vec3 transmissionBtdf(MaterialSample m, vec3 n, vec3 v, vec3 l) {
     vec3 mirrored = reflect(l, n); // through the surface plane
     vec3 h = normalize(mirrored + v);
-    // The materials' floor of perceptual roughness (0.04) keeps the lobe finite at IOR 1.
+    // The lights' floor of perceptual roughness (lightLobeAlpha's 0.04) keeps the lobe finite at IOR 1.
     float a = max(transmissionRoughness(m.roughness, gTransmission.ior), 0.04);
     a *= a;
     float a2 = a * a;

@@ -162,7 +162,7 @@ void applyDecal(uint st, GpuDecal d, inout MaterialSample o, vec3 p, vec3 n) {
         g -= o.normal * dot(o.normal, g);
         o.normal = normalize(o.normal - g * (0.02 * d.normalStrength * fade));
     } else if (st == DECAL_STAGE_ROUGHNESS) {
-        o.roughness = clamp(mix(o.roughness, d.roughness, mask), 0.04, 1.0);
+        o.roughness = clamp(mix(o.roughness, d.roughness, mask), 0.0, 1.0);
     } else {
         o.ambientOcclusion *= 1.0 - d.occlusion * mask;
     }

@@ -24,7 +24,7 @@ TransparentFragment transparentFragment(vec3 shaded, float alpha, float additive
 
 float transparentOpacity(TransparentFragment t) { return t.coverage * (1.0 - t.additiveness); }
 
-// The seed's canonical depth range: weights are tuned once, whatever the camera's near/far.
+// A fixed canonical depth range: the weights are tuned once, whatever the camera's near/far.
 const float WBOIT_CANONICAL_NEAR = 0.5;
 const float WBOIT_CANONICAL_FAR = 300.0;
 const float WBOIT_PRECISION_SCALAR = 1e4;
@@ -70,9 +70,9 @@ void wboitOutputs(TransparentFragment t, float viewDepth, out vec4 accum, out ve
 // additive layer by its own opacity).
 // final = C ((1 - R) + mix(A / 4, A, G)) + D R. Limits: all additive (R = 1) is exactly the
 // sum of the layers; no additiveness is exactly McGuire's WBOIT; a single layer of any
-// additiveness is exact. The seed divides by the sum of weights instead of coverage-weighted
-// ones, which darkens stacked alpha layers (two 50% layers of colour c give 0.5 c instead of
-// 0.75 c) and then amplifies to hide it; this form needs no max(., 1) floor.
+// additiveness is exact. Dividing by the plain sum of weights instead of coverage-weighted
+// ones would darken stacked alpha layers (two 50% layers of colour c would give 0.5 c instead
+// of 0.75 c) and need an amplification to hide it; this form needs no max(., 1) floor.
 vec4 wboitComposite(vec4 accum, vec4 reveal) {
     float revealage = clamp(reveal.r, 0.0, 1.0);
     float alphaRevealage = clamp(reveal.g, 0.0, 1.0);

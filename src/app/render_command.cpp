@@ -27,6 +27,7 @@
 #include "render/shadel/decoupled.h"
 #include "render/view_density.h"
 #include "rhi/pipeline.h"
+#include "rhi/pipeline_cache.h"
 #include "scene/load.h"
 
 namespace shadel {
@@ -744,6 +745,16 @@ RenderRun finishRender(RenderSessionPtr sessionPtr) {
     s["pipelines"] = {{"created", pipelines.created},
                       {"shared", pipelines.shared},
                       {"create_ms", pipelines.createSeconds * 1000.0}};
+    // The run's pipelines are all built: the cache file is written now (not only when the device
+    // goes) so the stats say what it held and what this run added (rhi/pipeline_cache.h).
+    savePipelineCache(gpu);
+    const PipelineCacheState cache = pipelineCacheState(gpu);
+    s["pipeline_cache"] = {{"status", cache.status},
+                           {"reason", cache.reason},
+                           {"file", cache.path},
+                           {"loaded_bytes", cache.loadedBytes},
+                           {"saved_bytes", cache.savedBytes},
+                           {"save_error", cache.saveError}};
     s["instances"] = gpuScene.instanceCount;
     s["triangles"] = scene.triangleCount();
     s["lights"] = scene.lights.size();

@@ -5,9 +5,11 @@
 
 #include "app/cli_validate.h"
 #include "app/subcommands.h"
+#include "bake/bake_cache.h"
 #include "bake/cache_eviction.h"
 #include "core/error.h"
 #include "core/log.h"
+#include "rhi/pipeline_cache.h"
 
 namespace shadel {
 
@@ -22,6 +24,11 @@ void addGlobalFlags(CLI::App& app, GlobalFlags& f) {
                    "bake cache size; least recently used files beyond it are removed (0 = none)")
         ->capture_default_str()
         ->check(byteSize());
+    app.add_option("--pipeline-cache", f.pipelineCache,
+                   "keep compiled pipelines in the cache folder between runs: on | off "
+                   "(or SHADEL_PIPELINE_CACHE=off)")
+        ->capture_default_str()
+        ->check(CLI::IsMember({"on", "off"}));
 }
 
 DeviceDesc GlobalFlags::deviceDesc() const {
@@ -32,8 +39,16 @@ DeviceDesc GlobalFlags::deviceDesc() const {
     return d;
 }
 
+std::string GlobalFlags::pipelineCacheFolder() const {
+    const char* env = std::getenv("SHADEL_PIPELINE_CACHE");
+    bool off = pipelineCache == "off" || (env && std::string(env) == "off");
+    return off ? std::string() : defaultBakeCacheDir();
+}
+
 GpuGuard::GpuGuard(const GlobalFlags& flags) {
     createGpu(gpu, flags.deviceDesc());
+    if (std::string folder = flags.pipelineCacheFolder(); !folder.empty())
+        keepPipelineCacheIn(gpu, folder);
 }
 
 GpuGuard::~GpuGuard() {

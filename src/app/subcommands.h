@@ -22,8 +22,13 @@ struct GlobalFlags {
     bool allowExternalFiles = false; // glTF URIs may leave the model's folder
     std::string cacheLimit = "4G";
     uint64_t cacheLimitBytes = 0; // cacheLimit, parsed
+    // The device's pipeline cache file in the cache folder (rhi/pipeline_cache.h): on | off
+    // (or SHADEL_PIPELINE_CACHE=off), off for cold pipeline compiles.
+    std::string pipelineCache = "on";
     // --device and --validation (or SHADEL_VALIDATION=1).
     DeviceDesc deviceDesc() const;
+    // The bake cache's folder, or "" when --pipeline-cache off or SHADEL_PIPELINE_CACHE=off.
+    std::string pipelineCacheFolder() const;
 };
 void addGlobalFlags(CLI::App& app, GlobalFlags& flags);
 

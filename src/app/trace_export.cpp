@@ -5,17 +5,39 @@
 
 namespace shadel {
 
+namespace {
+
+// Where a frame's slice on the CPU track ends: frameMs (from beginFrame to the GPU finishing) or
+// later, when a CPU scope of the frame ends after it (the end-frame scope also reads the timings
+// back after the wait). Every child is measured on the same wall clock from the frame's start,
+// so the frame grows to hold them rather than clipping a measured scope: a trace viewer needs
+// each slice inside its parent, and the frame did last until its last scope ended.
+double frameEndMs(const FrameResult& f) {
+    double end = f.startMs + std::max(f.frameMs, f.cpuPrepareMs);
+    for (const CpuScope& c : f.cpuScopes) end = std::max(end, f.startMs + c.startMs + c.wallMs);
+    return end;
+}
+
+} // namespace
+
 nlohmann::json chromeTrace(const std::vector<FrameResult>& frames, const std::string& label) {
-    constexpr int kPid = 1, kCpuTrack = 1, kGpuTrack = 2, kFrontendTrack = 3, kFirstWorkerTrack = 4;
+    // The CPU threads in one process; the GPU's passes in a process of their own, so a viewer
+    // shows them as a separate timeline rather than as one more thread.
+    constexpr int kPid = 1, kGpuPid = 2;
+    constexpr int kCpuTrack = 1, kGpuTrack = 1, kFrontendTrack = 3, kFirstWorkerTrack = 4;
     nlohmann::json events = nlohmann::json::array();
-    auto meta = [&](const char* what, int tid, const std::string& name) {
-        nlohmann::json e = {{"name", what}, {"ph", "M"}, {"pid", kPid}, {"args", {{"name", name}}}};
+    auto metaOf = [&](int pid, const char* what, int tid, const std::string& name) {
+        nlohmann::json e = {{"name", what}, {"ph", "M"}, {"pid", pid}, {"args", {{"name", name}}}};
         if (tid) e["tid"] = tid;
         events.push_back(e);
     };
+    auto meta = [&](const char* what, int tid, const std::string& name) {
+        metaOf(kPid, what, tid, name);
+    };
     meta("process_name", 0, "shadel " + label);
     meta("thread_name", kCpuTrack, "CPU");
-    meta("thread_name", kGpuTrack, "GPU passes");
+    metaOf(kGpuPid, "process_name", 0, "GPU");
+    metaOf(kGpuPid, "thread_name", kGpuTrack, "GPU passes");
     bool frontendWorker = std::any_of(frames.begin(), frames.end(), [](const FrameResult& f) {
         return !f.frontendWorker.empty();
     });
@@ -30,7 +52,7 @@ nlohmann::json chromeTrace(const std::vector<FrameResult>& frames, const std::st
         events.push_back({{"name", name},
                           {"cat", category},
                           {"ph", "X"},
-                          {"pid", kPid},
+                          {"pid", std::string(category) == "gpu" ? kGpuPid : kPid},
                           {"tid", tid},
                           {"ts", startMs * 1000.0},
                           {"dur", durationMs * 1000.0},
@@ -38,8 +60,8 @@ nlohmann::json chromeTrace(const std::vector<FrameResult>& frames, const std::st
     };
     for (size_t i = 0; i < frames.size(); ++i) {
         const FrameResult& f = frames[i];
-        span("frame " + std::to_string(i), "cpu", kCpuTrack, f.startMs, f.frameMs,
-             {{"frame", i}, {"cpu_frame_ms", f.cpuFrameMs}});
+        span("frame " + std::to_string(i), "cpu", kCpuTrack, f.startMs, frameEndMs(f) - f.startMs,
+             {{"frame", i}, {"frame_ms", f.frameMs}, {"cpu_frame_ms", f.cpuFrameMs}});
         span("frontend", "cpu", kCpuTrack, f.startMs, f.cpuPrepareMs, {{"frame", i}});
         // Finer scopes of the render thread (--trace): the frontend's steps, the submits.
         for (const CpuScope& c : f.cpuScopes)

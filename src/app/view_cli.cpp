@@ -39,6 +39,7 @@ Subcommand addViewCommand(CLI::App& app) {
                 o.allowExternalFiles = g.allowExternalFiles;
                 o.threads = parseThreads(f->threads);
                 o.cacheLimitBytes = g.cacheLimitBytes;
+                o.pipelineCacheFolder = g.pipelineCacheFolder();
                 return runViewer(o, g.deviceDesc());
             }};
 }

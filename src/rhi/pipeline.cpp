@@ -15,6 +15,7 @@
 #include "core/assert.h"
 #include "core/log.h"
 #include "rhi/gpu.h"
+#include "rhi/pipeline_cache.h"
 #include "rhi/shader_reload.h"
 
 #ifndef SHADEL_SHADER_BINARY_DIR
@@ -63,7 +64,15 @@ struct PipelineLibrary {
     std::unordered_map<std::string, VkPipeline> byKey;
     std::unordered_set<VkPipeline> owned;
     PipelineLibraryCounters counters;
+    // Given to every vkCreate*Pipelines (rhi/pipeline_cache.h). Internally synchronized (made
+    // without VK_PIPELINE_CACHE_CREATE_EXTERNALLY_SYNCHRONIZED_BIT): threads compile into it at
+    // once without the mutex.
+    PipelineCacheState cache;
 };
+
+static VkPipelineCache cacheOf(const Gpu& gpu) {
+    return gpu.pipelineLibrary ? gpu.pipelineLibrary->cache.cache : VK_NULL_HANDLE;
+}
 
 // A pipeline's identity as bytes: every input vkCreate*Pipelines sees.
 struct KeyWriter {
@@ -161,6 +170,29 @@ static VkPipeline keepPipeline(Gpu& gpu, const std::string& key, VkPipeline buil
 
 void initPipelineLibrary(Gpu& gpu) {
     gpu.pipelineLibrary = std::make_shared<PipelineLibrary>();
+    createPipelineCache(gpu.device, gpu.pipelineLibrary->cache, "");
+}
+
+void keepPipelineCacheIn(Gpu& gpu, const std::string& folder) {
+    SHADEL_ASSERT(gpu.pipelineLibrary, "createGpu makes the pipeline library");
+    PipelineLibrary& l = *gpu.pipelineLibrary;
+    std::lock_guard lock(l.mutex);
+    SHADEL_ASSERT(l.counters.created == 0, "the pipeline cache is chosen before any pipeline");
+    destroyPipelineCache(gpu.device, l.cache, false);
+    createPipelineCache(gpu.device, l.cache, folder);
+}
+
+bool savePipelineCache(Gpu& gpu) {
+    if (!gpu.pipelineLibrary) return true;
+    PipelineLibrary& l = *gpu.pipelineLibrary;
+    std::lock_guard lock(l.mutex);
+    return savePipelineCache(gpu.device, l.cache, l.counters.created > 0);
+}
+
+PipelineCacheState pipelineCacheState(const Gpu& gpu) {
+    if (!gpu.pipelineLibrary) return {};
+    std::lock_guard lock(gpu.pipelineLibrary->mutex);
+    return gpu.pipelineLibrary->cache;
 }
 
 PipelineLibraryCounters pipelineLibraryCounters(const Gpu& gpu) {
@@ -178,8 +210,9 @@ PipelineLibraryCounters pipelineLibraryCountersSince(const Gpu& gpu,
 
 void destroyPipelineLibrary(Gpu& gpu) {
     if (!gpu.pipelineLibrary) return;
-    for (VkPipeline p : gpu.pipelineLibrary->owned)
-        vkDestroyPipeline(gpu.device.device, p, nullptr);
+    PipelineLibrary& l = *gpu.pipelineLibrary;
+    destroyPipelineCache(gpu.device, l.cache, l.counters.created > 0); // saved first
+    for (VkPipeline p : l.owned) vkDestroyPipeline(gpu.device.device, p, nullptr);
     gpu.pipelineLibrary.reset();
 }
 
@@ -317,7 +350,7 @@ Pipeline createGraphicsPipeline(Gpu& gpu, const GraphicsPipelineDesc& desc) {
     auto start = std::chrono::steady_clock::now();
     VkPipeline built = VK_NULL_HANDLE;
     VkResult result =
-        vkCreateGraphicsPipelines(gpu.device.device, VK_NULL_HANDLE, 1, &ci, nullptr, &built);
+        vkCreateGraphicsPipelines(gpu.device.device, cacheOf(gpu), 1, &ci, nullptr, &built);
     vkDestroyShaderModule(gpu.device.device, vs, nullptr);
     if (fs) vkDestroyShaderModule(gpu.device.device, fs, nullptr);
     VK_CHECK(result);
@@ -333,7 +366,7 @@ Pipeline createComputePipeline(Gpu& gpu, const std::string& name, const std::str
 }
 
 // One compute pipeline compiled (no library or hot-reload bookkeeping: the caller's thread does
-// that). Thread-safe: vkCreateComputePipelines without a cache synchronizes nothing external.
+// that). Thread-safe: the device's pipeline cache is internally synchronized (PipelineLibrary).
 struct BuiltPipeline {
     VkPipeline pipeline = VK_NULL_HANDLE;
     VkResult result = VK_SUCCESS;
@@ -352,7 +385,7 @@ static BuiltPipeline buildComputePipeline(const Gpu& gpu, const ComputePipelineD
     auto start = std::chrono::steady_clock::now();
     BuiltPipeline b;
     b.result =
-        vkCreateComputePipelines(gpu.device.device, VK_NULL_HANDLE, 1, &ci, nullptr, &b.pipeline);
+        vkCreateComputePipelines(gpu.device.device, cacheOf(gpu), 1, &ci, nullptr, &b.pipeline);
     b.seconds = secondsSince(start);
     return b;
 }

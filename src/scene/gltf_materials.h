@@ -1,5 +1,5 @@
 #pragma once
-// glTF material extensions applied to the scene's Material at import (gltf_import.cpp calls
+// glTF material extensions applied to the scene's Material at import (gltf_convert.cpp calls
 // this; the shared material code in shaders/common/material.glsl evaluates the result, so the
 // forward and decoupled paths agree):
 //  KHR_texture_transform              uv transform per texture slot (offset, rotation, scale)

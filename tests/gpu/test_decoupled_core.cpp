@@ -110,7 +110,7 @@ TEST(DecoupledCore, SeedSizedSheetWorksEndToEnd) {
     EXPECT_GE(psnr(big.frames[0].rgba, small.frames[0].rgba), 50.0);
 }
 
-// The seed's bookkeeping figure: a 64-bit mask + 32-bit offset per block in use, over the
+// The occupancy bookkeeping: a 64-bit mask + 32-bit offset per block in use, over the
 // shadels of its marked chunks (~1.5 bits per shadel or less); and shadels per covered pixel
 // in the range a MIP chain with chunk rounding gives.
 TEST(DecoupledCore, OccupancyAndShadelsPerPixelAreInRange) {

@@ -43,7 +43,7 @@ int runShadel(const std::string& args, std::string& err) {
 
 } // namespace
 
-// The seed's claim: classifying tiles is an optimisation only. Each pass computes the same
+// Classifying tiles is an optimisation only: each pass computes the same
 // value per pixel whether it runs on its list or on every tile.
 TEST(Tiles, ClassificationOnMatchesOffForward) {
     RenderRun on = renderChecked(arena(RenderMode::Forward, true, true));

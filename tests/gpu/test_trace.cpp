@@ -2,9 +2,11 @@
 // names them, plus the CPU frontend of each frame.
 #include "gpu_test_env.h"
 
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <set>
 
 using namespace shadel;
 using namespace shadel::test;
@@ -123,4 +125,66 @@ TEST(Trace, CpuScopesItemiseTheFrontendAndEverySubmit) {
     EXPECT_TRUE(statScopes.count("decoupled coarse allocation"));
     EXPECT_TRUE(statScopes.count("submit (all passes)"));
     for (const auto& p : run.stats["passes"]) EXPECT_TRUE(p.contains("record_cpu_ms")) << p["name"];
+}
+
+// Every slice lies within its parent on its track (what Perfetto needs to nest them): on each
+// (pid, tid), slices in start order form a stack, and one that starts inside an open slice
+// ends inside it too. Checked over 8 frames of the default scene, where the end-frame scope
+// once ended up to 0.3 ms after its frame. The GPU passes are a process of their own ("GPU").
+TEST(Trace, EverySliceLiesWithinItsParentOnItsTrack) {
+    std::string path = tempPath("trace-nesting.json");
+    RenderOptions o = renderOptions("builtin:default", RenderMode::Decoupled, 160, 90);
+    o.frames = 8;
+    o.trace = path;
+    RenderRun run = renderChecked(o);
+    nlohmann::json trace = takeJsonFile(path);
+    ASSERT_FALSE(trace.is_null()) << path;
+
+    struct Slice {
+        std::string name;
+        double start, end; // microseconds
+    };
+    std::map<std::pair<int, int>, std::vector<Slice>> tracks;
+    std::map<int, std::string> processNames;
+    std::set<int> gpuPids;
+    int frames = 0;
+    for (const auto& e : trace["traceEvents"]) {
+        if (e["ph"] == "M" && e["name"] == "process_name")
+            processNames[e["pid"].get<int>()] = e["args"]["name"].get<std::string>();
+        if (e["ph"] != "X") continue;
+        double ts = e["ts"].get<double>(), dur = e["dur"].get<double>();
+        tracks[{e["pid"].get<int>(), e["tid"].get<int>()}].push_back(
+            {e["name"].get<std::string>(), ts, ts + dur});
+        if (e["cat"] == "gpu") gpuPids.insert(e["pid"].get<int>());
+        frames += e["name"].get<std::string>().rfind("frame ", 0) == 0;
+    }
+    EXPECT_EQ(frames, 8);
+    ASSERT_EQ(gpuPids.size(), 1u);
+    EXPECT_EQ(processNames[*gpuPids.begin()], "GPU");
+    for (const auto& e : trace["traceEvents"]) { // nothing else shares the GPU's process
+        if (e["ph"] == "X" && e["pid"] == *gpuPids.begin()) {
+            EXPECT_EQ(e["cat"], "gpu") << e["name"];
+        }
+    }
+
+    constexpr double kEpsUs = 1e-3; // a nanosecond: the export's doubles, not a tolerance
+    size_t nested = 0;
+    for (auto& [track, slices] : tracks) {
+        std::stable_sort(slices.begin(), slices.end(), [](const Slice& a, const Slice& b) {
+            return a.start != b.start ? a.start < b.start : a.end > b.end;
+        });
+        std::vector<const Slice*> open;
+        for (const Slice& s : slices) {
+            while (!open.empty() && open.back()->end <= s.start + kEpsUs) open.pop_back();
+            if (!open.empty()) {
+                ++nested;
+                EXPECT_LE(s.end, open.back()->end + kEpsUs)
+                    << "track " << track.first << "/" << track.second << ": \"" << s.name
+                    << "\" ends " << s.end - open.back()->end << " us after its parent \""
+                    << open.back()->name << "\"";
+            }
+            open.push_back(&s);
+        }
+    }
+    EXPECT_GT(nested, 8u * 3u); // frontend, its steps and the submits nest in every frame
 }

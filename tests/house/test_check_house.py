@@ -30,6 +30,11 @@ def main():
             f.write(text)
         with open(os.path.join(root, "docs", "notes.md"), "a") as f:
             f.write("See " + "iss" + "ue 12 for the figures.\n")
+            # Any case: a sentence opening with the citation is still one.
+            f.write("The " + "se" + "ed's rule: fall back to the coarsest level.\n")
+            f.write("As shown in THE " + "ta" + "lk, tiles are classified first.\n")
+        with open(os.path.join(root, "src", "cited.cpp"), "w") as f:
+            f.write("// The " + "SE" + "ED's measure: 1.5 bits per shadel.\nint cited = 0;\n")
         with open(os.path.join(root, "src", "big.cpp"), "w") as f:
             f.write("int big = 0;\n" * 901)
         with open(os.path.join(root, "src", "long.cpp"), "w") as f:
@@ -56,6 +61,9 @@ def main():
         expect("docs/notes.md:5: reference:", "an issue number in docs")
         expect("docs/notes.md:4: names: the doc names `vanishedDocName`", "a stale name in docs")
         refuse("docs/notes.md:3", "a random seed is not a citation")
+        expect("docs/notes.md:6: reference:", "a seed document cited in sentence case")
+        expect("docs/notes.md:7: reference:", "a talk cited in capitals")
+        expect("src/cited.cpp:1: reference:", "a seed document cited in a C++ comment")
         expect("src/big.cpp:1: size: 901 lines", "a file over 900 lines")
         expect("src/long.cpp:2: size: function tooLong is 151 lines", "a function over 150 lines")
         refuse("justRight", "a function of exactly 150 lines")
@@ -68,11 +76,11 @@ def main():
         refuse("src/clean.cpp", "flags, file names, JSON keys and allowed names")
         refuse("VkImage", "a Vulkan name in docs")
         refuse("ab77a3e", "a commit id in docs")
-        if len(out) != 10:
-            failures.append(f"{len(out)} lines reported, expected 10:\n  " + "\n  ".join(out))
+        if len(out) != 13:
+            failures.append(f"{len(out)} lines reported, expected 13:\n  " + "\n  ".join(out))
 
         # A tree without violations passes.
-        for name in ("big.cpp", "long.cpp", "stale.cpp"):
+        for name in ("big.cpp", "long.cpp", "stale.cpp", "cited.cpp"):
             os.remove(os.path.join(root, "src", name))
         os.remove(os.path.join(root, "shaders", "reference.glsl"))
         os.remove(os.path.join(root, "docs", "notes.md"))

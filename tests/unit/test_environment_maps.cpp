@@ -149,7 +149,7 @@ TEST(EnvironmentPrefilter, SheenChainKeepsAUniformEnvironment) {
     WorkerPool pool(2);
     const glm::vec3 radiance(0.7f, 1.3f, 2.0f);
     PrefilterSettings s;
-    s.sheenWidth = 64, s.specularLevels = 6, s.specularSamples = 64;
+    s.sheenWidth = 64, s.sheenLevels = 6, s.specularSamples = 64;
     std::vector<EquirectImage> levels = prefilterSheen(makeEquirect(96, 48, radiance), s, pool);
     ASSERT_EQ(levels.size(), 6u);
     double worst = 0.0;
@@ -171,7 +171,8 @@ TEST(EnvironmentPrefilter, SheenChainSpreadsLightFartherThanGgx) {
     for (uint32_t y = 0; y < 32; ++y)
         for (uint32_t x = 0; x < 128; ++x) source.at(x, y) = glm::vec3(1.0f);
     PrefilterSettings s;
-    s.specularWidth = 64, s.sheenWidth = 64, s.specularLevels = 5, s.specularSamples = 256;
+    s.specularWidth = 64, s.sheenWidth = 64, s.specularLevels = 5, s.sheenLevels = 5;
+    s.specularSamples = 256;
     std::vector<EquirectImage> sheen = prefilterSheen(source, s, pool);
     std::vector<EquirectImage> ggx = prefilterSpecular(source, s, pool);
     const uint32_t level = 2; // roughness 0.5
@@ -190,6 +191,68 @@ TEST(EnvironmentPrefilter, SheenChainSpreadsLightFartherThanGgx) {
                 "(GGX %.3f)\n",
                 level, zenith, nadir, sheenBelow, ggxBelow);
     EXPECT_GT(sheenBelow, 3.0f * ggxBelow) << "sheen " << sheenBelow << ", GGX " << ggxBelow;
+}
+
+// Each GGX level against a plain quadrature of its lobe over every source texel (weights
+// D(h) n.l with v = n, as the split sum defines the prefiltered radiance): an environment with a
+// small bright window over a dim gradient, where a lobe drawn too wide (too few samples, too
+// coarse a source MIP, too coarse a level) loses the window's peak and spreads it around.
+TEST(EnvironmentPrefilter, GgxLevelsMatchQuadratureAroundABrightWindow) {
+    WorkerPool pool(2);
+    EquirectImage source = makeEquirect(256, 128, glm::vec3(0.0f));
+    for (uint32_t y = 0; y < source.height; ++y)
+        for (uint32_t x = 0; x < source.width; ++x) {
+            glm::vec3 d = equirectDirection({(x + 0.5f) / source.width, (y + 0.5f) / source.height});
+            bool window = glm::dot(d, glm::normalize(glm::vec3(0.3f, 0.5f, 0.8f))) > 0.985f;
+            source.at(x, y) = glm::vec3(0.2f + 0.3f * d.y + 0.1f) + (window ? glm::vec3(40.0f) : glm::vec3(0.0f));
+        }
+    PrefilterSettings s; // the default sizes, samples and level count
+    s.specularWidth = 256;
+    std::vector<EquirectImage> levels = prefilterSpecular(source, s, pool);
+    ASSERT_EQ(levels.size(), size_t(s.specularLevels));
+    struct Tap {
+        glm::dvec3 d;
+        double radiance, solidAngle;
+    };
+    std::vector<Tap> taps;
+    for (uint32_t y = 0; y < source.height; ++y)
+        for (uint32_t x = 0; x < source.width; ++x)
+            taps.push_back({glm::dvec3(equirectDirection({(x + 0.5f) / source.width,
+                                                           (y + 0.5f) / source.height})),
+                            double(source.at(x, y).x),
+                            equirectTexelSolidAngle(source.width, source.height, y)});
+    for (uint32_t l = 1; l < levels.size(); ++l) {
+        const EquirectImage& level = levels[l];
+        double a = double(l) / double(levels.size() - 1), a2 = a * a * a * a;
+        double peakExact = 0.0, peakOurs = 0.0, squared = 0.0, norm = 0.0;
+        // Texel centres only where a level is 32 texels wide or more (coarser levels hold the
+        // mean over each texel).
+        if (level.width < 32) continue;
+        for (uint32_t y = 0; y < level.height; ++y)
+            for (uint32_t x = 0; x < level.width; ++x) {
+                glm::dvec3 n(equirectDirection({(x + 0.5f) / level.width, (y + 0.5f) / level.height}));
+                double sum = 0.0, weights = 0.0;
+                for (const Tap& t : taps) {
+                    double nl = glm::dot(n, t.d);
+                    if (nl <= 0.0) continue;
+                    double nh = glm::dot(n, glm::normalize(n + t.d));
+                    double den = nh * nh * (a2 - 1.0) + 1.0;
+                    double w = a2 / (kPi * den * den) * nl * t.solidAngle;
+                    sum += w * t.radiance, weights += w;
+                }
+                double exact = sum / weights, ours = level.at(x, y).x;
+                peakExact = std::max(peakExact, exact), peakOurs = std::max(peakOurs, ours);
+                squared += (ours - exact) * (ours - exact), norm += exact * exact;
+            }
+        double rms = std::sqrt(squared / norm);
+        std::printf("[ figures ] GGX level %u (roughness %.2f, %ux%u): peak %.3f of the "
+                    "quadrature's %.3f (ratio %.3f), relative RMS error %.4f\n",
+                    l, a, level.width, level.height, peakOurs, peakExact, peakOurs / peakExact, rms);
+        // Measured: peak ratios 0.999, 1.003, 0.996 and RMS errors 0.0093, 0.0173, 0.0252 at
+        // levels 1-3 (with a quarter of the samples at level 1: 0.924 and 0.078).
+        EXPECT_NEAR(peakOurs / peakExact, 1.0, 0.01) << "level " << l;
+        EXPECT_LT(rms, 0.028) << "level " << l;
+    }
 }
 
 // Directional albedo of the GGX specular with F = 1 (scale + bias), or of shadel's Charlie

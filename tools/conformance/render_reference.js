@@ -19,7 +19,7 @@
 // down; the projection is moved up by reference_y_offset canvas pixels (see README.md).
 //
 // Usage: node tools/conformance/render_reference.js [--only NAME[,NAME...]] [--chromium PATH]
-//          [--out DIR] [--scale N] [--y-offset PIXELS] [--no-msaa]
+//          [--out DIR] [--scale N] [--y-offset PIXELS] [--no-msaa] [--no-punctual] [--no-ibl]
 // --scale and --y-offset default to the manifest's reference_scale and reference_y_offset; --out
 // (experiments) writes elsewhere and leaves VERSIONS.md alone. CONFORMANCE_ENVIRONMENT=FILE.hdr
 // replaces the manifest's environment (a small one skips minutes of prefiltering).
@@ -38,13 +38,15 @@ const origin = "http://conformance.invalid";
 
 function parseArgs() {
   const args = { only: null, chromium: "/usr/lib/chromium/chromium", out: null, msaa: true,
-    scale: null, yOffset: null };
+    scale: null, yOffset: null, punctual: true, ibl: true };
   const argv = process.argv.slice(2);
   for (let i = 0; i < argv.length; i++) {
     if (argv[i] === "--only") args.only = argv[++i].split(",");
     else if (argv[i] === "--chromium") args.chromium = argv[++i];
     else if (argv[i] === "--out") args.out = argv[++i];
     else if (argv[i] === "--no-msaa") args.msaa = false;
+    else if (argv[i] === "--no-punctual") args.punctual = false;
+    else if (argv[i] === "--no-ibl") args.ibl = false;
     else if (argv[i] === "--scale") args.scale = Number(argv[++i]);
     else if (argv[i] === "--y-offset") args.yOffset = Number(argv[++i]);
     else {
@@ -190,8 +192,8 @@ async function setUpViewer(page, settings) {
     const p = state.renderingParameters;
     p.toneMap = GltfState.ToneMaps.ACES_NARKOWICZ;
     p.exposure = 1.0;
-    p.usePunctual = true;
-    p.useIBL = true;
+    p.usePunctual = settings.punctual;
+    p.useIBL = settings.ibl;
     p.iblIntensity = 1.0;
     p.renderEnvironmentMap = false;
     p.clearColor = [0, 0, 0, 0];
@@ -305,6 +307,7 @@ async function main() {
     await page.waitForFunction(() => window.viewerReady === true);
     const env = await setUpViewer(page, {
       width: width * scale, height: height * scale, msaa: args.msaa, yOffset,
+      punctual: args.punctual, ibl: args.ibl,
       environmentRotation: manifest.viewer_environment_rotation,
     });
     console.log(`WebGL renderer: ${env.renderer}`);

@@ -20,6 +20,7 @@
 #include "render/shadel/decoupled.h"
 #include "render/view_density.h"
 #include "rhi/gpu.h"
+#include "rhi/pipeline_cache.h"
 #include "rhi/shader_reload.h"
 #include "scene/load.h"
 
@@ -131,6 +132,7 @@ int runViewer(const ViewOptions& o, DeviceDesc deviceDesc) {
             openWindow(window, o.width, o.height, "shadel view: " + o.scene);
         deviceDesc.swapchain = true;
         createGpu(gpu, deviceDesc);
+        if (!o.pipelineCacheFolder.empty()) keepPipelineCacheIn(gpu, o.pipelineCacheFolder);
         createSwapchain(window, gpu);
         bool hotReload = !o.shaderSource.empty() && std::filesystem::is_directory(o.shaderSource);
         if (hotReload) enableShaderHotReload(gpu, o.shaderSource); // before any pipeline

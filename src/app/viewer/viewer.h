@@ -23,6 +23,7 @@ struct ViewOptions : RenderSettings {
     std::string shaderSource = SHADEL_SHADER_SOURCE_DIR;
     bool allowExternalFiles = false;
     uint64_t cacheLimitBytes = 4ull << 30;
+    std::string pipelineCacheFolder; // where the pipeline cache is kept ("" = in memory only)
 };
 
 // Returns the process exit code (4 when validation errors or shader asserts happened).

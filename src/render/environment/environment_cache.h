@@ -18,7 +18,7 @@
 namespace shadel {
 
 // Bump whenever the maps for the same source can change (sky model, filters, layout).
-constexpr uint32_t kEnvironmentFormatVersion = 2;
+constexpr uint32_t kEnvironmentFormatVersion = 3;
 
 std::string environmentCachePath(const std::string& cacheDir, const BakeKey& key);
 

@@ -56,6 +56,7 @@ BakeKey sourceKey(const EnvironmentRequest& r, const std::vector<uint8_t>& fileB
     h.add(kEnvironmentFormatVersion);
     h.add(uint32_t(r.kind));
     h.add(s.specularWidth), h.add(s.specularLevels), h.add(s.specularSamples), h.add(s.sheenWidth);
+    h.add(s.sheenLevels);
     h.add(s.irradianceWidth);
     if (r.kind == EnvironmentKind::File) h.add(fileBytes.data(), fileBytes.size());
     if (r.kind == EnvironmentKind::Sky) h.add(glm::normalize(r.sunDirection)), h.add(r.sunColor);

@@ -75,11 +75,13 @@ std::vector<LobeSample> lobeSamples(PrefilterLobe lobe, double roughness, uint32
         glm::dvec3 l = 2.0 * h.z * h - glm::dvec3(0.0, 0.0, 1.0);
         if (l.z <= 0.0) continue;
         // With n = v the pdf of l is D n.h / (4 v.h) = D / 4 (over `within` of the lobe); the
-        // sample stands for 1 / (count * pdf) steradians.
+        // sample stands for 1 / (count * pdf) steradians. It reads the source MIP whose texels
+        // are about that size (half a level finer: a full level coarser blurs a small bright
+        // source past the lobe, and none at all lets single texels alias between samples).
         double d = lobe == PrefilterLobe::Ggx ? ggx(h.z, alpha * alpha) : charlie(h.z, alpha);
         double pdf = std::max(d / 4.0 / std::max(within, 1e-300), 1e-12);
         double sampleSolidAngle = 1.0 / (double(count) * pdf);
-        double lod = std::max(0.0, 0.5 * std::log2(sampleSolidAngle / texelSolidAngle) + 1.0);
+        double lod = std::max(0.0, 0.5 * std::log2(sampleSolidAngle / texelSolidAngle) + 0.5);
         out.push_back({glm::vec3(l), float(l.z), float(lod)});
     }
     return out;
@@ -133,7 +135,7 @@ std::vector<EquirectImage> prefilterSheen(const EquirectImage& source,
 uint32_t sheenLevelCount(const PrefilterSettings& settings) {
     uint32_t fit = 1;
     while ((settings.sheenWidth >> fit) >= 2) ++fit; // level fit - 1 is 2 texels wide
-    return std::max(std::min(settings.specularLevels, fit), 2u);
+    return std::max(std::min(settings.sheenLevels, fit), 2u);
 }
 
 std::vector<EquirectImage> prefilterLobes(const EquirectImage& source, PrefilterLobe lobeKind,
@@ -161,13 +163,8 @@ std::vector<EquirectImage> prefilterLobes(const EquirectImage& source, Prefilter
         uint32_t w = std::max(w0 >> l, 2u), h = std::max(h0 >> l, 1u);
         double roughness = double(l) / double(levelCount - 1);
         if (!ggxLobe) roughness = std::max(roughness, double(kMinSheenRoughness));
-        // The narrow GGX lobes of the first (largest) levels span a few source texels, which the
-        // MIP-filtered reads cover with a quarter and a half of the samples. (Thin Charlie lobes
-        // are wide rings.)
-        uint32_t samples = ggxLobe && l == 1   ? std::max(samplesWanted / 4, 16u)
-                           : ggxLobe && l == 2 ? std::max(samplesWanted / 2, 16u)
-                                               : samplesWanted;
-        std::vector<LobeSample> lobe = lobeSamples(lobeKind, roughness, samples, texelSolidAngle);
+        std::vector<LobeSample> lobe =
+            lobeSamples(lobeKind, roughness, samplesWanted, texelSolidAngle);
         EquirectImage level = makeEquirect(w, h);
         std::atomic<uint32_t> rows{0};
         // Levels under 32 texels wide hold the mean of the filtered radiance over each texel

@@ -21,11 +21,15 @@ class WorkerPool;
 
 struct PrefilterSettings {
     uint32_t specularWidth = 512;   // level 0; height = width / 2, each level half the last
-    uint32_t sheenWidth = 128;      // level 0 of the sheen chain (as many levels as specular)
-    uint32_t specularLevels = 8;    // perceptual roughness of level l = l / (levels - 1)
-    uint32_t specularSamples = 256; // per texel; a quarter at level 1, half at level 2
+    uint32_t sheenWidth = 128;      // level 0 of the sheen chain (sheenLevels levels)
+    // Perceptual roughness of level l = l / (levels - 1). Five levels keep the roughest (the
+    // widest lobe) at 32x16 texels, enough for the shading across a rough sphere that a 4x2 level
+    // flattens, at a step of 0.25 in roughness, as the glTF reference renderer's chain has.
+    uint32_t specularLevels = 5;
+    uint32_t specularSamples = 256; // per texel and level
     uint32_t irradianceWidth = 64;  // height = width / 2
     uint32_t brdfSize = 64;         // the BRDF table is brdfSize x brdfSize
+    uint32_t sheenLevels = 7;       // sheen roughness of level l = max(l / (levels - 1), min)
 };
 
 // Reports the share of the work done, 0..1, from the calling thread only.

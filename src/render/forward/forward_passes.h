@@ -44,7 +44,7 @@ void drawSunShadowList(Renderer& r, VkCommandBuffer cmd);
 void drawCameraList(Renderer& r, VkCommandBuffer cmd, uint32_t list, BufferHandle indices = {});
 // The cull mode of a draw of side `side` (DRAW_SIDE_*), for dynamicCulling pipelines: back
 // faces culled for single-sided materials, none for double-sided ones (front faces are counter-
-// clockwise: mirrored instances have a mesh copy with the winding reversed, scene/gltf_import).
+// clockwise: mirrored instances have a mesh copy with the winding reversed, scene/gltf_convert).
 void setDrawSide(VkCommandBuffer cmd, uint32_t side);
 // Begins depth-only rendering into the scene depth (cleared for the prepass, loaded after).
 void beginSceneDepthPass(Renderer& r, VkCommandBuffer cmd, bool clear);

@@ -22,9 +22,9 @@ namespace {
 // Measured (shadel bench --scene builtin:lights --size 1280x720 --spectra compare, lavapipe):
 // frame medians spectra / single all-features permutation 1.037 (3 frames) and 0.934 (5 frames,
 // machine loaded), tile shading / raster forward 0.895 and 0.976: no clear gain from spectra
-// here. The seed's gain is GPU occupancy (fewer registers per thread); a CPU rasterizer has no
-// such limit, and a tile's features are uniform across its workgroup, so branches for features
-// it lacks are already skipped at run time.
+// here. What permutations gain on a GPU is occupancy (fewer registers per thread); a CPU
+// rasterizer has no such limit, and a tile's features are uniform across its workgroup, so
+// branches for features it lacks are already skipped at run time.
 // Measured at the pass (bench --spectra compare --timing submit: on and single in two rounds of
 // opposite order, shading = the tile pass + tile shading, or the chunk classify + shadel
 // shading), 1280x720, 8 frames, machine shared (load 6.7-7.5 on 2 cores): forward frame

@@ -189,7 +189,8 @@ static void buildBatch(Gpu& gpu, const RtFunctions& fn, BlasPools& pools,
         std::vector<int32_t>& lods = out.meshLods[j.mesh];
         std::optional<BlasRange> range = pools.allocate(compacted[i]);
         if (!range) {
-            // The seed's rule: a BLAS allocation may fail; the least-detailed BLAS stands in.
+            // A BLAS allocation may fail (the pools are bounded): the mesh's least-detailed
+            // BLAS stands in for the missing LOD, so the mesh still casts rays.
             int32_t fallback = lods.back();
             bool isLeastDetailed = j.lod + 1 == lods.size();
             if (isLeastDetailed || fallback < 0) {

@@ -27,9 +27,9 @@ std::vector<TextureUse> textureUses(const Scene& scene);
 std::vector<float> cpuWantedSizes(const std::vector<TextureUse>& uses, size_t textureCount,
                                   const CameraView& camera, float viewportHeight);
 
-// The seed's split: the CPU is trusted for the small and middle layers (up to cpuCap), where
-// being early matters most; above, only the GPU's exact, latent wish counts. gpuWanted = 0 when
-// shading has not sampled the texture lately.
+// The split: the CPU's estimate is trusted for the small and middle layers (up to cpuCap), where
+// being early matters most and its overshoot costs little; above, only the GPU's exact, latent wish
+// counts. gpuWanted = 0 when shading has not sampled the texture lately.
 float mergedWanted(float cpuWanted, float gpuWanted, float cpuCap);
 
 } // namespace shadel
