@@ -173,20 +173,12 @@ bool parsePayload(const uint8_t* data, size_t size, const Mesh& mesh, BakedMesh&
     return true;
 }
 
-// Reads a whole regular file. Returns "" or why not ("missing" if it does not exist): a
-// directory or device where a cache file should be is a reason to rebake, not to stop.
+// Reads a whole cache entry (core/atomic_file.h): "" or why not ("missing" if it does not
+// exist); a link, pipe, device or oversized file where an entry should be is a reason to rebake,
+// not to stop (or to wait).
 std::string readCacheFile(const std::string& path, std::vector<uint8_t>& bytes) {
-    std::error_code ec;
-    auto status = std::filesystem::status(path, ec);
-    if (!std::filesystem::exists(status)) return "missing";
-    if (!std::filesystem::is_regular_file(status)) return "not a regular file";
-    std::ifstream file(path, std::ios::binary);
-    uint64_t size = std::filesystem::file_size(path, ec);
-    if (!file || ec) return "cannot open: " + std::string(std::strerror(errno));
-    bytes.resize(size);
-    if (size > 0 && !file.read(reinterpret_cast<char*>(bytes.data()), std::streamsize(size)))
-        return "read error";
-    return {};
+    constexpr uint64_t kMaxEntryBytes = uint64_t(4) << 30; // a bake of a mesh at the import limits
+    return readCacheEntry(path, kMaxEntryBytes, bytes);
 }
 
 } // namespace
@@ -304,7 +296,7 @@ bool writeBakeCache(const std::string& path, const BakeKey& key, const BakedMesh
     std::vector<uint8_t> bytes(sizeof header + payload.size());
     std::memcpy(bytes.data(), &header, sizeof header);
     std::memcpy(bytes.data() + sizeof header, payload.data(), payload.size());
-    reason = writeFileAtomically(path, bytes.data(), bytes.size());
+    reason = writeCacheEntry(path, bytes.data(), bytes.size());
     return reason.empty();
 }
 

@@ -78,9 +78,11 @@ BakeKey fieldKey(const Mesh& mesh, uint32_t resolution) {
 
 bool readField(const std::string& path, const BakeKey& key, uint32_t resolution,
                MeshDistanceField& out) {
-    std::ifstream in(path, std::ios::binary);
-    if (!in) return false;
-    std::vector<char> bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    uint64_t side = 4ull * resolution; // the largest field readField accepts
+    std::vector<uint8_t> bytes;
+    if (!readCacheEntry(path, sizeof(FileHeader) + side * side * side * sizeof(float), bytes)
+             .empty())
+        return false;
     FileHeader h;
     if (bytes.size() < sizeof h) return false;
     std::memcpy(&h, bytes.data(), sizeof h);
@@ -91,7 +93,7 @@ bool readField(const std::string& path, const BakeKey& key, uint32_t resolution,
     if (h.res[0] == 0 || h.res[0] > 4 * resolution || h.res[1] > 4 * resolution ||
         h.res[2] > 4 * resolution || bytes.size() != sizeof h + count * sizeof(float))
         return false;
-    const char* payload = bytes.data() + sizeof h;
+    const char* payload = reinterpret_cast<const char*>(bytes.data()) + sizeof h;
     if (hashBytes(payload, count * sizeof(float), 0) != h.checksum) return false;
     out.resolution = {h.res[0], h.res[1], h.res[2]};
     out.origin = {h.origin[0], h.origin[1], h.origin[2]};
@@ -175,7 +177,7 @@ MeshDistanceField loadOrBuildMeshDistanceField(const Mesh& mesh, const std::stri
                     f.distances.size() * sizeof(float));
         std::error_code ec;
         std::filesystem::create_directories(std::filesystem::path(path).parent_path(), ec);
-        std::string why = writeFileAtomically(path, bytes.data(), bytes.size());
+        std::string why = writeCacheEntry(path, bytes.data(), bytes.size());
         if (!why.empty()) SHADEL_WARN("distance field cache not written: %s", why.c_str());
     }
     return f;

@@ -51,12 +51,64 @@ std::string writeInPlace(const std::string& path, const void* data, size_t size)
 
 } // namespace
 
+static std::string writeViaTemporary(const std::string& path, const void* data, size_t size);
+
 std::string writeFileAtomically(const std::string& path, const void* data, size_t size) {
     struct stat existing {};
     if (::stat(path.c_str(), &existing) == 0) {
         if (S_ISDIR(existing.st_mode)) return failure(path, EISDIR);
         if (!S_ISREG(existing.st_mode)) return writeInPlace(path, data, size);
     }
+    return writeViaTemporary(path, data, size);
+}
+
+std::string writeCacheEntry(const std::string& path, const void* data, size_t size) {
+    // lstat: a symbolic link is judged as itself, never by what it points to.
+    struct stat existing {};
+    if (::lstat(path.c_str(), &existing) == 0 && S_ISDIR(existing.st_mode))
+        return failure(path, EISDIR);
+    return writeViaTemporary(path, data, size);
+}
+
+std::string readCacheEntry(const std::string& path, uint64_t maxBytes,
+                           std::vector<uint8_t>& bytes) {
+    bytes.clear();
+    // O_NONBLOCK: opening a FIFO for reading would otherwise wait for a writer forever.
+    int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC | O_NOFOLLOW | O_NONBLOCK);
+    if (fd < 0) {
+        if (errno == ENOENT) return "missing";
+        if (errno == ELOOP) return "a symbolic link";
+        return std::string("cannot open: ") + std::strerror(errno);
+    }
+    struct stat st {};
+    std::string why;
+    if (::fstat(fd, &st) != 0)
+        why = std::string("cannot stat: ") + std::strerror(errno);
+    else if (!S_ISREG(st.st_mode))
+        why = "not a regular file";
+    else if (uint64_t(st.st_size) > maxBytes)
+        why = format("%llu bytes, more than the %llu an entry may hold",
+                     (unsigned long long)st.st_size, (unsigned long long)maxBytes);
+    if (why.empty()) {
+        bytes.resize(size_t(st.st_size));
+        size_t done = 0;
+        while (done < bytes.size()) {
+            ssize_t n = ::read(fd, bytes.data() + done, bytes.size() - done);
+            if (n < 0 && errno == EINTR) continue;
+            if (n <= 0) {
+                why = n == 0 ? "shorter than its size"
+                             : std::string("read error: ") + std::strerror(errno);
+                break;
+            }
+            done += size_t(n);
+        }
+    }
+    ::close(fd);
+    if (!why.empty()) bytes.clear();
+    return why;
+}
+
+static std::string writeViaTemporary(const std::string& path, const void* data, size_t size) {
     static std::atomic<unsigned long long> counter{0};
     // Hidden, unique per process and call, in the target's folder (same file system).
     std::filesystem::path target(path);

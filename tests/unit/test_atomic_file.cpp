@@ -8,6 +8,7 @@
 #include <sstream>
 
 #include <sys/resource.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include "core/atomic_file.h"
@@ -90,4 +91,46 @@ TEST(AtomicFile, MissingFolderAndDirectoryTargetsAreOneLineErrors) {
     EXPECT_EQ(checkFileCreatable((dir.path / "new.png").string()), "");
     EXPECT_EQ(checkFileCreatable("/dev/full"), "");
     EXPECT_EQ(dir.entries(), 0u);
+}
+
+// A cache entry is never written through what stands at its path: a symbolic link (here to a
+// file that stands for a device or a file of the user's) is replaced, its target left as it was.
+TEST(CacheEntry, ASymbolicLinkIsReplacedAndItsTargetLeftAlone) {
+    TempDir dir("shadel_cache_entry_test");
+    fs::path target = dir.path / "precious.txt", entry = dir.path / "bake-0001.bin";
+    { std::ofstream(target) << "precious"; }
+    fs::create_symlink(target, entry);
+    std::vector<uint8_t> bytes;
+    EXPECT_EQ(readCacheEntry(entry.string(), 1 << 20, bytes), "a symbolic link");
+    EXPECT_TRUE(bytes.empty());
+    EXPECT_EQ(writeCacheEntry(entry.string(), "entry", 5), "");
+    EXPECT_EQ(readText(target), "precious");
+    EXPECT_FALSE(fs::is_symlink(entry));
+    EXPECT_EQ(readCacheEntry(entry.string(), 1 << 20, bytes), "");
+    EXPECT_EQ(std::string(bytes.begin(), bytes.end()), "entry");
+}
+
+// A FIFO at an entry's path neither blocks the read (no writer ever comes) nor the write.
+TEST(CacheEntry, AFifoIsNeitherWaitedOnNorWrittenThrough) {
+    TempDir dir("shadel_cache_entry_test");
+    fs::path entry = dir.path / "environment-0001.bin";
+    ASSERT_EQ(::mkfifo(entry.c_str(), 0644), 0);
+    std::vector<uint8_t> bytes;
+    EXPECT_EQ(readCacheEntry(entry.string(), 1 << 20, bytes), "not a regular file");
+    EXPECT_EQ(writeCacheEntry(entry.string(), "entry", 5), "");
+    EXPECT_TRUE(fs::is_regular_file(fs::symlink_status(entry)));
+    EXPECT_EQ(readText(entry), "entry");
+}
+
+// An entry larger than its kind can be is not read at all (a sparse 1 GiB file here).
+TEST(CacheEntry, AnOversizedEntryIsRefusedBeforeItIsRead) {
+    TempDir dir("shadel_cache_entry_test");
+    fs::path entry = dir.path / "df-0001.bin";
+    { std::ofstream(entry) << "x"; }
+    fs::resize_file(entry, uint64_t(1) << 30);
+    std::vector<uint8_t> bytes;
+    std::string why = readCacheEntry(entry.string(), 1 << 20, bytes);
+    EXPECT_NE(why.find("more than the 1048576"), std::string::npos) << why;
+    EXPECT_TRUE(bytes.empty());
+    EXPECT_EQ(readCacheEntry((dir.path / "absent.bin").string(), 1 << 20, bytes), "missing");
 }

@@ -71,12 +71,11 @@ bool readEnvironmentCache(const std::string& path, const BakeKey& key,
                           std::vector<EquirectImage>& images, std::string* why) {
     std::string ignored;
     if (!why) why = &ignored;
-    std::error_code ec;
-    if (!std::filesystem::is_regular_file(path, ec)) return *why = "missing", false;
-    std::ifstream in(path, std::ios::binary);
-    if (!in) return *why = "cannot open", false;
-    std::vector<uint8_t> bytes((std::istreambuf_iterator<char>(in)),
-                               std::istreambuf_iterator<char>());
+    // The largest maps: a 2048x1024 background and the levels, as RGB floats, well under this.
+    constexpr uint64_t kMaxEntryBytes = uint64_t(256) << 20;
+    std::vector<uint8_t> bytes;
+    if (std::string reason = readCacheEntry(path, kMaxEntryBytes, bytes); !reason.empty())
+        return *why = reason, false;
     Header h{};
     size_t offset = 0;
     if (!take(bytes, offset, h)) return *why = "truncated header", false;
@@ -116,7 +115,7 @@ bool writeEnvironmentCache(const std::string& path, const BakeKey& key,
     bytes.insert(bytes.end(), payload.begin(), payload.end());
     std::error_code ec;
     std::filesystem::create_directories(std::filesystem::path(path).parent_path(), ec);
-    std::string error = writeFileAtomically(path, bytes.data(), bytes.size());
+    std::string error = writeCacheEntry(path, bytes.data(), bytes.size());
     if (!error.empty()) {
         if (why) *why = error;
         return false;
