@@ -2,8 +2,8 @@
 // The environment's maps, from the settings and the scene to the CPU images the GPU side
 // (environment_state.h) uploads: built once per source and cached on disk by content.
 //
-// Sizes (defaults of PrefilterSettings): specular 512x256 at level 0 and 8 levels down to 4x2
-// (level l: GGX of perceptual roughness l / 7); sheen 128x64 and 7 levels down to 2x1 (the Charlie
+// Sizes (defaults of PrefilterSettings): specular 512x256 at level 0 and 5 levels down to 32x16
+// (level l: GGX of perceptual roughness l / 4); sheen 128x64 and 7 levels down to 2x1 (the Charlie
 // lobe of sheen roughness l / 6); irradiance / pi 64x32; BRDF table 64x64;
 // background the source up to 2048x1024 (the sky: 1024x512; the hemisphere: its sky colour).
 #include <cstdint>
