@@ -51,7 +51,27 @@ std::string writeInPlace(const std::string& path, const void* data, size_t size)
 
 } // namespace
 
-static std::string writeViaTemporary(const std::string& path, const void* data, size_t size);
+// Writes a temporary file next to path and renames it over path.
+static std::string writeViaTemporary(const std::string& path, const void* data, size_t size) {
+    static std::atomic<unsigned long long> counter{0};
+    // Hidden, unique per process and call, in the target's folder (same file system).
+    std::filesystem::path target(path);
+    std::string name =
+        format(".%s.tmp.%d.%llu", target.filename().c_str(), int(::getpid()), counter.fetch_add(1));
+    std::string temp = (target.parent_path() / name).string();
+    int fd = ::open(temp.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0644);
+    if (fd < 0) return failure(path, errno);
+    int error = writeAll(fd, data, size);
+    // Delayed allocation: on some file systems a full disk only shows at fsync or close.
+    if (error == 0 && ::fsync(fd) != 0 && errno != EINVAL) error = errno;
+    if (::close(fd) != 0 && error == 0) error = errno;
+    if (error == 0 && ::rename(temp.c_str(), path.c_str()) != 0) error = errno;
+    if (error != 0) {
+        ::unlink(temp.c_str());
+        return failure(path, error);
+    }
+    return {};
+}
 
 std::string writeFileAtomically(const std::string& path, const void* data, size_t size) {
     struct stat existing {};
@@ -106,27 +126,6 @@ std::string readCacheEntry(const std::string& path, uint64_t maxBytes,
     ::close(fd);
     if (!why.empty()) bytes.clear();
     return why;
-}
-
-static std::string writeViaTemporary(const std::string& path, const void* data, size_t size) {
-    static std::atomic<unsigned long long> counter{0};
-    // Hidden, unique per process and call, in the target's folder (same file system).
-    std::filesystem::path target(path);
-    std::string name =
-        format(".%s.tmp.%d.%llu", target.filename().c_str(), int(::getpid()), counter.fetch_add(1));
-    std::string temp = (target.parent_path() / name).string();
-    int fd = ::open(temp.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0644);
-    if (fd < 0) return failure(path, errno);
-    int error = writeAll(fd, data, size);
-    // Delayed allocation: on some file systems a full disk only shows at fsync or close.
-    if (error == 0 && ::fsync(fd) != 0 && errno != EINVAL) error = errno;
-    if (::close(fd) != 0 && error == 0) error = errno;
-    if (error == 0 && ::rename(temp.c_str(), path.c_str()) != 0) error = errno;
-    if (error != 0) {
-        ::unlink(temp.c_str());
-        return failure(path, error);
-    }
-    return {};
 }
 
 std::string checkFileCreatable(const std::string& path) {

@@ -20,8 +20,8 @@ namespace shadel {
 class WorkerPool;
 
 struct PrefilterSettings {
-    uint32_t specularWidth = 512;   // level 0; height = width / 2, each level half the last
-    uint32_t sheenWidth = 128;      // level 0 of the sheen chain (sheenLevels levels)
+    uint32_t specularWidth = 512; // level 0; height = width / 2, each level half the last
+    uint32_t sheenWidth = 128;    // level 0 of the sheen chain (sheenLevels levels)
     // Perceptual roughness of level l = l / (levels - 1). Five levels keep the roughest (the
     // widest lobe) at 32x16 texels, enough for the shading across a rough sphere that a 4x2 level
     // flattens, at a step of 0.25 in roughness, as the glTF reference renderer's chain has.
