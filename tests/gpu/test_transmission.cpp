@@ -162,8 +162,9 @@ glm::vec3 meanLinear(const std::vector<uint8_t>& rgba, uint32_t width, uint32_t 
     return sum / float(n);
 }
 
-// The slab's colour over the backdrop's, per channel (linear), in `mode`.
-glm::vec3 transmittedRatio(const std::string& name, const Slab& slab, RenderMode mode) {
+// The slab scene through its orthographic camera, 96x96, lit by its light alone, linear tone
+// curve: the display values are the linear colours (sRGB-encoded).
+std::vector<uint8_t> renderSlab(const std::string& name, const Slab& slab, RenderMode mode) {
     RenderOptions o = renderOptions(writeSlabScene(name, slab), mode, 96, 96);
     o.camera = "ortho";
     o.environment = "none";
@@ -172,8 +173,12 @@ glm::vec3 transmittedRatio(const std::string& name, const Slab& slab, RenderMode
     o.shadows = false;
     o.tonemap = Tonemap::Linear;
     o.exposure = 1.0f;
-    RenderRun run = renderChecked(o);
-    const std::vector<uint8_t>& rgba = run.frames[0].rgba;
+    return renderChecked(o).frames[0].rgba;
+}
+
+// The slab's colour over the backdrop's, per channel (linear), in `mode`.
+glm::vec3 transmittedRatio(const std::string& name, const Slab& slab, RenderMode mode) {
+    std::vector<uint8_t> rgba = renderSlab(name, slab, mode);
     // The slab spans the middle quarter (pixels 36..59); the backdrop fills the corners.
     glm::vec3 behind = meanLinear(rgba, 96, 8, 8, 4);
     glm::vec3 through = meanLinear(rgba, 96, 48, 48, 6);
@@ -230,17 +235,7 @@ TEST_P(TransmissionTest, RoughThinSlabAtIorOneKeepsTheBackdropSharp) {
     Slab slab;
     slab.roughness = 0.8f;
     slab.darkRightHalf = true;
-    RenderOptions o =
-        renderOptions(writeSlabScene("transmission_rough_ior1", slab), GetParam(), 96, 96);
-    o.camera = "ortho";
-    o.environment = "none";
-    o.environmentGiven = true;
-    o.addDefaultSun = false;
-    o.shadows = false;
-    o.tonemap = Tonemap::Linear;
-    o.exposure = 1.0f;
-    RenderRun run = renderChecked(o);
-    const std::vector<uint8_t>& rgba = run.frames[0].rgba;
+    std::vector<uint8_t> rgba = renderSlab("transmission_rough_ior1", slab, GetParam());
     glm::vec3 leftBeside = meanLinear(rgba, 96, 45, 12, 1);
     glm::vec3 rightBeside = meanLinear(rgba, 96, 50, 12, 1);
     glm::vec3 leftBehind = meanLinear(rgba, 96, 45, 48, 1);
