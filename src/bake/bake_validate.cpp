@@ -46,17 +46,10 @@ std::string checkStructure(const Mesh& mesh, const BakedMesh& b) {
     return {};
 }
 
-} // namespace
-
-BakeValidation validateBake(const Mesh& mesh, const BakedMesh& b) {
-    namespace sh = shader;
-    BakeValidation v;
-    v.structureError = checkStructure(mesh, b);
-    if (!v.structureError.empty()) return v;
-    uint32_t triangles = mesh.triangleCount();
-
-    // Charts = connected regions in UV space: triangles joined by a shared baked vertex, or by
-    // baked vertices at the identical UV (seam duplicates of one surface point).
+// Charts = connected regions in UV space: triangles joined by a shared baked vertex, or by
+// baked vertices at the identical UV (seam duplicates of one surface point). Returns each
+// triangle's chart (a representative baked vertex) and sets v.chartComponents.
+std::vector<uint32_t> chartOfTriangles(const BakedMesh& b, uint32_t triangles, BakeValidation& v) {
     std::vector<uint32_t> parent(b.vertexRemap.size());
     std::iota(parent.begin(), parent.end(), 0u);
     std::unordered_map<uint64_t, uint32_t> byUv;
@@ -75,6 +68,11 @@ BakeValidation validateBake(const Mesh& mesh, const BakedMesh& b) {
     std::sort(roots.begin(), roots.end());
     v.chartComponents = uint32_t(std::unique(roots.begin(), roots.end()) - roots.begin());
 
+    return chartOf;
+}
+
+// The world-space area of every triangle (0 where it is not finite).
+std::vector<double> triangleAreas(const Mesh& mesh, uint32_t triangles) {
     std::vector<double> worldArea(triangles);
     for (uint32_t t = 0; t < triangles; ++t) {
         glm::dvec3 p0 = mesh.vertices[mesh.indices[3 * t]].position;
@@ -84,6 +82,12 @@ BakeValidation validateBake(const Mesh& mesh, const BakedMesh& b) {
         worldArea[t] = std::isfinite(a) ? a : 0.0;
     }
 
+    return worldArea;
+}
+
+// Overlaps and ownership at MIP 0.
+void checkOverlaps(const BakedMesh& b, uint32_t triangles, const std::vector<uint32_t>& chartOf,
+                   BakeValidation& v) {
     // Overlaps: standard coverage of every triangle at MIP 0, counting shadels claimed twice.
     size_t texels = size_t(b.width) * b.height;
     std::vector<uint32_t> claim(texels, kNone);
@@ -104,7 +108,11 @@ BakeValidation validateBake(const Mesh& mesh, const BakedMesh& b) {
     for (uint16_t id : b.idMaps[0])
         if (id != kEmptyShadel) ++owned[id];
     for (uint32_t t = 0; t < triangles; ++t) v.unownedTriangles += owned[t] == 0;
+}
 
+// Empty and foreign reads of the reconstruction filter, per level.
+void countFilterReads(const BakedMesh& b, const std::vector<uint32_t>& chartOf,
+                      const std::vector<double>& worldArea, BakeValidation& v) {
     // Reads of the reconstruction filter, per level: bilinear taps at points inside visible
     // triangles, namely each covered shadel centre pushed 0.49 shadel towards each of its eight
     // neighbours (kept if still inside the triangle), read the 2x2 shadels around the point.
@@ -145,7 +153,11 @@ BakeValidation validateBake(const Mesh& mesh, const BakedMesh& b) {
         v.emptyReads.push_back(empty);
         v.foreignReads.push_back(foreign);
     }
+}
 
+// Shadel density over the mesh: area-weighted mean and coefficient of variation.
+void measureDensity(const BakedMesh& b, uint32_t triangles, const std::vector<double>& worldArea,
+                    BakeValidation& v) {
     // Density: shadels per m^2 of every triangle with area, weighted by area.
     double sumW = 0, sum = 0, sum2 = 0;
     for (uint32_t t = 0; t < triangles; ++t) {
@@ -164,7 +176,12 @@ BakeValidation validateBake(const Mesh& mesh, const BakedMesh& b) {
         double variance = std::max(0.0, sum2 / sumW - v.densityMean * v.densityMean);
         v.densityCv = v.densityMean > 0 ? std::sqrt(variance) / v.densityMean : 0;
     }
+}
 
+// Reconstruction error and neighbour spacing at MIP 0.
+void checkReconstruction(const Mesh& mesh, const BakedMesh& b, const std::vector<double>& worldArea,
+                         BakeValidation& v) {
+    namespace sh = shader;
     // Reconstruction from ID shadel + clamped barycentrics (the GPU path, in float) against the
     // exact surface point mapped to the shadel centre (double).
     double shadelsPerMetre = b.shadelsPerMetre;
@@ -220,6 +237,21 @@ BakeValidation validateBake(const Mesh& mesh, const BakedMesh& b) {
     }
     if (v.minNeighbourSpacing > v.maxNeighbourSpacing)
         v.minNeighbourSpacing = v.maxNeighbourSpacing = 0;
+}
+
+} // namespace
+
+BakeValidation validateBake(const Mesh& mesh, const BakedMesh& b) {
+    BakeValidation v;
+    v.structureError = checkStructure(mesh, b);
+    if (!v.structureError.empty()) return v;
+    uint32_t triangles = mesh.triangleCount();
+    std::vector<uint32_t> chartOf = chartOfTriangles(b, triangles, v);
+    std::vector<double> worldArea = triangleAreas(mesh, triangles);
+    checkOverlaps(b, triangles, chartOf, v);
+    countFilterReads(b, chartOf, worldArea, v);
+    measureDensity(b, triangles, worldArea, v);
+    checkReconstruction(mesh, b, worldArea, v);
     return v;
 }
 
