@@ -10,11 +10,17 @@
 #include "app/commands.h"
 #include "app/option_table.h"
 #include "app/output_files.h"
+#include "app/stats_schema.h"
 #include "core/error.h"
 #include "core/log.h"
 #include "scene/builtin_scenes.h"
 
 namespace shadel {
+
+void writeBenchJson(const std::string& path, nlohmann::json& out) {
+    out["schema"] = kStatsSchemaVersion;
+    if (!path.empty()) writeOutputFile(path, out.dump(2) + "\n");
+}
 
 double passMs(const nlohmann::json& stats, const char* name) {
     for (const auto& p : stats["passes"])
@@ -83,7 +89,7 @@ nlohmann::json runParticleLightingBench(Gpu& gpu, const BenchOptions& b, RenderO
     std::printf("  particle total atlas %.3f ms / pixel %.3f ms = %.3f\n",
                 atlasLight + atlasSprites, pixelSprites,
                 out["ratios"]["particle_total_atlas_over_pixel"].get<double>());
-    if (!b.json.empty()) writeOutputFile(b.json, out.dump(2) + "\n");
+    writeBenchJson(b.json, out);
     return out;
 }
 
@@ -137,7 +143,7 @@ nlohmann::json runStencilBench(Gpu& gpu, const BenchOptions& b, RenderOptions o)
                 out["stencil_ms"]["water_composite_unbounded"].get<double>());
     std::printf("  stencilMark (depth-stencil copy + marks) %.3f ms\n",
                 out["stencil_ms"]["stencil_mark"].get<double>());
-    if (!b.json.empty()) writeOutputFile(b.json, out.dump(2) + "\n");
+    writeBenchJson(b.json, out);
     return out;
 }
 
@@ -251,7 +257,7 @@ nlohmann::json runStreamingBench(Gpu& gpu, const BenchOptions& b, RenderOptions 
                         rounds.c_str());
         }
     }
-    if (!b.json.empty()) writeOutputFile(b.json, out.dump(2) + "\n");
+    writeBenchJson(b.json, out);
     return out;
 }
 
@@ -384,7 +390,7 @@ nlohmann::json runInstanceScalingBench(Gpu& gpu, const BenchOptions& b, RenderOp
     std::printf("  (ms: cpu frame = renderFrame without GPU waits; prepare = its CPU frontend; "
                 "coarse = the decoupled coarse allocation, with --cpu-scopes; submits = the "
                 "vkQueueSubmit calls' thread CPU time; gpu frame = frame time)\n");
-    if (!b.json.empty()) writeOutputFile(b.json, out.dump(2) + "\n");
+    writeBenchJson(b.json, out);
     return out;
 }
 
@@ -838,7 +844,7 @@ nlohmann::json runBench(Gpu& gpu, const BenchOptions& b) {
     if (b.compareThreads) compareThreadRuns(gpu, b, o, out);
     printBenchTable(gpu, b, out);
     if (!b.plot.empty()) writeBenchPlot(out, b.plot);
-    if (!b.json.empty()) writeOutputFile(b.json, out.dump(2) + "\n");
+    writeBenchJson(b.json, out);
     return out;
 }
 

@@ -9,6 +9,7 @@
 
 #include "app/commands.h"
 #include "app/output_files.h"
+#include "app/stats_schema.h"
 
 namespace shadel {
 
@@ -66,7 +67,7 @@ nlohmann::json runEnvironmentBench(Gpu& gpu, const BenchOptions& b, RenderOption
         std::printf("  %-10s %9.3f ms %9.3f ms %8.3f\n", m == 0 ? "forward" : "decoupled", sky,
                     none, median(m == 0 ? forwardRatios : decoupledRatios));
     }
-    if (!b.json.empty()) writeOutputFile(b.json, out.dump(2) + "\n");
+    writeBenchJson(b.json, out);
     return out;
 }
 

@@ -4,6 +4,7 @@
 
 #include "app/commands.h"
 #include "app/output_files.h"
+#include "app/stats_schema.h"
 
 namespace shadel {
 
@@ -87,7 +88,7 @@ nlohmann::json runShadowCullingBench(Gpu& gpu, const BenchOptions& b, RenderOpti
                     row["instances_drawn"].get<uint32_t>(),
                     ws["culling"]["views"][view]["instances_drawn"].get<uint32_t>());
     }
-    if (!b.json.empty()) writeOutputFile(b.json, out.dump(2) + "\n");
+    writeBenchJson(b.json, out);
     return out;
 }
 

@@ -12,6 +12,7 @@
 #include "app/commands.h"
 #include "app/option_table.h"
 #include "app/output_files.h"
+#include "app/stats_schema.h"
 #include "app/trace_export.h"
 #include "bake/bake.h"
 #include "bake/bake_cache.h"
@@ -703,8 +704,10 @@ RenderRun finishRender(RenderSessionPtr sessionPtr) {
     if (!o.captures.empty())
         run.captureFiles = writeCaptures(renderer.captures, o.captures, o.captureDir, o.out);
 
-    // Stats (the stats contract in docs/design.md): medians over frames.
+    // Stats (every key, its unit and meaning: docs/stats.md; the layout: docs/stats.schema.json):
+    // medians over frames.
     nlohmann::json s;
+    s["schema"] = kStatsSchemaVersion;
     recordDevice(s, gpu);
     s["driver"] = gpu.device.driver;
     s["scene"] = o.scene;
