@@ -6,7 +6,7 @@ set -euo pipefail
 export DEBIAN_FRONTEND=noninteractive
 
 stamp=/var/lib/shadel-setup.stamp
-want_version=7
+want_version=8
 if [ -f "$stamp" ] && [ "$(cat "$stamp")" = "$want_version" ] && [ "${SHADEL_FORCE_SETUP:-0}" != 1 ]; then
   echo "setup: already done (remove $stamp to redo)"
   exit 0
@@ -43,7 +43,7 @@ $SUDO apt-get install -y -qq \
   build-essential cmake ninja-build pkg-config git clang libclang-rt-14-dev \
   glslc libshaderc-dev spirv-tools vulkan-validationlayers \
   libglm-dev libtinygltf-dev libmeshoptimizer-dev libstb-dev libcli11-dev nlohmann-json3-dev \
-  libgtest-dev libgmock-dev libbenchmark-dev libeigen3-dev assimp-testmodels python3 \
+  libgtest-dev libgmock-dev libbenchmark-dev libeigen3-dev assimp-testmodels python3 python3-jsonschema \
   gltfpack libtinyexr-dev libglfw3-dev libimgui-dev xvfb xauth xdotool
 # The test suite's fuzz runs need clang with libFuzzer: fail here rather than skip them later.
 if ! command -v clang++ >/dev/null 2>&1; then
