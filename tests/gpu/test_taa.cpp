@@ -180,7 +180,8 @@ TEST(Taa, OrbitDecoupledStaysNearSupersamplingUnderMotion) {
 }
 
 // Still camera, jitter on: aliased frames change with every sub-pixel offset (edges step by a
-// pixel), TAA's converge. Differences between consecutive frames after 8 warm-up frames.
+// pixel), TAA's converge. Differences between consecutive frames after 8 warm-up frames
+// (measured: forward 8.57 -> 0.58 levels, decoupled 2.70 -> 0.20).
 TEST(Taa, StillCameraDoesNotFlickerUnderJitter) {
     for (RenderMode mode : {RenderMode::Forward, RenderMode::Decoupled}) {
         RenderOptions none = renderOptions("builtin:default", mode, kW, kH);
@@ -227,7 +228,10 @@ TEST(Taa, AaFramesStillIsCloserToSupersamplingThanOneFrame) {
 
 // A glowing cube slides across a dark wall before a still camera (0.375 m, ~13 pixels, a
 // frame): the wall where it was shows no trace of it. The object has no motion vectors (only
-// the camera's are computed): the depth test rejects the history where the cube was.
+// the camera's are computed): the depth test rejects the history where the cube was. Measured:
+// no pixel of the ~7000 behind it over 8 frames is more than 5 (forward) / 6 (decoupled) levels
+// brighter than the 4x4 SSAA reference, its edge's own aliasing; a trail would be the cube's
+// ~200 levels fading by 0.9 a frame.
 TEST(Taa, MovingObjectLeavesNoTrail) {
     for (RenderMode mode : {RenderMode::Forward, RenderMode::Decoupled}) {
         RenderOptions o = renderOptions(writeMovingCubeScene("taa_moving_cube"), mode, kW, kH);
@@ -253,9 +257,9 @@ TEST(Taa, MovingObjectLeavesNoTrail) {
         std::printf("%s moving cube: worst trail %d levels over %zu pixels\n", modeName(mode),
                     worst, trailPixels);
         EXPECT_GT(trailPixels, 1000u) << "the cube should sweep over the wall";
-        EXPECT_LE(worst, 16) << modeName(mode) << ": a pixel behind the cube is " << worst
-                             << " levels brighter than the reference (" << trailPixels
-                             << " trail pixels)";
+        EXPECT_LE(worst, 7) << modeName(mode) << ": a pixel behind the cube is " << worst
+                            << " levels brighter than the reference (" << trailPixels
+                            << " trail pixels)";
     }
 }
 
