@@ -29,5 +29,7 @@ std::vector<std::string> writeCaptures(const CaptureRegistry& registry,
 // The HDR frame at the output resolution (an N x N SSAA target is box-filtered), as EXR.
 void writeHdrFrame(const CaptureRegistry& registry, uint32_t ssaa, const std::string& path);
 bool isExrPath(const std::string& path);
+// "" if the extension names a format shadel writes (.png, .exr, any case), else why not.
+std::string imageFormatProblem(const std::string& path);
 
 } // namespace shadel

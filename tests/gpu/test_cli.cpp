@@ -367,6 +367,10 @@ TEST(Cli, BlockingCollidingOrWrappingOutputsFailBeforeRendering) {
          "--size 4294967616x4294967476: each side must be between 1 and 16384"},
         {"render --scene /nonexistent.gltf --size 99999999999999999999999x9",
          "--size 99999999999999999999999x9: expected WIDTHxHEIGHT"},
+        {"render --scene /nonexistent.gltf --out " + dir.file("frame.jpg"),
+         "frame.jpg: '.jpg' is not an image format shadel writes: .png or .exr"},
+        {"render --scene /nonexistent.gltf --out " + dir.file("frame"),
+         "frame: no file extension: .png (display colours) or .exr (scene-linear HDR)"},
     };
     for (const auto& [args, message] : cases) expectOneLineError(args, message);
     EXPECT_EQ(dir.entries(), 1u) << "only the FIFO: nothing written";
