@@ -102,6 +102,12 @@ void writeHdrFrame(const CaptureRegistry& registry, uint32_t ssaa, const std::st
     const CaptureSource* source = findCapture(registry, "hdr");
     if (!source) throw InputError(format("--out %s: this frame has no HDR target", path.c_str()));
     CapturedImage hdr = source->read();
+    // With TAA the displayed colour is the resolve's (render/taa); alpha stays the scene's.
+    if (const CaptureSource* taa = findCapture(registry, "taa")) {
+        CapturedImage resolved = taa->read();
+        for (size_t i = 0; i < hdr.floats.size() && i < resolved.floats.size(); i += 4)
+            for (int c = 0; c < 3; ++c) hdr.floats[i + c] = resolved.floats[i + c];
+    }
     uint32_t w = hdr.width / ssaa, h = hdr.height / ssaa;
     std::vector<float> pixels(size_t(w) * h * 4, 0.0f);
     float weight = 1.0f / float(ssaa * ssaa);

@@ -152,6 +152,15 @@ void validateCombinations(const RenderOptions& o) {
     if (o.debugLinesAtX >= int32_t(o.width) || o.debugLinesAtY >= int32_t(o.height))
         throw InputError(format("--debug-lines-at %d,%d: outside the %ux%u image", o.debugLinesAtX,
                                 o.debugLinesAtY, o.width, o.height));
+    if (o.aaFrames > 1 &&
+        (o.aa != AntiAliasing::Taa || o.frames != 1 || o.cameraPath != CameraPath::Static))
+        throw InputError(format("--aa-frames %u: accumulates a still; needs --aa taa, --frames 1 "
+                                "and --camera-path static",
+                                o.aaFrames));
+    if (o.aa == AntiAliasing::Taa && o.ssaa != 1)
+        throw InputError(format("--aa taa with --ssaa %u: TAA resolves one sample per pixel; use "
+                                "one of them",
+                                o.ssaa));
 }
 
 } // namespace

@@ -16,6 +16,17 @@ void addImageOptions(std::vector<SettingOption>& t) {
         {{"forward", RenderMode::Forward}, {"decoupled", RenderMode::Decoupled}}, RV,
         "forward shading, or decoupled: shaded in shadel space, then rasterized"));
     t.push_back(countOption("--ssaa", SETTING(ssaa), 1, 16, R, "NxN supersampled reference"));
+    t.push_back(choiceOption<AntiAliasing>(
+        "--aa", SETTING(aa),
+        {{"auto", AntiAliasing::Auto}, {"none", AntiAliasing::None}, {"taa", AntiAliasing::Taa}},
+        RBV,
+        "anti-aliasing: taa (temporal: jittered frames accumulated with reprojection; jitter "
+        "on by itself) | none | auto (none for render and bench, taa for view)"));
+    t.push_back(floatOption("--taa-sharpen", SETTING(taaSharpen), FloatRange{0, 1}, RBV,
+                            "TAA: unsharp mask over the displayed image (0: off)"));
+    t.push_back(countOption("--aa-frames", SETTING(aaFrames), 1, 256, R,
+                            "TAA: a still (--frames 1, static camera) accumulates this many "
+                            "jittered frames and outputs the last"));
     t.push_back(choiceOption<Visualize>(
         "--visualize", SETTING(visualize),
         {{"none", Visualize::None},

@@ -215,7 +215,8 @@ void addPipelines(PipelineLibraryCounters& sum, const PipelineLibraryCounters& m
 // The camera of frame i: the path, the cut, the sub-pixel jitter.
 CameraView viewOfFrame(const RenderSession& session, uint32_t i) {
     const RenderOptions& o = session.o;
-    glm::vec2 jitter = o.jitter ? subpixelJitter(i) : glm::vec2(0.0f);
+    // (With TAA the renderer jitters the camera itself: render/taa.)
+    glm::vec2 jitter = o.jitter && !taaEnabled(o) ? subpixelJitter(i) : glm::vec2(0.0f);
     const Camera& start =
         session.cutCamera && i >= o.cutFrame ? *session.cutCamera : session.camera;
     Camera onPath = cameraOnPath(start, o.cameraPath, i, o.frames, session.bounds);
@@ -523,6 +524,7 @@ void renderNextFrame(RenderSession& session) {
         throw std::logic_error("renderNextFrame: the render has no frame left");
     const PipelineLibraryCounters pipelinesBefore = pipelineLibraryCounters(gpu);
     CameraView view = viewOfFrame(session, i);
+    if (session.cutCamera && i == o.cutFrame) resetTaaHistory(renderer); // (render/taa)
     if (playback && i > 0) {
         poseFrame(gpu, *playback, i, session.gpuScene, renderer.reposedInstances,
                   renderer.skinning != nullptr, &renderer.reposedFrom);
@@ -546,6 +548,9 @@ void renderNextFrame(RenderSession& session) {
         if (playback) prefetchPose(*playback, i + 1);
         renderer.nextFrame = Renderer::NextFrame{viewOfFrame(session, i + 1), playback.has_value()};
     }
+    // --aa-frames: a still's earlier jittered frames, into the TAA history only.
+    for (uint32_t k = 1; i == 0 && k < o.aaFrames; ++k)
+        renderFrame(renderer, session.gpuScene, view);
     run.frames.push_back(renderFrame(renderer, session.gpuScene, view));
     if (i > 0) // what this frame took from the worker ran beside the last one
         for (FrontendWorkerTask& t : renderer.frontendTaken)
@@ -667,6 +672,7 @@ void featureStats(const RenderSession& session, nlohmann::json& s) {
     if (renderer.rt) rayTracingStats(renderer, s);
     if (renderer.screenSpace) screenSpaceStats(renderer, s);
     if (renderer.distanceFields) distanceFieldStats(*renderer.distanceFields, s);
+    taaStats(renderer, s);
     if (streaming) {
         textureStreamingStats(*streaming, s);
     } else { // textures loaded whole (RGBA8 with MIPs, what the images need at least)

@@ -193,6 +193,7 @@ void initRenderer(Renderer& r, Gpu& gpu, const RenderSettings& requested, const 
     r.debugLines = createDebugLines(r);
     if (settings.rt.enabled()) r.rt = createRayTracing(r, scene);
     createScreenSpace(r);
+    r.taa = createTaa(r);
     // Last: prefiltering a new environment takes seconds, and every check above that can refuse
     // the settings (a device without ray queries, ...) answers first.
     createEnvironment(gpu, r.environment, settings, scene,
@@ -211,6 +212,7 @@ void destroyRenderer(Renderer& r) {
     destroyLightCulling(r, r.lightCulling);
     destroyDebugLines(r, r.debugLines);
     destroyScreenSpace(r);
+    destroyTaa(r, r.taa);
     if (r.distanceFields) destroyDistanceFields(r, *r.distanceFields);
     r.distanceFields.reset();
     if (r.stencilEffects) destroyStencilEffects(r, *r.stencilEffects);
@@ -353,9 +355,11 @@ static void updateLights(Renderer& r, const GpuScene& scene, gpu::FrameConstants
 
 // One frame, top to bottom. Forward: cull, shadow, depth prepass, shading, tonemap.
 // Decoupled replaces shading with marking, allocation, work queues, shadel shading and
-// reconstruction (render/shadel/decoupled.h).
-FrameResult renderFrame(Renderer& r, const GpuScene& scene, const CameraView& camera) {
+// reconstruction (render/shadel/decoupled.h). With TAA the camera is jittered and the resolve
+// runs before the tonemap (render/taa).
+FrameResult renderFrame(Renderer& r, const GpuScene& scene, const CameraView& unjittered) {
     Gpu& gpu = *r.gpu;
+    const CameraView camera = r.taa ? prepareTaaFrame(r, unjittered) : unjittered;
     double threadStart = threadCpuMs();
     using Clock = std::chrono::steady_clock;
     auto msSince = [](Clock::time_point t) {
@@ -449,7 +453,9 @@ FrameResult renderFrame(Renderer& r, const GpuScene& scene, const CameraView& ca
     uint64_t frame = address(gpu, r.frameConstants);
     double prepareMs = msSince(cpuStart);
     if (r.nextFrame) { // the next frame's frontend beside this frame's backend
-        prefetchCoarseVisit(r, scene, r.nextFrame->camera, r.nextFrame->sceneMoves);
+        const CameraView& next = r.nextFrame->camera;
+        prefetchCoarseVisit(r, scene, r.taa ? taaNextFrameView(r, next) : next,
+                            r.nextFrame->sceneMoves);
         r.nextFrame.reset();
     }
 
@@ -518,7 +524,8 @@ FrameResult renderFrame(Renderer& r, const GpuScene& scene, const CameraView& ca
     recordTransmissionPasses(r, rec, frame); // over a mipmapped copy of the opaque scene colour
     recordTransparencyPasses(r, rec, frame); // blended materials, after every opaque surface
     if (r.debugLines) recordDebugLinePasses(r, rec, frame, scene, constants.lightCount);
-    recordParticleAtlasView(r, rec, frame); // --visualize particle-atlas
+    recordParticleAtlasView(r, rec, frame);    // --visualize particle-atlas
+    if (r.taa) recordTaaPasses(r, rec, frame); // jittered frames accumulated (render/taa)
     if (!r.tonemapFused) // else forward shading or the resolve wrote display pixels (render/post)
         pass(rec, "tonemap", [&](VkCommandBuffer cmd) { recordTonemap(r, cmd, frame); });
     else if (r.settings.mode == RenderMode::Forward) // (the resolve wrote the readback itself)
@@ -548,6 +555,7 @@ FrameResult renderFrame(Renderer& r, const GpuScene& scene, const CameraView& ca
     result.transparentDraws =
         uint32_t(transparentDrawOrder(r).size()) + result.transparentDecoupledDraws;
     if (r.decoupled) finishDecoupledFrame(r);
+    if (r.taa) finishTaaFrame(r);
     readLightCullingStats(r);
     readFeatureSpectraStats(r);
     readDecalStats(r);

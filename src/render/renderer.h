@@ -29,6 +29,7 @@
 #include "render/shadel/visibility.h"
 #include "render/skinning/skinning.h"
 #include "render/stencil/stencil_effects.h"
+#include "render/taa/taa.h"
 #include "render/transmission/transmission.h"
 #include "rhi/frame.h"
 #include "rhi/pipeline.h"
@@ -80,9 +81,18 @@ enum class LightCulling { None, Tiled };
 // every one of them draws the sun's whole-scene list (render/culling/culling.h).
 enum class ShadowCulling { PerView, WholeScene };
 
+// --aa: temporal anti-aliasing (render/taa) or none. Auto: each command's default (none for
+// `render` and `bench`, TAA for `view`); the renderer treats it as none.
+enum class AntiAliasing { Auto, None, Taa };
+
 struct RenderSettings {
     uint32_t width = 1280, height = 720;
     uint32_t ssaa = 1; // N x N supersampling (forward reference)
+    AntiAliasing aa = AntiAliasing::Auto;
+    float taaSharpen = 0.0f; // --taa-sharpen: unsharp mask over the TAA output (0: off)
+    // --aa-frames: a still (one frame, --camera-path static) renders this many jittered frames
+    // into the TAA history and outputs the last (render/taa).
+    uint32_t aaFrames = 1;
     RenderMode mode = RenderMode::Forward;
     // Decoupled only. Visibility is the default (Auto): on lavapipe the visibility prepass,
     // compute marking and compute resolve together cost less than the depth prepass, raster
@@ -363,6 +373,7 @@ struct Renderer {
     };
     std::optional<NextFrame> nextFrame;
     TransmissionStatePtr transmission; // scenes with transmissive materials (render/transmission)
+    TaaStatePtr taa;                   // --aa taa (render/taa)
 };
 
 // Times the enclosing block as the CPU scope `name` of this frame (nothing unless

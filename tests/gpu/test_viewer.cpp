@@ -61,8 +61,12 @@ TEST(Viewer, ScreenshotUnderXvfbMatchesRenderOfTheSameCamera) {
     std::vector<uint8_t> window = readPng(shot, w, h);
     ASSERT_EQ(w, 320);
     ASSERT_EQ(h, 180);
-    RenderRun render =
-        renderChecked(renderOptions("builtin:default", RenderMode::Forward, 320, 180));
+    // The viewer's anti-aliasing is TAA by default (--aa auto): its 5th frame is the 5th of a
+    // render with --aa taa (the same jitter sequence on the same still camera).
+    RenderOptions same = renderOptions("builtin:default", RenderMode::Forward, 320, 180);
+    same.aa = AntiAliasing::Taa;
+    same.frames = 5;
+    RenderRun render = renderChecked(same);
     double p = psnr(window, render.frames.back().rgba);
     std::printf("[ figures ] view --no-ui screenshot vs render: %.2f dB\n", p);
     EXPECT_GE(p, 30.0);

@@ -60,6 +60,7 @@ RenderSettings settingsFor(const ViewOptions& o, const ViewerPanel& p, const Gpu
     s.timing = defaultTimingMode(gpu);
     s.recordingThreads = o.threads ? o.threads : defaultRecordingThreads();
     s.materialRate = p.materialRate;
+    s.aa = p.taa ? AntiAliasing::Taa : AntiAliasing::None;
     return s;
 }
 
@@ -131,6 +132,7 @@ int runViewer(const ViewOptions& o, DeviceDesc deviceDesc) {
     SceneEditor editor; // lights, sun and materials the user edits
     panel.mode = o.mode == RenderMode::Decoupled ? 1 : 0;
     panel.materialRate = o.materialRate;
+    panel.taa = o.aa != AntiAliasing::None; // (auto: TAA in the viewer)
 
     ViewerWindow window;
     ViewerInput input;
@@ -311,8 +313,10 @@ int runViewer(const ViewOptions& o, DeviceDesc deviceDesc) {
             }
             ++frame;
             if (lastFrame) break;
-            if (panel.modeChanged || panel.cameraModeChanged || panel.visualizeChanged) {
-                if (panel.modeChanged) { // a new renderer: the decoupled path owns its state
+            if (panel.modeChanged || panel.cameraModeChanged || panel.visualizeChanged ||
+                panel.taaChanged) {
+                // A new renderer: the decoupled path and TAA own their state.
+                if (panel.modeChanged || panel.taaChanged) {
                     vkDeviceWaitIdle(dev);
                     destroyRenderer(renderer);
                     renderer = Renderer{};

@@ -123,7 +123,7 @@ bool uiWantsKeyboard(const ViewerUi& ui) {
 void buildUi(ViewerUi& ui, ViewerPanel& p, const std::function<void()>& sections) {
     (void)ui;
     p.modeChanged = p.visualizeChanged = p.cameraModeChanged = p.screenshotRequested = false;
-    p.materialRateChanged = false;
+    p.materialRateChanged = p.taaChanged = false;
     ImGui_ImplVulkan_NewFrame();
     ImGui_ImplGlfw_NewFrame();
     ImGui::NewFrame();
@@ -138,6 +138,8 @@ void buildUi(ViewerUi& ui, ViewerPanel& p, const std::function<void()>& sections
         // Plain rough materials shaded up to a MIP coarser (render/shadel/material_rate.h).
         p.materialRateChanged = ImGui::Checkbox("material shading rate", &p.materialRate);
     }
+    // Jittered frames accumulated with reprojection (render/taa).
+    p.taaChanged = ImGui::Checkbox("temporal anti-aliasing", &p.taa);
     p.cameraModeChanged = ImGui::Checkbox("orbit camera (Tab)", &p.orbit);
     ImGui::TextUnformatted(p.orbit ? "left drag: turn, wheel: zoom"
                                    : "WASD/QE: move, right drag: look, shift: fast");

@@ -31,9 +31,10 @@ struct ViewerPanel {
     int visualize = 0; // index into kVisualizeNames
     bool orbit = false;
     bool materialRate = true; // decoupled: --material-rate
+    bool taa = true;          // --aa taa
     // Out: events.
     bool modeChanged = false, visualizeChanged = false, cameraModeChanged = false;
-    bool materialRateChanged = false;
+    bool materialRateChanged = false, taaChanged = false;
     bool screenshotRequested = false;
 };
 

@@ -24,7 +24,9 @@ void createTonemapPipeline(Renderer& r) {
     r.tonemap = createComputePipeline(*r.gpu, "tonemap", "post_tonemap.comp.spv");
 }
 
-void recordTonemap(Renderer& r, VkCommandBuffer cmd, uint64_t frame) {
+// The scene colour and depth into the layouts the pass reads them in (with TAA the resolve
+// has moved them).
+static void tonemapBarriers(Renderer& r, VkCommandBuffer cmd) {
     Gpu& gpu = *r.gpu;
     // A target that also allows storage (the visibility resolve) is read in GENERAL layout.
     VkImageLayout hdrLayout = (desc(gpu, r.hdr).usage & VK_IMAGE_USAGE_STORAGE_BIT)
@@ -41,10 +43,15 @@ void recordTonemap(Renderer& r, VkCommandBuffer cmd, uint64_t frame) {
                      VK_PIPELINE_STAGE_2_EARLY_FRAGMENT_TESTS_BIT,
                  VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT,
                  VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_SHADER_SAMPLED_READ_BIT);
+}
+
+void recordTonemap(Renderer& r, VkCommandBuffer cmd, uint64_t frame) {
+    Gpu& gpu = *r.gpu;
+    if (!r.taa) tonemapBarriers(r, cmd);
     bind(gpu, cmd, r.tonemap);
     TonemapPush push{frame,
                      address(gpu, r.pixels),
-                     slot(gpu, r.hdrRead).value,
+                     r.taa ? taaDisplaySlot(r) : slot(gpu, r.hdrRead).value,
                      slot(gpu, r.depthRead).value,
                      r.settings.width,
                      r.settings.height,
@@ -58,7 +65,8 @@ void recordTonemap(Renderer& r, VkCommandBuffer cmd, uint64_t frame) {
 
 bool forwardMayFuseTonemap(const Renderer& r) {
     return r.settings.fuseTonemap && r.settings.ssaa == 1 &&
-           r.settings.mode == RenderMode::Forward && !usesTileShading(r);
+           r.settings.mode == RenderMode::Forward && !usesTileShading(r) &&
+           !taaEnabled(r.settings); // (TAA reads the scene colour)
 }
 
 bool tonemapFusedThisFrame(const Renderer& r) {
@@ -69,7 +77,7 @@ bool tonemapFusedThisFrame(const Renderer& r) {
                           : r.settings.fuseTonemap && r.settings.ssaa == 1 && r.visibility;
     // Every pass declared after it that draws into or reads the scene colour.
     bool drawnAfter = r.particles || r.screenSpace || r.stencilEffects || r.pointsLines ||
-                      r.debugLines || transparencyThisFrame(r) || transmissionThisFrame(r);
+                      r.debugLines || transparencyThisFrame(r) || transmissionThisFrame(r) || r.taa;
     return fusingPass && !drawnAfter;
 }
 
