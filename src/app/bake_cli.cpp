@@ -31,7 +31,7 @@ int runBakeCommand(const BakeFlags& f, const GlobalFlags& g) {
         SHADEL_WARN("%s: %.0f units^2 of surface: using %.3f shadels/unit to stay within %.0fM "
                     "shadels",
                     f.scene.c_str(), area, double(bs.shadelsPerMetre), f.budget / 1e6);
-    std::string dir = f.noCache ? "" : f.cacheDir.empty() ? defaultCacheDir() : f.cacheDir;
+    std::string dir = f.noCache ? "" : usableCacheFolder(f.cacheDir);
     bool tty = isatty(STDERR_FILENO);
     auto start = std::chrono::steady_clock::now();
     auto baked = bakeScene(scene, bs, dir, [&](size_t done, size_t total) {

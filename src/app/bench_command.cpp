@@ -817,6 +817,7 @@ void printBenchTable(const Gpu& gpu, const BenchOptions& b, const nlohmann::json
 nlohmann::json runBench(Gpu& gpu, const BenchOptions& b) {
     if (!b.json.empty()) requireCreatableOutput("--json", b.json); // before minutes of rendering
     if (!b.plot.empty()) requireCreatableOutput("--plot", b.plot);
+    requireDistinctOutputs({{"--json", b.json}, {"--plot", b.plot}});
     validate(b);
     const RenderOptions o = benchBaseOptions(b);
     if (b.compareShadowCulling) return runShadowCullingBench(gpu, b, o);

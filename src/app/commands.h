@@ -7,6 +7,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "bake/cache_folder.h"
 #include "render/camera_framing.h"
 #include "render/renderer.h"
 #include "render/streaming/texture_streaming.h"
@@ -88,8 +89,6 @@ double median(std::vector<double> values);
 void parseCameraCut(const std::string& text, std::string& camera, uint32_t& frame);
 // "X,Y" of a pixel for `flag`; one-line InputError otherwise.
 void parsePixel(const char* flag, const std::string& text, int32_t& x, int32_t& y);
-// The bake cache folder when --cache-dir is not given (see defaultBakeCacheDir()).
-std::string defaultCacheDir();
 
 // The device a run measured on, as render stats and bench JSON record it ("device", "host"):
 // a software device's timings are its host CPU's, so that CPU (core/host.h) goes beside it.

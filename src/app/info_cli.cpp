@@ -10,7 +10,7 @@ Subcommand addInfoCommand(CLI::App& app) {
     CLI::App* c = app.add_subcommand("info", "print the device, driver, features and limits");
     return {c, [](const GlobalFlags& g) {
                 std::printf("Vulkan devices:\n%s", listPhysicalDevices().c_str());
-                std::printf("bake cache: %s\n", defaultCacheDir().c_str());
+                std::printf("cache folder: %s\n", defaultCacheFolder().c_str());
                 GpuGuard device(g);
                 std::printf("selected (--device %s):\n%s", g.device.c_str(),
                             describeDevice(device.gpu.device).c_str());

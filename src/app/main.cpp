@@ -2,6 +2,7 @@
 // one line on stderr naming the input and the reason; exit 2 for bad input, 3 for a device
 // problem, 1 for anything else.
 #include <cstdio>
+#include <new>
 #include <vector>
 
 #include <CLI/CLI.hpp>
@@ -12,6 +13,7 @@
 #include "bake/cache_eviction.h"
 #include "core/error.h"
 #include "core/log.h"
+#include "scene/load_budget.h"
 
 using namespace shadel;
 
@@ -30,12 +32,23 @@ int main(int argc, char** argv) {
         return exitForParseError(app, e);
     }
     parseByteSize(global.cacheLimit, global.cacheLimitBytes); // validated by byteSize()
+    if (!global.loadMemoryLimit.empty()) {
+        uint64_t bytes = 0;
+        parseByteSize(global.loadMemoryLimit, bytes); // validated by byteSize()
+        setLoadMemoryLimit(bytes);
+    }
     if (global.verbose) setLogLevel(LogLevel::Debug);
     try {
         for (const Subcommand& sub : subcommands)
             if (*sub.app) return sub.run(global);
     } catch (const InputError& e) {
         std::fprintf(stderr, "shadel: %s\n", e.what());
+        return kExitBadInput;
+    } catch (const std::bad_alloc&) {
+        // A load's budget (scene/load_budget.h) stops what it can foresee; anything else that
+        // outgrows memory is still one line and a bad-input exit, never an abort.
+        std::fprintf(stderr, "shadel: out of memory (a larger input than this machine can hold; "
+                             "see --load-memory-limit)\n");
         return kExitBadInput;
     } catch (const DeviceError& e) {
         std::fprintf(stderr, "shadel: device: %s\n", e.what());

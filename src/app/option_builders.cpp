@@ -5,6 +5,7 @@
 #include <filesystem>
 
 #include "app/commands.h"
+#include "core/whole_number.h"
 
 namespace shadel {
 
@@ -134,16 +135,15 @@ SettingOption sizeOption() {
     SettingOption o{"--size", "image size in pixels (each side 1..16384)", kEveryRenderingCommand,
                     "WIDTHxHEIGHT"};
     o.parse = [](OptionTarget t, const std::string& text) {
-        unsigned w = 0, h = 0;
-        char x = 0, extra = 0;
-        int n = std::sscanf(text.c_str(), "%u%c%u%c", &w, &x, &h, &extra);
-        if (n != 3 || (x != 'x' && x != 'X'))
+        auto size = parseWholeNumberPair(text, "xX", UINT64_MAX);
+        if (!size)
             throw InputError(
                 format("--size %s: expected WIDTHxHEIGHT, e.g. 1280x720", text.c_str()));
+        auto [w, h] = *size;
         if (w < 1 || h < 1 || w > 16384 || h > 16384)
             throw InputError(
                 format("--size %s: each side must be between 1 and 16384", text.c_str()));
-        t.settings.width = w, t.settings.height = h;
+        t.settings.width = uint32_t(w), t.settings.height = uint32_t(h);
     };
     o.text = [](ConstOptionTarget t) {
         return format("%ux%u", t.settings.width, t.settings.height);
@@ -193,14 +193,13 @@ SettingOption shuffleDrawsOption() {
             t.settings.shuffleDraws = false;
             return;
         }
-        char* end = nullptr;
-        unsigned long long seed = std::strtoull(text.c_str(), &end, 10);
-        if (text.empty() || text[0] == '-' || end != text.c_str() + text.size())
+        std::optional<uint64_t> seed = parseWholeNumber(text);
+        if (!seed)
             throw InputError(
                 format("--shuffle-draws %s: expected none or a whole number (a random seed)",
                        text.c_str()));
         t.settings.shuffleDraws = true;
-        t.settings.shuffleSeed = seed;
+        t.settings.shuffleSeed = *seed;
     };
     o.text = [](ConstOptionTarget t) {
         return t.settings.shuffleDraws ? std::to_string(t.settings.shuffleSeed)

@@ -1,5 +1,7 @@
 #include "app/output_files.h"
 
+#include <filesystem>
+
 #include <stb/stb_image_write.h>
 
 #include "core/atomic_file.h"
@@ -11,6 +13,21 @@ namespace shadel {
 void requireCreatableOutput(const char* flag, const std::string& path) {
     std::string why = checkFileCreatable(path);
     if (!why.empty()) throw InputError(format("%s %s", flag, why.c_str()));
+}
+
+void requireDistinctOutputs(const std::vector<std::pair<const char*, std::string>>& outputs) {
+    std::vector<std::pair<const char*, std::filesystem::path>> seen;
+    for (const auto& [flag, path] : outputs) {
+        if (path.empty()) continue;
+        std::error_code ec;
+        std::filesystem::path file = std::filesystem::weakly_canonical(path, ec);
+        if (ec) file = std::filesystem::absolute(path, ec).lexically_normal();
+        for (const auto& [otherFlag, other] : seen)
+            if (other == file)
+                throw InputError(format("%s %s: the same file as %s; give each output its own path",
+                                        flag, path.c_str(), otherFlag));
+        seen.push_back({flag, file});
+    }
 }
 
 void writeOutputFile(const std::string& path, const void* data, size_t size) {

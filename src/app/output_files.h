@@ -4,6 +4,7 @@
 // naming the file and the reason.
 #include <cstdint>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace shadel {
@@ -11,6 +12,10 @@ namespace shadel {
 // Throws unless `path` (the value of `flag`) can be created: fails fast, before minutes of
 // rendering, on a missing or read-only folder or a path that is a directory.
 void requireCreatableOutput(const char* flag, const std::string& path);
+
+// Throws unless the given outputs (flag, path; empty paths skipped) name different files: the
+// same file given twice (also through a link or "./") would be overwritten by the later write.
+void requireDistinctOutputs(const std::vector<std::pair<const char*, std::string>>& outputs);
 
 // Writes the whole file atomically; throws InputError "<path>: <strerror>" on any failure.
 void writeOutputFile(const std::string& path, const void* data, size_t size);

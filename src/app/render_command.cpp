@@ -15,9 +15,11 @@
 #include "app/trace_export.h"
 #include "bake/bake.h"
 #include "bake/bake_cache.h"
+#include "bake/cache_folder.h"
 #include "core/error.h"
 #include "core/host.h"
 #include "core/log.h"
+#include "core/whole_number.h"
 #include "gi/gi_types.h"
 #include "render/animation/scene_playback.h"
 #include "render/debug/inspect.h"
@@ -72,12 +74,10 @@ MarkingMode parseMarking(const std::string& text) {
 }
 
 void parsePixel(const char* flag, const std::string& text, int32_t& x, int32_t& y) {
-    unsigned px = 0, py = 0;
-    char comma = 0, extra = 0;
-    if (std::sscanf(text.c_str(), "%u%c%u%c", &px, &comma, &py, &extra) != 3 || comma != ',' ||
-        px > 16383 || py > 16383)
+    auto pixel = parseWholeNumberPair(text, ",", 16383);
+    if (!pixel)
         throw InputError(format("%s %s: expected X,Y (a pixel, e.g. 40,20)", flag, text.c_str()));
-    x = int32_t(px), y = int32_t(py);
+    x = int32_t(pixel->first), y = int32_t(pixel->second);
 }
 
 void parseCameraCut(const std::string& text, std::string& camera, uint32_t& frame) {
@@ -89,10 +89,6 @@ void parseCameraCut(const std::string& text, std::string& camera, uint32_t& fram
             "--camera-cut %s: expected CAMERA@FRAME (a scene camera, frame >= 1)", text.c_str()));
     camera = text.substr(0, at);
     frame = uint32_t(std::stoul(digits));
-}
-
-std::string defaultCacheDir() {
-    return defaultBakeCacheDir();
 }
 
 void writePng(const std::string& path, const std::vector<uint8_t>& rgba, uint32_t width,
@@ -268,6 +264,8 @@ void prepareOutputs(RenderSession& session) {
     if (!o.out.empty()) requireCreatableOutput("--out", outDir ? o.out + "frame_0000.png" : o.out);
     if (!o.stats.empty()) requireCreatableOutput("--stats", o.stats);
     if (!o.trace.empty()) requireCreatableOutput("--trace", o.trace);
+    requireDistinctOutputs(
+        {{"--out", outDir ? std::string() : o.out}, {"--stats", o.stats}, {"--trace", o.trace}});
     bool listCaptures = o.captures.size() == 1 && o.captures[0] == "list";
     if (!o.captures.empty() && !listCaptures && !o.captureDir.empty()) {
         std::error_code ec;
@@ -352,8 +350,8 @@ void densityAndBake(RenderSession& session) {
         BakeSettings bs;
         bs.cacheLimitBytes = o.cacheLimitBytes;
         if (autoDensity) {
-            baked = bakeScene(scene, bs, o.cacheDir.empty() ? defaultCacheDir() : o.cacheDir,
-                              nullptr, viewDensity.meshDensity);
+            baked = bakeScene(scene, bs, usableCacheFolder(o.cacheDir), nullptr,
+                              viewDensity.meshDensity);
         } else {
             double area = 0.0;
             bs.shadelsPerMetre = sceneShadelDensity(scene, o.shadelsPerMetre, o.shadelBudget, area);
@@ -365,8 +363,7 @@ void densityAndBake(RenderSession& session) {
                             area * o.shadelsPerMetre * o.shadelsPerMetre / 1e6,
                             double(bs.shadelsPerMetre), o.shadelBudget / 1e6);
             density = bs.shadelsPerMetre;
-            baked =
-                bakeScene(scene, bs, o.cacheDir.empty() ? defaultCacheDir() : o.cacheDir, nullptr);
+            baked = bakeScene(scene, bs, usableCacheFolder(o.cacheDir), nullptr);
         }
         bakeSeconds =
             std::chrono::duration<double>(std::chrono::steady_clock::now() - bakeStart).count();
@@ -390,8 +387,7 @@ void uploadRunScene(RenderSession& session) {
         ts.budgetMiB = o.textureBudgetMiB;
         ts.mode = o.streaming;
         ts.cpuCap = o.textureCpuCap;
-        streaming = createTextureStreaming(gpu, scene, ts,
-                                           o.cacheDir.empty() ? defaultCacheDir() : o.cacheDir);
+        streaming = createTextureStreaming(gpu, scene, ts, usableCacheFolder(o.cacheDir));
     }
     uploadScene(gpu, scene, gpuScene, o.mode == RenderMode::Decoupled ? &baked : nullptr,
                 streaming ? &streamedTextureSlots(*streaming) : nullptr);
@@ -459,8 +455,8 @@ void buildRenderer(RenderSession& session) {
         session.rendererLive = true; // (destroyRenderer takes a half-built one)
         initRenderer(renderer, gpu, settings, gpuScene);
         if (o.distanceFieldLighting)
-            renderer.distanceFields = createDistanceFields(
-                renderer, scene, gpuScene, o.cacheDir.empty() ? defaultCacheDir() : o.cacheDir);
+            renderer.distanceFields =
+                createDistanceFields(renderer, scene, gpuScene, usableCacheFolder(o.cacheDir));
         if (o.stencilEffects != StencilEffects::Off)
             renderer.stencilEffects =
                 createStencilEffects(renderer, scene, gpuScene, o.stencilEffects);

@@ -7,6 +7,7 @@
 #include "app/subcommands.h"
 #include "bake/bake_cache.h"
 #include "bake/cache_eviction.h"
+#include "bake/cache_folder.h"
 #include "core/error.h"
 #include "core/log.h"
 #include "rhi/pipeline_cache.h"
@@ -23,6 +24,10 @@ void addGlobalFlags(CLI::App& app, GlobalFlags& f) {
     app.add_option("--cache-limit", f.cacheLimit,
                    "bake cache size; least recently used files beyond it are removed (0 = none)")
         ->capture_default_str()
+        ->check(byteSize());
+    app.add_option("--load-memory-limit", f.loadMemoryLimit,
+                   "memory a scene load may allocate (e.g. 8G; default: a quarter of RAM, at "
+                   "most 2G)")
         ->check(byteSize());
     app.add_option("--pipeline-cache", f.pipelineCache,
                    "keep compiled pipelines in the cache folder between runs: on | off "
@@ -42,7 +47,7 @@ DeviceDesc GlobalFlags::deviceDesc() const {
 std::string GlobalFlags::pipelineCacheFolder() const {
     const char* env = std::getenv("SHADEL_PIPELINE_CACHE");
     bool off = pipelineCache == "off" || (env && std::string(env) == "off");
-    return off ? std::string() : defaultBakeCacheDir();
+    return off ? std::string() : usableCacheFolder("");
 }
 
 GpuGuard::GpuGuard(const GlobalFlags& flags) {

@@ -25,6 +25,8 @@ struct GlobalFlags {
     // The device's pipeline cache file in the cache folder (rhi/pipeline_cache.h): on | off
     // (or SHADEL_PIPELINE_CACHE=off), off for cold pipeline compiles.
     std::string pipelineCache = "on";
+    // --load-memory-limit: what loading a scene may allocate ("": scene/load_budget.h's default).
+    std::string loadMemoryLimit;
     // --device and --validation (or SHADEL_VALIDATION=1).
     DeviceDesc deviceDesc() const;
     // The bake cache's folder, or "" when --pipeline-cache off or SHADEL_PIPELINE_CACHE=off.

@@ -396,7 +396,7 @@ std::vector<BakedMesh> bakeScene(const Scene& scene, const BakeSettings& setting
                 std::string why;
                 BakedMesh baked;
                 if (!path.empty() && readBakeCache(path, keys[i], mesh, baked, &why)) {
-                    markBakeCacheFileUsed(path); // for least-recently-used eviction
+                    // (the read refreshed its use time, for least-recently-used eviction)
                     baked.fromCache = true;
                     baked.bakeSeconds = secondsSince(start);
                 } else {
@@ -443,9 +443,9 @@ std::vector<BakedMesh> bakeScene(const Scene& scene, const BakeSettings& setting
         std::set<std::string> keep;
         for (size_t j : jobs)
             keep.insert(std::filesystem::path(bakeCachePath(cacheDir, keys[j])).filename());
-        CacheUsage removed = evictBakeCache(cacheDir, settings.cacheLimitBytes, keep);
+        CacheUsage removed = evictCache(cacheDir, settings.cacheLimitBytes, keep);
         if (removed.files > 0)
-            SHADEL_INFO("bake cache %s: removed %llu least recently used files (%.1f MiB) to "
+            SHADEL_INFO("cache %s: removed %llu least recently used files (%.1f MiB) to "
                         "stay within %.1f MiB (--cache-limit)",
                         cacheDir.c_str(), (unsigned long long)removed.files,
                         double(removed.bytes) / (1 << 20),

@@ -220,16 +220,6 @@ BakeKey bakeKey(const Mesh& mesh, const BakeSettings& settings) {
     return h.key();
 }
 
-std::string defaultBakeCacheDir() {
-    if (const char* dir = std::getenv("SHADEL_CACHE_DIR"); dir && *dir) return dir;
-    auto absolute = [](const char* path) { return path && path[0] == '/'; };
-    if (const char* xdg = std::getenv("XDG_CACHE_HOME"); absolute(xdg))
-        return std::string(xdg) + "/shadel";
-    if (const char* home = std::getenv("HOME"); absolute(home))
-        return std::string(home) + "/.cache/shadel";
-    return format("/tmp/shadel-cache-%u", unsigned(getuid()));
-}
-
 std::string bakeCachePath(const std::string& cacheDir, const BakeKey& key) {
     return cacheDir + "/bake-" + key.hex() + ".bin";
 }

@@ -30,11 +30,6 @@ struct BakeKey {
 // Hash of positions, normals, indices, the settings that affect the bake and kBakeFormatVersion.
 BakeKey bakeKey(const Mesh& mesh, const BakeSettings& settings);
 
-// $SHADEL_CACHE_DIR if set, else $XDG_CACHE_HOME/shadel, else $HOME/.cache/shadel, else
-// /tmp/shadel-cache-UID. Empty or relative XDG_CACHE_HOME and HOME are ignored (the XDG spec
-// says so: a relative path would put the cache wherever the command happens to run, and an empty
-// one at /shadel).
-std::string defaultBakeCacheDir();
 std::string bakeCachePath(const std::string& cacheDir, const BakeKey& key);
 
 // Loads a cached bake for `mesh`. Returns false and sets *why if the file is missing (why =

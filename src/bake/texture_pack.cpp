@@ -9,6 +9,7 @@
 #include <filesystem>
 
 #include <fcntl.h>
+#include <sys/mman.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
@@ -202,10 +203,9 @@ std::string texturePackPath(const std::string& cacheDir, const BakeKey& key) {
     return cacheDir + "/textures-" + key.hex() + ".bin";
 }
 
-bool buildTexturePack(const Scene& scene, const std::string& path, std::string* why) {
-    namespace fs = std::filesystem;
-    std::string scratch;
-    std::string& reason = why ? *why : scratch;
+// Writes the whole file through fd (header and directory last, once the checksums are known).
+// Returns 0 or the errno of the first failure.
+static int writePackTo(int fd, const Scene& scene) {
     std::vector<bool> srgb = srgbTextures(scene);
     std::vector<uint32_t> sizes;
     for (const Texture& t : scene.textures) sizes.push_back(packedTextureSize(t));
@@ -223,20 +223,7 @@ bool buildTexturePack(const Scene& scene, const std::string& path, std::string* 
         }
     const uint64_t fileSize = offset;
 
-    std::error_code ec;
-    fs::path target(path);
-    if (target.has_parent_path()) fs::create_directories(target.parent_path(), ec);
-    static std::atomic<unsigned long long> counter{0};
-    std::string temp = (target.parent_path() / format(".%s.tmp.%d.%llu", target.filename().c_str(),
-                                                      int(::getpid()), counter.fetch_add(1)))
-                           .string();
-    int fd = ::open(temp.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0644);
-    if (fd < 0) {
-        reason = path + ": " + std::strerror(errno);
-        return false;
-    }
     int error = 0;
-    // Header and directory are written last, once the checksums are known.
     if (::lseek(fd, off_t(sizeof(FileHeader) + directory.size()), SEEK_SET) < 0) error = errno;
     size_t levelIndex = 0;
     for (size_t i = 0; i < scene.textures.size() && error == 0; ++i) {
@@ -283,6 +270,26 @@ bool buildTexturePack(const Scene& scene, const std::string& path, std::string* 
     if (error == 0 && ::lseek(fd, 0, SEEK_SET) < 0) error = errno;
     if (error == 0) error = writeAll(fd, &header, sizeof header);
     if (error == 0) error = writeAll(fd, directory.data(), directory.size());
+    return error;
+}
+
+bool buildTexturePack(const Scene& scene, const std::string& path, std::string* why) {
+    namespace fs = std::filesystem;
+    std::string scratch;
+    std::string& reason = why ? *why : scratch;
+    std::error_code ec;
+    fs::path target(path);
+    if (target.has_parent_path()) fs::create_directories(target.parent_path(), ec);
+    static std::atomic<unsigned long long> counter{0};
+    std::string temp = (target.parent_path() / format(".%s.tmp.%d.%llu", target.filename().c_str(),
+                                                      int(::getpid()), counter.fetch_add(1)))
+                           .string();
+    int fd = ::open(temp.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0644);
+    if (fd < 0) {
+        reason = path + ": " + std::strerror(errno);
+        return false;
+    }
+    int error = writePackTo(fd, scene);
     // Delayed allocation: a full disk may only show at fsync or close.
     if (error == 0 && ::fsync(fd) != 0 && errno != EINVAL) error = errno;
     if (::close(fd) != 0 && error == 0) error = errno;
@@ -295,22 +302,33 @@ bool buildTexturePack(const Scene& scene, const std::string& path, std::string* 
     return true;
 }
 
-bool openTexturePack(const std::string& path, const BakeKey& key, TexturePack& out,
-                     std::string* why, bool verifyData) {
-    std::string scratch;
-    std::string& reason = why ? *why : scratch;
-    int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
+// Opens a streaming file for reading: a regular file of this user's, never through a link and
+// never waiting on a pipe. Returns the descriptor, or -1 and why not.
+static int openPackFile(const std::string& path, std::string& reason) {
+    int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC | O_NOFOLLOW | O_NONBLOCK);
     if (fd < 0) {
-        reason = errno == ENOENT ? "missing" : std::string("cannot open: ") + std::strerror(errno);
-        return false;
+        reason = errno == ENOENT  ? "missing"
+                 : errno == ELOOP ? "a symbolic link"
+                                  : std::string("cannot open: ") + std::strerror(errno);
+        return -1;
     }
-    struct FdCloser {
-        int fd;
-        ~FdCloser() { ::close(fd); }
-    } closer{fd};
     struct stat st {};
-    if (::fstat(fd, &st) != 0 || !S_ISREG(st.st_mode)) {
+    if (::fstat(fd, &st) != 0 || !S_ISREG(st.st_mode))
         reason = "not a regular file";
+    else if (st.st_uid != ::geteuid())
+        reason = format("owned by user %u, not this user", unsigned(st.st_uid));
+    else
+        return fd;
+    ::close(fd);
+    return -1;
+}
+
+// Reads and checks the header and directory of the file open at fd (see openTexturePack).
+static bool readPack(int fd, const std::string& path, const BakeKey& key, TexturePack& out,
+                     std::string& reason, bool verifyData) {
+    struct stat st {};
+    if (::fstat(fd, &st) != 0) {
+        reason = std::string("cannot stat: ") + std::strerror(errno);
         return false;
     }
     const uint64_t fileBytes = uint64_t(st.st_size);
@@ -403,25 +421,77 @@ bool openTexturePack(const std::string& path, const BakeKey& key, TexturePack& o
     return true;
 }
 
-TexturePack openOrBuildTexturePack(const Scene& scene, const std::string& cacheDir) {
-    BakeKey key = texturePackKey(scene);
-    std::string path = texturePackPath(cacheDir, key);
+bool openTexturePack(const std::string& path, const BakeKey& key, TexturePack& out,
+                     std::string* why, bool verifyData) {
+    std::string scratch;
+    std::string& reason = why ? *why : scratch;
+    int fd = openPackFile(path, reason);
+    if (fd < 0) return false;
+    bool ok = readPack(fd, path, key, out, reason, verifyData);
+    ::close(fd);
+    return ok;
+}
+
+// Writes the pack into an anonymous in-memory file: the fallback when there is no cache folder or
+// it cannot be written. Throws if even that fails.
+static TexturePack buildTexturePackInMemory(const Scene& scene, const BakeKey& key) {
+    int fd = ::memfd_create("shadel-texture-streaming", MFD_CLOEXEC);
+    if (fd < 0)
+        throw std::runtime_error(std::string("texture streaming file in memory: ") +
+                                 std::strerror(errno));
     TexturePack pack;
     std::string why;
-    if (openTexturePack(path, key, pack, &why)) return pack;
-    if (why != "missing")
-        SHADEL_WARN("texture streaming file %s unusable (%s): rebuilding", path.c_str(),
-                    why.c_str());
+    if (int error = writePackTo(fd, scene); error != 0)
+        why = std::strerror(error);
+    else if (!readPack(fd, "(memory)", key, pack, why, false))
+        why = "unreadable right after writing: " + why;
+    if (!why.empty()) {
+        ::close(fd);
+        throw std::runtime_error("texture streaming file in memory: " + why);
+    }
+    pack.fd = fd;
+    return pack;
+}
+
+TexturePack openOrBuildTexturePack(const Scene& scene, const std::string& cacheDir) {
+    BakeKey key = texturePackKey(scene);
     uint64_t texels = 0;
     for (const Texture& t : scene.textures)
         texels += uint64_t(packedTextureSize(t)) * packedTextureSize(t);
+    const double mib = double(texels * 4) / 1048576.0;
+    if (cacheDir.empty()) {
+        SHADEL_INFO("building the texture streaming file of %zu textures (%.0f MiB at level 0) "
+                    "in memory: no cache folder",
+                    scene.textures.size(), mib);
+        return buildTexturePackInMemory(scene, key);
+    }
+    std::string path = texturePackPath(cacheDir, key);
+    TexturePack pack;
+    std::string why;
+    if (int fd = openPackFile(path, why); fd >= 0) {
+        if (readPack(fd, path, key, pack, why, true)) {
+            ::futimens(fd, nullptr); // a use, for least-recently-used eviction
+            pack.fd = fd;
+            return pack;
+        }
+        ::close(fd);
+    }
+    if (why != "missing")
+        SHADEL_WARN("texture streaming file %s unusable (%s): rebuilding", path.c_str(),
+                    why.c_str());
     SHADEL_INFO("building the texture streaming file of %zu textures (%.0f MiB at level 0): %s",
-                scene.textures.size(), double(texels * 4) / 1048576.0, path.c_str());
-    if (!buildTexturePack(scene, path, &why))
-        throw std::runtime_error("texture streaming file: " + why);
-    if (!openTexturePack(path, key, pack, &why, false))
+                scene.textures.size(), mib, path.c_str());
+    if (!buildTexturePack(scene, path, &why)) {
+        SHADEL_WARN("texture streaming file not cached (%s): streaming from memory", why.c_str());
+        return buildTexturePackInMemory(scene, key);
+    }
+    int fd = openPackFile(path, why);
+    if (fd < 0 || !readPack(fd, path, key, pack, why, false)) {
+        if (fd >= 0) ::close(fd);
         throw std::runtime_error("texture streaming file " + path +
                                  " unreadable right after writing: " + why);
+    }
+    pack.fd = fd;
     return pack;
 }
 

@@ -36,7 +36,8 @@ struct PackedTexture {
 };
 
 struct TexturePack {
-    std::string path;
+    std::string path; // "(memory)" when built in memory
+    int fd = -1;      // open for reading (openOrBuildTexturePack only; the caller closes it)
     BakeKey key;
     uint64_t fileSize = 0;
     std::vector<PackedTexture> textures; // one per Scene::textures entry
@@ -58,7 +59,9 @@ bool buildTexturePack(const Scene& scene, const std::string& path, std::string* 
 bool openTexturePack(const std::string& path, const BakeKey& key, TexturePack& out,
                      std::string* why, bool verifyData = true);
 // The scene's pack from the cache folder, built (or rebuilt, with a warning naming the reason)
-// when missing or unusable. Throws std::runtime_error if it cannot be written.
+// when missing or unusable, and open (TexturePack::fd). Without a cache folder, or when the file
+// cannot be written there (read-only, full), the pack is built in memory with a warning. Throws
+// std::runtime_error only if that fails too.
 TexturePack openOrBuildTexturePack(const Scene& scene, const std::string& cacheDir);
 
 // Reads one level's tiles into dst (level.bytes) through an open descriptor and checks its

@@ -33,6 +33,16 @@ int writeAll(int fd, const void* data, size_t size) {
     return 0;
 }
 
+// Why an existing non-regular path cannot be an output, or "": writing a FIFO or socket waits for
+// a reader (forever, for a FIFO nobody reads), and writing a block device overwrites a disk.
+// Character devices (/dev/null, /dev/stdout, /dev/full) never wait and stay usable.
+std::string unwritableKind(const struct stat& st) {
+    if (S_ISFIFO(st.st_mode)) return "a FIFO, not a file";
+    if (S_ISSOCK(st.st_mode)) return "a socket, not a file";
+    if (S_ISBLK(st.st_mode)) return "a block device, not a file";
+    return {};
+}
+
 std::string folderOf(const std::string& path) {
     std::string folder = std::filesystem::path(path).parent_path().string();
     return folder.empty() ? "." : folder;
@@ -77,6 +87,7 @@ std::string writeFileAtomically(const std::string& path, const void* data, size_
     struct stat existing {};
     if (::stat(path.c_str(), &existing) == 0) {
         if (S_ISDIR(existing.st_mode)) return failure(path, EISDIR);
+        if (std::string kind = unwritableKind(existing); !kind.empty()) return path + ": " + kind;
         if (!S_ISREG(existing.st_mode)) return writeInPlace(path, data, size);
     }
     return writeViaTemporary(path, data, size);
@@ -106,6 +117,8 @@ std::string readCacheEntry(const std::string& path, uint64_t maxBytes,
         why = std::string("cannot stat: ") + std::strerror(errno);
     else if (!S_ISREG(st.st_mode))
         why = "not a regular file";
+    else if (st.st_uid != ::geteuid())
+        why = format("owned by user %u, not this user", unsigned(st.st_uid));
     else if (uint64_t(st.st_size) > maxBytes)
         why = format("%llu bytes, more than the %llu an entry may hold",
                      (unsigned long long)st.st_size, (unsigned long long)maxBytes);
@@ -123,6 +136,9 @@ std::string readCacheEntry(const std::string& path, uint64_t maxBytes,
             done += size_t(n);
         }
     }
+    // A read is a use: least-recently-used eviction goes by modification time (access times are
+    // unreliable under relatime and noatime). Best effort: a read-only cache stays as it is.
+    if (why.empty()) ::futimens(fd, nullptr);
     ::close(fd);
     if (!why.empty()) bytes.clear();
     return why;
@@ -133,6 +149,7 @@ std::string checkFileCreatable(const std::string& path) {
     struct stat existing {};
     if (::stat(path.c_str(), &existing) == 0) {
         if (S_ISDIR(existing.st_mode)) return failure(path, EISDIR);
+        if (std::string kind = unwritableKind(existing); !kind.empty()) return path + ": " + kind;
         if (!S_ISREG(existing.st_mode))
             return ::access(path.c_str(), W_OK) == 0 ? std::string() : failure(path, errno);
     }

@@ -6,6 +6,7 @@
 #include <glm/gtc/matrix_transform.hpp>
 
 #include "bake/bake_cache.h"
+#include "bake/cache_folder.h"
 #include "common/print_labels.h"
 #include "core/log.h"
 #include "render/background/background.h"
@@ -209,7 +210,7 @@ void initRenderer(Renderer& r, Gpu& gpu, const RenderSettings& requested, const 
     // Last: prefiltering a new environment takes seconds, and every check above that can refuse
     // the settings (a device without ray queries, ...) answers first.
     createEnvironment(gpu, r.environment, settings, scene,
-                      settings.cacheDir.empty() ? defaultBakeCacheDir() : settings.cacheDir);
+                      usableCacheFolder(settings.cacheDir));
 }
 
 void destroyRenderer(Renderer& r) {

@@ -6,6 +6,7 @@
 #include "core/error.h"
 #include "core/log.h"
 #include "scene/gltf_files.h"
+#include "scene/load_budget.h"
 
 namespace shadel::gltf {
 
@@ -181,6 +182,7 @@ std::vector<float> AccessorReader::readFloats(int index, int components, const c
     if (a.componentType == TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT)
         error(format("accessor %d (%s) has unsigned int components, not allowed for %s", index,
                      semantic, semantic));
+    chargeLoadMemory(uint64_t(a.count) * uint64_t(components) * sizeof(float), "an accessor read");
     std::vector<float> out(a.count * size_t(components), 0.0f);
     size_t cs = componentSize(a.componentType);
     if (a.base) {
@@ -206,6 +208,7 @@ std::vector<uint32_t> AccessorReader::readIndices(int index) {
         error(format("accessor %d (indices) must be an unsigned byte/short/int SCALAR (is %s of "
                      "component type %d)",
                      index, typeName(acc.type), acc.componentType));
+    chargeLoadMemory(uint64_t(a.count) * sizeof(uint32_t), "an index accessor read");
     std::vector<uint32_t> out(a.count, 0);
     if (a.base)
         for (size_t i = 0; i < a.count; ++i)

@@ -116,17 +116,23 @@ private:
             wrongType(p, "a non-negative integer", v);
         return v.get<uint64_t>();
     }
-    uint64_t requiredUint(const json& obj, const char* key, const std::string& p,
-                          uint64_t min = 0) {
+    // maxValue: what the importer's field holds (tinygltf keeps some as int: a larger value
+    // would wrap silently).
+    uint64_t requiredUint(const json& obj, const char* key, const std::string& p, uint64_t min = 0,
+                          uint64_t maxValue = UINT64_MAX) {
         const json* v = member(obj, key);
         if (!v) bad(p, format("missing required '%s'", key));
         uint64_t value = uintValue(*v, child(p, key));
         if (value < min)
             bad(child(p, key), format("must be at least %llu", (unsigned long long)min));
+        if (value > maxValue)
+            bad(child(p, key), format("%llu is out of range (at most %llu)",
+                                      (unsigned long long)value, (unsigned long long)maxValue));
         return value;
     }
-    void optUint(const json& obj, const char* key, const std::string& p) {
-        if (const json* v = member(obj, key)) uintValue(*v, child(p, key));
+    void optUint(const json& obj, const char* key, const std::string& p,
+                 uint64_t maxValue = UINT64_MAX) {
+        if (member(obj, key)) requiredUint(obj, key, p, 0, maxValue);
     }
     void checkIndexValue(const json& v, const std::string& p, const char* array) {
         uint64_t index = uintValue(v, p);
@@ -302,13 +308,13 @@ private:
         optNumberArray(a, "min", p, 0);
         optNumberArray(a, "max", p, 0);
         optObject(a, "sparse", p, [&](const json& s, const std::string& sp) {
-            requiredUint(s, "count", sp, 1);
+            requiredUint(s, "count", sp, 1, INT32_MAX);
             for (const char* part : {"indices", "values"}) {
                 const json* o = member(s, part);
                 if (!o) bad(sp, format("missing required '%s'", part));
                 optObject(s, part, sp, [&](const json& io, const std::string& ip) {
                     requiredIndex(io, "bufferView", ip, "bufferViews");
-                    optUint(io, "byteOffset", ip);
+                    optUint(io, "byteOffset", ip, INT32_MAX);
                     if (std::string_view(part) == "indices") {
                         uint64_t ct = requiredUint(io, "componentType", ip);
                         if (ct != 5121 && ct != 5123 && ct != 5125)

@@ -14,6 +14,7 @@
 #include "scene/gltf_accessors.h"
 #include "scene/gltf_files.h"
 #include "scene/gltf_materials.h"
+#include "scene/load_budget.h"
 #include "scene/mesh_utils.h"
 
 namespace shadel::gltf {
@@ -357,6 +358,7 @@ private:
         std::vector<float> positions = accessors_.readFloats(positionAccessor, 3, "POSITION");
         size_t vertexCount = positions.size() / 3;
         Mesh mesh;
+        chargeLoadMemory(uint64_t(vertexCount) * sizeof(Vertex), "a mesh's vertices");
         mesh.vertices.resize(vertexCount);
         for (size_t v = 0; v < vertexCount; ++v) {
             glm::vec3 p = glm::make_vec3(&positions[v * 3]);
@@ -492,6 +494,9 @@ private:
 
     uint32_t mirroredCopy(uint32_t mesh) {
         if (auto it = mirroredMesh_.find(mesh); it != mirroredMesh_.end()) return it->second;
+        chargeLoadMemory(uint64_t(scene_.meshes[mesh].vertices.size()) * sizeof(Vertex) +
+                             scene_.meshes[mesh].indices.size() * sizeof(uint32_t),
+                         "a mirrored mesh");
         Mesh copy = scene_.meshes[mesh];
         copy.name += " (mirrored)";
         for (size_t t = 0; t + 2 < copy.indices.size(); t += 3)
@@ -515,6 +520,7 @@ private:
             bool mirrored = glm::determinant(glm::mat3(world)) < 0.0f;
             const auto& parts = meshParts_[size_t(node.mesh)];
             for (size_t p = 0; p < parts.size(); ++p) {
+                chargeLoadMemory(sizeof(Instance), "an instance");
                 Instance inst;
                 inst.name = parts.size() > 1 ? nodeName + format("#%zu", p) : nodeName;
                 inst.mesh = mirrored ? mirroredCopy(parts[p]) : parts[p];
@@ -674,6 +680,9 @@ private:
                 if (ji.size() != count * 4 || wi.size() != count * 4)
                     error(where + ": JOINTS_0/WEIGHTS_0 do not match POSITION");
                 // The unskinned vertices and influences, for GPU skinning (render/skinning).
+                chargeLoadMemory(uint64_t(count) *
+                                     (sizeof(Vertex) + sizeof(glm::uvec4) + sizeof(glm::vec4)),
+                                 "a skinned mesh's bind pose");
                 auto skinData = std::make_shared<MeshSkin>();
                 skinData->skin = poseIndex;
                 skinData->bindVertices = mesh->vertices;

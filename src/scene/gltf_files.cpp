@@ -8,6 +8,7 @@
 
 #include "core/error.h"
 #include "core/log.h"
+#include "scene/load_budget.h"
 
 namespace shadel::gltf {
 
@@ -107,6 +108,8 @@ bool decodeImageToRgba8(tinygltf::Image* image, const int index, std::string*, s
         return reject(stbi_failure_reason() ? stbi_failure_reason() : "unknown format");
     if (w <= 0 || h <= 0 || uint64_t(w) * uint64_t(h) > kMaxImagePixels)
         return reject(format("%dx%d is too large", w, h));
+    // The decoded pixels, and the scene's copy of them (gltf_convert.cpp).
+    chargeLoadMemory(uint64_t(w) * uint64_t(h) * 4 * 2, "decoding an image");
     stbi_uc* pixels = stbi_load_from_memory(bytes, size, &w, &h, &channels, 4);
     if (!pixels) return reject(stbi_failure_reason() ? stbi_failure_reason() : "decode failed");
     image->width = w;
@@ -139,6 +142,7 @@ bool fsReadWholeFile(std::vector<unsigned char>* out, std::string* err, const st
         if (err) *err += ec ? "cannot read " + path : path + " is larger than the size limit";
         return false;
     }
+    chargeLoadMemory(size, "reading a buffer or image file");
     std::ifstream in(path, std::ios::binary);
     out->resize(size);
     if (!in ||

@@ -40,6 +40,7 @@
 #include "core/log.h"
 #include "scene/gltf_checks.h"
 #include "scene/gltf_extensions.h"
+#include "scene/load_budget.h"
 
 namespace shadel {
 
@@ -54,6 +55,8 @@ Scene importGltfBytes(std::vector<uint8_t> bytes, const std::string& path,
                       const SceneFileOptions& options) {
     const std::string& input = path;
     if (bytes.size() > kMaxFileBytes) fail(input, "file is larger than the size limit");
+    LoadBudgetScope budget(input);
+    chargeLoadMemory(bytes.size() * 2, "the file and its parsed copy");
     bool binary = bytes.size() >= 4 && readU32(bytes.data()) == kGlbMagic;
 
     json document = parseJson(jsonTextOf(bytes, binary, input), input);

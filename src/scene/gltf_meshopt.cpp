@@ -7,6 +7,7 @@
 
 #include "core/error.h"
 #include "core/log.h"
+#include "scene/load_budget.h"
 
 namespace shadel {
 
@@ -123,6 +124,7 @@ MeshoptPlan prepareMeshopt(json& document, const std::string& input) {
 
 void decodeMeshopt(const MeshoptPlan& plan, tinygltf::Model& model, const std::string& input) {
     for (const MeshoptPlan::Fallback& f : plan.fallbacks) {
+        chargeLoadMemory(f.byteLength, "a meshopt fallback buffer");
         if (f.buffer >= model.buffers.size())
             throw InputError(input + ": " + kExt + ": fallback buffer missing after loading");
         model.buffers[f.buffer].data.assign(size_t(f.byteLength), 0);

@@ -2,6 +2,8 @@
 // input and the reason and exit code 2 — never a crash or a hang.
 #include <gtest/gtest.h>
 
+#include <sys/stat.h>
+
 #include <algorithm>
 #include <array>
 #include <cstdio>
@@ -305,7 +307,7 @@ TEST(Cli, SubcommandHelpShowsGlobalFlagsAndTheBakeCache) {
         Output o = runWithEnv("SHADEL_CACHE_DIR=/tmp/some-cache", std::string(sub) + " --help");
         EXPECT_EQ(o.exitCode, 0) << sub << ": " << o.stderrText;
         for (const char* global : {"--device", "--validation", "--verbose",
-                                   "--allow-external-files", "Bake cache: /tmp/some-cache"})
+                                   "--allow-external-files", "Cache folder: /tmp/some-cache"})
             EXPECT_NE(o.stdoutText.find(global), std::string::npos) << sub << " --help: " << global;
     }
     // ... and they are accepted after the subcommand too.
@@ -345,6 +347,31 @@ TEST(Cli, UncreatableOutputsFailBeforeRendering) {
     EXPECT_EQ(dir.entries(), 0u) << "nothing may be left behind";
 }
 
+// Outputs that would block (a FIFO nobody reads) or clobber each other (one path for two
+// outputs, also through "./"), and numbers that would wrap, are one line and exit 2 before any
+// work; the scene here does not exist, so the error must come first.
+TEST(Cli, BlockingCollidingOrWrappingOutputsFailBeforeRendering) {
+    CliTempDir dir;
+    std::string fifo = dir.file("frame.png");
+    ASSERT_EQ(::mkfifo(fifo.c_str(), 0644), 0);
+    std::string same = dir.file("same.png");
+    std::string sameAgain = dir.path.string() + "/./same.png";
+    const std::pair<std::string, std::string> cases[] = {
+        {"render --scene /nonexistent.gltf --out " + fifo,
+         "--out " + fifo + ": a FIFO, not a file"},
+        {"render --scene /nonexistent.gltf --out " + same + " --stats " + sameAgain,
+         "--stats " + sameAgain + ": the same file as --out"},
+        {"bench --scene /nonexistent.gltf --json " + same + " --plot " + same,
+         "--plot " + same + ": the same file as --json"},
+        {"render --scene /nonexistent.gltf --size 4294967616x4294967476",
+         "--size 4294967616x4294967476: each side must be between 1 and 16384"},
+        {"render --scene /nonexistent.gltf --size 99999999999999999999999x9",
+         "--size 99999999999999999999999x9: expected WIDTHxHEIGHT"},
+    };
+    for (const auto& [args, message] : cases) expectOneLineError(args, message);
+    EXPECT_EQ(dir.entries(), 1u) << "only the FIFO: nothing written";
+}
+
 // Options that contradict each other are errors before the scene is loaded and baked (the
 // scene here does not exist: the error must name the options, not the file).
 TEST(Cli, InconsistentOptionsFailBeforeLoading) {
@@ -367,17 +394,18 @@ TEST(Cli, EmptyOrRelativeXdgCacheHomeIsIgnored) {
         Output o = runWithEnv(std::string("-u SHADEL_CACHE_DIR ") + xdg + " HOME=/home/someone",
                               "render --help");
         EXPECT_EQ(o.exitCode, 0);
-        EXPECT_NE(o.stdoutText.find("Bake cache: /home/someone/.cache/shadel"), std::string::npos)
+        EXPECT_NE(o.stdoutText.find("Cache folder: /home/someone/.cache/shadel"), std::string::npos)
             << xdg << ": " << o.stdoutText;
     }
     Output o = runWithEnv("-u SHADEL_CACHE_DIR XDG_CACHE_HOME=/xdg", "bake --help");
-    EXPECT_NE(o.stdoutText.find("Bake cache: /xdg/shadel"), std::string::npos) << o.stdoutText;
+    EXPECT_NE(o.stdoutText.find("Cache folder: /xdg/shadel"), std::string::npos) << o.stdoutText;
 }
 
 TEST(Cli, InfoShowsTheBakeCache) {
     Output o = runWithEnv("SHADEL_CACHE_DIR=/tmp/info-cache", "info");
     EXPECT_EQ(o.exitCode, 0) << o.stderrText;
-    EXPECT_NE(o.stdoutText.find("bake cache: /tmp/info-cache"), std::string::npos) << o.stdoutText;
+    EXPECT_NE(o.stdoutText.find("cache folder: /tmp/info-cache"), std::string::npos)
+        << o.stdoutText;
 }
 
 // A buffer URI ../../../../etc/passwd was read (absolute paths were already refused).
@@ -437,7 +465,7 @@ TEST(Cli, CacheCommandShowsAndCleansTheCache) {
     ASSERT_NE(files, "0 files");
     Output shown = runWithEnv("SHADEL_CACHE_DIR=" + cache, "cache");
     EXPECT_EQ(shown.exitCode, 0) << shown.stderrText;
-    EXPECT_NE(shown.stdoutText.find("bake cache: " + cache + "\n" + files), std::string::npos)
+    EXPECT_NE(shown.stdoutText.find("cache: " + cache + "\n" + files), std::string::npos)
         << shown.stdoutText;
     Output cleaned = runWithEnv("", "cache clean --cache-dir " + cache);
     EXPECT_EQ(cleaned.exitCode, 0) << cleaned.stderrText;

@@ -43,7 +43,7 @@ EditFrames renderEdit(RenderMode mode, const Edit& edit) {
     scene = std::move(density.scene);
     std::vector<BakedMesh> baked;
     if (mode == RenderMode::Decoupled)
-        baked = bakeScene(scene, {}, defaultCacheDir(), nullptr, density.meshDensity);
+        baked = bakeScene(scene, {}, defaultCacheFolder(), nullptr, density.meshDensity);
     GpuScene gs;
     uploadScene(gpu, scene, gs, mode == RenderMode::Decoupled ? &baked : nullptr);
     RenderSettings s;

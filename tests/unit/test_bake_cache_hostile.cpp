@@ -12,6 +12,7 @@
 
 #include "bake/bake.h"
 #include "bake/bake_cache.h"
+#include "bake/cache_folder.h"
 #include "scene/mesh_utils.h"
 #include "temp_dir.h"
 
@@ -179,14 +180,14 @@ TEST(BakeCacheHostile, DefaultDirIgnoresEmptyAndRelativeXdgCacheHome) {
     unsetenv("SHADEL_CACHE_DIR");
     setenv("HOME", "/home/someone", 1);
     setenv("XDG_CACHE_HOME", "", 1);
-    EXPECT_EQ(defaultBakeCacheDir(), "/home/someone/.cache/shadel");
+    EXPECT_EQ(defaultCacheFolder(), "/home/someone/.cache/shadel");
     setenv("XDG_CACHE_HOME", "relative", 1);
-    EXPECT_EQ(defaultBakeCacheDir(), "/home/someone/.cache/shadel");
+    EXPECT_EQ(defaultCacheFolder(), "/home/someone/.cache/shadel");
     setenv("XDG_CACHE_HOME", "/xdg", 1);
-    EXPECT_EQ(defaultBakeCacheDir(), "/xdg/shadel");
+    EXPECT_EQ(defaultCacheFolder(), "/xdg/shadel");
     unsetenv("XDG_CACHE_HOME");
     setenv("HOME", "", 1);
-    EXPECT_EQ(defaultBakeCacheDir(), "/tmp/shadel-cache-" + std::to_string(getuid()));
+    EXPECT_EQ(defaultCacheFolder(), "/tmp/shadel-cache-" + std::to_string(getuid()));
     setenv("SHADEL_CACHE_DIR", "/explicit", 1);
-    EXPECT_EQ(defaultBakeCacheDir(), "/explicit");
+    EXPECT_EQ(defaultCacheFolder(), "/explicit");
 }

@@ -182,3 +182,33 @@ TEST(TexturePack, EveryByteFlipOfTheHeadAndDirectoryIsCaught) {
         flipByte(path, at); // restore
     }
 }
+
+// Without a cache folder, or with one that cannot be written, the pack is built in memory and
+// streams the same texels: texture streaming degrades to "run from memory", never fails.
+TEST(TexturePack, WithoutAWritableCacheThePackIsBuiltInMemory) {
+    TempDir dir("texpack");
+    Scene scene = makeTextureGallery(16);
+    scene.textures.resize(3);
+    TexturePack onDisk = openOrBuildTexturePack(scene, dir.path.string());
+    ASSERT_GE(onDisk.fd, 0);
+    std::ofstream(dir.path / "a-file") << "not a folder";
+    for (const std::string& cacheDir : {std::string(), (dir.path / "a-file" / "cache").string()}) {
+        TexturePack inMemory = openOrBuildTexturePack(scene, cacheDir);
+        ASSERT_GE(inMemory.fd, 0) << cacheDir;
+        EXPECT_EQ(inMemory.path, "(memory)") << cacheDir;
+        ASSERT_EQ(inMemory.textures.size(), onDisk.textures.size());
+        for (size_t t = 0; t < onDisk.textures.size(); ++t)
+            for (size_t l = 0; l < onDisk.textures[t].levels.size(); ++l) {
+                const PackedLevel& level = onDisk.textures[t].levels[l];
+                std::vector<uint8_t> a(level.bytes), b(level.bytes);
+                std::string why;
+                ASSERT_TRUE(readPackedLevel(onDisk.fd, level, a.data(), &why)) << why;
+                ASSERT_TRUE(
+                    readPackedLevel(inMemory.fd, inMemory.textures[t].levels[l], b.data(), &why))
+                    << why;
+                EXPECT_EQ(a, b) << "texture " << t << " level " << l;
+            }
+        ::close(inMemory.fd);
+    }
+    ::close(onDisk.fd);
+}

@@ -48,7 +48,7 @@ void prepareScene(Gpu& gpu, const ViewOptions& o, ViewerScene& v) {
     BakeSettings bs;
     bs.cacheLimitBytes = o.cacheLimitBytes;
     std::vector<BakedMesh> baked =
-        bakeScene(v.scene, bs, o.cacheDir.empty() ? defaultCacheDir() : o.cacheDir, nullptr,
+        bakeScene(v.scene, bs, usableCacheFolder(o.cacheDir), nullptr,
                   density.meshDensity);
     uploadScene(gpu, v.scene, v.gpu, &baked);
 }

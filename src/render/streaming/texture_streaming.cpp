@@ -339,9 +339,7 @@ TextureStreamingPtr createTextureStreaming(Gpu& gpu, const Scene& scene,
     s.gpu = &gpu;
     s.settings = settings;
     s.pack = openOrBuildTexturePack(scene, cacheDir);
-    s.fd = ::open(s.pack.path.c_str(), O_RDONLY | O_CLOEXEC);
-    if (s.fd < 0)
-        throw std::runtime_error(s.pack.path + ": cannot open the texture streaming file");
+    s.fd = s.pack.fd; // closed with the streaming state
     s.resident = !(settings.budgetMiB > 0.0);
     const size_t n = s.pack.textures.size();
     std::vector<uint32_t> sizes;
