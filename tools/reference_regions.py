@@ -1,15 +1,19 @@
 #!/usr/bin/env python3
 """Judges renders of builtin:cornell at 640x360 against the reference path tracer's, standard
-library only: the mean luminance of screen regions (the floor and the block's faces) in each
-HDR image (EXR as shadel writes it: 32-bit float channels, ZIP or uncompressed scanlines), the
-PSNR of each PNG against the reference's, and a side-by-side PNG of them all.
+library only: the mean luminance of screen regions (the floor, the block's faces, the back wall)
+in each HDR image (EXR as shadel writes it: 32-bit float channels, ZIP or uncompressed scanlines),
+the PSNR of each against the reference once both are tonemapped as the PNGs are (exposure 1,
+aces-narkowicz, sRGB, 8 bits), and a side-by-side PNG of them, the reference last.
 
-  tools/reference_regions.py REF.exr REF.png NAME=IMG.exr,IMG.png [...] [--side-by-side OUT.png]
+  tools/reference_regions.py REF.exr [REF2.exr ...] -- NAME=IMG.exr [...] [--side-by-side OUT.png]
+
+Several reference EXRs (independent seeds, the same path count each) are averaged; their
+regions' spread is printed as the reference's own noise.
 """
 import math, os, struct, sys, zlib
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from imgdiff import read_png, write_png, psnr  # noqa: E402
+from imgdiff import write_png, psnr  # noqa: E402
 
 # Screen rectangles (x0, y0, x1, y1) of builtin:cornell's main camera at 640x360, each inside
 # one surface (the 20-pixel margins keep them off edges).
@@ -21,6 +25,7 @@ REGIONS = {
     'block, face to the camera': (430, 160, 490, 250),
     'block, top': (425, 110, 480, 125),
     'back wall': (230, 40, 360, 150),
+    'red wall, in the spot': (20, 110, 60, 170),
 }
 
 
@@ -99,6 +104,26 @@ def region_luminance(exr, rect):
     return total / count
 
 
+def display(exr):
+    """The 8-bit sRGB pixels the tonemap pass makes of a scene colour (exposure 1, ACES fit)."""
+    w, h, planes = exr
+    out = bytearray(w * h * 3)
+    for i in range(w * h):
+        for c, name in enumerate('RGB'):
+            x = max(planes[name][i], 0.0)
+            y = min(max((x * (2.51 * x + 0.03)) / (x * (2.43 * x + 0.59) + 0.14), 0.0), 1.0)
+            y = y * 12.92 if y < 0.0031308 else 1.055 * y ** (1.0 / 2.4) - 0.055
+            out[i * 3 + c] = int(min(max(y, 0.0), 1.0) * 255.0 + 0.5)
+    return out
+
+
+def average(exrs):
+    w, h, _ = exrs[0]
+    planes = {c: [sum(e[2][c][i] for e in exrs) / len(exrs) for i in range(w * h)]
+              for c in 'RGB'}
+    return w, h, planes
+
+
 def main():
     args = sys.argv[1:]
     out = None
@@ -106,29 +131,37 @@ def main():
         k = args.index('--side-by-side')
         out = args[k + 1]
         del args[k:k + 2]
-    if len(args) < 3:
+    if '--' not in args:
         sys.exit(__doc__)
-    ref = read_exr(args[0])
-    _, _, ref_png = read_png(args[1])
-    runs = []
-    for spec in args[2:]:
-        name, files = spec.split('=', 1)
-        exr_path, png_path = files.split(',')
-        runs.append((name, read_exr(exr_path), read_png(png_path)))
-    names = [n for n, _, _ in runs]
+    k = args.index('--')
+    refs = [read_exr(p) for p in args[:k]]
+    runs = [(spec.split('=', 1)[0], read_exr(spec.split('=', 1)[1])) for spec in args[k + 1:]]
+    ref = average(refs)
+    names = [n for n, _ in runs]
     print('| region | ' + ' | '.join(names) + ' | reference | ' +
           ' | '.join('%s / reference' % n for n in names) + ' |')
     print('| --- ' * (2 * len(names) + 2) + '|')
     for region, rect in REGIONS.items():
         r = region_luminance(ref, rect)
-        values = [region_luminance(e, rect) for _, e, _ in runs]
-        print('| %s | ' % region + ' | '.join('%.4f' % v for v in values) + ' | %.4f | ' % r +
-              ' | '.join('%.2f' % (v / r) for v in values) + ' |')
-    for name, _, (_, _, rgb) in runs:
-        print('PSNR %s vs reference: %.2f dB' % (name, psnr(rgb, ref_png)))
+        values = [region_luminance(e, rect) for _, e in runs]
+        spread = ''
+        if len(refs) > 1:
+            each = [region_luminance(e, rect) for e in refs]
+            spread = ' (seeds %s)' % ', '.join('%.4f' % v for v in each)
+        print('| %s | ' % region + ' | '.join('%.4f' % v for v in values) +
+              ' | %.4f%s | ' % (r, spread) + ' | '.join('%.2f' % (v / r) for v in values) + ' |')
+    ref_display = display(ref)
+    images = []
+    for name, exr in runs:
+        rgb = display(exr)
+        images.append(rgb)
+        print('PSNR %s vs reference: %.2f dB' % (name, psnr(rgb, ref_display)))
+    if len(refs) > 1:
+        print('PSNR reference seed 0 vs seed 1: %.2f dB' %
+              psnr(display(refs[0]), display(refs[1])))
     if out:
-        w, h, _ = runs[0][2]
-        images = [png[2] for _, _, png in runs] + [ref_png]
+        w, h, _ = ref
+        images.append(ref_display)
         rows = bytearray()
         for y in range(h):
             for rgb in images:

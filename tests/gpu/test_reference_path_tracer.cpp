@@ -9,10 +9,14 @@
 //   same image.
 #include "gpu_test_env.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <fstream>
 #include <iterator>
+#include <sstream>
+#include <sys/wait.h>
 
 #include "app/exr_file.h"
 
@@ -172,7 +176,39 @@ Agreement agreement(const HdrImage& image, double expected) {
     return a;
 }
 
+// Runs the shadel binary with `env` set before it; returns its exit code and its stderr.
+int runShadel(const std::string& env, const std::string& args, std::string& err) {
+    std::string errFile = tempPath("reference_stderr.txt");
+    std::string cmd =
+        env + " timeout 120 " + SHADEL_BINARY + " " + args + " >/dev/null 2>" + errFile;
+    int status = std::system(cmd.c_str());
+    std::ifstream in(errFile);
+    std::stringstream ss;
+    ss << in.rdbuf();
+    err = ss.str();
+    return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+}
+
 } // namespace
+
+// A device without ray queries: --mode reference is one line naming the mode and what is
+// missing, exit 2; so are bad values of its options.
+TEST(ReferencePathTracer, WithoutRayQueryOrWithBadOptionsOneClearError) {
+    std::string err;
+    EXPECT_EQ(runShadel("SHADEL_DISABLE_RAY_QUERY=1",
+                        "render --scene builtin:cornell --size 32x18 --mode reference", err),
+              2);
+    EXPECT_EQ(std::count(err.begin(), err.end(), '\n'), 1) << err;
+    EXPECT_NE(err.find("--mode reference"), std::string::npos) << err;
+    EXPECT_NE(err.find("VK_KHR_ray_query"), std::string::npos) << err;
+    for (const char* bad : {"--spp 0", "--max-bounces -1", "--seed x"}) {
+        EXPECT_EQ(runShadel("", std::string("render --size 32x18 --mode reference ") + bad, err), 2)
+            << bad;
+        EXPECT_NE(err.find(std::string(bad).substr(0, std::string(bad).find(' '))),
+                  std::string::npos)
+            << err;
+    }
+}
 
 // A white sphere alone: every path leaves it after one bounce, and its estimate (the
 // environment's cosine sample and the BRDF's, weighted half and half) is exactly L, except when
