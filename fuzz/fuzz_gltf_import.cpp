@@ -1,6 +1,8 @@
 // libFuzzer target: the input is a .gltf or .glb file's contents. Every input must either import
-// or throw InputError ("<file>: <reason>"); a crash, a sanitizer report, an uncaught exception
-// of another type, a hang (-timeout) or runaway memory (-rss_limit_mb) is a finding.
+// into a scene that keeps the engine's invariants (sceneInvariantViolation: indices in range,
+// finite positions and transforms, unit normals, materials and textures that exist...) or throw
+// InputError ("<file>: <reason>"); a crash, a sanitizer report, an uncaught exception of another
+// type, a broken invariant, a hang (-timeout) or runaway memory (-rss_limit_mb) is a finding.
 //
 // Buffer and image URIs resolve in an empty private folder, so inputs cannot reach other files
 // (URIs escaping it are refused by the importer itself).
@@ -16,6 +18,8 @@
 #include "core/error.h"
 #include "core/log.h"
 #include "scene/gltf_import.h"
+#include "scene/load_budget.h"
+#include "scene/mesh_utils.h"
 
 namespace {
 
@@ -38,14 +42,21 @@ std::string modelPath() {
 
 extern "C" int LLVMFuzzerInitialize(int*, char***) {
     shadel::setLogLevel(shadel::LogLevel::Error); // warnings for every input would drown it
+    // Well under -rss_limit_mb: an input that expands past the load budget is an InputError.
+    shadel::setLoadMemoryLimit(512ull << 20);
     return 0;
 }
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
+    shadel::Scene scene;
     try {
-        shadel::importGltfBytes(std::vector<uint8_t>(data, data + size), modelPath());
+        scene = shadel::importGltfBytes(std::vector<uint8_t>(data, data + size), modelPath());
     } catch (const shadel::InputError&) {
-        // The expected outcome for malformed input.
+        return 0; // the expected outcome for malformed input
+    }
+    if (std::string broken = shadel::sceneInvariantViolation(scene); !broken.empty()) {
+        std::fprintf(stderr, "accepted input breaks a scene invariant: %s\n", broken.c_str());
+        std::abort(); // a finding: libFuzzer saves the input
     }
     return 0;
 }

@@ -44,7 +44,7 @@ $SUDO apt-get install -y -qq \
   glslc libshaderc-dev spirv-tools vulkan-validationlayers \
   libglm-dev libtinygltf-dev libmeshoptimizer-dev libstb-dev libcli11-dev nlohmann-json3-dev \
   libgtest-dev libgmock-dev libbenchmark-dev libeigen3-dev assimp-testmodels python3 \
-  gltfpack libtinyexr-dev libglfw3-dev libimgui-dev xvfb xauth
+  gltfpack libtinyexr-dev libglfw3-dev libimgui-dev xvfb xauth xdotool
 # The test suite's fuzz runs need clang with libFuzzer: fail here rather than skip them later.
 if ! command -v clang++ >/dev/null 2>&1; then
   echo "setup: clang++ is missing after installing clang" >&2

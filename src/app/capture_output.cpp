@@ -1,5 +1,6 @@
 #include "app/capture_output.h"
 
+#include <cctype>
 #include <filesystem>
 
 #include "app/exr_file.h"
@@ -46,8 +47,21 @@ static bool writesExr(CaptureKind kind) {
     return kind == CaptureKind::Hdr || kind == CaptureKind::Depth;
 }
 
+static std::string lowerExtension(const std::string& path) {
+    std::string ext = std::filesystem::path(path).extension().string();
+    for (char& c : ext) c = char(std::tolower(static_cast<unsigned char>(c)));
+    return ext;
+}
+
 bool isExrPath(const std::string& path) {
-    return path.size() > 4 && path.compare(path.size() - 4, 4, ".exr") == 0;
+    return lowerExtension(path) == ".exr";
+}
+
+std::string imageFormatProblem(const std::string& path) {
+    std::string ext = lowerExtension(path);
+    if (ext == ".png" || ext == ".exr") return {};
+    return ext.empty() ? "no file extension: .png (display colours) or .exr (scene-linear HDR)"
+                       : "'" + ext + "' is not an image format shadel writes: .png or .exr";
 }
 
 std::string capturePath(const std::string& captureDir, const std::string& out,

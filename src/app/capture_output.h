@@ -31,5 +31,7 @@ std::vector<std::string> writeCaptures(const CaptureRegistry& registry,
 void writeHdrFrame(const CaptureRegistry& registry, uint32_t ssaa, const std::string& path,
                    const char* capture = "hdr");
 bool isExrPath(const std::string& path);
+// "" if the extension names a format shadel writes (.png, .exr, any case), else why not.
+std::string imageFormatProblem(const std::string& path);
 
 } // namespace shadel

@@ -22,6 +22,7 @@ int main(int argc, char** argv) {
     app.require_subcommand(1);
     GlobalFlags global;
     addGlobalFlags(app, global);
+    app.set_version_flag("--version", "shadel 0.1.0: decoupled shading on Vulkan 1.3");
     const std::vector<Subcommand> subcommands = {addRenderCommand(app), addBenchCommand(app),
                                                  addBakeCommand(app),   addViewCommand(app),
                                                  addInfoCommand(app),   addCacheCommand(app)};

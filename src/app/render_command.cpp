@@ -261,6 +261,11 @@ void prepareOutputs(RenderSession& session) {
                                     ec.message().c_str()));
     }
     // Fail before loading and rendering, not after.
+    // (A character device such as /dev/null or /dev/stdout has no extension: it gets a PNG.)
+    std::error_code deviceCheck;
+    if (!o.out.empty() && !outDir && !std::filesystem::is_character_file(o.out, deviceCheck))
+        if (std::string why = imageFormatProblem(o.out); !why.empty())
+            throw InputError(format("--out %s: %s", o.out.c_str(), why.c_str()));
     if (!o.out.empty()) requireCreatableOutput("--out", outDir ? o.out + "frame_0000.png" : o.out);
     if (!o.stats.empty()) requireCreatableOutput("--stats", o.stats);
     if (!o.trace.empty()) requireCreatableOutput("--trace", o.trace);

@@ -58,22 +58,94 @@ constexpr glm::vec3 kCandidateSides[] = {
 constexpr float kPreferredCoverage = 0.3f;
 constexpr float kPreferredBonus = 1.25f;
 
+// Cells of a coarse grid marked covered, each at most once: per row, a link from every cell to
+// the next cell that is still uncovered (path-compressed), so marking a span costs the cells it
+// newly covers plus a near-constant, never the span's length again.
+class CoverageGrid {
+public:
+    CoverageGrid(int width, int height)
+        : width_(width), height_(height), next_(size_t(width + 1) * size_t(height)) {
+        for (int y = 0; y < height; ++y)
+            for (int x = 0; x <= width; ++x) next_[index(x, y)] = x;
+    }
+    // Marks cells x0..x1 of row y.
+    void mark(int y, int x0, int x1) {
+        for (int x = find(x0, y); x <= x1; x = find(x, y)) {
+            next_[index(x, y)] = x + 1;
+            ++covered_;
+        }
+    }
+    float fraction() const { return float(covered_) / float(size_t(width_) * size_t(height_)); }
+
+private:
+    size_t index(int x, int y) const { return size_t(y) * size_t(width_ + 1) + size_t(x); }
+    int find(int x, int y) {
+        int root = x;
+        while (next_[index(root, y)] != root) root = next_[index(root, y)];
+        while (next_[index(x, y)] != root) { // path compression
+            int up = next_[index(x, y)];
+            next_[index(x, y)] = root;
+            x = up;
+        }
+        return root;
+    }
+    int width_, height_;
+    std::vector<int> next_; // per row: width + 1 links (the last, a sentinel, points at itself)
+    size_t covered_ = 0;
+};
+
+// Marks the cells whose centres lie inside triangle a, b, d (grid units), row by row: per row
+// the triangle's cross-section at the cell centres' height is one interval.
+void markTriangle(CoverageGrid& grid, int gridW, int gridH, glm::vec2 a, glm::vec2 b, glm::vec2 d) {
+    int y0 = std::max(0, int(std::ceil(std::min({a.y, b.y, d.y}) - 0.5f)));
+    int y1 = std::min(gridH - 1, int(std::floor(std::max({a.y, b.y, d.y}) - 0.5f)));
+    for (int y = y0; y <= y1; ++y) {
+        float py = float(y) + 0.5f;
+        float left = INFINITY, right = -INFINITY;
+        for (auto [u, v] : {std::pair{a, b}, std::pair{b, d}, std::pair{d, a}}) {
+            if ((u.y - py) * (v.y - py) > 0.0f) continue; // the edge does not reach this row
+            if (u.y == v.y) {                             // along the row
+                left = std::min({left, u.x, v.x}), right = std::max({right, u.x, v.x});
+                continue;
+            }
+            float x = u.x + (py - u.y) / (v.y - u.y) * (v.x - u.x);
+            left = std::min(left, x), right = std::max(right, x);
+        }
+        int x0 = std::max(0, int(std::ceil(left - 0.5f)));
+        int x1 = std::min(gridW - 1, int(std::floor(right - 0.5f)));
+        if (x0 <= x1) grid.mark(y, x0, x1);
+    }
+}
+
+// Triangles the estimate looks at, at most: a larger scene is sampled at a fixed stride (the
+// same for every candidate view, so the comparison stays fair).
+constexpr size_t kMaxEstimateTriangles = 1u << 18;
+
 // Fraction of the image the scene's triangles cover seen by `c`, on a coarse grid (cell
 // centres inside a triangle). Only the sides meant to be seen count: a triangle's front
 // (counter-clockwise in glTF, the other way under a mirroring transform), or both sides of a
 // double-sided material; so a view of a model's back (a row of backdrops hiding the samples in
-// front of them, ClearCoatTest.gltf) loses to the view of its front. Linear in the triangles
-// plus the cells they cover.
+// front of them, ClearCoatTest.gltf) loses to the view of its front. The cost is bounded by the
+// grid, not by triangles x cells: at most kMaxEstimateTriangles triangles, each costing its
+// rows, and every cell is marked once (a million overlapping screen-filling triangles cost what
+// their rows cost).
 float estimatedCoverage(const Scene& scene, const Camera& c, float aspect) {
     constexpr int kGridH = 48;
     const int gridW = std::clamp(int(std::lround(kGridH * aspect)), 1, 16 * kGridH);
     CameraView view = makeCameraView(c, uint32_t(gridW), uint32_t(kGridH));
     glm::mat4 viewProj = view.proj * view.view;
-    std::vector<uint8_t> grid(size_t(gridW) * kGridH, 0);
+    CoverageGrid grid(gridW, kGridH);
+    const size_t stride = std::max<size_t>(1, scene.triangleCount() / kMaxEstimateTriangles + 1);
+    size_t triangle = 0; // across the scene, for the stride
     std::vector<glm::vec3> projected, world;
     for (const Instance& inst : scene.instances) {
         if (inst.mesh >= scene.meshes.size()) continue;
         const Mesh& mesh = scene.meshes[inst.mesh];
+        const size_t triangles = mesh.indices.size() / 3;
+        // The first triangle of this instance the stride lands on.
+        size_t first = (stride - triangle % stride) % stride;
+        triangle += triangles;
+        if (first >= triangles) continue;
         bool doubleSided =
             mesh.material < scene.materials.size() && scene.materials[mesh.material].doubleSided;
         float facing = glm::determinant(glm::mat3(inst.transform)) < 0.0f ? -1.0f : 1.0f;
@@ -89,7 +161,7 @@ float estimatedCoverage(const Scene& scene, const Camera& c, float aspect) {
                                 1.0f)
                     : glm::vec3(0.0f); // behind: z = 0 marks it
         }
-        for (size_t t = 0; t + 2 < mesh.indices.size(); t += 3) {
+        for (size_t t = first * 3; t + 2 < mesh.indices.size(); t += 3 * stride) {
             glm::vec3 a = projected[mesh.indices[t]], b = projected[mesh.indices[t + 1]],
                       d = projected[mesh.indices[t + 2]];
             if (a.z == 0.0f || b.z == 0.0f || d.z == 0.0f) continue;
@@ -100,26 +172,11 @@ float estimatedCoverage(const Scene& scene, const Camera& c, float aspect) {
                     continue; // its back faces the camera
             }
             float area = (b.x - a.x) * (d.y - a.y) - (b.y - a.y) * (d.x - a.x);
-            if (area == 0.0f) continue;
-            int x0 = std::max(0, int(std::floor(std::min({a.x, b.x, d.x}))));
-            int x1 = std::min(gridW - 1, int(std::ceil(std::max({a.x, b.x, d.x}))));
-            int y0 = std::max(0, int(std::floor(std::min({a.y, b.y, d.y}))));
-            int y1 = std::min(kGridH - 1, int(std::ceil(std::max({a.y, b.y, d.y}))));
-            for (int y = y0; y <= y1; ++y) {
-                for (int x = x0; x <= x1; ++x) {
-                    glm::vec2 p(float(x) + 0.5f, float(y) + 0.5f);
-                    auto edge = [&](glm::vec3 u, glm::vec3 v) {
-                        return ((v.x - u.x) * (p.y - u.y) - (v.y - u.y) * (p.x - u.x)) * area;
-                    };
-                    if (edge(a, b) >= 0.0f && edge(b, d) >= 0.0f && edge(d, a) >= 0.0f)
-                        grid[size_t(y) * size_t(gridW) + size_t(x)] = 1;
-                }
-            }
+            if (area == 0.0f || !std::isfinite(area)) continue;
+            markTriangle(grid, gridW, kGridH, glm::vec2(a), glm::vec2(b), glm::vec2(d));
         }
     }
-    size_t covered = 0;
-    for (uint8_t g : grid) covered += g;
-    return float(covered) / float(grid.size());
+    return grid.fraction();
 }
 
 } // namespace

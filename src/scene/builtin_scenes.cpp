@@ -139,23 +139,26 @@ private:
     Scene& scene_;
 };
 
-// A small city block around a plaza: one large ground, tens of buildings, props, and a hundred
-// or so objects of a few centimetres, lit by a sun, street lamps and spots.
-Scene makeDefault() {
-    Scene scene;
-    scene.name = "default";
-    SceneBuilder b(scene);
-    Rng rng(0x5ADE1D0001ull);
-    const float pi = glm::pi<float>();
+const glm::vec3 kDefaultLampSpots[6] = {{-9, 0, 9}, {9, 0, 9},  {-9, 0, -9},
+                                        {9, 0, -9}, {0, 0, 18}, {-18, 0, 0}};
+const glm::vec3 kDefaultTable{3.0f, 0.0f, 8.0f};
 
-    uint32_t asphalt = b.material("asphalt", {0.22f, 0.22f, 0.24f}, 0.92f);
-    uint32_t plazaChecker = b.material("plaza checker", {0.85f, 0.85f, 0.82f}, 0.6f, 0.0f,
-                                       Procedural::TexelChecker, 20.0f); // 5 cm cells
-    uint32_t wallChecker = b.material("wall checker", {0.9f, 0.9f, 0.9f}, 0.5f, 0.0f,
-                                      Procedural::TexelChecker, 32.0f); // ~3 cm cells
-    uint32_t bricks =
-        b.material("bricks", {0.62f, 0.28f, 0.2f}, 0.85f, 0.0f, Procedural::Bricks, 4.0f);
-    uint32_t darkBricks =
+// The default scene's materials, created in this order (material indices are part of what the
+// tests' reference images show).
+struct DefaultMaterials {
+    uint32_t asphalt, plazaChecker, wallChecker, bricks, darkBricks, concrete[4], roofGrey, steel,
+        lampGlass, wood, barrelRed, stone, plastic[4], chrome;
+};
+
+DefaultMaterials makeDefaultMaterials(SceneBuilder& b) {
+    DefaultMaterials m;
+    m.asphalt = b.material("asphalt", {0.22f, 0.22f, 0.24f}, 0.92f);
+    m.plazaChecker = b.material("plaza checker", {0.85f, 0.85f, 0.82f}, 0.6f, 0.0f,
+                                Procedural::TexelChecker, 20.0f); // 5 cm cells
+    m.wallChecker = b.material("wall checker", {0.9f, 0.9f, 0.9f}, 0.5f, 0.0f,
+                               Procedural::TexelChecker, 32.0f); // ~3 cm cells
+    m.bricks = b.material("bricks", {0.62f, 0.28f, 0.2f}, 0.85f, 0.0f, Procedural::Bricks, 4.0f);
+    m.darkBricks =
         b.material("dark bricks", {0.4f, 0.22f, 0.18f}, 0.9f, 0.0f, Procedural::Bricks, 3.0f);
     const uint32_t concrete[4] = {
         b.material("concrete", {0.7f, 0.68f, 0.62f}, 0.8f),
@@ -163,27 +166,28 @@ Scene makeDefault() {
         b.material("sandstone", {0.8f, 0.72f, 0.55f}, 0.85f),
         b.material("slate", {0.4f, 0.41f, 0.45f}, 0.6f),
     };
-    uint32_t roofGrey = b.material("roof units", {0.55f, 0.55f, 0.55f}, 0.5f, 0.6f);
-    uint32_t steel = b.material("steel", {0.85f, 0.86f, 0.88f}, 0.3f, 1.0f);
-    uint32_t lampGlass = b.material("lamp globe", {1.0f, 0.95f, 0.85f}, 0.2f, 0.0f,
-                                    Procedural::None, 1.0f, {4.0f, 3.2f, 2.2f});
-    uint32_t wood = b.material("wood", {0.55f, 0.38f, 0.22f}, 0.7f);
-    uint32_t barrelRed = b.material("barrel paint", {0.6f, 0.08f, 0.06f}, 0.45f, 0.3f);
-    uint32_t stone = b.material("stone", {0.62f, 0.6f, 0.58f}, 0.75f);
+    m.roofGrey = b.material("roof units", {0.55f, 0.55f, 0.55f}, 0.5f, 0.6f);
+    m.steel = b.material("steel", {0.85f, 0.86f, 0.88f}, 0.3f, 1.0f);
+    m.lampGlass = b.material("lamp globe", {1.0f, 0.95f, 0.85f}, 0.2f, 0.0f, Procedural::None, 1.0f,
+                             {4.0f, 3.2f, 2.2f});
+    m.wood = b.material("wood", {0.55f, 0.38f, 0.22f}, 0.7f);
+    m.barrelRed = b.material("barrel paint", {0.6f, 0.08f, 0.06f}, 0.45f, 0.3f);
+    m.stone = b.material("stone", {0.62f, 0.6f, 0.58f}, 0.75f);
     const uint32_t plastic[4] = {
         b.material("red plastic", {0.8f, 0.1f, 0.08f}, 0.35f),
         b.material("yellow plastic", {0.9f, 0.75f, 0.1f}, 0.4f),
         b.material("blue plastic", {0.1f, 0.25f, 0.8f}, 0.3f),
         b.material("green plastic", {0.15f, 0.6f, 0.2f}, 0.45f),
     };
-    uint32_t chrome = b.material("chrome", {0.95f, 0.93f, 0.9f}, 0.1f, 1.0f);
+    m.chrome = b.material("chrome", {0.95f, 0.93f, 0.9f}, 0.1f, 1.0f);
 
-    // Ground and the high-frequency surfaces.
-    b.place("ground", b.mesh(makePlane("ground", 120.0f, 120.0f, asphalt, 12)), {0, 0, 0});
-    b.box("checker plaza", {16.0f, 0.05f, 16.0f}, plazaChecker, {0, 0, 0});
-    b.box("checker wall", {12.0f, 5.0f, 0.3f}, wallChecker, {0, 0, -14.0f});
+    std::copy(std::begin(concrete), std::end(concrete), m.concrete);
+    std::copy(std::begin(plastic), std::end(plastic), m.plastic);
+    return m;
+}
 
-    // Buildings on a 15 m lot grid around an open centre of 45 m x 45 m, with an avenue along X.
+// Buildings on a 15 m lot grid around an open centre of 45 m x 45 m, with an avenue along X.
+void addDefaultBuildings(SceneBuilder& b, Rng& rng, const DefaultMaterials& m) {
     int buildingCount = 0;
     for (int gz = -3; gz <= 3; ++gz) {
         for (int gx = -3; gx <= 3; ++gx) {
@@ -197,7 +201,9 @@ Scene makeDefault() {
             glm::vec3 lot{gx * 15.0f + rng.uniform(-1.0f, 1.0f), 0.0f,
                           gz * 15.0f + rng.uniform(-1.0f, 1.0f)};
             float r = rng.uniform(0.0f, 1.0f);
-            uint32_t mat = r < 0.25f ? bricks : r < 0.35f ? darkBricks : concrete[rng.range(0, 3)];
+            uint32_t mat = r < 0.25f   ? m.bricks
+                           : r < 0.35f ? m.darkBricks
+                                       : m.concrete[rng.range(0, 3)];
             std::string name = "building " + std::to_string(buildingCount++);
             b.box(name, size, mat, lot);
             int roofUnits = rng.range(0, 3);
@@ -206,61 +212,68 @@ Scene makeDefault() {
                                rng.uniform(0.8f, 2.5f)};
                 glm::vec3 at = lot + glm::vec3(rng.uniform(-0.3f, 0.3f) * (size.x - unit.x), size.y,
                                                rng.uniform(-0.3f, 0.3f) * (size.z - unit.z));
-                b.box(name + " roof unit " + std::to_string(u), unit, roofGrey, at,
+                b.box(name + " roof unit " + std::to_string(u), unit, m.roofGrey, at,
                       rng.uniform(0.0f, 0.3f));
             }
         }
     }
+}
 
-    // Pillars around the plaza, lamp posts with glowing globes.
-    uint32_t pillar = b.mesh(makeCylinder("pillar", 0.45f, 6.0f, stone));
+// Pillars around the plaza, lamp posts with glowing globes, benches, crates, barrels and
+// decorative spheres.
+void addDefaultProps(SceneBuilder& b, Rng& rng, const DefaultMaterials& m) {
+    const float pi = glm::pi<float>();
+    uint32_t pillar = b.mesh(makeCylinder("pillar", 0.45f, 6.0f, m.stone));
     for (int i = 0; i < 8; ++i) {
         float a = 2.0f * pi * (float(i) + 0.5f) / 8.0f;
         b.place("pillar " + std::to_string(i), pillar,
                 {std::cos(a) * 11.5f, 0.0f, std::sin(a) * 11.5f});
     }
-    uint32_t post = b.mesh(makeCylinder("lamp post", 0.08f, 5.0f, steel, 12));
-    uint32_t globe = b.mesh(makeSphere("lamp globe", 0.22f, lampGlass, 16, 8));
-    const glm::vec3 lampSpots[6] = {{-9, 0, 9}, {9, 0, 9},  {-9, 0, -9},
-                                    {9, 0, -9}, {0, 0, 18}, {-18, 0, 0}};
+    uint32_t post = b.mesh(makeCylinder("lamp post", 0.08f, 5.0f, m.steel, 12));
+    uint32_t globe = b.mesh(makeSphere("lamp globe", 0.22f, m.lampGlass, 16, 8));
     for (int i = 0; i < 6; ++i) {
-        b.place("lamp post " + std::to_string(i), post, lampSpots[i]);
-        b.place("lamp globe " + std::to_string(i), globe, lampSpots[i] + glm::vec3(0, 5.2f, 0));
+        b.place("lamp post " + std::to_string(i), post, kDefaultLampSpots[i]);
+        b.place("lamp globe " + std::to_string(i), globe,
+                kDefaultLampSpots[i] + glm::vec3(0, 5.2f, 0));
     }
 
     // Benches, crates, barrels and decorative spheres.
     for (int i = 0; i < 6; ++i) {
         float a = 2.0f * pi * float(i) / 6.0f;
-        b.box("bench " + std::to_string(i), {2.0f, 0.45f, 0.5f}, wood,
+        b.box("bench " + std::to_string(i), {2.0f, 0.45f, 0.5f}, m.wood,
               {std::cos(a) * 9.5f, 0.0f, std::sin(a) * 9.5f}, -a + pi * 0.5f);
     }
     for (int i = 0; i < 20; ++i) {
         float s = rng.uniform(0.45f, 1.0f);
         glm::vec3 at{rng.uniform(-20.0f, -12.0f), 0.0f, rng.uniform(-20.0f, 20.0f)};
-        b.box("crate " + std::to_string(i), glm::vec3(s), wood, at, rng.uniform(0.0f, pi));
+        b.box("crate " + std::to_string(i), glm::vec3(s), m.wood, at, rng.uniform(0.0f, pi));
         if (rng.chance(0.3f)) {
             float s2 = s * rng.uniform(0.5f, 0.9f);
-            b.box("crate " + std::to_string(i) + " top", glm::vec3(s2), wood,
+            b.box("crate " + std::to_string(i) + " top", glm::vec3(s2), m.wood,
                   at + glm::vec3(0, s, 0), rng.uniform(0.0f, pi));
         }
     }
-    uint32_t barrel = b.mesh(makeCylinder("barrel", 0.3f, 0.9f, barrelRed, 20));
+    uint32_t barrel = b.mesh(makeCylinder("barrel", 0.3f, 0.9f, m.barrelRed, 20));
     for (int i = 0; i < 12; ++i)
         b.place("barrel " + std::to_string(i), barrel,
                 {rng.uniform(12.0f, 20.0f), 0.0f, rng.uniform(-20.0f, 20.0f)},
                 rng.uniform(0.0f, pi));
     for (int i = 0; i < 10; ++i) {
         float r = rng.uniform(0.3f, 1.5f);
-        uint32_t mat = i % 3 == 0 ? chrome : plastic[rng.range(0, 3)];
+        uint32_t mat = i % 3 == 0 ? m.chrome : m.plastic[rng.range(0, 3)];
         uint32_t m = b.mesh(makeSphere("ball " + std::to_string(i), r, mat, 32, 16));
         b.place("ball " + std::to_string(i), m,
                 {rng.uniform(-7.0f, 7.0f), r + 0.05f, rng.uniform(-7.0f, 7.0f)});
     }
+}
 
-    // A table near the main camera covered with objects of a few centimetres.
-    const glm::vec3 table{3.0f, 0.0f, 8.0f};
-    b.box("table top", {1.6f, 0.05f, 0.9f}, wood, table + glm::vec3(0, 0.72f, 0));
-    uint32_t leg = b.mesh(makeCylinder("table leg", 0.03f, 0.72f, steel, 10));
+// A table near the main camera covered with objects of a few centimetres, and pebbles and tiny
+// debris on the ground around the plaza.
+void addDefaultSmallObjects(SceneBuilder& b, Rng& rng, const DefaultMaterials& m) {
+    const float pi = glm::pi<float>();
+    const glm::vec3 table = kDefaultTable;
+    b.box("table top", {1.6f, 0.05f, 0.9f}, m.wood, table + glm::vec3(0, 0.72f, 0));
+    uint32_t leg = b.mesh(makeCylinder("table leg", 0.03f, 0.72f, m.steel, 10));
     for (int i = 0; i < 4; ++i)
         b.place("table leg " + std::to_string(i), leg,
                 table + glm::vec3((i & 1) ? 0.72f : -0.72f, 0, (i & 2) ? 0.38f : -0.38f));
@@ -268,10 +281,10 @@ Scene makeDefault() {
     for (int i = 0; i < 4; ++i) {
         float s = 0.02f + 0.015f * float(i);
         tinyBoxes.push_back(
-            b.mesh(makeBox("tiny box " + std::to_string(i), glm::vec3(s), plastic[i])));
+            b.mesh(makeBox("tiny box " + std::to_string(i), glm::vec3(s), m.plastic[i])));
         tinySpheres.push_back(
             b.mesh(makeSphere("tiny sphere " + std::to_string(i), 0.01f + 0.01f * float(i),
-                              i % 2 ? chrome : plastic[(i + 2) % 4], 12, 6)));
+                              i % 2 ? m.chrome : m.plastic[(i + 2) % 4], 12, 6)));
     }
     for (int i = 0; i < 30; ++i) {
         int k = rng.range(0, 3);
@@ -290,7 +303,7 @@ Scene makeDefault() {
     std::vector<uint32_t> pebbles;
     for (int i = 0; i < 4; ++i)
         pebbles.push_back(b.mesh(
-            makeSphere("pebble " + std::to_string(i), 0.02f + 0.012f * float(i), stone, 10, 5)));
+            makeSphere("pebble " + std::to_string(i), 0.02f + 0.012f * float(i), m.stone, 10, 5)));
     for (int i = 0; i < 100; ++i) {
         int k = rng.range(0, 3);
         glm::vec3 at{rng.uniform(-10.0f, 10.0f), 0.0f, rng.uniform(6.0f, 16.0f)};
@@ -303,12 +316,15 @@ Scene makeDefault() {
                     at + glm::vec3(0, 0.02f + 0.012f * float(k), 0));
         }
     }
+}
 
-    // Lights: sun, warm street lamps, a cool accent, spots on the checker wall, a facade, the
-    // table.
+// Lights: sun, warm street lamps, a cool accent, spots on the checker wall, a facade, the table;
+// and the cameras.
+void addDefaultLightsAndCameras(SceneBuilder& b) {
+    const glm::vec3 table = kDefaultTable;
     b.sun({-0.45f, -1.0f, -0.3f}, 3.0f);
     for (int i = 0; i < 4; ++i)
-        b.pointLight("lamp " + std::to_string(i), lampSpots[i] + glm::vec3(0, 4.9f, 0),
+        b.pointLight("lamp " + std::to_string(i), kDefaultLampSpots[i] + glm::vec3(0, 4.9f, 0),
                      {1.0f, 0.8f, 0.55f}, 40.0f, 14.0f);
     b.pointLight("blue accent", {-16.0f, 1.5f, -16.0f}, {0.4f, 0.6f, 1.0f}, 25.0f, 10.0f);
     b.spotLight("wall spot", {0.0f, 6.0f, -5.0f}, {0.0f, 2.5f, -14.0f}, {1.0f, 0.97f, 0.9f}, 300.0f,
@@ -323,6 +339,26 @@ Scene makeDefault() {
     b.camera("main", {1.5f, 1.7f, 17.0f}, {-0.5f, 1.2f, -10.0f});
     b.camera("overview", {60.0f, 50.0f, 60.0f}, {0.0f, 0.0f, 0.0f}, 0.8f, 0.5f, 400.0f);
     b.camera("street", {-52.0f, 1.6f, 2.0f}, {0.0f, 3.0f, -1.0f});
+}
+
+// A small city block around a plaza: one large ground, tens of buildings, props, and a hundred
+// or so objects of a few centimetres, lit by a sun, street lamps and spots. The parts draw from
+// one random sequence in this order.
+Scene makeDefault() {
+    Scene scene;
+    scene.name = "default";
+    SceneBuilder b(scene);
+    Rng rng(0x5ADE1D0001ull);
+    const DefaultMaterials m = makeDefaultMaterials(b);
+    // Ground and the high-frequency surfaces.
+    b.place("ground", b.mesh(makePlane("ground", 120.0f, 120.0f, m.asphalt, 12)), {0, 0, 0});
+    b.box("checker plaza", {16.0f, 0.05f, 16.0f}, m.plazaChecker, {0, 0, 0});
+    b.box("checker wall", {12.0f, 5.0f, 0.3f}, m.wallChecker, {0, 0, -14.0f});
+
+    addDefaultBuildings(b, rng, m);
+    addDefaultProps(b, rng, m);
+    addDefaultSmallObjects(b, rng, m);
+    addDefaultLightsAndCameras(b);
     return scene;
 }
 

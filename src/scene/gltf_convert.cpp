@@ -403,6 +403,10 @@ private:
             for (size_t i = 0; i < vertexCount; ++i) indices[i] = uint32_t(i);
         }
         mesh.indices = triangulate(indices, mode, where);
+        if (size_t repeated = removeDuplicateTriangles(mesh.indices); repeated > 0)
+            warn(format("%s: %zu triangles repeat an earlier one (the same vertices, the same "
+                        "winding); drawn once",
+                        where.c_str(), repeated));
         if (mesh.indices.empty()) {
             warn(where + " has no triangles; skipped");
             noteSkip("no triangles");

@@ -58,7 +58,15 @@ bool pathInsideFolder(const std::string& path, const std::string& folder) {
     if (!base.has_filename()) base = base.parent_path(); // "dir/" compares as "dir"
     fs::path target = fs::absolute(fs::path(path)).lexically_normal();
     fs::path relative = target.lexically_relative(base);
-    return !relative.empty() && *relative.begin() != "..";
+    if (relative.empty() || *relative.begin() == "..") return false;
+    // And by real path: a link inside the folder to a file outside it is outside.
+    std::error_code ec;
+    fs::path realBase = fs::weakly_canonical(base, ec);
+    if (ec) return false;
+    fs::path realTarget = fs::weakly_canonical(target, ec);
+    if (ec) return false;
+    fs::path realRelative = realTarget.lexically_relative(realBase);
+    return !realRelative.empty() && *realRelative.begin() != "..";
 }
 
 } // namespace shadel

@@ -13,7 +13,8 @@ std::string decodeUriPath(const std::string& uri);
 // absolute, or with more "../" than it descends (checked lexically, like the resolution).
 bool uriEscapesFolder(const std::string& uri);
 
-// True if `path` lies inside `folder` lexically (after normalising "." and ".." components).
+// True if `path` lies inside `folder`, both lexically (after normalising "." and "..") and by
+// real path (symbolic links resolved: a link in the folder to a file elsewhere is outside).
 bool pathInsideFolder(const std::string& path, const std::string& folder);
 
 } // namespace shadel

@@ -1,6 +1,7 @@
 #include "scene/mesh_utils.h"
 
 #include <cmath>
+#include <unordered_set>
 
 #include <glm/gtc/constants.hpp>
 
@@ -169,6 +170,33 @@ std::vector<Mesh> splitMesh(Mesh mesh, uint32_t maxTriangles) {
         parts.push_back(std::move(out));
     }
     return parts;
+}
+
+size_t removeDuplicateTriangles(std::vector<uint32_t>& indices) {
+    struct Key {
+        uint32_t a, b, c;
+        bool operator==(const Key&) const = default;
+    };
+    struct KeyHash {
+        size_t operator()(const Key& k) const {
+            uint64_t h = (uint64_t(k.a) * 0x9E3779B97F4A7C15ull) ^ (uint64_t(k.b) << 21) ^
+                         (uint64_t(k.c) * 0xC2B2AE3D27D4EB4Full);
+            return size_t(h ^ (h >> 29));
+        }
+    };
+    std::unordered_set<Key, KeyHash> seen;
+    seen.reserve(indices.size() / 3);
+    size_t kept = 0;
+    for (size_t t = 0; t + 2 < indices.size(); t += 3) {
+        uint32_t a = indices[t], b = indices[t + 1], c = indices[t + 2];
+        // The rotation that starts at the smallest index: one key per face and winding.
+        Key key = a <= b && a <= c ? Key{a, b, c} : b <= c ? Key{b, c, a} : Key{c, a, b};
+        if (!seen.insert(key).second) continue;
+        indices[kept++] = a, indices[kept++] = b, indices[kept++] = c;
+    }
+    size_t removed = (indices.size() / 3) - kept / 3;
+    indices.resize(kept);
+    return removed;
 }
 
 std::string sceneInvariantViolation(const Scene& scene) {

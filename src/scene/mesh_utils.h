@@ -31,6 +31,11 @@ uint32_t sanitizeNormalsAndTangents(Mesh& mesh);
 
 void computeBounds(Mesh& mesh);
 
+// Removes triangles that repeat an earlier one (the same three vertices in the same cyclic order:
+// the same face, drawn again). Keeps the first of each, in order. Returns how many were removed.
+// A strip of a million copies of one triangle would otherwise cost a million full-screen draws.
+size_t removeDuplicateTriangles(std::vector<uint32_t>& indices);
+
 // Splits a mesh into parts of at most maxTriangles triangles each, keeping triangle order and
 // compacting vertices per part. A mesh already small enough comes back as the only element.
 std::vector<Mesh> splitMesh(Mesh mesh, uint32_t maxTriangles = kMaxTrianglesPerMesh);

@@ -9,27 +9,14 @@
 
 namespace shadel {
 
-// Stand-ins for the engine's consumers, with the signatures the real code uses.
-void bindColor(RenderTargetView view);
-void bindDepth(DepthTargetView view);
-void sampleIn(TextureReadView view);
-void writeIn(TextureWriteView view);
-
+// Each concept asks whether the real rhi API (rhi/resources.h) accepts a handle kind.
 template <typename V>
-concept BindableAsColor = requires(V v) {
-    bindColor(v);
+concept Attachable = requires(const Gpu& g, V v) { // a colour or depth attachment's image view
+    { vkView(g, v) } -> std::same_as<VkImageView>;
 };
 template <typename V>
-concept BindableAsDepth = requires(V v) {
-    bindDepth(v);
-};
-template <typename V>
-concept Sampleable = requires(V v) {
-    sampleIn(v);
-};
-template <typename V>
-concept Writable = requires(V v) {
-    writeIn(v);
+concept Sampleable = requires(const Gpu& g, V v) {
+    { sampledImageView(g, v) } -> std::same_as<VkImageView>;
 };
 template <typename H>
 concept BufferAccess = requires(const Gpu& g, H h) {
@@ -40,29 +27,27 @@ concept ImageAccess = requires(const Gpu& g, H h) {
     vkImage(g, h);
 };
 template <typename H>
-concept ReadViewSlot = requires(const Gpu& g, H h) {
-    slot(g, h);
+concept BindlessSlotOf = requires(const Gpu& g, H h) {
+    { slot(g, h) } -> std::same_as<BindlessSlot>;
+};
+template <typename H>
+concept ViewOfATexture = requires(const Gpu& g, H h) {
+    { textureOf(g, h) } -> std::same_as<TextureHandle>;
 };
 
-// A render target view binds as colour; nothing else does.
-static_assert(BindableAsColor<RenderTargetView>);
-static_assert(!BindableAsColor<TextureReadView>, "a read view must not bind as a render target");
-static_assert(!BindableAsColor<TextureWriteView>);
-static_assert(!BindableAsColor<DepthTargetView>);
-static_assert(!BindableAsColor<TextureHandle>, "a texture must go through a view");
+// Render target and depth target views bind as attachments; nothing else does.
+static_assert(Attachable<RenderTargetView>);
+static_assert(Attachable<DepthTargetView>);
+static_assert(!Attachable<TextureReadView>, "a read view must not bind as a render target");
+static_assert(!Attachable<TextureWriteView>);
+static_assert(!Attachable<TextureHandle>, "a texture must go through a view");
+static_assert(!Attachable<BufferHandle>, "a buffer must not be a depth target");
 
-// Depth targets: only depth target views; a buffer is never a depth target.
-static_assert(BindableAsDepth<DepthTargetView>);
-static_assert(!BindableAsDepth<BufferHandle>, "a buffer must not be a depth target");
-static_assert(!BindableAsDepth<RenderTargetView>);
-static_assert(!BindableAsDepth<TextureHandle>);
-
-// Shaders sample read views and write write views.
+// Only read views are sampled through an image view.
 static_assert(Sampleable<TextureReadView>);
 static_assert(!Sampleable<TextureWriteView>);
+static_assert(!Sampleable<RenderTargetView>);
 static_assert(!Sampleable<TextureHandle>);
-static_assert(Writable<TextureWriteView>);
-static_assert(!Writable<TextureReadView>);
 
 // Buffers and textures are not interchangeable.
 static_assert(BufferAccess<BufferHandle>);
@@ -73,14 +58,21 @@ static_assert(!ImageAccess<BufferHandle>);
 static_assert(!ImageAccess<TextureReadView>);
 
 // Only read and write views own bindless slots.
-static_assert(ReadViewSlot<TextureReadView>);
-static_assert(ReadViewSlot<TextureWriteView>);
-static_assert(!ReadViewSlot<RenderTargetView>);
-static_assert(!ReadViewSlot<BufferHandle>);
+static_assert(BindlessSlotOf<TextureReadView>);
+static_assert(BindlessSlotOf<TextureWriteView>);
+static_assert(!BindlessSlotOf<RenderTargetView>);
+static_assert(!BindlessSlotOf<BufferHandle>);
+
+// Every view knows its texture; a buffer is no view.
+static_assert(ViewOfATexture<TextureReadView> && ViewOfATexture<TextureWriteView>);
+static_assert(ViewOfATexture<RenderTargetView> && ViewOfATexture<DepthTargetView>);
+static_assert(!ViewOfATexture<BufferHandle>);
 
 // No implicit conversions between handle kinds, in either direction.
 static_assert(!std::is_convertible_v<TextureReadView, RenderTargetView>);
 static_assert(!std::is_convertible_v<RenderTargetView, TextureReadView>);
+static_assert(!std::is_convertible_v<RenderTargetView, DepthTargetView>);
+static_assert(!std::is_convertible_v<TextureReadView, TextureWriteView>);
 static_assert(!std::is_convertible_v<BufferHandle, TextureHandle>);
 static_assert(!std::is_convertible_v<uint32_t, BufferHandle>);
 static_assert(!std::is_constructible_v<DepthTargetView, BufferHandle>);

@@ -444,7 +444,12 @@ TEST(GltfFeatures, UnlitIgnoresLightsSheenIorAndSpecularChangeTheLitColour) {
         std::printf("%s: %.1f dB from the plain quad; decoupled vs forward %.1f dB\n",
                     ext.begin().key().c_str(), fromPlain, agree);
         EXPECT_LT(fromPlain, 45.0) << ext.dump();
-        EXPECT_GE(agree, 30.0) << ext.dump();
+        // Forward and decoupled agree far closer than the extension's effect: a path that
+        // ignored it would score about `fromPlain` against the other. Measured 59.3 / 55.8 /
+        // 55.4 dB; floors 1.5 dB below.
+        const double agreeFloor[] = {57.8, 54.3, 53.9};
+        EXPECT_GE(agree, agreeFloor[i - 1]) << ext.dump() << ": measured " << agree;
+        EXPECT_GT(agree, fromPlain + 10.0) << ext.dump();
         EXPECT_EQ(dec.stats["reconstruction_misses"].get<uint64_t>(), 0u) << ext.dump();
     }
 }
@@ -501,7 +506,12 @@ TEST(GltfFeatures, SpecularAndSheenTexturesApplyInBothPaths) {
             {"sheenRoughnessFactor", 1.0},
             {"sheenRoughnessTexture", tex}}}}},
     };
+    // Decoupled vs forward measured 33.6 / 57.2 / 44.5 / 50.5 dB; floors 1.5 dB below, and
+    // always well above the texture's own effect (a path that ignored it would score that).
+    const double agreeFloor[] = {32.1, 55.7, 43.0, 49.0};
+    size_t caseIndex = 0;
     for (const Case& c : cases) {
+        const double floor = agreeFloor[caseIndex++];
         RenderRun factors = renderQuad(
             withTexture(std::string(c.name) + "_factors.gltf", c.factors), RenderMode::Forward);
         std::string file = withTexture(std::string(c.name) + ".gltf", c.textured);
@@ -512,7 +522,8 @@ TEST(GltfFeatures, SpecularAndSheenTexturesApplyInBothPaths) {
         std::printf("%s: %.1f dB from the factor-only quad; decoupled vs forward %.1f dB\n", c.name,
                     fromFactors, agree);
         EXPECT_LT(fromFactors, 45.0) << c.name;
-        EXPECT_GE(agree, 30.0) << c.name;
+        EXPECT_GE(agree, floor) << c.name << ": measured " << agree;
+        EXPECT_GT(agree, fromFactors + 10.0) << c.name;
         EXPECT_EQ(dec.stats["reconstruction_misses"].get<uint64_t>(), 0u) << c.name;
     }
 }
@@ -537,7 +548,9 @@ TEST(GltfFeatures, MorphCubeDiffersBetweenTimesAndAgreesBetweenPaths) {
     std::printf("morph cube: t=0 vs t=1 %.1f dB; decoupled vs forward at t=1 %.1f dB\n", between,
                 paths);
     EXPECT_LT(between, 30.0);
-    EXPECT_GE(paths, 30.0);
+    // Measured 47.2 dB; far above the animation's own change (`between`).
+    EXPECT_GE(paths, 45.7) << "measured " << paths;
+    EXPECT_GT(paths, between + 10.0);
     EXPECT_EQ(d1.stats["reconstruction_misses"].get<uint64_t>(), 0u);
 }
 
@@ -562,6 +575,7 @@ TEST(GltfFeatures, SkinnedModelBendsWithTimeAndAgreesBetweenPaths) {
                 (unsigned long long)t1.frames[0].pixelsCovered, paths);
     EXPECT_LT(between, 30.0);
     EXPECT_NE(t0.frames[0].pixelsCovered, t1.frames[0].pixelsCovered);
-    EXPECT_GE(paths, 30.0);
+    EXPECT_GE(paths, 78.2) << "measured " << paths; // measured 79.7 dB
+    EXPECT_GT(paths, between + 10.0);
     EXPECT_EQ(d1.stats["reconstruction_misses"].get<uint64_t>(), 0u);
 }

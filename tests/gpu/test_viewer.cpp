@@ -4,6 +4,8 @@
 
 #include <cstdlib>
 #include <filesystem>
+#include <fstream>
+#include <sstream>
 #include <sys/wait.h>
 
 #include <stb/stb_image.h>
@@ -23,6 +25,17 @@ int runView(const std::string& args) {
                       std::string(SHADEL_BINARY) + " --validation view " + args + " >/dev/null";
     int status = std::system(cmd.c_str());
     return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+}
+
+bool haveXdotool() {
+    return std::system("command -v xdotool >/dev/null 2>&1") == 0;
+}
+
+std::string readAll(const std::string& path) {
+    std::ifstream in(path);
+    std::stringstream ss;
+    ss << in.rdbuf();
+    return ss.str();
 }
 
 std::vector<uint8_t> readPng(const std::string& path, int& w, int& h) {
@@ -62,4 +75,36 @@ TEST(Viewer, ScreenshotUnderXvfbMatchesRenderOfTheSameCamera) {
     std::printf("[ figures ] view with the panel vs --no-ui: %.2f dB\n", ui);
     EXPECT_LT(ui, 30.0);
     std::filesystem::remove(shot);
+}
+
+// The viewer takes its keys from window events (a tap between two 300 ms frames is not lost):
+// xdotool taps F (frame the scene), R (back to the scene's camera) and Esc (quit, exit 0) into
+// the real window under Xvfb.
+TEST(Viewer, KeyTapsFrameResetAndQuit) {
+    SHADEL_REQUIRE(haveXvfb(), "xvfb-run (scripts/setup.sh installs xvfb)");
+    SHADEL_REQUIRE(haveXdotool(), "xdotool (scripts/setup.sh installs it)");
+    std::string base = (std::filesystem::temp_directory_path() /
+                        ("shadel-view-keys-" + std::to_string(::getpid())))
+                           .string();
+    std::string script = base + ".sh", log = base + ".log";
+    std::ofstream(script) << "#!/bin/sh\n"
+                          << SHADEL_BINARY
+                          << " --validation view --scene builtin:default --size 320x180 "
+                             "--frames 0 >"
+                          << log << " 2>&1 &\n"
+                          << "pid=$!\n"
+                          << "wid=$(timeout 240 xdotool search --sync --name 'shadel view')\n"
+                          << "xdotool windowfocus --sync $wid\n"
+                          << "xdotool key f; sleep 1; xdotool key r; sleep 1; xdotool key Escape\n"
+                          << "wait $pid; echo \"exit $?\" >>" << log << "\n";
+    std::string cmd = "timeout 300 xvfb-run -a -s '-screen 0 1024x768x24' sh " + script;
+    ASSERT_EQ(std::system(cmd.c_str()), 0);
+    std::string out = readAll(log);
+    EXPECT_NE(out.find("shadel view: F: the scene framed, --from "), std::string::npos) << out;
+    EXPECT_NE(out.find("shadel view: R: the scene's camera, --from "), std::string::npos) << out;
+    EXPECT_NE(out.find("shadel view: Esc: quit"), std::string::npos) << out;
+    EXPECT_NE(out.find("0 validation errors"), std::string::npos) << out;
+    EXPECT_NE(out.find("exit 0"), std::string::npos) << out;
+    std::filesystem::remove(script);
+    std::filesystem::remove(log);
 }

@@ -216,6 +216,27 @@ TEST(GltfLimits, BufferOutsideTheModelFolderIsRefusedUnlessAllowed) {
     }
 }
 
+// The folder check is by real path: a link inside the model's folder to a file outside it does
+// not let the file be read (a link to a file inside the folder still works).
+TEST(GltfLimits, ALinkOutOfTheModelFolderIsRefused) {
+    ModelDir dir;
+    writeFile(dir.file("outside.bin"), triangleBytes());
+    writeFile(dir.file("model/inside.bin"), triangleBytes());
+    fs::create_symlink(dir.file("outside.bin"), dir.file("model/escape.bin"));
+    fs::create_symlink(dir.file("model/inside.bin"), dir.file("model/alias.bin"));
+    std::string escape = dir.file("model/escape.gltf"), alias = dir.file("model/alias.gltf");
+    writeFile(escape, gltfWithNodes("[0]", R"([{"mesh":0}])", "escape.bin"));
+    writeFile(alias, gltfWithNodes("[0]", R"([{"mesh":0}])", "alias.bin"));
+    Outcome refused = load(escape);
+    EXPECT_EQ(refused.instances, 0u);
+    EXPECT_NE(refused.error.find("escape.bin"), std::string::npos) << refused.error;
+    EXPECT_FALSE(pathInsideFolder(dir.file("model/escape.bin"), dir.file("model")));
+    EXPECT_EQ(load(escape, {.allowExternalFiles = true}).instances, 1u);
+    Outcome inside = load(alias);
+    EXPECT_EQ(inside.error, "");
+    EXPECT_EQ(inside.instances, 1u);
+}
+
 TEST(GltfLimits, ImageOutsideTheModelFolderIsRefused) {
     ModelDir dir;
     std::string path = dir.file("model/image.gltf");

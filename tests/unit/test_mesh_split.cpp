@@ -118,3 +118,16 @@ TEST(MeshSplit, AMeshKeptWholeComesBackUnchanged) {
     EXPECT_EQ(out[0].indices, sphere.indices);
     EXPECT_EQ(out[0].name, sphere.name);
 }
+
+// A repeated face is drawn once: the same vertices in the same cyclic order are one face; the
+// other winding is the other side, kept; the first of each stays, in order.
+TEST(MeshUtils, RepeatedTrianglesAreDrawnOnce) {
+    std::vector<uint32_t> indices = {0, 1, 2, /*rotated*/ 1, 2, 0, /*other side*/ 2,       1, 0,
+                                     3, 4, 5, /*again*/ 2,   0, 1, /*other side again*/ 0, 2, 1};
+    EXPECT_EQ(removeDuplicateTriangles(indices), 3u);
+    EXPECT_EQ(indices, (std::vector<uint32_t>{0, 1, 2, 2, 1, 0, 3, 4, 5}));
+    std::vector<uint32_t> strip;
+    for (uint32_t t = 0; t < 100000; ++t) strip.insert(strip.end(), {0, 1, 2});
+    EXPECT_EQ(removeDuplicateTriangles(strip), 99999u);
+    EXPECT_EQ(strip.size(), 3u);
+}

@@ -5,6 +5,9 @@
 
 #include <GLFW/glfw3.h>
 
+#include "app/viewer/viewer_input.h"
+#include "core/log.h"
+
 namespace shadel {
 
 namespace {
@@ -26,11 +29,15 @@ CameraControl makeCameraControl(const Camera& start, const Aabb& sceneBounds) {
     c.distance = std::max(glm::dot(centre - start.position, glm::normalize(start.forward)), 0.5f);
     c.target = start.position + glm::normalize(start.forward) * c.distance;
     float extent = sceneBounds.valid() ? glm::length(sceneBounds.extent()) : 10.0f;
-    c.speed = std::max(extent * 0.15f, 0.5f);
+    c.speed = std::max(extent * 0.05f, 0.1f); // the scene's diagonal in 20 s
     return c;
 }
 
-bool updateCamera(CameraControl& c, GLFWwindow* window, float dt, bool mouseFree, float wheel) {
+bool updateCamera(CameraControl& c, GLFWwindow* window, float dt, bool mouseFree,
+                  const ViewerInput& input) {
+    // A long frame (compiling, reshading) must not turn one held key into a jump.
+    dt = std::min(dt, 0.25f);
+    const float wheel = input.wheel;
     double x = 0, y = 0;
     glfwGetCursorPos(window, &x, &y);
     float dx = float(x - c.lastX), dy = float(y - c.lastY);
@@ -54,7 +61,9 @@ bool updateCamera(CameraControl& c, GLFWwindow* window, float dt, bool mouseFree
     } else {
         glm::vec3 right = glm::normalize(glm::cross(forward, glm::vec3(0, 1, 0)));
         glm::vec3 step(0.0f);
-        auto key = [&](int k) { return glfwGetKey(window, k) == GLFW_PRESS; };
+        auto key = [&](int k) { return !input.uiWantsKeyboard && input.down(k); };
+        if (!input.uiWantsKeyboard && input.tapped(GLFW_KEY_LEFT_BRACKET)) c.speed *= 0.5f;
+        if (!input.uiWantsKeyboard && input.tapped(GLFW_KEY_RIGHT_BRACKET)) c.speed *= 2.0f;
         if (key(GLFW_KEY_W)) step += forward;
         if (key(GLFW_KEY_S)) step -= forward;
         if (key(GLFW_KEY_D)) step += right;
@@ -73,6 +82,25 @@ bool updateCamera(CameraControl& c, GLFWwindow* window, float dt, bool mouseFree
         c.camera.up = glm::vec3(0, 1, 0);
     }
     return moved;
+}
+
+void frameScene(CameraControl& c, const Aabb& sceneBounds) {
+    if (!sceneBounds.valid()) return;
+    glm::vec3 forward = direction(c.yaw, c.pitch);
+    float radius = std::max(0.5f * glm::length(sceneBounds.extent()), 1e-3f);
+    float halfFov = 0.5f * (c.camera.yfov > 0.0f ? c.camera.yfov : 0.8f);
+    c.distance = radius / std::sin(halfFov) * 1.05f;
+    c.target = sceneBounds.center();
+    c.camera.position = c.target - forward * c.distance;
+    c.camera.forward = forward;
+    c.camera.up = glm::vec3(0, 1, 0);
+}
+
+std::string cameraArguments(const CameraControl& c) {
+    glm::vec3 p = c.camera.position, t = c.camera.position + glm::normalize(c.camera.forward) *
+                                                                 std::max(c.distance, 1e-3f);
+    return format("--from %.3g,%.3g,%.3g --look-at %.3g,%.3g,%.3g", double(p.x), double(p.y),
+                  double(p.z), double(t.x), double(t.y), double(t.z));
 }
 
 } // namespace shadel

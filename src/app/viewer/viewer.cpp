@@ -11,6 +11,7 @@
 #include "app/output_files.h"
 #include "app/viewer/camera_control.h"
 #include "app/viewer/scene_editor.h"
+#include "app/viewer/viewer_input.h"
 #include "app/viewer/viewer_ui.h"
 #include "app/viewer/window.h"
 #include "bake/bake.h"
@@ -48,8 +49,7 @@ void prepareScene(Gpu& gpu, const ViewOptions& o, ViewerScene& v) {
     BakeSettings bs;
     bs.cacheLimitBytes = o.cacheLimitBytes;
     std::vector<BakedMesh> baked =
-        bakeScene(v.scene, bs, usableCacheFolder(o.cacheDir), nullptr,
-                  density.meshDensity);
+        bakeScene(v.scene, bs, usableCacheFolder(o.cacheDir), nullptr, density.meshDensity);
     uploadScene(gpu, v.scene, v.gpu, &baked);
 }
 
@@ -94,7 +94,31 @@ void copyPixels(const std::vector<uint8_t>& rgba, bool bgra, uint8_t* out) {
     }
 }
 
-float gWheel = 0.0f;
+// The viewer's keys that act once per press: Esc quits (returns true), Tab switches orbit and
+// fly, F frames the scene, R returns to the scene's camera.
+bool applyViewerKeys(const ViewerInput& input, GLFWwindow* window, CameraControl& camera,
+                     ViewerPanel& panel, const ViewerScene& scene) {
+    if (input.uiWantsKeyboard) return false;
+    for (int key : input.pressed) {
+        if (key == GLFW_KEY_ESCAPE) {
+            SHADEL_INFO("shadel view: Esc: quit");
+            glfwSetWindowShouldClose(window, GLFW_TRUE);
+            return true;
+        }
+        if (key == GLFW_KEY_TAB) panel.orbit = !panel.orbit;
+        if (key == GLFW_KEY_F) {
+            frameScene(camera, scene.bounds);
+            SHADEL_INFO("shadel view: F: the scene framed, %s", cameraArguments(camera).c_str());
+        }
+        if (key == GLFW_KEY_R) {
+            bool orbit = camera.orbit;
+            camera = makeCameraControl(scene.camera, scene.bounds);
+            camera.orbit = orbit;
+            SHADEL_INFO("shadel view: R: the scene's camera, %s", cameraArguments(camera).c_str());
+        }
+    }
+    return false;
+}
 
 } // namespace
 
@@ -109,6 +133,7 @@ int runViewer(const ViewOptions& o, DeviceDesc deviceDesc) {
     panel.materialRate = o.materialRate;
 
     ViewerWindow window;
+    ViewerInput input;
     Gpu gpu;
     ViewerUi ui;
     ViewerScene scene;
@@ -141,9 +166,9 @@ int runViewer(const ViewOptions& o, DeviceDesc deviceDesc) {
         if (window.extent.width != o.width || window.extent.height != o.height)
             throw DeviceError(format("shadel view: asked for a %ux%u window, got %ux%u", o.width,
                                      o.height, window.extent.width, window.extent.height));
+        // Ours first: ImGui's backend chains to the callbacks it finds installed.
+        installViewerInput(window.window, input);
         if (!o.noUi) initUi(ui, window, gpu);
-        glfwSetScrollCallback(window.window,
-                              [](GLFWwindow*, double, double y) { gWheel += float(y); });
         prepareScene(gpu, o, scene);
         initRenderer(renderer, gpu, settingsFor(o, panel, gpu), scene.gpu);
         VkDeviceSize bytes = VkDeviceSize(o.width) * o.height * 4;
@@ -155,18 +180,17 @@ int runViewer(const ViewOptions& o, DeviceDesc deviceDesc) {
         VkDevice dev = gpu.device.device;
         auto last = std::chrono::steady_clock::now();
         auto lastPoll = last;
-        bool tabDown = false;
         while (!glfwWindowShouldClose(window.window)) {
+            nextFrameInput(input);
             glfwPollEvents();
             auto now = std::chrono::steady_clock::now();
             float dt = std::chrono::duration<float>(now - last).count();
             last = now;
-            bool tab = glfwGetKey(window.window, GLFW_KEY_TAB) == GLFW_PRESS;
-            if (tab && !tabDown) panel.orbit = !panel.orbit;
-            tabDown = tab;
+            input.uiWantsKeyboard = uiWantsKeyboard(ui);
+            if (applyViewerKeys(input, window.window, camera, panel, scene)) break;
             camera.orbit = panel.orbit;
-            updateCamera(camera, window.window, dt, !uiWantsMouse(ui), gWheel);
-            gWheel = 0.0f;
+            updateCamera(camera, window.window, dt, !uiWantsMouse(ui), input);
+            panel.cameraArguments = cameraArguments(camera);
 
             if (hotReload && now - lastPoll > std::chrono::milliseconds(500)) {
                 lastPoll = now;

@@ -116,6 +116,10 @@ bool uiWantsMouse(const ViewerUi& ui) {
     return ui.enabled && ImGui::GetIO().WantCaptureMouse;
 }
 
+bool uiWantsKeyboard(const ViewerUi& ui) {
+    return ui.enabled && ImGui::GetIO().WantCaptureKeyboard;
+}
+
 void buildUi(ViewerUi& ui, ViewerPanel& p, const std::function<void()>& sections) {
     (void)ui;
     p.modeChanged = p.visualizeChanged = p.cameraModeChanged = p.screenshotRequested = false;
@@ -164,6 +168,12 @@ void buildUi(ViewerUi& ui, ViewerPanel& p, const std::function<void()>& sections
         }
     }
     for (const std::string& line : p.statLines) ImGui::TextUnformatted(line.c_str());
+    if (!p.cameraArguments.empty()) {
+        ImGui::TextWrapped("camera: %s", p.cameraArguments.c_str());
+        if (ImGui::Button("copy camera as render arguments"))
+            ImGui::SetClipboardText(p.cameraArguments.c_str());
+        ImGui::TextUnformatted("keys: F frame, R reset, Tab orbit/fly, [ ] speed, Esc quit");
+    }
     if (sections) sections();
     p.screenshotRequested = ImGui::Button("capture screenshot");
     ImGui::End();

@@ -25,6 +25,7 @@ struct ViewerPanel {
     std::vector<PassTiming> passes;
     std::deque<float> frameMsHistory;
     std::vector<std::string> statLines;
+    std::string cameraArguments; // "--from X,Y,Z --look-at X,Y,Z" (app/viewer/camera_control.h)
     // In/out: the choices.
     int mode = 0;      // 0 forward, 1 decoupled
     int visualize = 0; // index into kVisualizeNames
@@ -43,6 +44,7 @@ extern const int kVisualizeCount;
 void initUi(ViewerUi& ui, ViewerWindow& w, Gpu& gpu);
 void destroyUi(ViewerUi& ui, Gpu& gpu);
 bool uiWantsMouse(const ViewerUi& ui);
+bool uiWantsKeyboard(const ViewerUi& ui);
 // Builds this frame's panel (ImGui NewFrame .. Render); `sections` adds more to the window
 // (the scene editor) before the capture button.
 void buildUi(ViewerUi& ui, ViewerPanel& panel, const std::function<void()>& sections = {});

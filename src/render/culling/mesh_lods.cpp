@@ -16,6 +16,18 @@ constexpr float kMinReduction = 0.8f;
 // Point-triangle pairs one level's deviation measurement may test; larger meshes sample LOD 0's
 // vertices with a stride (the measured error then underestimates by at most the sampling).
 constexpr double kMaxDeviationPairs = 3e7;
+// Vertex cache optimization and simplification cost about triangles x valence: a vertex shared
+// by more triangles than this (a fan of thousands, a strip of overlapping copies) leaves the
+// mesh as authored, with LOD 0 only, so the upload stays linear in the input.
+constexpr uint32_t kMaxOptimizedValence = 512;
+
+uint32_t maxValence(const std::vector<uint32_t>& indices, size_t vertexCount) {
+    std::vector<uint32_t> valence(vertexCount, 0);
+    uint32_t most = 0;
+    for (uint32_t i : indices)
+        if (i < vertexCount) most = std::max(most, ++valence[i]);
+    return most;
+}
 
 float pointTriangleDistance(glm::vec3 p, glm::vec3 a, glm::vec3 b, glm::vec3 c) {
     // Ericson, Real-Time Collision Detection 5.1.5: the closest point by Voronoi region.
@@ -76,12 +88,13 @@ gpu::GpuMeshLods appendMeshWithLods(MeshGeometry mesh, std::vector<gpu::GpuVerte
     constexpr size_t stride = sizeof(gpu::GpuVertex);
     std::vector<std::vector<uint32_t>> levels;
     std::vector<float> errors;
-    if (!mesh.keepTriangleOrder && !mesh.indices.empty())
+    const bool optimizable = maxValence(mesh.indices, vertexCount) <= kMaxOptimizedValence;
+    if (!mesh.keepTriangleOrder && !mesh.indices.empty() && optimizable)
         meshopt_optimizeVertexCache(mesh.indices.data(), mesh.indices.data(), mesh.indices.size(),
                                     vertexCount);
     levels.push_back(mesh.indices);
     errors.push_back(0.0f);
-    if (vertexCount > 0 && mesh.indices.size() >= 6) {
+    if (vertexCount > 0 && mesh.indices.size() >= 6 && optimizable) {
         float scale = meshopt_simplifyScale(positions, vertexCount, stride);
         float bound = kFirstLevelError;
         for (uint32_t k = 1; k < CULL_MAX_LODS && bound <= kMaxRelativeError; ++k, bound *= 4.0f) {

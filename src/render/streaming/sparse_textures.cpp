@@ -54,34 +54,20 @@ uint32_t blocksAcross(uint32_t side, uint32_t block) {
     return (side + block - 1) / block;
 }
 
-} // namespace
-
-std::string sparseUnsupportedReason(const Gpu& gpu) {
-    const Device& d = gpu.device;
-    if (!d.optional.sparseResidency)
-        return d.name + " has no sparse residency for 2-D images (sparseBinding, "
-                        "sparseResidencyImage2D and a sparse-binding queue)";
-    for (bool srgb : {false, true}) {
-        uint32_t n = 0;
-        vkGetPhysicalDeviceSparseImageFormatProperties(d.physical, formatOf(srgb), VK_IMAGE_TYPE_2D,
-                                                       VK_SAMPLE_COUNT_1_BIT, kUsage,
-                                                       VK_IMAGE_TILING_OPTIMAL, &n, nullptr);
-        if (n == 0)
-            return d.name + " cannot make sparse-resident " +
-                   (srgb ? "R8G8B8A8_SRGB" : "R8G8B8A8_UNORM") + " images";
-    }
-    return {};
-}
-
-void createSparseTextures(Gpu& gpu, const std::vector<uint32_t>& sizes,
-                          const std::vector<bool>& srgb, uint64_t budgetBytes,
-                          SparseTextures& out) {
-    VkDevice device = gpu.device.device;
-    out.gpu = &gpu;
+// What creating the images finds out, for the checks and the binds after.
+struct SparseImagesMade {
+    std::vector<SparseLayout> layouts;
+    std::vector<SparseTexture> book; // per texture: its paged levels
     uint32_t memoryTypeBits = ~0u;
     uint64_t addressSpace = 0;
-    std::vector<SparseLayout> layouts;
-    std::vector<SparseTexture> book;
+};
+
+// One sparse image per texture, named; the page size and granularity, each texture's always-
+// resident tail and its size.
+SparseImagesMade createSparseImages(Gpu& gpu, const std::vector<uint32_t>& sizes,
+                                    const std::vector<bool>& srgb, SparseTextures& out) {
+    VkDevice device = gpu.device.device;
+    SparseImagesMade made;
     for (size_t i = 0; i < sizes.size(); ++i) {
         SparseImage img;
         img.levels = log2u(sizes[i]) + 1;
@@ -104,8 +90,8 @@ void createSparseTextures(Gpu& gpu, const std::vector<uint32_t>& sizes,
         setName(gpu.device, img.image, VK_OBJECT_TYPE_IMAGE, format("streaming.sparse.%zu", i));
         VkMemoryRequirements req;
         vkGetImageMemoryRequirements(device, img.image, &req);
-        memoryTypeBits &= req.memoryTypeBits;
-        addressSpace += req.size;
+        made.memoryTypeBits &= req.memoryTypeBits;
+        made.addressSpace += req.size;
         if (out.pageBytes == 0) out.pageBytes = req.alignment;
         if (req.alignment != out.pageBytes)
             throw DeviceError("sparse texture images with different page sizes");
@@ -131,29 +117,19 @@ void createSparseTextures(Gpu& gpu, const std::vector<uint32_t>& sizes,
         for (uint32_t l = 0; l < t.tailFirst; ++l) t.levelPages.push_back(pagesOf(l));
         for (uint32_t l = t.tailFirst; l < img.deviceTailFirst; ++l)
             out.tailBytes += uint64_t(pagesOf(l)) * out.pageBytes;
-        book.push_back(std::move(t));
+        made.book.push_back(std::move(t));
         if (img.deviceTailFirst < img.levels)
             out.tailBytes += alignUp(c.imageMipTailSize, out.pageBytes);
         for (const auto& m : layout.metadata)
             out.tailBytes += alignUp(m.imageMipTailSize, out.pageBytes);
-        layouts.push_back(std::move(layout));
+        made.layouts.push_back(std::move(layout));
     }
-    if (addressSpace > gpu.device.properties.limits.sparseAddressSpaceSize)
-        throw InputError(
-            format("--streaming sparse: the %zu textures need %.0f MiB of sparse "
-                   "address space, the device has %.0f MiB",
-                   sizes.size(), double(addressSpace) / 1048576.0,
-                   double(gpu.device.properties.limits.sparseAddressSpaceSize) / 1048576.0));
-    if (out.tailBytes > budgetBytes)
-        throw InputError(format("--texture-budget %.2f: below the %.2f MiB the %zu textures' "
-                                "sparse MIP tails need",
-                                double(budgetBytes) / 1048576.0, double(out.tailBytes) / 1048576.0,
-                                sizes.size()));
-    out.residency = makeSparseResidency(std::move(book),
-                                        uint32_t((budgetBytes - out.tailBytes) / out.pageBytes));
-    out.poolBytes = uint64_t(out.residency.poolPages) * out.pageBytes;
+    return made;
+}
 
-    // Memory: device-local if the images allow it.
+// The memory every image binds from: device-local if the images allow it.
+void allocateSparseMemory(Gpu& gpu, uint32_t memoryTypeBits, SparseTextures& out) {
+    VkDevice device = gpu.device.device;
     const VkPhysicalDeviceMemoryProperties& mp = gpu.device.memory;
     int32_t type = -1;
     for (uint32_t i = 0; i < mp.memoryTypeCount && type < 0; ++i)
@@ -177,9 +153,13 @@ void createSparseTextures(Gpu& gpu, const std::vector<uint32_t>& sizes,
     };
     out.tailMemory = allocate(out.tailBytes, "streaming.sparse.tails");
     if (out.poolBytes) out.poolMemory = allocate(out.poolBytes, "streaming.sparse.pagePool");
+}
 
-    // Every tail bound once: the device's opaquely (its layout is the device's business), the
-    // sub-page levels before it block by block.
+// Binds every tail once: the device's opaquely (its layout is the device's business), the
+// sub-page levels before it block by block.
+void bindSparseTails(Gpu& gpu, const std::vector<uint32_t>& sizes,
+                     const std::vector<SparseLayout>& layouts, SparseTextures& out) {
+    VkDevice device = gpu.device.device;
     std::vector<std::vector<VkSparseMemoryBind>> tailBinds(out.images.size());
     std::vector<std::vector<VkSparseImageMemoryBind>> levelBinds(out.images.size());
     std::vector<VkSparseImageOpaqueMemoryBindInfo> opaque;
@@ -233,8 +213,11 @@ void createSparseTextures(Gpu& gpu, const std::vector<uint32_t>& sizes,
     VK_CHECK(vkQueueBindSparse(gpu.device.queue, 1, &bi, fence));
     VK_CHECK(vkWaitForFences(device, 1, &fence, VK_TRUE, ~0ull)); // creation, not a frame
     vkDestroyFence(device, fence, nullptr);
+}
 
-    // Views: one per possible resident level.
+// One view per texture and possible resident level.
+void createSparseViews(Gpu& gpu, const std::vector<bool>& srgb, SparseTextures& out) {
+    VkDevice device = gpu.device.device;
     for (size_t i = 0; i < out.images.size(); ++i) {
         SparseImage& img = out.images[i];
         for (uint32_t base = 0; base <= out.residency.textures[i].tailFirst; ++base) {
@@ -250,6 +233,52 @@ void createSparseTextures(Gpu& gpu, const std::vector<uint32_t>& sizes,
             img.views.push_back(v);
         }
     }
+}
+
+} // namespace
+
+std::string sparseUnsupportedReason(const Gpu& gpu) {
+    const Device& d = gpu.device;
+    if (!d.optional.sparseResidency)
+        return d.name + " has no sparse residency for 2-D images (sparseBinding, "
+                        "sparseResidencyImage2D and a sparse-binding queue)";
+    for (bool srgb : {false, true}) {
+        uint32_t n = 0;
+        vkGetPhysicalDeviceSparseImageFormatProperties(d.physical, formatOf(srgb), VK_IMAGE_TYPE_2D,
+                                                       VK_SAMPLE_COUNT_1_BIT, kUsage,
+                                                       VK_IMAGE_TILING_OPTIMAL, &n, nullptr);
+        if (n == 0)
+            return d.name + " cannot make sparse-resident " +
+                   (srgb ? "R8G8B8A8_SRGB" : "R8G8B8A8_UNORM") + " images";
+    }
+    return {};
+}
+
+void createSparseTextures(Gpu& gpu, const std::vector<uint32_t>& sizes,
+                          const std::vector<bool>& srgb, uint64_t budgetBytes,
+                          SparseTextures& out) {
+    VkDevice device = gpu.device.device;
+    out.gpu = &gpu;
+    SparseImagesMade made = createSparseImages(gpu, sizes, srgb, out);
+    const uint64_t addressSpace = made.addressSpace;
+    if (addressSpace > gpu.device.properties.limits.sparseAddressSpaceSize)
+        throw InputError(
+            format("--streaming sparse: the %zu textures need %.0f MiB of sparse "
+                   "address space, the device has %.0f MiB",
+                   sizes.size(), double(addressSpace) / 1048576.0,
+                   double(gpu.device.properties.limits.sparseAddressSpaceSize) / 1048576.0));
+    if (out.tailBytes > budgetBytes)
+        throw InputError(format("--texture-budget %.2f: below the %.2f MiB the %zu textures' "
+                                "sparse MIP tails need",
+                                double(budgetBytes) / 1048576.0, double(out.tailBytes) / 1048576.0,
+                                sizes.size()));
+    out.residency = makeSparseResidency(std::move(made.book),
+                                        uint32_t((budgetBytes - out.tailBytes) / out.pageBytes));
+    out.poolBytes = uint64_t(out.residency.poolPages) * out.pageBytes;
+
+    allocateSparseMemory(gpu, made.memoryTypeBits, out);
+    bindSparseTails(gpu, sizes, made.layouts, out);
+    createSparseViews(gpu, srgb, out);
     VkSemaphoreCreateInfo sci{VK_STRUCTURE_TYPE_SEMAPHORE_CREATE_INFO};
     VK_CHECK(vkCreateSemaphore(device, &sci, nullptr, &out.bound));
     setName(gpu.device, out.bound, VK_OBJECT_TYPE_SEMAPHORE, "streaming.sparse.bound");
