@@ -209,8 +209,7 @@ void initRenderer(Renderer& r, Gpu& gpu, const RenderSettings& requested, const 
     createScreenSpace(r);
     // Last: prefiltering a new environment takes seconds, and every check above that can refuse
     // the settings (a device without ray queries, ...) answers first.
-    createEnvironment(gpu, r.environment, settings, scene,
-                      usableCacheFolder(settings.cacheDir));
+    createEnvironment(gpu, r.environment, settings, scene, usableCacheFolder(settings.cacheDir));
 }
 
 void destroyRenderer(Renderer& r) {
