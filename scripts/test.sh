@@ -72,12 +72,13 @@ if ! command -v clang++ >/dev/null 2>&1; then
 fi
 CC=clang CXX=clang++ cmake -S . -B build-fuzz -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo \
     -DSHADEL_CPU_ONLY=ON -DSHADEL_BENCH=OFF -DSHADEL_FUZZ=ON >/dev/null
-cmake --build build-fuzz -j"$jobs" --target shadel_fuzz_allocators shadel_fuzz_gltf_import
+cmake --build build-fuzz -j"$jobs" --target shadel_fuzz_allocators shadel_fuzz_gltf_import \
+    shadel_fuzz_cache_files
 
-# A finding makes libFuzzer exit non-zero, which fails the suite. The two fuzzers run side by
-# side (each is one process on one core), so the stage takes 60 s, not 120.
-echo "== fuzz: allocators and glTF import (libFuzzer, 60 s each, side by side)"
-mkdir -p build-fuzz/corpus build-fuzz/corpus-gltf
+# A finding makes libFuzzer exit non-zero, which fails the suite. The three fuzzers run side by
+# side (each is one process), so the stage takes 60 s, not 180.
+echo "== fuzz: allocators, glTF import and cache files (libFuzzer, 60 s each, side by side)"
+mkdir -p build-fuzz/corpus build-fuzz/corpus-gltf build-fuzz/corpus-cache
 ./build-fuzz/fuzz/shadel_fuzz_allocators -max_total_time=60 -seed=1 build-fuzz/corpus \
     fuzz/regressions/allocators >build-fuzz/allocators.log 2>&1 &
 allocators=$!
@@ -86,6 +87,9 @@ allocators=$!
     -rss_limit_mb=2048 build-fuzz/corpus-gltf tests/data/bad tests/data/gltf \
     >build-fuzz/gltf_import.log 2>&1 &
 gltf=$!
+./build-fuzz/fuzz/shadel_fuzz_cache_files -max_total_time=60 -seed=1 -timeout=10 \
+    -rss_limit_mb=2048 build-fuzz/corpus-cache >build-fuzz/cache_files.log 2>&1 &
+cache=$!
 fuzz_failed=0
 finish_fuzzer() { # name pid: its log's tail, or its last 60 lines when it failed
   if wait "$2"; then
@@ -96,6 +100,7 @@ finish_fuzzer() { # name pid: its log's tail, or its last 60 lines when it faile
 }
 finish_fuzzer allocators "$allocators"
 finish_fuzzer gltf_import "$gltf"
+finish_fuzzer cache_files "$cache"
 if [ "$fuzz_failed" -ne 0 ]; then
   echo "test: a fuzzer found a failure (its log is above and in build-fuzz/)" >&2
   exit 1

@@ -266,12 +266,7 @@ bool readBakeCache(const std::string& path, const BakeKey& key, const Mesh& mesh
     return true;
 }
 
-bool writeBakeCache(const std::string& path, const BakeKey& key, const BakedMesh& baked,
-                    std::string* why) {
-    namespace fs = std::filesystem;
-    std::string scratch;
-    std::string& reason = why ? *why : scratch;
-    std::vector<uint8_t> payload = serializePayload(baked);
+std::vector<uint8_t> bakeCacheFileBytes(const BakeKey& key, const std::vector<uint8_t>& payload) {
     FileHeader header{};
     std::memcpy(header.magic, kMagic, sizeof kMagic);
     header.version = kBakeFormatVersion;
@@ -279,13 +274,21 @@ bool writeBakeCache(const std::string& path, const BakeKey& key, const BakedMesh
     header.keyLo = key.lo, header.keyHi = key.hi;
     header.payloadSize = payload.size();
     header.payloadChecksum = hashBytes(payload.data(), payload.size(), 0);
+    std::vector<uint8_t> bytes(sizeof header + payload.size());
+    std::memcpy(bytes.data(), &header, sizeof header);
+    if (!payload.empty()) std::memcpy(bytes.data() + sizeof header, payload.data(), payload.size());
+    return bytes;
+}
 
+bool writeBakeCache(const std::string& path, const BakeKey& key, const BakedMesh& baked,
+                    std::string* why) {
+    namespace fs = std::filesystem;
+    std::string scratch;
+    std::string& reason = why ? *why : scratch;
+    std::vector<uint8_t> bytes = bakeCacheFileBytes(key, serializePayload(baked));
     std::error_code ec;
     fs::path target(path);
     if (target.has_parent_path()) fs::create_directories(target.parent_path(), ec);
-    std::vector<uint8_t> bytes(sizeof header + payload.size());
-    std::memcpy(bytes.data(), &header, sizeof header);
-    std::memcpy(bytes.data() + sizeof header, payload.data(), payload.size());
     reason = writeCacheEntry(path, bytes.data(), bytes.size());
     return reason.empty();
 }

@@ -8,6 +8,7 @@
 // file and concurrent writers of the same key cannot corrupt each other.
 #include <cstdint>
 #include <string>
+#include <vector>
 
 #include "bake/bake.h"
 
@@ -36,6 +37,9 @@ std::string bakeCachePath(const std::string& cacheDir, const BakeKey& key);
 // "missing") or unusable (truncated, corrupted, stale, inconsistent with the mesh).
 bool readBakeCache(const std::string& path, const BakeKey& key, const Mesh& mesh, BakedMesh& out,
                    std::string* why);
+// The bytes of a cache file holding `payload` for `key` (a valid header and checksum): what
+// writeBakeCache writes, exposed so that tests and the fuzzer can hand the reader any payload.
+std::vector<uint8_t> bakeCacheFileBytes(const BakeKey& key, const std::vector<uint8_t>& payload);
 // Atomically writes a cache file (creating directories). Returns false and sets *why on failure.
 bool writeBakeCache(const std::string& path, const BakeKey& key, const BakedMesh& baked,
                     std::string* why);

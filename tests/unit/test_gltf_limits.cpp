@@ -262,3 +262,31 @@ TEST(GltfLimits, WorkingDirectoryIsNotSearchedForBuffers) {
     EXPECT_NE(r.error.find("cwd_only.bin"), std::string::npos) << r.error;
     EXPECT_EQ(r.instances, 0u);
 }
+
+// Sparse accessor fields the importer holds as int: 2^32 and 2^32 + 1 used to wrap to 0 and 1
+// and be accepted; they are refused by name.
+TEST(GltfLimits, SparseCountAndOffsetBeyondTheImportersRangeAreRefused) {
+    ModelDir dir;
+    writeFile(dir.file("model/tri.bin"), triangleBytes());
+    const std::pair<const char*, const char*> cases[] = {
+        {R"("count":4294967297,"indices":{"bufferView":0,"componentType":5125},
+            "values":{"bufferView":0})",
+         "/accessors/0/sparse/count: 4294967297 is out of range (at most 2147483647)"},
+        {R"("count":1,"indices":{"bufferView":0,"byteOffset":4294967296,"componentType":5125},
+            "values":{"bufferView":0})",
+         "/accessors/0/sparse/indices/byteOffset: 4294967296 is out of range (at most "
+         "2147483647)"},
+    };
+    for (const auto& [sparse, expected] : cases) {
+        std::string text = gltfWithNodes("[0]", R"([{"mesh":0}])");
+        size_t at = text.find(R"("max":[1,1,0]})");
+        ASSERT_NE(at, std::string::npos);
+        text.insert(at + std::string(R"("max":[1,1,0])").size(),
+                    std::string(R"(,"sparse":{)") + sparse + "}");
+        std::string path = dir.file("model/sparse.gltf");
+        writeFile(path, text);
+        Outcome r = load(path);
+        EXPECT_NE(r.error.find(expected), std::string::npos) << r.error;
+        EXPECT_EQ(r.instances, 0u);
+    }
+}
