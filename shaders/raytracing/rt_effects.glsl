@@ -151,9 +151,18 @@ float rtAmbientOcclusion(FrameConstants f, RtFrame rt, vec3 p, vec3 n, vec3 ng, 
     return rays == 0u ? 1.0 : open / float(rays);
 }
 
-// Radiance leaving the committed hit of `q` toward the ray's origin (diffuse only).
-vec3 rtShadeHit(FrameConstants f, RtFrame rt, uint instanceId, uint primitive, vec2 bary,
-                bool frontFace, vec3 rayDir) {
+// The surface of a hit (committed or candidate): the triangle of the LOD the instance's BLAS
+// was built from, its attributes interpolated at the barycentrics (no UV derivatives: textures
+// are read at their finest MIP), its geometric normal and its material. Shared by every shader
+// that shades what a ray hit (here, and the reference path tracer, shaders/reference).
+struct RtHitSurface {
+    SurfaceInput s;
+    vec3 geometricNormal; // unit, the triangle's winding (not turned toward the ray)
+    uint material;
+};
+
+RtHitSurface rtHitSurface(FrameConstants f, RtFrame rt, uint instanceId, uint primitive, vec2 bary,
+                          bool frontFace) {
     GpuInstance inst = InstanceBuffer(f.instances).i[instanceId];
     GpuMesh mesh = MeshBuffer(f.meshes).m[inst.mesh];
     uint first = UintBuffer(rt.instanceLods).v[instanceId] + primitive * 3u;
@@ -162,21 +171,31 @@ vec3 rtShadeHit(FrameConstants f, RtFrame rt, uint instanceId, uint primitive, v
     WorldVertex b = fetchWorldVertex(f, inst, uint(int(indices.i[first + 1u]) + mesh.vertexOffset));
     WorldVertex c = fetchWorldVertex(f, inst, uint(int(indices.i[first + 2u]) + mesh.vertexOffset));
     vec3 w = vec3(1.0 - bary.x - bary.y, bary.x, bary.y);
-    SurfaceInput s;
-    s.position = a.position * w.x + b.position * w.y + c.position * w.z;
-    s.normal = normalize(a.normal * w.x + b.normal * w.y + c.normal * w.z);
-    s.tangent = a.tangent * w.x + b.tangent * w.y + c.tangent * w.z;
-    s.uv = a.uv0 * w.x + b.uv0 * w.y + c.uv0 * w.z;
-    s.uvDx = vec2(0.0);
-    s.uvDy = vec2(0.0);
-    s.uv1 = a.uv1 * w.x + b.uv1 * w.y + c.uv1 * w.z;
-    s.uv1Dx = vec2(0.0);
-    s.uv1Dy = vec2(0.0);
-    s.frontFacing = frontFace;
-    GpuMaterial mat = MaterialBuffer(f.materials).m[inst.material];
+    RtHitSurface h;
+    h.s.position = a.position * w.x + b.position * w.y + c.position * w.z;
+    h.s.normal = normalize(a.normal * w.x + b.normal * w.y + c.normal * w.z);
+    h.s.tangent = a.tangent * w.x + b.tangent * w.y + c.tangent * w.z;
+    h.s.uv = a.uv0 * w.x + b.uv0 * w.y + c.uv0 * w.z;
+    h.s.uvDx = vec2(0.0);
+    h.s.uvDy = vec2(0.0);
+    h.s.uv1 = a.uv1 * w.x + b.uv1 * w.y + c.uv1 * w.z;
+    h.s.uv1Dx = vec2(0.0);
+    h.s.uv1Dy = vec2(0.0);
+    h.s.frontFacing = frontFace;
+    h.geometricNormal = normalize(cross(b.position - a.position, c.position - a.position));
+    h.material = inst.material;
+    return h;
+}
+
+// Radiance leaving the committed hit of `q` toward the ray's origin (diffuse only).
+vec3 rtShadeHit(FrameConstants f, RtFrame rt, uint instanceId, uint primitive, vec2 bary,
+                bool frontFace, vec3 rayDir) {
+    RtHitSurface hit = rtHitSurface(f, rt, instanceId, primitive, bary, frontFace);
+    SurfaceInput s = hit.s;
+    GpuMaterial mat = MaterialBuffer(f.materials).m[hit.material];
     MaterialSample m = evaluateMaterial(mat, s);
     if (m.unlit) return m.baseColor;
-    vec3 ng = normalize(cross(b.position - a.position, c.position - a.position));
+    vec3 ng = hit.geometricNormal;
     vec3 n = dot(m.normal, rayDir) > 0.0 ? -m.normal : m.normal; // the side the ray sees
     m.metallic = 0.0; // diffuse bounce only
     m.roughness = 1.0;

@@ -98,8 +98,9 @@ std::vector<std::string> writeCaptures(const CaptureRegistry& registry,
     return written;
 }
 
-void writeHdrFrame(const CaptureRegistry& registry, uint32_t ssaa, const std::string& path) {
-    const CaptureSource* source = findCapture(registry, "hdr");
+void writeHdrFrame(const CaptureRegistry& registry, uint32_t ssaa, const std::string& path,
+                   const char* capture) {
+    const CaptureSource* source = findCapture(registry, capture);
     if (!source) throw InputError(format("--out %s: this frame has no HDR target", path.c_str()));
     CapturedImage hdr = source->read();
     // With TAA the displayed colour is the resolve's (render/taa); alpha stays the scene's.

@@ -26,8 +26,10 @@ std::string capturePath(const std::string& captureDir, const std::string& out,
 std::vector<std::string> writeCaptures(const CaptureRegistry& registry,
                                        const std::vector<std::string>& names,
                                        const std::string& captureDir, const std::string& out);
-// The HDR frame at the output resolution (an N x N SSAA target is box-filtered), as EXR.
-void writeHdrFrame(const CaptureRegistry& registry, uint32_t ssaa, const std::string& path);
+// The HDR frame at the output resolution (an N x N SSAA target is box-filtered), as EXR: the
+// `capture` named ("hdr": the scene colour).
+void writeHdrFrame(const CaptureRegistry& registry, uint32_t ssaa, const std::string& path,
+                   const char* capture = "hdr");
 bool isExrPath(const std::string& path);
 // "" if the extension names a format shadel writes (.png, .exr, any case), else why not.
 std::string imageFormatProblem(const std::string& path);

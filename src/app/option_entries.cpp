@@ -13,8 +13,12 @@ void addImageOptions(std::vector<SettingOption>& t) {
     t.push_back(sizeOption());
     t.push_back(choiceOption<RenderMode>(
         "--mode", SETTING(mode),
-        {{"forward", RenderMode::Forward}, {"decoupled", RenderMode::Decoupled}}, RV,
-        "forward shading, or decoupled: shaded in shadel space, then rasterized"));
+        {{"forward", RenderMode::Forward},
+         {"decoupled", RenderMode::Decoupled},
+         {"reference", RenderMode::Reference}},
+        RV,
+        "forward shading; decoupled: shaded in shadel space, then rasterized; reference: "
+        "path traced (unbiased, accumulated over --frames; needs ray queries)"));
     t.push_back(countOption("--ssaa", SETTING(ssaa), 1, 16, R, "NxN supersampled reference"));
     t.push_back(choiceOption<AntiAliasing>(
         "--aa", SETTING(aa),
@@ -267,6 +271,14 @@ void addRayTracingOptions(std::vector<SettingOption>& t) {
     t.push_back(countOption("--rt-history-rays", SETTING(rt.historyRays), 1, 1024, R,
                             "decoupled: rays a cached texel accumulates, then reuses until its "
                             "inputs change"));
+    t.push_back(countOption("--spp", SETTING(reference.samplesPerFrame), 1, 4096, R,
+                            "reference: paths per pixel each frame adds to the accumulated mean"));
+    t.push_back(countOption("--max-bounces", SETTING(reference.maxBounces), 0, 256, R,
+                            "reference: surface hits a path continues through after the first "
+                            "(0: direct light only); Russian roulette may end it earlier"));
+    t.push_back(countOption("--seed", SETTING(reference.seed), 0, 0xFFFFFFFFu, R,
+                            "reference: the random sequences' seed (the same seed, the same "
+                            "image)"));
     t.push_back(onOffOption("--rt-animated-blas", SETTING(rt.animatedBlas), R,
                             "GPU-skinned meshes' BLASes refit as the pose changes (rebuilt every "
                             "8 refits; beyond 16 m at most every ceil(distance / 16 m) frames); "

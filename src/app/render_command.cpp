@@ -143,7 +143,9 @@ static nlohmann::json cpuScopeStats(const std::vector<FrameResult>& frames) {
 }
 
 const char* modeName(RenderMode m) {
-    return m == RenderMode::Forward ? "forward" : "decoupled";
+    return m == RenderMode::Forward     ? "forward"
+           : m == RenderMode::Decoupled ? "decoupled"
+                                        : "reference";
 }
 
 void printPassTable(const nlohmann::json& stats) {
@@ -670,6 +672,7 @@ void featureStats(const RenderSession& session, nlohmann::json& s) {
         {"gpu_vertices", renderer.skinning ? skinnedVertexCount(*renderer.skinning) : 0u}};
     if (renderer.gi) giStats(renderer, s);
     if (renderer.rt) rayTracingStats(renderer, s);
+    if (renderer.reference) referenceStats(renderer, s);
     if (renderer.screenSpace) screenSpaceStats(renderer, s);
     if (renderer.distanceFields) distanceFieldStats(*renderer.distanceFields, s);
     taaStats(renderer, s);
@@ -708,7 +711,9 @@ RenderRun finishRender(RenderSessionPtr sessionPtr) {
     const double viewDensitySeconds = session.viewDensitySeconds;
     if (!o.out.empty() && !outDir) {
         if (isExrPath(o.out))
-            writeHdrFrame(renderer.captures, o.ssaa, o.out);
+            // (reference: the accumulated mean in full float, not the half-float scene colour)
+            writeHdrFrame(renderer.captures, o.ssaa, o.out,
+                          renderer.reference ? "reference" : "hdr");
         else
             writePng(o.out, run.frames.back().rgba, o.width, o.height, !o.backgroundEnvironment);
     }

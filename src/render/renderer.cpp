@@ -50,7 +50,8 @@ static void createTargets(Renderer& r) {
     hdr.usage = VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT | VK_IMAGE_USAGE_SAMPLED_BIT |
                 VK_IMAGE_USAGE_TRANSFER_SRC_BIT;
     // compute resolve, screen space, tile shading
-    if (usesVisibilityBuffer(r.settings) || r.settings.screenSpace || usesTileShading(r))
+    if (usesVisibilityBuffer(r.settings) || r.settings.screenSpace || usesTileShading(r) ||
+        r.settings.mode == RenderMode::Reference) // (the path tracer writes its mean)
         hdr.usage |= VK_IMAGE_USAGE_STORAGE_BIT;
     r.hdr = need(createTexture(gpu, hdr), "the scene colour target");
     r.hdrTarget = createRenderTargetView(gpu, r.hdr);
@@ -114,6 +115,17 @@ static RenderSettings resolveSettings(RenderSettings s, const GpuScene& scene) {
                         scene.lightInfo.size() > LIGHT_SUBGROUP_MAX_LIGHTS;
         s.spectra = perChunk || s.visualize == Visualize::Spectra ? Spectra::On : Spectra::Off;
     }
+    if (s.mode == RenderMode::Reference) { // render/reference: traced, no raster lighting
+        s.shadows = false;                 // shadow rays instead of maps
+        s.gi = GiMode::Off;                // every bounce traced
+        s.rt = RtSettings{.blasPoolMb = s.rt.blasPoolMb, .blasPoolLimit = s.rt.blasPoolLimit};
+        s.lod = false; // rays meet LOD 0, the finest surface
+        s.occlusion = s.screenSpace = s.particles = s.decals = false;
+        s.distanceFieldLighting = false;
+        s.lightCulling = LightCulling::None;
+        s.spectra = Spectra::Off;
+        s.fuseTonemap = false;
+    }
     if (!s.shadows) { // --shadows off: no shadow map of any light
         s.spotShadows = false;
         s.sunCascades = 1;
@@ -176,8 +188,9 @@ void initRenderer(Renderer& r, Gpu& gpu, const RenderSettings& requested, const 
     if (settings.mode == RenderMode::Decoupled) r.decoupled = createDecoupled(r, scene);
     // Tile shading (--spectra on|single, forward) reads the visibility buffer too.
     if (usesVisibilityBuffer(settings) || usesTileShading(r)) r.visibility = createVisibility(r);
-    r.oit = createOit(r, scene);
-    r.transmission = createTransmission(r, scene);
+    const bool reference = settings.mode == RenderMode::Reference; // traces every surface
+    if (!reference) r.oit = createOit(r, scene);
+    if (!reference) r.transmission = createTransmission(r, scene);
     r.particles = createParticles(r, scene);
     r.lightCulling = createLightCulling(r, scene);
     r.spotShadows = createSpotShadows(r, scene);
@@ -191,19 +204,20 @@ void initRenderer(Renderer& r, Gpu& gpu, const RenderSettings& requested, const 
     r.culling = createCulling(r, scene);
     r.decals = createDecals(r, scene); // after the decoupled state (its queue's capacity)
     r.debugLines = createDebugLines(r);
-    if (settings.rt.enabled()) r.rt = createRayTracing(r, scene);
+    if (settings.rt.enabled() || reference) r.rt = createRayTracing(r, scene);
+    if (reference) r.reference = createReference(r, scene); // (its TLAS: the ray-tracing state's)
     createScreenSpace(r);
     r.taa = createTaa(r);
     // Last: prefiltering a new environment takes seconds, and every check above that can refuse
     // the settings (a device without ray queries, ...) answers first.
-    createEnvironment(gpu, r.environment, settings, scene,
-                      usableCacheFolder(settings.cacheDir));
+    createEnvironment(gpu, r.environment, settings, scene, usableCacheFolder(settings.cacheDir));
 }
 
 void destroyRenderer(Renderer& r) {
     if (!r.gpu) return;
     Gpu& gpu = *r.gpu;
     vkDeviceWaitIdle(gpu.device.device);
+    destroyReference(r, r.reference);
     destroyRayTracing(r, r.rt);
     destroyFeatureSpectra(r, r.spectra);
     destroySpotShadows(r, r.spotShadows);
@@ -449,6 +463,7 @@ FrameResult renderFrame(Renderer& r, const GpuScene& scene, const CameraView& un
         auto timer = cpuScope(r, "ray tracing");
         prepareRayTracingFrame(r, scene, camera, constants);
     }
+    if (r.reference) prepareReferenceFrame(r, camera);
     std::memcpy(mapped(gpu, r.frameConstants), &constants, sizeof(constants));
     uint64_t frame = address(gpu, r.frameConstants);
     double prepareMs = msSince(cpuStart);
@@ -510,6 +525,9 @@ FrameResult renderFrame(Renderer& r, const GpuScene& scene, const CameraView& un
     } else if (r.settings.mode == RenderMode::Forward) { // (tonemap fused: display pixels)
         pass(rec, "forwardShading",
              [&](VkCommandBuffer cmd) { recordForwardShading(r, cmd, frame); });
+    } else if (r.reference) { // path traced, accumulated over frames (render/reference)
+        pass(rec, "referencePathTrace",
+             [&](VkCommandBuffer cmd) { recordReferencePathTrace(r, cmd, frame); });
     } else {
         recordDecoupledMarking(r, rec, frame); // what the frame's pixels read, in shadel space
         if (r.rt) // the RT cache the shadel shading reads, where marked (render/raytracing)

@@ -25,6 +25,8 @@
 #include "render/points_lines/points_lines.h"
 #include "render/raytracing/ray_tracing.h"
 #include "render/raytracing/rt_settings.h"
+#include "render/reference/reference.h"
+#include "render/reference/reference_settings.h"
 #include "render/scene_edits.h"
 #include "render/shadel/visibility.h"
 #include "render/skinning/skinning.h"
@@ -40,7 +42,9 @@ namespace shadel {
 // Forward opaque material classes: plain, textures only, other features (render/forward).
 constexpr uint32_t kForwardClassCount = 3;
 
-enum class RenderMode { Forward, Decoupled };
+// Reference: an unbiased path tracer of the same scene (render/reference), the oracle of the
+// other modes' light transport.
+enum class RenderMode { Forward, Decoupled, Reference };
 // Decoupled marking + reconstruction: raster passes over the objects, or compute passes over
 // the pixels of a visibility buffer (render/shadel/visibility.h). Auto (the default) is
 // visibility, the faster one, unless a feature that needs the raster path is on (--occlusion on,
@@ -168,8 +172,9 @@ struct RenderSettings {
     // --debug-lines-at X,Y: light lines only for the lights reaching the surface at that pixel
     // of the output image (-1: every light in view).
     int32_t debugLinesAtX = -1, debugLinesAtY = -1;
-    RtSettings rt;         // --rt-*: ray-traced shadows, AO, GI (render/raytracing)
-    bool particles = true; // the scene's GPU particle emitters (render/particles)
+    RtSettings rt;               // --rt-*: ray-traced shadows, AO, GI (render/raytracing)
+    ReferenceSettings reference; // --mode reference: --spp, --max-bounces, --seed
+    bool particles = true;       // the scene's GPU particle emitters (render/particles)
     ParticleLighting particleLighting = ParticleLighting::Atlas;
     uint32_t particleAtlasSize = 1024; // texels per side of the particle lightmap atlas
     // Sprites accumulated at half resolution in their own WBOIT targets, combined with the
@@ -329,6 +334,7 @@ struct Renderer {
     DebugLinesStatePtr debugLines;         // --debug-lines (render/debug/debug_lines.h)
     CullingStatePtr culling;               // LODs, occlusion, per-view counts (render/culling)
     RayTracingStatePtr rt;                 // BLASes, TLAS, traced terms (--rt-*, render/raytracing)
+    ReferenceStatePtr reference;           // --mode reference: the path tracer (render/reference)
     CaptureRegistry captures;              // --capture: named resources of the frame (render/debug)
     ScreenSpaceStatePtr screenSpace;       // --screen-space on (render/screenspace, render/tiles)
     DistanceFieldStatePtr distanceFields;  // --distance-fields on (render/distance_fields)

@@ -49,7 +49,9 @@ void RayTracingStateDeleter::operator()(RayTracingState* state) const {
     delete state;
 }
 
-static const char* firstEffectFlag(const RtSettings& s) {
+static const char* firstEffectFlag(const RenderSettings& settings) {
+    const RtSettings& s = settings.rt;
+    if (settings.mode == RenderMode::Reference) return "--mode reference";
     return s.shadows ? "--rt-shadows on" : s.ao ? "--rt-ao on" : "--rt-gi on";
 }
 
@@ -98,7 +100,7 @@ RayTracingStatePtr createRayTracing(Renderer& r, const GpuScene& scene) {
     if (!gpu.device.optional.rayQuery)
         throw InputError(format("%s: %s cannot trace rays (it lacks VK_KHR_ray_query or "
                                 "VK_KHR_acceleration_structure)",
-                                firstEffectFlag(rt), gpu.device.name.c_str()));
+                                firstEffectFlag(r.settings), gpu.device.name.c_str()));
     RayTracingStatePtr state(new RayTracingState);
     RayTracingState& s = *state;
     s.fn = loadRtFunctions(gpu.device);
@@ -127,8 +129,9 @@ RayTracingStatePtr createRayTracing(Renderer& r, const GpuScene& scene) {
     std::memcpy(mapped(gpu, s.spotLights), spotLights.data(), spotLights.size() * 4);
     if (tracesPerPixel(r))
         createPixelTargets(r, s);
-    else
+    else if (r.settings.mode == RenderMode::Decoupled)
         createRtShadelCache(r, scene, s.spotShadowCount != 0, s.shadelCache);
+    // (--mode reference: the TLAS alone, render/reference traces it)
     return state;
 }
 
