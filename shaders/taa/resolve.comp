@@ -25,6 +25,11 @@ layout(push_constant, scalar) uniform Push {
 };
 
 shared uint gRejected, gClipped;
+// The group's pixels and a one-pixel border: this frame's compressed colour and its depth,
+// fetched once each instead of nine times (every pixel reads its 3x3).
+const uint kTileX = TAA_GROUP_X + 2u, kTileY = TAA_GROUP_Y + 2u;
+shared vec3 gTileColour[kTileX * kTileY];
+shared float gTileDepth[kTileX * kTileY];
 
 // Relative difference of inverse depths above which the history shows another surface.
 const float kDepthTolerance = 0.04;
@@ -89,15 +94,31 @@ vec3 clipToBox(vec3 history, vec3 center, vec3 extent, out bool clipped) {
     return clipped ? center + d / m : history;
 }
 
+// Fills the tile: the group's pixels and their border, clamped to the image.
+void loadTile(float exposure) {
+    ivec2 origin = ivec2(gl_WorkGroupID.xy * uvec2(TAA_GROUP_X, TAA_GROUP_Y)) - 1;
+    ivec2 last = ivec2(pc.width - 1u, pc.height - 1u);
+    for (uint i = gl_LocalInvocationIndex; i < kTileX * kTileY; i += TAA_GROUP_X * TAA_GROUP_Y) {
+        ivec2 q = clamp(origin + ivec2(i % kTileX, i / kTileX), ivec2(0), last);
+        gTileColour[i] = currentSample(q, exposure);
+        gTileDepth[i] = fetchTextureUniform(pc.depthSlot, q, 0).r;
+    }
+}
+
 void main() {
     bool lead = gl_LocalInvocationIndex == 0u;
     if (lead) gRejected = gClipped = 0u;
+    // Only the fields used: copying the whole frame block per invocation is costly on some
+    // compilers.
+    FrameConstantsRef frame = FrameConstantsRef(pc.frame);
+    const float exposure = frame.f.exposure;
+    loadTile(exposure);
     barrier();
     ivec2 p = ivec2(gl_GlobalInvocationID.xy);
     bool inside = p.x < int(pc.width) && p.y < int(pc.height);
     if (inside) {
-        FrameConstants f = FrameConstantsRef(pc.frame).f;
         vec2 size = vec2(pc.width, pc.height);
+        ivec2 local = ivec2(gl_LocalInvocationID.xy) + 1; // in the tile
         // 1. Reconstruction and the neighbourhood's moments; 2. the closest depth.
         vec3 sum = vec3(0.0), m1 = vec3(0.0), m2 = vec3(0.0);
         float weight = 0.0, closest = -1.0;
@@ -105,7 +126,8 @@ void main() {
         for (int y = -1; y <= 1; ++y) {
             for (int x = -1; x <= 1; ++x) {
                 ivec2 q = p + ivec2(x, y);
-                vec3 c = currentSample(q, f.exposure);
+                uint t = uint(local.y + y) * kTileX + uint(local.x + x);
+                vec3 c = gTileColour[t];
                 vec2 d = vec2(x, y) + pc.jitter;
                 float w = exp(-2.29 * dot(d, d));
                 sum += c * w;
@@ -114,7 +136,7 @@ void main() {
                 m1 += ycocg;
                 m2 += ycocg * ycocg;
                 ivec2 qc = clamp(q, ivec2(0), ivec2(size) - 1);
-                float depth = fetchTextureUniform(pc.depthSlot, qc, 0).r;
+                float depth = gTileDepth[t];
                 if (depth > closest) closest = depth, closestAt = qc;
             }
         }
@@ -124,7 +146,7 @@ void main() {
 
         // 2. Where the closest surface was last frame (homogeneous: the sky is a direction).
         vec2 closestNdc = (vec2(closestAt) + 0.5) / size * 2.0 - 1.0;
-        vec4 closestWorld = f.invViewProj * vec4(closestNdc, closest, 1.0);
+        vec4 closestWorld = frame.f.invViewProj * vec4(closestNdc, closest, 1.0);
         vec4 prevClip = pc.prevViewProj * closestWorld;
         vec2 prevPos = (prevClip.xy / prevClip.w * 0.5 + 0.5) * size;
         vec2 nowPos = vec2(closestAt) + 0.5 + pc.jitter;
@@ -133,7 +155,7 @@ void main() {
         // The closest surface's inverse depth now, for the next frame's test (the w row of
         // viewProj has no jitter in it). Dilated as the expected one is: at an edge both are the
         // front surface's, whichever side this frame's jitter sampled.
-        float invDepth = closest > 0.0 ? closestWorld.w / (f.viewProj * closestWorld).w : 0.0;
+        float invDepth = closest > 0.0 ? closestWorld.w / (frame.f.viewProj * closestWorld).w : 0.0;
 
         // 3. Rejection; 4. clipping; 5. the blend.
         bool valid = (pc.flags & TAA_HISTORY_VALID) != 0u && prevClip.w > 0.0 &&
@@ -143,11 +165,11 @@ void main() {
         vec3 result = current;
         bool clipped = false;
         if (valid) {
-            vec3 history = taaCompress(historyCatmullRom(historyPos) * f.exposure);
+            vec3 history = taaCompress(historyCatmullRom(historyPos) * exposure);
             vec3 h = yCoCgToRgb(clipToBox(rgbToYCoCg(history), mean, kClipSigma * sigma, clipped));
             result = mix(h, current, pc.currentWeight);
         }
-        vec3 hdr = taaExpand(clamp(result, vec3(0.0), vec3(0.999))) / max(f.exposure, 1e-20);
+        vec3 hdr = taaExpand(clamp(result, vec3(0.0), vec3(0.999))) / max(exposure, 1e-20);
         imageStore(gImagesRgba16f[pc.outputSlot], p, vec4(hdr, invDepth));
         if (!valid) atomicAdd(gRejected, 1u);
         if (clipped) atomicAdd(gClipped, 1u);

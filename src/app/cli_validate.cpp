@@ -157,6 +157,9 @@ void validateCombinations(const RenderOptions& o) {
         throw InputError(format("--aa-frames %u: accumulates a still; needs --aa taa, --frames 1 "
                                 "and --camera-path static",
                                 o.aaFrames));
+    if (o.aa == AntiAliasing::Taa && o.mode == RenderMode::Reference)
+        throw InputError("--aa taa with --mode reference: the path tracer jitters its own "
+                         "samples inside each pixel and averages them; it needs no TAA");
     if (o.aa == AntiAliasing::Taa && o.ssaa != 1)
         throw InputError(format("--aa taa with --ssaa %u: TAA resolves one sample per pixel; use "
                                 "one of them",

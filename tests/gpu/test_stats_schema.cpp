@@ -158,6 +158,16 @@ TEST(StatsSchema, RayTracingMatchesTheSchema) {
                 {{"--rt-shadows", "on"}, {"--rt-ao", "on"}}, {"rt", "blas_count"});
 }
 
+// Temporal anti-aliasing ("taa") and the reference path tracer ("reference", mode reference).
+TEST(StatsSchema, TaaAndThePathTracerMatchTheSchema) {
+    SHADEL_REQUIRE(haveJsonSchema(), "python3 with jsonschema (scripts/setup.sh)");
+    expectValid("taa", smallOptions("builtin:default", RenderMode::Forward), {{"--aa", "taa"}},
+                {"taa"});
+    SHADEL_REQUIRE(sharedGpu().device.optional.rayQuery, "a device with ray query");
+    expectValid("reference", smallOptions("builtin:cornell", RenderMode::Reference),
+                {{"--spp", "1"}}, {"reference"});
+}
+
 // The schema must be able to fail: an undocumented key, a missing always-present key and a
 // wrong type are each rejected, with the validator naming the key.
 TEST(StatsSchema, UndocumentedMissingOrMistypedKeysAreRejected) {

@@ -224,6 +224,10 @@ TEST(Taa, AaFramesStillIsCloserToSupersamplingThanOneFrame) {
     RenderOptions bad = still;
     bad.frames = 2;
     EXPECT_THROW(runRender(sharedGpu(), bad), InputError);
+    RenderOptions traced = one;
+    traced.mode = RenderMode::Reference; // the path tracer averages its own jittered samples
+    traced.aa = AntiAliasing::Taa;
+    EXPECT_THROW(runRender(sharedGpu(), traced), InputError);
 }
 
 // A glowing cube slides across a dark wall before a still camera (0.375 m, ~13 pixels, a
