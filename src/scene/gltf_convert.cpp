@@ -777,6 +777,17 @@ private:
 
     void finishCamerasAndLights() {
         Aabb bounds = scene_.worldBounds();
+        // Beyond this, 32-bit floats cannot place a camera or a near plane: squared lengths
+        // overflow and depth has no precision left (a real scene in metres stays far below).
+        constexpr float kMaxWorldCoordinate = 1e15f;
+        if (bounds.valid()) {
+            glm::vec3 reach = glm::max(glm::abs(bounds.min), glm::abs(bounds.max));
+            float farthest = std::max({reach.x, reach.y, reach.z});
+            if (!(farthest <= kMaxWorldCoordinate))
+                error(format("the scene reaches %g units from the origin, beyond the %g that "
+                             "32-bit floats can frame and render",
+                             double(farthest), double(kMaxWorldCoordinate)));
+        }
         glm::vec3 centre = bounds.center();
         float radius = std::max(0.5f * glm::length(bounds.extent()), 1e-3f);
         for (size_t i = 0; i < scene_.cameras.size(); ++i) {

@@ -113,6 +113,7 @@ def bad_files():
     nan = float("nan"); inf = float("inf")
     d = quad([(-1, 0, 1), (1, nan, 1), (1, 0, -1), (-1, 0, -1)]); out["nan_position.gltf"] = d
     d = quad([(-1, 0, 1), (1, 0, 1), (inf, 0, -1), (-1, 0, -1)]); out["inf_position.gltf"] = d
+    d = quad([(-1, 0, 1), (1, 0, 1), (7e31, 0, -1), (-1, 0, -1)]); out["huge_coordinates.gltf"] = d
 
     d = copy.deepcopy(q); d["nodes"] = [{"children": [1]}, {"children": [0], "mesh": 0}]
     out["cyclic_nodes.gltf"] = d
