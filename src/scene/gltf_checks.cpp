@@ -460,6 +460,11 @@ private:
             if (!member(persp, "yfov") || !member(persp, "znear"))
                 bad(pp, "perspective camera needs 'yfov' and 'znear'");
             optNumber(persp, "yfov", pp, 1e-6);
+            // A field of view of pi or more has no perspective projection.
+            if (const json* yfov = member(persp, "yfov");
+                yfov && yfov->is_number() && yfov->get<double>() >= 3.14159)
+                bad(child(pp, "yfov"),
+                    format("%g radians: a field of view must be below pi", yfov->get<double>()));
             optNumber(persp, "znear", pp, 1e-9);
             optNumber(persp, "zfar", pp, 0.0);
             optNumber(persp, "aspectRatio", pp, 0.0);

@@ -114,6 +114,9 @@ def bad_files():
     d = quad([(-1, 0, 1), (1, nan, 1), (1, 0, -1), (-1, 0, -1)]); out["nan_position.gltf"] = d
     d = quad([(-1, 0, 1), (1, 0, 1), (inf, 0, -1), (-1, 0, -1)]); out["inf_position.gltf"] = d
     d = quad([(-1, 0, 1), (1, 0, 1), (7e31, 0, -1), (-1, 0, -1)]); out["huge_coordinates.gltf"] = d
+    d = quad(); d["nodes"][0]["camera"] = 0
+    d["cameras"] = [{"type": "perspective", "perspective": {"yfov": 5.7, "znear": 0.1}}]
+    out["field_of_view_over_pi.gltf"] = d
 
     d = copy.deepcopy(q); d["nodes"] = [{"children": [1]}, {"children": [0], "mesh": 0}]
     out["cyclic_nodes.gltf"] = d

@@ -131,6 +131,8 @@ const BadFile kOurBadFiles[] = {
     {"index_out_of_range.gltf", "accessor 3 index 9001 out of range (vertex count 4)"},
     {"inf_position.gltf", "accessor 0 (POSITION) element 2 is not finite"},
     {"huge_coordinates.gltf", "the scene reaches 7e+31 units from the origin, beyond the 1e+15"},
+    {"field_of_view_over_pi.gltf",
+     "/cameras/0/perspective/yfov: 5.7 radians: a field of view must be below pi"},
     {"light_index_out_of_range.gltf", "light: index 3 out of range"},
     {"mesh_index_out_of_range.gltf", "/nodes/0/mesh: index 5 out of range"},
     {"missing_buffer.gltf", "does_not_exist.bin"},
