@@ -25,12 +25,12 @@ struct TaaResolvePush {
     vec2 jitter;
     vec2 prevJitter; // last frame's: where its stored depths were sampled
     uint width, height;
-    uint hdrSlot;       // sampled: this frame's scene colour
-    uint depthSlot;     // sampled: this frame's depth (reversed Z)
-    uint historySlot;   // sampled: last frame's resolved colour (rgb) + inverse depth (a)
-    uint outputSlot;    // storage rgba16f: this frame's resolved colour + inverse depth
+    uint hdrSlot;        // sampled: this frame's scene colour
+    uint depthSlot;      // sampled: this frame's depth (reversed Z)
+    uint historySlot;    // sampled: last frame's resolved colour (rgb) + inverse depth (a)
+    uint outputSlot;     // storage rgba16f: this frame's resolved colour + inverse depth
     float currentWeight; // the exponential blend's weight of this frame (at least)
-    uint flags;         // TAA_HISTORY_VALID
+    uint flags;          // TAA_HISTORY_VALID
 };
 
 struct TaaSharpenPush {

@@ -12,8 +12,7 @@ namespace shadel {
 std::optional<uint64_t> parseWholeNumber(std::string_view text, uint64_t maxValue = UINT64_MAX);
 
 // Two whole numbers separated by one of `separators` ("x" for 1280x720, "," for 40,20).
-std::optional<std::pair<uint64_t, uint64_t>> parseWholeNumberPair(std::string_view text,
-                                                                  std::string_view separators,
-                                                                  uint64_t maxValue);
+std::optional<std::pair<uint64_t, uint64_t>>
+parseWholeNumberPair(std::string_view text, std::string_view separators, uint64_t maxValue);
 
 } // namespace shadel
