@@ -24,9 +24,7 @@ void createTonemapPipeline(Renderer& r) {
     r.tonemap = createComputePipeline(*r.gpu, "tonemap", "post_tonemap.comp.spv");
 }
 
-// The scene colour and depth into the layouts the pass reads them in (with TAA the resolve
-// has moved them).
-static void tonemapBarriers(Renderer& r, VkCommandBuffer cmd) {
+void recordSceneTargetsForComputeReads(Renderer& r, VkCommandBuffer cmd) {
     Gpu& gpu = *r.gpu;
     // A target that also allows storage (the visibility resolve) is read in GENERAL layout.
     VkImageLayout hdrLayout = (desc(gpu, r.hdr).usage & VK_IMAGE_USAGE_STORAGE_BIT)
@@ -47,7 +45,7 @@ static void tonemapBarriers(Renderer& r, VkCommandBuffer cmd) {
 
 void recordTonemap(Renderer& r, VkCommandBuffer cmd, uint64_t frame) {
     Gpu& gpu = *r.gpu;
-    if (!r.taa) tonemapBarriers(r, cmd);
+    if (!r.taa) recordSceneTargetsForComputeReads(r, cmd); // (with TAA the resolve did)
     bind(gpu, cmd, r.tonemap);
     TonemapPush push{frame,
                      address(gpu, r.pixels),

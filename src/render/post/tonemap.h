@@ -17,6 +17,9 @@ namespace shadel {
 struct Renderer;
 void createTonemapPipeline(Renderer& r);
 void recordTonemap(Renderer& r, VkCommandBuffer cmd, uint64_t frame);
+// The scene colour and depth from attachments into the layouts compute passes sample them in
+// (the tonemap, or the TAA resolve before it, which leaves them there for the tonemap).
+void recordSceneTargetsForComputeReads(Renderer& r, VkCommandBuffer cmd);
 
 // Whether this frame's tonemap is fused (see above): after the frame's draws are prepared.
 bool tonemapFusedThisFrame(const Renderer& r);

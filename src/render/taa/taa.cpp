@@ -8,6 +8,7 @@
 #include "core/error.h"
 #include "core/log.h"
 #include "render/camera.h"
+#include "render/post/tonemap.h"
 #include "render/renderer.h"
 #include "taa/taa_types.h"
 
@@ -147,20 +148,7 @@ namespace {
 // with TAA on), the history images into GENERAL once.
 void taaBarriersBefore(Renderer& r, TaaState& s, VkCommandBuffer cmd) {
     Gpu& gpu = *r.gpu;
-    VkImageLayout hdrLayout = (desc(gpu, r.hdr).usage & VK_IMAGE_USAGE_STORAGE_BIT)
-                                  ? VK_IMAGE_LAYOUT_GENERAL
-                                  : VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL;
-    imageBarrier(cmd, vkImage(gpu, r.hdr), VK_IMAGE_ASPECT_COLOR_BIT,
-                 VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL, hdrLayout,
-                 VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT,
-                 VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
-                 VK_ACCESS_2_SHADER_SAMPLED_READ_BIT);
-    imageBarrier(cmd, vkImage(gpu, r.depth), VK_IMAGE_ASPECT_DEPTH_BIT,
-                 VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL,
-                 VK_PIPELINE_STAGE_2_LATE_FRAGMENT_TESTS_BIT |
-                     VK_PIPELINE_STAGE_2_EARLY_FRAGMENT_TESTS_BIT,
-                 VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT,
-                 VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_SHADER_SAMPLED_READ_BIT);
+    recordSceneTargetsForComputeReads(r, cmd);
     if (!s.layoutsReady) {
         for (TextureHandle t : {s.history[0], s.history[1], s.sharpened})
             if (t)
