@@ -7,6 +7,7 @@
 //   sky's above the horizon);
 // - decoupled reuse: an environment turning every frame leaves no stale shading.
 #include "gpu_test_env.h"
+#include "scene_files.h"
 
 #include <cmath>
 #include <cstdio>
@@ -21,19 +22,6 @@ using nlohmann::json;
 namespace {
 
 constexpr float kPi = 3.14159265358979f;
-
-// A uniform Radiance .hdr (RGBE, uncompressed scanlines) of `radiance` in every texel.
-std::string writeUniformHdr(const std::string& name, float radiance) {
-    std::string path = tempPath(name + ".hdr");
-    std::ofstream out(path, std::ios::binary);
-    out << "#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y 16 +X 32\n";
-    int exponent = 0;
-    float mantissa = std::frexp(radiance, &exponent); // radiance = mantissa * 2^exponent
-    uint8_t m = uint8_t(std::lround(mantissa * 256.0f));
-    uint8_t e = uint8_t(exponent + 128);
-    for (int i = 0; i < 16 * 32; ++i) out << m << m << m << e;
-    return path;
-}
 
 // A UV sphere of radius 1 at the origin, the given material, a camera on +Z looking at it.
 std::string writeSphere(const std::string& name, float metallic, float roughness,

@@ -15,6 +15,7 @@
 #include <nlohmann/json.hpp>
 
 #include "gpu_test_env.h"
+#include "scene_files.h"
 
 using namespace shadel;
 using namespace shadel::test;
@@ -41,20 +42,6 @@ double meanLuma(const RenderRun& run) {
     for (size_t i = 0; i < p.size(); i += 4, ++n)
         sum += 0.2126 * p[i] + 0.7152 * p[i + 1] + 0.0722 * p[i + 2];
     return sum / double(std::max<size_t>(n, 1));
-}
-
-int runShadel(const std::string& env, const std::string& args, std::string& err) {
-    std::string errFile = (std::filesystem::temp_directory_path() /
-                           ("shadel_rt_stderr_" + std::to_string(getpid()) + ".txt"))
-                              .string();
-    std::string cmd =
-        env + " timeout 120 " + SHADEL_BINARY + " " + args + " >/dev/null 2>" + errFile;
-    int status = std::system(cmd.c_str());
-    std::ifstream in(errFile);
-    std::stringstream ss;
-    ss << in.rdbuf();
-    err = ss.str();
-    return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
 }
 
 size_t lineCount(const std::string& s) {

@@ -8,6 +8,7 @@
 // - noise: two seeds of builtin:cornell agree as their sample counts say; one seed twice is the
 //   same image.
 #include "gpu_test_env.h"
+#include "scene_files.h"
 
 #include <algorithm>
 #include <cmath>
@@ -30,19 +31,6 @@ constexpr float kPi = 3.14159265358979f;
 
 bool canTrace() {
     return sharedGpu().device.optional.rayQuery;
-}
-
-// A uniform Radiance .hdr (RGBE, uncompressed scanlines) of `radiance` in every texel.
-std::string writeUniformHdr(const std::string& name, float radiance) {
-    std::string path = tempPath(name + ".hdr");
-    std::ofstream out(path, std::ios::binary);
-    out << "#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y 16 +X 32\n";
-    int exponent = 0;
-    float mantissa = std::frexp(radiance, &exponent); // radiance = mantissa * 2^exponent
-    uint8_t m = uint8_t(std::lround(mantissa * 256.0f));
-    uint8_t e = uint8_t(exponent + 128);
-    for (int i = 0; i < 16 * 32; ++i) out << m << m << m << e;
-    return path;
 }
 
 // A Lambertian material of `albedo`: KHR_materials_specular with a factor of 0 removes the
@@ -174,19 +162,6 @@ Agreement agreement(const HdrImage& image, double expected) {
     }
     if (a.pixels) a.mean /= double(a.pixels * 3);
     return a;
-}
-
-// Runs the shadel binary with `env` set before it; returns its exit code and its stderr.
-int runShadel(const std::string& env, const std::string& args, std::string& err) {
-    std::string errFile = tempPath("reference_stderr.txt");
-    std::string cmd =
-        env + " timeout 120 " + SHADEL_BINARY + " " + args + " >/dev/null 2>" + errFile;
-    int status = std::system(cmd.c_str());
-    std::ifstream in(errFile);
-    std::stringstream ss;
-    ss << in.rdbuf();
-    err = ss.str();
-    return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
 }
 
 } // namespace

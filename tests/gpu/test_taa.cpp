@@ -6,6 +6,7 @@
 #include <cstdio>
 
 #include "gpu_test_env.h"
+#include "scene_files.h"
 
 namespace shadel::test {
 namespace {
@@ -66,60 +67,26 @@ void expectOrbitCloserToSsaa(RenderMode mode, double floorGainDb) {
 // A dark wall (8 x 4 m at z = 0) and a white, glowing 1 m cube 1 m in front of it that an
 // animation slides from x = -3 to x = 3 over 2 s. Written as FILE.gltf + FILE.bin.
 std::string writeMovingCubeScene(const std::string& name) {
-    std::vector<float> f; // wall positions, normals; cube positions, normals; key times, values
-    std::vector<uint16_t> indices;
-    auto push3 = [&](float x, float y, float z) { f.insert(f.end(), {x, y, z}); };
-    for (float y : {-0.5f, 3.5f})
-        for (float x : {-4.0f, 4.0f}) push3(x, y, 0.0f);
-    for (int i = 0; i < 4; ++i) push3(0.0f, 0.0f, 1.0f);
-    indices.insert(indices.end(), {0, 1, 2, 2, 1, 3});
-    std::vector<float> cubeNormals;
-    const float cubeCentre[3] = {0.0f, 0.0f, 0.0f}, cubeHalf[3] = {0.5f, 0.5f, 0.5f};
-    appendBox(cubeCentre, cubeHalf, f, cubeNormals, indices);
-    f.insert(f.end(), cubeNormals.begin(), cubeNormals.end());
-    f.insert(f.end(), {0.0f, 2.0f, -3.0f, 1.5f, 1.0f, 3.0f, 1.5f, 1.0f});
-    using nlohmann::json;
-    auto view = gltfBufferView;
-    auto accessor = gltfAccessor;
-    size_t ib = f.size() * 4;
-    json doc;
-    doc["asset"] = {{"version", "2.0"}};
-    doc["scene"] = 0;
-    doc["scenes"] = {{{"nodes", {0, 1}}}};
-    doc["nodes"] = {{{"mesh", 0}, {"name", "wall"}},
-                    {{"mesh", 1}, {"name", "cube"}, {"translation", {-3.0, 1.5, 1.0}}}};
-    doc["bufferViews"] = {view(0, 48),  view(48, 48),  view(96, 288), view(384, 288),
-                          view(672, 8), view(680, 24), view(ib, 12),  view(ib + 12, 72)};
-    const int f32 = 5126, u16 = 5123;
-    doc["accessors"] = {accessor(0, f32, 4, "VEC3"),   accessor(1, f32, 4, "VEC3"),
-                        accessor(2, f32, 24, "VEC3"),  accessor(3, f32, 24, "VEC3"),
-                        accessor(4, f32, 2, "SCALAR"), accessor(5, f32, 2, "VEC3"),
-                        accessor(6, u16, 6, "SCALAR"), accessor(7, u16, 36, "SCALAR")};
-    doc["accessors"][0]["min"] = {-4, -0.5, 0};
-    doc["accessors"][0]["max"] = {4, 3.5, 0};
-    doc["accessors"][2]["min"] = {-0.5, -0.5, -0.5};
-    doc["accessors"][2]["max"] = {0.5, 0.5, 0.5};
-    doc["accessors"][4]["min"] = {0.0};
-    doc["accessors"][4]["max"] = {2.0};
-    json dark = {{"pbrMetallicRoughness",
-                  {{"baseColorFactor", {0.03, 0.03, 0.03, 1.0}},
-                   {"metallicFactor", 0.0},
-                   {"roughnessFactor", 0.9}}}};
-    json white = {{"pbrMetallicRoughness",
-                   {{"baseColorFactor", {1.0, 1.0, 1.0, 1.0}},
-                    {"metallicFactor", 0.0},
-                    {"roughnessFactor", 0.9}}},
-                  {"emissiveFactor", {1.0, 1.0, 1.0}}};
-    doc["materials"] = {dark, white};
-    doc["meshes"] = {
-        {{"primitives",
-          {{{"attributes", {{"POSITION", 0}, {"NORMAL", 1}}}, {"indices", 6}, {"material", 0}}}}},
-        {{"primitives",
-          {{{"attributes", {{"POSITION", 2}, {"NORMAL", 3}}}, {"indices", 7}, {"material", 1}}}}}};
-    doc["animations"] = {
-        {{"channels", {{{"sampler", 0}, {"target", {{"node", 1}, {"path", "translation"}}}}}},
-         {"samplers", {{{"input", 4}, {"output", 5}, {"interpolation", "LINEAR"}}}}}};
-    return writeGltf(name, doc, f, indices);
+    nlohmann::json dark = {{"pbrMetallicRoughness",
+                            {{"baseColorFactor", {0.03, 0.03, 0.03, 1.0}},
+                             {"metallicFactor", 0.0},
+                             {"roughnessFactor", 0.9}}}};
+    nlohmann::json white = {{"pbrMetallicRoughness",
+                             {{"baseColorFactor", {1.0, 1.0, 1.0, 1.0}},
+                              {"metallicFactor", 0.0},
+                              {"roughnessFactor", 0.9}}},
+                            {"emissiveFactor", {1.0, 1.0, 1.0}}};
+    SlidingCubeScene scene{{glm::vec3(-4.0f, -0.5f, 0.0f), glm::vec3(4.0f, -0.5f, 0.0f),
+                            glm::vec3(-4.0f, 3.5f, 0.0f), glm::vec3(4.0f, 3.5f, 0.0f)},
+                           glm::vec3(0.0f, 0.0f, 1.0f),
+                           {0, 1, 2, 2, 1, 3},
+                           glm::vec3(-3.0f, 1.5f, 1.0f),
+                           glm::vec3(3.0f, 1.5f, 1.0f),
+                           "wall",
+                           "cube",
+                           dark,
+                           white};
+    return writeSlidingCubeScene(name, scene);
 }
 
 // Per pixel of an RGBA8 image: its brightest channel.

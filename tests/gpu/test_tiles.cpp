@@ -12,6 +12,7 @@
 #include <algorithm>
 
 #include "gpu_test_env.h"
+#include "scene_files.h"
 
 using namespace shadel;
 using namespace shadel::test;
@@ -25,20 +26,6 @@ RenderOptions arena(RenderMode mode, bool screenSpace, bool classification, uint
     o.tileClassification = classification;
     o.progress = false;
     return o;
-}
-
-int runShadel(const std::string& args, std::string& err) {
-    std::string errFile = (std::filesystem::temp_directory_path() /
-                           ("shadel_tiles_stderr_" + std::to_string(getpid()) + ".txt"))
-                              .string();
-    std::string cmd =
-        std::string("timeout 120 ") + SHADEL_BINARY + " " + args + " >/dev/null 2>" + errFile;
-    int status = std::system(cmd.c_str());
-    std::ifstream in(errFile);
-    std::stringstream ss;
-    ss << in.rdbuf();
-    err = ss.str();
-    return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
 }
 
 } // namespace
@@ -105,7 +92,7 @@ TEST(Tiles, BadFlagsAreOneLineAndExitCode2) {
           "render --size 16x16 --visualize tiles",
           "render --size 16x16 --mode decoupled --marking visibility --screen-space on"}) {
         std::string err;
-        EXPECT_EQ(runShadel(args, err), 2) << args << ": " << err;
+        EXPECT_EQ(runShadel("", args, err), 2) << args << ": " << err;
         EXPECT_EQ(err.rfind("shadel: ", 0), 0u) << args << ": " << err;
         EXPECT_EQ(std::count(err.begin(), err.end(), '\n'), 1) << args << ": " << err;
     }
@@ -139,7 +126,7 @@ TEST(DistanceFields, ShadowsAgreeWithTheShadowMap) {
 
 TEST(DistanceFields, NeedScreenSpace) {
     std::string err;
-    EXPECT_EQ(runShadel("render --size 16x16 --distance-fields on", err), 2) << err;
+    EXPECT_EQ(runShadel("", "render --size 16x16 --distance-fields on", err), 2) << err;
     EXPECT_EQ(std::count(err.begin(), err.end(), '\n'), 1) << err;
-    EXPECT_EQ(runShadel("render --size 16x16 --distance-fields yes", err), 2) << err;
+    EXPECT_EQ(runShadel("", "render --size 16x16 --distance-fields yes", err), 2) << err;
 }
