@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
 
 #include "bake/bake.h"
 #include "core/log.h"
@@ -122,9 +123,14 @@ static_assert(kTextureSlotCount == TEXTURE_SLOT_COUNT && 3 * TEXTURE_SLOT_COUNT 
                   TEXTURE_SLOT_COUNT <= 4 * 4,
               "scene.h TextureSlot and shared_types.h TEXTURE_SLOT_* agree");
 
-void uploadScene(Gpu& gpu, const Scene& scene, GpuScene& out, const std::vector<BakedMesh>* baked,
-                 const std::vector<uint32_t>* streamedTextureSlots) {
-    // Textures: sRGB for colour data. Every texture gets a full mip chain and a bindless slot.
+namespace {
+
+using TextureSlotOf = std::function<uint32_t(int32_t)>;
+
+// Every texture with a full mip chain and a bindless slot, sRGB for colour data. Streamed
+// textures (render/streaming) keep their slots there; none load here.
+void uploadTextures(Gpu& gpu, const Scene& scene, GpuScene& out,
+                    const std::vector<uint32_t>* streamedTextureSlots) {
     std::vector<bool> srgb(scene.textures.size(), false);
     for (const Material& m : scene.materials) {
         if (m.baseColorTexture >= 0 && size_t(m.baseColorTexture) < srgb.size())
@@ -134,7 +140,6 @@ void uploadScene(Gpu& gpu, const Scene& scene, GpuScene& out, const std::vector<
     }
     for (const Light& l : scene.lights) // gobos and area lights' emission are colour
         if (l.texture >= 0 && size_t(l.texture) < srgb.size()) srgb[l.texture] = true;
-    // Streamed textures (render/streaming) keep their bindless slots there; none load here.
     for (size_t i = 0; !streamedTextureSlots && i < scene.textures.size(); ++i) {
         const Texture& t = scene.textures[i];
         if (t.rgba8.empty()) { // procedural: its texels exist only in the streaming file
@@ -162,16 +167,10 @@ void uploadScene(Gpu& gpu, const Scene& scene, GpuScene& out, const std::vector<
         out.textures.push_back(tex);
         out.textureViews.push_back(createReadView(gpu, tex));
     }
-    auto textureSlot = [&](int32_t index) -> uint32_t {
-        if (streamedTextureSlots)
-            return index >= 0 && size_t(index) < streamedTextureSlots->size()
-                       ? (*streamedTextureSlots)[index]
-                       : NO_TEXTURE;
-        if (index < 0 || size_t(index) >= out.textureViews.size() || !out.textureViews[index])
-            return NO_TEXTURE;
-        return slot(gpu, out.textureViews[index]).value;
-    };
+}
 
+// The GPU materials (a default one when the scene has none), their texture slots resolved.
+std::vector<gpu::GpuMaterial> buildMaterials(const Scene& scene, const TextureSlotOf& textureSlot) {
     std::vector<gpu::GpuMaterial> materials;
     for (const Material& m : scene.materials) {
         gpu::GpuMaterial g{};
@@ -211,13 +210,14 @@ void uploadScene(Gpu& gpu, const Scene& scene, GpuScene& out, const std::vector<
         materials.push_back(g);
     }
     for (gpu::GpuMaterial& g : materials) setMaterialFeatureFlags(g);
-    out.materialTexels = materialTexels(scene);
-    out.materialTexels.resize(materials.size()); // (the default material: no textures)
+    return materials;
+}
 
-    // Unified geometry.
-    std::vector<gpu::GpuVertex> vertices;
-    std::vector<glm::vec2> shadelUvs;
-    std::vector<uint32_t> indices;
+// Every mesh with its LODs into the unified vertex, shadel-UV and index arrays; baked meshes in
+// their baked vertex order, so the triangle-ID maps index their triangles.
+void appendSceneGeometry(const Scene& scene, const std::vector<BakedMesh>* baked, GpuScene& out,
+                         std::vector<gpu::GpuVertex>& vertices, std::vector<glm::vec2>& shadelUvs,
+                         std::vector<uint32_t>& indices) {
     out.meshInfo.clear();
     out.lodInfo.clear();
     out.vertexSource.clear();
@@ -255,7 +255,10 @@ void uploadScene(Gpu& gpu, const Scene& scene, GpuScene& out, const std::vector<
         out.meshInfo.push_back(g);
         out.lodInfo.push_back(lods);
     }
+}
 
+std::vector<gpu::GpuInstance> buildInstances(const Scene& scene, size_t materialCount,
+                                             GpuScene& out) {
     std::vector<gpu::GpuInstance> instances;
     out.bounds = Aabb{};
     for (const Instance& inst : scene.instances) {
@@ -267,18 +270,23 @@ void uploadScene(Gpu& gpu, const Scene& scene, GpuScene& out, const std::vector<
         g.worldMax = world.max;
         g.mesh = inst.mesh;
         uint32_t material = scene.meshes[inst.mesh].material;
-        g.material = material < materials.size() ? material : 0;
+        g.material = material < materialCount ? material : 0;
         instances.push_back(g);
         out.bounds.extend(world);
     }
-    out.instanceInfo = instances;
 
-    // Triangle-ID maps of every baked mesh and MIP, packed as 16-bit values.
+    out.instanceInfo = instances;
+    return instances;
+}
+
+// Triangle-ID maps of every baked mesh and MIP, packed as 16-bit values.
+void uploadIdMaps(Gpu& gpu, const Scene& scene, const std::vector<BakedMesh>& baked,
+                  GpuScene& out) {
     std::vector<uint16_t> idMaps;
-    if (baked) {
+    {
         out.shadelMeshes.resize(scene.meshes.size());
         for (size_t mi = 0; mi < scene.meshes.size(); ++mi) {
-            const BakedMesh& b = (*baked)[mi];
+            const BakedMesh& b = baked[mi];
             ShadelMeshInfo& info = out.shadelMeshes[mi];
             if (b.indices.empty() || b.idMaps.empty()) continue;
             info.mip0Size = {b.width, b.height};
@@ -305,9 +313,22 @@ void uploadScene(Gpu& gpu, const Scene& scene, GpuScene& out, const std::vector<
         out.idMaps = uploadArray(gpu, "scene.idMaps", idMaps.data(), idMaps.size() * 2);
         out.idMapBytes = idMaps.size() * 2;
     }
+}
 
+// The lights after the sun (which goes to out.sun*), their blocker lists and spot shadow
+// indices; the blockers and their portals.
+struct SceneLights {
     std::vector<gpu::GpuLight> lights;
     std::vector<uint32_t> lightBlockers;
+    std::vector<gpu::GpuLightBlocker> blockers;
+    std::vector<gpu::GpuLightPortal> portals;
+};
+SceneLights buildLights(const Scene& scene, GpuScene& out, const TextureSlotOf& textureSlot) {
+    SceneLights sl;
+    std::vector<gpu::GpuLight>& lights = sl.lights;
+    std::vector<uint32_t>& lightBlockers = sl.lightBlockers;
+    std::vector<gpu::GpuLightBlocker>& blockers = sl.blockers;
+    std::vector<gpu::GpuLightPortal>& portals = sl.portals;
     bool haveSun = false;
     uint32_t spotShadows = 0;
     for (const Light& l : scene.lights) {
@@ -325,8 +346,6 @@ void uploadScene(Gpu& gpu, const Scene& scene, GpuScene& out, const std::vector<
             lights.back().shadowIndex = spotShadows++;
         out.lightCastsShadow.push_back(l.castsShadow ? 1 : 0);
     }
-    std::vector<gpu::GpuLightBlocker> blockers;
-    std::vector<gpu::GpuLightPortal> portals;
     for (const LightBlocker& b : scene.blockers) {
         gpu::GpuLightBlocker g{};
         g.center = b.center;
@@ -340,6 +359,38 @@ void uploadScene(Gpu& gpu, const Scene& scene, GpuScene& out, const std::vector<
         for (const LightBlocker::Portal& p : b.portals) portals.push_back({p.min, p.max});
         blockers.push_back(g);
     }
+    return sl;
+}
+
+} // namespace
+
+void uploadScene(Gpu& gpu, const Scene& scene, GpuScene& out, const std::vector<BakedMesh>* baked,
+                 const std::vector<uint32_t>* streamedTextureSlots) {
+    uploadTextures(gpu, scene, out, streamedTextureSlots);
+    auto textureSlot = [&](int32_t index) -> uint32_t {
+        if (streamedTextureSlots)
+            return index >= 0 && size_t(index) < streamedTextureSlots->size()
+                       ? (*streamedTextureSlots)[index]
+                       : NO_TEXTURE;
+        if (index < 0 || size_t(index) >= out.textureViews.size() || !out.textureViews[index])
+            return NO_TEXTURE;
+        return slot(gpu, out.textureViews[index]).value;
+    };
+
+    std::vector<gpu::GpuMaterial> materials = buildMaterials(scene, textureSlot);
+    out.materialTexels = materialTexels(scene);
+    out.materialTexels.resize(materials.size()); // (the default material: no textures)
+    std::vector<gpu::GpuVertex> vertices;
+    std::vector<glm::vec2> shadelUvs;
+    std::vector<uint32_t> indices;
+    appendSceneGeometry(scene, baked, out, vertices, shadelUvs, indices);
+    std::vector<gpu::GpuInstance> instances = buildInstances(scene, materials.size(), out);
+    if (baked) uploadIdMaps(gpu, scene, *baked, out);
+    SceneLights sl = buildLights(scene, out, textureSlot);
+    const std::vector<gpu::GpuLight>& lights = sl.lights;
+    const std::vector<uint32_t>& lightBlockers = sl.lightBlockers;
+    const std::vector<gpu::GpuLightBlocker>& blockers = sl.blockers;
+    const std::vector<gpu::GpuLightPortal>& portals = sl.portals;
     out.skyColor = scene.skyColor;
     out.emitters = scene.emitters;
     out.decals = scene.decals;

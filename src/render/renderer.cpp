@@ -371,28 +371,11 @@ static void updateLights(Renderer& r, const GpuScene& scene, gpu::FrameConstants
 // Decoupled replaces shading with marking, allocation, work queues, shadel shading and
 // reconstruction (render/shadel/decoupled.h). With TAA the camera is jittered and the resolve
 // runs before the tonemap (render/taa).
-FrameResult renderFrame(Renderer& r, const GpuScene& scene, const CameraView& unjittered) {
-    Gpu& gpu = *r.gpu;
-    const CameraView camera = r.taa ? prepareTaaFrame(r, unjittered) : unjittered;
-    double threadStart = threadCpuMs();
-    using Clock = std::chrono::steady_clock;
-    auto msSince = [](Clock::time_point t) {
-        return std::chrono::duration<double, std::milli>(Clock::now() - t).count();
-    };
-    Clock::time_point cpuStart = Clock::now();
-    double startMs = std::chrono::duration<double, std::milli>(cpuStart - r.createdAt).count();
-    r.cpuScopes.clear();
-    r.frontendTaken.clear();
-    r.frameCpuStart = cpuStart;
-    r.recorder.timeRecording = r.settings.cpuScopes;
-    r.sceneIndices = scene.indices;
-    r.sceneVisibilityIndices = scene.visibilityIndices;
-    // Uncovered pixels: the environment, or the radiance the display curve shows as the solid
-    // --background colour (the clears of the colour passes use it too).
-    r.skyColor = r.settings.backgroundEnvironment
-                     ? scene.skyColor
-                     : radianceForDisplay(r.settings.backgroundColor, r.settings.exposure,
-                                          r.settings.tonemap);
+// The frame's CPU frontends in order (lights, streaming, culling, decoupled allocation,
+// transparency, shadows, ray tracing...): they fill the frame constants the passes read.
+// `streamingMs`: the texture streaming frontend's CPU time.
+static gpu::FrameConstants prepareFrame(Renderer& r, const GpuScene& scene,
+                                        const CameraView& camera, double& streamingMs) {
     gpu::FrameConstants constants;
     {
         auto timer = cpuScope(r, "constants + lights");
@@ -410,7 +393,6 @@ FrameResult renderFrame(Renderer& r, const GpuScene& scene, const CameraView& un
     // the decoupled frontend (which must not carry over shading of re-streamed textures).
     r.changedMaterials.clear();
     // The streaming frontend's CPU time (its pass may be recorded on a worker: rhi/frame.h).
-    double streamingMs = 0.0;
     if (r.streaming) {
         auto timer = cpuScope(r, "texture streaming");
         double streamingStart = threadCpuMs();
@@ -464,6 +446,97 @@ FrameResult renderFrame(Renderer& r, const GpuScene& scene, const CameraView& un
         prepareRayTracingFrame(r, scene, camera, constants);
     }
     if (r.reference) prepareReferenceFrame(r, camera);
+    return constants;
+}
+
+// When and how long the CPU worked on a frame, for its result.
+struct FrameCpuTimes {
+    std::chrono::steady_clock::time_point start;
+    double threadStartMs = 0.0, startMs = 0.0, prepareMs = 0.0, streamingMs = 0.0;
+};
+
+// After the frame's submission: its pixels read back, every technique's per-frame statistics
+// and bookkeeping, the timings.
+static FrameResult finishFrame(Renderer& r, FrameCpuTimes t) {
+    Gpu& gpu = *r.gpu;
+    FrameRecorder& rec = r.recorder;
+    auto msSince = [](std::chrono::steady_clock::time_point at) {
+        return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - at)
+            .count();
+    };
+    FrameResult result;
+    result.passes = rec.passes;
+    result.tonemapFused = r.tonemapFused;
+    result.recordingMs = rec.recordingMs;
+    result.recordingWorkers = rec.workerTimings;
+    result.frameMs = rec.frameMs;
+    result.startMs = t.startMs;
+    result.cpuPrepareMs = t.prepareMs;
+    // CPU cost: the whole call minus the time spent waiting for the GPU (submit-per-pass waits
+    // inside the passes, so this is an upper bound there).
+    result.cpuFrameMs = t.prepareMs + std::max(0.0, msSince(t.start) - t.prepareMs - rec.gpuWaitMs);
+    auto finishing = cpuScope(r, "finish: read back, stats");
+    result.shaderAsserts = collectShaderMessages(gpu, r.messages);
+    result.prints = r.messages.prints;
+    result.transparentDecoupledDraws = decoupledTransparentDraws(r);
+    result.transparentDraws =
+        uint32_t(transparentDrawOrder(r).size()) + result.transparentDecoupledDraws;
+    if (r.decoupled) finishDecoupledFrame(r);
+    if (r.taa) finishTaaFrame(r);
+    readLightCullingStats(r);
+    readFeatureSpectraStats(r);
+    readDecalStats(r);
+    finishCullingFrame(r);
+    if (r.rt) finishRayTracingFrame(r);
+    finishScreenSpaceFrame(r);
+    if (r.streaming) {
+        double finishStart = threadCpuMs();
+        finishTextureStreamingFrame(*r.streaming);
+        t.streamingMs += threadCpuMs() - finishStart;
+    }
+    finishSceneEdits(r);
+    r.framesRendered++;
+    size_t bytes = size_t(r.settings.width) * r.settings.height * 4;
+    result.rgba.resize(bytes);
+    std::memcpy(result.rgba.data(), mapped(gpu, r.pixels), bytes);
+    for (size_t i = 3; i < bytes; i += 4) result.pixelsCovered += result.rgba[i] != 0;
+    finishing.stop();
+    result.cpuThreadMs = threadCpuMs() - t.threadStartMs;
+    result.cpuScopes = std::move(r.cpuScopes);
+    double recorderStartMs =
+        std::chrono::duration<double, std::milli>(rec.frameStart - t.start).count();
+    for (CpuScope submit : rec.submits) { // from the recorder's frame start
+        submit.startMs += recorderStartMs;
+        result.cpuScopes.push_back(std::move(submit));
+    }
+    result.cpuStreamingMs = t.streamingMs;
+    return result;
+}
+
+FrameResult renderFrame(Renderer& r, const GpuScene& scene, const CameraView& unjittered) {
+    Gpu& gpu = *r.gpu;
+    const CameraView camera = r.taa ? prepareTaaFrame(r, unjittered) : unjittered;
+    double threadStart = threadCpuMs();
+    using Clock = std::chrono::steady_clock;
+    auto msSince = [](Clock::time_point t) {
+        return std::chrono::duration<double, std::milli>(Clock::now() - t).count();
+    };
+    Clock::time_point cpuStart = Clock::now();
+    double startMs = std::chrono::duration<double, std::milli>(cpuStart - r.createdAt).count();
+    r.cpuScopes.clear();
+    r.frontendTaken.clear();
+    r.frameCpuStart = cpuStart;
+    r.recorder.timeRecording = r.settings.cpuScopes;
+    r.sceneIndices = scene.indices;
+    r.sceneVisibilityIndices = scene.visibilityIndices;
+    // Uncovered pixels: the environment, or the radiance the display curve shows as the solid
+    // --background colour (the clears of the colour passes use it too).
+    r.skyColor = r.settings.backgroundEnvironment
+                     ? scene.skyColor
+                     : radianceForDisplay(r.settings.backgroundColor, r.settings.exposure,
+                                          r.settings.tonemap);
+    double streamingMs = 0.0;
+    gpu::FrameConstants constants = prepareFrame(r, scene, camera, streamingMs);
     std::memcpy(mapped(gpu, r.frameConstants), &constants, sizeof(constants));
     uint64_t frame = address(gpu, r.frameConstants);
     double prepareMs = msSince(cpuStart);
@@ -555,53 +628,7 @@ FrameResult renderFrame(Renderer& r, const GpuScene& scene, const CameraView& un
         endFrame(rec);
     }
 
-    FrameResult result;
-    result.passes = rec.passes;
-    result.tonemapFused = r.tonemapFused;
-    result.recordingMs = rec.recordingMs;
-    result.recordingWorkers = rec.workerTimings;
-    result.frameMs = rec.frameMs;
-    result.startMs = startMs;
-    result.cpuPrepareMs = prepareMs;
-    // CPU cost: the whole call minus the time spent waiting for the GPU (submit-per-pass waits
-    // inside the passes, so this is an upper bound there).
-    result.cpuFrameMs = prepareMs + std::max(0.0, msSince(cpuStart) - prepareMs - rec.gpuWaitMs);
-    auto finishing = cpuScope(r, "finish: read back, stats");
-    result.shaderAsserts = collectShaderMessages(gpu, r.messages);
-    result.prints = r.messages.prints;
-    result.transparentDecoupledDraws = decoupledTransparentDraws(r);
-    result.transparentDraws =
-        uint32_t(transparentDrawOrder(r).size()) + result.transparentDecoupledDraws;
-    if (r.decoupled) finishDecoupledFrame(r);
-    if (r.taa) finishTaaFrame(r);
-    readLightCullingStats(r);
-    readFeatureSpectraStats(r);
-    readDecalStats(r);
-    finishCullingFrame(r);
-    if (r.rt) finishRayTracingFrame(r);
-    finishScreenSpaceFrame(r);
-    if (r.streaming) {
-        double finishStart = threadCpuMs();
-        finishTextureStreamingFrame(*r.streaming);
-        streamingMs += threadCpuMs() - finishStart;
-    }
-    finishSceneEdits(r);
-    r.framesRendered++;
-    size_t bytes = size_t(r.settings.width) * r.settings.height * 4;
-    result.rgba.resize(bytes);
-    std::memcpy(result.rgba.data(), mapped(gpu, r.pixels), bytes);
-    for (size_t i = 3; i < bytes; i += 4) result.pixelsCovered += result.rgba[i] != 0;
-    finishing.stop();
-    result.cpuThreadMs = threadCpuMs() - threadStart;
-    result.cpuScopes = std::move(r.cpuScopes);
-    double recorderStartMs =
-        std::chrono::duration<double, std::milli>(rec.frameStart - cpuStart).count();
-    for (CpuScope submit : rec.submits) { // from the recorder's frame start
-        submit.startMs += recorderStartMs;
-        result.cpuScopes.push_back(std::move(submit));
-    }
-    result.cpuStreamingMs = streamingMs;
-    return result;
+    return finishFrame(r, {cpuStart, threadStart, startMs, prepareMs, streamingMs});
 }
 
 } // namespace shadel

@@ -276,7 +276,11 @@ static VkPhysicalDevice choosePhysicalDevice(VkInstance instance, const std::str
     return best;
 }
 
-void createDevice(Device& device, const DeviceDesc& desc) {
+namespace {
+
+// The instance (Vulkan 1.3; the validation layer and its messenger when asked), and the debug
+// utils entry points that name objects and passes.
+void createInstance(Device& device, const DeviceDesc& desc) {
     device.printValidation = desc.printValidation;
     VkApplicationInfo app{VK_STRUCTURE_TYPE_APPLICATION_INFO};
     app.pApplicationName = "shadel";
@@ -333,7 +337,12 @@ void createDevice(Device& device, const DeviceDesc& desc) {
                 VK_CHECK(create(device.instance, &messengerInfo, nullptr, &device.messenger));
         }
     }
+}
 
+// The physical device's properties, driver and the one queue family the engine uses (graphics,
+// compute, timestamps); returns every family's properties.
+std::vector<VkQueueFamilyProperties> describePhysicalDevice(Device& device,
+                                                            const DeviceDesc& desc) {
     device.physical = choosePhysicalDevice(device.instance, desc.selection);
     vkGetPhysicalDeviceProperties(device.physical, &device.properties);
     vkGetPhysicalDeviceMemoryProperties(device.physical, &device.memory);
@@ -364,11 +373,17 @@ void createDevice(Device& device, const DeviceDesc& desc) {
         throw DeviceError(
             format("%s has no graphics+compute queue with timestamps", device.name.c_str()));
 
+    return families;
+}
+
+// Exactly what the engine requires, plus optional core features when present (sparse
+// residency among them).
+void requiredFeatures(Device& device, const std::vector<VkQueueFamilyProperties>& families,
+                      FeatureChain& enable) {
     // Enable exactly what we require, plus optional features when present.
     FeatureChain f;
     f.link();
     vkGetPhysicalDeviceFeatures2(device.physical, &f.core);
-    FeatureChain enable;
     enable.link();
     enable.v13.dynamicRendering = VK_TRUE;
     enable.v13.synchronization2 = VK_TRUE;
@@ -416,10 +431,11 @@ void createDevice(Device& device, const DeviceDesc& desc) {
         enable.core.features.sparseResidencyImage2D = VK_TRUE;
         device.optional.sparseResidency = true;
     }
+}
 
-    auto exts = deviceExtensions(device.physical);
-    std::vector<const char*> deviceExts;
-    void* tail = nullptr;
+// Optional device extensions the device has (mesh shaders, ray queries, compute derivatives),
+// their feature structs chained from `tail`. Not copyable: the chain points into it.
+struct OptionalExtensions {
     VkPhysicalDeviceMeshShaderFeaturesEXT mesh{
         VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_MESH_SHADER_FEATURES_EXT};
     VkPhysicalDeviceRayQueryFeaturesKHR rayQuery{
@@ -428,17 +444,26 @@ void createDevice(Device& device, const DeviceDesc& desc) {
         VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_ACCELERATION_STRUCTURE_FEATURES_KHR};
     VkPhysicalDeviceComputeShaderDerivativesFeaturesNV derivs{
         VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_COMPUTE_SHADER_DERIVATIVES_FEATURES_NV};
-    if (hasExtension(exts, VK_EXT_MESH_SHADER_EXTENSION_NAME)) {
+    std::vector<const char*> deviceExts;
+    void* tail = nullptr;
+    OptionalExtensions() = default;
+    OptionalExtensions(const OptionalExtensions&) = delete;
+    OptionalExtensions& operator=(const OptionalExtensions&) = delete;
+};
+
+void chainOptionalExtensions(Device& device, const std::vector<VkExtensionProperties>& available,
+                             OptionalExtensions& o) {
+    if (hasExtension(available, VK_EXT_MESH_SHADER_EXTENSION_NAME)) {
         VkPhysicalDeviceFeatures2 q{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2};
-        q.pNext = &mesh;
+        q.pNext = &o.mesh;
         vkGetPhysicalDeviceFeatures2(device.physical, &q);
-        if (mesh.meshShader && mesh.taskShader) {
-            mesh.multiviewMeshShader = VK_FALSE;
-            mesh.primitiveFragmentShadingRateMeshShader = VK_FALSE;
-            mesh.meshShaderQueries = VK_FALSE;
-            deviceExts.push_back(VK_EXT_MESH_SHADER_EXTENSION_NAME);
-            mesh.pNext = tail;
-            tail = &mesh;
+        if (o.mesh.meshShader && o.mesh.taskShader) {
+            o.mesh.multiviewMeshShader = VK_FALSE;
+            o.mesh.primitiveFragmentShadingRateMeshShader = VK_FALSE;
+            o.mesh.meshShaderQueries = VK_FALSE;
+            o.deviceExts.push_back(VK_EXT_MESH_SHADER_EXTENSION_NAME);
+            o.mesh.pNext = o.tail;
+            o.tail = &o.mesh;
             device.optional.meshShader = true;
         }
     }
@@ -446,46 +471,59 @@ void createDevice(Device& device, const DeviceDesc& desc) {
     // the --rt-* error path on a device that has it).
     const char* noRayQuery = std::getenv("SHADEL_DISABLE_RAY_QUERY");
     bool rayQueryAllowed = !noRayQuery || std::strcmp(noRayQuery, "1") != 0;
-    if (rayQueryAllowed && hasExtension(exts, VK_KHR_RAY_QUERY_EXTENSION_NAME) &&
-        hasExtension(exts, VK_KHR_ACCELERATION_STRUCTURE_EXTENSION_NAME) &&
-        hasExtension(exts, VK_KHR_DEFERRED_HOST_OPERATIONS_EXTENSION_NAME)) {
+    if (rayQueryAllowed && hasExtension(available, VK_KHR_RAY_QUERY_EXTENSION_NAME) &&
+        hasExtension(available, VK_KHR_ACCELERATION_STRUCTURE_EXTENSION_NAME) &&
+        hasExtension(available, VK_KHR_DEFERRED_HOST_OPERATIONS_EXTENSION_NAME)) {
         VkPhysicalDeviceFeatures2 q{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2};
-        q.pNext = &rayQuery;
-        rayQuery.pNext = &accel;
+        q.pNext = &o.rayQuery;
+        o.rayQuery.pNext = &o.accel;
         vkGetPhysicalDeviceFeatures2(device.physical, &q);
-        if (rayQuery.rayQuery && accel.accelerationStructure) {
-            deviceExts.push_back(VK_KHR_RAY_QUERY_EXTENSION_NAME);
-            deviceExts.push_back(VK_KHR_ACCELERATION_STRUCTURE_EXTENSION_NAME);
-            deviceExts.push_back(VK_KHR_DEFERRED_HOST_OPERATIONS_EXTENSION_NAME);
+        if (o.rayQuery.rayQuery && o.accel.accelerationStructure) {
+            o.deviceExts.push_back(VK_KHR_RAY_QUERY_EXTENSION_NAME);
+            o.deviceExts.push_back(VK_KHR_ACCELERATION_STRUCTURE_EXTENSION_NAME);
+            o.deviceExts.push_back(VK_KHR_DEFERRED_HOST_OPERATIONS_EXTENSION_NAME);
             VkPhysicalDeviceRayQueryFeaturesKHR rq{
                 VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_RAY_QUERY_FEATURES_KHR};
-            rayQuery = rq;
-            rayQuery.rayQuery = VK_TRUE;
+            o.rayQuery = rq;
+            o.rayQuery.rayQuery = VK_TRUE;
             VkPhysicalDeviceAccelerationStructureFeaturesKHR as{
                 VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_ACCELERATION_STRUCTURE_FEATURES_KHR};
-            accel = as;
-            accel.accelerationStructure = VK_TRUE;
-            rayQuery.pNext = &accel;
-            accel.pNext = tail;
-            tail = &rayQuery;
+            o.accel = as;
+            o.accel.accelerationStructure = VK_TRUE;
+            o.rayQuery.pNext = &o.accel;
+            o.accel.pNext = o.tail;
+            o.tail = &o.rayQuery;
             device.optional.rayQuery = true;
         } else {
-            rayQuery.pNext = nullptr;
+            o.rayQuery.pNext = nullptr;
         }
     }
-    if (hasExtension(exts, VK_NV_COMPUTE_SHADER_DERIVATIVES_EXTENSION_NAME)) {
+    if (hasExtension(available, VK_NV_COMPUTE_SHADER_DERIVATIVES_EXTENSION_NAME)) {
         VkPhysicalDeviceFeatures2 q{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2};
-        q.pNext = &derivs;
+        q.pNext = &o.derivs;
         vkGetPhysicalDeviceFeatures2(device.physical, &q);
-        if (derivs.computeDerivativeGroupQuads) {
-            deviceExts.push_back(VK_NV_COMPUTE_SHADER_DERIVATIVES_EXTENSION_NAME);
-            derivs.computeDerivativeGroupLinear = VK_FALSE;
-            derivs.pNext = tail;
-            tail = &derivs;
+        if (o.derivs.computeDerivativeGroupQuads) {
+            o.deviceExts.push_back(VK_NV_COMPUTE_SHADER_DERIVATIVES_EXTENSION_NAME);
+            o.derivs.computeDerivativeGroupLinear = VK_FALSE;
+            o.derivs.pNext = o.tail;
+            o.tail = &o.derivs;
             device.optional.computeDerivatives = true;
         }
     }
-    enable.v13.pNext = tail;
+}
+
+} // namespace
+
+void createDevice(Device& device, const DeviceDesc& desc) {
+    createInstance(device, desc);
+    std::vector<VkQueueFamilyProperties> families = describePhysicalDevice(device, desc);
+    FeatureChain enable;
+    requiredFeatures(device, families, enable);
+    auto exts = deviceExtensions(device.physical);
+    OptionalExtensions optional;
+    chainOptionalExtensions(device, exts, optional);
+    std::vector<const char*>& deviceExts = optional.deviceExts;
+    enable.v13.pNext = optional.tail;
 
     float priority = 1.0f;
     VkDeviceQueueCreateInfo qci{VK_STRUCTURE_TYPE_DEVICE_QUEUE_CREATE_INFO};
@@ -504,7 +542,7 @@ void createDevice(Device& device, const DeviceDesc& desc) {
     }
     dci.enabledExtensionCount = uint32_t(deviceExts.size());
     dci.ppEnabledExtensionNames = deviceExts.data();
-    r = vkCreateDevice(device.physical, &dci, nullptr, &device.device);
+    VkResult r = vkCreateDevice(device.physical, &dci, nullptr, &device.device);
     if (r != VK_SUCCESS)
         throw DeviceError(format("cannot create the Vulkan device on %s (%s)", device.name.c_str(),
                                  vkResultName(r)));

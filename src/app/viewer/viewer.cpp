@@ -121,6 +121,106 @@ bool applyViewerKeys(const ViewerInput& input, GLFWwindow* window, CameraControl
     return false;
 }
 
+// Shows the renderer's frame in the window: copied into the swapchain image, the panel drawn
+// over it, read back first when `screenshot` (written to --screenshot); returns once presented.
+void presentFrame(Gpu& gpu, ViewerWindow& window, ViewerUi& ui, const ViewOptions& o,
+                  BufferHandle upload, BufferHandle readback, const FrameResult& result,
+                  bool screenshot) {
+    VkDevice dev = gpu.device.device;
+    uint32_t image = 0;
+    VkResult acquired = vkAcquireNextImageKHR(dev, window.swapchain, UINT64_MAX, window.acquired,
+                                              VK_NULL_HANDLE, &image);
+    if (acquired != VK_SUCCESS && acquired != VK_SUBOPTIMAL_KHR)
+        throw DeviceError(
+            format("shadel view: cannot acquire a swapchain image (%d)", int(acquired)));
+    copyPixels(result.rgba, window.bgra, static_cast<uint8_t*>(mapped(gpu, upload)));
+    VkCommandBuffer cmd = window.cmd;
+    VK_CHECK(vkResetCommandBuffer(cmd, 0));
+    VkCommandBufferBeginInfo bi{VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
+    bi.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
+    VK_CHECK(vkBeginCommandBuffer(cmd, &bi));
+    beginLabel(gpu, cmd, "present");
+    VkImage target = window.images[image];
+    imageBarrier(cmd, target, VK_IMAGE_ASPECT_COLOR_BIT, VK_IMAGE_LAYOUT_UNDEFINED,
+                 VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL,
+                 VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT, 0, VK_PIPELINE_STAGE_2_COPY_BIT,
+                 VK_ACCESS_2_TRANSFER_WRITE_BIT);
+    VkBufferImageCopy copy{};
+    copy.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
+    copy.imageExtent = {o.width, o.height, 1};
+    vkCmdCopyBufferToImage(cmd, vkBuffer(gpu, upload), target, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL,
+                           1, &copy);
+    VkImageLayout layout = VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL;
+    VkPipelineStageFlags2 stage = VK_PIPELINE_STAGE_2_COPY_BIT;
+    VkAccessFlags2 access = VK_ACCESS_2_TRANSFER_WRITE_BIT;
+    if (ui.enabled) {
+        imageBarrier(cmd, target, VK_IMAGE_ASPECT_COLOR_BIT, layout,
+                     VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL, stage, access,
+                     VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT,
+                     VK_ACCESS_2_COLOR_ATTACHMENT_READ_BIT |
+                         VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT);
+        recordUi(ui, cmd, image, window.extent); // leaves PRESENT_SRC
+        layout = VK_IMAGE_LAYOUT_PRESENT_SRC_KHR;
+        stage = VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT;
+        access = VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT;
+    }
+    if (screenshot) { // what the window shows, read back before it is presented
+        imageBarrier(cmd, target, VK_IMAGE_ASPECT_COLOR_BIT, layout,
+                     VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, stage, access,
+                     VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_TRANSFER_READ_BIT);
+        vkCmdCopyImageToBuffer(cmd, target, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL,
+                               vkBuffer(gpu, readback), 1, &copy);
+        memoryBarrier(cmd, VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT,
+                      VK_PIPELINE_STAGE_2_HOST_BIT, VK_ACCESS_2_HOST_READ_BIT);
+        layout = VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL;
+        stage = VK_PIPELINE_STAGE_2_COPY_BIT;
+        access = 0;
+    }
+    if (layout != VK_IMAGE_LAYOUT_PRESENT_SRC_KHR)
+        imageBarrier(cmd, target, VK_IMAGE_ASPECT_COLOR_BIT, layout,
+                     VK_IMAGE_LAYOUT_PRESENT_SRC_KHR, stage, access,
+                     VK_PIPELINE_STAGE_2_BOTTOM_OF_PIPE_BIT, 0);
+    endLabel(gpu, cmd);
+    VK_CHECK(vkEndCommandBuffer(cmd));
+    VkSemaphoreSubmitInfo wait{VK_STRUCTURE_TYPE_SEMAPHORE_SUBMIT_INFO};
+    wait.semaphore = window.acquired;
+    wait.stageMask = VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT;
+    VkSemaphoreSubmitInfo signal{VK_STRUCTURE_TYPE_SEMAPHORE_SUBMIT_INFO};
+    signal.semaphore = window.presentReady[image];
+    signal.stageMask = VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT;
+    VkCommandBufferSubmitInfo cbi{VK_STRUCTURE_TYPE_COMMAND_BUFFER_SUBMIT_INFO};
+    cbi.commandBuffer = cmd;
+    VkSubmitInfo2 si{VK_STRUCTURE_TYPE_SUBMIT_INFO_2};
+    si.waitSemaphoreInfoCount = 1;
+    si.pWaitSemaphoreInfos = &wait;
+    si.signalSemaphoreInfoCount = 1;
+    si.pSignalSemaphoreInfos = &signal;
+    si.commandBufferInfoCount = 1;
+    si.pCommandBufferInfos = &cbi;
+    VK_CHECK(vkResetFences(dev, 1, &window.done));
+    VK_CHECK(vkQueueSubmit2(gpu.device.queue, 1, &si, window.done));
+    VkPresentInfoKHR pi{VK_STRUCTURE_TYPE_PRESENT_INFO_KHR};
+    pi.waitSemaphoreCount = 1;
+    pi.pWaitSemaphores = &window.presentReady[image];
+    pi.swapchainCount = 1;
+    pi.pSwapchains = &window.swapchain;
+    pi.pImageIndices = &image;
+    VkResult presented = vkQueuePresentKHR(gpu.device.queue, &pi);
+    if (presented != VK_SUCCESS && presented != VK_SUBOPTIMAL_KHR)
+        throw DeviceError(format("shadel view: present failed (%d)", int(presented)));
+    VK_CHECK(vkWaitForFences(dev, 1, &window.done, VK_TRUE, UINT64_MAX));
+
+    if (screenshot) {
+        std::vector<uint8_t> pixels(size_t(o.width) * o.height * 4);
+        copyPixels(
+            std::vector<uint8_t>(static_cast<uint8_t*>(mapped(gpu, readback)),
+                                 static_cast<uint8_t*>(mapped(gpu, readback)) + pixels.size()),
+            window.bgra, pixels.data());
+        writePng(o.screenshot, pixels, o.width, o.height);
+        SHADEL_INFO("shadel view: screenshot -> %s", o.screenshot.c_str());
+    }
+}
+
 } // namespace
 
 int runViewer(const ViewOptions& o, DeviceDesc deviceDesc) {
@@ -219,98 +319,7 @@ int runViewer(const ViewOptions& o, DeviceDesc deviceDesc) {
             }
             bool screenshot = !o.screenshot.empty() && (lastFrame || panel.screenshotRequested);
 
-            uint32_t image = 0;
-            VkResult acquired = vkAcquireNextImageKHR(dev, window.swapchain, UINT64_MAX,
-                                                      window.acquired, VK_NULL_HANDLE, &image);
-            if (acquired != VK_SUCCESS && acquired != VK_SUBOPTIMAL_KHR)
-                throw DeviceError(
-                    format("shadel view: cannot acquire a swapchain image (%d)", int(acquired)));
-            copyPixels(result.rgba, window.bgra, static_cast<uint8_t*>(mapped(gpu, upload)));
-            VkCommandBuffer cmd = window.cmd;
-            VK_CHECK(vkResetCommandBuffer(cmd, 0));
-            VkCommandBufferBeginInfo bi{VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
-            bi.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
-            VK_CHECK(vkBeginCommandBuffer(cmd, &bi));
-            beginLabel(gpu, cmd, "present");
-            VkImage target = window.images[image];
-            imageBarrier(cmd, target, VK_IMAGE_ASPECT_COLOR_BIT, VK_IMAGE_LAYOUT_UNDEFINED,
-                         VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL,
-                         VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT, 0,
-                         VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT);
-            VkBufferImageCopy copy{};
-            copy.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
-            copy.imageExtent = {o.width, o.height, 1};
-            vkCmdCopyBufferToImage(cmd, vkBuffer(gpu, upload), target,
-                                   VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1, &copy);
-            VkImageLayout layout = VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL;
-            VkPipelineStageFlags2 stage = VK_PIPELINE_STAGE_2_COPY_BIT;
-            VkAccessFlags2 access = VK_ACCESS_2_TRANSFER_WRITE_BIT;
-            if (ui.enabled) {
-                imageBarrier(cmd, target, VK_IMAGE_ASPECT_COLOR_BIT, layout,
-                             VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL, stage, access,
-                             VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT,
-                             VK_ACCESS_2_COLOR_ATTACHMENT_READ_BIT |
-                                 VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT);
-                recordUi(ui, cmd, image, window.extent); // leaves PRESENT_SRC
-                layout = VK_IMAGE_LAYOUT_PRESENT_SRC_KHR;
-                stage = VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT;
-                access = VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT;
-            }
-            if (screenshot) { // what the window shows, read back before it is presented
-                imageBarrier(cmd, target, VK_IMAGE_ASPECT_COLOR_BIT, layout,
-                             VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, stage, access,
-                             VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_TRANSFER_READ_BIT);
-                vkCmdCopyImageToBuffer(cmd, target, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL,
-                                       vkBuffer(gpu, readback), 1, &copy);
-                memoryBarrier(cmd, VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT,
-                              VK_PIPELINE_STAGE_2_HOST_BIT, VK_ACCESS_2_HOST_READ_BIT);
-                layout = VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL;
-                stage = VK_PIPELINE_STAGE_2_COPY_BIT;
-                access = 0;
-            }
-            if (layout != VK_IMAGE_LAYOUT_PRESENT_SRC_KHR)
-                imageBarrier(cmd, target, VK_IMAGE_ASPECT_COLOR_BIT, layout,
-                             VK_IMAGE_LAYOUT_PRESENT_SRC_KHR, stage, access,
-                             VK_PIPELINE_STAGE_2_BOTTOM_OF_PIPE_BIT, 0);
-            endLabel(gpu, cmd);
-            VK_CHECK(vkEndCommandBuffer(cmd));
-            VkSemaphoreSubmitInfo wait{VK_STRUCTURE_TYPE_SEMAPHORE_SUBMIT_INFO};
-            wait.semaphore = window.acquired;
-            wait.stageMask = VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT;
-            VkSemaphoreSubmitInfo signal{VK_STRUCTURE_TYPE_SEMAPHORE_SUBMIT_INFO};
-            signal.semaphore = window.presentReady[image];
-            signal.stageMask = VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT;
-            VkCommandBufferSubmitInfo cbi{VK_STRUCTURE_TYPE_COMMAND_BUFFER_SUBMIT_INFO};
-            cbi.commandBuffer = cmd;
-            VkSubmitInfo2 si{VK_STRUCTURE_TYPE_SUBMIT_INFO_2};
-            si.waitSemaphoreInfoCount = 1;
-            si.pWaitSemaphoreInfos = &wait;
-            si.signalSemaphoreInfoCount = 1;
-            si.pSignalSemaphoreInfos = &signal;
-            si.commandBufferInfoCount = 1;
-            si.pCommandBufferInfos = &cbi;
-            VK_CHECK(vkResetFences(dev, 1, &window.done));
-            VK_CHECK(vkQueueSubmit2(gpu.device.queue, 1, &si, window.done));
-            VkPresentInfoKHR pi{VK_STRUCTURE_TYPE_PRESENT_INFO_KHR};
-            pi.waitSemaphoreCount = 1;
-            pi.pWaitSemaphores = &window.presentReady[image];
-            pi.swapchainCount = 1;
-            pi.pSwapchains = &window.swapchain;
-            pi.pImageIndices = &image;
-            VkResult presented = vkQueuePresentKHR(gpu.device.queue, &pi);
-            if (presented != VK_SUCCESS && presented != VK_SUBOPTIMAL_KHR)
-                throw DeviceError(format("shadel view: present failed (%d)", int(presented)));
-            VK_CHECK(vkWaitForFences(dev, 1, &window.done, VK_TRUE, UINT64_MAX));
-
-            if (screenshot) {
-                std::vector<uint8_t> pixels(size_t(o.width) * o.height * 4);
-                copyPixels(std::vector<uint8_t>(static_cast<uint8_t*>(mapped(gpu, readback)),
-                                                static_cast<uint8_t*>(mapped(gpu, readback)) +
-                                                    pixels.size()),
-                           window.bgra, pixels.data());
-                writePng(o.screenshot, pixels, o.width, o.height);
-                SHADEL_INFO("shadel view: screenshot -> %s", o.screenshot.c_str());
-            }
+            presentFrame(gpu, window, ui, o, upload, readback, result, screenshot);
             ++frame;
             if (lastFrame) break;
             if (panel.modeChanged || panel.cameraModeChanged || panel.visualizeChanged ||
