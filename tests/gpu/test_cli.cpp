@@ -376,10 +376,11 @@ TEST(Cli, BlockingCollidingOrWrappingOutputsFailBeforeRendering) {
     EXPECT_EQ(dir.entries(), 1u) << "only the FIFO: nothing written";
 }
 
-// Small files that used to hang: a 1 MB strip of a million copies of one triangle (automatic
-// framing cost triangles x covered cells, vertex cache optimization triangles x valence) and a
-// grid of 100k instances. Each now renders well within the harness's 120 s timeout (measured
-// 3.5 s and 4.6 s on a 2-core lavapipe machine); the strip is drawn as its two faces.
+// Small files whose cost must stay linear: a 1 MB strip of a million copies of one triangle
+// (automatic framing marks each grid cell once; vertex-cache optimization is skipped at high
+// valence; repeated triangles are drawn once) and a grid of 100k instances. Each renders well
+// within the harness's 120 s timeout (3.5 s and 4.6 s on a 2-core lavapipe machine); the strip
+// is drawn as its two faces.
 TEST(Cli, HostileGeometryRendersInLinearTime) {
     CliTempDir dir;
     const uint32_t copies = 1000000;

@@ -263,8 +263,8 @@ TEST(GltfLimits, WorkingDirectoryIsNotSearchedForBuffers) {
     EXPECT_EQ(r.instances, 0u);
 }
 
-// Sparse accessor fields the importer holds as int: 2^32 and 2^32 + 1 used to wrap to 0 and 1
-// and be accepted; they are refused by name.
+// Sparse accessor fields the importer holds as int: 2^32 and 2^32 + 1 would wrap to 0 and 1;
+// they are refused by name.
 TEST(GltfLimits, SparseCountAndOffsetBeyondTheImportersRangeAreRefused) {
     ModelDir dir;
     writeFile(dir.file("model/tri.bin"), triangleBytes());
