@@ -9,12 +9,14 @@
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
+#include <fstream>
 #include <random>
 
 #include "bake/block_compression/block_compression.h"
 #include "conformance_oracle.h"
 #include "rhi/frame.h"
 #include "rhi/pipeline.h"
+#include "scene_files.h"
 
 using namespace shadel;
 using namespace shadel::test;
@@ -177,4 +179,26 @@ TEST(TextureCompressionRender, StreamedModelsAgainstTheSampleViewer) {
         }
         fs::remove_all(scene.parent_path());
     }
+}
+
+// Without device support the file is RGBA8: a warning naming the reason, the reason in the stats,
+// 4 bytes a texel; and a bad --texture-compression value is one input error.
+TEST(TextureCompressionRender, WithoutDeviceSupportTexturesStreamAsRgba8) {
+    const std::string stats = tempPath("texture_compression_fallback.json");
+    const std::string args = "render --size 32x18 --scene builtin:textures --gallery-texture-size "
+                             "64 --texture-budget 4 --stats " +
+                             stats;
+    std::string err;
+    ASSERT_EQ(runShadel("SHADEL_DISABLE_BC=1", args, err), 0) << err;
+    EXPECT_NE(err.find("--texture-compression bc"), std::string::npos) << err;
+    std::ifstream in(stats);
+    nlohmann::json s = nlohmann::json::parse(in);
+    EXPECT_EQ(s["texture_streaming"]["compression"], "rgba8");
+    EXPECT_NE(s["texture_streaming"]["compression_fallback"].get<std::string>().find(
+                  "textureCompressionBC"),
+              std::string::npos);
+    EXPECT_DOUBLE_EQ(s["texture_bytes_per_texel"].get<double>(), 4.0);
+    EXPECT_EQ(runShadel("", args + " --texture-compression bc9", err), 2);
+    EXPECT_NE(err.find("--texture-compression"), std::string::npos) << err;
+    fs::remove(stats);
 }

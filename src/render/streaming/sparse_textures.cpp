@@ -93,7 +93,11 @@ SparseImagesMade createSparseImages(Gpu& gpu, const std::vector<uint32_t>& sizes
             throw DeviceError("sparse texture images with different page sizes");
         SparseLayout layout = sparseLayout(device, img.image);
         const VkSparseImageMemoryRequirements& c = layout.color;
-        if (out.granularity.width == 0) out.granularity = c.formatProperties.imageGranularity;
+        if (out.granularity.width == 0) { // the device gives compressed formats' in blocks
+            out.granularity = c.formatProperties.imageGranularity;
+            out.granularity.width *= blockSide(out.format);
+            out.granularity.height *= blockSide(out.format);
+        }
         // The device's packed tail (none on lavapipe: every level is paged, down to 1x1).
         img.deviceTailFirst = std::min(c.imageMipTailFirstLod, img.levels);
         SparseTexture t;

@@ -34,7 +34,7 @@ struct SparseTextures {
     Gpu* gpu = nullptr;
     BlockFormat format = BlockFormat::Rgba8;
     std::vector<SparseImage> images;
-    VkExtent3D granularity{}; // texels per page
+    VkExtent3D granularity{}; // texels per page (blocks times the block side for BC formats)
     uint64_t pageBytes = 0;
     uint32_t memoryType = 0;
     VkDeviceMemory tailMemory = VK_NULL_HANDLE, poolMemory = VK_NULL_HANDLE;
