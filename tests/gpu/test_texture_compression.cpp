@@ -136,7 +136,7 @@ TEST(TextureCompressionRender, StreamedModelsAgainstTheSampleViewer) {
     struct Case {
         const char* model;
         double floorBc, floorNone; // measured less 1.5 dB
-    } cases[] = {{"BoxTextured", 34.0, 34.0}, {"TextureTransformTest", 29.5, 29.5}};
+    } cases[] = {{"BoxTextured", 41.5, 41.4}, {"TextureTransformTest", 51.4, 51.8}};
     for (const Case& c : cases) {
         nlohmann::json model = conformanceModel(c.model);
         ASSERT_FALSE(model.is_null()) << c.model;

@@ -431,12 +431,13 @@ void encodeBc7Block(const uint8_t rgba[64], uint8_t out[16]) {
             }
             uint32_t parts[kPartitionCandidates];
             bestPartitions(px, kPartitionCandidates, parts);
+            // Opaque: RGB with 3-bit (6-bit endpoints) or 2-bit indices; else RGBA.
+            static const uint32_t kOpaqueModes[] = {1, 3}, kAlphaModes[] = {7};
+            const uint32_t* modes = opaque ? kOpaqueModes : kAlphaModes;
             for (uint32_t part : parts)
-                for (uint32_t mode :
-                     opaque ? std::array<uint32_t, 2>{1, 3} : std::array<uint32_t, 2>{7, 7}) {
-                    Candidate c = fitMode(px, mode, part);
+                for (uint32_t m = 0; m < (opaque ? 2u : 1u); ++m) {
+                    Candidate c = fitMode(px, modes[m], part);
                     if (c.error < best.error) best = c;
-                    if (!opaque) break;
                 }
         }
     }
