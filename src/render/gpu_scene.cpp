@@ -7,6 +7,7 @@
 #include "bake/bake.h"
 #include "core/log.h"
 #include "render/culling/mesh_lods.h"
+#include "render/normal_matrix.h"
 #include "scene/visibility_vertices.h"
 
 namespace shadel {
@@ -264,7 +265,7 @@ std::vector<gpu::GpuInstance> buildInstances(const Scene& scene, size_t material
     for (const Instance& inst : scene.instances) {
         gpu::GpuInstance g{};
         g.model = inst.transform;
-        g.normalMatrix = glm::transpose(glm::inverse(inst.transform));
+        g.normalMatrix = normalMatrixOf(inst.transform);
         Aabb world = transformAabb(scene.meshes[inst.mesh].bounds, inst.transform);
         g.worldMin = world.min;
         g.worldMax = world.max;

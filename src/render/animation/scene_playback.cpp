@@ -5,6 +5,7 @@
 
 #include "core/error.h"
 #include "core/log.h"
+#include "render/normal_matrix.h"
 #include "scene/load.h"
 
 namespace shadel {
@@ -132,7 +133,7 @@ void poseFrame(Gpu& gpu, ScenePlayback& p, uint32_t frame, GpuScene& gpuScene,
             gpu::GpuInstance& g = gpuScene.instanceInfo[i];
             if (reposedFrom) (*reposedFrom)[i] = Aabb{g.worldMin, g.worldMax};
             g.model = inst.transform;
-            g.normalMatrix = glm::transpose(glm::inverse(inst.transform));
+            g.normalMatrix = normalMatrixOf(inst.transform);
             Aabb world = transformAabb(drawn.meshes[inst.mesh].bounds, inst.transform);
             g.worldMin = world.min;
             g.worldMax = world.max;
