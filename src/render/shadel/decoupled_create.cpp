@@ -257,6 +257,9 @@ DecoupledStatePtr createDecoupled(Renderer& r, const GpuScene& scene) {
     DecoupledState& d = *state;
     setUpSheet(r.settings, scene, d);
     setUpCoarseVisit(r, scene, d);
+    // Material programs first: a bad program file or stage ends the run before anything else
+    // is created.
+    d.programs = createMaterialPrograms(*r.gpu, scene, d.capacityChunks);
     createSheetBuffers(*r.gpu, scene, d);
     createStorage(*r.gpu, r.settings, d);
     createComputePipelines(r, scene, d);
@@ -274,6 +277,7 @@ void destroyDecoupled(Renderer& r, DecoupledStatePtr& state) {
           &d.nearChange, &d.sheetView, &d.mark, &d.markTransparent, &d.reconstruct})
         destroy(gpu, *p);
     for (Pipeline& p : d.shade) destroy(gpu, p);
+    destroyMaterialPrograms(gpu, d.programs);
     destroyShadeStorage(gpu, d.storage);
     for (BufferHandle b :
          {d.frameInfo, d.changedVolumes, d.objectBuffer, d.rectBuffer, d.levelWants, d.occupancy[0],
