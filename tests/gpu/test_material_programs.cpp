@@ -22,7 +22,7 @@ constexpr double kFactorsFloor = 43.1;
 // The accumulating program's gain over 16 still frames: measured 14.82 -> 33.42 dB (+18.61).
 constexpr double kAccumulationGainFloor = 17.1;
 // The keep program on an orbit against the same pattern computed every frame: measured 99 dB
-// (the same image).
+// (the same image; prevSample reading the chunk's shadels transposed gave 14.89 dB).
 constexpr double kKeepFloor = 97.5;
 
 std::string baseName(const std::string& path) {
@@ -46,9 +46,11 @@ std::string writeProgram(const std::string& name, const std::string& glsl,
     return shmat;
 }
 
-// A wall facing the camera and a cube in front of it, both with material program `program`
-// (a reference as extras.shadel_material writes it; "" for none).
-std::string writeWallScene(const std::string& name, const std::string& program) {
+// A wall facing the camera and a cube in front of it (or, `floor`, a floor with the cube on it),
+// both with material program `program` (a reference as extras.shadel_material writes it; ""
+// for none).
+std::string writeWallScene(const std::string& name, const std::string& program,
+                           bool floor = false) {
     nlohmann::json wall = {{"pbrMetallicRoughness",
                             {{"baseColorFactor", {0.7, 0.45, 0.25, 1.0}},
                              {"metallicFactor", 0.0},
@@ -71,6 +73,13 @@ std::string writeWallScene(const std::string& name, const std::string& program) 
                            "cube",
                            wall,
                            cube};
+    if (floor) {
+        scene.quadCorners = {glm::vec3(-5.0f, 0.0f, -5.0f), glm::vec3(5.0f, 0.0f, -5.0f),
+                             glm::vec3(-5.0f, 0.0f, 5.0f), glm::vec3(5.0f, 0.0f, 5.0f)};
+        scene.quadNormal = glm::vec3(0.0f, 1.0f, 0.0f);
+        scene.quadIndices = {0, 2, 1, 1, 2, 3};
+        scene.cubeFrom = scene.cubeTo = glm::vec3(0.0f, 0.5f, 0.0f);
+    }
     return writeSlidingCubeScene(name, scene);
 }
 
@@ -288,13 +297,13 @@ void main() {
                             baseName(stage) + "\"}]}");
         return path;
     };
-    RenderOptions o =
-        wallView(writeWallScene("keep", baseName(program("keep", 0.0f))), RenderMode::Decoupled);
+    RenderOptions o = wallView(writeWallScene("keep", baseName(program("keep", 0.0f)), true),
+                               RenderMode::Decoupled);
     o.frames = 12;
     o.cameraPath = CameraPath::Orbit;
     RenderRun kept = renderChecked(o);
     RenderOptions marked = o;
-    marked.scene = writeWallScene("keep_marked", baseName(program("keep_marked", 1.0f)));
+    marked.scene = writeWallScene("keep_marked", baseName(program("keep_marked", 1.0f)), true);
     RenderRun shown = renderChecked(marked);
     o.reuse = false;
     RenderRun fresh = renderChecked(o);
@@ -304,5 +313,7 @@ void main() {
                 "the pattern computed every frame; preserved shadels painted: last frame %.2f dB\n",
                 worst, markedLast);
     EXPECT_GE(worst, kKeepFloor) << "worst frame " << worst << " dB";
-    EXPECT_LT(markedLast, 20.0) << "painting the preserved shadels changed little: " << markedLast;
+    EXPECT_GT(imageContent(fresh.frames.back().rgba).coverage, 0.3);
+    // Measured 7.44 dB: most of the last frame's shadels were preserved.
+    EXPECT_LT(markedLast, 8.9) << "painting the preserved shadels changed little: " << markedLast;
 }
