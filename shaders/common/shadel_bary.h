@@ -30,6 +30,7 @@ namespace shadel::shader {
 using glm::abs;
 using glm::clamp;
 using glm::max;
+using glm::min;
 using glm::uvec2;
 using glm::vec2;
 using glm::vec3;
@@ -90,6 +91,12 @@ SHADEL_INLINE ShadelBary shadelBaryWithNeighbours(uvec2 shadel, uvec2 levelSize,
     r.right = shadelBarycentrics(p + vec2(step.x, 0.0f), a, b, c);
     r.down = shadelBarycentrics(p + vec2(0.0f, step.y), a, b, c);
     return r;
+}
+
+// A texture coordinate extrapolated from a triangle (a shadel outside it), kept within the box of
+// the triangle's own coordinates a, b, c.
+SHADEL_INLINE vec2 clampToTriangleUv(vec2 uv, vec2 a, vec2 b, vec2 c) {
+    return clamp(uv, min(a, min(b, c)), max(a, max(b, c)));
 }
 
 SHADEL_INLINE vec3 shadelInterpolate(vec3 bary, vec3 a, vec3 b, vec3 c) {

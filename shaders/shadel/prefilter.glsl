@@ -37,7 +37,8 @@ SurfaceInput prefilterSample(SurfaceInput si, uint i, uint j, uint n, inout uint
     vec2 offset = (vec2(i, j) + jitter) / float(n) - 0.5; // in shadels from the centre
     vec2 at = centre + offset * step;
     SurfaceInput sub = si;
-    sub.uv = shadelInterpolate2(shadelBarycentrics(at, s0, s1, s2), t0, t1, t2);
+    sub.uv = clampToTriangleUv(shadelInterpolate2(shadelBarycentrics(at, s0, s1, s2), t0, t1, t2),
+                               t0, t1, t2);
     sub.uvDx = si.uvDx / float(n);
     sub.uvDy = si.uvDy / float(n);
     // The second UV set is affine over the triangle too: its shadel derivatives carry it.

@@ -219,12 +219,21 @@ void main() {
     vec3 p = shadelInterpolate(bary.center, v0.position, v1.position, v2.position);
     vec3 n = shadelInterpolate(bary.center, v0.normal, v1.normal, v2.normal);
     vec4 tangent = vec4(shadelInterpolate(bary.center, v0.tangent.xyz, v1.tangent.xyz, v2.tangent.xyz), v0.tangent.w);
-    vec2 uv = shadelInterpolate2(bary.center, v0.uv0, v1.uv0, v2.uv0);
-    vec2 uvDx = shadelInterpolate2(bary.right, v0.uv0, v1.uv0, v2.uv0) - uv;
-    vec2 uvDy = shadelInterpolate2(bary.down, v0.uv0, v1.uv0, v2.uv0) - uv;
-    vec2 uv1 = shadelInterpolate2(bary.center, v0.uv1, v1.uv1, v2.uv1);
-    vec2 uv1Dx = shadelInterpolate2(bary.right, v0.uv1, v1.uv1, v2.uv1) - uv1;
-    vec2 uv1Dy = shadelInterpolate2(bary.down, v0.uv1, v1.uv1, v2.uv1) - uv1;
+    // Texture coordinates extrapolate as far as the triangle's own UV box and no further: past
+    // a mesh's border (a quad's edge at v = 0) they would read the texture's far side through
+    // REPEAT, and the reconstruction blends those gutter shadels into the border pixels.
+    vec2 uv = clampToTriangleUv(shadelInterpolate2(bary.center, v0.uv0, v1.uv0, v2.uv0),
+                                v0.uv0, v1.uv0, v2.uv0);
+    vec2 uvDx = shadelInterpolate2(bary.right, v0.uv0, v1.uv0, v2.uv0) -
+                shadelInterpolate2(bary.center, v0.uv0, v1.uv0, v2.uv0);
+    vec2 uvDy = shadelInterpolate2(bary.down, v0.uv0, v1.uv0, v2.uv0) -
+                shadelInterpolate2(bary.center, v0.uv0, v1.uv0, v2.uv0);
+    vec2 uv1 = clampToTriangleUv(shadelInterpolate2(bary.center, v0.uv1, v1.uv1, v2.uv1),
+                                 v0.uv1, v1.uv1, v2.uv1);
+    vec2 uv1Dx = shadelInterpolate2(bary.right, v0.uv1, v1.uv1, v2.uv1) -
+                 shadelInterpolate2(bary.center, v0.uv1, v1.uv1, v2.uv1);
+    vec2 uv1Dy = shadelInterpolate2(bary.down, v0.uv1, v1.uv1, v2.uv1) -
+                 shadelInterpolate2(bary.center, v0.uv1, v1.uv1, v2.uv1);
 
     SurfaceInput si;
     si.position = (inst.model * vec4(p, 1.0)).xyz;

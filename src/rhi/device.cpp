@@ -1,6 +1,7 @@
 #include "rhi/device.h"
 
 #include <cstdlib>
+#include <dlfcn.h>
 #include <cstring>
 #include <optional>
 #include <vector>
@@ -214,6 +215,18 @@ static std::optional<std::string> missingRequiredFeature(VkPhysicalDevice pd) {
     return std::nullopt;
 }
 
+// RenderDoc's capture layer offers Vulkan 1.3 (and buffer device addresses, which shadel's
+// shaders read everything through) only on devices with bufferDeviceAddressCaptureReplay, so a
+// device without it (lavapipe among them) shows up as Vulkan 1.2 under RenderDoc. Its library
+// is loaded into the process when the layer is active.
+static std::string renderDocHint() {
+    void* renderDoc = dlopen("librenderdoc.so", RTLD_NOW | RTLD_NOLOAD);
+    if (!renderDoc) return "";
+    dlclose(renderDoc);
+    return " (under RenderDoc, which offers Vulkan 1.3 only on devices with "
+           "bufferDeviceAddressCaptureReplay: capture on a GPU whose driver has it)";
+}
+
 static VkPhysicalDevice choosePhysicalDevice(VkInstance instance, const std::string& selection) {
     auto pds = physicalDevices(instance);
     if (pds.empty())
@@ -246,8 +259,9 @@ static VkPhysicalDevice choosePhysicalDevice(VkInstance instance, const std::str
             throw InputError(format("--device %s: no such device index (devices:\n%s)",
                                     selection.c_str(), listPhysicalDevices().c_str()));
         if (auto missing = missingRequiredFeature(pds[index]))
-            throw DeviceError(format("--device %s lacks required Vulkan feature %s",
-                                     selection.c_str(), missing->c_str()));
+            throw DeviceError(format("--device %s lacks required Vulkan feature %s%s",
+                                     selection.c_str(), missing->c_str(),
+                                     renderDocHint().c_str()));
         return pds[index];
     }
     if (selection != "auto" && selection != "cpu" && selection != "gpu")
@@ -270,7 +284,7 @@ static VkPhysicalDevice choosePhysicalDevice(VkInstance instance, const std::str
         if (rank(pd) > bestRank) best = pd, bestRank = rank(pd);
     }
     if (!best) {
-        if (!lastMissing.empty()) throw DeviceError(lastMissing);
+        if (!lastMissing.empty()) throw DeviceError(lastMissing + renderDocHint());
         throw DeviceError(format("--device %s: no matching Vulkan device", selection.c_str()));
     }
     return best;

@@ -160,8 +160,9 @@ RenderOptions conformanceOptions(const std::string& scene, RenderMode mode, uint
     o.backgroundColor = glm::vec3(0.0f);
     o.shadows = false;
     o.addDefaultSun = false;
-    // The reference is rendered at this many times the size and box-filtered (and multisampled):
-    // shadel supersamples as much, so edges and minified textures compare like for like.
+    // The reference is rendered at this many times the size, one sample per canvas pixel, and
+    // box-filtered: shadel supersamples on the same grid, so edges and minified textures compare
+    // like for like.
     o.ssaa = manifest().value("shadel_ssaa", 1u);
     return o;
 }

@@ -209,7 +209,9 @@ def write_docs(results, manifest, missing, notes, commit, command, seconds):
              "tools/conformance/README.md.", "",
              f"Measured on `{commit}` with `{command}` ({seconds:.0f} s), "
              f"{manifest['size'][0]}x{manifest['size'][1]}: the reference drawn "
-             f"{manifest.get('reference_scale', 1)}x as large (multisampled) and box-filtered, "
+             f"{manifest.get('reference_scale', 1)}x as large "
+             f"({'multisampled' if manifest.get('reference_msaa') else 'one sample per pixel'}) "
+             f"and box-filtered, "
              f"shadel with --ssaa {manifest.get('shadel_ssaa', 1)}.", "",
              "PSNR is over covered pixels (alpha > 0 in either image), RGB in sRGB encoding;",
              "the images (docs/conformance/NAME.png) are reference | shadel | difference x4,",

@@ -15,12 +15,14 @@
 // (renderEnvironmentMap false), clearColor (0, 0, 0, 0), exposure 1, tone map "ACES Filmic Tone
 // Mapping (Narkowicz)", no animation. The PNG holds the drawing buffer as read back: RGB as the
 // viewer encodes it, pow(x, 1/2.2) (not the sRGB curve), over black; alpha is coverage (0 where
-// nothing was drawn). The canvas is reference_scale times the size, multisampled, and box-filtered
-// down; the projection is moved up by reference_y_offset canvas pixels (see README.md).
+// nothing was drawn). The canvas is reference_scale times the size, one sample per canvas pixel
+// unless reference_msaa, and box-filtered down (see README.md). The camera's aspectRatio is left
+// to the canvas: the viewer sizes its viewport by the file's aspect ratio, and a ratio written
+// a hair above the canvas's (1.7777778 for 16:9) truncates the viewport to one row fewer.
 //
 // Usage: node tools/conformance/render_reference.js [--only NAME[,NAME...]] [--chromium PATH]
-//          [--out DIR] [--scale N] [--y-offset PIXELS] [--no-msaa] [--no-punctual] [--no-ibl]
-// --scale and --y-offset default to the manifest's reference_scale and reference_y_offset; --out
+//          [--out DIR] [--scale N] [--msaa | --no-msaa] [--no-punctual] [--no-ibl]
+// --scale and --msaa default to the manifest's reference_scale and reference_msaa; --out
 // (experiments) writes elsewhere and leaves VERSIONS.md alone. CONFORMANCE_ENVIRONMENT=FILE.hdr
 // replaces the manifest's environment (a small one skips minutes of prefiltering).
 "use strict";
@@ -37,18 +39,18 @@ const outDir = path.join(root, "tests", "data", "conformance", "reference");
 const origin = "http://conformance.invalid";
 
 function parseArgs() {
-  const args = { only: null, chromium: "/usr/lib/chromium/chromium", out: null, msaa: true,
-    scale: null, yOffset: null, punctual: true, ibl: true };
+  const args = { only: null, chromium: "/usr/lib/chromium/chromium", out: null, msaa: null,
+    scale: null, punctual: true, ibl: true };
   const argv = process.argv.slice(2);
   for (let i = 0; i < argv.length; i++) {
     if (argv[i] === "--only") args.only = argv[++i].split(",");
     else if (argv[i] === "--chromium") args.chromium = argv[++i];
     else if (argv[i] === "--out") args.out = argv[++i];
+    else if (argv[i] === "--msaa") args.msaa = true;
     else if (argv[i] === "--no-msaa") args.msaa = false;
     else if (argv[i] === "--no-punctual") args.punctual = false;
     else if (argv[i] === "--no-ibl") args.ibl = false;
     else if (argv[i] === "--scale") args.scale = Number(argv[++i]);
-    else if (argv[i] === "--y-offset") args.yOffset = Number(argv[++i]);
     else {
       console.error(`render_reference.js: unknown argument ${argv[i]}`);
       process.exit(2);
@@ -204,7 +206,6 @@ async function setUpViewer(page, settings) {
     state.environment = await loader.loadEnvironment("/environment.hdr", {
       lut_sheen_E_file: "/lut_sheen_E.png",
     });
-    window.conformanceYOffset = settings.yOffset;
     window.conformance = { gl, view, state, loader, canvas };
     return {
       renderer: gl.getParameter(gl.getExtension("WEBGL_debug_renderer_info").UNMASKED_RENDERER_WEBGL),
@@ -222,16 +223,12 @@ async function renderModel(page, name, file) {
     const cameras = state.gltf.cameras || [];
     state.cameraIndex = cameras.findIndex((c) => c.name === "conformance");
     if (state.cameraIndex < 0) throw new Error(`${name}: no camera named "conformance"`);
-    const yOffset = window.conformanceYOffset;
-    if (yOffset) {
-      // Moves the picture up by yOffset pixels: clip y += ndcOffset * w, and w = -z_view.
-      const camera = cameras[state.cameraIndex];
-      const projection = camera.getProjectionMatrix.bind(camera);
-      camera.getProjectionMatrix = (aspect) => {
-        const m = projection(aspect);
-        m[9] -= (2 * yOffset) / canvas.height;
-        return m;
-      };
+    const perspective = cameras[state.cameraIndex].perspective;
+    if (perspective && perspective.aspectRatio !== undefined) {
+      const canvasAspect = canvas.width / canvas.height;
+      if (Math.abs(perspective.aspectRatio - canvasAspect) > 1e-4 * canvasAspect)
+        throw new Error(`${name}: camera aspect ratio ${perspective.aspectRatio} is not the canvas's ${canvasAspect}`);
+      perspective.aspectRatio = undefined; // the canvas's exactly (see the header)
     }
     for (let i = 0; i < 3; i++) view.renderFrame(state, canvas.width, canvas.height);
     gl.finish();
@@ -299,14 +296,14 @@ async function main() {
       req.respond({ status: 200, contentType: found.type, body: found.body });
     });
     const scale = args.scale || manifest.reference_scale || 1;
-    const yOffset = args.yOffset !== null ? args.yOffset : manifest.reference_y_offset || 0;
+    const msaa = args.msaa !== null ? args.msaa : manifest.reference_msaa === true;
     const out = args.out || outDir;
     fs.mkdirSync(out, { recursive: true });
     await page.setViewport({ width: width * scale, height: height * scale });
     await page.goto(`${origin}/index.html`);
     await page.waitForFunction(() => window.viewerReady === true);
     const env = await setUpViewer(page, {
-      width: width * scale, height: height * scale, msaa: args.msaa, yOffset,
+      width: width * scale, height: height * scale, msaa,
       punctual: args.punctual, ibl: args.ibl,
       environmentRotation: manifest.viewer_environment_rotation,
     });
@@ -338,8 +335,8 @@ tests/gpu/test_conformance.cpp. Regenerate with \`tools/conformance/setup.sh\` (
 | node | ${v.node} |
 
 - Chromium flags: \`--headless --use-angle=swiftshader --enable-unsafe-swiftshader --no-sandbox\`.
-- Size ${width}x${height}: drawn ${scale}x as large into a multisampled canvas with the projection
-  moved ${yOffset} canvas pixels up (headless ANGLE/SwiftShader draws half a pixel low), then
+- Size ${width}x${height}: drawn ${scale}x as large into a canvas with ${msaa ? "multisampling" : "one sample per pixel"},
+  the camera's aspect ratio taken from the canvas (see render_reference.js), then
   box-filtered (RGB as light, alpha as coverage); camera "conformance" and the file's lights; environment
   ${manifest.environment} as image-based light only (not drawn), environmentRotation
   ${manifest.viewer_environment_rotation}; tone map ACES Filmic (Narkowicz), exposure 1;
