@@ -52,10 +52,14 @@ void main() {
     surface.positionDy = mat3(inst.model) * (pDy - p);
     surface.normal = normalize(mat3(inst.normalMatrix) * n);
     surface.tangent = vec4(mat3(inst.model) * t, v0.tangent.w);
-    surface.uv = shadelInterpolate2(bary.center, v0.uv0, v1.uv0, v2.uv0);
-    surface.uvDx = shadelInterpolate2(bary.right, v0.uv0, v1.uv0, v2.uv0) - surface.uv;
-    surface.uvDy = shadelInterpolate2(bary.down, v0.uv0, v1.uv0, v2.uv0) - surface.uv;
-    surface.uv1 = shadelInterpolate2(bary.center, v0.uv1, v1.uv1, v2.uv1);
+    // UVs extrapolate to gutter shadels only as far as the triangle's own UV box (as in
+    // shadel/shade.comp: further, a texture's REPEAT would read its far side).
+    vec2 uv = shadelInterpolate2(bary.center, v0.uv0, v1.uv0, v2.uv0);
+    surface.uv = clampToTriangleUv(uv, v0.uv0, v1.uv0, v2.uv0);
+    surface.uvDx = shadelInterpolate2(bary.right, v0.uv0, v1.uv0, v2.uv0) - uv;
+    surface.uvDy = shadelInterpolate2(bary.down, v0.uv0, v1.uv0, v2.uv0) - uv;
+    surface.uv1 = clampToTriangleUv(shadelInterpolate2(bary.center, v0.uv1, v1.uv1, v2.uv1),
+                                    v0.uv1, v1.uv1, v2.uv1);
     surface.geometricNormal = normalize(mat3(inst.normalMatrix) *
                                         cross(v1.position - v0.position, v2.position - v0.position));
     surface.frontFacing = dot(surface.geometricNormal, f.cameraPosition - surface.position) >= 0.0;
