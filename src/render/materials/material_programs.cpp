@@ -1,6 +1,7 @@
 #include "render/materials/material_programs.h"
 
 #include <cstring>
+#include <filesystem>
 #include <map>
 
 #include <nlohmann/json.hpp>
@@ -14,8 +15,13 @@
 
 namespace shadel {
 
+// A program's files as last loaded: path -> (time stamp, size).
+using ProgramFileStamps =
+    std::map<std::string, std::pair<std::filesystem::file_time_type, uintmax_t>>;
+
 struct MaterialProgramSet {
     std::vector<MaterialProgram> programs;
+    std::vector<ProgramFileStamps> stamps;     // per program
     std::vector<std::vector<Pipeline>> stages; // per program, in order
     std::vector<uint32_t> programOfMaterial;   // 0: built-in, k: programs[k - 1]
     Pipeline setup;                            // materials/program_setup.comp
@@ -42,6 +48,32 @@ struct StagePush {
     uint32_t program, capacity;
 };
 
+ProgramFileStamps fileStamps(const MaterialProgram& program) {
+    ProgramFileStamps out;
+    std::vector<std::string> files = {program.path};
+    if (!program.common.empty()) files.push_back(program.common);
+    for (const MaterialStage& s : program.stages) files.push_back(s.path);
+    for (const std::string& f : files) {
+        std::error_code ec;
+        auto time = std::filesystem::last_write_time(f, ec);
+        uintmax_t size = ec ? 0 : std::filesystem::file_size(f, ec);
+        out[f] = {time, size};
+    }
+    return out;
+}
+
+// Loads and compiles the program in `file` into pipelines named after it.
+std::vector<Pipeline> buildProgram(Gpu& gpu, const std::string& file, MaterialProgram& program) {
+    program = loadMaterialProgram(file);
+    std::vector<std::vector<uint32_t>> code =
+        compileMaterialProgram(program, SHADEL_SHADER_SOURCE_DIR);
+    std::vector<Pipeline> pipelines;
+    for (size_t s = 0; s < code.size(); ++s)
+        pipelines.push_back(createComputePipelineFromSpirv(
+            gpu, "material." + program.name + "." + program.stages[s].name, code[s]));
+    return pipelines;
+}
+
 void loadPrograms(Gpu& gpu, const GpuScene& scene, MaterialProgramSet& set) {
     std::map<std::string, uint32_t> byFile; // resolved .shmat -> its program number (1-based)
     set.programOfMaterial.assign(scene.materialInfo.size(), 0u);
@@ -54,13 +86,9 @@ void loadPrograms(Gpu& gpu, const GpuScene& scene, MaterialProgramSet& set) {
             if (set.programs.size() == MATERIAL_MAX_PROGRAMS)
                 throw InputError(format("%s: more than %u material programs in one scene",
                                         file.c_str(), MATERIAL_MAX_PROGRAMS));
-            MaterialProgram program = loadMaterialProgram(file);
-            std::vector<std::vector<uint32_t>> code =
-                compileMaterialProgram(program, SHADEL_SHADER_SOURCE_DIR);
-            std::vector<Pipeline> pipelines;
-            for (size_t s = 0; s < code.size(); ++s)
-                pipelines.push_back(createComputePipelineFromSpirv(
-                    gpu, "material." + program.name + "." + program.stages[s].name, code[s]));
+            MaterialProgram program;
+            std::vector<Pipeline> pipelines = buildProgram(gpu, file, program);
+            set.stamps.push_back(fileStamps(program));
             set.programs.push_back(std::move(program));
             set.stages.push_back(std::move(pipelines));
             known = byFile.emplace(file, uint32_t(set.programs.size())).first;
@@ -174,6 +202,35 @@ void recordMaterialProgramStages(const Gpu& gpu, VkCommandBuffer cmd, const Mate
             vkCmdDispatchIndirect(cmd, vkBuffer(gpu, set->header), VkDeviceSize(p) * 16);
         }
     }
+}
+
+uint32_t pollMaterialPrograms(Gpu& gpu, MaterialProgramSet* set, std::vector<std::string>& errors,
+                              std::vector<uint8_t>& reshade) {
+    if (!set) return 0;
+    uint32_t swapped = 0;
+    for (size_t p = 0; p < set->programs.size(); ++p) {
+        if (fileStamps(set->programs[p]) == set->stamps[p]) continue;
+        set->stamps[p] = fileStamps(set->programs[p]); // a failed edit is reported once
+        MaterialProgram fresh;
+        std::vector<Pipeline> pipelines;
+        try {
+            pipelines = buildProgram(gpu, set->programs[p].path, fresh);
+        } catch (const std::exception& e) {
+            SHADEL_ERROR("material program reload: %s (the last good program stays)", e.what());
+            errors.push_back(e.what());
+            continue;
+        }
+        vkDeviceWaitIdle(gpu.device.device); // the old pipelines may still be in flight
+        for (Pipeline& old : set->stages[p]) destroy(gpu, old);
+        set->stages[p] = std::move(pipelines);
+        set->programs[p] = std::move(fresh);
+        set->stamps[p] = fileStamps(set->programs[p]);
+        reshade.resize(std::max(reshade.size(), set->programOfMaterial.size()), 0);
+        for (size_t m = 0; m < set->programOfMaterial.size(); ++m)
+            if (set->programOfMaterial[m] == p + 1) reshade[m] = 1;
+        ++swapped;
+    }
+    return swapped;
 }
 
 void finishMaterialProgramsFrame(const Gpu& gpu, MaterialProgramSet* set, uint32_t shadedChunks) {

@@ -47,6 +47,15 @@ void recordProgramListsSetup(const Gpu& gpu, VkCommandBuffer cmd, const Material
 void recordMaterialProgramStages(const Gpu& gpu, VkCommandBuffer cmd, const MaterialProgramSet* set,
                                  uint64_t frame);
 
+// Hot reload (the viewer): recompiles every program whose .shmat, common or stage file changed
+// (time stamp or size) and swaps its pipelines, waiting for the device to idle first. A program
+// that fails to load or compile keeps its last good pipelines; its error (file:line for a
+// stage) is returned in `errors`. The materials of a swapped program are set in `reshade` (per
+// material, resized to the material count), so their carried-over chunks are shaded again.
+// Returns the programs swapped.
+uint32_t pollMaterialPrograms(Gpu& gpu, MaterialProgramSet* set, std::vector<std::string>& errors,
+                              std::vector<uint8_t>& reshade);
+
 // After the GPU finished the frame: adds its list lengths to the statistics; `shadedChunks` is
 // the frame's whole shading queue (the built-in program's share is what the programs left).
 void finishMaterialProgramsFrame(const Gpu& gpu, MaterialProgramSet* set, uint32_t shadedChunks);

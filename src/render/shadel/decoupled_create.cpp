@@ -268,6 +268,13 @@ DecoupledStatePtr createDecoupled(Renderer& r, const GpuScene& scene) {
     return state;
 }
 
+uint32_t pollMaterialPrograms(Renderer& r, std::vector<std::string>& errors) {
+    if (!r.decoupled) return 0;
+    // Their materials reshade as edited ones do (render/scene_edits.h).
+    return pollMaterialPrograms(*r.gpu, r.decoupled->programs.get(), errors,
+                                r.edits.materialsChanged);
+}
+
 void destroyDecoupled(Renderer& r, DecoupledStatePtr& state) {
     if (!state) return;
     Gpu& gpu = *r.gpu;
