@@ -222,16 +222,18 @@ using uint = uint32_t;
 #define DRAW_LIST_OPAQUE_FEATURED 4u
 #define DRAW_LIST_OPAQUE_TEXTURED 5u
 #define DRAW_LIST_COUNT 6u
-// Each camera list is two, by the faces its instances draw (render/forward drawCameraList sets
-// the cull mode per side, vkCmdSetCullMode): single-sided materials cull back faces
-// (DRAW_SIDE_FRONT), double-sided ones draw both (DRAW_SIDE_BOTH). Front faces are
-// counter-clockwise for every instance: the glTF importer gives instances whose transform mirrors
-// (which glTF says flips the winding) a copy of the mesh with the winding reversed. Camera list l,
-// side s: slot l * DRAW_SIDE_COUNT + s of DRAW_CAMERA_SLOTS.
+// Each camera list is four, by the faces its instances draw (render/forward drawCameraList sets
+// the cull mode and front face per side): single-sided materials cull back faces
+// (DRAW_SIDE_FRONT), double-sided ones draw both (DRAW_SIDE_BOTH); and instances whose transform
+// mirrors (a negative determinant, which glTF says flips the winding; it may change sign while
+// an animation plays) take the clockwise front face (DRAW_SIDE_MIRRORED set). The cull pass
+// decides from the transform every frame, so a mesh is stored once whatever its instances'
+// signs. Camera list l, side s: slot l * DRAW_SIDE_COUNT + s of DRAW_CAMERA_SLOTS.
 #define DRAW_SIDE_FRONT 0u
 #define DRAW_SIDE_BOTH 1u
-#define DRAW_SIDE_COUNT 2u
-#define DRAW_CAMERA_SLOTS 12u
+#define DRAW_SIDE_MIRRORED 2u // added to FRONT or BOTH
+#define DRAW_SIDE_COUNT 4u
+#define DRAW_CAMERA_SLOTS 24u
 
 // Debug views (--visualize).
 #define VISUALIZE_NONE 0u

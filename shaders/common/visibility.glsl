@@ -47,8 +47,9 @@ VisTriangle loadVisTriangle(FrameConstants f, GpuInstance inst, uint triangle) {
     t.r1 = r1;
     t.r2 = r2;
     // det(M) = w0 w1 w2 * (NDC signed area); Vulkan's counter-clockwise front face (y down)
-    // is a negative NDC cross product.
-    t.frontFacing = dot(a, r0) < 0.0;
+    // is a negative NDC cross product, and a mirroring instance transform turns it clockwise
+    // (the raster passes draw such instances with the clockwise front face).
+    t.frontFacing = (dot(a, r0) < 0.0) != (determinant(mat3(inst.model)) < 0.0);
     return t;
 }
 

@@ -41,7 +41,7 @@ layout(buffer_reference, scalar) readonly buffer ShadowCullViewBuffer {
 
 // The camera's list for an instance (its material's bucket), and in it the side the instance
 // draws (DRAW_SIDE_*): its slot of DRAW_CAMERA_SLOTS.
-uint cameraSlotOf(FrameConstants f, GpuMaterial mat, uint id) {
+uint cameraSlotOf(FrameConstants f, GpuMaterial mat, GpuInstance inst, uint id) {
     uint list = (mat.flags & MATERIAL_ALPHA_BLEND) != 0u ? DRAW_LIST_BLEND : DRAW_LIST_OPAQUE;
     // Instances allocated in the shadel sheet this frame are drawn by the decoupled passes
     // (blended ones through the OIT targets, render/oit).
@@ -55,6 +55,8 @@ uint cameraSlotOf(FrameConstants f, GpuMaterial mat, uint id) {
                                                      : DRAW_LIST_OPAQUE_FEATURED;
     // Single-sided materials cull back faces.
     uint side = (mat.flags & MATERIAL_DOUBLE_SIDED) != 0u ? DRAW_SIDE_BOTH : DRAW_SIDE_FRONT;
+    // A mirroring transform turns counter-clockwise triangles clockwise.
+    if (determinant(mat3(inst.model)) < 0.0) side += DRAW_SIDE_MIRRORED;
     return list * DRAW_SIDE_COUNT + side;
 }
 
@@ -138,7 +140,7 @@ void main() {
         if (draw) {
             lod = selectLod(f, c, inst, mesh);
             haveLod = true;
-            if (appendDraw(pc.draws, pc.counts, cameraSlotOf(f, mat, id), lod, false, mesh, id,
+            if (appendDraw(pc.draws, pc.counts, cameraSlotOf(f, mat, inst, id), lod, false, mesh, id,
                            f)) {
                 drawn = true;
                 triangles = lod.indexCount / 3u;

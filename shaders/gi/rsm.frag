@@ -29,7 +29,9 @@ void main() {
     s.uv1 = inUv1;
     s.uv1Dx = dFdx(inUv1);
     s.uv1Dy = dFdy(inUv1);
-    s.frontFacing = gl_FrontFacing;
+    // Drawn without culling and one front face for every instance: a mirroring transform turns
+    // the rasterizer's facing around.
+    s.frontFacing = gl_FrontFacing != (determinant(mat3(inst.model)) < 0.0);
     MaterialSample m = evaluateMaterial(mat, s);
     if ((mat.flags & MATERIAL_ALPHA_MASK) != 0u && m.alpha < mat.alphaCutoff) discard;
 

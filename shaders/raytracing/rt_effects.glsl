@@ -157,7 +157,7 @@ float rtAmbientOcclusion(FrameConstants f, RtFrame rt, vec3 p, vec3 n, vec3 ng, 
 // that shades what a ray hit (here, and the reference path tracer, shaders/reference).
 struct RtHitSurface {
     SurfaceInput s;
-    vec3 geometricNormal; // unit, the triangle's winding (not turned toward the ray)
+    vec3 geometricNormal; // unit, on the triangle's front side (not turned toward the ray)
     uint material;
 };
 
@@ -183,6 +183,7 @@ RtHitSurface rtHitSurface(FrameConstants f, RtFrame rt, uint instanceId, uint pr
     h.s.uv1Dy = vec2(0.0);
     h.s.frontFacing = frontFace;
     h.geometricNormal = normalize(cross(b.position - a.position, c.position - a.position));
+    if (determinant(mat3(inst.model)) < 0.0) h.geometricNormal = -h.geometricNormal; // mirrored
     h.material = inst.material;
     return h;
 }

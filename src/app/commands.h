@@ -55,9 +55,11 @@ struct RenderOptions : RenderSettings {
     // --stencil-effects on|fullscreen: water composite + character outline (render/stencil)
     StencilEffects stencilEffects = StencilEffects::Off;
     // Texture streaming (render/streaming): --texture-budget MiB (0 = none: every texture
-    // resident), --streaming, and builtin:textures' texture side (0 = 2048).
+    // resident), --streaming, --texture-compression, and builtin:textures' texture side
+    // (0 = 2048).
     double textureBudgetMiB = 0.0;
     StreamingMode streaming = StreamingMode::Layered;
+    TextureCompression textureCompression = TextureCompression::Bc;
     uint32_t galleryTextureSize = 0;
     float textureCpuCap = 512.0f; // side up to which CPU estimates count (0: GPU feedback only)
     // --capture NAME[,NAME...] (or {"list"}) and --capture-dir: the last frame's named

@@ -22,7 +22,7 @@ struct RenderFlags {
     std::string from, lookAt, jitter = "none", skinning = "gpu", timing = "auto", threads = "auto",
                               density = "auto", cameraPath = "static", cameraCut,
                               giLocalVolumes = "on", stencilEffects = "off", streaming = "layered",
-                              captures;
+                              textureCompression = "bc", captures;
     double time = -1.0, timeStep = 0.0;
     CLI::Option* instances = nullptr;
 };
@@ -107,6 +107,10 @@ void addSceneFlags(CLI::App& c, RenderFlags& f) {
         ->check(finiteInRange(kTextureBudgetRange));
     c.add_option("--streaming", f.streaming, "layered | sparse: texture streaming residency")
         ->capture_default_str();
+    c.add_option("--texture-compression", f.textureCompression,
+                 "bc | none: streamed textures block-compressed (BC7, 1 byte a texel; RGBA8 with a "
+                 "warning where the device cannot sample BC) or RGBA8 (4 bytes)")
+        ->capture_default_str();
     c.add_option("--gallery-texture-size", ro.galleryTextureSize,
                  "builtin:textures: side of each texture (power of two, default 2048)");
 }
@@ -140,6 +144,9 @@ void applyRenderFlags(RenderFlags& f) {
     ro.streaming = parseChoice<StreamingMode>(
         "--streaming", f.streaming,
         {{"layered", StreamingMode::Layered}, {"sparse", StreamingMode::Sparse}});
+    ro.textureCompression = parseChoice<TextureCompression>(
+        "--texture-compression", f.textureCompression,
+        {{"bc", TextureCompression::Bc}, {"none", TextureCompression::None}});
     if (!f.captures.empty()) ro.captures = parseCaptureNames(f.captures);
 }
 

@@ -393,6 +393,7 @@ void uploadRunScene(RenderSession& session) {
         TextureStreamingSettings ts;
         ts.budgetMiB = o.textureBudgetMiB;
         ts.mode = o.streaming;
+        ts.compression = o.textureCompression;
         ts.cpuCap = o.textureCpuCap;
         streaming = createTextureStreaming(gpu, scene, ts, usableCacheFolder(o.cacheDir));
     }
@@ -683,6 +684,8 @@ void featureStats(const RenderSession& session, nlohmann::json& s) {
         for (TextureHandle t : gpuScene.textures)
             if (t) bytes += uint64_t(desc(gpu, t).width) * desc(gpu, t).height * 4 * 4 / 3;
         s["texture_memory_peak_bytes"] = bytes;
+        s["texture_total_bytes"] = bytes;
+        s["texture_bytes_per_texel"] = bytes ? 4.0 : 0.0;
     }
 }
 

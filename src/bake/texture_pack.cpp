@@ -4,9 +4,12 @@
 #include <array>
 #include <atomic>
 #include <cerrno>
+#include <chrono>
 #include <cmath>
 #include <cstring>
 #include <filesystem>
+#include <memory>
+#include <thread>
 
 #include <fcntl.h>
 #include <sys/mman.h>
@@ -15,6 +18,7 @@
 
 #include "core/error.h"
 #include "core/log.h"
+#include "core/worker_pool.h"
 #include "scene/procedural_textures.h"
 
 namespace shadel {
@@ -37,8 +41,11 @@ struct FileHeader {
 static_assert(sizeof(FileHeader) == 64);
 
 struct TextureRecord {
-    uint32_t size, levels, srgb, pad;
+    uint32_t size, levels, srgb, format;
+    float psnr;
+    uint32_t pad;
 };
+static_assert(sizeof(TextureRecord) == 24);
 struct LevelRecord {
     uint64_t offset, bytes, checksum;
 };
@@ -128,17 +135,24 @@ std::vector<uint8_t> resample(const Texture& t, uint32_t size) {
     return out;
 }
 
-// A level in tile order: tiles row-major, each tile's rows contiguous (levels smaller than a
-// tile are one tile of their own size).
-std::vector<uint8_t> tiled(const std::vector<uint8_t>& level, uint32_t size) {
-    uint32_t tile = std::min(size, kTexturePackTile);
+uint64_t levelBytes(BlockFormat format, uint32_t side) {
+    return encodedBytes(format, side, side);
+}
+
+// An encoded level (texels or 4x4 blocks, row-major) in tile order: tiles row-major, each tile's
+// rows contiguous (levels smaller than a tile are one tile of their own size).
+std::vector<uint8_t> tiled(const std::vector<uint8_t>& level, uint32_t size, BlockFormat format) {
+    const uint32_t unit = blockSide(format), bytes = blockBytes(format);
+    const uint32_t across = (size + unit - 1) / unit; // blocks (texels) per row
+    const uint32_t tile = std::max(std::min(size, kTexturePackTile) / unit, 1u);
     std::vector<uint8_t> out(level.size());
     size_t o = 0;
-    for (uint32_t ty = 0; ty < size; ty += tile)
-        for (uint32_t tx = 0; tx < size; tx += tile)
+    for (uint32_t ty = 0; ty < across; ty += tile)
+        for (uint32_t tx = 0; tx < across; tx += tile)
             for (uint32_t y = 0; y < tile; ++y) {
-                std::memcpy(&out[o], &level[(size_t(ty + y) * size + tx) * 4], size_t(tile) * 4);
-                o += size_t(tile) * 4;
+                std::memcpy(&out[o], &level[(size_t(ty + y) * across + tx) * bytes],
+                            size_t(tile) * bytes);
+                o += size_t(tile) * bytes;
             }
     return out;
 }
@@ -185,14 +199,21 @@ std::vector<bool> srgbTextures(const Scene& scene) {
     return srgb;
 }
 
-BakeKey texturePackKey(const Scene& scene) {
+std::vector<BlockFormat> packedTextureFormats(const Scene& scene, TextureCompression compression) {
+    return std::vector<BlockFormat>(scene.textures.size(), compression == TextureCompression::Bc
+                                                               ? BlockFormat::Bc7
+                                                               : BlockFormat::Rgba8);
+}
+
+BakeKey texturePackKey(const Scene& scene, TextureCompression compression) {
     std::vector<bool> srgb = srgbTextures(scene);
+    std::vector<BlockFormat> formats = packedTextureFormats(scene, compression);
     std::vector<uint64_t> words = {kTexturePackVersion, kTexturePackTile, scene.textures.size()};
     for (size_t i = 0; i < scene.textures.size(); ++i) {
         const Texture& t = scene.textures[i];
         words.insert(words.end(),
-                     {t.width, t.height, uint64_t(srgb[i]), t.procedural.kind, t.procedural.seed,
-                      hashBytes(t.rgba8.data(), t.rgba8.size(), 7)});
+                     {t.width, t.height, uint64_t(srgb[i]), uint64_t(formats[i]), t.procedural.kind,
+                      t.procedural.seed, hashBytes(t.rgba8.data(), t.rgba8.size(), 7)});
     }
     const size_t bytes = words.size() * sizeof(uint64_t);
     return {hashBytes(words.data(), bytes, 0x243F6A8885A308D3ull),
@@ -203,55 +224,91 @@ std::string texturePackPath(const std::string& cacheDir, const BakeKey& key) {
     return cacheDir + "/textures-" + key.hex() + ".bin";
 }
 
-// Writes the whole file through fd (header and directory last, once the checksums are known).
-// Returns 0 or the errno of the first failure.
-static int writePackTo(int fd, const Scene& scene) {
+// The RGBA8 level 0 of a texture at its packed size.
+static std::vector<uint8_t> levelZero(const Texture& t, uint32_t size) {
+    if (t.procedural.kind != 0) {
+        std::vector<uint8_t> level(size_t(size) * size * 4);
+        generateProceduralTexture(t.procedural, size, level.data());
+        return level;
+    }
+    if (t.width == size && t.height == size) return t.rgba8;
+    return resample(t, size);
+}
+
+// Says how far a long encode has come, at most every few seconds.
+struct EncodeProgress {
+    std::chrono::steady_clock::time_point start = std::chrono::steady_clock::now(), last = start;
+    uint64_t done = 0, total = 0; // RGBA8 bytes of every level
+    void advance(uint64_t bytes, size_t texture, size_t textures) {
+        done += bytes;
+        auto now = std::chrono::steady_clock::now();
+        if (now - last < std::chrono::seconds(5)) return;
+        last = now;
+        SHADEL_INFO("texture streaming file: encoded %zu of %zu textures (%.0f of %.0f MiB)",
+                    texture, textures, double(done) / 1048576.0, double(total) / 1048576.0);
+    }
+    double seconds() const {
+        return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    }
+};
+
+// Writes the whole file through fd (header and directory last, once the checksums and PSNRs are
+// known). Returns 0 or the errno of the first failure; *seconds: the time it took.
+static int writePackTo(int fd, const Scene& scene, TextureCompression compression,
+                       double* seconds) {
     std::vector<bool> srgb = srgbTextures(scene);
+    std::vector<BlockFormat> formats = packedTextureFormats(scene, compression);
     std::vector<uint32_t> sizes;
     for (const Texture& t : scene.textures) sizes.push_back(packedTextureSize(t));
-    BakeKey key = texturePackKey(scene);
+    BakeKey key = texturePackKey(scene, compression);
 
-    // Layout first (it depends only on the sizes), so the data streams out in one pass.
+    // Layout first (it depends only on sizes and formats), so the data streams out in one pass.
     std::vector<uint8_t> directory(directoryBytes(sizes));
     uint64_t offset = sizeof(FileHeader) + directory.size();
     std::vector<LevelRecord> levels;
-    for (uint32_t s : sizes)
-        for (uint32_t l = 0; l < levelCount(s); ++l) {
-            uint64_t side = std::max(s >> l, 1u);
-            levels.push_back({offset, side * side * 4, 0});
-            offset += side * side * 4;
+    EncodeProgress progress;
+    for (size_t i = 0; i < sizes.size(); ++i)
+        for (uint32_t l = 0; l < levelCount(sizes[i]); ++l) {
+            uint32_t side = std::max(sizes[i] >> l, 1u);
+            levels.push_back({offset, levelBytes(formats[i], side), 0});
+            offset += levelBytes(formats[i], side);
+            progress.total += uint64_t(side) * side * 4;
         }
     const uint64_t fileSize = offset;
+    std::vector<float> psnr(sizes.size(), 99.0f);
+    std::unique_ptr<WorkerPool> pool;
+    if (compression != TextureCompression::None)
+        pool = std::make_unique<WorkerPool>(std::max(1u, std::thread::hardware_concurrency()));
 
     int error = 0;
     if (::lseek(fd, off_t(sizeof(FileHeader) + directory.size()), SEEK_SET) < 0) error = errno;
     size_t levelIndex = 0;
     for (size_t i = 0; i < scene.textures.size() && error == 0; ++i) {
-        const Texture& t = scene.textures[i];
         uint32_t size = sizes[i];
-        std::vector<uint8_t> level;
-        if (t.procedural.kind != 0) {
-            level.resize(size_t(size) * size * 4);
-            generateProceduralTexture(t.procedural, size, level.data());
-        } else if (t.width == size && t.height == size) {
-            level = t.rgba8;
-        } else {
-            level = resample(t, size);
-        }
+        std::vector<uint8_t> level = levelZero(scene.textures[i], size);
         for (uint32_t l = 0; l < levelCount(size) && error == 0; ++l) {
             uint32_t side = std::max(size >> l, 1u);
             if (l > 0) level = halve(level, side * 2, srgb[i]);
-            std::vector<uint8_t> tiles = tiled(level, side);
+            std::vector<uint8_t> encoded =
+                encodeImage(formats[i], level.data(), side, side, pool.get());
+            if (l == 0 && formats[i] != BlockFormat::Rgba8) {
+                std::vector<uint8_t> decoded = decodeImage(formats[i], encoded.data(), side, side);
+                psnr[i] = float(imagePsnr(level.data(), decoded.data(), size_t(side) * side,
+                                          blockFormatChannels(formats[i])));
+            }
+            std::vector<uint8_t> tiles = tiled(encoded, side, formats[i]);
             levels[levelIndex].checksum = hashBytes(tiles.data(), tiles.size(), 0);
             ++levelIndex;
             error = writeAll(fd, tiles.data(), tiles.size());
+            progress.advance(uint64_t(side) * side * 4, i, sizes.size());
         }
     }
     // The directory.
     size_t o = 0;
     levelIndex = 0;
     for (size_t i = 0; i < sizes.size(); ++i) {
-        TextureRecord rec{sizes[i], levelCount(sizes[i]), uint32_t(srgb[i]), 0};
+        TextureRecord rec{
+            sizes[i], levelCount(sizes[i]), uint32_t(srgb[i]), uint32_t(formats[i]), psnr[i], 0};
         std::memcpy(&directory[o], &rec, sizeof rec), o += sizeof rec;
         for (uint32_t l = 0; l < rec.levels; ++l, ++levelIndex)
             std::memcpy(&directory[o], &levels[levelIndex], sizeof(LevelRecord)),
@@ -270,10 +327,17 @@ static int writePackTo(int fd, const Scene& scene) {
     if (error == 0 && ::lseek(fd, 0, SEEK_SET) < 0) error = errno;
     if (error == 0) error = writeAll(fd, &header, sizeof header);
     if (error == 0) error = writeAll(fd, directory.data(), directory.size());
+    *seconds = progress.seconds();
+    if (error == 0 && pool)
+        SHADEL_INFO("texture streaming file: %zu textures (%.1f MiB RGBA8 with MIPs) block-"
+                    "compressed in %.2f s (%.1f MB/s, %u threads)",
+                    sizes.size(), double(progress.total) / 1048576.0, *seconds,
+                    double(progress.total) / 1e6 / std::max(*seconds, 1e-9), pool->threads());
     return error;
 }
 
-bool buildTexturePack(const Scene& scene, const std::string& path, std::string* why) {
+bool buildTexturePack(const Scene& scene, const std::string& path, std::string* why,
+                      TextureCompression compression) {
     namespace fs = std::filesystem;
     std::string scratch;
     std::string& reason = why ? *why : scratch;
@@ -289,7 +353,8 @@ bool buildTexturePack(const Scene& scene, const std::string& path, std::string* 
         reason = path + ": " + std::strerror(errno);
         return false;
     }
-    int error = writePackTo(fd, scene);
+    double seconds = 0.0;
+    int error = writePackTo(fd, scene, compression, &seconds);
     // Delayed allocation: a full disk may only show at fsync or close.
     if (error == 0 && ::fsync(fd) != 0 && errno != EINVAL) error = errno;
     if (::close(fd) != 0 && error == 0) error = errno;
@@ -381,6 +446,7 @@ static bool readPack(int fd, const std::string& path, const BakeKey& key, Textur
         std::memcpy(&rec, &directory[o], sizeof rec), o += sizeof rec;
         if (rec.size == 0 || rec.size > kTexturePackMaxSize || (rec.size & (rec.size - 1)) != 0 ||
             rec.levels != levelCount(rec.size) || rec.srgb > 1 ||
+            rec.format > uint32_t(BlockFormat::Bc5) || !(rec.psnr >= 0.0f && rec.psnr <= 99.0f) ||
             (directory.size() - o) / sizeof(LevelRecord) < rec.levels) {
             reason = format("texture %u: bad directory entry", i);
             return false;
@@ -388,17 +454,19 @@ static bool readPack(int fd, const std::string& path, const BakeKey& key, Textur
         PackedTexture t;
         t.size = rec.size;
         t.srgb = rec.srgb != 0;
+        t.format = BlockFormat(rec.format);
+        t.psnr = rec.psnr;
         for (uint32_t l = 0; l < rec.levels; ++l) {
             LevelRecord lr{};
             std::memcpy(&lr, &directory[o], sizeof lr), o += sizeof lr;
-            uint64_t side = std::max(rec.size >> l, 1u);
-            if (lr.bytes != side * side * 4 || lr.offset != cursor || lr.offset > fileBytes ||
-                lr.bytes > fileBytes - lr.offset) {
+            uint32_t side = std::max(rec.size >> l, 1u);
+            if (lr.bytes != levelBytes(t.format, side) || lr.offset != cursor ||
+                lr.offset > fileBytes || lr.bytes > fileBytes - lr.offset) {
                 reason = format("texture %u level %u: outside the file or misplaced", i, l);
                 return false;
             }
             cursor += lr.bytes;
-            t.levels.push_back({uint32_t(side), lr.offset, lr.bytes, lr.checksum});
+            t.levels.push_back({side, lr.offset, lr.bytes, lr.checksum});
         }
         pack.textures.push_back(std::move(t));
     }
@@ -434,14 +502,16 @@ bool openTexturePack(const std::string& path, const BakeKey& key, TexturePack& o
 
 // Writes the pack into an anonymous in-memory file: the fallback when there is no cache folder or
 // it cannot be written. Throws if even that fails.
-static TexturePack buildTexturePackInMemory(const Scene& scene, const BakeKey& key) {
+static TexturePack buildTexturePackInMemory(const Scene& scene, const BakeKey& key,
+                                            TextureCompression compression) {
     int fd = ::memfd_create("shadel-texture-streaming", MFD_CLOEXEC);
     if (fd < 0)
         throw std::runtime_error(std::string("texture streaming file in memory: ") +
                                  std::strerror(errno));
     TexturePack pack;
     std::string why;
-    if (int error = writePackTo(fd, scene); error != 0)
+    double seconds = 0.0;
+    if (int error = writePackTo(fd, scene, compression, &seconds); error != 0)
         why = std::strerror(error);
     else if (!readPack(fd, "(memory)", key, pack, why, false))
         why = "unreadable right after writing: " + why;
@@ -450,11 +520,13 @@ static TexturePack buildTexturePackInMemory(const Scene& scene, const BakeKey& k
         throw std::runtime_error("texture streaming file in memory: " + why);
     }
     pack.fd = fd;
+    pack.encodeSeconds = seconds;
     return pack;
 }
 
-TexturePack openOrBuildTexturePack(const Scene& scene, const std::string& cacheDir) {
-    BakeKey key = texturePackKey(scene);
+TexturePack openOrBuildTexturePack(const Scene& scene, const std::string& cacheDir,
+                                   TextureCompression compression) {
+    BakeKey key = texturePackKey(scene, compression);
     uint64_t texels = 0;
     for (const Texture& t : scene.textures)
         texels += uint64_t(packedTextureSize(t)) * packedTextureSize(t);
@@ -463,7 +535,7 @@ TexturePack openOrBuildTexturePack(const Scene& scene, const std::string& cacheD
         SHADEL_INFO("building the texture streaming file of %zu textures (%.0f MiB at level 0) "
                     "in memory: no cache folder",
                     scene.textures.size(), mib);
-        return buildTexturePackInMemory(scene, key);
+        return buildTexturePackInMemory(scene, key, compression);
     }
     std::string path = texturePackPath(cacheDir, key);
     TexturePack pack;
@@ -481,9 +553,10 @@ TexturePack openOrBuildTexturePack(const Scene& scene, const std::string& cacheD
                     why.c_str());
     SHADEL_INFO("building the texture streaming file of %zu textures (%.0f MiB at level 0): %s",
                 scene.textures.size(), mib, path.c_str());
-    if (!buildTexturePack(scene, path, &why)) {
+    const auto start = std::chrono::steady_clock::now();
+    if (!buildTexturePack(scene, path, &why, compression)) {
         SHADEL_WARN("texture streaming file not cached (%s): streaming from memory", why.c_str());
-        return buildTexturePackInMemory(scene, key);
+        return buildTexturePackInMemory(scene, key, compression);
     }
     int fd = openPackFile(path, why);
     if (fd < 0 || !readPack(fd, path, key, pack, why, false)) {
@@ -492,6 +565,8 @@ TexturePack openOrBuildTexturePack(const Scene& scene, const std::string& cacheD
                                  " unreadable right after writing: " + why);
     }
     pack.fd = fd;
+    pack.encodeSeconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     return pack;
 }
 

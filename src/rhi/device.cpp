@@ -435,6 +435,13 @@ void requiredFeatures(Device& device, const std::vector<VkQueueFamilyProperties>
         f.core.features.shaderStorageImageReadWithoutFormat;
     enable.core.features.depthClamp = VK_TRUE;
     enable.core.features.independentBlend = f.core.features.independentBlend;
+    // Block-compressed textures (texture streaming). SHADEL_DISABLE_BC=1 leaves them off, as on
+    // a device without them (tests of the RGBA8 fallback).
+    const char* noBc = std::getenv("SHADEL_DISABLE_BC");
+    if ((!noBc || std::strcmp(noBc, "1") != 0) && f.core.features.textureCompressionBC) {
+        enable.core.features.textureCompressionBC = VK_TRUE;
+        device.optional.textureCompressionBC = true;
+    }
     // Sparse residency (texture streaming, --streaming sparse). SHADEL_DISABLE_SPARSE=1 leaves
     // it off, as on a device without it (tests of that error path).
     const char* noSparse = std::getenv("SHADEL_DISABLE_SPARSE");
@@ -591,10 +598,12 @@ std::string describeDevice(const Device& device) {
            "bufferDeviceAddress shaderInt64 shaderBufferInt64Atomics fragmentStoresAndAtomics "
            "multiDrawIndirect drawIndirectCount timestamps subgroups: all present\n";
     out +=
-        format("optional: meshShader=%s rayQuery=%s computeDerivatives=%s sparseResidency=%s\n",
+        format("optional: meshShader=%s rayQuery=%s computeDerivatives=%s sparseResidency=%s "
+               "textureCompressionBC=%s\n",
                device.optional.meshShader ? "yes" : "no", device.optional.rayQuery ? "yes" : "no",
                device.optional.computeDerivatives ? "yes" : "no",
-               device.optional.sparseResidency ? "yes" : "no");
+               device.optional.sparseResidency ? "yes" : "no",
+               device.optional.textureCompressionBC ? "yes" : "no");
     out += format("limits:   maxImageDimension2D=%u maxComputeWorkGroupInvocations=%u "
                   "maxPushConstantsSize=%u maxDescriptorSetUpdateAfterBindSampledImages=%u "
                   "timestampPeriod=%.3fns\n",

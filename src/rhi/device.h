@@ -24,6 +24,8 @@ struct DeviceFeatures { // optional features, used when present
     bool computeDerivatives = false;
     // sparseBinding + sparseResidencyImage2D, on a queue with sparse binding (--streaming sparse)
     bool sparseResidency = false;
+    // BC1-7 sampling (texture streaming's block-compressed files, --texture-compression bc)
+    bool textureCompressionBC = false;
 };
 
 struct Device {

@@ -323,6 +323,7 @@ Pipeline createGraphicsPipeline(Gpu& gpu, const GraphicsPipelineDesc& desc) {
     if (desc.depthBias) dynamics.push_back(VK_DYNAMIC_STATE_DEPTH_BIAS);
     if (desc.dynamicCulling) {
         dynamics.push_back(VK_DYNAMIC_STATE_CULL_MODE);
+        dynamics.push_back(VK_DYNAMIC_STATE_FRONT_FACE);
     }
     VkPipelineDynamicStateCreateInfo dynamic{VK_STRUCTURE_TYPE_PIPELINE_DYNAMIC_STATE_CREATE_INFO};
     dynamic.dynamicStateCount = uint32_t(dynamics.size());

@@ -26,8 +26,9 @@ struct GraphicsPipelineDesc {
     VkPrimitiveTopology topology = VK_PRIMITIVE_TOPOLOGY_TRIANGLE_LIST;
     bool depthClamp = false;
     bool depthBias = false;
-    // The cull mode set by the command buffer (vkCmdSetCullMode) instead of cullMode: passes
-    // drawing the camera's lists, which cull per list side.
+    // The cull mode and front face set by the command buffer (vkCmdSetCullMode,
+    // vkCmdSetFrontFace) instead of cullMode and counter-clockwise: passes drawing the camera's
+    // lists, which cull per list side.
     bool dynamicCulling = false;
     enum class Blend { None, Alpha, Additive } blend = Blend::None;
     // Per colour attachment, overriding `blend` when not empty (e.g. WBOIT's two targets

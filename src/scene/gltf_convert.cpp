@@ -66,7 +66,6 @@ private:
     std::vector<std::vector<uint32_t>> meshParts_;
     std::vector<std::vector<PointLineSet>> pointLineParts_; // per glTF mesh, object space
     std::vector<bool> meshConverted_;
-    std::map<uint32_t, uint32_t> mirroredMesh_;        // mesh -> copy with reversed winding
     std::map<std::pair<int, bool>, int32_t> textures_; // (image, sRGB) -> scene texture
     int32_t defaultMaterial_ = -1;
     uint32_t skippedPrimitives_ = 0;
@@ -520,21 +519,6 @@ private:
         return m;
     }
 
-    uint32_t mirroredCopy(uint32_t mesh) {
-        if (auto it = mirroredMesh_.find(mesh); it != mirroredMesh_.end()) return it->second;
-        chargeLoadMemory(uint64_t(scene_.meshes[mesh].vertices.size()) * sizeof(Vertex) +
-                             scene_.meshes[mesh].indices.size() * sizeof(uint32_t),
-                         "a mirrored mesh");
-        Mesh copy = scene_.meshes[mesh];
-        copy.name += " (mirrored)";
-        for (size_t t = 0; t + 2 < copy.indices.size(); t += 3)
-            std::swap(copy.indices[t + 1], copy.indices[t + 2]);
-        uint32_t index = uint32_t(scene_.meshes.size());
-        scene_.meshes.push_back(std::move(copy));
-        mirroredMesh_[mesh] = index;
-        return index;
-    }
-
     void addNodeContent(const tinygltf::Node& node, int index, const glm::mat4& world) {
         std::string nodeName = node.name.empty() ? format("node%d", index) : node.name;
         if (node.skin >= 0 && node.mesh >= 0 && skinning_) {
@@ -543,15 +527,15 @@ private:
             if (node.skin >= 0)
                 warnOnce("skinned meshes are drawn in their bind pose without --time");
             if (!meshConverted_[size_t(node.mesh)]) convertMesh(node.mesh, node.weights);
-            // A mirroring transform turns CCW into CW: give those instances a mesh with the
-            // winding reversed so front faces stay front faces.
-            bool mirrored = glm::determinant(glm::mat3(world)) < 0.0f;
+            // A mirroring transform turns counter-clockwise into clockwise: the renderer draws
+            // such instances with the clockwise front face, deciding every frame (the sign may
+            // change while an animation plays), so the mesh is shared as it is.
             const auto& parts = meshParts_[size_t(node.mesh)];
             for (size_t p = 0; p < parts.size(); ++p) {
                 chargeLoadMemory(sizeof(Instance), "an instance");
                 Instance inst;
                 inst.name = parts.size() > 1 ? nodeName + format("#%zu", p) : nodeName;
-                inst.mesh = mirrored ? mirroredCopy(parts[p]) : parts[p];
+                inst.mesh = parts[p];
                 inst.transform = world;
                 scene_.instances.push_back(std::move(inst));
             }

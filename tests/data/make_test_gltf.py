@@ -217,7 +217,7 @@ def good_files():
     # Points only (mode 0): no triangles, drawn forward as points (render/points_lines).
     d = copy.deepcopy(q); d["meshes"][0]["primitives"][0]["mode"] = 0; out["points_only.gltf"] = d
 
-    # Mirrored instance: scale -1 in X must reverse the winding of its mesh copy.
+    # Mirrored instance: scale -1 in X turns its winding (drawn with the clockwise front face).
     d = copy.deepcopy(q)
     d["nodes"] = [{"name": "normal", "mesh": 0}, {"name": "mirrored", "mesh": 0, "scale": [-1, 1, 1]}]
     d["scenes"][0]["nodes"] = [0, 1]

@@ -3,6 +3,7 @@
 // bounds: the tests run under ASan too) and rebuilt by openOrBuildTexturePack.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -95,6 +96,38 @@ TEST(TexturePack, LargeLevelsAreStoredAsTiles) {
     // Tile (0, 1), row 3: texels 0..127 of row 131.
     EXPECT_EQ(0,
               std::memcmp(&stored[2 * tileBytes + 3 * 128 * 4], &full[(131 * 256) * 4], 128 * 4));
+}
+
+// With block compression every level is BC7 (whole 4x4 blocks, the 2x2 and 1x1 levels one block
+// each), tiled as the RGBA8 file is, a separate file (its own key), each texture's PSNR in the
+// directory; level 0's tiles decode to the RGBA8 file's texels within that PSNR.
+TEST(TexturePack, BlockCompressedLevelsAreBc7Tiles) {
+    TempDir dir("texpack");
+    Scene scene = makeTextureGallery(256);
+    scene.textures.resize(2);
+    TexturePack rgba = openOrBuildTexturePack(scene, dir.path.string());
+    TexturePack bc = openOrBuildTexturePack(scene, dir.path.string(), TextureCompression::Bc);
+    EXPECT_NE(rgba.path, bc.path);
+    ASSERT_EQ(bc.textures.size(), 2u);
+    for (size_t t = 0; t < 2; ++t) {
+        const PackedTexture& p = bc.textures[t];
+        EXPECT_EQ(p.format, BlockFormat::Bc7);
+        EXPECT_TRUE(p.srgb);
+        for (const PackedLevel& l : p.levels)
+            EXPECT_EQ(l.bytes, uint64_t(std::max(l.size / 4, 1u)) * std::max(l.size / 4, 1u) * 16);
+        // Level 0 in tile order: each 128^2 tile is 32x32 blocks, row-major.
+        std::vector<uint8_t> tiles = readLevel(bc, t, 0), texels = readLevel(rgba, t, 0);
+        const size_t tileBlocks = 32 * 32, tileTexels = 128 * 128;
+        double worst = 99.0;
+        for (size_t k = 0; k < 4; ++k) {
+            std::vector<uint8_t> decoded =
+                decodeImage(BlockFormat::Bc7, &tiles[k * tileBlocks * 16], 128, 128);
+            worst = std::min(
+                worst, imagePsnr(decoded.data(), &texels[k * tileTexels * 4], tileTexels, 0xF));
+        }
+        EXPECT_GE(p.psnr, 40.0f);
+        EXPECT_NEAR(worst, p.psnr, 1.0) << "a tile against the whole level's PSNR";
+    }
 }
 
 TEST(TexturePack, CorruptTruncatedStaleAreRejectedAndRebuilt) {

@@ -54,7 +54,15 @@ void drawOneCameraList(Renderer& r, VkCommandBuffer cmd, uint32_t list, BufferHa
 } // namespace
 
 void setDrawSide(VkCommandBuffer cmd, uint32_t side) {
-    vkCmdSetCullMode(cmd, side == DRAW_SIDE_BOTH ? VK_CULL_MODE_NONE : VK_CULL_MODE_BACK_BIT);
+    bool both = (side & ~DRAW_SIDE_MIRRORED) == DRAW_SIDE_BOTH;
+    vkCmdSetCullMode(cmd, both ? VK_CULL_MODE_NONE : VK_CULL_MODE_BACK_BIT);
+    vkCmdSetFrontFace(cmd, (side & DRAW_SIDE_MIRRORED) != 0u ? VK_FRONT_FACE_CLOCKWISE
+                                                             : VK_FRONT_FACE_COUNTER_CLOCKWISE);
+}
+
+uint32_t drawSideOf(bool doubleSided, const glm::mat4& transform) {
+    return (doubleSided ? DRAW_SIDE_BOTH : DRAW_SIDE_FRONT) +
+           (glm::determinant(glm::mat3(transform)) < 0.0f ? DRAW_SIDE_MIRRORED : 0u);
 }
 
 BufferHandle shadingIndices(const Renderer& r) {

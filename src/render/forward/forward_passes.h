@@ -3,6 +3,8 @@
 // map, the depth prepass and forward shading. The decoupled path reuses the first three.
 #include <cstdint>
 
+#include <glm/mat4x4.hpp>
+
 #include "rhi/handles.h"
 #include "rhi/vk.h"
 
@@ -42,10 +44,12 @@ void drawSunShadowList(Renderer& r, VkCommandBuffer cmd);
 // prepass's: GpuScene::visibilityIndices). Each list is drawn side by side (DRAW_SIDE_*), the
 // cull mode set for each: the pipeline has GraphicsPipelineDesc::dynamicCulling.
 void drawCameraList(Renderer& r, VkCommandBuffer cmd, uint32_t list, BufferHandle indices = {});
-// The cull mode of a draw of side `side` (DRAW_SIDE_*), for dynamicCulling pipelines: back
-// faces culled for single-sided materials, none for double-sided ones (front faces are counter-
-// clockwise: mirrored instances have a mesh copy with the winding reversed, scene/gltf_convert).
+// The cull mode and front face of a draw of side `side` (DRAW_SIDE_*), for dynamicCulling
+// pipelines: back faces culled for single-sided materials, none for double-sided ones; front
+// faces clockwise for instances whose transform mirrors.
 void setDrawSide(VkCommandBuffer cmd, uint32_t side);
+// The side of an instance drawn on its own (the CPU lists of transparency and transmission).
+uint32_t drawSideOf(bool doubleSided, const glm::mat4& transform);
 // Begins depth-only rendering into the scene depth (cleared for the prepass, loaded after).
 void beginSceneDepthPass(Renderer& r, VkCommandBuffer cmd, bool clear);
 // --inspect prints the triangle under the pixel: forward shading and the raster reconstruction

@@ -17,6 +17,7 @@ struct OitState {
     std::vector<gpu::GpuMesh> meshes;   // the scene's (draws are recorded from the CPU list)
     std::vector<uint32_t> instanceMesh; // per instance
     std::vector<uint8_t> doubleSided;   // per instance: its material's
+    std::vector<uint32_t> drawSide;     // per instance: this frame's DRAW_SIDE_* (drawSideOf)
     // WBOIT targets: accumulation (sum of premultiplied colour * w, sum of coverage * w) and
     // revealage (R: product of 1 - opacity; G: the same over plain alpha layers; A: summed
     // additiveness).
@@ -203,8 +204,10 @@ void prepareTransparentDraws(Renderer& r, const GpuScene& scene, const CameraVie
     o.draws.clear();
     auto planes = frustumPlanes(camera.proj * camera.view);
     o.decoupledDraws = 0;
+    o.drawSide.resize(scene.instanceCount);
     for (uint32_t i : o.blended) {
         const gpu::GpuInstance& inst = scene.instanceInfo[i];
+        o.drawSide[i] = drawSideOf(o.doubleSided[i], inst.model); // the transform may animate
         if (drawnDecoupled(r, i)) {
             o.decoupledDraws++; // the GPU lists it (DRAW_LIST_DECOUPLED_BLEND)
             continue;
@@ -327,6 +330,7 @@ void recordTransparencyPasses(Renderer& r, FrameRecorder& rec, uint64_t frame) {
             for (uint32_t i : o.draws) {
                 // A double-sided instance's back faces, then its front faces; a single-sided
                 // one's front faces only.
+                setDrawSide(cmd, o.drawSide[i]); // its front face
                 if (o.doubleSided[i]) {
                     vkCmdSetCullMode(cmd, VK_CULL_MODE_FRONT_BIT);
                     drawInstance(cmd, meshOf(i), i);
@@ -346,7 +350,7 @@ void recordTransparencyPasses(Renderer& r, FrameRecorder& rec, uint64_t frame) {
         pushConstants(gpu, cmd, RasterPush{frame, 0});
         vkCmdBindIndexBuffer(cmd, vkBuffer(gpu, r.sceneIndices), 0, VK_INDEX_TYPE_UINT32);
         for (uint32_t i : o.draws) {
-            setDrawSide(cmd, o.doubleSided[i] ? DRAW_SIDE_BOTH : DRAW_SIDE_FRONT);
+            setDrawSide(cmd, o.drawSide[i]);
             drawInstance(cmd, meshOf(i), i);
         }
         if (o.decoupledDraws) { // reconstructed from shadel space into the same targets

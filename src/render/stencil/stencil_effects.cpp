@@ -31,6 +31,7 @@ struct MarkDraw {
     int32_t vertexOffset;
     uint32_t instance;
     glm::vec3 worldMin, worldMax;
+    bool mirrored; // its transform mirrors: clockwise front faces
 };
 
 struct StencilEffectsState {
@@ -118,12 +119,15 @@ void beginDepthStencil(Renderer& r, StencilEffectsState& s, VkCommandBuffer cmd,
 }
 
 void drawMarks(Renderer& r, VkCommandBuffer cmd, const Pipeline& p,
-               const std::vector<MarkDraw>& draws, uint64_t frame) {
+               const std::vector<MarkDraw>& draws, uint64_t frame, bool cullBack) {
     if (draws.empty()) return;
     bind(*r.gpu, cmd, p);
     pushConstants(*r.gpu, cmd, RasterPush{frame, 0});
-    for (const MarkDraw& d : draws)
+    for (const MarkDraw& d : draws) {
+        setDrawSide(cmd, (cullBack ? DRAW_SIDE_FRONT : DRAW_SIDE_BOTH) +
+                             (d.mirrored ? DRAW_SIDE_MIRRORED : 0u));
         vkCmdDrawIndexed(cmd, d.indexCount, 1, d.firstIndex, d.vertexOffset, d.instance);
+    }
 }
 
 // Disjoint rects covering every pixel the instances' world boxes can cover (a coarse stand-in
@@ -159,8 +163,13 @@ StencilEffectsStatePtr createStencilEffects(Renderer& r, const Scene& scene,
     for (uint32_t i = 0; i < gpuScene.instanceInfo.size(); ++i) {
         const gpu::GpuInstance& inst = gpuScene.instanceInfo[i];
         const gpu::GpuMesh& mesh = gpuScene.meshInfo[inst.mesh];
-        MarkDraw d{mesh.indexCount, mesh.firstIndex, mesh.vertexOffset, i,
-                   inst.worldMin,   inst.worldMax};
+        MarkDraw d{mesh.indexCount,
+                   mesh.firstIndex,
+                   mesh.vertexOffset,
+                   i,
+                   inst.worldMin,
+                   inst.worldMax,
+                   glm::determinant(glm::mat3(inst.model)) < 0.0f};
         uint32_t cls = (gpuScene.materialInfo[inst.material].flags >> MATERIAL_CLASS_SHIFT) &
                        MATERIAL_CLASS_MASK;
         if (cls == uint32_t(SurfaceClass::Water)) s->waterDraws.push_back(d);
@@ -211,12 +220,12 @@ StencilEffectsStatePtr createStencilEffects(Renderer& r, const Scene& scene,
     mark.fragmentShader = "stencil_character_mark.frag.spv";
     mark.depthWrite = false;
     mark.stencilTest = true;
+    mark.dynamicCulling = true; // both sides for water, front faces for characters (drawMarks)
     mark.name = "stencilMarkWater";
     mark.depthCompare = VK_COMPARE_OP_EQUAL; // the visible water surface
     mark.stencil = stencilOps(VK_COMPARE_OP_ALWAYS, STENCIL_WATER, VK_STENCIL_OP_REPLACE);
     s->markWater = createGraphicsPipeline(gpu, mark);
     mark.name = "stencilMarkCharacterVisible";
-    mark.cullMode = VK_CULL_MODE_BACK_BIT; // a character's far side is not "hidden"
     mark.attachmentBlends = {maskBlend(true)};
     mark.depthCompare = VK_COMPARE_OP_GREATER_OR_EQUAL; // reversed Z: in front or the surface
     mark.stencil = stencilOps(VK_COMPARE_OP_ALWAYS, STENCIL_CHARACTER | STENCIL_CHARACTER_VISIBLE,
@@ -300,9 +309,10 @@ void recordStencilEffects(Renderer& r, FrameRecorder& rec, uint64_t frame,
         pushConstants(gpu, cmd, push);
         vkCmdDraw(cmd, 3, 1, 0, 0);
         vkCmdBindIndexBuffer(cmd, vkBuffer(gpu, r.sceneIndices), 0, VK_INDEX_TYPE_UINT32);
-        drawMarks(r, cmd, s.markWater, s.waterDraws, frame);
-        drawMarks(r, cmd, s.markVisible, s.characterDraws, frame);
-        drawMarks(r, cmd, s.markHidden, s.characterDraws, frame);
+        drawMarks(r, cmd, s.markWater, s.waterDraws, frame, false);
+        // Front faces only: a character's far side is not "hidden".
+        drawMarks(r, cmd, s.markVisible, s.characterDraws, frame, true);
+        drawMarks(r, cmd, s.markHidden, s.characterDraws, frame, true);
         vkCmdEndRendering(cmd);
         imageBarrier(cmd, vkImage(gpu, r.depth), VK_IMAGE_ASPECT_DEPTH_BIT,
                      VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL,

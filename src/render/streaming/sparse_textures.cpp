@@ -17,10 +17,6 @@ uint32_t log2u(uint32_t v) {
     return r;
 }
 
-VkFormat formatOf(bool srgb) {
-    return srgb ? VK_FORMAT_R8G8B8A8_SRGB : VK_FORMAT_R8G8B8A8_UNORM;
-}
-
 constexpr VkImageUsageFlags kUsage = VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT;
 
 uint64_t alignUp(uint64_t v, uint64_t a) {
@@ -74,7 +70,7 @@ SparseImagesMade createSparseImages(Gpu& gpu, const std::vector<uint32_t>& sizes
         VkImageCreateInfo ci{VK_STRUCTURE_TYPE_IMAGE_CREATE_INFO};
         ci.flags = VK_IMAGE_CREATE_SPARSE_BINDING_BIT | VK_IMAGE_CREATE_SPARSE_RESIDENCY_BIT;
         ci.imageType = VK_IMAGE_TYPE_2D;
-        ci.format = formatOf(srgb[i]);
+        ci.format = packedVkFormat(out.format, srgb[i]);
         ci.extent = {sizes[i], sizes[i], 1};
         ci.mipLevels = img.levels;
         ci.arrayLayers = 1;
@@ -97,7 +93,11 @@ SparseImagesMade createSparseImages(Gpu& gpu, const std::vector<uint32_t>& sizes
             throw DeviceError("sparse texture images with different page sizes");
         SparseLayout layout = sparseLayout(device, img.image);
         const VkSparseImageMemoryRequirements& c = layout.color;
-        if (out.granularity.width == 0) out.granularity = c.formatProperties.imageGranularity;
+        if (out.granularity.width == 0) { // the device gives compressed formats' in blocks
+            out.granularity = c.formatProperties.imageGranularity;
+            out.granularity.width *= blockSide(out.format);
+            out.granularity.height *= blockSide(out.format);
+        }
         // The device's packed tail (none on lavapipe: every level is paged, down to 1x1).
         img.deviceTailFirst = std::min(c.imageMipTailFirstLod, img.levels);
         SparseTexture t;
@@ -224,7 +224,7 @@ void createSparseViews(Gpu& gpu, const std::vector<bool>& srgb, SparseTextures& 
             VkImageViewCreateInfo vi{VK_STRUCTURE_TYPE_IMAGE_VIEW_CREATE_INFO};
             vi.image = img.image;
             vi.viewType = VK_IMAGE_VIEW_TYPE_2D;
-            vi.format = formatOf(srgb[i]);
+            vi.format = packedVkFormat(out.format, srgb[i]);
             vi.subresourceRange = {VK_IMAGE_ASPECT_COLOR_BIT, base, img.levels - base, 0, 1};
             VkImageView v = VK_NULL_HANDLE;
             VK_CHECK(vkCreateImageView(device, &vi, nullptr, &v));
@@ -237,28 +237,37 @@ void createSparseViews(Gpu& gpu, const std::vector<bool>& srgb, SparseTextures& 
 
 } // namespace
 
-std::string sparseUnsupportedReason(const Gpu& gpu) {
+VkFormat packedVkFormat(BlockFormat format, bool srgb) {
+    if (format == BlockFormat::Bc7)
+        return srgb ? VK_FORMAT_BC7_SRGB_BLOCK : VK_FORMAT_BC7_UNORM_BLOCK;
+    if (format == BlockFormat::Bc5) return VK_FORMAT_BC5_UNORM_BLOCK;
+    if (format == BlockFormat::Bc4) return VK_FORMAT_BC4_UNORM_BLOCK;
+    return srgb ? VK_FORMAT_R8G8B8A8_SRGB : VK_FORMAT_R8G8B8A8_UNORM;
+}
+
+std::string sparseUnsupportedReason(const Gpu& gpu, BlockFormat format) {
     const Device& d = gpu.device;
     if (!d.optional.sparseResidency)
         return d.name + " has no sparse residency for 2-D images (sparseBinding, "
                         "sparseResidencyImage2D and a sparse-binding queue)";
     for (bool srgb : {false, true}) {
         uint32_t n = 0;
-        vkGetPhysicalDeviceSparseImageFormatProperties(d.physical, formatOf(srgb), VK_IMAGE_TYPE_2D,
-                                                       VK_SAMPLE_COUNT_1_BIT, kUsage,
-                                                       VK_IMAGE_TILING_OPTIMAL, &n, nullptr);
+        vkGetPhysicalDeviceSparseImageFormatProperties(
+            d.physical, packedVkFormat(format, srgb), VK_IMAGE_TYPE_2D, VK_SAMPLE_COUNT_1_BIT,
+            kUsage, VK_IMAGE_TILING_OPTIMAL, &n, nullptr);
         if (n == 0)
-            return d.name + " cannot make sparse-resident " +
-                   (srgb ? "R8G8B8A8_SRGB" : "R8G8B8A8_UNORM") + " images";
+            return d.name + " cannot make sparse-resident " + blockFormatName(format) +
+                   (srgb ? " sRGB" : " linear") + " images";
     }
     return {};
 }
 
 void createSparseTextures(Gpu& gpu, const std::vector<uint32_t>& sizes,
-                          const std::vector<bool>& srgb, uint64_t budgetBytes,
-                          SparseTextures& out) {
+                          const std::vector<bool>& srgb, BlockFormat blockFormat,
+                          uint64_t budgetBytes, SparseTextures& out) {
     VkDevice device = gpu.device.device;
     out.gpu = &gpu;
+    out.format = blockFormat;
     SparseImagesMade made = createSparseImages(gpu, sizes, srgb, out);
     const uint64_t addressSpace = made.addressSpace;
     if (addressSpace > gpu.device.properties.limits.sparseAddressSpaceSize)

@@ -3,8 +3,9 @@
 // (its whole MIP chain as address space), its MIP tail bound at creation from one tail
 // allocation (the device's packed tail opaquely; before it, the levels smaller than a page, which
 // a device without a packed tail such as lavapipe pages like any other), and a fixed pool of pages
-// (sparse blocks, 64 KiB for RGBA8) that level loads bind into and evictions unbind from, with
-// vkQueueBindSparse. The bookkeeping of who holds which page is sparse_residency.h.
+// (sparse blocks of 64 KiB: 128^2 RGBA8 or 256^2 BC7 texels) that level loads bind into and
+// evictions unbind from, with vkQueueBindSparse. The bookkeeping of who holds which page is
+// sparse_residency.h.
 //
 // Binds are queued before the frame and signal a semaphore the frame's first submission waits on
 // (binds are not ordered against command buffers otherwise). Unbinds are safe then too: the
@@ -14,6 +15,7 @@
 #include <string>
 #include <vector>
 
+#include "bake/block_compression/block_compression.h"
 #include "render/streaming/sparse_residency.h"
 #include "rhi/vk.h"
 
@@ -30,8 +32,9 @@ struct SparseImage {
 
 struct SparseTextures {
     Gpu* gpu = nullptr;
+    BlockFormat format = BlockFormat::Rgba8;
     std::vector<SparseImage> images;
-    VkExtent3D granularity{}; // texels per page
+    VkExtent3D granularity{}; // texels per page (blocks times the block side for BC formats)
     uint64_t pageBytes = 0;
     uint32_t memoryType = 0;
     VkDeviceMemory tailMemory = VK_NULL_HANDLE, poolMemory = VK_NULL_HANDLE;
@@ -41,14 +44,18 @@ struct SparseTextures {
     uint64_t pageBinds = 0, pageUnbinds = 0;
 };
 
-// Empty when the device can page RGBA8 2-D images (features, queue, format), else why not.
-std::string sparseUnsupportedReason(const Gpu& gpu);
+// The Vulkan format of a streamed texture's blocks, read as sRGB or linear.
+VkFormat packedVkFormat(BlockFormat format, bool srgb);
 
-// Images for textures of the given sides (power of two, sRGB or linear), their tails bound (not
-// yet uploaded: levels tailFirst.. are UNDEFINED), and a pool of the pages the budget has left
-// after the tails. Throws InputError when the tails alone exceed budgetBytes.
+// Empty when the device can page 2-D images of the format (features, queue), else why not.
+std::string sparseUnsupportedReason(const Gpu& gpu, BlockFormat format);
+
+// Images for textures of the given sides (power of two, sRGB or linear, all of one format), their
+// tails bound (not yet uploaded: levels tailFirst.. are UNDEFINED), and a pool of the pages the
+// budget has left after the tails. Throws InputError when the tails alone exceed budgetBytes.
 void createSparseTextures(Gpu& gpu, const std::vector<uint32_t>& sizes,
-                          const std::vector<bool>& srgb, uint64_t budgetBytes, SparseTextures& out);
+                          const std::vector<bool>& srgb, BlockFormat format, uint64_t budgetBytes,
+                          SparseTextures& out);
 void destroySparseTextures(SparseTextures& s);
 
 // The view a texture is sampled through: its resident level and coarser.

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <atomic>
+#include <cmath>
 #include <condition_variable>
 #include <cstring>
 #include <deque>
@@ -29,18 +30,19 @@ uint32_t log2u(uint32_t v) {
     return r;
 }
 
-// One cache image: a square RGBA8 image with its full MIP chain, read through a linear or an sRGB
-// view (the slot serves both kinds of texture, so one slot size serves both).
+// One cache image: a square image of the file's format (RGBA8 or BC7) with its full MIP chain,
+// read through a linear or an sRGB view (the slot serves both kinds of texture, so one slot size
+// serves both).
 struct CacheImage {
     TextureHandle image;
     TextureReadView linear, srgb;
     uint32_t size = 0;
 };
 
-TextureDesc cacheImageDesc(const std::string& name, uint32_t size) {
+TextureDesc cacheImageDesc(const std::string& name, uint32_t size, BlockFormat format) {
     TextureDesc d;
     d.name = name;
-    d.format = VK_FORMAT_R8G8B8A8_UNORM;
+    d.format = packedVkFormat(format, false);
     d.width = d.height = size;
     d.mipLevels = log2u(size) + 1;
     d.usage = VK_IMAGE_USAGE_SAMPLED_BIT;
@@ -48,13 +50,15 @@ TextureDesc cacheImageDesc(const std::string& name, uint32_t size) {
     return d;
 }
 
-CacheImage makeCacheImage(Gpu& gpu, const std::string& name, uint32_t size) {
+CacheImage makeCacheImage(Gpu& gpu, const std::string& name, uint32_t size, BlockFormat format) {
     CacheImage c;
     c.size = size;
-    c.image = createTexture(gpu, cacheImageDesc(name, size));
+    c.image = createTexture(gpu, cacheImageDesc(name, size, format));
     if (!c.image) throw DeviceError("out of GPU memory for texture cache image " + name);
-    c.linear = createReadView(gpu, c.image, {0, VK_REMAINING_MIP_LEVELS, VK_FORMAT_R8G8B8A8_UNORM});
-    c.srgb = createReadView(gpu, c.image, {0, VK_REMAINING_MIP_LEVELS, VK_FORMAT_R8G8B8A8_SRGB});
+    c.linear =
+        createReadView(gpu, c.image, {0, VK_REMAINING_MIP_LEVELS, packedVkFormat(format, false)});
+    c.srgb =
+        createReadView(gpu, c.image, {0, VK_REMAINING_MIP_LEVELS, packedVkFormat(format, true)});
     return c;
 }
 
@@ -71,21 +75,23 @@ void destroyCacheImage(Gpu& gpu, CacheImage& c) {
 void appendLevelRegions(const PackedTexture& t, uint32_t firstLevel, uint32_t endLevel,
                         uint32_t firstMip, VkDeviceSize bufferOffset,
                         std::vector<VkBufferImageCopy>& regions) {
+    const uint32_t unit = blockSide(t.format); // rows of whole blocks in the buffer
     for (uint32_t l = firstLevel; l < endLevel; ++l) {
         uint32_t side = t.levels[l].size;
         uint32_t tile = std::min(side, kTexturePackTile);
+        uint32_t rowTexels = (tile + unit - 1) / unit * unit;
         VkDeviceSize o = bufferOffset;
         for (uint32_t ty = 0; ty < side; ty += tile)
             for (uint32_t tx = 0; tx < side; tx += tile) {
                 VkBufferImageCopy r{};
                 r.bufferOffset = o;
-                r.bufferRowLength = tile;
-                r.bufferImageHeight = tile;
+                r.bufferRowLength = rowTexels;
+                r.bufferImageHeight = rowTexels;
                 r.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, l - firstLevel + firstMip, 0, 1};
                 r.imageOffset = {int32_t(tx), int32_t(ty), 0};
                 r.imageExtent = {tile, tile, 1};
                 regions.push_back(r);
-                o += VkDeviceSize(tile) * tile * 4;
+                o += encodedBytes(t.format, tile, tile);
             }
         bufferOffset += t.levels[l].bytes;
     }
@@ -154,7 +160,9 @@ struct TextureStreaming {
     TextureStreamingSettings settings;
     TexturePack pack;
     int fd = -1;
-    bool resident = false; // no budget: every texture whole
+    BlockFormat format = BlockFormat::Rgba8; // every texture's in the file and the caches
+    std::string compressionFallback;         // why BC was asked for but the file is RGBA8
+    bool resident = false;                   // no budget: every texture whole
     TextureCache cache;
     std::vector<CacheImage> tails;              // per texture (resident: the whole texture)
     std::vector<std::vector<CacheImage>> slots; // per layer, per slot
@@ -238,8 +246,8 @@ void TextureStreamingDeleter::operator()(TextureStreaming* s) const {
     delete s;
 }
 
-static uint64_t deviceImageBytes(Gpu& gpu, uint32_t size) {
-    TextureDesc d = cacheImageDesc("probe", size);
+static uint64_t deviceImageBytes(Gpu& gpu, uint32_t size, BlockFormat format) {
+    TextureDesc d = cacheImageDesc("probe", size, format);
     VkImageCreateInfo ci{VK_STRUCTURE_TYPE_IMAGE_CREATE_INFO};
     ci.flags = d.flags;
     ci.imageType = VK_IMAGE_TYPE_2D;
@@ -331,16 +339,33 @@ TextureStreamingPtr createTextureStreaming(Gpu& gpu, const Scene& scene,
                                            const TextureStreamingSettings& settings,
                                            const std::string& cacheDir) {
     if (settings.mode == StreamingMode::Sparse) {
-        std::string why = sparseUnsupportedReason(gpu);
+        std::string why = sparseUnsupportedReason(gpu, BlockFormat::Rgba8);
         if (!why.empty()) throw InputError("--streaming sparse: " + why);
     }
     TextureStreamingPtr sp(new TextureStreaming);
     TextureStreaming& s = *sp;
     s.gpu = &gpu;
     s.settings = settings;
-    s.pack = openOrBuildTexturePack(scene, cacheDir);
-    s.fd = s.pack.fd; // closed with the streaming state
     s.resident = !(settings.budgetMiB > 0.0);
+    TextureCompression compression = settings.compression;
+    if (compression == TextureCompression::Bc) {
+        if (!gpu.device.optional.textureCompressionBC)
+            s.compressionFallback =
+                gpu.device.name + " cannot sample block-compressed textures (textureCompressionBC)";
+        else if (!s.resident && settings.mode == StreamingMode::Sparse)
+            s.compressionFallback = sparseUnsupportedReason(gpu, BlockFormat::Bc7);
+        if (!s.compressionFallback.empty()) {
+            SHADEL_WARN("--texture-compression bc: %s: textures stream as RGBA8",
+                        s.compressionFallback.c_str());
+            compression = TextureCompression::None;
+        }
+    }
+    s.pack = openOrBuildTexturePack(scene, cacheDir, compression);
+    s.fd = s.pack.fd; // closed with the streaming state
+    if (!s.pack.textures.empty()) s.format = s.pack.textures[0].format;
+    for (const PackedTexture& t : s.pack.textures)
+        if (t.format != s.format)
+            throw std::runtime_error(s.pack.path + ": textures of different block formats");
     const size_t n = s.pack.textures.size();
     std::vector<uint32_t> sizes;
     for (const PackedTexture& t : s.pack.textures) sizes.push_back(t.size);
@@ -354,7 +379,7 @@ TextureStreamingPtr createTextureStreaming(Gpu& gpu, const Scene& scene,
     if (s.sparseMode) {
         std::vector<bool> srgb;
         for (const PackedTexture& t : s.pack.textures) srgb.push_back(t.srgb);
-        createSparseTextures(gpu, sizes, srgb, budget, s.sparse);
+        createSparseTextures(gpu, sizes, srgb, s.format, budget, s.sparse);
         for (uint32_t i = 0; i < n; ++i) {
             uint32_t tailFirst = s.sparse.residency.textures[i].tailFirst;
             items.push_back({i, tailFirst});
@@ -364,23 +389,24 @@ TextureStreamingPtr createTextureStreaming(Gpu& gpu, const Scene& scene,
     } else {
         for (uint32_t i = 0; i < n; ++i) {
             uint32_t side = s.resident ? sizes[i] : std::min(sizes[i], kTailSize);
-            s.tails.push_back(makeCacheImage(
-                gpu, format("streaming.%s.%u", s.resident ? "texture" : "tail", i), side));
+            s.tails.push_back(
+                makeCacheImage(gpu, format("streaming.%s.%u", s.resident ? "texture" : "tail", i),
+                               side, s.format));
             items.push_back({i, log2u(sizes[i]) - log2u(side)});
             targets.push_back({vkImage(gpu, s.tails.back().image), 0});
-            s.imageBytes += deviceImageBytes(gpu, side);
+            s.imageBytes += deviceImageBytes(gpu, side, s.format);
         }
     }
     if (!s.resident && !s.sparseMode) {
-        s.cache = makeTextureCache(sizes, budget,
-                                   [&](uint32_t side) { return deviceImageBytes(gpu, side); });
+        s.cache = makeTextureCache(
+            sizes, budget, [&](uint32_t side) { return deviceImageBytes(gpu, side, s.format); });
         for (size_t k = 0; k < s.cache.layers.size(); ++k) {
             s.slots.emplace_back();
             for (size_t j = 0; j < s.cache.layers[k].owner.size(); ++j) {
                 s.slots[k].push_back(makeCacheImage(
                     gpu, format("streaming.layer%u.slot%zu", s.cache.layers[k].size, j),
-                    s.cache.layers[k].size));
-                s.imageBytes += deviceImageBytes(gpu, s.cache.layers[k].size);
+                    s.cache.layers[k].size, s.format));
+                s.imageBytes += deviceImageBytes(gpu, s.cache.layers[k].size, s.format);
             }
         }
         immediateSubmit(gpu, [&](VkCommandBuffer cmd) {
@@ -428,7 +454,8 @@ TextureStreamingPtr createTextureStreaming(Gpu& gpu, const Scene& scene,
                                              VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL));
         s.logicalSlots.push_back(s.logical.back().value);
     }
-    SHADEL_INFO("texture streaming: %zu textures, %s, %.1f MiB of cache images", n,
+    SHADEL_INFO("texture streaming: %zu textures (%s), %s, %.1f MiB of cache images", n,
+                blockFormatName(s.format),
                 s.resident     ? "all resident (no budget)"
                 : s.sparseMode ? "sparse residency"
                                : "layered cache",
@@ -497,8 +524,8 @@ static void prepareSparseFrame(TextureStreaming& s) {
 
     std::vector<SparseLevelLoad> planned;
     std::vector<SparseEviction> evictions;
-    // Loads land in the staging ring: none larger than its free space (pages hold as many bytes
-    // as the file's RGBA8 tiles), so a load is rarely planned (and room made) for nothing.
+    // Loads land in the staging ring: none larger than its free space (a page holds as many bytes
+    // as the file's tiles of its texels), so a load is rarely planned (and room made) for nothing.
     uint64_t ringFree = s.ring.capacity - s.ring.used();
     planSparseLoads(res, s.settings.limits, ringFree / s.sparse.pageBytes, planned, evictions);
     for (const SparseEviction& e : evictions) rebind(e.texture);
@@ -727,11 +754,28 @@ uint64_t textureMemoryPeakBytes(const TextureStreaming& s) {
 
 void textureStreamingStats(const TextureStreaming& s, nlohmann::json& stats) {
     stats["texture_memory_peak_bytes"] = textureMemoryPeakBytes(s);
+    uint64_t totalBytes = 0, texels = 0;
+    nlohmann::json formats = nlohmann::json::array(), psnr = nlohmann::json::array();
+    for (const PackedTexture& t : s.pack.textures) {
+        for (const PackedLevel& l : t.levels) {
+            totalBytes += l.bytes;
+            texels += uint64_t(l.size) * l.size;
+        }
+        formats.push_back(blockFormatName(t.format));
+        psnr.push_back(std::round(double(t.psnr) * 100.0) / 100.0);
+    }
+    stats["texture_total_bytes"] = totalBytes;
+    stats["texture_bytes_per_texel"] = texels ? double(totalBytes) / double(texels) : 0.0;
     nlohmann::json j;
     j["mode"] = s.resident ? "resident" : s.sparseMode ? "sparse" : "layered";
     j["textures"] = s.pack.textures.size();
     j["file"] = s.pack.path;
     j["file_bytes"] = s.pack.fileSize;
+    j["compression"] = blockFormatName(s.format);
+    if (!s.compressionFallback.empty()) j["compression_fallback"] = s.compressionFallback;
+    j["formats"] = formats;
+    j["psnr_db"] = psnr; // level 0 against its RGBA8 texels, 99 when identical
+    j["encode_seconds"] = s.pack.encodeSeconds; // 0: the file came from the cache
     j["budget_bytes"] = s.resident ? 0 : uint64_t(s.settings.budgetMiB * 1048576.0);
     j["cache_image_bytes"] = s.imageBytes;
     if (s.sparseMode) {

@@ -19,6 +19,12 @@
 // Without a budget every texture is loaded whole at start from the same file (the "everything
 // resident" reference for quality and timing).
 //
+// The file's textures are BC7 by default (--texture-compression bc: 1 byte a texel, against 4 for
+// RGBA8), so every cache image and sparse page holds 4 times the texels; sRGB and linear views
+// of the same block data keep colour and data textures sampled as before. Without device support
+// for BC sampling (or sparse BC7 images with --streaming sparse) the file is RGBA8, with a warning
+// and the reason in the statistics.
+//
 // --streaming sparse (sparse_textures.h, sparse_residency.h): the same priorities, loads and
 // staging ring, but one sparse-resident image per texture whose MIP levels are paged in and out
 // of a fixed page pool instead of slots; the slot's view is rebound to start at the resident
@@ -29,6 +35,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "bake/texture_pack.h"
 #include "common/shared_types.h"
 #include "render/camera.h"
 #include "render/streaming/texture_cache.h"
@@ -44,6 +51,7 @@ enum class StreamingMode { Layered, Sparse };
 struct TextureStreamingSettings {
     double budgetMiB = 0.0; // 0: no budget, every texture resident at full resolution
     StreamingMode mode = StreamingMode::Layered;
+    TextureCompression compression = TextureCompression::Bc; // what the file should hold
     uint32_t stagingMiB = 64; // the staging ring (host memory, not counted in the budget)
     TextureCacheLimits limits;
     float cpuCap = 512.0f;       // CPU estimates count up to this side (see mergedWanted)
@@ -75,8 +83,9 @@ VkSemaphore takeTextureStreamingWait(TextureStreaming& s);
 void recordTextureStreaming(TextureStreaming& s, VkCommandBuffer cmd);
 void finishTextureStreamingFrame(TextureStreaming& s);
 
-// "texture_memory_peak_bytes" and a "texture_streaming" object (per-frame resident memory,
-// exchanges, loads).
+// "texture_memory_peak_bytes", "texture_total_bytes" (every texture whole with its MIPs as
+// stored), "texture_bytes_per_texel" and a "texture_streaming" object (per-frame resident memory,
+// exchanges, loads, each texture's format and PSNR against its RGBA8 texels).
 void textureStreamingStats(const TextureStreaming& s, nlohmann::json& stats);
 uint64_t textureMemoryPeakBytes(const TextureStreaming& s);
 

@@ -18,6 +18,7 @@ struct TransmissionState {
     std::vector<gpu::GpuMesh> meshes;   // the scene's (draws are recorded from the CPU list)
     std::vector<uint32_t> instanceMesh; // per instance
     std::vector<uint8_t> doubleSided;   // per instance: its material's
+    std::vector<uint32_t> drawSide;     // per instance: this frame's DRAW_SIDE_* (drawSideOf)
     // The scene colour's copy behind the transmissive surfaces, with its whole MIP chain.
     TextureHandle background;
     TextureReadView backgroundRead;
@@ -117,7 +118,7 @@ void recordShading(Renderer& r, VkCommandBuffer cmd, uint64_t frame) {
     bind(gpu, cmd, t.shading);
     pushConstants(gpu, cmd, ShadingPush{frame, 0, slot(gpu, t.backgroundRead).value, t.levels});
     for (uint32_t i : t.draws) {
-        setDrawSide(cmd, t.doubleSided[i] ? DRAW_SIDE_BOTH : DRAW_SIDE_FRONT);
+        setDrawSide(cmd, t.drawSide[i]);
         const gpu::GpuMesh& mesh = t.meshes[t.instanceMesh[i]];
         vkCmdDrawIndexed(cmd, mesh.indexCount, 1, mesh.firstIndex, mesh.vertexOffset, i);
     }
@@ -182,8 +183,10 @@ void prepareTransmissionDraws(Renderer& r, const GpuScene& scene, const CameraVi
     TransmissionState& t = *r.transmission;
     t.draws.clear();
     auto planes = frustumPlanes(camera.proj * camera.view);
+    t.drawSide.resize(scene.instanceCount);
     for (uint32_t i : t.instances) {
         const gpu::GpuInstance& inst = scene.instanceInfo[i];
+        t.drawSide[i] = drawSideOf(t.doubleSided[i], inst.model); // the transform may animate
         if (!boxOutside(planes, inst.worldMin, inst.worldMax)) t.draws.push_back(i);
     }
 }
