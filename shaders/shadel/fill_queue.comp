@@ -12,9 +12,15 @@
 // (raytracing/rt_history.glsl).
 #include "shadel/shadel.glsl"
 #include "raytracing/rt_history.glsl"
+#include "materials/program_types.h"
 
 layout(local_size_x = 64) in;
-layout(push_constant, scalar) uniform Push { uint64_t frame; } pc;
+// programHeader, programQueues: the material program lists (0: none loaded).
+layout(push_constant, scalar) uniform Push {
+    uint64_t frame;
+    uint64_t programHeader;
+    uint64_t programQueues;
+} pc;
 
 void main() {
     FrameConstants f = FrameConstantsRef(pc.frame).f;
@@ -70,7 +76,8 @@ void main() {
             }
             rtHistory = rtHistoryStepped(f, entry.z, uvs, w.chunk);
         }
-        bool carryable = stored && !refresh && !viewTurned && !rtHistory;
+        bool carryable = stored && !refresh && !viewTurned && !rtHistory &&
+                         (o.v.flags & SHADEL_OBJECT_PROGRAM_EVERY_FRAME) == 0u;
         if (carryable && !nearChange) {
             w.chunk = prevSlot; // where last frame stored it
             ShadelWorkBuffer(s.copyQueue).w[atomicAdd(counters.c.copyCount, 1u)] = w;
@@ -78,10 +85,14 @@ void main() {
         }
         uint queued = atomicAdd(counters.c.shadeCount, 1u);
         ShadelWorkBuffer(s.queue).w[queued] = w;
-        uint list = carryable ? SHADE_NEAR_CHANGE_LIST : shadeClassOf(o);
-        uint place = carryable ? atomicAdd(counters.c.nearChangeCount, 1u)
-                               : atomicAdd(counters.c.classCount[list], 1u);
-        UintBuffer(s.classQueues).v[list * s.capacityChunks + place] = queued;
+        // A material program's chunk goes to its program's list (materials/program_types.h).
+        if (carryable || !appendToProgramList(pc.programHeader, pc.programQueues,
+                                              s.capacityChunks, o.v.flags, queued)) {
+            uint list = carryable ? SHADE_NEAR_CHANGE_LIST : shadeClassOf(o);
+            uint place = carryable ? atomicAdd(counters.c.nearChangeCount, 1u)
+                                   : atomicAdd(counters.c.classCount[list], 1u);
+            UintBuffer(s.classQueues).v[list * s.capacityChunks + place] = queued;
+        }
         uint reason = !levelReusable ? SHADEL_SHADED_NOT_REUSABLE
                       : nearChange   ? SHADEL_SHADED_NEAR_CHANGE
                       : refresh      ? SHADEL_SHADED_REFRESH

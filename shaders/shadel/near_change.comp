@@ -11,9 +11,15 @@
 // coroutines on lavapipe, near change or not.
 #include "shadel/shade_chunk.glsl"
 #include "common/dispatch_2d.h"
+#include "materials/program_types.h"
 
 layout(local_size_x = 64) in;
-layout(push_constant, scalar) uniform Push { uint64_t frame; } pc;
+// As fill_queue.comp's: the material program lists (0: none loaded).
+layout(push_constant, scalar) uniform Push {
+    uint64_t frame;
+    uint64_t programHeader;
+    uint64_t programQueues;
+} pc;
 
 void main() {
     FrameConstants f = FrameConstantsRef(pc.frame).f;
@@ -32,6 +38,8 @@ void main() {
         carryChunkRecord(s, uint(carrySlot), work.slot);
         return;
     }
+    if (appendToProgramList(pc.programHeader, pc.programQueues, s.capacityChunks, o.v.flags, queued))
+        return;
     uint shadeClass = shadeClassOf(o);
     uint place = atomicAdd(counters.c.classCount[shadeClass], 1u);
     UintBuffer(s.classQueues).v[shadeClass * s.capacityChunks + place] = queued;

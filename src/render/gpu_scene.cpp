@@ -434,6 +434,7 @@ void uploadScene(Gpu& gpu, const Scene& scene, GpuScene& out, const std::vector<
     out.instances = uploadArray(gpu, "scene.instances", instances.data(),
                                 instances.size() * sizeof(gpu::GpuInstance));
     out.materialInfo = materials;
+    for (const Material& m : scene.materials) out.materialPrograms.push_back(m.shadelMaterial);
     out.materials = uploadArray(gpu, "scene.materials", materials.data(),
                                 materials.size() * sizeof(gpu::GpuMaterial));
     out.lights =

@@ -57,6 +57,8 @@ struct GpuScene {
     std::vector<gpu::GpuLight> lightInfo;       // what `lights` holds
     std::vector<uint8_t> lightCastsShadow;      // per lightInfo entry (GI light views)
     std::vector<gpu::GpuMaterial> materialInfo; // what `materials` holds
+    // Per material: its program (Material::shadelMaterial), empty = the built-in glTF PBR one.
+    std::vector<std::string> materialPrograms;
     // Per material as loaded: its textures' density and roughness bound (the texture-limited
     // shading rate: render/shadel/texture_rate.h).
     std::vector<MaterialTexels> materialTexels;

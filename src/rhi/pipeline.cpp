@@ -1,4 +1,5 @@
 #include "rhi/pipeline.h"
+#include "rhi/pipeline_spirv.h"
 
 #include <atomic>
 #include <chrono>
@@ -468,6 +469,27 @@ void bind(const Gpu& gpu, VkCommandBuffer cmd, const Pipeline& pipeline) {
 
 void pushConstants(const Gpu& gpu, VkCommandBuffer cmd, const void* data, uint32_t size) {
     vkCmdPushConstants(cmd, gpu.bindless.pipelineLayout, VK_SHADER_STAGE_ALL, 0, size, data);
+}
+
+} // namespace shadel
+
+namespace shadel {
+
+Pipeline createComputePipelineFromSpirv(Gpu& gpu, const std::string& name,
+                                        const std::vector<uint32_t>& code) {
+    Pipeline out;
+    out.name = name;
+    out.bindPoint = VK_PIPELINE_BIND_POINT_COMPUTE;
+    ComputePipelineDesc desc{name, "(run-time SPIR-V) " + name, {}};
+    std::string key = computeKey(desc.name, desc.shader, code, desc.specialization);
+    if ((out.pipeline = sharedPipeline(gpu, key))) return out;
+    VkShaderModule module = createModule(gpu, desc.shader, code);
+    BuiltPipeline built = buildComputePipeline(gpu, desc, module);
+    vkDestroyShaderModule(gpu.device.device, module, nullptr);
+    VK_CHECK(built.result);
+    setName(gpu.device, built.pipeline, VK_OBJECT_TYPE_PIPELINE, name);
+    out.pipeline = keepPipeline(gpu, key, built.pipeline, built.seconds);
+    return out;
 }
 
 } // namespace shadel

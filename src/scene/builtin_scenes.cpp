@@ -13,6 +13,7 @@
 #include "scene/builtin_decals.h"
 #include "scene/builtin_gallery.h"
 #include "scene/builtin_lights.h"
+#include "scene/builtin_materials.h"
 #include "scene/mesh_utils.h"
 
 namespace shadel {
@@ -838,6 +839,7 @@ const std::vector<std::pair<std::string, std::function<Scene()>>>& registry() {
         {"arena", makeArena},
         {"decals", makeDecalsScene},
         {"textures", [] { return makeTextureGallery(); }},
+        {"materials", makeMaterialsScene},
     };
     return scenes;
 }

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
 #include <map>
 #include <optional>
 #include <set>
@@ -14,6 +15,7 @@
 #include "scene/gltf_accessors.h"
 #include "scene/gltf_files.h"
 #include "scene/gltf_materials.h"
+#include "scene/gltf_uri.h"
 #include "scene/load_budget.h"
 #include "scene/mesh_utils.h"
 
@@ -137,11 +139,33 @@ private:
         return 0.0f;
     }
 
+    // extras "shadel_material": the material program that shades it decoupled
+    // (render/materials), a .shmat path relative to the glTF's folder and inside it, like the
+    // model's other files, or "builtin:NAME". A program runs code: it is never read from
+    // elsewhere, whatever --allow-external-files says.
+    std::string materialProgram(const tinygltf::Material& m, int index) {
+        if (!m.extras.IsObject() || !m.extras.Has("shadel_material")) return "";
+        const tinygltf::Value& v = m.extras.Get("shadel_material");
+        std::string where = format("material %d: extras.shadel_material", index);
+        if (!v.IsString() || v.Get<std::string>().empty())
+            error(where + ": expected a path string");
+        std::string ref = v.Get<std::string>();
+        if (ref.rfind("builtin:", 0) == 0) return ref;
+        std::string decoded = decodeUriPath(ref);
+        std::filesystem::path folder = std::filesystem::path(input_).parent_path();
+        std::string path = (folder / decoded).lexically_normal().string();
+        if (uriEscapesFolder(decoded) ||
+            !pathInsideFolder(path, folder.empty() ? std::string(".") : folder.string()))
+            error(where + " \"" + ref + "\" is outside the model's folder");
+        return path;
+    }
+
     Material convertMaterial(int index) {
         const tinygltf::Material& m = model_.materials[size_t(index)];
         const auto& pbr = m.pbrMetallicRoughness;
         Material out;
         out.name = m.name.empty() ? format("material %d", index) : m.name;
+        out.shadelMaterial = materialProgram(m, index);
         if (pbr.baseColorFactor.size() == 4)
             out.baseColorFactor =
                 glm::vec4(float(pbr.baseColorFactor[0]), float(pbr.baseColorFactor[1]),

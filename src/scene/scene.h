@@ -148,6 +148,9 @@ struct Material {
     // Blended materials only: 0 = alpha-blended, 1 = additive (the additiveness channel),
     // composited without sorting by weighted blended OIT (render/oit).
     float additiveness = 0.0f;
+    // The material program that shades it decoupled (render/materials): a .shmat path or
+    // "builtin:NAME"; empty = the built-in glTF PBR program. glTF: extras.shadel_material.
+    std::string shadelMaterial;
 
     // glTF material extensions (scene/gltf_materials.h); the defaults leave core PBR unchanged.
     UvTransform uvTransforms[kTextureSlotCount];

@@ -297,6 +297,10 @@ int runViewer(const ViewOptions& o, DeviceDesc deviceDesc) {
             if (hotReload && now - lastPoll > std::chrono::milliseconds(500)) {
                 lastPoll = now;
                 ShaderReloadResult reload = pollShaderReload(gpu);
+                // Material programs (decoupled): their .shmat and stage files.
+                uint32_t programs = pollMaterialPrograms(renderer, reload.errors);
+                if (programs)
+                    reloadStatus = format("hot reload: %u material program(s) swapped", programs);
                 if (!reload.errors.empty())
                     reloadStatus = "hot reload failed, old pipeline kept:\n" + reload.errors[0];
                 else if (reload.pipelinesSwapped)

@@ -3,6 +3,8 @@
 // glossary, shadel, chunk, block, virtual sheet, offset map, storage, shading bias, are in
 // docs/design.md).
 #include <memory>
+#include <string>
+#include <vector>
 
 #include <nlohmann/json_fwd.hpp>
 
@@ -38,6 +40,9 @@ void recordDecoupledShading(Renderer& r, FrameRecorder& rec, uint64_t frame, con
 void recordDecoupledPostPasses(Renderer& r, FrameRecorder& rec, uint64_t frame);
 // Whether the instance is shaded in shadel space this frame (after prepareDecoupledFrame).
 bool drawnDecoupled(const Renderer& r, uint32_t instance);
+// The viewer's hot reload of the material programs (render/materials/material_programs.h
+// pollMaterialPrograms): the programs swapped, errors (file:line) of those kept.
+uint32_t pollMaterialPrograms(Renderer& r, std::vector<std::string>& errors);
 // Reads back the frame's counters (after the GPU finished).
 void finishDecoupledFrame(Renderer& r);
 // The shading queue, for passes that run once per queued chunk before shading (the spectra's

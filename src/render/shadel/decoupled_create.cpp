@@ -257,12 +257,22 @@ DecoupledStatePtr createDecoupled(Renderer& r, const GpuScene& scene) {
     DecoupledState& d = *state;
     setUpSheet(r.settings, scene, d);
     setUpCoarseVisit(r, scene, d);
+    // Material programs first: a bad program file or stage ends the run before anything else
+    // is created.
+    d.programs = createMaterialPrograms(*r.gpu, scene, d.capacityChunks);
     createSheetBuffers(*r.gpu, scene, d);
     createStorage(*r.gpu, r.settings, d);
     createComputePipelines(r, scene, d);
     createRasterPipelines(r, d);
     registerDecoupledCaptures(r, d);
     return state;
+}
+
+uint32_t pollMaterialPrograms(Renderer& r, std::vector<std::string>& errors) {
+    if (!r.decoupled) return 0;
+    // Their materials reshade as edited ones do (render/scene_edits.h).
+    return pollMaterialPrograms(*r.gpu, r.decoupled->programs.get(), errors,
+                                r.edits.materialsChanged);
 }
 
 void destroyDecoupled(Renderer& r, DecoupledStatePtr& state) {
@@ -274,6 +284,7 @@ void destroyDecoupled(Renderer& r, DecoupledStatePtr& state) {
           &d.nearChange, &d.sheetView, &d.mark, &d.markTransparent, &d.reconstruct})
         destroy(gpu, *p);
     for (Pipeline& p : d.shade) destroy(gpu, p);
+    destroyMaterialPrograms(gpu, d.programs);
     destroyShadeStorage(gpu, d.storage);
     for (BufferHandle b :
          {d.frameInfo, d.changedVolumes, d.objectBuffer, d.rectBuffer, d.levelWants, d.occupancy[0],

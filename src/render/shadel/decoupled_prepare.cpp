@@ -331,6 +331,8 @@ void decideDecoupled(Renderer& r, const GpuScene& scene, uint32_t i, const Coars
     // Its shading class (the pipeline that shades its chunks, shaders/shadel/shade.comp).
     if (features != 0u) g.flags |= SHADEL_OBJECT_FEATURED_MATERIAL;
     if (features == MATERIAL_FEATURE_TEXTURES) g.flags |= SHADEL_OBJECT_TEXTURED_MATERIAL;
+    // Or its material program's list (render/materials), if its material names one.
+    if (known) g.flags |= materialProgramFlags(d.programs.get(), inst.material);
     // Only point-function procedurals are supersampled (shaders/shadel/prefilter.glsl).
     if ((features & MATERIAL_FEATURE_PROCEDURAL) && r.settings.materialSamples >= 4)
         g.flags |= SHADEL_OBJECT_SUPERSAMPLED; // 2 x 2 samples at least

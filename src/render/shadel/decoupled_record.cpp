@@ -37,6 +37,14 @@ void dispatchCounted(Gpu& gpu, VkCommandBuffer cmd, const DecoupledState& d, con
     pushConstants(gpu, cmd, FramePush{frame});
     vkCmdDispatchIndirect(cmd, vkBuffer(gpu, d.counters), argsOffset);
 }
+// The passes that route chunks to the material program lists (fill, near change) push their
+// addresses after the frame's (render/materials/material_programs.h).
+void dispatchRouting(Gpu& gpu, VkCommandBuffer cmd, const DecoupledState& d, const Pipeline& p,
+                     uint64_t frame, VkDeviceSize argsOffset) {
+    bind(gpu, cmd, p);
+    pushConstants(gpu, cmd, programListsPush(gpu, d.programs.get(), frame));
+    vkCmdDispatchIndirect(cmd, vkBuffer(gpu, d.counters), argsOffset);
+}
 } // namespace
 
 ShadelShadingQueue shadelShadingQueue(const Renderer& r) {
@@ -107,12 +115,14 @@ void recordDecoupledShading(Renderer& r, FrameRecorder& rec, uint64_t frame, con
     DecoupledState& d = *r.decoupled;
 
     pass(rec, "workQueues", [&, frame](VkCommandBuffer cmd) {
+        recordProgramListsClear(gpu, cmd, d.programs.get());
         dispatchFrame(gpu, cmd, d.queueSetup, frame, 1);
         computeToCompute(cmd);
-        dispatchCounted(gpu, cmd, d, d.fillQueue, frame,
+        dispatchRouting(gpu, cmd, d, d.fillQueue, frame,
                         offsetof(gpu::GpuShadelCounters, fillDispatch));
         computeToCompute(cmd);
         dispatchFrame(gpu, cmd, d.dispatchSetup, frame, 1);
+        recordProgramListsSetup(gpu, cmd, d.programs.get());
         computeToCompute(cmd);
     });
 
@@ -133,10 +143,11 @@ void recordDecoupledShading(Renderer& r, FrameRecorder& rec, uint64_t frame, con
         // shadels lies in a region, else appended to their class's list, whose dispatch sizes
         // are then set again. (Spectra's classify decides for its whole queue instead.)
         if (d.nearChange.pipeline && !usesChunkSpectra(r)) {
-            dispatchCounted(gpu, cmd, d, d.nearChange, frame,
+            dispatchRouting(gpu, cmd, d, d.nearChange, frame,
                             offsetof(gpu::GpuShadelCounters, nearChangeDispatch));
             computeToCompute(cmd);
             dispatchFrame(gpu, cmd, d.dispatchSetup, frame, 1);
+            recordProgramListsSetup(gpu, cmd, d.programs.get());
             computeToCompute(cmd);
         }
     });
@@ -158,6 +169,8 @@ void recordDecoupledShading(Renderer& r, FrameRecorder& rec, uint64_t frame, con
                                 offsetof(gpu::GpuShadelCounters, classDispatch) +
                                     c * sizeof(glm::uvec4));
         }
+        // The material programs' stages over their lists (render/materials).
+        recordMaterialProgramStages(gpu, cmd, d.programs.get(), frame);
         // The shade storage this pass and carry-over wrote, read by reconstruction (raster:
         // fragment; --marking visibility: the compute resolve) and the transparency passes.
         memoryBarrier(

@@ -11,6 +11,7 @@
 
 #include "core/block_allocator.h"
 #include "render/culling/instance_grid.h"
+#include "render/materials/material_programs.h"
 #include "render/renderer.h"
 #include "render/shadel/capacity_control.h"
 #include "render/shadel/coarse_visit.h"
@@ -176,11 +177,13 @@ struct DecoupledState {
     uint32_t refreshPeriod = 16; // --reuse-refresh
     uint32_t objectsReusable = 0;
     uint32_t shadeOptional = 0; // SHADE_OPTIONAL_* of the shading pipelines
-    BufferHandle allocId;       // uint per block (upload: written by the CPU allocator)
-    BufferHandle counters;      // GpuShadelCounters (readback, also indirect args)
-    BufferHandle markedBlocks;  // uvec4 per marked block, capacityChunks of them
-    BufferHandle queue;         // GpuShadelWork[capacity]: chunks to shade
-    BufferHandle copyQueue;     // GpuShadelWork[capacity]: chunks carried over from last frame
+    // The material programs (render/materials) and their chunk lists; none loaded: an empty set.
+    MaterialProgramSetPtr programs;
+    BufferHandle allocId;      // uint per block (upload: written by the CPU allocator)
+    BufferHandle counters;     // GpuShadelCounters (readback, also indirect args)
+    BufferHandle markedBlocks; // uvec4 per marked block, capacityChunks of them
+    BufferHandle queue;        // GpuShadelWork[capacity]: chunks to shade
+    BufferHandle copyQueue;    // GpuShadelWork[capacity]: chunks carried over from last frame
     // uint[SHADE_CLASSES + 1][capacity]: queue entries by shading class, then near change
     BufferHandle classQueues;
     BufferHandle changedVolumes;        // ChangedVolume[SHADEL_MAX_CHANGED_VOLUMES] (upload)

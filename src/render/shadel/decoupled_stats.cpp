@@ -14,6 +14,7 @@ void finishDecoupledFrame(Renderer& r) {
     DecoupledState& d = *r.decoupled;
     FrameCounters f;
     std::memcpy(&f.counters, mapped(*r.gpu, d.counters), sizeof(f.counters));
+    finishMaterialProgramsFrame(*r.gpu, d.programs.get(), f.counters.shadeCount);
     f.objectsDecoupled = d.objectsDecoupled;
     f.objectsForward = d.objectsForward;
     f.objectsSmallForward = d.objectsSmallForward;
@@ -58,6 +59,7 @@ void decoupledStats(const Renderer& r, nlohmann::json& s) {
     const DecoupledState& d = *r.decoupled;
     if (d.history.empty()) return;
     const FrameCounters& last = d.history.back();
+    materialProgramStats(d.programs.get(), s);
     uint64_t misses = 0, overflowSamples = 0;
     for (const FrameCounters& f : d.history) {
         misses += f.counters.reconstructionMisses;
