@@ -1,8 +1,8 @@
 #include "rhi/device.h"
 
 #include <cstdlib>
-#include <dlfcn.h>
 #include <cstring>
+#include <dlfcn.h>
 #include <optional>
 #include <vector>
 
@@ -260,8 +260,7 @@ static VkPhysicalDevice choosePhysicalDevice(VkInstance instance, const std::str
                                     selection.c_str(), listPhysicalDevices().c_str()));
         if (auto missing = missingRequiredFeature(pds[index]))
             throw DeviceError(format("--device %s lacks required Vulkan feature %s%s",
-                                     selection.c_str(), missing->c_str(),
-                                     renderDocHint().c_str()));
+                                     selection.c_str(), missing->c_str(), renderDocHint().c_str()));
         return pds[index];
     }
     if (selection != "auto" && selection != "cpu" && selection != "gpu")
